@@ -1,0 +1,327 @@
+//! `lightgrid`: render catalog scenes with any registry pipeline, compare images, list what
+//! exists. With no arguments it runs the default job: every pipeline on `robots-many`, with
+//! each image's difference from the `forward` reference.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand};
+use lightgrid::gpu::{list_adapters, GpuContext};
+use lightgrid::image_io::{check_writable, diff, load_image, save_png, write_atomic};
+use lightgrid::pipelines::{self, PIPELINES, REFERENCE};
+use lightgrid::scene::catalog::{self, SceneParams, SCENES};
+use lightgrid::Renderer;
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "lightgrid",
+    version,
+    about = "Many-lights renderer: forward, deferred, tiled and clustered shading side by side.\n\nWith no command, runs the default job (`lightgrid compare`): robots-many at 640x360 with every pipeline, images in out/."
+)]
+struct Cli {
+    /// Adapter to use: an index from `lightgrid list`, a backend (vulkan, gl), or part of
+    /// the adapter's name (e.g. llvmpipe). Default: the best one (hardware first).
+    #[arg(long, global = true)]
+    adapter: Option<String>,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one frame of a scene with one pipeline.
+    Render(RenderArgs),
+    /// Render a frame with every pipeline and compare each with the forward reference.
+    Compare(CompareArgs),
+    /// Per-pixel difference of two images, in 8-bit sRGB levels.
+    Diff(DiffArgs),
+    /// List adapters, scenes and pipelines.
+    List,
+}
+
+/// Frame size as WIDTHxHEIGHT.
+#[derive(Clone, Copy, Debug)]
+struct Size(u32, u32);
+
+fn parse_size(s: &str) -> Result<Size, String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT (e.g. 640x360)"))?;
+    let edge = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{v}' in '{s}' is not a positive whole number"))
+    };
+    let (w, h) = (edge(w)?, edge(h)?);
+    if w == 0 || h == 0 {
+        return Err(format!("{w}x{h}: both edges must be at least 1"));
+    }
+    Ok(Size(w, h))
+}
+
+#[derive(Args, Clone)]
+struct SceneArgs {
+    /// Scene from the catalog (see `lightgrid list`).
+    #[arg(long, default_value = "robots-many")]
+    scene: String,
+    /// Animation frame to render.
+    #[arg(long, default_value_t = 0)]
+    frame: u32,
+    /// Frame size WIDTHxHEIGHT (default: the scene's own size).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<Size>,
+    /// Light count, for scenes that take one (stress: 1 to 1000000).
+    #[arg(long)]
+    lights: Option<u32>,
+    /// Seed of the scene's random placement.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Pipeline id (see `lightgrid list`).
+    #[arg(long, default_value = REFERENCE)]
+    pipeline: String,
+    /// Image to write (PNG).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Statistics to write (JSON).
+    #[arg(long)]
+    stats: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Directory for the images and statistics.
+    #[arg(long, default_value = "out")]
+    out_dir: PathBuf,
+}
+
+#[derive(Args)]
+struct DiffArgs {
+    a: PathBuf,
+    b: PathBuf,
+    /// Print a JSON object {"mean", "p99", "max"} instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Exit with status 1 when the mean difference is above this.
+    #[arg(long)]
+    max_mean: Option<f64>,
+    /// Exit with status 1 when the 99th-percentile difference is above this.
+    #[arg(long)]
+    max_p99: Option<f64>,
+    /// Write a visual diff image (PNG) here.
+    #[arg(long)]
+    diff_image: Option<PathBuf>,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => compare(
+            cli.adapter.as_deref(),
+            &CompareArgs {
+                scene: SceneArgs {
+                    scene: "robots-many".into(),
+                    frame: DEFAULT_JOB_FRAME,
+                    size: Some(Size(640, 360)),
+                    lights: None,
+                    seed: 1,
+                },
+                out_dir: PathBuf::from("out"),
+            },
+        ),
+        Some(Command::Render(a)) => render(cli.adapter.as_deref(), &a),
+        Some(Command::Compare(a)) => compare(cli.adapter.as_deref(), &a),
+        Some(Command::Diff(a)) => diff_cmd(&a),
+        Some(Command::List) => list(),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Frame of `robots-many` the default job renders: street level, looking down the street.
+const DEFAULT_JOB_FRAME: u32 = 200;
+
+fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
+    let params = SceneParams {
+        seed: a.seed,
+        lights: a.lights,
+    };
+    Ok(catalog::build(&a.scene, &params)?)
+}
+
+fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
+    pipelines::find(&a.pipeline)?;
+    for path in a.out.iter().chain(a.stats.iter()) {
+        check_writable(path).context("output is not writable")?;
+    }
+    let scene = build_scene(&a.scene)?;
+    let ctx = GpuContext::new(adapter)?;
+    let Size(w, h) = a
+        .scene
+        .size
+        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let mut renderer = Renderer::new(&ctx, w, h)?;
+    let out = renderer.render(&scene, a.scene.frame, &a.pipeline)?;
+    if let Some(path) = &a.out {
+        save_png(&out.image, path)?;
+    }
+    if let Some(path) = &a.stats {
+        let json = serde_json::to_vec_pretty(&out.stats)?;
+        write_atomic(path, &json)?;
+    }
+    let s = &out.stats;
+    println!(
+        "{} / {} frame {} at {}x{}: {} lights, {:.2} ms ({}) on {}",
+        s.scene,
+        s.pipeline,
+        s.frame,
+        s.width,
+        s.height,
+        s.lights,
+        s.gpu_ms,
+        timing_label(s.timing),
+        s.adapter
+    );
+    Ok(())
+}
+
+fn timing_label(t: lightgrid::TimingSource) -> &'static str {
+    match t {
+        lightgrid::TimingSource::GpuTimestamps => "GPU timestamps",
+        lightgrid::TimingSource::WallClock => "wall clock",
+    }
+}
+
+fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+    let scene = build_scene(&a.scene)?;
+    let ctx = GpuContext::new(adapter)?;
+    let Size(w, h) = a
+        .scene
+        .size
+        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let mut renderer = Renderer::new(&ctx, w, h)?;
+    println!(
+        "{} frame {} at {w}x{h}, {} lights, on {}",
+        scene.name,
+        a.scene.frame,
+        scene.lights.len(),
+        ctx.adapter_label()
+    );
+    println!(
+        "{:<24} {:>10}  {:>10} {:>8} {:>8}",
+        "pipeline", "time ms", "diff mean", "p99", "max"
+    );
+    let mut reference = None;
+    let mut failed = Vec::new();
+    for p in PIPELINES {
+        let out = match renderer.render(&scene, a.scene.frame, p.id) {
+            Ok(o) => o,
+            Err(e) => {
+                println!("{:<24} failed: {e}", p.id);
+                failed.push(p.id);
+                continue;
+            }
+        };
+        let png = a.out_dir.join(format!("{}.png", p.id));
+        save_png(&out.image, &png)?;
+        write_atomic(
+            &a.out_dir.join(format!("{}.json", p.id)),
+            &serde_json::to_vec_pretty(&out.stats)?,
+        )?;
+        let d = match &reference {
+            None => None,
+            Some(r) => Some(diff(r, &out.image)?.0),
+        };
+        let time = format!(
+            "{:.2}{}",
+            out.stats.gpu_ms,
+            if out.stats.timing == lightgrid::TimingSource::WallClock {
+                "*"
+            } else {
+                ""
+            }
+        );
+        match d {
+            None => println!(
+                "{:<24} {:>10}  {:>10} {:>8} {:>8}",
+                p.id, time, "reference", "", ""
+            ),
+            Some(d) => println!(
+                "{:<24} {:>10}  {:>10.3} {:>8} {:>8}",
+                p.id, time, d.mean, d.p99, d.max
+            ),
+        }
+        if p.id == REFERENCE {
+            reference = Some(out.image);
+        }
+    }
+    if !ctx.timestamps {
+        println!("* wall clock: this adapter has no timestamp queries");
+    }
+    println!("images and stats in {}", a.out_dir.display());
+    if !failed.is_empty() {
+        bail!("pipelines failed: {}", failed.join(", "));
+    }
+    Ok(())
+}
+
+fn diff_cmd(a: &DiffArgs) -> Result<()> {
+    let img_a = load_image(&a.a)?;
+    let img_b = load_image(&a.b)?;
+    let (d, vis) = diff(&img_a, &img_b)?;
+    if let Some(p) = &a.diff_image {
+        save_png(&vis, p)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string(&d)?);
+    } else {
+        println!(
+            "mean {:.4}  p99 {}  max {}  (8-bit sRGB levels, largest channel per pixel)",
+            d.mean, d.p99, d.max
+        );
+    }
+    let mut over = Vec::new();
+    if let Some(m) = a.max_mean.filter(|&m| d.mean > m) {
+        over.push(format!("mean {:.4} > {m}", d.mean));
+    }
+    if let Some(m) = a.max_p99.filter(|&m| d.p99 > m) {
+        over.push(format!("p99 {} > {m}", d.p99));
+    }
+    if !over.is_empty() {
+        bail!("images differ: {}", over.join(", "));
+    }
+    Ok(())
+}
+
+fn list() -> Result<()> {
+    println!("adapters (in order of preference):");
+    let adapters = list_adapters();
+    if adapters.is_empty() {
+        println!("  none found: install mesa-vulkan-drivers for a software Vulkan adapter");
+    }
+    for a in adapters {
+        println!(
+            "  {}: {} [{}, {}] {}",
+            a.index, a.name, a.backend, a.device_type, a.driver
+        );
+    }
+    println!("scenes:");
+    for s in SCENES {
+        println!("  {:<12} {}", s.name, s.description);
+    }
+    println!("pipelines:");
+    for p in PIPELINES {
+        println!("  {:<24} {} ({})", p.id, p.description, p.paper);
+    }
+    Ok(())
+}

@@ -1,0 +1,59 @@
+//! The only home of numeric constants shared between Rust and WGSL.
+//!
+//! [`wgsl_prelude`] writes every entry of [`WGSL_CONSTS`] as a WGSL `const`, and the shader
+//! composer puts that prelude in front of every shader, so no shader types a number that Rust
+//! also uses.
+
+/// Most lights one frame can hold. 2^20 covers the million-light stress test; at 32 bytes a
+/// light this is 32 MiB, well under the 128 MiB storage binding limit seen on lavapipe.
+pub const MAX_LIGHTS: u32 = 1 << 20;
+
+/// Default screen tile edge in pixels (tiled-shading §5 discusses 16 and 32).
+pub const DEFAULT_TILE_SIZE: u32 = 16;
+
+/// Largest accepted frame edge, before the adapter's own texture limit is applied.
+pub const MAX_FRAME_EDGE: u32 = 16384;
+
+/// Global ambient light intensity that multiplies every material's ambient colour.
+pub const SCENE_AMBIENT: f32 = 0.04;
+
+/// Exposure applied before tonemapping the HDR target.
+pub const EXPOSURE: f32 = 1.0;
+
+/// Workgroup edge of the full-screen compute passes (8×8 = 64 invocations).
+pub const SCREEN_WORKGROUP: u32 = 8;
+
+/// Material flag bit: the material is transparent (blended, drawn after opaque geometry).
+pub const MATERIAL_FLAG_TRANSPARENT: u32 = 1;
+
+/// A WGSL constant value: unsigned integer or float.
+#[derive(Clone, Copy, Debug)]
+pub enum WgslConst {
+    U32(u32),
+    F32(f32),
+}
+
+/// Every constant the shaders see, by its WGSL name.
+pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
+    ("MAX_LIGHTS", WgslConst::U32(MAX_LIGHTS)),
+    ("SCENE_AMBIENT", WgslConst::F32(SCENE_AMBIENT)),
+    ("EXPOSURE", WgslConst::F32(EXPOSURE)),
+    ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
+    (
+        "MATERIAL_FLAG_TRANSPARENT",
+        WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),
+    ),
+];
+
+/// The WGSL prelude: one `const` line per entry of [`WGSL_CONSTS`].
+pub fn wgsl_prelude() -> String {
+    let mut out = String::from("// generated from consts.rs; do not edit\n");
+    for (name, value) in WGSL_CONSTS {
+        let line = match value {
+            WgslConst::U32(v) => format!("const {name}: u32 = {v}u;\n"),
+            WgslConst::F32(v) => format!("const {name}: f32 = {v:?};\n"),
+        };
+        out.push_str(&line);
+    }
+    out
+}

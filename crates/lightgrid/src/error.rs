@@ -1,0 +1,48 @@
+//! Typed errors of the library. Binaries add context; tests match on variants.
+
+use thiserror::Error;
+
+/// Everything the library can refuse or fail at.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// No adapter at all, or none matching `--adapter`.
+    #[error("{0}")]
+    NoAdapter(String),
+    /// The adapter exists but the device could not be created.
+    #[error("could not create a device on adapter '{adapter}': {reason}")]
+    Device { adapter: String, reason: String },
+    /// A wgpu validation or out-of-memory error caught in an error scope.
+    #[error("GPU error during {stage}: {message}")]
+    Gpu { stage: String, message: String },
+    /// A name that is not in a catalog or registry; `valid` lists the accepted ones.
+    #[error("unknown {what} '{name}'; valid: {valid}")]
+    Unknown {
+        what: &'static str,
+        name: String,
+        valid: String,
+    },
+    /// A parameter outside what the renderer or adapter accepts.
+    #[error("invalid {what}: {reason}")]
+    Invalid { what: &'static str, reason: String },
+    /// File I/O, with the path that failed.
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// An image that could not be decoded or encoded.
+    #[error("{path}: {reason}")]
+    Image { path: String, reason: String },
+}
+
+impl Error {
+    pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> Self {
+        Error::Invalid {
+            what,
+            reason: reason.into(),
+        }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

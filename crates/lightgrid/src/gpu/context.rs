@@ -1,0 +1,179 @@
+//! Headless adapter and device selection.
+//!
+//! Order of preference: discrete GPU, integrated, virtual, then software adapters with
+//! Vulkan (Mesa lavapipe) before GL (llvmpipe), which cannot run every pipeline correctly
+//! (see ECOSYSTEM.md). `--adapter` overrides the choice by index, name or backend.
+
+use crate::error::{Error, Result};
+
+/// A device ready to render, with what was learnt about its adapter.
+pub struct GpuContext {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// Timestamp queries at pass boundaries are available and enabled.
+    pub timestamps: bool,
+}
+
+/// One line of `lightgrid list`.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AdapterSummary {
+    pub index: usize,
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+}
+
+const NO_ADAPTER_HELP: &str = "no GPU adapter found. lightgrid needs a Vulkan, Metal, DX12 or GL \
+adapter; on a machine without a GPU install Mesa's software Vulkan driver: \
+`sudo apt-get install -y mesa-vulkan-drivers libvulkan1` (Debian/Ubuntu)";
+
+fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+fn rank(info: &wgpu::AdapterInfo) -> u32 {
+    let ty = match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    };
+    let backend = match info.backend {
+        wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
+        _ => 1,
+    };
+    ty * 2 + backend
+}
+
+fn sorted_adapters(instance: &wgpu::Instance) -> Vec<wgpu::Adapter> {
+    let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    adapters.sort_by_key(|a| rank(&a.get_info()));
+    adapters
+}
+
+fn summarize(index: usize, info: &wgpu::AdapterInfo) -> AdapterSummary {
+    AdapterSummary {
+        index,
+        name: info.name.clone(),
+        backend: format!("{:?}", info.backend).to_lowercase(),
+        device_type: format!("{:?}", info.device_type),
+        driver: format!("{} {}", info.driver, info.driver_info)
+            .trim()
+            .to_string(),
+    }
+}
+
+/// Every adapter wgpu sees, in preference order (index 0 is the default choice).
+pub fn list_adapters() -> Vec<AdapterSummary> {
+    sorted_adapters(&instance())
+        .iter()
+        .enumerate()
+        .map(|(i, a)| summarize(i, &a.get_info()))
+        .collect()
+}
+
+/// Does `wanted` (an index, a backend name, or part of the adapter name) select this adapter?
+fn matches(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
+    let w = wanted.trim().to_lowercase();
+    if let Ok(i) = w.parse::<usize>() {
+        return i == index;
+    }
+    let backend = format!("{:?}", info.backend).to_lowercase();
+    backend == w || info.name.to_lowercase().contains(&w) || info.driver.to_lowercase().contains(&w)
+}
+
+impl GpuContext {
+    /// Pick an adapter (the best one, or the one `wanted` names) and create a device on it.
+    pub fn new(wanted: Option<&str>) -> Result<Self> {
+        let instance = instance();
+        let adapters = sorted_adapters(&instance);
+        if adapters.is_empty() {
+            return Err(Error::NoAdapter(NO_ADAPTER_HELP.to_string()));
+        }
+        let adapter = match wanted {
+            None => adapters.into_iter().next(),
+            Some(w) => {
+                let names: Vec<String> = adapters
+                    .iter()
+                    .enumerate()
+                    .map(|(i, a)| {
+                        let s = summarize(i, &a.get_info());
+                        format!("{}: {} ({})", s.index, s.name, s.backend)
+                    })
+                    .collect();
+                let found = adapters
+                    .into_iter()
+                    .enumerate()
+                    .find(|(i, a)| matches(w, *i, &a.get_info()))
+                    .map(|(_, a)| a);
+                if found.is_none() {
+                    return Err(Error::NoAdapter(format!(
+                        "no adapter matches '{w}'; available: {}",
+                        names.join(", ")
+                    )));
+                }
+                found
+            }
+        }
+        .expect("checked above");
+        Self::from_adapter(adapter)
+    }
+
+    fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let mut features = wgpu::Features::empty();
+        if timestamps {
+            features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("lightgrid"),
+            required_features: features,
+            // The adapter's own limits: large light lists need big storage bindings.
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        };
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&desc)).map_err(|e| Error::Device {
+                adapter: info.name.clone(),
+                reason: e.to_string(),
+            })?;
+        // Errors are caught by error scopes around every stage; anything that escapes is a
+        // bug, reported loudly rather than turned into a wrong image.
+        device.on_uncaptured_error(std::sync::Arc::new(|e| {
+            eprintln!("lightgrid: uncaptured GPU error: {e}");
+        }));
+        Ok(Self {
+            adapter,
+            device,
+            queue,
+            info,
+            timestamps,
+        })
+    }
+
+    /// "name (backend)", as printed in stats and tables.
+    pub fn adapter_label(&self) -> String {
+        format!(
+            "{} ({})",
+            self.info.name,
+            format!("{:?}", self.info.backend).to_lowercase()
+        )
+    }
+
+    /// Is this a software rasterizer (lavapipe / llvmpipe)?
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Largest 2D texture edge the device accepts.
+    pub fn max_texture_edge(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+}

@@ -1,0 +1,59 @@
+//! Every `#[repr(C)]` struct shared with WGSL. Sizes are asserted at compile time here; the
+//! `layout` test parses the WGSL with naga and compares every field offset with these.
+
+use bytemuck::{Pod, Zeroable};
+
+/// A point light with a finite range (tiled-shading §1.1). `color` is linear RGB, scaled by
+/// `intensity`; the light contributes nothing at or beyond `range`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub range: f32,
+    pub color: [f32; 3],
+    pub intensity: f32,
+}
+
+/// A Blinn-Phong material. `flags` holds `MATERIAL_FLAG_*` bits.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub diffuse: [f32; 3],
+    pub alpha: f32,
+    pub specular: [f32; 3],
+    pub shininess: f32,
+    pub emissive: [f32; 3],
+    pub flags: u32,
+    pub ambient: [f32; 3],
+    pub _pad: f32,
+}
+
+/// One vertex in world space (the CPU bakes object transforms each frame).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+    pub material: u32,
+}
+
+/// Per-frame uniforms: camera matrices, viewport and light count.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FrameUniforms {
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 3],
+    pub light_count: u32,
+    pub viewport: [f32; 2],
+    pub near: f32,
+    pub far: f32,
+}
+
+const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
+const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 288);

@@ -1,0 +1,141 @@
+//! Images: PNG files written whole or not at all, and the per-pixel difference measure used by
+//! `lightgrid diff` and the image tests.
+
+use crate::error::{Error, Result};
+use image::RgbaImage;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Per-pixel difference summary, in 8-bit sRGB levels (0-255). A pixel's difference is the
+/// largest absolute difference of its three colour channels.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiffSummary {
+    pub mean: f64,
+    /// 99th percentile (nearest rank) of the per-pixel differences.
+    pub p99: f64,
+    pub max: f64,
+}
+
+/// Compare two images of the same size; returns the summary and a visual diff image
+/// (difference ×8, in red, over a dimmed copy of `a`).
+pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
+    if a.dimensions() != b.dimensions() {
+        return Err(Error::invalid(
+            "images",
+            format!(
+                "sizes differ: {}x{} vs {}x{}",
+                a.width(),
+                a.height(),
+                b.width(),
+                b.height()
+            ),
+        ));
+    }
+    let mut histogram = [0u64; 256];
+    let mut sum = 0u64;
+    let mut vis = RgbaImage::new(a.width(), a.height());
+    for ((pa, pb), pv) in a.pixels().zip(b.pixels()).zip(vis.pixels_mut()) {
+        let d = (0..3).map(|c| pa[c].abs_diff(pb[c])).max().unwrap_or(0);
+        histogram[d as usize] += 1;
+        sum += u64::from(d);
+        let luma = ((u32::from(pa[0]) + u32::from(pa[1]) + u32::from(pa[2])) / 12) as u8;
+        let red = (u32::from(d) * 8).min(255) as u8;
+        *pv = image::Rgba([red.max(luma), luma, luma, 255]);
+    }
+    let n = u64::from(a.width()) * u64::from(a.height());
+    let rank = ((n as f64) * 0.99).ceil().max(1.0) as u64;
+    let mut seen = 0;
+    let mut p99 = 0;
+    for (level, count) in histogram.iter().enumerate() {
+        seen += count;
+        if seen >= rank {
+            p99 = level;
+            break;
+        }
+    }
+    let max = histogram.iter().rposition(|&c| c > 0).unwrap_or(0);
+    Ok((
+        DiffSummary {
+            mean: sum as f64 / n.max(1) as f64,
+            p99: p99 as f64,
+            max: max as f64,
+        },
+        vis,
+    ))
+}
+
+/// Read a PNG (or any format the image crate decodes) as RGBA8.
+pub fn load_image(path: &Path) -> Result<RgbaImage> {
+    let img = image::open(path).map_err(|e| Error::Image {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    Ok(img.to_rgba8())
+}
+
+/// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
+/// the file is either the complete new content or untouched.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let io = |source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path.file_name().ok_or_else(|| {
+        Error::invalid(
+            "output path",
+            format!("{} has no file name", path.display()),
+        )
+    })?;
+    let tmp = dir.join(format!(
+        ".{}.tmp{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    std::fs::write(&tmp, bytes).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })
+}
+
+/// Encode as PNG and write atomically.
+pub fn save_png(img: &RgbaImage, path: &Path) -> Result<()> {
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| Error::Image {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    write_atomic(path, &bytes)
+}
+
+/// Fail early (before rendering) when `path` cannot be written: its directory must exist and
+/// accept a new file, and the path must not be a directory.
+pub fn check_writable(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::invalid(
+            "output path",
+            format!("{} is a directory", path.display()),
+        ));
+    }
+    let probe = path.with_file_name(format!(
+        ".{}.probe{}",
+        path.file_name()
+            .map(|n| n.to_string_lossy())
+            .unwrap_or_default(),
+        std::process::id()
+    ));
+    std::fs::write(&probe, b"").map_err(|source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}

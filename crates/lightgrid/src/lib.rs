@@ -1,0 +1,21 @@
+//! lightgrid: many-lights rendering on wgpu. Forward (the reference), deferred, tiled and
+//! clustered shading side by side, sharing one light function and one light-grid contract.
+//!
+//! Start with [`gpu::GpuContext::new`], build a scene from [`scene::catalog`], and render it
+//! with a [`Renderer`] and a pipeline id from [`pipelines::PIPELINES`].
+
+pub mod consts;
+pub mod error;
+pub mod gpu;
+pub mod gpu_types;
+pub mod image_io;
+pub mod passes;
+pub mod pipelines;
+mod renderer;
+pub mod scene;
+pub mod shader;
+pub mod stats;
+
+pub use error::{Error, Result};
+pub use renderer::{validate_size, FrameOutput, Renderer};
+pub use stats::{FrameStats, TimingSource};

@@ -1,0 +1,344 @@
+//! The renderer: owns the targets and scene buffers, runs one registry pipeline for one frame
+//! of a scene, tonemaps, reads the image back and collects the frame's statistics.
+
+use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
+use crate::error::{Error, Result};
+use crate::gpu::{read_buffer, scoped, wait_idle, GpuContext, PassTimer};
+use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::passes::{scene_layout, Targets, Tonemap};
+use crate::pipelines::{self, FrameInputs, PipelineContext, Technique};
+use crate::scene::Scene;
+use crate::stats::{FrameStats, TimingSource};
+use image::RgbaImage;
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// Most passes one frame may record (timestamp slots).
+const MAX_PASSES: u32 = 32;
+
+/// An image and its statistics.
+pub struct FrameOutput {
+    pub image: RgbaImage,
+    pub stats: FrameStats,
+}
+
+/// A storage/vertex/index buffer that grows to fit.
+struct GrowBuffer {
+    buffer: wgpu::Buffer,
+    usage: wgpu::BufferUsages,
+    label: &'static str,
+}
+
+impl GrowBuffer {
+    fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        usage: wgpu::BufferUsages,
+        size: u64,
+    ) -> Self {
+        let usage = usage | wgpu::BufferUsages::COPY_DST;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage,
+            mapped_at_creation: false,
+        });
+        GrowBuffer {
+            buffer,
+            usage,
+            label,
+        }
+    }
+
+    /// Upload `bytes`, reallocating when too small. Returns true when the buffer was replaced.
+    fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, bytes: &[u8]) -> bool {
+        let grown = bytes.len() as u64 > self.buffer.size();
+        if grown {
+            *self = GrowBuffer::new(
+                device,
+                self.label,
+                self.usage,
+                (bytes.len() as u64).next_power_of_two(),
+            );
+        }
+        queue.write_buffer(&self.buffer, 0, bytes);
+        grown
+    }
+}
+
+/// Renders frames at one size on one device.
+pub struct Renderer<'c> {
+    ctx: &'c GpuContext,
+    targets: Targets,
+    scene_layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    lights: GrowBuffer,
+    materials: GrowBuffer,
+    vertices: GrowBuffer,
+    indices: GrowBuffer,
+    scene_bind_group: wgpu::BindGroup,
+    tonemap: Tonemap,
+    timer: PassTimer,
+    techniques: HashMap<&'static str, Box<dyn Technique>>,
+    readback: wgpu::Buffer,
+    padded_row: u32,
+}
+
+/// Check a frame size against lightgrid's and the adapter's limits.
+pub fn validate_size(ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
+    let limit = ctx.max_texture_edge().min(MAX_FRAME_EDGE);
+    if width == 0 || height == 0 {
+        return Err(Error::invalid(
+            "size",
+            format!("{width}x{height}: both edges must be at least 1"),
+        ));
+    }
+    if width > limit || height > limit {
+        return Err(Error::invalid(
+            "size",
+            format!("{width}x{height}: edges above {limit} are not supported by this adapter"),
+        ));
+    }
+    Ok(())
+}
+
+impl<'c> Renderer<'c> {
+    pub fn new(ctx: &'c GpuContext, width: u32, height: u32) -> Result<Self> {
+        validate_size(ctx, width, height)?;
+        let device = &ctx.device;
+        scoped(device, "creating render targets", || {
+            let targets = Targets::new(device, width, height);
+            let scene_layout = scene_layout(device);
+            let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame uniforms"),
+                size: std::mem::size_of::<FrameUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            use wgpu::BufferUsages as U;
+            let lights = GrowBuffer::new(device, "lights", U::STORAGE, 1 << 16);
+            let materials = GrowBuffer::new(device, "materials", U::STORAGE, 1 << 12);
+            let vertices = GrowBuffer::new(device, "vertices", U::VERTEX, 1 << 20);
+            let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
+            let scene_bind_group =
+                Self::bind_scene(device, &scene_layout, &uniforms, &lights, &materials);
+            let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+                * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+            let readback = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("image readback"),
+                size: u64::from(padded_row) * u64::from(height),
+                usage: U::MAP_READ | U::COPY_DST,
+                mapped_at_creation: false,
+            });
+            Renderer {
+                ctx,
+                targets,
+                tonemap: Tonemap::new(device),
+                timer: PassTimer::new(ctx, MAX_PASSES),
+                scene_layout,
+                uniforms,
+                lights,
+                materials,
+                vertices,
+                indices,
+                scene_bind_group,
+                techniques: HashMap::new(),
+                readback,
+                padded_row,
+            }
+        })
+    }
+
+    fn bind_scene(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        uniforms: &wgpu::Buffer,
+        lights: &GrowBuffer,
+        materials: &GrowBuffer,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene (group 0)"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: lights.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: materials.buffer.as_entire_binding(),
+                },
+            ],
+        })
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.targets.width, self.targets.height)
+    }
+
+    fn technique(&mut self, id: &str) -> Result<&dyn Technique> {
+        let info = pipelines::find(id)?;
+        if !self.techniques.contains_key(info.id) {
+            let device = &self.ctx.device;
+            let ctx = PipelineContext {
+                device,
+                scene_layout: &self.scene_layout,
+            };
+            let t = scoped(device, &format!("creating pipeline {}", info.id), || {
+                (info.create)(&ctx)
+            })?;
+            self.techniques.insert(info.id, t);
+        }
+        Ok(self.techniques[info.id].as_ref())
+    }
+
+    /// Render `frame` of `scene` with pipeline `pipeline_id`.
+    pub fn render(&mut self, scene: &Scene, frame: u32, pipeline_id: &str) -> Result<FrameOutput> {
+        let frames = scene.frame_count();
+        if frame >= frames {
+            return Err(Error::invalid(
+                "frame",
+                format!(
+                    "{frame} is past the end of {} (frames 0..={})",
+                    scene.name,
+                    frames - 1
+                ),
+            ));
+        }
+        let state = scene.frame(frame);
+        if state.lights.len() > MAX_LIGHTS as usize {
+            return Err(Error::invalid(
+                "lights",
+                format!(
+                    "{} lights exceed the maximum of {MAX_LIGHTS}",
+                    state.lights.len()
+                ),
+            ));
+        }
+        for (i, l) in state.lights.iter().enumerate() {
+            l.validate(i)?;
+        }
+        let (vertices, indices) = scene.geometry(&state);
+        let (width, height) = self.size();
+        let view = state.camera.view();
+        let proj = state.camera.proj(width as f32 / height as f32);
+        let view_proj = proj * view;
+        let uniforms = FrameUniforms {
+            view: view.to_cols_array_2d(),
+            proj: proj.to_cols_array_2d(),
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            camera_pos: state.camera.eye.to_array(),
+            light_count: state.lights.len() as u32,
+            viewport: [width as f32, height as f32],
+            near: state.camera.near,
+            far: state.camera.far,
+        };
+        let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
+        let materials = scene.materials_gpu();
+
+        self.technique(pipeline_id)?;
+        let device = &self.ctx.device;
+        let queue = &self.ctx.queue;
+        let mut rebind = self
+            .lights
+            .upload(device, queue, bytemuck::cast_slice(&gpu_lights));
+        rebind |= self
+            .materials
+            .upload(device, queue, bytemuck::cast_slice(&materials));
+        if rebind {
+            self.scene_bind_group = Self::bind_scene(
+                device,
+                &self.scene_layout,
+                &self.uniforms,
+                &self.lights,
+                &self.materials,
+            );
+        }
+        self.vertices
+            .upload(device, queue, bytemuck::cast_slice(&vertices));
+        self.indices
+            .upload(device, queue, bytemuck::cast_slice(&indices));
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+
+        let info = pipelines::find(pipeline_id)?;
+        let technique = self.techniques[info.id].as_ref();
+        self.timer.reset();
+        let start = Instant::now();
+        scoped(device, &format!("rendering with {}", info.id), || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some(info.id),
+            });
+            let inputs = FrameInputs {
+                device,
+                scene_bind_group: &self.scene_bind_group,
+                vertices: &self.vertices.buffer,
+                indices: &self.indices.buffer,
+                index_count: indices.len() as u32,
+                targets: &self.targets,
+            };
+            technique.encode(&inputs, &mut encoder, &mut self.timer);
+            self.tonemap.encode(
+                device,
+                &mut encoder,
+                &mut self.timer,
+                &self.targets.hdr,
+                &self.targets.ldr,
+            );
+            encoder.copy_texture_to_buffer(
+                self.targets.ldr_texture.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &self.readback,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(self.padded_row),
+                        rows_per_image: Some(height),
+                    },
+                },
+                wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+            );
+            self.timer.resolve(&mut encoder);
+            queue.submit([encoder.finish()]);
+        })?;
+        wait_idle(device)?;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (passes, span) = self.timer.read(device)?;
+        let bytes = read_buffer(device, &self.readback)?;
+        let mut image = RgbaImage::new(width, height);
+        for (y, row) in bytes.chunks_exact(self.padded_row as usize).enumerate() {
+            let src = &row[..(width * 4) as usize];
+            let dst =
+                &mut image.as_mut()[(y * (width * 4) as usize)..((y + 1) * (width * 4) as usize)];
+            dst.copy_from_slice(src);
+        }
+        let (gpu_ms, timing) = match span {
+            Some(ms) => (ms, TimingSource::GpuTimestamps),
+            None => (wall_ms, TimingSource::WallClock),
+        };
+        Ok(FrameOutput {
+            image,
+            stats: FrameStats {
+                scene: scene.name.clone(),
+                pipeline: info.id.to_string(),
+                adapter: self.ctx.adapter_label(),
+                width,
+                height,
+                frame,
+                lights: state.lights.len() as u32,
+                triangles: (indices.len() / 3) as u32,
+                gpu_ms,
+                timing,
+                wall_ms,
+                passes,
+            },
+        })
+    }
+}

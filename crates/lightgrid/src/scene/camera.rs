@@ -1,0 +1,118 @@
+//! Perspective camera and the camera path of an animation.
+//!
+//! Conventions: right-handed world, y up; view space looks down -z; clip depth is WebGPU's
+//! [0, 1] (near maps to 0).
+
+use glam::{Mat4, Vec3, Vec4};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    pub fn view(&self) -> Mat4 {
+        let f = (self.target - self.eye).normalize();
+        let s = f.cross(self.up).normalize();
+        let u = s.cross(f);
+        Mat4::from_cols(
+            Vec4::new(s.x, u.x, -f.x, 0.0),
+            Vec4::new(s.y, u.y, -f.y, 0.0),
+            Vec4::new(s.z, u.z, -f.z, 0.0),
+            Vec4::new(-s.dot(self.eye), -u.dot(self.eye), f.dot(self.eye), 1.0),
+        )
+    }
+
+    /// Right-handed perspective with depth 0 at `near` and 1 at `far`.
+    pub fn proj(&self, aspect: f32) -> Mat4 {
+        let h = 1.0 / (self.fov_y * 0.5).tan();
+        let w = h / aspect;
+        let r = self.far / (self.near - self.far);
+        Mat4::from_cols(
+            Vec4::new(w, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, h, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, r, -1.0),
+            Vec4::new(0.0, 0.0, r * self.near, 0.0),
+        )
+    }
+}
+
+/// Keyframed eye/target positions, interpolated with a Catmull-Rom spline so the camera moves
+/// without stopping at keys.
+#[derive(Clone, Debug)]
+pub struct CameraPath {
+    /// (frame, eye, target), frames increasing.
+    pub keys: Vec<(u32, Vec3, Vec3)>,
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+fn catmull_rom(p0: Vec3, p1: Vec3, p2: Vec3, p3: Vec3, t: f32) -> Vec3 {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    0.5 * ((2.0 * p1)
+        + (p2 - p0) * t
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+        + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t3)
+}
+
+impl CameraPath {
+    /// A camera that does not move.
+    pub fn fixed(eye: Vec3, target: Vec3, fov_y_deg: f32, near: f32, far: f32) -> Self {
+        CameraPath {
+            keys: vec![(0, eye, target)],
+            fov_y: fov_y_deg.to_radians(),
+            near,
+            far,
+        }
+    }
+
+    /// Number of frames the path spans (last key frame + 1).
+    pub fn frame_count(&self) -> u32 {
+        self.keys.last().map_or(1, |k| k.0 + 1)
+    }
+
+    pub fn at(&self, frame: u32) -> Camera {
+        let n = self.keys.len();
+        let seg = self
+            .keys
+            .windows(2)
+            .position(|w| frame >= w[0].0 && frame <= w[1].0);
+        let (eye, target) = match seg {
+            None => {
+                let k = if frame < self.keys[0].0 { 0 } else { n - 1 };
+                (self.keys[k].1, self.keys[k].2)
+            }
+            Some(i) => {
+                let (f1, f2) = (self.keys[i].0, self.keys[i + 1].0);
+                let t = (frame - f1) as f32 / (f2 - f1).max(1) as f32;
+                let k = |j: isize| self.keys[j.clamp(0, n as isize - 1) as usize];
+                let (a, b, c, d) = (
+                    k(i as isize - 1),
+                    k(i as isize),
+                    k(i as isize + 1),
+                    k(i as isize + 2),
+                );
+                (
+                    catmull_rom(a.1, b.1, c.1, d.1, t),
+                    catmull_rom(a.2, b.2, c.2, d.2, t),
+                )
+            }
+        };
+        Camera {
+            eye,
+            target,
+            up: Vec3::Y,
+            fov_y: self.fov_y,
+            near: self.near,
+            far: self.far,
+        }
+    }
+}

@@ -1,0 +1,648 @@
+//! The scene catalog: procedural scenes, deterministic from a seed.
+//!
+//! The robots street follows tiled-shading §8 (the BART Robots scene with two light
+//! distributions); `scattered` follows the Forward+ demo (forward-plus §5, 3072 lights at
+//! 1280×720); `random-top` / `random-fps` follow tiled-forward-shading Fig. 4.6 (1024 random
+//! lights, top-down and first-person); `stress` takes any light count for scaling runs.
+
+use super::{
+    CameraPath, LightAnchor, Material, Mesh, Motion, Object, Path, PointLight, Rng, Scene,
+    SceneLight,
+};
+use crate::error::{Error, Result};
+use glam::{Mat4, Vec3};
+
+/// Width of the robots scene's main street (tiled-shading §8).
+pub const MAIN_STREET_WIDTH: f32 = 29.1;
+/// Robots walking the street (the BART Robots scene has 11).
+pub const ROBOT_COUNT: usize = 11;
+/// `robots-many`: static lights spread evenly along the robots' paths.
+pub const ROBOTS_MANY_LIGHTS: usize = 924;
+pub const ROBOTS_MANY_RANGE: f32 = 12.5;
+/// `robots-few`: one light per robot.
+pub const ROBOTS_FEW_RANGE: f32 = 40.0;
+/// Frames of the robots camera path (the paper shows frames 0 to 259).
+pub const ROBOTS_FRAMES: u32 = 260;
+pub const SCATTERED_LIGHTS: usize = 3072;
+pub const RANDOM_LIGHTS: usize = 1024;
+/// `stress` without `--lights`.
+pub const STRESS_DEFAULT_LIGHTS: u32 = 10_000;
+/// Largest `--lights` accepted by `stress`.
+pub const STRESS_MAX_LIGHTS: u32 = 1_000_000;
+
+/// What the user can vary when building a catalog scene.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneParams {
+    pub seed: u64,
+    /// Light count; only scenes with `variable_lights` accept it.
+    pub lights: Option<u32>,
+}
+
+impl Default for SceneParams {
+    fn default() -> Self {
+        SceneParams {
+            seed: 1,
+            lights: None,
+        }
+    }
+}
+
+/// One catalog row.
+pub struct SceneInfo {
+    pub name: &'static str,
+    pub description: &'static str,
+    /// Accepts `--lights N`.
+    pub variable_lights: bool,
+    build: fn(&SceneParams) -> Scene,
+}
+
+/// Every scene, in the order `lightgrid list` prints them.
+pub const SCENES: &[SceneInfo] = &[
+    SceneInfo {
+        name: "robots-many",
+        description:
+            "city street, 11 walking robots, 924 static lights (range 12.5) along their paths",
+        variable_lights: false,
+        build: robots_many,
+    },
+    SceneInfo {
+        name: "robots-few",
+        description: "the same street with one light (range 40) carried by each of the 11 robots",
+        variable_lights: false,
+        build: robots_few,
+    },
+    SceneInfo {
+        name: "scattered",
+        description:
+            "3072 lights scattered through a volume of pillars and blocks (Forward+ demo), 1280x720",
+        variable_lights: false,
+        build: scattered,
+    },
+    SceneInfo {
+        name: "random-top",
+        description: "1024 randomly placed lights over a block field, seen top-down",
+        variable_lights: false,
+        build: random_top,
+    },
+    SceneInfo {
+        name: "random-fps",
+        description: "the same 1024 lights and field, seen first-person",
+        variable_lights: false,
+        build: random_fps,
+    },
+    SceneInfo {
+        name: "stress",
+        description:
+            "any light count (--lights N, up to 1,000,000; default 10,000) over a large block field",
+        variable_lights: true,
+        build: stress,
+    },
+];
+
+/// Comma-separated scene names, for error messages and help.
+pub fn scene_names() -> String {
+    SCENES.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+}
+
+/// Look up a scene by name.
+pub fn find(name: &str) -> Result<&'static SceneInfo> {
+    SCENES
+        .iter()
+        .find(|s| s.name == name)
+        .ok_or_else(|| Error::Unknown {
+            what: "scene",
+            name: name.to_string(),
+            valid: scene_names(),
+        })
+}
+
+/// Build a catalog scene by name.
+pub fn build(name: &str, params: &SceneParams) -> Result<Scene> {
+    let info = find(name)?;
+    match params.lights {
+        Some(_) if !info.variable_lights => {
+            return Err(Error::invalid(
+                "--lights",
+                format!(
+                    "scene {name} has a fixed light count; --lights applies to: {}",
+                    SCENES
+                        .iter()
+                        .filter(|s| s.variable_lights)
+                        .map(|s| s.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ))
+        }
+        Some(0) => return Err(Error::invalid("--lights", "must be at least 1")),
+        Some(n) if n > STRESS_MAX_LIGHTS => {
+            return Err(Error::invalid(
+                "--lights",
+                format!("{n} is above the maximum of {STRESS_MAX_LIGHTS}"),
+            ))
+        }
+        _ => {}
+    }
+    let scene = (info.build)(params);
+    scene.validate()?;
+    Ok(scene)
+}
+
+/// Scene under construction.
+struct Builder {
+    scene: Scene,
+    rng: Rng,
+}
+
+impl Builder {
+    fn new(name: &str, seed: u64, camera_path: CameraPath, default_size: (u32, u32)) -> Self {
+        Builder {
+            scene: Scene {
+                name: name.to_string(),
+                meshes: Vec::new(),
+                materials: Vec::new(),
+                objects: Vec::new(),
+                paths: Vec::new(),
+                lights: Vec::new(),
+                camera_path,
+                default_size,
+            },
+            rng: Rng::new(seed),
+        }
+    }
+
+    fn material(&mut self, m: Material) -> usize {
+        self.scene.materials.push(m);
+        self.scene.materials.len() - 1
+    }
+
+    fn object(&mut self, mesh: Mesh, material: usize, motion: Motion) -> usize {
+        self.scene.meshes.push(mesh);
+        self.scene.objects.push(Object {
+            mesh: self.scene.meshes.len() - 1,
+            material,
+            local: Mat4::IDENTITY,
+            motion,
+        });
+        self.scene.objects.len() - 1
+    }
+
+    fn light(&mut self, light: PointLight, anchor: LightAnchor) {
+        self.scene.lights.push(SceneLight { light, anchor });
+    }
+
+    /// A saturated random colour (random hue), as lights in the papers' scenes.
+    fn light_color(&mut self) -> Vec3 {
+        let h = self.rng.unit() * 6.0;
+        let s = self.rng.range(0.45, 0.85);
+        let x = 1.0 - (h % 2.0 - 1.0).abs();
+        let rgb = match h as u32 {
+            0 => Vec3::new(1.0, x, 0.0),
+            1 => Vec3::new(x, 1.0, 0.0),
+            2 => Vec3::new(0.0, 1.0, x),
+            3 => Vec3::new(0.0, x, 1.0),
+            4 => Vec3::new(x, 0.0, 1.0),
+            _ => Vec3::new(1.0, 0.0, x),
+        };
+        Vec3::ONE.lerp(rgb, s)
+    }
+
+    /// Boxes standing on the ground at random heights, in a grid of `cells` over the square
+    /// [-half, half]², each leaving a `gap` to the cell edge. Returns the merged mesh.
+    fn block_field(&mut self, half: f32, cells: u32, gap: f32, height: (f32, f32)) -> Mesh {
+        let mut mesh = Mesh::default();
+        let cell = 2.0 * half / cells as f32;
+        for i in 0..cells {
+            for j in 0..cells {
+                if self.rng.unit() < 0.25 {
+                    continue;
+                }
+                let x0 = -half + i as f32 * cell + gap;
+                let z0 = -half + j as f32 * cell + gap;
+                let w = (cell - 2.0 * gap) * self.rng.range(0.4, 1.0);
+                let d = (cell - 2.0 * gap) * self.rng.range(0.4, 1.0);
+                let h = self.rng.range(height.0, height.1);
+                mesh.append(
+                    &Mesh::cuboid(Vec3::new(x0, 0.0, z0), Vec3::new(x0 + w, h, z0 + d)),
+                    Mat4::IDENTITY,
+                );
+            }
+        }
+        mesh
+    }
+}
+
+// ---------------------------------------------------------------- robots street
+
+/// Street layout: the main street runs along z; two cross streets run along x.
+const STREET_HALF_LENGTH: f32 = 160.0;
+const CROSS_STREETS_Z: [f32; 2] = [-70.0, 70.0];
+const CROSS_STREET_WIDTH: f32 = 20.0;
+const SIDEWALK: f32 = 3.5;
+
+/// The robots' walking loops: five lanes up and down the main street, five along the cross
+/// streets and one around a block.
+fn robot_paths() -> Vec<Path> {
+    let lane = |a: Vec3, b: Vec3, side: Vec3| Path {
+        points: vec![a - side, b - side, b + side, a + side],
+    };
+    let mut paths = Vec::new();
+    for x in [-9.0, -4.5, 0.0, 4.5, 9.0] {
+        paths.push(lane(
+            Vec3::new(x, 0.0, -150.0),
+            Vec3::new(x, 0.0, 150.0),
+            Vec3::X * 1.5,
+        ));
+    }
+    for (z, dz) in [
+        (-70.0, -3.0),
+        (-70.0, 3.0),
+        (70.0, -4.0),
+        (70.0, 0.0),
+        (70.0, 4.0),
+    ] {
+        paths.push(lane(
+            Vec3::new(-150.0, 0.0, z + dz),
+            Vec3::new(150.0, 0.0, z + dz),
+            Vec3::Z * 1.2,
+        ));
+    }
+    paths.push(Path {
+        points: vec![
+            Vec3::new(-6.0, 0.0, -70.0),
+            Vec3::new(-6.0, 0.0, 70.0),
+            Vec3::new(-140.0, 0.0, 70.0),
+            Vec3::new(-140.0, 0.0, -70.0),
+        ],
+    });
+    debug_assert_eq!(paths.len(), ROBOT_COUNT);
+    paths
+}
+
+/// Is the point (x, z) on a street or sidewalk (where no building may stand)?
+fn in_street(x0: f32, x1: f32, z0: f32, z1: f32) -> bool {
+    let main = MAIN_STREET_WIDTH * 0.5 + SIDEWALK;
+    let overlaps_main = x1 > -main && x0 < main;
+    let cross = CROSS_STREET_WIDTH * 0.5 + SIDEWALK;
+    let overlaps_cross = CROSS_STREETS_Z
+        .iter()
+        .any(|&c| z1 > c - cross && z0 < c + cross);
+    overlaps_main || overlaps_cross
+}
+
+/// The street, its buildings and the 11 robots. Returns the builder and the object index of
+/// each robot's body (lights of `robots-few` ride on it).
+fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
+    let camera = CameraPath {
+        keys: vec![
+            (0, Vec3::new(0.0, 70.0, -185.0), Vec3::new(0.0, 0.0, -60.0)),
+            (50, Vec3::new(6.0, 30.0, -140.0), Vec3::new(0.0, 4.0, -50.0)),
+            (100, Vec3::new(-8.0, 7.0, -75.0), Vec3::new(6.0, 4.0, 10.0)),
+            (150, Vec3::new(4.0, 6.0, -10.0), Vec3::new(-10.0, 5.0, 60.0)),
+            (200, Vec3::new(-5.0, 9.0, 55.0), Vec3::new(-80.0, 4.0, 75.0)),
+            (259, Vec3::new(30.0, 45.0, 130.0), Vec3::new(0.0, 0.0, 0.0)),
+        ],
+        fov_y: 60f32.to_radians(),
+        near: 0.5,
+        far: 800.0,
+    };
+    let mut b = Builder::new(name, seed, camera, (640, 360));
+    let asphalt = b.material(Material::plain(Vec3::splat(0.30), 0.15, 16.0));
+    let pavement = b.material(Material::plain(Vec3::new(0.55, 0.53, 0.50), 0.1, 8.0));
+    let facades: Vec<usize> = [
+        Vec3::new(0.70, 0.62, 0.52),
+        Vec3::new(0.55, 0.58, 0.64),
+        Vec3::new(0.72, 0.70, 0.68),
+        Vec3::new(0.60, 0.45, 0.40),
+    ]
+    .into_iter()
+    .map(|c| b.material(Material::plain(c, 0.25, 24.0)))
+    .collect();
+    let metal = b.material(Material::plain(Vec3::new(0.45, 0.50, 0.58), 0.9, 64.0));
+    let eyes = b.material(Material {
+        emissive: Vec3::new(1.5, 0.2, 0.1),
+        ..Material::plain(Vec3::new(0.2, 0.05, 0.05), 0.5, 32.0)
+    });
+
+    let extent = STREET_HALF_LENGTH + 40.0;
+    b.object(
+        Mesh::ground(-extent, -extent, extent, extent, 0.0),
+        asphalt,
+        Motion::Static,
+    );
+
+    // Sidewalks along both sides of the main street and the cross streets.
+    let mut walks = Mesh::default();
+    let m = MAIN_STREET_WIDTH * 0.5;
+    for side in [-1.0f32, 1.0] {
+        let (x0, x1) = if side < 0.0 {
+            (-m - SIDEWALK, -m)
+        } else {
+            (m, m + SIDEWALK)
+        };
+        walks.append(
+            &Mesh::cuboid(
+                Vec3::new(x0, 0.0, -STREET_HALF_LENGTH),
+                Vec3::new(x1, 0.2, STREET_HALF_LENGTH),
+            ),
+            Mat4::IDENTITY,
+        );
+    }
+    for c in CROSS_STREETS_Z {
+        let h = CROSS_STREET_WIDTH * 0.5;
+        for (z0, z1) in [(c - h - SIDEWALK, c - h), (c + h, c + h + SIDEWALK)] {
+            walks.append(
+                &Mesh::cuboid(
+                    Vec3::new(-STREET_HALF_LENGTH, 0.0, z0),
+                    Vec3::new(STREET_HALF_LENGTH, 0.2, z1),
+                ),
+                Mat4::IDENTITY,
+            );
+        }
+    }
+    b.object(walks, pavement, Motion::Static);
+
+    // Buildings: rows of boxes along every block's street fronts, two rows deep.
+    let mut buildings: Vec<Mesh> = vec![Mesh::default(); facades.len()];
+    let inner = MAIN_STREET_WIDTH * 0.5 + SIDEWALK + 0.5;
+    for side in [-1.0f32, 1.0] {
+        for row in 0..2 {
+            let mut z = -STREET_HALF_LENGTH;
+            while z < STREET_HALF_LENGTH {
+                let width = b.rng.range(9.0, 22.0);
+                let depth = b.rng.range(14.0, 26.0);
+                let height = b.rng.range(10.0, 55.0) * if row == 0 { 1.0 } else { 1.4 };
+                let near = inner + row as f32 * 30.0;
+                let (x0, x1) = if side > 0.0 {
+                    (near, near + depth)
+                } else {
+                    (-near - depth, -near)
+                };
+                let (z0, z1) = (z, (z + width).min(STREET_HALF_LENGTH));
+                // Fronts facing the main street stop at the cross streets.
+                if !in_street(x0, x1, z0, z1) {
+                    let f = b.rng.below(facades.len() as u32) as usize;
+                    buildings[f].append(
+                        &Mesh::cuboid(Vec3::new(x0, 0.0, z0), Vec3::new(x1, height, z1)),
+                        Mat4::IDENTITY,
+                    );
+                }
+                z += width + b.rng.range(0.5, 3.0);
+            }
+        }
+    }
+    for (mesh, f) in buildings.into_iter().zip(facades) {
+        b.object(mesh, f, Motion::Static);
+    }
+
+    // The robots: 2x scale humanoids made of boxes, facing +z in object space.
+    let mut body = Mesh::default();
+    let parts = [
+        (Vec3::new(-1.8, 0.0, -0.7), Vec3::new(-0.4, 4.4, 0.7)), // left leg
+        (Vec3::new(0.4, 0.0, -0.7), Vec3::new(1.8, 4.4, 0.7)),   // right leg
+        (Vec3::new(-2.2, 4.4, -1.2), Vec3::new(2.2, 9.2, 1.2)),  // torso
+        (Vec3::new(-3.2, 5.0, -0.6), Vec3::new(-2.3, 9.0, 0.6)), // left arm
+        (Vec3::new(2.3, 5.0, -0.6), Vec3::new(3.2, 9.0, 0.6)),   // right arm
+        (Vec3::new(-1.2, 9.4, -1.0), Vec3::new(1.2, 11.4, 1.0)), // head
+    ];
+    for (lo, hi) in parts {
+        body.append(&Mesh::cuboid(lo, hi), Mat4::IDENTITY);
+    }
+    let mut eye_mesh = Mesh::default();
+    for x in [-0.7, 0.3] {
+        eye_mesh.append(
+            &Mesh::cuboid(Vec3::new(x, 10.4, 1.0), Vec3::new(x + 0.4, 10.8, 1.15)),
+            Mat4::IDENTITY,
+        );
+    }
+    b.scene.paths = robot_paths();
+    let mut robots = Vec::new();
+    for p in 0..ROBOT_COUNT {
+        let len = b.scene.paths[p].length();
+        let motion = Motion::Walk {
+            path: p,
+            speed: b.rng.range(0.6, 1.0),
+            start: b.rng.range(0.0, len),
+        };
+        robots.push(b.object(body.clone(), metal, motion.clone()));
+        b.object(eye_mesh.clone(), eyes, motion);
+    }
+    (b, robots)
+}
+
+fn robots_many(p: &SceneParams) -> Scene {
+    let (mut b, _) = robots_street("robots-many", p.seed);
+    let per_path = ROBOTS_MANY_LIGHTS / ROBOT_COUNT;
+    for path in 0..ROBOT_COUNT {
+        let len = b.scene.paths[path].length();
+        for k in 0..per_path {
+            let (pos, dir) = b.scene.paths[path].sample((k as f32 + 0.5) * len / per_path as f32);
+            let sideways = dir.cross(Vec3::Y) * b.rng.range(-5.0, 5.0);
+            let light = PointLight {
+                position: pos + sideways + Vec3::Y * b.rng.range(1.0, 6.0),
+                color: b.light_color(),
+                intensity: 0.35,
+                range: ROBOTS_MANY_RANGE,
+            };
+            b.light(light, LightAnchor::World);
+        }
+    }
+    b.scene
+}
+
+fn robots_few(p: &SceneParams) -> Scene {
+    let (mut b, robots) = robots_street("robots-few", p.seed);
+    for body in robots {
+        let light = PointLight {
+            position: Vec3::new(0.0, 14.0, 0.0),
+            color: b.light_color(),
+            intensity: 1.2,
+            range: ROBOTS_FEW_RANGE,
+        };
+        b.light(light, LightAnchor::Object(body));
+    }
+    b.scene
+}
+
+// ---------------------------------------------------------------- scattered (Forward+ demo)
+
+fn scattered(p: &SceneParams) -> Scene {
+    let mut keys = Vec::new();
+    for k in 0..=6u32 {
+        let a = k as f32 / 6.0 * std::f32::consts::PI;
+        keys.push((
+            k * 20,
+            Vec3::new(
+                a.cos() * 110.0,
+                28.0 + 8.0 * (a * 2.0).sin(),
+                a.sin() * 110.0,
+            ),
+            Vec3::new(0.0, 8.0, 0.0),
+        ));
+    }
+    let camera = CameraPath {
+        keys,
+        fov_y: 60f32.to_radians(),
+        near: 0.5,
+        far: 600.0,
+    };
+    let mut b = Builder::new("scattered", p.seed, camera, (1280, 720));
+    let floor = b.material(Material::plain(Vec3::splat(0.55), 0.2, 16.0));
+    let stone = b.material(Material::plain(Vec3::new(0.66, 0.62, 0.56), 0.4, 32.0));
+    let shiny = b.material(Material::plain(Vec3::new(0.35, 0.40, 0.50), 0.9, 96.0));
+    b.object(
+        Mesh::ground(-100.0, -100.0, 100.0, 100.0, 0.0),
+        floor,
+        Motion::Static,
+    );
+    let mut pillars = Mesh::default();
+    for i in 0..6 {
+        for j in 0..6 {
+            let pos = Vec3::new(-75.0 + i as f32 * 30.0, 0.0, -75.0 + j as f32 * 30.0);
+            pillars.append(&Mesh::cylinder(2.0, 30.0, 24), Mat4::from_translation(pos));
+        }
+    }
+    b.object(pillars, stone, Motion::Static);
+    let mut blocks = Mesh::default();
+    for _ in 0..60 {
+        let c = Vec3::new(b.rng.range(-90.0, 90.0), 0.0, b.rng.range(-90.0, 90.0));
+        let s = Vec3::new(
+            b.rng.range(2.0, 8.0),
+            b.rng.range(1.0, 10.0),
+            b.rng.range(2.0, 8.0),
+        );
+        blocks.append(
+            &Mesh::cuboid(c - s * Vec3::new(1.0, 0.0, 1.0), c + s),
+            Mat4::IDENTITY,
+        );
+    }
+    for _ in 0..20 {
+        let c = Vec3::new(
+            b.rng.range(-90.0, 90.0),
+            b.rng.range(3.0, 25.0),
+            b.rng.range(-90.0, 90.0),
+        );
+        blocks.append(
+            &Mesh::sphere(b.rng.range(1.5, 4.0), 12, 24),
+            Mat4::from_translation(c),
+        );
+    }
+    b.object(blocks, shiny, Motion::Static);
+    for _ in 0..SCATTERED_LIGHTS {
+        let light = PointLight {
+            position: Vec3::new(
+                b.rng.range(-100.0, 100.0),
+                b.rng.range(0.5, 35.0),
+                b.rng.range(-100.0, 100.0),
+            ),
+            color: b.light_color(),
+            intensity: 0.6,
+            range: 10.0,
+        };
+        b.light(light, LightAnchor::World);
+    }
+    b.scene
+}
+
+// ---------------------------------------------------------------- random lights (Fig. 4.6)
+
+fn random_field(name: &str, seed: u64, camera: CameraPath) -> Scene {
+    let mut b = Builder::new(name, seed, camera, (640, 360));
+    let ground = b.material(Material::plain(Vec3::new(0.45, 0.50, 0.42), 0.1, 8.0));
+    let block = b.material(Material::plain(Vec3::new(0.70, 0.66, 0.60), 0.3, 32.0));
+    b.object(
+        Mesh::ground(-100.0, -100.0, 100.0, 100.0, 0.0),
+        ground,
+        Motion::Static,
+    );
+    let field = b.block_field(80.0, 12, 2.5, (1.0, 9.0));
+    b.object(field, block, Motion::Static);
+    for _ in 0..RANDOM_LIGHTS {
+        let light = PointLight {
+            position: Vec3::new(
+                b.rng.range(-80.0, 80.0),
+                b.rng.range(0.5, 6.0),
+                b.rng.range(-80.0, 80.0),
+            ),
+            color: b.light_color(),
+            intensity: 0.9,
+            range: 9.0,
+        };
+        b.light(light, LightAnchor::World);
+    }
+    b.scene
+}
+
+fn random_top(p: &SceneParams) -> Scene {
+    let camera = CameraPath {
+        keys: vec![
+            (0, Vec3::new(-20.0, 150.0, 10.0), Vec3::new(-20.0, 0.0, 0.0)),
+            (119, Vec3::new(20.0, 150.0, 10.0), Vec3::new(20.0, 0.0, 0.0)),
+        ],
+        fov_y: 60f32.to_radians(),
+        near: 1.0,
+        far: 400.0,
+    };
+    random_field("random-top", p.seed, camera)
+}
+
+fn random_fps(p: &SceneParams) -> Scene {
+    let camera = CameraPath {
+        keys: vec![
+            (0, Vec3::new(-75.0, 2.5, -72.0), Vec3::new(0.0, 2.0, 0.0)),
+            (
+                119,
+                Vec3::new(-45.0, 2.5, -40.0),
+                Vec3::new(30.0, 2.0, 30.0),
+            ),
+        ],
+        fov_y: 60f32.to_radians(),
+        near: 0.3,
+        far: 400.0,
+    };
+    random_field("random-fps", p.seed, camera)
+}
+
+// ---------------------------------------------------------------- stress
+
+fn stress(p: &SceneParams) -> Scene {
+    let n = p.lights.unwrap_or(STRESS_DEFAULT_LIGHTS);
+    let camera = CameraPath {
+        keys: vec![
+            (0, Vec3::new(0.0, 110.0, 230.0), Vec3::new(0.0, 0.0, 20.0)),
+            (119, Vec3::new(160.0, 90.0, 160.0), Vec3::new(0.0, 0.0, 0.0)),
+        ],
+        fov_y: 60f32.to_radians(),
+        near: 1.0,
+        far: 1000.0,
+    };
+    let mut b = Builder::new("stress", p.seed, camera, (640, 360));
+    let ground = b.material(Material::plain(Vec3::splat(0.5), 0.2, 16.0));
+    let block = b.material(Material::plain(Vec3::new(0.62, 0.64, 0.70), 0.4, 32.0));
+    let half = 200.0;
+    b.object(
+        Mesh::ground(-half, -half, half, half, 0.0),
+        ground,
+        Motion::Static,
+    );
+    let field = b.block_field(half, 20, 3.0, (2.0, 20.0));
+    b.object(field, block, Motion::Static);
+    // Keep the number of lights reaching a ground point roughly constant (about 12) as the
+    // count grows: coverage = n * pi * r^2 / area.
+    let range = (25.0 * (1000.0 / n as f32).sqrt()).clamp(0.4, 40.0);
+    let intensity = 0.35;
+    for _ in 0..n {
+        let light = PointLight {
+            position: Vec3::new(
+                b.rng.range(-half, half),
+                b.rng.range(0.2, 0.2 + range.min(12.0)),
+                b.rng.range(-half, half),
+            ),
+            color: b.light_color(),
+            intensity,
+            range,
+        };
+        b.light(light, LightAnchor::World);
+    }
+    b.scene
+}

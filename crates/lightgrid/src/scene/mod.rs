@@ -1,0 +1,318 @@
+//! Scenes as plain CPU data: meshes, materials, point lights, objects with motion, and a camera
+//! path. [`Scene::frame`] evaluates the animation at one frame; [`Scene::geometry`] bakes the
+//! frame's objects into one world-space vertex/index list for the GPU.
+
+mod camera;
+pub mod catalog;
+mod mesh;
+mod rng;
+
+pub use camera::{Camera, CameraPath};
+pub use catalog::{SceneInfo, SceneParams, SCENES};
+pub use mesh::Mesh;
+pub use rng::Rng;
+
+use crate::consts::{MATERIAL_FLAG_TRANSPARENT, MAX_LIGHTS};
+use crate::error::{Error, Result};
+use crate::gpu_types::{GpuLight, GpuMaterial, GpuVertex};
+use glam::{Mat4, Quat, Vec3};
+
+/// Blinn-Phong material. `alpha` and `transparent` are carried for transparency support.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    pub diffuse: Vec3,
+    pub specular: Vec3,
+    pub shininess: f32,
+    pub emissive: Vec3,
+    pub ambient: Vec3,
+    pub alpha: f32,
+    pub transparent: bool,
+}
+
+impl Material {
+    /// An opaque material with ambient equal to diffuse and a modest white specular.
+    pub fn plain(diffuse: Vec3, specular: f32, shininess: f32) -> Self {
+        Material {
+            diffuse,
+            specular: Vec3::splat(specular),
+            shininess,
+            emissive: Vec3::ZERO,
+            ambient: diffuse,
+            alpha: 1.0,
+            transparent: false,
+        }
+    }
+
+    pub fn to_gpu(&self) -> GpuMaterial {
+        GpuMaterial {
+            diffuse: self.diffuse.to_array(),
+            alpha: self.alpha,
+            specular: self.specular.to_array(),
+            shininess: self.shininess,
+            emissive: self.emissive.to_array(),
+            flags: if self.transparent {
+                MATERIAL_FLAG_TRANSPARENT
+            } else {
+                0
+            },
+            ambient: self.ambient.to_array(),
+            _pad: 0.0,
+        }
+    }
+}
+
+/// A point light with a finite range: it contributes nothing at or beyond `range`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub color: Vec3,
+    pub intensity: f32,
+    pub range: f32,
+}
+
+impl PointLight {
+    pub fn to_gpu(&self) -> GpuLight {
+        GpuLight {
+            position: self.position.to_array(),
+            range: self.range,
+            color: self.color.to_array(),
+            intensity: self.intensity,
+        }
+    }
+
+    /// Finite position, colour and intensity, and a positive finite range.
+    pub fn validate(&self, index: usize) -> Result<()> {
+        let finite = self.position.is_finite()
+            && self.color.is_finite()
+            && self.intensity.is_finite()
+            && self.range.is_finite();
+        if !finite {
+            return Err(Error::invalid(
+                "light",
+                format!("light {index} has a non-finite position, colour, intensity or range"),
+            ));
+        }
+        if self.range <= 0.0 || self.intensity < 0.0 || self.color.min_element() < 0.0 {
+            return Err(Error::invalid(
+                "light",
+                format!("light {index} needs range > 0 and non-negative colour and intensity"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A closed polyline in the xz plane that something walks along.
+#[derive(Clone, Debug)]
+pub struct Path {
+    pub points: Vec<Vec3>,
+}
+
+impl Path {
+    pub fn length(&self) -> f32 {
+        self.segments().map(|(a, b)| a.distance(b)).sum()
+    }
+
+    fn segments(&self) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
+        let n = self.points.len();
+        (0..n).map(move |i| (self.points[i], self.points[(i + 1) % n]))
+    }
+
+    /// Position and unit direction at arc length `s` (wraps around).
+    pub fn sample(&self, s: f32) -> (Vec3, Vec3) {
+        let len = self.length();
+        let mut s = s.rem_euclid(len);
+        for (a, b) in self.segments() {
+            let d = a.distance(b);
+            if s <= d && d > 0.0 {
+                let dir = (b - a) / d;
+                return (a + dir * s, dir);
+            }
+            s -= d;
+        }
+        let (a, b) = self.segments().last().expect("path has points");
+        (b, (b - a).normalize_or_zero())
+    }
+}
+
+/// How an object moves over the animation.
+#[derive(Clone, Debug)]
+pub enum Motion {
+    Static,
+    /// Walks along `paths[path]` at `speed` units per frame, starting at arc length `start`,
+    /// facing the direction of travel.
+    Walk {
+        path: usize,
+        speed: f32,
+        start: f32,
+    },
+}
+
+/// A mesh placed in the world with a material.
+#[derive(Clone, Debug)]
+pub struct Object {
+    pub mesh: usize,
+    pub material: usize,
+    /// Placement relative to the motion's frame (or the world, for static objects).
+    pub local: Mat4,
+    pub motion: Motion,
+}
+
+/// Where a light sits: fixed in the world, or carried by an object.
+#[derive(Clone, Copy, Debug)]
+pub enum LightAnchor {
+    World,
+    /// Offset from the object's motion frame.
+    Object(usize),
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct SceneLight {
+    /// For `LightAnchor::Object`, `light.position` is relative to the object.
+    pub light: PointLight,
+    pub anchor: LightAnchor,
+}
+
+/// A complete scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    pub objects: Vec<Object>,
+    pub paths: Vec<Path>,
+    pub lights: Vec<SceneLight>,
+    pub camera_path: CameraPath,
+    /// Frame size used when the user gives none.
+    pub default_size: (u32, u32),
+}
+
+/// The scene evaluated at one frame.
+#[derive(Clone, Debug)]
+pub struct FrameState {
+    pub frame: u32,
+    pub camera: Camera,
+    pub lights: Vec<PointLight>,
+    /// World transform of each object.
+    pub transforms: Vec<Mat4>,
+}
+
+impl Scene {
+    pub fn frame_count(&self) -> u32 {
+        self.camera_path.frame_count()
+    }
+
+    fn motion_transform(&self, motion: &Motion, frame: u32) -> Mat4 {
+        match motion {
+            Motion::Static => Mat4::IDENTITY,
+            Motion::Walk { path, speed, start } => {
+                let (pos, dir) = self.paths[*path].sample(start + speed * frame as f32);
+                // Object space faces +z; turn it toward the direction of travel.
+                let yaw = dir.x.atan2(dir.z);
+                Mat4::from_rotation_translation(Quat::from_rotation_y(yaw), pos)
+            }
+        }
+    }
+
+    /// Evaluate the animation at `frame` (frames past the end hold the last camera key).
+    pub fn frame(&self, frame: u32) -> FrameState {
+        let motion: Vec<Mat4> = self
+            .objects
+            .iter()
+            .map(|o| self.motion_transform(&o.motion, frame))
+            .collect();
+        let transforms = self
+            .objects
+            .iter()
+            .zip(&motion)
+            .map(|(o, m)| *m * o.local)
+            .collect();
+        let lights = self
+            .lights
+            .iter()
+            .map(|l| match l.anchor {
+                LightAnchor::World => l.light,
+                LightAnchor::Object(o) => PointLight {
+                    position: motion[o].transform_point3(l.light.position),
+                    ..l.light
+                },
+            })
+            .collect();
+        FrameState {
+            frame,
+            camera: self.camera_path.at(frame),
+            lights,
+            transforms,
+        }
+    }
+
+    /// All objects of the frame in world space, as one vertex and index list.
+    pub fn geometry(&self, state: &FrameState) -> (Vec<GpuVertex>, Vec<u32>) {
+        let mut vertices = Vec::new();
+        let mut indices = Vec::new();
+        for (o, m) in self.objects.iter().zip(&state.transforms) {
+            let mesh = &self.meshes[o.mesh];
+            let base = vertices.len() as u32;
+            let nm = glam::Mat3::from_mat4(*m).inverse().transpose();
+            for i in 0..mesh.positions.len() {
+                vertices.push(GpuVertex {
+                    position: m.transform_point3(mesh.positions[i]).to_array(),
+                    normal: (nm * mesh.normals[i]).normalize_or_zero().to_array(),
+                    uv: mesh.uvs[i].to_array(),
+                    material: o.material as u32,
+                });
+            }
+            indices.extend(mesh.indices.iter().map(|i| i + base));
+        }
+        (vertices, indices)
+    }
+
+    /// Check the scene is renderable: lights valid and within [`MAX_LIGHTS`], indices in
+    /// range, materials referenced exist.
+    pub fn validate(&self) -> Result<()> {
+        if self.lights.is_empty() {
+            return Err(Error::invalid(
+                "scene",
+                format!("{} has no lights", self.name),
+            ));
+        }
+        if self.lights.len() > MAX_LIGHTS as usize {
+            return Err(Error::invalid(
+                "scene",
+                format!(
+                    "{} lights exceed the maximum of {MAX_LIGHTS}",
+                    self.lights.len()
+                ),
+            ));
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            l.light.validate(i)?;
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let mesh = self.meshes.get(o.mesh).ok_or_else(|| {
+                Error::invalid("scene", format!("object {i} references a missing mesh"))
+            })?;
+            if o.material >= self.materials.len() {
+                return Err(Error::invalid(
+                    "scene",
+                    format!("object {i} references a missing material"),
+                ));
+            }
+            if mesh
+                .indices
+                .iter()
+                .any(|&v| v as usize >= mesh.positions.len())
+            {
+                return Err(Error::invalid(
+                    "scene",
+                    format!("mesh {} has an index out of range", o.mesh),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn materials_gpu(&self) -> Vec<GpuMaterial> {
+        self.materials.iter().map(Material::to_gpu).collect()
+    }
+}

@@ -1,0 +1,73 @@
+//! Shader composition: the generated constants prelude, then shared WGSL modules, then the
+//! stage file. WGSL has no includes, so a composed shader is a plain concatenation in a fixed
+//! order; every composed shader is validated by naga in the tests (no GPU needed).
+
+use crate::consts::wgsl_prelude;
+
+/// Shared WGSL sources, in the order a shader lists them.
+pub mod src {
+    pub const TYPES: &str = include_str!("../shading/types.wgsl");
+    pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
+    pub const LIGHTING: &str = include_str!("../shading/lighting.wgsl");
+    pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
+}
+
+/// The modules every scene-geometry shader starts with: structs, group-0 bindings, the light
+/// function and the shared vertex stage.
+pub const SCENE_PARTS: &[&str] = &[
+    src::TYPES,
+    src::SCENE_BINDINGS,
+    src::LIGHTING,
+    src::GEOMETRY,
+];
+
+/// A named, composed WGSL shader.
+#[derive(Clone, Debug)]
+pub struct ComposedShader {
+    pub name: String,
+    pub source: String,
+}
+
+/// Prelude + the given parts, in order.
+pub fn compose(name: &str, parts: &[&str]) -> ComposedShader {
+    let mut source = wgsl_prelude();
+    for part in parts {
+        source.push('\n');
+        source.push_str(part);
+    }
+    ComposedShader {
+        name: name.to_string(),
+        source,
+    }
+}
+
+/// Parse and validate with naga; the error message carries naga's annotated source span.
+pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
+    let module = naga::front::wgsl::parse_str(&shader.source)
+        .map_err(|e| format!("{}: {}", shader.name, e.emit_to_string(&shader.source)))?;
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .map_err(|e| format!("{}: {}", shader.name, e.emit_to_string(&shader.source)))?;
+    Ok(module)
+}
+
+/// Create a wgpu shader module from a composed shader.
+pub fn create_module(device: &wgpu::Device, shader: &ComposedShader) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(&shader.name),
+        source: wgpu::ShaderSource::Wgsl(shader.source.as_str().into()),
+    })
+}
+
+/// Every shader the library can create, for the validation test: the registry's pipelines
+/// plus the shared passes.
+pub fn all_shaders() -> Vec<ComposedShader> {
+    let mut out = crate::passes::shaders();
+    for p in crate::pipelines::PIPELINES {
+        out.extend((p.shaders)());
+    }
+    out
+}

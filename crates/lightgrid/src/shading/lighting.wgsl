@@ -1,0 +1,63 @@
+// The one light function. Every pipeline shades through `light_terms` / `shade_light`;
+// none has its own attenuation or BRDF.
+
+// A shading sample: everything the light function needs, wherever it came from
+// (interpolated vertex data or a G-buffer).
+struct Surface {
+    position: vec3<f32>,   // world space
+    normal: vec3<f32>,     // world space, unit length
+    diffuse: vec3<f32>,
+    alpha: f32,
+    specular: vec3<f32>,
+    shininess: f32,
+    emissive: vec3<f32>,
+    ambient: vec3<f32>,
+}
+
+// Diffuse and specular irradiance from one light, before the material colours multiply them.
+// The light pre-pass accumulates these two separately; everything else uses `shade_light`.
+struct LightTerms {
+    diffuse: vec3<f32>,
+    specular: vec3<f32>,
+}
+
+// Smooth window that is 1 at the light and reaches exactly 0 at `range`, with zero slope there:
+// (1 - (d/r)^2)^2. Lights are bounded spheres (tiled-shading §1.1), so culling by range is exact.
+fn range_falloff(dist_sq: f32, range: f32) -> f32 {
+    let t = saturate(1.0 - dist_sq / (range * range));
+    return t * t;
+}
+
+// Blinn-Phong from a point light with a finite range. `view_dir` points from the surface to
+// the eye.
+fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
+    var out: LightTerms;
+    out.diffuse = vec3<f32>(0.0);
+    out.specular = vec3<f32>(0.0);
+    let to_light = light.position - s.position;
+    let dist_sq = dot(to_light, to_light);
+    if (dist_sq >= light.range * light.range) {
+        return out;
+    }
+    let l = to_light * inverseSqrt(max(dist_sq, 1e-12));
+    let n_dot_l = dot(s.normal, l);
+    if (n_dot_l <= 0.0) {
+        return out;
+    }
+    let radiance = light.color * (light.intensity * range_falloff(dist_sq, light.range));
+    let h = normalize(l + view_dir);
+    let n_dot_h = max(dot(s.normal, h), 0.0);
+    out.diffuse = radiance * n_dot_l;
+    out.specular = radiance * (pow(n_dot_h, s.shininess) * n_dot_l);
+    return out;
+}
+
+fn shade_light(s: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
+    let t = light_terms(s, view_dir, light);
+    return t.diffuse * s.diffuse + t.specular * s.specular;
+}
+
+// The part of a sample's colour that does not depend on any light.
+fn surface_base(s: Surface) -> vec3<f32> {
+    return s.emissive + s.ambient * SCENE_AMBIENT;
+}
