@@ -1,0 +1,246 @@
+//! The `lightgrid` binary as a user runs it: outputs, and clear errors with non-zero exits.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn lightgrid(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .args(args)
+        .output()
+        .expect("run lightgrid")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lightgrid-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn assert_fails_with(args: &[&str], needle: &str) {
+    let o = lightgrid(args);
+    assert!(!o.status.success(), "{args:?} should fail");
+    let err = stderr(&o);
+    assert!(
+        err.contains(needle),
+        "{args:?}: stderr lacks '{needle}':\n{err}"
+    );
+    assert!(!err.contains("panicked"), "{args:?} panicked:\n{err}");
+}
+
+#[test]
+fn unknown_names_list_the_valid_ones() {
+    assert_fails_with(
+        &["render", "--scene", "nope", "--pipeline", "forward"],
+        "robots-many",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--pipeline", "nope"],
+        "forward",
+    );
+}
+
+#[test]
+fn bad_numbers_are_rejected() {
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--size", "0x0"],
+        "at least 1",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--size", "-5x10"],
+        "-5",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--size", "abc"],
+        "WIDTHxHEIGHT",
+    );
+    assert_fails_with(
+        &["render", "--scene", "stress", "--lights", "0"],
+        "at least 1",
+    );
+    assert_fails_with(&["render", "--scene", "stress", "--lights", "-3"], "-3");
+    assert_fails_with(
+        &["render", "--scene", "stress", "--lights", "2000000"],
+        "maximum",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-many", "--lights", "5"],
+        "fixed light count",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--frame", "x"],
+        "invalid value",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--frame", "100000"],
+        "past the end",
+    );
+}
+
+#[test]
+fn sizes_above_the_adapter_limit_are_rejected() {
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--size", "100000x10"],
+        "not supported",
+    );
+}
+
+#[test]
+fn unwritable_out_fails_before_rendering() {
+    let start = std::time::Instant::now();
+    assert_fails_with(
+        &[
+            "render",
+            "--scene",
+            "stress",
+            "--lights",
+            "1000000",
+            "--out",
+            "/nonexistent/dir/x.png",
+        ],
+        "not writable",
+    );
+    // Building and rendering a million-light frame takes far longer than the check.
+    assert!(start.elapsed().as_secs() < 5, "failed only after rendering");
+}
+
+#[test]
+fn render_writes_image_and_stats() {
+    let dir = temp_dir("render");
+    let png = dir.join("x.png");
+    let json = dir.join("s.json");
+    let o = lightgrid(&[
+        "render",
+        "--scene",
+        "robots-few",
+        "--pipeline",
+        "forward",
+        "--size",
+        "96x54",
+        "--frame",
+        "7",
+        "--out",
+        png.to_str().unwrap(),
+        "--stats",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (96, 54));
+    let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    for key in [
+        "scene", "pipeline", "adapter", "width", "height", "frame", "lights", "gpu_ms",
+    ] {
+        assert!(stats.get(key).is_some(), "stats lack {key}: {stats}");
+    }
+    assert_eq!(stats["scene"], "robots-few");
+    assert_eq!(stats["frame"], 7);
+    assert_eq!(stats["lights"], 11);
+    assert!(stats["gpu_ms"].as_f64().unwrap() > 0.0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn write_png(path: &Path, f: impl Fn(u32, u32) -> [u8; 4]) {
+    let img = image::RgbaImage::from_fn(20, 10, |x, y| image::Rgba(f(x, y)));
+    img.save(path).unwrap();
+}
+
+#[test]
+fn diff_prints_json_and_enforces_thresholds() {
+    let dir = temp_dir("diff");
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    write_png(&a, |_, _| [50, 50, 50, 255]);
+    write_png(&b, |x, _| {
+        if x == 0 {
+            [50, 90, 50, 255]
+        } else {
+            [50, 50, 50, 255]
+        }
+    });
+    let o = lightgrid(&["diff", a.to_str().unwrap(), b.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["max"], 40.0);
+    assert!((v["mean"].as_f64().unwrap() - 2.0).abs() < 1e-9, "{v}");
+    assert_eq!(v["p99"], 40.0);
+    let over = lightgrid(&[
+        "diff",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--max-mean",
+        "1",
+    ]);
+    assert!(!over.status.success());
+    let under = lightgrid(&[
+        "diff",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--max-mean",
+        "5",
+        "--max-p99",
+        "40",
+    ]);
+    assert!(under.status.success(), "{}", stderr(&under));
+    assert_fails_with(
+        &["diff", a.to_str().unwrap(), "/nonexistent.png"],
+        "nonexistent",
+    );
+    std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
+    assert_fails_with(
+        &[
+            "diff",
+            a.to_str().unwrap(),
+            dir.join("bad.png").to_str().unwrap(),
+        ],
+        "bad.png",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn list_names_adapters_scenes_and_pipelines() {
+    let o = lightgrid(&["list"]);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
+    for s in [
+        "robots-many",
+        "robots-few",
+        "scattered",
+        "random-top",
+        "random-fps",
+        "stress",
+        "forward",
+    ] {
+        assert!(out.contains(s), "list lacks {s}");
+    }
+    assert!(!out.contains("none found"), "no adapter visible:\n{out}");
+}
+
+#[test]
+fn compare_renders_every_pipeline_with_its_difference() {
+    let dir = temp_dir("compare");
+    let o = lightgrid(&[
+        "compare",
+        "--scene",
+        "robots-few",
+        "--size",
+        "64x36",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for p in lightgrid::pipelines::PIPELINES {
+        assert!(
+            dir.join(format!("{}.png", p.id)).exists(),
+            "{} image missing",
+            p.id
+        );
+        assert!(out.contains(p.id), "table lacks {}", p.id);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,137 @@
+//! The catalog's scenes: exact light counts and ranges, determinism, and bad input.
+
+use lightgrid::scene::catalog::{self, SceneParams, SCENES};
+use lightgrid::scene::PointLight;
+use lightgrid::Error;
+
+fn lights_of(name: &str) -> Vec<PointLight> {
+    let scene = catalog::build(name, &SceneParams::default()).expect(name);
+    scene.frame(0).lights
+}
+
+#[test]
+fn light_counts_and_ranges_are_the_papers() {
+    let many = lights_of("robots-many");
+    assert_eq!(many.len(), 924);
+    assert!(many.iter().all(|l| l.range == 12.5));
+    let few = lights_of("robots-few");
+    assert_eq!(few.len(), 11);
+    assert!(few.iter().all(|l| l.range == 40.0));
+    assert_eq!(lights_of("scattered").len(), 3072);
+    assert_eq!(lights_of("random-top").len(), 1024);
+    assert_eq!(lights_of("random-fps").len(), 1024);
+    for n in [1, 1000, 65_536] {
+        let s = catalog::build(
+            "stress",
+            &SceneParams {
+                seed: 1,
+                lights: Some(n),
+            },
+        )
+        .unwrap();
+        assert_eq!(s.lights.len(), n as usize);
+    }
+}
+
+#[test]
+fn robots_few_lights_move_with_the_robots_and_many_stay() {
+    let few = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let (a, b) = (few.frame(0).lights, few.frame(50).lights);
+    assert!(a.iter().zip(&b).all(|(x, y)| x.position != y.position));
+    let many = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    assert_eq!(many.frame(0).lights, many.frame(50).lights);
+}
+
+#[test]
+fn robots_camera_path_is_about_260_frames_and_street_is_29_1_wide() {
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    assert_eq!(s.frame_count(), 260);
+    assert_eq!(catalog::MAIN_STREET_WIDTH, 29.1);
+    assert_eq!(s.default_size, (640, 360));
+    let scattered = catalog::build("scattered", &SceneParams::default()).unwrap();
+    assert_eq!(scattered.default_size, (1280, 720));
+}
+
+#[test]
+fn scenes_are_deterministic_from_the_seed() {
+    for info in SCENES {
+        let a = catalog::build(info.name, &SceneParams::default())
+            .unwrap()
+            .frame(3);
+        let b = catalog::build(info.name, &SceneParams::default())
+            .unwrap()
+            .frame(3);
+        assert_eq!(a.lights, b.lights, "{}", info.name);
+        assert_eq!(a.transforms, b.transforms, "{}", info.name);
+    }
+    let a = lights_of("robots-many");
+    let c = catalog::build(
+        "robots-many",
+        &SceneParams {
+            seed: 2,
+            lights: None,
+        },
+    )
+    .unwrap()
+    .frame(0)
+    .lights;
+    assert_ne!(a, c, "another seed places lights differently");
+}
+
+#[test]
+fn every_scene_builds_valid_geometry() {
+    for info in SCENES {
+        let s = catalog::build(info.name, &SceneParams::default()).unwrap();
+        let state = s.frame(0);
+        let (v, i) = s.geometry(&state);
+        assert!(!v.is_empty() && i.len() % 3 == 0, "{}", info.name);
+        assert!(i.iter().all(|&x| (x as usize) < v.len()), "{}", info.name);
+        assert!(v.iter().all(|v| v.position.iter().all(|c| c.is_finite())));
+        assert!(state.camera.view().is_finite(), "{}", info.name);
+    }
+}
+
+#[test]
+fn bad_input_is_a_typed_error() {
+    let unknown = catalog::build("nope", &SceneParams::default()).unwrap_err();
+    match unknown {
+        Error::Unknown { valid, .. } => {
+            assert!(valid.contains("robots-many") && valid.contains("stress"))
+        }
+        e => panic!("unexpected {e}"),
+    }
+    let zero = catalog::build(
+        "stress",
+        &SceneParams {
+            seed: 1,
+            lights: Some(0),
+        },
+    );
+    assert!(matches!(zero, Err(Error::Invalid { .. })));
+    let too_many = catalog::build(
+        "stress",
+        &SceneParams {
+            seed: 1,
+            lights: Some(1_000_001),
+        },
+    );
+    assert!(matches!(too_many, Err(Error::Invalid { .. })));
+    let fixed = catalog::build(
+        "robots-many",
+        &SceneParams {
+            seed: 1,
+            lights: Some(5),
+        },
+    );
+    assert!(matches!(fixed, Err(Error::Invalid { .. })));
+}
+
+#[test]
+fn nan_or_non_positive_lights_are_rejected() {
+    let mut s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    s.lights[3].light.position.x = f32::NAN;
+    assert!(s.validate().is_err());
+    let mut s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    s.lights[0].light.range = 0.0;
+    assert!(s.validate().is_err());
+}

@@ -1,0 +1,88 @@
+//! Rust structs in gpu_types.rs and their WGSL twins agree on size and every field offset.
+
+use lightgrid::gpu_types::{FrameUniforms, GpuLight, GpuMaterial};
+use lightgrid::shader::{compose, src, validate};
+use std::mem::{offset_of, size_of};
+
+fn wgsl_layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
+    let ty = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("WGSL struct {name} not found"))
+        .1;
+    match &ty.inner {
+        naga::TypeInner::Struct { members, span } => (
+            *span,
+            members
+                .iter()
+                .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                .collect(),
+        ),
+        other => panic!("{name} is not a struct: {other:?}"),
+    }
+}
+
+macro_rules! check_layout {
+    ($module:expr, $wgsl:literal, $rust:ty, [$($field:ident),* $(,)?]) => {{
+        let (span, members) = wgsl_layout($module, $wgsl);
+        assert_eq!(span as usize, size_of::<$rust>(), "size of {}", $wgsl);
+        let rust: Vec<(String, u32)> = vec![$((stringify!($field).to_string(), offset_of!($rust, $field) as u32)),*];
+        assert_eq!(members, rust, "fields and offsets of {}", $wgsl);
+    }};
+}
+
+#[test]
+fn gpu_structs_match_wgsl() {
+    // A throwaway entry point keeps the module non-empty for validation.
+    let shader = compose(
+        "layout",
+        &[src::TYPES, "@compute @workgroup_size(1) fn main() {}"],
+    );
+    let module = validate(&shader).expect("types.wgsl validates");
+    check_layout!(
+        &module,
+        "Light",
+        GpuLight,
+        [position, range, color, intensity]
+    );
+    check_layout!(
+        &module,
+        "Material",
+        GpuMaterial,
+        [diffuse, alpha, specular, shininess, emissive, flags, ambient, _pad]
+    );
+    check_layout!(
+        &module,
+        "FrameUniforms",
+        FrameUniforms,
+        [
+            view,
+            proj,
+            view_proj,
+            inv_view_proj,
+            camera_pos,
+            light_count,
+            viewport,
+            near,
+            far
+        ]
+    );
+}
+
+#[test]
+fn vertex_layout_matches_gpu_vertex() {
+    use lightgrid::gpu_types::GpuVertex;
+    let layout = lightgrid::passes::vertex_layout();
+    assert_eq!(layout.array_stride as usize, size_of::<GpuVertex>());
+    let offsets: Vec<u64> = layout.attributes.iter().map(|a| a.offset).collect();
+    assert_eq!(
+        offsets,
+        vec![
+            offset_of!(GpuVertex, position) as u64,
+            offset_of!(GpuVertex, normal) as u64,
+            offset_of!(GpuVertex, uv) as u64,
+            offset_of!(GpuVertex, material) as u64,
+        ]
+    );
+}
