@@ -6,9 +6,10 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use lightgrid::gpu::{list_adapters, GpuContext};
 use lightgrid::image_io::{check_writable, diff, load_image, save_png, write_atomic};
+use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{self, PIPELINES, REFERENCE};
 use lightgrid::scene::catalog::{self, SceneParams, SCENES};
-use lightgrid::Renderer;
+use lightgrid::{RenderSettings, Renderer};
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -75,6 +76,29 @@ struct SceneArgs {
     /// Seed of the scene's random placement.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Screen tile edge in pixels for grid pipelines (4 to 64).
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    tile: u32,
+    /// G-buffer channel precision in bits for deferred pipelines.
+    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
+    gbuffer: GBufferFormat,
+}
+
+fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
+    match s {
+        "16" => Ok(GBufferFormat::F16),
+        "32" => Ok(GBufferFormat::F32),
+        _ => Err(format!("'{s}': the G-buffer is 16 or 32 bits per channel")),
+    }
+}
+
+impl SceneArgs {
+    fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            tile_size: self.tile,
+            gbuffer: self.gbuffer,
+        }
+    }
 }
 
 #[derive(Args)]
@@ -90,6 +114,10 @@ struct RenderArgs {
     /// Statistics to write (JSON).
     #[arg(long)]
     stats: Option<PathBuf>,
+    /// Lights-per-tile heatmap to write (PNG): the pipeline's own grid, or for pipelines
+    /// without a CPU grid the depth-bounded grid used for the ideal count.
+    #[arg(long)]
+    heatmap: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -131,6 +159,8 @@ fn main() {
                     size: Some(Size(640, 360)),
                     lights: None,
                     seed: 1,
+                    tile: lightgrid::consts::DEFAULT_TILE_SIZE,
+                    gbuffer: GBufferFormat::F16,
                 },
                 out_dir: PathBuf::from("out"),
             },
@@ -159,7 +189,7 @@ fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
 
 fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     pipelines::find(&a.pipeline)?;
-    for path in a.out.iter().chain(a.stats.iter()) {
+    for path in a.out.iter().chain(a.stats.iter()).chain(a.heatmap.iter()) {
         check_writable(path).context("output is not writable")?;
     }
     let scene = build_scene(&a.scene)?;
@@ -168,10 +198,13 @@ fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         .scene
         .size
         .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
-    let mut renderer = Renderer::new(&ctx, w, h)?;
+    let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
     let out = renderer.render(&scene, a.scene.frame, &a.pipeline)?;
     if let Some(path) = &a.out {
         save_png(&out.image, path)?;
+    }
+    if let Some(path) = &a.heatmap {
+        save_png(&lightgrid::heatmap::heatmap(&out.image, &out.grid), path)?;
     }
     if let Some(path) = &a.stats {
         let json = serde_json::to_vec_pretty(&out.stats)?;
@@ -189,6 +222,19 @@ fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         s.gpu_ms,
         timing_label(s.timing),
         s.adapter
+    );
+    println!(
+        "lighting computations {} (ideal {}, efficiency {}){}",
+        s.lighting_computations
+            .map_or("n/a".into(), |n| n.to_string()),
+        s.ideal_lighting_computations,
+        s.efficiency
+            .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0)),
+        match (s.lights_per_tile_avg, s.lights_per_tile_max) {
+            (Some(avg), Some(max)) =>
+                format!(", lights per {}px tile avg {avg:.1} max {max}", s.tile_size),
+            _ => String::new(),
+        }
     );
     Ok(())
 }
@@ -209,7 +255,7 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         .scene
         .size
         .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
-    let mut renderer = Renderer::new(&ctx, w, h)?;
+    let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
     println!(
         "{} frame {} at {w}x{h}, {} lights, on {}",
         scene.name,
@@ -218,8 +264,8 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         ctx.adapter_label()
     );
     println!(
-        "{:<24} {:>10}  {:>10} {:>8} {:>8}",
-        "pipeline", "time ms", "diff mean", "p99", "max"
+        "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
+        "pipeline", "time ms", "diff mean", "p99", "max", "lighting comp", "x ideal", "lights/tile"
     );
     let mut reference = None;
     let mut failed = Vec::new();
@@ -251,16 +297,32 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
                 ""
             }
         );
-        match d {
-            None => println!(
-                "{:<24} {:>10}  {:>10} {:>8} {:>8}",
-                p.id, time, "reference", "", ""
+        let s = &out.stats;
+        let (mean, p99, max) = match d {
+            None => ("reference".to_string(), String::new(), String::new()),
+            Some(d) => (
+                format!("{:.3}", d.mean),
+                d.p99.to_string(),
+                d.max.to_string(),
             ),
-            Some(d) => println!(
-                "{:<24} {:>10}  {:>10.3} {:>8} {:>8}",
-                p.id, time, d.mean, d.p99, d.max
-            ),
-        }
+        };
+        let comps = s
+            .lighting_computations
+            .map_or("n/a".into(), |n| n.to_string());
+        let ratio = s
+            .lighting_computations
+            .filter(|_| s.ideal_lighting_computations > 0)
+            .map_or("n/a".into(), |n| {
+                format!("{:.2}", n as f64 / s.ideal_lighting_computations as f64)
+            });
+        let per_tile = match (s.lights_per_tile_avg, s.lights_per_tile_max) {
+            (Some(avg), Some(max)) => format!("{avg:.1}/{max}"),
+            _ => "-".into(),
+        };
+        println!(
+            "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
+            p.id, time, mean, p99, max, comps, ratio, per_tile
+        );
         if p.id == REFERENCE {
             reference = Some(out.image);
         }
@@ -268,6 +330,10 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     if !ctx.timestamps {
         println!("* wall clock: this adapter has no timestamp queries");
     }
+    println!(
+        "diff in 8-bit sRGB levels vs {REFERENCE}; 'x ideal' = lighting computations / ideal (one per light reaching a visible sample); lights/tile = avg/max of the pipeline's CPU grid ({}px tiles)",
+        a.scene.tile
+    );
     println!("images and stats in {}", a.out_dir.display());
     if !failed.is_empty() {
         bail!("pipelines failed: {}", failed.join(", "));

@@ -11,6 +11,19 @@ pub const MAX_LIGHTS: u32 = 1 << 20;
 /// Default screen tile edge in pixels (tiled-shading §5 discusses 16 and 32).
 pub const DEFAULT_TILE_SIZE: u32 = 16;
 
+/// Tile edges accepted by `--tile`. The single-kernel tiled deferred pipeline keeps
+/// (MAX_TILE_SIZE / TILE_THREADS)^2 accumulators per thread, so this bounds its registers.
+pub const MIN_TILE_SIZE: u32 = 4;
+pub const MAX_TILE_SIZE: u32 = 64;
+
+/// Threads along one edge of a per-tile workgroup (depth bounds, single-kernel tiled deferred):
+/// 16×16 = 256 invocations stride over the tile's pixels, so any tile size works.
+pub const TILE_THREADS: u32 = 16;
+
+/// Light indices the single-kernel tiled deferred pipeline culls into workgroup memory at a
+/// time. More lights per tile are handled in further batches, never dropped.
+pub const TILE_LIGHT_BATCH: u32 = 1024;
+
 /// Largest accepted frame edge, before the adapter's own texture limit is applied.
 pub const MAX_FRAME_EDGE: u32 = 16384;
 
@@ -39,6 +52,9 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("SCENE_AMBIENT", WgslConst::F32(SCENE_AMBIENT)),
     ("EXPOSURE", WgslConst::F32(EXPOSURE)),
     ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
+    ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
+    ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
+    ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     (
         "MATERIAL_FLAG_TRANSPARENT",
         WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),

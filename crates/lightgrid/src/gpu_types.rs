@@ -53,6 +53,17 @@ pub struct FrameUniforms {
     pub far: f32,
 }
 
+/// The light grid's shape (`culling/light_grid.wgsl`). A tiled grid has one slice.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GridParams {
+    pub tile_size: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub slices: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<GridParams>() == 16);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);

@@ -5,9 +5,11 @@
 //! with a [`Renderer`] and a pipeline id from [`pipelines::PIPELINES`].
 
 pub mod consts;
+pub mod culling;
 pub mod error;
 pub mod gpu;
 pub mod gpu_types;
+pub mod heatmap;
 pub mod image_io;
 pub mod passes;
 pub mod pipelines;
@@ -17,5 +19,6 @@ pub mod shader;
 pub mod stats;
 
 pub use error::{Error, Result};
+pub use pipelines::RenderSettings;
 pub use renderer::{validate_size, FrameOutput, Renderer};
 pub use stats::{FrameStats, TimingSource};

@@ -2,11 +2,17 @@
 //! of a scene, tonemaps, reads the image back and collects the frame's statistics.
 
 use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
+use crate::culling::{
+    assign_cpu, depth_bounds_cpu, ideal_lighting_computations, to_view_bounds, DepthRange,
+    GridDims, LightGrid, ViewSetup,
+};
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, scoped, wait_idle, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::{scene_layout, Targets, Tonemap};
-use crate::pipelines::{self, FrameInputs, PipelineContext, Technique};
+use crate::pipelines::{
+    self, FrameEncoder, FrameInputs, PipelineContext, RenderSettings, Technique,
+};
 use crate::scene::Scene;
 use crate::stats::{FrameStats, TimingSource};
 use image::RgbaImage;
@@ -16,10 +22,16 @@ use std::time::Instant;
 /// Most passes one frame may record (timestamp slots).
 const MAX_PASSES: u32 = 32;
 
-/// An image and its statistics.
+/// An image, its statistics, and what the analysis saw.
 pub struct FrameOutput {
     pub image: RgbaImage,
     pub stats: FrameStats,
+    /// The grid the pipeline shaded with; for pipelines that build none on the CPU, the
+    /// depth-bounded CPU grid used for the ideal count (see `grid_is_pipelines`).
+    pub grid: LightGrid,
+    pub grid_is_pipelines: bool,
+    /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry).
+    pub depth: Vec<f32>,
 }
 
 /// A storage/vertex/index buffer that grows to fit.
@@ -80,7 +92,11 @@ pub struct Renderer<'c> {
     tonemap: Tonemap,
     timer: PassTimer,
     techniques: HashMap<&'static str, Box<dyn Technique>>,
+    settings: RenderSettings,
+    dims: GridDims,
     readback: wgpu::Buffer,
+    counts_readback: wgpu::Buffer,
+    depth_readback: wgpu::Buffer,
     padded_row: u32,
 }
 
@@ -103,8 +119,14 @@ pub fn validate_size(ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
 }
 
 impl<'c> Renderer<'c> {
-    pub fn new(ctx: &'c GpuContext, width: u32, height: u32) -> Result<Self> {
+    pub fn new(
+        ctx: &'c GpuContext,
+        width: u32,
+        height: u32,
+        settings: RenderSettings,
+    ) -> Result<Self> {
         validate_size(ctx, width, height)?;
+        let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
         scoped(device, "creating render targets", || {
             let targets = Targets::new(device, width, height);
@@ -124,12 +146,15 @@ impl<'c> Renderer<'c> {
                 Self::bind_scene(device, &scene_layout, &uniforms, &lights, &materials);
             let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
                 * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-            let readback = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("image readback"),
-                size: u64::from(padded_row) * u64::from(height),
-                usage: U::MAP_READ | U::COPY_DST,
-                mapped_at_creation: false,
-            });
+            // Display, count and depth targets all have 4 bytes per pixel.
+            let readback_buffer = |label| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: u64::from(padded_row) * u64::from(height),
+                    usage: U::MAP_READ | U::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            };
             Renderer {
                 ctx,
                 targets,
@@ -143,7 +168,11 @@ impl<'c> Renderer<'c> {
                 indices,
                 scene_bind_group,
                 techniques: HashMap::new(),
-                readback,
+                settings,
+                dims,
+                readback: readback_buffer("image readback"),
+                counts_readback: readback_buffer("counts readback"),
+                depth_readback: readback_buffer("depth readback"),
                 padded_row,
             }
         })
@@ -180,20 +209,70 @@ impl<'c> Renderer<'c> {
         (self.targets.width, self.targets.height)
     }
 
-    fn technique(&mut self, id: &str) -> Result<&dyn Technique> {
+    pub fn settings(&self) -> RenderSettings {
+        self.settings
+    }
+
+    fn prepare_technique(&mut self, id: &str) -> Result<()> {
         let info = pipelines::find(id)?;
         if !self.techniques.contains_key(info.id) {
             let device = &self.ctx.device;
             let ctx = PipelineContext {
                 device,
                 scene_layout: &self.scene_layout,
+                dims: self.dims,
+                settings: self.settings,
+                count_blend: self.ctx.count_blend,
             };
             let t = scoped(device, &format!("creating pipeline {}", info.id), || {
                 (info.create)(&ctx)
             })?;
             self.techniques.insert(info.id, t);
         }
-        Ok(self.techniques[info.id].as_ref())
+        Ok(())
+    }
+
+    /// Copy a 4-byte-per-pixel texture into a padded readback buffer.
+    fn copy_out(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+        to: &wgpu::Buffer,
+    ) {
+        let (width, height) = self.size();
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: to,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// Read a padded 4-byte-per-pixel buffer into tightly packed rows.
+    fn read_rows(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+        let (width, _) = self.size();
+        let bytes = read_buffer(&self.ctx.device, buffer)?;
+        let row = (width * 4) as usize;
+        Ok(bytes
+            .chunks_exact(self.padded_row as usize)
+            .flat_map(|r| r[..row].iter().copied())
+            .collect())
     }
 
     /// Render `frame` of `scene` with pipeline `pipeline_id`.
@@ -241,7 +320,7 @@ impl<'c> Renderer<'c> {
         let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
         let materials = scene.materials_gpu();
 
-        self.technique(pipeline_id)?;
+        self.prepare_technique(pipeline_id)?;
         let device = &self.ctx.device;
         let queue = &self.ctx.queue;
         let mut rebind = self
@@ -266,63 +345,94 @@ impl<'c> Renderer<'c> {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
 
         let info = pipelines::find(pipeline_id)?;
-        let technique = self.techniques[info.id].as_ref();
+        let setup = ViewSetup::new(&state.camera, width, height);
+        let technique = self.techniques.get_mut(info.id).expect("prepared above");
         self.timer.reset();
         let start = Instant::now();
+        let inputs = FrameInputs {
+            device,
+            queue,
+            scene_bind_group: &self.scene_bind_group,
+            vertices: &self.vertices.buffer,
+            indices: &self.indices.buffer,
+            index_count: indices.len() as u32,
+            targets: &self.targets,
+            setup,
+            lights: &state.lights,
+            count_blend: self.ctx.count_blend,
+        };
+        let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
+        let pipeline_grid = technique.render(&inputs, &mut enc)?;
+        let mut encoder = enc.finish();
+        self.tonemap.encode(
+            device,
+            &mut encoder,
+            &mut self.timer,
+            &self.targets.hdr,
+            &self.targets.ldr,
+        );
+        self.copy_out(
+            &mut encoder,
+            &self.targets.ldr_texture,
+            wgpu::TextureAspect::All,
+            &self.readback,
+        );
+        self.copy_out(
+            &mut encoder,
+            &self.targets.counts_texture,
+            wgpu::TextureAspect::All,
+            &self.counts_readback,
+        );
+        self.copy_out(
+            &mut encoder,
+            &self.targets.depth_texture,
+            wgpu::TextureAspect::DepthOnly,
+            &self.depth_readback,
+        );
+        self.timer.resolve(&mut encoder);
         scoped(device, &format!("rendering with {}", info.id), || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some(info.id),
-            });
-            let inputs = FrameInputs {
-                device,
-                scene_bind_group: &self.scene_bind_group,
-                vertices: &self.vertices.buffer,
-                indices: &self.indices.buffer,
-                index_count: indices.len() as u32,
-                targets: &self.targets,
-            };
-            technique.encode(&inputs, &mut encoder, &mut self.timer);
-            self.tonemap.encode(
-                device,
-                &mut encoder,
-                &mut self.timer,
-                &self.targets.hdr,
-                &self.targets.ldr,
-            );
-            encoder.copy_texture_to_buffer(
-                self.targets.ldr_texture.as_image_copy(),
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &self.readback,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(self.padded_row),
-                        rows_per_image: Some(height),
-                    },
-                },
-                wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-            );
-            self.timer.resolve(&mut encoder);
-            queue.submit([encoder.finish()]);
+            queue.submit([encoder.finish()])
         })?;
         wait_idle(device)?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
         let (passes, span) = self.timer.read(device)?;
-        let bytes = read_buffer(device, &self.readback)?;
-        let mut image = RgbaImage::new(width, height);
-        for (y, row) in bytes.chunks_exact(self.padded_row as usize).enumerate() {
-            let src = &row[..(width * 4) as usize];
-            let dst =
-                &mut image.as_mut()[(y * (width * 4) as usize)..((y + 1) * (width * 4) as usize)];
-            dst.copy_from_slice(src);
-        }
+        let image = RgbaImage::from_raw(width, height, self.read_rows(&self.readback)?)
+            .expect("size matches");
+        let depth: Vec<f32> = bytemuck::cast_slice(&self.read_rows(&self.depth_readback)?).to_vec();
+        let lighting_computations = if self.ctx.count_blend {
+            let counts: Vec<f32> =
+                bytemuck::cast_slice(&self.read_rows(&self.counts_readback)?).to_vec();
+            Some(counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64)
+        } else {
+            None
+        };
+
+        // The ideal: for each visible sample, the lights reaching it. The depth-bounded CPU
+        // grid narrows the search (it provably contains every such light).
+        let view_distance: Vec<f32> = depth
+            .iter()
+            .map(|&d| {
+                if d < 1.0 {
+                    setup.view_distance(d)
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        let bounds = to_view_bounds(&setup, &depth_bounds_cpu(&depth, &self.dims));
+        let bounded = assign_cpu(
+            &setup,
+            &self.dims,
+            &state.lights,
+            DepthRange::PerTile(&bounds),
+        );
+        let ideal = ideal_lighting_computations(&setup, &bounded, &state.lights, &view_distance);
         let (gpu_ms, timing) = match span {
             Some(ms) => (ms, TimingSource::GpuTimestamps),
             None => (wall_ms, TimingSource::WallClock),
         };
+        let grid_is_pipelines = pipeline_grid.is_some();
+        let grid = pipeline_grid.unwrap_or(bounded);
         Ok(FrameOutput {
             image,
             stats: FrameStats {
@@ -338,7 +448,20 @@ impl<'c> Renderer<'c> {
                 timing,
                 wall_ms,
                 passes,
+                tile_size: self.settings.tile_size,
+                gbuffer_bits: self.settings.gbuffer.bits(),
+                lighting_computations,
+                ideal_lighting_computations: ideal,
+                efficiency: lighting_computations
+                    .filter(|&n| n > 0)
+                    .map(|n| ideal as f64 / n as f64),
+                lights_per_tile_avg: grid_is_pipelines.then(|| grid.average_lights_per_cell()),
+                lights_per_tile_max: grid_is_pipelines.then(|| grid.max_lights_per_cell()),
+                grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
             },
+            grid,
+            grid_is_pipelines,
+            depth,
         })
     }
 }

@@ -31,4 +31,23 @@ pub struct FrameStats {
     pub wall_ms: f64,
     /// GPU time per pass, when timestamps are available.
     pub passes: Vec<PassTiming>,
+    /// Screen tile edge in pixels used by grid pipelines (and for the ideal count's grid).
+    pub tile_size: u32,
+    /// G-buffer channel bits (16 or 32); meaningful for deferred pipelines.
+    pub gbuffer_bits: u32,
+    /// Times the light function ran this frame (tiled-shading §8): for forward pipelines the
+    /// fragments shaded times the lights each looped over, for deferred ones the samples
+    /// times their tile's list length. None where the adapter cannot count (no R32Float
+    /// blending).
+    pub lighting_computations: Option<u64>,
+    /// For every visible sample, the lights whose range reaches it: the floor no technique
+    /// can go below.
+    pub ideal_lighting_computations: u64,
+    /// ideal / actual (1.0 is perfect culling).
+    pub efficiency: Option<f64>,
+    /// Lights per tile of the grid this pipeline shaded with (None: it built none on the CPU).
+    pub lights_per_tile_avg: Option<f64>,
+    pub lights_per_tile_max: Option<u32>,
+    /// Total entries of the grid's index lists.
+    pub grid_indices: Option<u64>,
 }

@@ -1,6 +1,6 @@
 //! Rust structs in gpu_types.rs and their WGSL twins agree on size and every field offset.
 
-use lightgrid::gpu_types::{FrameUniforms, GpuLight, GpuMaterial};
+use lightgrid::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GridParams};
 use lightgrid::shader::{compose, src, validate};
 use std::mem::{offset_of, size_of};
 
@@ -45,6 +45,12 @@ fn gpu_structs_match_wgsl() {
         "Light",
         GpuLight,
         [position, range, color, intensity]
+    );
+    check_layout!(
+        &module,
+        "GridParams",
+        GridParams,
+        [tile_size, tiles_x, tiles_y, slices]
     );
     check_layout!(
         &module,

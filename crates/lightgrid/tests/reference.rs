@@ -19,7 +19,7 @@ const MAX_P99: f64 = 4.0;
 fn check_against_golden(scene: &str, frame: u32, (w, h): (u32, u32)) {
     let ctx = common::gpu();
     let s = catalog::build(scene, &SceneParams::default()).unwrap();
-    let mut r = Renderer::new(&ctx, w, h).unwrap();
+    let mut r = Renderer::new(&ctx, w, h, Default::default()).unwrap();
     let out = r.render(&s, frame, "forward").unwrap();
     let name = format!("{scene}-f{frame}-{w}x{h}-forward.png");
     let golden = common::golden_dir().join(&name);
@@ -66,7 +66,7 @@ fn lights_really_light_the_street() {
     for l in &mut dark.lights {
         l.light.intensity = 0.0;
     }
-    let mut r = Renderer::new(&ctx, 128, 72).unwrap();
+    let mut r = Renderer::new(&ctx, 128, 72, Default::default()).unwrap();
     let lit = r.render(&s, 200, "forward").unwrap();
     let unlit = r.render(&dark, 200, "forward").unwrap();
     let mean = |img: &image::RgbaImage| {
@@ -89,11 +89,11 @@ fn lights_really_light_the_street() {
 #[test]
 fn bad_sizes_and_frames_are_errors_not_panics() {
     let ctx = common::gpu();
-    assert!(Renderer::new(&ctx, 0, 10).is_err());
+    assert!(Renderer::new(&ctx, 0, 10, Default::default()).is_err());
     let too_big = ctx.max_texture_edge() + 1;
-    assert!(Renderer::new(&ctx, too_big, 8).is_err());
+    assert!(Renderer::new(&ctx, too_big, 8, Default::default()).is_err());
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
-    let mut r = Renderer::new(&ctx, 32, 32).unwrap();
+    let mut r = Renderer::new(&ctx, 32, 32, Default::default()).unwrap();
     assert!(r.render(&s, s.frame_count(), "forward").is_err());
     assert!(r.render(&s, 0, "no-such-pipeline").is_err());
 }

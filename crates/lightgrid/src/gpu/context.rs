@@ -14,6 +14,8 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Timestamp queries at pass boundaries are available and enabled.
     pub timestamps: bool,
+    /// R32Float can be blended, so forward pipelines can count lighting computations.
+    pub count_blend: bool,
 }
 
 /// One line of `lightgrid list`.
@@ -130,6 +132,12 @@ impl GpuContext {
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;
         }
+        let count_blend = adapter
+            .features()
+            .contains(wgpu::Features::FLOAT32_BLENDABLE);
+        if count_blend {
+            features |= wgpu::Features::FLOAT32_BLENDABLE;
+        }
         let desc = wgpu::DeviceDescriptor {
             label: Some("lightgrid"),
             required_features: features,
@@ -155,6 +163,7 @@ impl GpuContext {
             queue,
             info,
             timestamps,
+            count_blend,
         })
     }
 

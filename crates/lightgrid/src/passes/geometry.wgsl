@@ -9,7 +9,7 @@ struct VertexIn {
 }
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
@@ -42,6 +42,16 @@ fn surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     return s;
 }
 
-fn view_dir_to(world: vec3<f32>) -> vec3<f32> {
-    return normalize(frame.camera_pos - world);
+// Output of a forward lighting fragment shader: colour, and how many times it ran the light
+// function (summed by additive blending into the count target).
+struct LitOut {
+    @location(0) color: vec4<f32>,
+    @location(1) count: f32,
+}
+
+fn lit(color: vec3<f32>, count: u32) -> LitOut {
+    var out: LitOut;
+    out.color = vec4<f32>(color, 1.0);
+    out.count = f32(count);
+    return out;
 }

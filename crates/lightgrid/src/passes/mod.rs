@@ -1,8 +1,10 @@
 //! Passes and resources several pipelines share: the render targets, the scene vertex layout,
 //! the scene bind group (group 0) and the tonemap pass.
 
+mod gbuffer;
 mod tonemap;
 
+pub use gbuffer::{GBuffer, GBufferFormat, GBUFFER_READ_WGSL};
 pub use tonemap::Tonemap;
 
 use crate::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GpuVertex};
@@ -16,9 +18,35 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Display target: the tonemap pass writes linear values and the format encodes sRGB.
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
+/// Per-pixel lighting-computation counts: every lighting shader adds the number of times it
+/// ran the light function for the sample (additive blending or a storage write), and the
+/// renderer sums the target. 32-bit float holds integers exactly up to 2^24 per pixel.
+pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
 /// Every shader of the shared passes, for validation.
 pub fn shaders() -> Vec<ComposedShader> {
-    vec![tonemap::shader()]
+    vec![
+        tonemap::shader(),
+        gbuffer::shader(),
+        crate::culling::depth_bounds_shader(),
+    ]
+}
+
+/// The count target of a fragment pipeline: additive blending where the adapter can blend
+/// R32Float, otherwise no target (the count is then not reported).
+pub fn count_target(count_blend: bool) -> Option<wgpu::ColorTargetState> {
+    count_blend.then(|| wgpu::ColorTargetState {
+        format: COUNT_FORMAT,
+        blend: Some(wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent::REPLACE,
+        }),
+        write_mask: wgpu::ColorWrites::RED,
+    })
 }
 
 /// The vertex buffer layout matching `passes/geometry.wgsl`'s `VertexIn`.
@@ -68,7 +96,10 @@ pub struct Targets {
     pub width: u32,
     pub height: u32,
     pub hdr: wgpu::TextureView,
+    pub depth_texture: wgpu::Texture,
     pub depth: wgpu::TextureView,
+    pub counts_texture: wgpu::Texture,
+    pub counts: wgpu::TextureView,
     pub ldr_texture: wgpu::Texture,
     pub ldr: wgpu::TextureView,
 }
@@ -92,25 +123,32 @@ impl Targets {
             })
         };
         use wgpu::TextureUsages as U;
-        let hdr = make("hdr", HDR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING);
-        let depth = make(
+        let hdr = make(
+            "hdr",
+            HDR_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING,
+        );
+        let depth_texture = make(
             "depth",
             DEPTH_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        let counts_texture = make(
+            "lighting counts",
+            COUNT_FORMAT,
+            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::COPY_SRC,
         );
         let ldr_texture = make("ldr", LDR_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
         Targets {
             width,
             height,
             hdr: hdr.create_view(&Default::default()),
-            depth: depth.create_view(&Default::default()),
+            depth: depth_texture.create_view(&Default::default()),
+            depth_texture,
+            counts: counts_texture.create_view(&Default::default()),
+            counts_texture,
             ldr: ldr_texture.create_view(&Default::default()),
             ldr_texture,
         }
-    }
-
-    /// Bytes per pixel of the targets every pipeline has (HDR + depth + display).
-    pub fn base_bytes_per_pixel() -> u32 {
-        8 + 4 + 4
     }
 }

@@ -1,11 +1,14 @@
 //! `forward`: one geometry pass; the fragment shader loops over every light.
-//! Inputs: group 0 only. Output: HDR colour and depth. Never reads a light grid: it is the
-//! independent reference every other pipeline is compared with.
+//! Inputs: group 0 only. Outputs: HDR colour, depth, counts. Never reads a light grid: it is
+//! the independent reference every other pipeline is compared with.
 
-use super::{geometry_pipeline, FrameInputs, GeometryPipelineDesc, PipelineContext, Technique};
-use crate::gpu::PassTimer;
-use crate::passes::HDR_FORMAT;
+use super::{
+    begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
+};
+use super::{GeometryPipelineDesc, PipelineContext, Technique};
+use crate::culling::LightGrid;
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
+use crate::Result;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
     let mut parts = SCENE_PARTS.to_vec();
@@ -24,9 +27,9 @@ pub(super) fn create(ctx: &PipelineContext) -> Box<dyn Technique> {
         &GeometryPipelineDesc {
             label: "forward",
             module: &module,
-            fragment_entry: "fs_main",
+            fragment_entry: Some("fs_main"),
             layouts: &[Some(ctx.scene_layout)],
-            color_targets: &[Some(HDR_FORMAT.into())],
+            color_targets: &lighting_targets(ctx.count_blend),
             depth_write: true,
             depth_compare: wgpu::CompareFunction::Less,
         },
@@ -35,34 +38,11 @@ pub(super) fn create(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 impl Technique for Forward {
-    fn encode(&self, f: &FrameInputs, encoder: &mut wgpu::CommandEncoder, timer: &mut PassTimer) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("forward shading"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &f.targets.hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &f.targets.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timer.render_pass("forward shading"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>> {
+        let (encoder, timer) = enc.parts();
+        let mut pass = begin_lighting_pass(encoder, timer, f, "forward shading", true);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, f.scene_bind_group, &[]);
-        pass.set_vertex_buffer(0, f.vertices.slice(..));
-        pass.set_index_buffer(f.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..f.index_count, 0, 0..1);
+        draw_scene(&mut pass, f, &[]);
+        Ok(None)
     }
 }

@@ -2,37 +2,114 @@
 //! default job and the tests iterate this table; adding a pipeline touches nothing else.
 
 mod forward;
+mod tiled_deferred;
+mod tiled_forward;
 
-use crate::error::{Error, Result};
-use crate::gpu::PassTimer;
-use crate::passes::Targets;
+use crate::culling::{GridDims, LightGrid, ViewSetup};
+use crate::error::Result;
+use crate::gpu::{scoped, wait_idle, PassTimer};
+use crate::passes::{GBufferFormat, Targets};
+use crate::scene::PointLight;
 use crate::shader::ComposedShader;
+use crate::Error;
+
+/// Settings every pipeline of a renderer shares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderSettings {
+    /// Screen tile edge in pixels (`--tile`).
+    pub tile_size: u32,
+    /// G-buffer channel precision (`--gbuffer 16|32`).
+    pub gbuffer: GBufferFormat,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            tile_size: crate::consts::DEFAULT_TILE_SIZE,
+            gbuffer: GBufferFormat::F16,
+        }
+    }
+}
 
 /// What a pipeline needs to create its GPU objects.
 pub struct PipelineContext<'a> {
     pub device: &'a wgpu::Device,
     /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
     pub scene_layout: &'a wgpu::BindGroupLayout,
+    pub dims: GridDims,
+    pub settings: RenderSettings,
+    /// The adapter can blend into the R32Float count target.
+    pub count_blend: bool,
 }
 
 /// What a pipeline reads to render one frame.
 pub struct FrameInputs<'a> {
     pub device: &'a wgpu::Device,
+    pub queue: &'a wgpu::Queue,
     pub scene_bind_group: &'a wgpu::BindGroup,
     pub vertices: &'a wgpu::Buffer,
     pub indices: &'a wgpu::Buffer,
     pub index_count: u32,
     pub targets: &'a Targets,
+    /// Camera and frame size, for CPU light assignment.
+    pub setup: ViewSetup,
+    /// The frame's lights (world space), as uploaded to group 0.
+    pub lights: &'a [PointLight],
+    /// The count target is blended into (see `PipelineContext::count_blend`).
+    pub count_blend: bool,
 }
 
-/// A rendering technique: records the passes that fill `targets.hdr` (and `targets.depth`).
+/// The frame's command encoder, which a pipeline may submit part-way (e.g. to read depth
+/// bounds back for CPU light assignment) and continue.
+pub struct FrameEncoder<'a> {
+    device: &'a wgpu::Device,
+    queue: &'a wgpu::Queue,
+    encoder: wgpu::CommandEncoder,
+    pub timer: &'a mut PassTimer,
+}
+
+impl<'a> FrameEncoder<'a> {
+    pub(crate) fn new(
+        device: &'a wgpu::Device,
+        queue: &'a wgpu::Queue,
+        timer: &'a mut PassTimer,
+    ) -> Self {
+        let encoder = device.create_command_encoder(&Default::default());
+        FrameEncoder {
+            device,
+            queue,
+            encoder,
+            timer,
+        }
+    }
+
+    /// The encoder and the pass timer, to begin a pass.
+    pub fn parts(&mut self) -> (&mut wgpu::CommandEncoder, &mut PassTimer) {
+        (&mut self.encoder, self.timer)
+    }
+
+    /// Submit what was recorded and wait until the GPU has finished it.
+    pub fn submit_and_wait(&mut self) -> Result<()> {
+        let done = std::mem::replace(
+            &mut self.encoder,
+            self.device.create_command_encoder(&Default::default()),
+        );
+        scoped(self.device, "submitting a frame part", || {
+            self.queue.submit([done.finish()])
+        })?;
+        wait_idle(self.device)
+    }
+
+    pub(crate) fn finish(self) -> wgpu::CommandEncoder {
+        self.encoder
+    }
+}
+
+/// A rendering technique: fills `targets.hdr`, `targets.depth` and `targets.counts`.
 pub trait Technique {
-    fn encode(
-        &self,
-        frame: &FrameInputs,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut PassTimer,
-    );
+    /// Record (and possibly submit part of) the frame. Returns the light grid the pipeline
+    /// shaded with, when it built one on the CPU.
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>>;
 }
 
 /// One registry row.
@@ -50,14 +127,48 @@ pub struct PipelineInfo {
 }
 
 /// The registry, reference first.
-pub const PIPELINES: &[PipelineInfo] = &[PipelineInfo {
-    id: "forward",
-    description: "every light evaluated for every fragment; the reference image",
-    paper: "all (brute force)",
-    uses_grid: false,
-    shaders: forward::shaders,
-    create: forward::create,
-}];
+pub const PIPELINES: &[PipelineInfo] = &[
+    PipelineInfo {
+        id: "forward",
+        description: "every light evaluated for every fragment; the reference image",
+        paper: "all (brute force)",
+        uses_grid: false,
+        shaders: forward::shaders,
+        create: forward::create,
+    },
+    PipelineInfo {
+        id: "tiled_forward",
+        description: "CPU-built tile grid without depth bounds, read by forward shading",
+        paper: "tiled-shading §3",
+        uses_grid: true,
+        shaders: tiled_forward::shaders,
+        create: tiled_forward::create_plain,
+    },
+    PipelineInfo {
+        id: "tiled_forward_prez",
+        description: "depth pre-pass, per-tile depth bounds (GPU), CPU grid, forward shading with early-Z",
+        paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
+        uses_grid: true,
+        shaders: tiled_forward::shaders,
+        create: tiled_forward::create_prez,
+    },
+    PipelineInfo {
+        id: "tiled_deferred",
+        description: "G-buffer, depth bounds (GPU), CPU grid, one compute pass shading each tile's samples",
+        paper: "tiled-shading §2, §6, §8",
+        uses_grid: true,
+        shaders: tiled_deferred::shaders,
+        create: tiled_deferred::create_multi,
+    },
+    PipelineInfo {
+        id: "tiled_deferred_single",
+        description: "G-buffer, then one kernel per tile: depth bounds, cull all lights in workgroup memory, shade",
+        paper: "tiled-shading §7",
+        uses_grid: true,
+        shaders: tiled_deferred::shaders_single,
+        create: tiled_deferred::create_single,
+    },
+];
 
 /// The reference pipeline's id.
 pub const REFERENCE: &str = "forward";
@@ -85,7 +196,8 @@ pub fn find(id: &str) -> Result<&'static PipelineInfo> {
 pub(crate) struct GeometryPipelineDesc<'a> {
     pub label: &'a str,
     pub module: &'a wgpu::ShaderModule,
-    pub fragment_entry: &'a str,
+    /// None for a depth-only pass.
+    pub fragment_entry: Option<&'a str>,
     pub layouts: &'a [Option<&'a wgpu::BindGroupLayout>],
     pub color_targets: &'a [Option<wgpu::ColorTargetState>],
     pub depth_write: bool,
@@ -120,13 +232,79 @@ pub(crate) fn geometry_pipeline(
             bias: Default::default(),
         }),
         multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
+        fragment: d.fragment_entry.map(|entry| wgpu::FragmentState {
             module: d.module,
-            entry_point: Some(d.fragment_entry),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             targets: d.color_targets,
         }),
         multiview_mask: None,
         cache: None,
     })
+}
+
+/// Bind group 0 (+ `extra` from group 1 on), the scene's buffers, and draw everything.
+pub(crate) fn draw_scene(pass: &mut wgpu::RenderPass, f: &FrameInputs, extra: &[&wgpu::BindGroup]) {
+    pass.set_bind_group(0, f.scene_bind_group, &[]);
+    for (i, g) in extra.iter().enumerate() {
+        pass.set_bind_group(1 + i as u32, *g, &[]);
+    }
+    pass.set_vertex_buffer(0, f.vertices.slice(..));
+    pass.set_index_buffer(f.indices.slice(..), wgpu::IndexFormat::Uint32);
+    pass.draw_indexed(0..f.index_count, 0, 0..1);
+}
+
+/// A forward lighting pass into HDR + counts. `depth_cleared`: clear and write depth (no
+/// pre-pass) or load the pre-pass depth.
+pub(crate) fn begin_lighting_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    timer: &mut PassTimer,
+    f: &FrameInputs,
+    label: &str,
+    depth_cleared: bool,
+) -> wgpu::RenderPass<'e> {
+    let clear = |c| wgpu::Operations {
+        load: wgpu::LoadOp::Clear(c),
+        store: wgpu::StoreOp::Store,
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[
+            Some(wgpu::RenderPassColorAttachment {
+                view: &f.targets.hdr,
+                depth_slice: None,
+                resolve_target: None,
+                ops: clear(wgpu::Color::BLACK),
+            }),
+            f.count_blend.then(|| wgpu::RenderPassColorAttachment {
+                view: &f.targets.counts,
+                depth_slice: None,
+                resolve_target: None,
+                ops: clear(wgpu::Color::TRANSPARENT),
+            }),
+        ],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &f.targets.depth,
+            depth_ops: Some(wgpu::Operations {
+                load: if depth_cleared {
+                    wgpu::LoadOp::Clear(1.0)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: timer.render_pass(label),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Colour targets of a forward lighting pipeline: HDR and (when countable) the count target.
+pub(crate) fn lighting_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
+    [
+        Some(crate::passes::HDR_FORMAT.into()),
+        crate::passes::count_target(count_blend),
+    ]
 }

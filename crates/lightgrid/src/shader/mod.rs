@@ -10,6 +10,7 @@ pub mod src {
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
     pub const LIGHTING: &str = include_str!("../shading/lighting.wgsl");
     pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
+    pub const LIGHT_GRID: &str = include_str!("../culling/light_grid.wgsl");
 }
 
 /// The modules every scene-geometry shader starts with: structs, group-0 bindings, the light

@@ -30,3 +30,10 @@ struct FrameUniforms {
     near: f32,
     far: f32,
 }
+
+struct GridParams {
+    tile_size: u32,
+    tiles_x: u32,
+    tiles_y: u32,
+    slices: u32,
+}

@@ -1,0 +1,174 @@
+//! CPU light assignment (tiled-shading §6.1, §6.3):
+//! 1. project each light's sphere to a tight screen rectangle, correct when the sphere
+//!    crosses the near plane, lies behind the camera or contains it (per axis, the extremes of
+//!    u/w over the sphere clipped to w >= near: tangent points from the eye where they are in
+//!    front of the near plane, else the sphere's intersection with the near plane);
+//! 2. bucket lights by tile row, then, in parallel over rows, insert each light into the tiles
+//!    its rectangle covers whose depth range its view-depth interval overlaps.
+//!
+//! The brute-force oracle in `oracle.rs` checks that nothing is ever missed.
+
+use super::{GridDims, LightGrid, ViewLight, ViewSetup};
+use crate::scene::PointLight;
+use rayon::prelude::*;
+
+/// Pixels covered by a projected light: inclusive pixel index ranges, clipped to the frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
+}
+
+/// Depth ranges the light must overlap to be inserted into a tile.
+#[derive(Clone, Copy, Debug)]
+pub enum DepthRange<'a> {
+    /// No depth bounds: every tile spans near..far (tiled-shading §3, `tiled_forward`).
+    NearFar,
+    /// Per-tile view-distance `[min, max]` from a depth buffer (§6.3); `min > max` marks a
+    /// tile without samples, which gets no lights.
+    PerTile(&'a [[f32; 2]]),
+}
+
+/// Relative slack for floating-point round-off in the depth test: assignment must be
+/// conservative, never tight enough to drop a light that reaches a sample.
+const DEPTH_SLACK: f32 = 1e-4;
+
+/// Range of s = u / w over the disc (centre (cu, cw), radius r) clipped to w >= near, where u
+/// is view x or y and w the view distance. None when nothing is in front of the near plane.
+fn axis_range(cu: f32, cw: f32, r: f32, near: f32) -> Option<(f32, f32)> {
+    if cw + r < near {
+        return None;
+    }
+    let mut lo = f32::INFINITY;
+    let mut hi = f32::NEG_INFINITY;
+    let mut take = |s: f32| {
+        lo = lo.min(s);
+        hi = hi.max(s);
+    };
+    let d2 = cu * cu + cw * cw;
+    let r2 = r * r;
+    if d2 > r2 {
+        // Tangent points from the eye: (t² c ± t r c⊥) / d², t² = d² - r², c⊥ = (-cw, cu).
+        let t2 = d2 - r2;
+        let t = t2.sqrt();
+        for sign in [-1.0f32, 1.0] {
+            let u = (t2 * cu + sign * t * r * -cw) / d2;
+            let w = (t2 * cw + sign * t * r * cu) / d2;
+            if w >= near {
+                take(u / w);
+            }
+        }
+    }
+    let dn = cw - near;
+    if dn.abs() <= r {
+        let k = (r2 - dn * dn).max(0.0).sqrt();
+        take((cu - k) / near);
+        take((cu + k) / near);
+    }
+    if lo > hi {
+        // Only reachable through round-off at a grazing configuration: be conservative.
+        return Some((f32::NEG_INFINITY, f32::INFINITY));
+    }
+    Some((lo, hi))
+}
+
+/// The pixels whose centres the light's projected sphere may cover, or None if it is
+/// entirely off screen, behind the near plane or beyond the far plane.
+pub fn project_sphere(setup: &ViewSetup, light: &ViewLight) -> Option<PixelRect> {
+    let c = light.center;
+    let r = light.radius;
+    let cw = -c.z;
+    if cw - r > setup.far {
+        return None;
+    }
+    let (sx0, sx1) = axis_range(c.x, cw, r, setup.near)?;
+    let (sy0, sy1) = axis_range(c.y, cw, r, setup.near)?;
+    let (w, h) = (setup.width as f32, setup.height as f32);
+    // NDC -> pixels (y down). A small widening absorbs round-off.
+    let px = |s: f32| ((setup.p00 * s) * 0.5 + 0.5) * w;
+    let py = |s: f32| (0.5 - (setup.p11 * s) * 0.5) * h;
+    let (x_lo, x_hi) = (px(sx0) - 0.01, px(sx1) + 0.01);
+    let (y_lo, y_hi) = (py(sy1) - 0.01, py(sy0) + 0.01);
+    if x_hi < 0.0 || y_hi < 0.0 || x_lo > w || y_lo > h {
+        return None;
+    }
+    let clamp = |v: f32, max: u32| (v.floor().max(0.0) as u32).min(max - 1);
+    Some(PixelRect {
+        x0: clamp(x_lo, setup.width),
+        x1: clamp(x_hi, setup.width),
+        y0: clamp(y_lo, setup.height),
+        y1: clamp(y_hi, setup.height),
+    })
+}
+
+/// Build the tile grid on the CPU.
+pub fn assign_cpu(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    lights: &[PointLight],
+    depth: DepthRange,
+) -> LightGrid {
+    struct Placed {
+        tx0: u32,
+        tx1: u32,
+        ty0: u32,
+        ty1: u32,
+        w_min: f32,
+        w_max: f32,
+    }
+    let placed: Vec<Option<Placed>> = lights
+        .par_iter()
+        .map(|l| {
+            let v = setup.to_view(l);
+            let rect = project_sphere(setup, &v)?;
+            let t = dims.tile_size;
+            Some(Placed {
+                tx0: rect.x0 / t,
+                tx1: rect.x1 / t,
+                ty0: rect.y0 / t,
+                ty1: rect.y1 / t,
+                w_min: -v.center.z - v.radius,
+                w_max: -v.center.z + v.radius,
+            })
+        })
+        .collect();
+    let mut rows: Vec<Vec<u32>> = vec![Vec::new(); dims.tiles_y as usize];
+    for (i, p) in placed.iter().enumerate() {
+        if let Some(p) = p {
+            for ty in p.ty0..=p.ty1 {
+                rows[ty as usize].push(i as u32);
+            }
+        }
+    }
+    let lists: Vec<Vec<u32>> = rows
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(ty, row)| {
+            let mut tiles: Vec<Vec<u32>> = vec![Vec::new(); dims.tiles_x as usize];
+            for &l in row {
+                let p = placed[l as usize]
+                    .as_ref()
+                    .expect("bucketed lights are placed");
+                for tx in p.tx0..=p.tx1 {
+                    let tile = ty * dims.tiles_x as usize + tx as usize;
+                    let reaches = match depth {
+                        DepthRange::NearFar => true,
+                        DepthRange::PerTile(b) => {
+                            let [lo, hi] = b[tile];
+                            lo <= hi
+                                && p.w_max >= lo * (1.0 - DEPTH_SLACK)
+                                && p.w_min <= hi * (1.0 + DEPTH_SLACK)
+                        }
+                    };
+                    if reaches {
+                        tiles[tx as usize].push(l);
+                    }
+                }
+            }
+            tiles
+        })
+        .collect();
+    LightGrid::from_lists(*dims, &lists)
+}

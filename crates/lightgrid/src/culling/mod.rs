@@ -1,0 +1,16 @@
+//! Light assignment: the light grid contract (tiled-shading §6.2), its CPU builder, the
+//! brute-force oracle that proves the builder never misses a light, and per-tile depth bounds
+//! (GPU kernel and its CPU twin).
+
+mod assign_cpu;
+mod depth_bounds;
+mod grid;
+mod oracle;
+mod view;
+
+pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
+pub use depth_bounds::{depth_bounds_cpu, to_view_bounds, DepthBoundsPass};
+pub(crate) use depth_bounds::{shader as depth_bounds_shader, TILE_DEPTH_WGSL};
+pub use grid::{GridBuffers, GridDims, LightGrid};
+pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
+pub use view::{ViewLight, ViewSetup};

@@ -1,0 +1,76 @@
+//! Brute force: which lights reach which samples. Used by the culling tests (the CPU and GPU
+//! grids must contain every light the oracle finds) and for the ideal lighting-computation
+//! count: for every visible sample, the lights whose range reaches it.
+
+use super::{GridDims, LightGrid, ViewSetup};
+use crate::scene::PointLight;
+use rayon::prelude::*;
+
+/// For every tile, the lights whose sphere contains at least one of the tile's samples.
+/// `view_distance[y * width + x]` is the sample's view distance; non-finite means no sample.
+pub fn oracle_tile_lights(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    lights: &[PointLight],
+    view_distance: &[f32],
+) -> Vec<Vec<u32>> {
+    let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
+    (0..dims.tile_count())
+        .into_par_iter()
+        .map(|t| {
+            let (x0, y0, x1, y1) = dims.tile_rect(t);
+            let mut samples = Vec::new();
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let w = view_distance[(y * dims.width + x) as usize];
+                    if w.is_finite() {
+                        samples.push(setup.sample_position(x, y, w));
+                    }
+                }
+            }
+            view_lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| {
+                    samples
+                        .iter()
+                        .any(|p| p.distance_squared(l.center) < l.radius * l.radius)
+                })
+                .map(|(i, _)| i as u32)
+                .collect()
+        })
+        .collect()
+}
+
+/// The ideal count: for every sample with a finite view distance, the number of lights whose
+/// range reaches it. `grid` must contain every such light for the sample's tile (the CPU
+/// assignment does; the culling tests prove it), so only its lists are searched.
+pub fn ideal_lighting_computations(
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[PointLight],
+    view_distance: &[f32],
+) -> u64 {
+    let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
+    let dims = grid.dims;
+    (0..dims.height)
+        .into_par_iter()
+        .map(|y| {
+            let mut n = 0u64;
+            for x in 0..dims.width {
+                let w = view_distance[(y * dims.width + x) as usize];
+                if !w.is_finite() {
+                    continue;
+                }
+                let p = setup.sample_position(x, y, w);
+                for &l in grid.cell(dims.tile_of(x, y)) {
+                    let v = &view_lights[l as usize];
+                    if p.distance_squared(v.center) < v.radius * v.radius {
+                        n += 1;
+                    }
+                }
+            }
+            n
+        })
+        .sum()
+}

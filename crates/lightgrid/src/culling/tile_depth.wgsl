@@ -1,0 +1,36 @@
+// Per-tile depth min/max over a depth texture, for a workgroup of TILE_THREADS x TILE_THREADS
+// invocations striding over one tile (any tile size). Depth 1.0 (cleared, no geometry) is
+// ignored; a tile without samples returns min > max. Positive floats order like their bit
+// patterns, so workgroup u32 atomics do the reduction.
+
+var<workgroup> tile_depth_min: atomic<u32>;
+var<workgroup> tile_depth_max: atomic<u32>;
+
+// Must be called from uniform control flow by the whole workgroup.
+fn reduce_tile_depth(depth_tex: texture_depth_2d, tile: vec2<u32>, tile_size: u32, lid: vec2<u32>, li: u32) -> vec2<f32> {
+    if (li == 0u) {
+        atomicStore(&tile_depth_min, bitcast<u32>(1.0));
+        atomicStore(&tile_depth_max, 0u);
+    }
+    workgroupBarrier();
+    let dims = textureDimensions(depth_tex);
+    let origin = tile * tile_size;
+    var lo = 1.0;
+    var hi = 0.0;
+    for (var y = lid.y; y < tile_size; y = y + TILE_THREADS) {
+        for (var x = lid.x; x < tile_size; x = x + TILE_THREADS) {
+            let p = origin + vec2<u32>(x, y);
+            if (p.x < dims.x && p.y < dims.y) {
+                let d = textureLoad(depth_tex, p, 0);
+                if (d < 1.0) {
+                    lo = min(lo, d);
+                    hi = max(hi, d);
+                }
+            }
+        }
+    }
+    atomicMin(&tile_depth_min, bitcast<u32>(lo));
+    atomicMax(&tile_depth_max, bitcast<u32>(hi));
+    workgroupBarrier();
+    return vec2<f32>(bitcast<f32>(atomicLoad(&tile_depth_min)), bitcast<f32>(atomicLoad(&tile_depth_max)));
+}

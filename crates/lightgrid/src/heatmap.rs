@@ -1,0 +1,96 @@
+//! The lights-per-tile view (forward-plus Fig. 2b style): each tile tinted by its light count
+//! over a dimmed copy of the frame, with a colour legend (blue 0, green half, red the maximum)
+//! and its end values drawn underneath.
+
+use crate::culling::LightGrid;
+use image::{Rgba, RgbaImage};
+
+/// Blue → green → red ramp over t in [0, 1].
+fn ramp(t: f32) -> [f32; 3] {
+    let t = t.clamp(0.0, 1.0);
+    if t < 0.5 {
+        let u = t * 2.0;
+        [0.0, u, 1.0 - u]
+    } else {
+        let u = (t - 0.5) * 2.0;
+        [u, 1.0 - u, 0.0]
+    }
+}
+
+/// 3×5 pixel digits, one row per u8 (3 low bits, left = 4).
+const DIGITS: [[u8; 5]; 10] = [
+    [7, 5, 5, 5, 7],
+    [2, 6, 2, 2, 7],
+    [7, 1, 7, 4, 7],
+    [7, 1, 7, 1, 7],
+    [5, 5, 7, 1, 1],
+    [7, 4, 7, 1, 7],
+    [7, 4, 7, 5, 7],
+    [7, 1, 1, 1, 1],
+    [7, 5, 7, 5, 7],
+    [7, 5, 7, 1, 7],
+];
+
+fn draw_number(img: &mut RgbaImage, mut x: u32, y: u32, n: u32, scale: u32) {
+    for ch in n.to_string().bytes() {
+        let glyph = DIGITS[(ch - b'0') as usize];
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..3u32 {
+                if bits & (4 >> col) != 0 {
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            let (px, py) = (x + col * scale + dx, y + row as u32 * scale + dy);
+                            if px < img.width() && py < img.height() {
+                                img.put_pixel(px, py, Rgba([255, 255, 255, 255]));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        x += 4 * scale;
+    }
+}
+
+/// The heatmap of `grid` over `frame`; the result is taller than the frame by the legend.
+pub fn heatmap(frame: &RgbaImage, grid: &LightGrid) -> RgbaImage {
+    let (w, h) = frame.dimensions();
+    let scale = (w / 320).max(1);
+    let legend_h = 14 * scale;
+    let max = grid.max_lights_per_cell().max(1);
+    let mut out = RgbaImage::from_pixel(w, h + legend_h, Rgba([0, 0, 0, 255]));
+    for (x, y, p) in frame.enumerate_pixels() {
+        let count = grid.cells[grid.dims.tile_of(x, y)][1];
+        let c = ramp(count as f32 / max as f32);
+        let luma = (0.2 * p[0] as f32 + 0.6 * p[1] as f32 + 0.2 * p[2] as f32) / 255.0;
+        let px = |i: usize| ((0.55 * c[i] + 0.45 * luma) * 255.0) as u8;
+        let on_edge = x % grid.dims.tile_size == 0 || y % grid.dims.tile_size == 0;
+        let v = if count == 0 {
+            [(luma * 90.0) as u8; 3]
+        } else {
+            [px(0), px(1), px(2)]
+        };
+        let v = if on_edge { v.map(|c| c / 2) } else { v };
+        out.put_pixel(x, y, Rgba([v[0], v[1], v[2], 255]));
+    }
+    // Legend: the ramp from 0 to max lights per tile, labelled at both ends.
+    let (bar_x0, bar_x1) = (14 * scale, w.saturating_sub(30 * scale).max(14 * scale + 1));
+    for x in bar_x0..bar_x1 {
+        let c = ramp((x - bar_x0) as f32 / (bar_x1 - bar_x0) as f32);
+        for y in h + 2 * scale..h + 8 * scale {
+            out.put_pixel(
+                x,
+                y,
+                Rgba([
+                    (c[0] * 255.0) as u8,
+                    (c[1] * 255.0) as u8,
+                    (c[2] * 255.0) as u8,
+                    255,
+                ]),
+            );
+        }
+    }
+    draw_number(&mut out, 2 * scale, h + 3 * scale, 0, scale);
+    draw_number(&mut out, bar_x1 + 3 * scale, h + 3 * scale, max, scale);
+    out
+}

@@ -1,0 +1,208 @@
+//! The G-buffer pass and the group-2 bindings deferred compute passes read it through
+//! (`gbuffer_read.wgsl`). Four colour targets of four channels, 16-bit float by default or
+//! 32-bit (`--gbuffer 32`), as tiled-shading §8 measures both; depth is the shared target.
+
+use super::{Targets, COUNT_FORMAT, HDR_FORMAT};
+use crate::gpu::PassTimer;
+use crate::pipelines::{draw_scene, geometry_pipeline, FrameInputs, GeometryPipelineDesc};
+use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
+
+/// Bits per G-buffer channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum GBufferFormat {
+    #[default]
+    F16,
+    F32,
+}
+
+impl GBufferFormat {
+    pub fn texture_format(self) -> wgpu::TextureFormat {
+        match self {
+            GBufferFormat::F16 => wgpu::TextureFormat::Rgba16Float,
+            GBufferFormat::F32 => wgpu::TextureFormat::Rgba32Float,
+        }
+    }
+
+    pub fn bits(self) -> u32 {
+        match self {
+            GBufferFormat::F16 => 16,
+            GBufferFormat::F32 => 32,
+        }
+    }
+}
+
+pub(crate) fn shader() -> ComposedShader {
+    let mut parts = SCENE_PARTS.to_vec();
+    parts.push(include_str!("gbuffer.wgsl"));
+    compose("gbuffer", &parts)
+}
+
+/// WGSL a deferred compute shader includes to read the G-buffer.
+pub const GBUFFER_READ_WGSL: &str = include_str!("gbuffer_read.wgsl");
+
+const TARGET_NAMES: [&str; 4] = [
+    "gbuffer normal",
+    "gbuffer diffuse",
+    "gbuffer specular",
+    "gbuffer base",
+];
+
+pub struct GBuffer {
+    pub format: GBufferFormat,
+    views: Vec<wgpu::TextureView>,
+    pipeline: wgpu::RenderPipeline,
+    pub read_layout: wgpu::BindGroupLayout,
+}
+
+impl GBuffer {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        format: GBufferFormat,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        let tf = format.texture_format();
+        let views = TARGET_NAMES
+            .iter()
+            .map(|name| {
+                device
+                    .create_texture(&wgpu::TextureDescriptor {
+                        label: Some(name),
+                        size: wgpu::Extent3d {
+                            width,
+                            height,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: tf,
+                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                            | wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    })
+                    .create_view(&Default::default())
+            })
+            .collect();
+        let module = create_module(device, &shader());
+        let targets: Vec<Option<wgpu::ColorTargetState>> =
+            (0..4).map(|_| Some(tf.into())).collect();
+        let pipeline = geometry_pipeline(
+            device,
+            &GeometryPipelineDesc {
+                label: "gbuffer",
+                module: &module,
+                fragment_entry: Some("fs_gbuffer"),
+                layouts: &[Some(scene_layout)],
+                color_targets: &targets,
+                depth_write: true,
+                depth_compare: wgpu::CompareFunction::Less,
+            },
+        );
+        GBuffer {
+            format,
+            views,
+            pipeline,
+            read_layout: Self::read_layout(device),
+        }
+    }
+
+    fn read_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Texture {
+                sample_type,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let storage = |binding, format| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        };
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gbuffer read (group 2)"),
+            entries: &[
+                tex(0, float),
+                tex(1, float),
+                tex(2, float),
+                tex(3, float),
+                tex(4, wgpu::TextureSampleType::Depth),
+                storage(5, HDR_FORMAT),
+                storage(6, COUNT_FORMAT),
+            ],
+        })
+    }
+
+    /// Group 2 for a deferred compute pass: the G-buffer, depth, and the outputs.
+    pub fn read_bind_group(&self, device: &wgpu::Device, targets: &Targets) -> wgpu::BindGroup {
+        let view = |binding, v| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(v),
+        };
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer read"),
+            layout: &self.read_layout,
+            entries: &[
+                view(0, &self.views[0]),
+                view(1, &self.views[1]),
+                view(2, &self.views[2]),
+                view(3, &self.views[3]),
+                view(4, &targets.depth),
+                view(5, &targets.hdr),
+                view(6, &targets.counts),
+            ],
+        })
+    }
+
+    /// Rasterize the scene into the G-buffer and the depth target.
+    pub fn encode(
+        &self,
+        f: &FrameInputs,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut PassTimer,
+    ) {
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = self
+            .views
+            .iter()
+            .map(|v| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view: v,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gbuffer"),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &f.targets.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.render_pass("gbuffer"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        draw_scene(&mut pass, f, &[]);
+    }
+}

@@ -1,0 +1,20 @@
+// G-buffer pass (tiled-shading §8): normal, diffuse colour, specular colour + shininess,
+// and the light-independent term (emissive + ambient). Depth goes to the shared depth target.
+
+struct GBufferOut {
+    @location(0) normal: vec4<f32>,
+    @location(1) diffuse: vec4<f32>,
+    @location(2) specular: vec4<f32>,
+    @location(3) base: vec4<f32>,
+}
+
+@fragment
+fn fs_gbuffer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
+    let s = surface_from_vertex(v, front);
+    var out: GBufferOut;
+    out.normal = vec4<f32>(s.normal, 0.0);
+    out.diffuse = vec4<f32>(s.diffuse, s.alpha);
+    out.specular = vec4<f32>(s.specular, s.shininess);
+    out.base = vec4<f32>(surface_base(s), 1.0);
+    return out;
+}

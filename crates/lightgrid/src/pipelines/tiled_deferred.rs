@@ -1,0 +1,221 @@
+//! `tiled_deferred` and `tiled_deferred_single`.
+//!
+//! tiled_deferred (tiled-shading §2, §6): 1. G-buffer pass; 2. per-tile depth bounds on the
+//! GPU, read back; 3. CPU assignment pruned by the bounds; 4. upload; 5. compute pass, one
+//! invocation per sample: read the G-buffer once, loop the tile's lights in registers.
+//! Groups: 0 scene, 1 grid, 2 G-buffer + outputs.
+//!
+//! tiled_deferred_single (§7): 1. G-buffer pass; 2. one kernel, one workgroup per tile:
+//! depth bounds, frustum culling of all lights into workgroup memory, shading.
+//! Groups: 0 scene, 1 tile params, 2 G-buffer + outputs.
+
+use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
+use crate::consts::SCREEN_WORKGROUP;
+use crate::culling::TILE_DEPTH_WGSL;
+use crate::culling::{
+    assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GridBuffers, GridDims, LightGrid,
+};
+use crate::passes::{GBuffer, GBUFFER_READ_WGSL};
+use crate::shader::{compose, create_module, src, ComposedShader};
+use crate::Result;
+
+/// Shared modules of a deferred compute shader (no vertex stage).
+fn deferred_parts() -> Vec<&'static str> {
+    vec![
+        src::TYPES,
+        src::SCENE_BINDINGS,
+        src::LIGHTING,
+        GBUFFER_READ_WGSL,
+    ]
+}
+
+pub(super) fn shaders() -> Vec<ComposedShader> {
+    let mut parts = deferred_parts();
+    parts.push(src::LIGHT_GRID);
+    parts.push(include_str!("tiled_deferred.wgsl"));
+    vec![compose("tiled_deferred", &parts)]
+}
+
+pub(super) fn shaders_single() -> Vec<ComposedShader> {
+    let mut parts = deferred_parts();
+    parts.push(TILE_DEPTH_WGSL);
+    parts.push(include_str!("tiled_deferred_single.wgsl"));
+    vec![compose("tiled_deferred_single", &parts)]
+}
+
+fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &ComposedShader,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::ComputePipeline {
+    let module = create_module(device, shader);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: layouts,
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+enum Variant {
+    /// Multi-pass: depth bounds kernel + CPU grid + shading kernel.
+    Multi {
+        bounds: DepthBoundsPass,
+        grid: GridBuffers,
+    },
+    /// Single kernel; group 1 holds the tile size.
+    Single {
+        params: wgpu::Buffer,
+        params_group: wgpu::BindGroup,
+    },
+}
+
+struct TiledDeferred {
+    gbuffer: GBuffer,
+    shading: wgpu::ComputePipeline,
+    variant: Variant,
+    dims: GridDims,
+}
+
+pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
+    let (w, h) = (ctx.dims.width, ctx.dims.height);
+    let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let grid = GridBuffers::new(ctx.device);
+    let shading = compute_pipeline(
+        ctx.device,
+        "tiled deferred shading",
+        &shaders()[0],
+        &[
+            Some(ctx.scene_layout),
+            Some(&grid.layout),
+            Some(&gbuffer.read_layout),
+        ],
+    );
+    let bounds = DepthBoundsPass::new(ctx.device, ctx.dims);
+    Box::new(TiledDeferred {
+        gbuffer,
+        shading,
+        variant: Variant::Multi { bounds, grid },
+        dims: ctx.dims,
+    })
+}
+
+pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
+    let (w, h) = (ctx.dims.width, ctx.dims.height);
+    let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let params_layout = ctx
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tile params"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+    let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("tile params"),
+        size: 16,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let params_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("tile params"),
+        layout: &params_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        }],
+    });
+    let shading = compute_pipeline(
+        ctx.device,
+        "tiled deferred single kernel",
+        &shaders_single()[0],
+        &[
+            Some(ctx.scene_layout),
+            Some(&params_layout),
+            Some(&gbuffer.read_layout),
+        ],
+    );
+    Box::new(TiledDeferred {
+        gbuffer,
+        shading,
+        variant: Variant::Single {
+            params,
+            params_group,
+        },
+        dims: ctx.dims,
+    })
+}
+
+impl Technique for TiledDeferred {
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>> {
+        let dims = self.dims;
+        {
+            let (encoder, timer) = enc.parts();
+            self.gbuffer.encode(f, encoder, timer);
+        }
+        let read_group = self.gbuffer.read_bind_group(f.device, f.targets);
+        let (grid, group1, label, groups) = match &mut self.variant {
+            Variant::Multi { bounds, grid } => {
+                {
+                    let (encoder, timer) = enc.parts();
+                    bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
+                }
+                enc.submit_and_wait()?;
+                let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
+                let built =
+                    assign_cpu(&f.setup, &dims, f.lights, DepthRange::PerTile(&view_bounds));
+                grid.upload(f.device, f.queue, &built);
+                let groups = (
+                    dims.width.div_ceil(SCREEN_WORKGROUP),
+                    dims.height.div_ceil(SCREEN_WORKGROUP),
+                );
+                (
+                    Some(built),
+                    grid.bind_group(),
+                    "tiled deferred shading",
+                    groups,
+                )
+            }
+            Variant::Single {
+                params,
+                params_group,
+            } => {
+                f.queue
+                    .write_buffer(params, 0, bytemuck::bytes_of(&dims.params()));
+                (
+                    None,
+                    &*params_group,
+                    "tiled deferred single kernel",
+                    (dims.tiles_x, dims.tiles_y),
+                )
+            }
+        };
+        let (encoder, timer) = enc.parts();
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: timer.compute_pass(label),
+        });
+        pass.set_pipeline(&self.shading);
+        pass.set_bind_group(0, f.scene_bind_group, &[]);
+        pass.set_bind_group(1, group1, &[]);
+        pass.set_bind_group(2, &read_group, &[]);
+        pass.dispatch_workgroups(groups.0, groups.1, 1);
+        drop(pass);
+        Ok(grid)
+    }
+}
