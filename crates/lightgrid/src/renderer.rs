@@ -275,6 +275,27 @@ impl<'c> Renderer<'c> {
             .collect())
     }
 
+    /// Run the GPU depth-bounds kernel over the depth target as the last frame left it and
+    /// read the per-tile `[min, max]` back (for tests and debugging: the GPU half of the
+    /// depth-bounds twin pair).
+    pub fn gpu_depth_bounds(&self) -> Result<Vec<[f32; 2]>> {
+        let device = &self.ctx.device;
+        let pass = crate::culling::DepthBoundsPass::new(device, self.dims);
+        let mut timer = PassTimer::new(self.ctx, 1);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        scoped(device, "depth bounds", || {
+            pass.encode(
+                device,
+                &self.ctx.queue,
+                &mut encoder,
+                &mut timer,
+                &self.targets.depth,
+            );
+            self.ctx.queue.submit([encoder.finish()]);
+        })?;
+        pass.read(device)
+    }
+
     /// Render `frame` of `scene` with pipeline `pipeline_id`.
     pub fn render(&mut self, scene: &Scene, frame: u32, pipeline_id: &str) -> Result<FrameOutput> {
         let frames = scene.frame_count();

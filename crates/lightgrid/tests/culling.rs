@@ -1,0 +1,295 @@
+//! CPU light assignment never misses a light: thousands of randomized cases against the
+//! brute-force oracle, including lights behind the camera, crossing the near plane,
+//! containing the camera and at the screen edges, tile sizes from 4 to 64 and resolutions
+//! that are not multiples of the tile size. CPU only.
+
+use glam::Vec3;
+use lightgrid::culling::{
+    assign_cpu, depth_bounds_cpu, oracle_tile_lights, project_sphere, to_view_bounds, DepthRange,
+    GridDims, ViewSetup,
+};
+use lightgrid::scene::{Camera, PointLight, Rng};
+
+const TILES: [u32; 9] = [4, 5, 7, 8, 13, 16, 31, 32, 64];
+
+struct Case {
+    setup: ViewSetup,
+    camera: Camera,
+    lights: Vec<PointLight>,
+}
+
+fn random_case(rng: &mut Rng) -> Case {
+    let eye = Vec3::new(
+        rng.range(-20.0, 20.0),
+        rng.range(-5.0, 20.0),
+        rng.range(-20.0, 20.0),
+    );
+    let dir = Vec3::new(
+        rng.range(-1.0, 1.0),
+        rng.range(-0.6, 0.6),
+        rng.range(-1.0, 1.0),
+    )
+    .normalize_or(Vec3::X);
+    let camera = Camera {
+        eye,
+        target: eye + dir,
+        up: Vec3::Y,
+        fov_y: rng.range(30.0, 100.0).to_radians(),
+        near: rng.range(0.05, 1.0),
+        far: rng.range(40.0, 200.0),
+    };
+    let (w, h) = (17 + rng.below(90), 9 + rng.below(70));
+    let setup = ViewSetup::new(&camera, w, h);
+    let inv_view = setup.view.inverse();
+    let world = |v: Vec3| inv_view.transform_point3(v);
+    let color = Vec3::ONE;
+    let mut lights = Vec::new();
+    for k in 0..24 {
+        let r = rng.range(0.2, 12.0);
+        // View-space placements covering the edge cases by construction.
+        let v = match k % 6 {
+            // Anywhere around the camera, including far behind it.
+            0 | 1 => Vec3::new(
+                rng.range(-30.0, 30.0),
+                rng.range(-30.0, 30.0),
+                rng.range(-40.0, 25.0),
+            ),
+            // Containing the camera.
+            2 => {
+                Vec3::new(
+                    rng.range(-0.5, 0.5),
+                    rng.range(-0.5, 0.5),
+                    rng.range(-0.5, 0.5),
+                ) * r
+            }
+            // Crossing the near plane.
+            3 => Vec3::new(
+                rng.range(-r, r),
+                rng.range(-r, r),
+                -camera.near + rng.range(-r, r),
+            ),
+            // Behind the camera but reaching forward past the near plane.
+            4 => Vec3::new(
+                rng.range(-2.0, 2.0),
+                rng.range(-2.0, 2.0),
+                rng.range(0.0, r),
+            ),
+            // Centred just outside a screen edge.
+            _ => {
+                let depth = rng.range(1.0, 40.0);
+                let edge_x = if rng.unit() < 0.5 { -1.0 } else { 1.0 } * rng.range(0.9, 1.2);
+                let y = rng.range(-1.2, 1.2);
+                let (sx, sy) = if rng.unit() < 0.5 {
+                    (edge_x, y)
+                } else {
+                    (y, edge_x)
+                };
+                Vec3::new(sx / setup.p00 * depth, sy / setup.p11 * depth, -depth)
+            }
+        };
+        lights.push(PointLight {
+            position: world(v),
+            color,
+            intensity: 1.0,
+            range: r,
+        });
+    }
+    Case {
+        setup,
+        camera,
+        lights,
+    }
+}
+
+/// A depth buffer ([0, 1] values) with sky, smooth surfaces, near-plane samples and noise.
+fn random_depth(rng: &mut Rng, case: &Case) -> Vec<f32> {
+    let s = &case.setup;
+    let to_ndc = |w: f32| {
+        let r = s.far / (s.near - s.far);
+        (r * s.near / w - r).clamp(0.0, 0.999_999)
+    };
+    let (a, b, c) = (
+        rng.range(0.5, 30.0),
+        rng.range(-20.0, 20.0),
+        rng.range(-20.0, 20.0),
+    );
+    (0..s.width * s.height)
+        .map(|i| {
+            let (x, y) = (
+                (i % s.width) as f32 / s.width as f32,
+                (i / s.width) as f32 / s.height as f32,
+            );
+            let roll = rng.unit();
+            if roll < 0.15 {
+                1.0
+            } else if roll < 0.2 {
+                to_ndc(s.near)
+            } else {
+                let w = (a + b * x + c * y).abs() + s.near + rng.range(0.0, 3.0);
+                to_ndc(w.min(s.far))
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn cpu_assignment_contains_the_oracle_in_randomized_cases() {
+    let mut rng = Rng::new(2024);
+    let mut oracle_pairs = 0usize;
+    let mut assigned_pairs = 0usize;
+    let mut all_pairs = 0usize;
+    for case_index in 0..1500 {
+        let case = random_case(&mut rng);
+        let depth = random_depth(&mut rng, &case);
+        let s = &case.setup;
+        let tile = TILES[case_index % TILES.len()];
+        let dims = GridDims::new(s.width, s.height, tile).unwrap();
+        let view_distance: Vec<f32> = depth
+            .iter()
+            .map(|&d| {
+                if d < 1.0 {
+                    s.view_distance(d)
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
+        let bounds = to_view_bounds(s, &depth_bounds_cpu(&depth, &dims));
+        let bounded = assign_cpu(s, &dims, &case.lights, DepthRange::PerTile(&bounds));
+        let plain = assign_cpu(s, &dims, &case.lights, DepthRange::NearFar);
+        for (t, must) in oracle.iter().enumerate() {
+            for l in must {
+                assert!(
+                    bounded.cell(t).contains(l),
+                    "case {case_index}: depth-bounded grid misses light {l} in tile {t} \
+                     ({}x{}, tile {tile}, light {:?}, camera {:?})",
+                    s.width,
+                    s.height,
+                    case.lights[*l as usize],
+                    case.camera
+                );
+            }
+            for l in bounded.cell(t) {
+                assert!(
+                    plain.cell(t).contains(l),
+                    "case {case_index}: depth bounds added light {l}"
+                );
+            }
+            oracle_pairs += must.len();
+        }
+        assigned_pairs += bounded.indices.len();
+        all_pairs += dims.tile_count() * case.lights.len();
+    }
+    // The cases must really exercise hits, and the assignment must really cull.
+    assert!(
+        oracle_pairs > 10_000,
+        "only {oracle_pairs} light-tile hits: cases too sparse"
+    );
+    assert!(
+        assigned_pairs < all_pairs / 2,
+        "assignment barely culls: {assigned_pairs} of {all_pairs}"
+    );
+}
+
+#[test]
+fn projected_rectangle_contains_every_visible_point_of_the_sphere() {
+    let mut rng = Rng::new(77);
+    for _ in 0..2000 {
+        let case = random_case(&mut rng);
+        let s = &case.setup;
+        for l in &case.lights {
+            let v = s.to_view(l);
+            let rect = project_sphere(s, &v);
+            for _ in 0..64 {
+                // A random point inside the ball, in front of the near plane.
+                let d = Vec3::new(
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                );
+                if d.length() > 1.0 {
+                    continue;
+                }
+                let p = v.center + d * v.radius;
+                let w = -p.z;
+                if w < s.near || w > s.far {
+                    continue;
+                }
+                let px = ((s.p00 * p.x / w) * 0.5 + 0.5) * s.width as f32;
+                let py = (0.5 - (s.p11 * p.y / w) * 0.5) * s.height as f32;
+                if px < 0.0 || py < 0.0 || px >= s.width as f32 || py >= s.height as f32 {
+                    continue;
+                }
+                let r = rect.unwrap_or_else(|| {
+                    panic!("visible point {p:?} of light {v:?} but no rectangle")
+                });
+                let (ix, iy) = (px as u32, py as u32);
+                assert!(
+                    r.x0 <= ix && ix <= r.x1 && r.y0 <= iy && iy <= r.y1,
+                    "pixel ({ix}, {iy}) of light {v:?} outside {r:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn lights_entirely_behind_the_camera_or_beyond_far_are_culled() {
+    let camera = Camera {
+        eye: Vec3::ZERO,
+        target: -Vec3::Z,
+        up: Vec3::Y,
+        fov_y: 1.0,
+        near: 0.5,
+        far: 100.0,
+    };
+    let s = ViewSetup::new(&camera, 64, 48);
+    let behind = s.to_view(&PointLight {
+        position: Vec3::new(0.0, 0.0, 5.0),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: 4.0,
+    });
+    assert_eq!(project_sphere(&s, &behind), None);
+    let beyond = s.to_view(&PointLight {
+        position: Vec3::new(0.0, 0.0, -120.0),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: 10.0,
+    });
+    assert_eq!(project_sphere(&s, &beyond), None);
+    // Containing the camera: covers the whole screen.
+    let around = s.to_view(&PointLight {
+        position: Vec3::new(0.1, 0.0, 0.2),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: 3.0,
+    });
+    let r = project_sphere(&s, &around).unwrap();
+    assert_eq!((r.x0, r.x1, r.y0, r.y1), (0, 63, 0, 47));
+    // Small and to the right: only the right part of the screen.
+    let right = s.to_view(&PointLight {
+        position: Vec3::new(8.0, 0.0, -20.0),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: 1.0,
+    });
+    let r = project_sphere(&s, &right).unwrap();
+    assert!(r.x0 > 40 && r.x1 < 63 && r.y0 > 10 && r.y1 < 40, "{r:?}");
+}
+
+#[test]
+fn depth_bounds_cpu_ignores_sky_and_marks_empty_tiles() {
+    let dims = GridDims::new(10, 5, 4).unwrap();
+    assert_eq!((dims.tiles_x, dims.tiles_y), (3, 2));
+    let mut depth = vec![1.0f32; 50];
+    depth[0] = 0.5;
+    depth[13] = 0.25; // (3, 1): tile 0
+    depth[9] = 0.75; // (9, 0): tile 2, a partial tile
+    let b = depth_bounds_cpu(&depth, &dims);
+    assert_eq!(b[0], [0.25, 0.5]);
+    assert_eq!(b[2], [0.75, 0.75]);
+    assert!(b[1][0] > b[1][1], "tile without samples is empty");
+    assert!(GridDims::new(10, 5, 0).is_err() && GridDims::new(10, 5, 65).is_err());
+}
