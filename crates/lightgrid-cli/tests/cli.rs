@@ -244,3 +244,63 @@ fn compare_renders_every_pipeline_with_its_difference() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn grid_pipeline_writes_counts_next_to_the_ideal_and_a_heatmap() {
+    let dir = temp_dir("grid");
+    let (png, json, heat) = (dir.join("x.png"), dir.join("s.json"), dir.join("h.png"));
+    let o = lightgrid(&[
+        "render",
+        "--scene",
+        "robots-many",
+        "--pipeline",
+        "tiled_deferred",
+        "--size",
+        "100x60",
+        "--frame",
+        "200",
+        "--tile",
+        "8",
+        "--out",
+        png.to_str().unwrap(),
+        "--stats",
+        json.to_str().unwrap(),
+        "--heatmap",
+        heat.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let actual = stats["lighting_computations"].as_u64().unwrap();
+    let ideal = stats["ideal_lighting_computations"].as_u64().unwrap();
+    assert!(ideal > 0 && actual >= ideal, "{stats}");
+    assert_eq!(stats["tile_size"], 8);
+    assert!(stats["lights_per_tile_max"].as_u64().unwrap() > 0);
+    let h = image::open(&heat).unwrap();
+    assert_eq!(h.width(), 100);
+    assert!(h.height() > 60, "heatmap has a legend under the frame");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_tile_and_gbuffer_values_are_rejected() {
+    assert_fails_with(
+        &[
+            "render",
+            "--scene",
+            "robots-few",
+            "--pipeline",
+            "tiled_forward",
+            "--tile",
+            "3",
+        ],
+        "tile size",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--tile", "100"],
+        "tile size",
+    );
+    assert_fails_with(
+        &["render", "--scene", "robots-few", "--gbuffer", "24"],
+        "16 or 32",
+    );
+}

@@ -35,7 +35,7 @@ pub fn shaders() -> Vec<ComposedShader> {
 /// The count target of a fragment pipeline: additive blending where the adapter can blend
 /// R32Float, otherwise no target (the count is then not reported).
 pub fn count_target(count_blend: bool) -> Option<wgpu::ColorTargetState> {
-    count_blend.then(|| wgpu::ColorTargetState {
+    count_blend.then_some(wgpu::ColorTargetState {
         format: COUNT_FORMAT,
         blend: Some(wgpu::BlendState {
             color: wgpu::BlendComponent {

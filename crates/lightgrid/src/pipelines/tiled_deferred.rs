@@ -68,7 +68,7 @@ fn compute_pipeline(
 enum Variant {
     /// Multi-pass: depth bounds kernel + CPU grid + shading kernel.
     Multi {
-        bounds: DepthBoundsPass,
+        bounds: Box<DepthBoundsPass>,
         grid: GridBuffers,
     },
     /// Single kernel; group 1 holds the tile size.
@@ -99,7 +99,7 @@ pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
             Some(&gbuffer.read_layout),
         ],
     );
-    let bounds = DepthBoundsPass::new(ctx.device, ctx.dims);
+    let bounds = Box::new(DepthBoundsPass::new(ctx.device, ctx.dims));
     Box::new(TiledDeferred {
         gbuffer,
         shading,

@@ -223,7 +223,7 @@ impl Builder {
                 let d = (cell - 2.0 * gap) * self.rng.range(0.4, 1.0);
                 let h = self.rng.range(height.0, height.1);
                 mesh.append(
-                    &Mesh::cuboid(Vec3::new(x0, 0.0, z0), Vec3::new(x0 + w, h, z0 + d)),
+                    &Mesh::block(Vec3::new(x0, 0.0, z0), Vec3::new(x0 + w, h, z0 + d)),
                     Mat4::IDENTITY,
                 );
             }
@@ -341,7 +341,7 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
             (m, m + SIDEWALK)
         };
         walks.append(
-            &Mesh::cuboid(
+            &Mesh::block(
                 Vec3::new(x0, 0.0, -STREET_HALF_LENGTH),
                 Vec3::new(x1, 0.2, STREET_HALF_LENGTH),
             ),
@@ -352,7 +352,7 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
         let h = CROSS_STREET_WIDTH * 0.5;
         for (z0, z1) in [(c - h - SIDEWALK, c - h), (c + h, c + h + SIDEWALK)] {
             walks.append(
-                &Mesh::cuboid(
+                &Mesh::block(
                     Vec3::new(-STREET_HALF_LENGTH, 0.0, z0),
                     Vec3::new(STREET_HALF_LENGTH, 0.2, z1),
                 ),
@@ -383,7 +383,7 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
                 if !in_street(x0, x1, z0, z1) {
                     let f = b.rng.below(facades.len() as u32) as usize;
                     buildings[f].append(
-                        &Mesh::cuboid(Vec3::new(x0, 0.0, z0), Vec3::new(x1, height, z1)),
+                        &Mesh::block(Vec3::new(x0, 0.0, z0), Vec3::new(x1, height, z1)),
                         Mat4::IDENTITY,
                     );
                 }
@@ -406,12 +406,12 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
         (Vec3::new(-1.2, 9.4, -1.0), Vec3::new(1.2, 11.4, 1.0)), // head
     ];
     for (lo, hi) in parts {
-        body.append(&Mesh::cuboid(lo, hi), Mat4::IDENTITY);
+        body.append(&Mesh::block(lo, hi), Mat4::IDENTITY);
     }
     let mut eye_mesh = Mesh::default();
     for x in [-0.7, 0.3] {
         eye_mesh.append(
-            &Mesh::cuboid(Vec3::new(x, 10.4, 1.0), Vec3::new(x + 0.4, 10.8, 1.15)),
+            &Mesh::cuboid(Vec3::new(x, 10.4, 1.02), Vec3::new(x + 0.4, 10.8, 1.15)),
             Mat4::IDENTITY,
         );
     }
@@ -512,7 +512,7 @@ fn scattered(p: &SceneParams) -> Scene {
             b.rng.range(2.0, 8.0),
         );
         blocks.append(
-            &Mesh::cuboid(c - s * Vec3::new(1.0, 0.0, 1.0), c + s),
+            &Mesh::block(c - s * Vec3::new(1.0, 0.0, 1.0), c + s),
             Mat4::IDENTITY,
         );
     }

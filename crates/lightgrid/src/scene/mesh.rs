@@ -46,6 +46,17 @@ impl Mesh {
 
     /// An axis-aligned box from `min` to `max`, faces pointing out.
     pub fn cuboid(min: Vec3, max: Vec3) -> Mesh {
+        Self::box_faces(min, max, true)
+    }
+
+    /// A box standing on something: [`Mesh::cuboid`] without the bottom face, which would be
+    /// coplanar with the ground and fight it for depth (and resolve differently under the
+    /// depth tests Less and LessEqual).
+    pub fn block(min: Vec3, max: Vec3) -> Mesh {
+        Self::box_faces(min, max, false)
+    }
+
+    fn box_faces(min: Vec3, max: Vec3, bottom: bool) -> Mesh {
         let mut m = Mesh::default();
         let d = max - min;
         let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
@@ -53,7 +64,9 @@ impl Mesh {
         m.quad(min + z, x, y, Vec2::new(d.x, d.y)); // +z
         m.quad(min, z, y, Vec2::new(d.z, d.y)); // -x
         m.quad(min + x, y, z, Vec2::new(d.y, d.z)); // +x
-        m.quad(min, x, z, Vec2::new(d.x, d.z)); // -y
+        if bottom {
+            m.quad(min, x, z, Vec2::new(d.x, d.z)); // -y
+        }
         m.quad(min + y, z, x, Vec2::new(d.z, d.x)); // +y
         m
     }
