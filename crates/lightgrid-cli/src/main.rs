@@ -35,6 +35,8 @@ enum Command {
     Compare(CompareArgs),
     /// Per-pixel difference of two images, in 8-bit sRGB levels.
     Diff(DiffArgs),
+    /// Render-target memory and the traffic model of every pipeline at a frame size.
+    Memory(MemoryArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -130,6 +132,16 @@ struct CompareArgs {
 }
 
 #[derive(Args)]
+struct MemoryArgs {
+    /// Frame size WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_size, default_value = "1920x1080")]
+    size: Size,
+    /// G-buffer channel precision in bits for deferred pipelines.
+    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
+    gbuffer: GBufferFormat,
+}
+
+#[derive(Args)]
 struct DiffArgs {
     a: PathBuf,
     b: PathBuf,
@@ -168,6 +180,7 @@ fn main() {
         Some(Command::Render(a)) => render(cli.adapter.as_deref(), &a),
         Some(Command::Compare(a)) => compare(cli.adapter.as_deref(), &a),
         Some(Command::Diff(a)) => diff_cmd(&a),
+        Some(Command::Memory(a)) => memory(&a),
         Some(Command::List) => list(),
     };
     if let Err(e) = result {
@@ -267,7 +280,9 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
         "pipeline", "time ms", "diff mean", "p99", "max", "lighting comp", "x ideal", "lights/tile"
     );
-    let mut reference = None;
+    // Reference images by id; `forward` is rendered first (registry order).
+    let mut references: std::collections::HashMap<&str, image::RgbaImage> = Default::default();
+    let mut notes = Vec::new();
     let mut failed = Vec::new();
     for p in PIPELINES {
         let out = match renderer.render(&scene, a.scene.frame, p.id) {
@@ -284,10 +299,19 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             &a.out_dir.join(format!("{}.json", p.id)),
             &serde_json::to_vec_pretty(&out.stats)?,
         )?;
-        let d = match &reference {
+        let d = match references.get(REFERENCE) {
             None => None,
             Some(r) => Some(diff(r, &out.image)?.0),
         };
+        if p.reference != REFERENCE && p.reference != p.id {
+            if let Some(r) = references.get(p.reference) {
+                let own = diff(r, &out.image)?.0;
+                notes.push(format!(
+                    "{} vs its own reference {}: mean {:.3}, p99 {}, max {}",
+                    p.id, p.reference, own.mean, own.p99, own.max
+                ));
+            }
+        }
         let time = format!(
             "{:.2}{}",
             out.stats.gpu_ms,
@@ -323,9 +347,12 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
             p.id, time, mean, p99, max, comps, ratio, per_tile
         );
-        if p.id == REFERENCE {
-            reference = Some(out.image);
+        if p.reference == p.id {
+            references.insert(p.id, out.image);
         }
+    }
+    for n in &notes {
+        println!("{n}");
     }
     if !ctx.timestamps {
         println!("* wall clock: this adapter has no timestamp queries");
@@ -366,6 +393,47 @@ fn diff_cmd(a: &DiffArgs) -> Result<()> {
     if !over.is_empty() {
         bail!("images differ: {}", over.join(", "));
     }
+    Ok(())
+}
+
+fn memory(a: &MemoryArgs) -> Result<()> {
+    let Size(w, h) = a.size;
+    let settings = RenderSettings {
+        tile_size: lightgrid::consts::DEFAULT_TILE_SIZE,
+        gbuffer: a.gbuffer,
+    };
+    println!("render targets at {w}x{h}, {}-bit G-buffer (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
+    println!(
+        "{:<22} {:>6} {:>10}   {:>9} {:>9} {:>9} {:>9}   targets",
+        "pipeline", "B/px", "total MiB", "wr B/px", "rd B/px", "wr B/lit", "rd B/lit"
+    );
+    for p in PIPELINES {
+        let m = (p.memory)(&settings);
+        let t = m.traffic;
+        let targets: Vec<String> = m
+            .targets
+            .iter()
+            .map(|t| format!("{} {}", t.name, t.bytes_per_pixel))
+            .collect();
+        println!(
+            "{:<22} {:>6} {:>10.2}   {:>9} {:>9} {:>9} {:>9}   {}",
+            p.id,
+            m.bytes_per_pixel(),
+            m.target_bytes(w, h) as f64 / (1024.0 * 1024.0),
+            t.write_per_pixel,
+            t.read_per_pixel,
+            t.write_per_lit,
+            t.read_per_lit,
+            targets.join(", ")
+        );
+    }
+    println!(
+        "traffic model (deferred-shading-vs-deferred-lighting): render-target bytes per pixel and per lit pixel \
+         (one lighting computation); blending counts as read + write; light data {} B per light, grid indices {} B; \
+         tiled pipelines also upload their grid each frame (see --stats memory.grid_bytes)",
+        lightgrid::memory::LIGHT_BYTES,
+        lightgrid::memory::INDEX_BYTES
+    );
     Ok(())
 }
 

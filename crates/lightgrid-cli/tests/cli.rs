@@ -304,3 +304,24 @@ fn bad_tile_and_gbuffer_values_are_rejected() {
         "16 or 32",
     );
 }
+
+#[test]
+fn memory_lists_every_pipeline_with_its_targets() {
+    let o = lightgrid(&["memory", "--size", "1920x1080", "--gbuffer", "32"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for p in lightgrid::pipelines::PIPELINES {
+        assert!(
+            out.lines().any(|l| l.starts_with(p.id)),
+            "memory table lacks {}",
+            p.id
+        );
+    }
+    // 32-bit G-buffer: depth 4 + 4 targets x 16 + HDR 8 = 76 bytes per pixel.
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("tiled_deferred "))
+        .unwrap();
+    assert!(line.split_whitespace().nth(1) == Some("76"), "{line}");
+    assert_fails_with(&["memory", "--size", "0x5"], "at least 1");
+}

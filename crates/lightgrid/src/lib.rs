@@ -11,6 +11,7 @@ pub mod gpu;
 pub mod gpu_types;
 pub mod heatmap;
 pub mod image_io;
+pub mod memory;
 pub mod passes;
 pub mod pipelines;
 mod renderer;

@@ -9,6 +9,7 @@ use crate::culling::{
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, scoped, wait_idle, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{
     self, FrameEncoder, FrameInputs, PipelineContext, RenderSettings, Technique,
@@ -98,6 +99,32 @@ pub struct Renderer<'c> {
     counts_readback: wgpu::Buffer,
     depth_readback: wgpu::Buffer,
     padded_row: u32,
+}
+
+/// The memory section of the stats: the pipeline's model applied to this frame.
+fn frame_memory(
+    model: MemoryModel,
+    (width, height): (u32, u32),
+    lighting_computations: Option<u64>,
+    grid: Option<&LightGrid>,
+) -> FrameMemory {
+    let pixels = u64::from(width) * u64::from(height);
+    let t = model.traffic;
+    let modelled = |per_pixel: u32, per_lit: u32| {
+        lighting_computations.map(|n| u64::from(per_pixel) * pixels + u64::from(per_lit) * n)
+    };
+    FrameMemory {
+        bytes_per_pixel: model.bytes_per_pixel(),
+        target_bytes: model.target_bytes(width, height),
+        grid_bytes: grid
+            .map(|g| (g.cells.len() * 8 + g.indices.len() * INDEX_BYTES as usize) as u64),
+        modelled_write_bytes: modelled(t.write_per_pixel, t.write_per_lit),
+        modelled_read_bytes: modelled(t.read_per_pixel, t.read_per_lit),
+        forward_plus_table1: grid
+            .map(|g| ForwardPlusTable1::new(pixels, g.average_lights_per_cell(), g.dims.tile_size)),
+        targets: model.targets,
+        traffic: t,
+    }
 }
 
 /// Check a frame size against lightgrid's and the adapter's limits.
@@ -454,6 +481,12 @@ impl<'c> Renderer<'c> {
         };
         let grid_is_pipelines = pipeline_grid.is_some();
         let grid = pipeline_grid.unwrap_or(bounded);
+        let memory = frame_memory(
+            (info.memory)(&self.settings),
+            (width, height),
+            lighting_computations,
+            grid_is_pipelines.then_some(&grid),
+        );
         Ok(FrameOutput {
             image,
             stats: FrameStats {
@@ -479,6 +512,7 @@ impl<'c> Renderer<'c> {
                 lights_per_tile_avg: grid_is_pipelines.then(|| grid.average_lights_per_cell()),
                 lights_per_tile_max: grid_is_pipelines.then(|| grid.max_lights_per_cell()),
                 grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
+                memory,
             },
             grid,
             grid_is_pipelines,

@@ -1,6 +1,7 @@
 //! Per-frame statistics written by `lightgrid render --stats`.
 
 use crate::gpu::PassTiming;
+use crate::memory::FrameMemory;
 use serde::{Deserialize, Serialize};
 
 /// How `gpu_ms` was measured.
@@ -50,4 +51,6 @@ pub struct FrameStats {
     pub lights_per_tile_max: Option<u32>,
     /// Total entries of the grid's index lists.
     pub grid_indices: Option<u64>,
+    /// Render targets, grid size and the traffic models (`memory.rs`).
+    pub memory: FrameMemory,
 }

@@ -293,3 +293,43 @@ fn depth_bounds_cpu_ignores_sky_and_marks_empty_tiles() {
     assert!(b[1][0] > b[1][1], "tile without samples is empty");
     assert!(GridDims::new(10, 5, 0).is_err() && GridDims::new(10, 5, 65).is_err());
 }
+
+#[test]
+fn light_volume_classes_follow_the_clip_planes() {
+    use lightgrid::passes::classify_lights;
+    let camera = Camera {
+        eye: Vec3::ZERO,
+        target: -Vec3::Z,
+        up: Vec3::Y,
+        fov_y: 1.0,
+        near: 0.5,
+        far: 100.0,
+    };
+    let s = ViewSetup::new(&camera, 64, 48);
+    let light = |z: f32, range: f32| PointLight {
+        position: Vec3::new(0.0, 0.0, z),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range,
+    };
+    let lights = [
+        light(-20.0, 5.0),  // 0: in the middle: front faces
+        light(-1.0, 3.0),   // 1: contains the camera: back faces
+        light(-50.0, 80.0), // 2: reaches both planes: full screen
+        light(-98.0, 5.0),  // 3: reaches the far plane only: front faces
+        light(10.0, 5.0),   // 4: behind the camera: nothing
+        light(-120.0, 5.0), // 5: beyond far: nothing
+    ];
+    let c = classify_lights(&s, &lights, false);
+    assert_eq!(
+        (c.front.clone(), c.back.clone(), c.full.clone()),
+        (vec![0, 3], vec![1], vec![2])
+    );
+    assert!(c.stencil.is_empty());
+    let c = classify_lights(&s, &lights, true);
+    // The z-fail stencil test needs unclipped back faces: far-plane lights keep the plain draws.
+    assert_eq!(
+        (c.stencil.clone(), c.front.clone(), c.full.clone()),
+        (vec![0, 1], vec![3], vec![2])
+    );
+}

@@ -2,7 +2,7 @@
 //! (`gbuffer_read.wgsl`). Four colour targets of four channels, 16-bit float by default or
 //! 32-bit (`--gbuffer 32`), as tiled-shading §8 measures both; depth is the shared target.
 
-use super::{Targets, COUNT_FORMAT, HDR_FORMAT};
+use super::Targets;
 use crate::gpu::PassTimer;
 use crate::pipelines::{draw_scene, geometry_pipeline, FrameInputs, GeometryPipelineDesc};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
@@ -21,6 +21,11 @@ impl GBufferFormat {
             GBufferFormat::F16 => wgpu::TextureFormat::Rgba16Float,
             GBufferFormat::F32 => wgpu::TextureFormat::Rgba32Float,
         }
+    }
+
+    /// Bytes per pixel of one four-channel G-buffer target.
+    pub fn bytes_per_target(self) -> u32 {
+        4 * self.bits() / 8
     }
 
     pub fn bits(self) -> u32 {
@@ -111,21 +116,11 @@ impl GBuffer {
     fn read_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
+            visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Texture {
                 sample_type,
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
-            },
-            count: None,
-        };
-        let storage = |binding, format| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format,
-                view_dimension: wgpu::TextureViewDimension::D2,
             },
             count: None,
         };
@@ -138,13 +133,11 @@ impl GBuffer {
                 tex(2, float),
                 tex(3, float),
                 tex(4, wgpu::TextureSampleType::Depth),
-                storage(5, HDR_FORMAT),
-                storage(6, COUNT_FORMAT),
             ],
         })
     }
 
-    /// Group 2 for a deferred compute pass: the G-buffer, depth, and the outputs.
+    /// Group 2 of a deferred pass: the G-buffer and the depth it was rendered with.
     pub fn read_bind_group(&self, device: &wgpu::Device, targets: &Targets) -> wgpu::BindGroup {
         let view = |binding, v| wgpu::BindGroupEntry {
             binding,
@@ -159,8 +152,6 @@ impl GBuffer {
                 view(2, &self.views[2]),
                 view(3, &self.views[3]),
                 view(4, &targets.depth),
-                view(5, &targets.hdr),
-                view(6, &targets.counts),
             ],
         })
     }

@@ -41,17 +41,3 @@ fn surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     s.ambient = m.ambient;
     return s;
 }
-
-// Output of a forward lighting fragment shader: colour, and how many times it ran the light
-// function (summed by additive blending into the count target).
-struct LitOut {
-    @location(0) color: vec4<f32>,
-    @location(1) count: f32,
-}
-
-fn lit(color: vec3<f32>, count: u32) -> LitOut {
-    var out: LitOut;
-    out.color = vec4<f32>(color, 1.0);
-    out.count = f32(count);
-    return out;
-}

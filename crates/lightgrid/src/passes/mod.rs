@@ -2,9 +2,14 @@
 //! the scene bind group (group 0) and the tonemap pass.
 
 mod gbuffer;
+mod light_volumes;
 mod tonemap;
 
 pub use gbuffer::{GBuffer, GBufferFormat, GBUFFER_READ_WGSL};
+pub use light_volumes::{
+    additive, classify_lights, LightVolumes, VolumeClasses, VolumeDraw, VolumePipelineDesc,
+    VOLUME_DEPTH_BYTES, VOLUME_DEPTH_FORMAT, VOLUME_WGSL,
+};
 pub use tonemap::Tonemap;
 
 use crate::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GpuVertex};
@@ -30,6 +35,52 @@ pub fn shaders() -> Vec<ComposedShader> {
         gbuffer::shader(),
         crate::culling::depth_bounds_shader(),
     ]
+}
+
+/// `fullscreen_position(vertex_index)`: a screen-covering triangle.
+pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
+
+/// WGSL of a deferred compute pass's outputs (group 3).
+pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
+
+/// Layout of group 3 of deferred compute passes (`compute_outputs.wgsl`).
+pub fn compute_outputs_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let storage = |binding, format| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("compute outputs (group 3)"),
+        entries: &[storage(0, HDR_FORMAT), storage(1, COUNT_FORMAT)],
+    })
+}
+
+/// Group 3 for a deferred compute pass: the HDR and count targets as storage textures.
+pub fn compute_outputs(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    targets: &Targets,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("compute outputs"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&targets.hdr),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&targets.counts),
+            },
+        ],
+    })
 }
 
 /// The count target of a fragment pipeline: additive blending where the adapter can blend

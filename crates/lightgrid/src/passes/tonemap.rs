@@ -6,7 +6,10 @@ use crate::gpu::PassTimer;
 use crate::shader::{compose, create_module, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
-    compose("tonemap", &[include_str!("tonemap.wgsl")])
+    compose(
+        "tonemap",
+        &[super::FULLSCREEN_WGSL, include_str!("tonemap.wgsl")],
+    )
 }
 
 pub struct Tonemap {

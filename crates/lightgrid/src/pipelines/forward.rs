@@ -2,11 +2,13 @@
 //! Inputs: group 0 only. Outputs: HDR colour, depth, counts. Never reads a light grid: it is
 //! the independent reference every other pipeline is compared with.
 
+use super::RenderSettings;
 use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
 use crate::culling::LightGrid;
+use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
 
@@ -21,13 +23,22 @@ struct Forward {
 }
 
 pub(super) fn create(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create_with(ctx, "fs_main")
+}
+
+/// `forward_mono`: the same, with the light pre-pass's monochrome specular model.
+pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create_with(ctx, "fs_mono")
+}
+
+fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let pipeline = geometry_pipeline(
         ctx.device,
         &GeometryPipelineDesc {
             label: "forward",
             module: &module,
-            fragment_entry: Some("fs_main"),
+            fragment_entry: Some(fragment_entry),
             layouts: &[Some(ctx.scene_layout)],
             color_targets: &lighting_targets(ctx.count_blend),
             depth_write: true,
@@ -45,4 +56,17 @@ impl Technique for Forward {
         draw_scene(&mut pass, f, &[]);
         Ok(None)
     }
+}
+
+/// HDR + depth; every fragment writes both and reads each light once.
+pub(super) fn memory(_: &RenderSettings) -> MemoryModel {
+    MemoryModel::new(
+        &[("hdr", HDR_BYTES), ("depth", DEPTH_BYTES)],
+        Traffic {
+            write_per_pixel: HDR_BYTES + DEPTH_BYTES,
+            read_per_pixel: 0,
+            write_per_lit: 0,
+            read_per_lit: LIGHT_BYTES,
+        },
+    )
 }

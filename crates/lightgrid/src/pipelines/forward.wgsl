@@ -10,3 +10,20 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     }
     return lit(color, frame.light_count);
 }
+
+// forward_mono: the reference for light_prepass_mono: every light for every fragment, with
+// the same monochrome-specular model.
+@fragment
+fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
+    let s = surface_from_vertex(v, front);
+    let view_dir = view_dir_to(s.position);
+    var diffuse = vec3<f32>(0.0);
+    var specular = 0.0;
+    for (var i = 0u; i < frame.light_count; i = i + 1u) {
+        let t = light_terms(s, view_dir, lights[i]);
+        diffuse += t.diffuse;
+        specular += luminance(t.specular);
+    }
+    let color = surface_base(s) + diffuse * s.diffuse + mono_specular(diffuse, specular) * s.specular;
+    return lit(color, frame.light_count);
+}

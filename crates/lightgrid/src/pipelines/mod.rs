@@ -1,13 +1,16 @@
 //! The pipeline registry: one module per pipeline id, one row in [`PIPELINES`]. The CLI, the
 //! default job and the tests iterate this table; adding a pipeline touches nothing else.
 
+mod deferred;
 mod forward;
+mod light_prepass;
 mod tiled_deferred;
 mod tiled_forward;
 
 use crate::culling::{GridDims, LightGrid, ViewSetup};
 use crate::error::Result;
 use crate::gpu::{scoped, wait_idle, PassTimer};
+use crate::memory::MemoryModel;
 use crate::passes::{GBufferFormat, Targets};
 use crate::scene::PointLight;
 use crate::shader::ComposedShader;
@@ -121,9 +124,14 @@ pub struct PipelineInfo {
     pub paper: &'static str,
     /// Reads a light grid. `forward` never does: it is the reference.
     pub uses_grid: bool,
+    /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
+    /// same approximations (e.g. `forward_mono`).
+    pub reference: &'static str,
     /// Every composed shader the pipeline creates (validated by the tests without a GPU).
     pub shaders: fn() -> Vec<ComposedShader>,
     pub create: fn(&PipelineContext) -> Box<dyn Technique>,
+    /// Render targets and the traffic model (`memory.rs`).
+    pub memory: fn(&RenderSettings) -> MemoryModel,
 }
 
 /// The registry, reference first.
@@ -133,40 +141,100 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "every light evaluated for every fragment; the reference image",
         paper: "all (brute force)",
         uses_grid: false,
+        reference: "forward",
         shaders: forward::shaders,
         create: forward::create,
+        memory: forward::memory,
+    },
+    PipelineInfo {
+        id: "forward_mono",
+        description: "forward with the light pre-pass's monochrome specular; the reference for light_prepass_mono",
+        paper: "deferred-shading-vs-deferred-lighting (the compromise)",
+        uses_grid: false,
+        reference: "forward_mono",
+        shaders: forward::shaders,
+        create: forward::create_mono,
+        memory: forward::memory,
     },
     PipelineInfo {
         id: "tiled_forward",
         description: "CPU-built tile grid without depth bounds, read by forward shading",
         paper: "tiled-shading §3",
         uses_grid: true,
+        reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
+        memory: tiled_forward::memory_plain,
     },
     PipelineInfo {
         id: "tiled_forward_prez",
         description: "depth pre-pass, per-tile depth bounds (GPU), CPU grid, forward shading with early-Z",
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
+        reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
+        memory: tiled_forward::memory_prez,
     },
     PipelineInfo {
         id: "tiled_deferred",
         description: "G-buffer, depth bounds (GPU), CPU grid, one compute pass shading each tile's samples",
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
+        reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
+        memory: tiled_deferred::memory_multi,
     },
     PipelineInfo {
         id: "tiled_deferred_single",
         description: "G-buffer, then one kernel per tile: depth bounds, cull all lights in workgroup memory, shade",
         paper: "tiled-shading §7",
         uses_grid: true,
+        reference: "forward",
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
+        memory: tiled_deferred::memory_single,
+    },
+    PipelineInfo {
+        id: "deferred",
+        description: "G-buffer, then each light's volume rasterized with additive blending",
+        paper: "tiled-shading §1.1, §8 (Deferred)",
+        uses_grid: false,
+        reference: "forward",
+        shaders: deferred::shaders,
+        create: deferred::create_plain,
+        memory: deferred::memory,
+    },
+    PipelineInfo {
+        id: "deferred_stencil",
+        description: "as deferred, with a two-sided stencil pass per light so only samples inside its volume are shaded",
+        paper: "tiled-shading §8 (Deferred-Stencil)",
+        uses_grid: false,
+        reference: "forward",
+        shaders: deferred::shaders,
+        create: deferred::create_stencil,
+        memory: deferred::memory,
+    },
+    PipelineInfo {
+        id: "light_prepass",
+        description: "deferred lighting: normal+exponent, diffuse and specular irradiance per light volume, second geometry pass",
+        paper: "deferred-shading-vs-deferred-lighting",
+        uses_grid: false,
+        reference: "forward",
+        shaders: light_prepass::shaders,
+        create: light_prepass::create_full,
+        memory: light_prepass::memory_full,
+    },
+    PipelineInfo {
+        id: "light_prepass_mono",
+        description: "light pre-pass with monochrome specular irradiance in the diffuse target's alpha",
+        paper: "deferred-shading-vs-deferred-lighting (the compromise)",
+        uses_grid: false,
+        reference: "forward_mono",
+        shaders: light_prepass::shaders,
+        create: light_prepass::create_mono,
+        memory: light_prepass::memory_mono,
     },
 ];
 

@@ -3,19 +3,23 @@
 //! tiled_deferred (tiled-shading §2, §6): 1. G-buffer pass; 2. per-tile depth bounds on the
 //! GPU, read back; 3. CPU assignment pruned by the bounds; 4. upload; 5. compute pass, one
 //! invocation per sample: read the G-buffer once, loop the tile's lights in registers.
-//! Groups: 0 scene, 1 grid, 2 G-buffer + outputs.
+//! Groups: 0 scene, 1 grid, 2 G-buffer, 3 outputs.
 //!
 //! tiled_deferred_single (§7): 1. G-buffer pass; 2. one kernel, one workgroup per tile:
 //! depth bounds, frustum culling of all lights into workgroup memory, shading.
-//! Groups: 0 scene, 1 tile params, 2 G-buffer + outputs.
+//! Groups: 0 scene, 1 tile params, 2 G-buffer, 3 outputs.
 
+use super::RenderSettings;
 use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
 use crate::consts::SCREEN_WORKGROUP;
 use crate::culling::TILE_DEPTH_WGSL;
 use crate::culling::{
     assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GridBuffers, GridDims, LightGrid,
 };
-use crate::passes::{GBuffer, GBUFFER_READ_WGSL};
+use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
+use crate::passes::{
+    compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
+};
 use crate::shader::{compose, create_module, src, ComposedShader};
 use crate::Result;
 
@@ -26,6 +30,7 @@ fn deferred_parts() -> Vec<&'static str> {
         src::SCENE_BINDINGS,
         src::LIGHTING,
         GBUFFER_READ_WGSL,
+        COMPUTE_OUTPUTS_WGSL,
     ]
 }
 
@@ -80,6 +85,7 @@ enum Variant {
 
 struct TiledDeferred {
     gbuffer: GBuffer,
+    outputs_layout: wgpu::BindGroupLayout,
     shading: wgpu::ComputePipeline,
     variant: Variant,
     dims: GridDims,
@@ -89,6 +95,7 @@ pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
     let grid = GridBuffers::new(ctx.device);
+    let outputs_layout = compute_outputs_layout(ctx.device);
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred shading",
@@ -97,11 +104,13 @@ pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
             Some(ctx.scene_layout),
             Some(&grid.layout),
             Some(&gbuffer.read_layout),
+            Some(&outputs_layout),
         ],
     );
     let bounds = Box::new(DepthBoundsPass::new(ctx.device, ctx.dims));
     Box::new(TiledDeferred {
         gbuffer,
+        outputs_layout,
         shading,
         variant: Variant::Multi { bounds, grid },
         dims: ctx.dims,
@@ -111,6 +120,7 @@ pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
 pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let outputs_layout = compute_outputs_layout(ctx.device);
     let params_layout = ctx
         .device
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -148,10 +158,12 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
             Some(ctx.scene_layout),
             Some(&params_layout),
             Some(&gbuffer.read_layout),
+            Some(&outputs_layout),
         ],
     );
     Box::new(TiledDeferred {
         gbuffer,
+        outputs_layout,
         shading,
         variant: Variant::Single {
             params,
@@ -169,6 +181,7 @@ impl Technique for TiledDeferred {
             self.gbuffer.encode(f, encoder, timer);
         }
         let read_group = self.gbuffer.read_bind_group(f.device, f.targets);
+        let outputs = compute_outputs(f.device, &self.outputs_layout, f.targets);
         let (grid, group1, label, groups) = match &mut self.variant {
             Variant::Multi { bounds, grid } => {
                 {
@@ -214,8 +227,36 @@ impl Technique for TiledDeferred {
         pass.set_bind_group(0, f.scene_bind_group, &[]);
         pass.set_bind_group(1, group1, &[]);
         pass.set_bind_group(2, &read_group, &[]);
+        pass.set_bind_group(3, &outputs, &[]);
         pass.dispatch_workgroups(groups.0, groups.1, 1);
         drop(pass);
         Ok(grid)
     }
+}
+
+/// Depth + four G-buffer targets + HDR; the shading kernel reads depth and the G-buffer once
+/// per sample, the bounds kernel depth once more; each lighting computation reads an index
+/// and a light.
+pub(super) fn memory_multi(settings: &RenderSettings) -> MemoryModel {
+    let g = settings.gbuffer.bytes_per_target();
+    MemoryModel::new(
+        &[
+            ("depth", DEPTH_BYTES),
+            ("gbuffer (4 targets)", 4 * g),
+            ("hdr", HDR_BYTES),
+        ],
+        Traffic {
+            write_per_pixel: DEPTH_BYTES + 4 * g + HDR_BYTES,
+            read_per_pixel: 2 * DEPTH_BYTES + 4 * g,
+            write_per_lit: 0,
+            read_per_lit: INDEX_BYTES + LIGHT_BYTES,
+        },
+    )
+}
+
+/// As `memory_multi`, but the tile's index list lives in workgroup memory.
+pub(super) fn memory_single(settings: &RenderSettings) -> MemoryModel {
+    let mut m = memory_multi(settings);
+    m.traffic.read_per_lit = LIGHT_BYTES;
+    m
 }

@@ -7,6 +7,7 @@
 //! 5. lighting pass with depth test LessEqual against the pre-pass depth, no depth writes, so
 //! early-Z shades each visible sample once.
 
+use super::RenderSettings;
 use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
@@ -14,6 +15,7 @@ use super::{GeometryPipelineDesc, PipelineContext, Technique};
 use crate::culling::{
     assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GridBuffers, GridDims, LightGrid,
 };
+use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
 
@@ -134,4 +136,25 @@ impl Technique for TiledForward {
         drop(pass);
         Ok(Some(grid))
     }
+}
+
+/// HDR + depth (+ the grid, reported per frame); each lighting computation reads an index
+/// and a light.
+pub(super) fn memory_plain(_: &RenderSettings) -> MemoryModel {
+    MemoryModel::new(
+        &[("hdr", HDR_BYTES), ("depth", DEPTH_BYTES)],
+        Traffic {
+            write_per_pixel: HDR_BYTES + DEPTH_BYTES,
+            read_per_pixel: 0,
+            write_per_lit: 0,
+            read_per_lit: INDEX_BYTES + LIGHT_BYTES,
+        },
+    )
+}
+
+/// As `memory_plain`, plus the pre-pass depth write and the depth-bounds read.
+pub(super) fn memory_prez(settings: &RenderSettings) -> MemoryModel {
+    let mut m = memory_plain(settings);
+    m.traffic.read_per_pixel += DEPTH_BYTES;
+    m
 }

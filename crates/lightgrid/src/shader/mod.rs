@@ -11,6 +11,7 @@ pub mod src {
     pub const LIGHTING: &str = include_str!("../shading/lighting.wgsl");
     pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
     pub const LIGHT_GRID: &str = include_str!("../culling/light_grid.wgsl");
+    pub const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
 }
 
 /// The modules every scene-geometry shader starts with: structs, group-0 bindings, the light
@@ -20,6 +21,7 @@ pub const SCENE_PARTS: &[&str] = &[
     src::SCENE_BINDINGS,
     src::LIGHTING,
     src::GEOMETRY,
+    src::LIT_OUT,
 ];
 
 /// A named, composed WGSL shader.

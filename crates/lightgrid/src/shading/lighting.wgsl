@@ -61,3 +61,20 @@ fn shade_light(s: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
 fn surface_base(s: Surface) -> vec3<f32> {
     return s.emissive + s.ambient * SCENE_AMBIENT;
 }
+
+// Relative luminance of linear RGB (Rec. 709 weights).
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// The light pre-pass compromise (deferred-shading-vs-deferred-lighting): specular irradiance
+// stored as one luminance value and re-coloured with the diffuse irradiance's chromaticity.
+// Exact when all lights reaching a sample share one colour; otherwise the specular takes the
+// mixture's colour.
+fn mono_specular(diffuse_irradiance: vec3<f32>, specular_luminance: f32) -> vec3<f32> {
+    let l = luminance(diffuse_irradiance);
+    if (l <= 1e-8) {
+        return vec3<f32>(specular_luminance);
+    }
+    return diffuse_irradiance * (specular_luminance / l);
+}

@@ -9,3 +9,11 @@
 fn view_dir_to(world: vec3<f32>) -> vec3<f32> {
     return normalize(frame.camera_pos - world);
 }
+
+// World position of the sample at the centre of pixel `p` with depth-buffer value `depth`.
+fn world_from_depth(p: vec2<u32>, depth: f32) -> vec3<f32> {
+    let uv = (vec2<f32>(p) + vec2<f32>(0.5)) / frame.viewport;
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let h = frame.inv_view_proj * ndc;
+    return h.xyz / h.w;
+}

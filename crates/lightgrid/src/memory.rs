@@ -1,0 +1,104 @@
+//! Memory accounting: each pipeline's render targets in bytes per pixel, and the traffic model
+//! of deferred-shading-vs-deferred-lighting (render-target bytes written and read per pixel and
+//! per lit pixel, i.e. per lighting computation; blending counts as a read and a write; vertex
+//! and material data excluded) plus the Forward+ paper's Table 1 evaluated with a frame's
+//! actual lights per tile. The R32Float lighting-count target is a statistics aid and is not
+//! counted.
+
+use serde::{Deserialize, Serialize};
+
+/// One render target (or per-pixel buffer) of a pipeline.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TargetBytes {
+    pub name: String,
+    pub bytes_per_pixel: u32,
+}
+
+/// The blog's traffic model, in bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Traffic {
+    pub write_per_pixel: u32,
+    pub read_per_pixel: u32,
+    /// Per lighting computation (a lit pixel, counted once per light).
+    pub write_per_lit: u32,
+    pub read_per_lit: u32,
+}
+
+/// A pipeline's memory footprint and traffic model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MemoryModel {
+    pub targets: Vec<TargetBytes>,
+    pub traffic: Traffic,
+}
+
+impl MemoryModel {
+    pub fn new(targets: &[(&str, u32)], traffic: Traffic) -> Self {
+        MemoryModel {
+            targets: targets
+                .iter()
+                .map(|(n, b)| TargetBytes {
+                    name: n.to_string(),
+                    bytes_per_pixel: *b,
+                })
+                .collect(),
+            traffic,
+        }
+    }
+
+    pub fn bytes_per_pixel(&self) -> u32 {
+        self.targets.iter().map(|t| t.bytes_per_pixel).sum()
+    }
+
+    pub fn target_bytes(&self, width: u32, height: u32) -> u64 {
+        u64::from(self.bytes_per_pixel()) * u64::from(width) * u64::from(height)
+    }
+}
+
+/// Bytes of the HDR colour target (RGBA16F).
+pub const HDR_BYTES: u32 = 8;
+/// Bytes of the scene depth (32-bit float).
+pub const DEPTH_BYTES: u32 = 4;
+/// Bytes of one light in the global light list (`GpuLight`; the paper's L = 8 floats).
+pub const LIGHT_BYTES: u32 = 32;
+/// Bytes of one light index in a grid list.
+pub const INDEX_BYTES: u32 = 4;
+
+/// Memory of a frame as reported in the stats.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameMemory {
+    pub targets: Vec<TargetBytes>,
+    pub bytes_per_pixel: u32,
+    pub target_bytes: u64,
+    /// Bytes of the CPU grid uploaded this frame (cells + index lists), if any.
+    pub grid_bytes: Option<u64>,
+    pub traffic: Traffic,
+    /// The traffic model applied to this frame's pixels and lighting computations.
+    pub modelled_write_bytes: Option<u64>,
+    pub modelled_read_bytes: Option<u64>,
+    /// Forward+ Table 1 with this frame's M (average lights per tile), when a grid exists.
+    pub forward_plus_table1: Option<ForwardPlusTable1>,
+}
+
+/// Forward+ (forward-plus §3, Table 1): total memory traffic of Forward+ and of compute-based
+/// deferred lighting, N pixels, F = 4-byte floats, M lights per tile, T pixels per tile,
+/// L = 8 floats per light.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ForwardPlusTable1 {
+    pub m: f64,
+    pub t: u32,
+    pub forward_plus_bytes: f64,
+    pub deferred_bytes: f64,
+}
+
+impl ForwardPlusTable1 {
+    pub fn new(pixels: u64, lights_per_tile: f64, tile_size: u32) -> Self {
+        let (n, f, l) = (pixels as f64, 4.0, 8.0);
+        let t = tile_size * tile_size;
+        ForwardPlusTable1 {
+            m: lights_per_tile,
+            t,
+            forward_plus_bytes: n * f + lights_per_tile * n * f * (1.0 / t as f64 + 1.0 + l),
+            deferred_bytes: n * f * 16.0,
+        }
+    }
+}

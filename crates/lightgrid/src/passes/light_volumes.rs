@@ -1,0 +1,424 @@
+//! Light volumes for the classic deferred family (`deferred`, `deferred_stencil`,
+//! `light_prepass*`).
+//!
+//! Each light's range sphere is drawn as an instanced low-poly sphere scaled to enclose it.
+//! Per frame the CPU sorts the lights into draw classes by where the sphere sits against the
+//! near and far planes, so the image is right when the camera is inside a volume or a volume
+//! crosses a clip plane:
+//! 1. `front`: the sphere is entirely beyond the near plane: front faces, depth test
+//!    LessEqual (drops fragments whose surface is in front of the volume).
+//! 2. `back`: the sphere reaches the near plane (or contains the camera) but not the far plane:
+//!    back faces, depth test GreaterEqual (drops fragments whose surface is behind it).
+//! 3. `full`: the sphere reaches both planes: a full-screen triangle, no depth test.
+//! 4. `stencil` (only when asked): every light not reaching the far plane, for the two-sided
+//!    stencil test (z-fail marking is exact with the camera inside, but needs the back faces
+//!    unclipped by the far plane); the others fall back to classes 1 and 3.
+//!
+//! The volume passes depth-test against a Depth24PlusStencil8 copy of the scene depth, made by
+//! a full-screen pass at the start, because they also sample the scene depth to rebuild
+//! positions, and a texture cannot be a written stencil attachment and sampled in one pass.
+
+use crate::culling::ViewSetup;
+use crate::scene::{Mesh, PointLight};
+use std::ops::Range;
+
+pub const VOLUME_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
+/// Bytes per pixel of [`VOLUME_DEPTH_FORMAT`] (24-bit depth + 8-bit stencil).
+pub const VOLUME_DEPTH_BYTES: u32 = 4;
+pub const VOLUME_WGSL: &str = include_str!("light_volume.wgsl");
+
+const RINGS: u32 = 8;
+const SEGMENTS: u32 = 16;
+/// The sphere mesh's faces lie inside the unit sphere; scaling by this moves every face out
+/// of it. Adjacent vertices are at most π/8 apart, so each face's circumscribed cap has an
+/// angular radius well under π/6, and 1/cos(π/6) ≈ 1.155 < 1.16 keeps faces outside.
+const ENCLOSING_SCALE: f32 = 1.16;
+/// Relative margin for the plane tests of the classification.
+const PLANE_SLACK: f32 = 1e-3;
+
+/// Light indices per draw class.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct VolumeClasses {
+    pub front: Vec<u32>,
+    pub back: Vec<u32>,
+    pub full: Vec<u32>,
+    pub stencil: Vec<u32>,
+}
+
+/// Sort the lights into draw classes (see the module docs). Lights that cannot reach any
+/// sample (entirely behind the near plane or beyond the far plane) are left out.
+pub fn classify_lights(setup: &ViewSetup, lights: &[PointLight], stencil: bool) -> VolumeClasses {
+    let mut c = VolumeClasses::default();
+    for (i, l) in lights.iter().enumerate() {
+        let v = setup.to_view(l);
+        let w = -v.center.z;
+        let r = v.radius * ENCLOSING_SCALE;
+        if w + v.radius < setup.near || w - v.radius > setup.far {
+            continue;
+        }
+        let near = w - r <= setup.near * (1.0 + PLANE_SLACK);
+        let far = w + r >= setup.far * (1.0 - PLANE_SLACK);
+        let i = i as u32;
+        match (near, far) {
+            (_, false) if stencil => c.stencil.push(i),
+            (false, _) => c.front.push(i),
+            (true, false) => c.back.push(i),
+            (true, true) => c.full.push(i),
+        }
+    }
+    c
+}
+
+/// Which light volumes a draw covers, and how they are rasterized.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeDraw {
+    Front,
+    Back,
+    Full,
+    /// Two-sided z-fail stencil marking, no colour.
+    StencilMark,
+    /// Back faces where the stencil is set; clears it.
+    StencilLight,
+}
+
+/// What a volume pipeline shades with.
+pub struct VolumePipelineDesc<'a> {
+    pub label: &'a str,
+    pub module: &'a wgpu::ShaderModule,
+    pub fragment_entry: &'a str,
+    pub layouts: &'a [Option<&'a wgpu::BindGroupLayout>],
+    pub color_targets: &'a [Option<wgpu::ColorTargetState>],
+    pub draw: VolumeDraw,
+}
+
+/// Additive blending (exit radiance, irradiance and counts accumulate over lights).
+pub fn additive(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
+    let add = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    wgpu::ColorTargetState {
+        format,
+        blend: Some(wgpu::BlendState {
+            color: add,
+            alpha: add,
+        }),
+        write_mask: wgpu::ColorWrites::ALL,
+    }
+}
+
+/// The sphere mesh, per-frame instance lists and the depth-stencil copy.
+pub struct LightVolumes {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    instances: wgpu::Buffer,
+    ranges: [Range<u32>; 4],
+    pub depth: wgpu::TextureView,
+    copy_layout: wgpu::BindGroupLayout,
+}
+
+fn instance_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("light volume instances"),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+impl LightVolumes {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        use wgpu::util::DeviceExt;
+        let sphere = Mesh::sphere(ENCLOSING_SCALE, RINGS, SEGMENTS);
+        let positions: Vec<[f32; 3]> = sphere.positions.iter().map(|p| p.to_array()).collect();
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("light volume sphere"),
+            contents: bytemuck::cast_slice(&positions),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("light volume sphere indices"),
+            contents: bytemuck::cast_slice(&sphere.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        let depth = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("light volume depth-stencil"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: VOLUME_DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        let copy_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth copy source"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        LightVolumes {
+            vertices,
+            indices,
+            index_count: sphere.indices.len() as u32,
+            instances: instance_buffer(device, 1 << 14),
+            ranges: Default::default(),
+            depth,
+            copy_layout,
+        }
+    }
+
+    /// Upload this frame's classes.
+    pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, c: &VolumeClasses) {
+        let mut all =
+            Vec::with_capacity(c.front.len() + c.back.len() + c.full.len() + c.stencil.len());
+        let mut start = 0u32;
+        for (slot, list) in [&c.front, &c.back, &c.full, &c.stencil]
+            .into_iter()
+            .enumerate()
+        {
+            all.extend_from_slice(list);
+            self.ranges[slot] = start..start + list.len() as u32;
+            start += list.len() as u32;
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(&all);
+        if bytes.len() as u64 > self.instances.size() {
+            self.instances = instance_buffer(device, (bytes.len() as u64).next_power_of_two());
+        }
+        if !bytes.is_empty() {
+            queue.write_buffer(&self.instances, 0, bytes);
+        }
+    }
+
+    pub fn stencil_count(&self) -> u32 {
+        self.ranges[3].len() as u32
+    }
+
+    /// A pipeline for one kind of volume draw (see [`VolumeDraw`]).
+    pub fn pipeline(&self, device: &wgpu::Device, d: &VolumePipelineDesc) -> wgpu::RenderPipeline {
+        use wgpu::{CompareFunction as C, Face, StencilFaceState, StencilOperation as Op};
+        let (cull, compare, vertex_entry) = match d.draw {
+            VolumeDraw::Front => (Some(Face::Back), C::LessEqual, "vs_volume"),
+            VolumeDraw::Back => (Some(Face::Front), C::GreaterEqual, "vs_volume"),
+            VolumeDraw::Full => (None, C::Always, "vs_volume_fullscreen"),
+            VolumeDraw::StencilMark => (None, C::LessEqual, "vs_volume"),
+            VolumeDraw::StencilLight => (Some(Face::Front), C::Always, "vs_volume"),
+        };
+        let stencil = match d.draw {
+            VolumeDraw::StencilMark => wgpu::StencilState {
+                front: StencilFaceState {
+                    compare: C::Always,
+                    fail_op: Op::Keep,
+                    depth_fail_op: Op::DecrementWrap,
+                    pass_op: Op::Keep,
+                },
+                back: StencilFaceState {
+                    compare: C::Always,
+                    fail_op: Op::Keep,
+                    depth_fail_op: Op::IncrementWrap,
+                    pass_op: Op::Keep,
+                },
+                read_mask: 0xff,
+                write_mask: 0xff,
+            },
+            VolumeDraw::StencilLight => {
+                let face = StencilFaceState {
+                    compare: C::NotEqual,
+                    fail_op: Op::Keep,
+                    depth_fail_op: Op::Keep,
+                    pass_op: Op::Zero,
+                };
+                wgpu::StencilState {
+                    front: face,
+                    back: face,
+                    read_mask: 0xff,
+                    write_mask: 0xff,
+                }
+            }
+            _ => Default::default(),
+        };
+        let targets: Vec<Option<wgpu::ColorTargetState>> = if d.draw == VolumeDraw::StencilMark {
+            d.color_targets
+                .iter()
+                .map(|t| {
+                    t.clone().map(|t| wgpu::ColorTargetState {
+                        write_mask: wgpu::ColorWrites::empty(),
+                        ..t
+                    })
+                })
+                .collect()
+        } else {
+            d.color_targets.to_vec()
+        };
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(d.label),
+            bind_group_layouts: d.layouts,
+            immediate_size: 0,
+        });
+        const POSITION: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
+        const LIGHT: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![1 => Uint32];
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(d.label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: d.module,
+                entry_point: Some(vertex_entry),
+                compilation_options: Default::default(),
+                buffers: &[
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: 12,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &POSITION,
+                    }),
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: 4,
+                        step_mode: wgpu::VertexStepMode::Instance,
+                        attributes: &LIGHT,
+                    }),
+                ],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: cull,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: VOLUME_DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(compare),
+                stencil,
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: d.module,
+                entry_point: Some(d.fragment_entry),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    /// The full-screen pipeline that copies the scene depth into [`Self::depth`]; the colour
+    /// targets must be the pass's (nothing is written to them).
+    pub fn copy_pipeline(
+        &self,
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        scene_layout: &wgpu::BindGroupLayout,
+        color_targets: &[Option<wgpu::ColorTargetState>],
+    ) -> wgpu::RenderPipeline {
+        let targets: Vec<Option<wgpu::ColorTargetState>> = color_targets
+            .iter()
+            .map(|t| {
+                t.clone().map(|t| wgpu::ColorTargetState {
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::empty(),
+                    ..t
+                })
+            })
+            .collect();
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth copy"),
+            bind_group_layouts: &[Some(scene_layout), Some(&self.copy_layout)],
+            immediate_size: 0,
+        });
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("depth copy"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_copy_depth"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: VOLUME_DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_copy_depth"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    pub fn copy_bind_group(
+        &self,
+        device: &wgpu::Device,
+        scene_depth: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("depth copy source"),
+            layout: &self.copy_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(scene_depth),
+            }],
+        })
+    }
+
+    /// Depth-stencil attachment for a volume pass: cleared, then filled by the copy draw.
+    pub fn attachment(&self) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+        wgpu::RenderPassDepthStencilAttachment {
+            view: &self.depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0),
+                store: wgpu::StoreOp::Discard,
+            }),
+        }
+    }
+
+    fn bind(&self, pass: &mut wgpu::RenderPass) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_vertex_buffer(1, self.instances.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+    }
+
+    /// Draw every light of class `Front`, `Back` or `Full` with the bound pipeline.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, draw: VolumeDraw) {
+        self.bind(pass);
+        match draw {
+            VolumeDraw::Front => pass.draw_indexed(0..self.index_count, 0, self.ranges[0].clone()),
+            VolumeDraw::Back => pass.draw_indexed(0..self.index_count, 0, self.ranges[1].clone()),
+            VolumeDraw::Full => pass.draw(0..3, self.ranges[2].clone()),
+            _ => panic!("stencil lights are drawn one at a time with draw_stencil_light"),
+        }
+    }
+
+    /// Draw the `k`-th light of the stencil class (mark or light, by the bound pipeline).
+    pub fn draw_stencil_light(&self, pass: &mut wgpu::RenderPass, k: u32) {
+        self.bind(pass);
+        let i = self.ranges[3].start + k;
+        pass.draw_indexed(0..self.index_count, 0, i..i + 1);
+    }
+}

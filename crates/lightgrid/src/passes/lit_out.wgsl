@@ -1,0 +1,13 @@
+// Output of a lighting fragment shader: colour, and how many times it ran the light function
+// (summed by additive blending into the count target).
+struct LitOut {
+    @location(0) color: vec4<f32>,
+    @location(1) count: f32,
+}
+
+fn lit(color: vec3<f32>, count: u32) -> LitOut {
+    var out: LitOut;
+    out.color = vec4<f32>(color, 1.0);
+    out.count = f32(count);
+    return out;
+}

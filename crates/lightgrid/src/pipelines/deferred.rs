@@ -1,0 +1,231 @@
+//! `deferred` and `deferred_stencil`: classic deferred shading with light volumes
+//! (tiled-shading §1.1, §8 "Deferred" and "Deferred-Stencil").
+//!
+//! 1. G-buffer pass (shared with tiled deferred; 16- or 32-bit channels).
+//! 2. One render pass into HDR + counts, depth-tested against a depth-stencil copy:
+//!    a. copy the scene depth (full screen);
+//!    b. the light-independent term (full screen);
+//!    c. `deferred`: each light's volume, additively blended (classes in `light_volumes.rs`);
+//!       `deferred_stencil`: per light, a two-sided z-fail stencil pass marks the samples inside
+//!       the volume, then the volume's back faces shade only marked samples and clear the mark.
+//!       Lights reaching the far plane fall back to the plain volume draws.
+//!
+//! Groups: 0 scene, 1 depth-copy source (copy draw only), 2 G-buffer.
+
+use super::RenderSettings;
+use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
+use crate::culling::LightGrid;
+use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
+use crate::passes::VOLUME_DEPTH_BYTES;
+use crate::passes::{
+    additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_DEPTH_FORMAT,
+    VOLUME_WGSL,
+};
+use crate::passes::{GBuffer, COUNT_FORMAT, FULLSCREEN_WGSL, GBUFFER_READ_WGSL, HDR_FORMAT};
+use crate::shader::{compose, create_module, src, ComposedShader};
+use crate::Result;
+
+pub(super) fn shaders() -> Vec<ComposedShader> {
+    vec![compose(
+        "deferred",
+        &[
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            src::LIGHTING,
+            src::LIT_OUT,
+            FULLSCREEN_WGSL,
+            VOLUME_WGSL,
+            GBUFFER_READ_WGSL,
+            include_str!("deferred.wgsl"),
+        ],
+    )]
+}
+
+struct Deferred {
+    gbuffer: GBuffer,
+    volumes: LightVolumes,
+    copy: wgpu::RenderPipeline,
+    base: wgpu::RenderPipeline,
+    front: wgpu::RenderPipeline,
+    back: wgpu::RenderPipeline,
+    full: wgpu::RenderPipeline,
+    /// (mark, light) for `deferred_stencil`.
+    stencil: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
+}
+
+/// HDR and count targets, both additive.
+pub(super) fn volume_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
+    [
+        Some(additive(HDR_FORMAT)),
+        count_blend.then(|| additive(COUNT_FORMAT)),
+    ]
+}
+
+fn create(ctx: &PipelineContext, stencil: bool) -> Box<dyn Technique> {
+    let device = ctx.device;
+    let (w, h) = (ctx.dims.width, ctx.dims.height);
+    let gbuffer = GBuffer::new(device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let volumes = LightVolumes::new(device, w, h);
+    let module = create_module(device, &shaders()[0]);
+    let targets = volume_targets(ctx.count_blend);
+    let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
+    let volume = |label, fragment_entry, draw| {
+        volumes.pipeline(
+            device,
+            &VolumePipelineDesc {
+                label,
+                module: &module,
+                fragment_entry,
+                layouts: &layouts,
+                color_targets: &targets,
+                draw,
+            },
+        )
+    };
+    let base = {
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("deferred base"),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("deferred base"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_base"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: VOLUME_DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_base"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let stencil = stencil.then(|| {
+        (
+            volume("stencil mark", "fs_light", VolumeDraw::StencilMark),
+            volume("stencil light", "fs_light", VolumeDraw::StencilLight),
+        )
+    });
+    Box::new(Deferred {
+        copy: volumes.copy_pipeline(device, &module, ctx.scene_layout, &targets),
+        base,
+        front: volume("light volumes (front faces)", "fs_light", VolumeDraw::Front),
+        back: volume("light volumes (back faces)", "fs_light", VolumeDraw::Back),
+        full: volume("light volumes (full screen)", "fs_light", VolumeDraw::Full),
+        stencil,
+        gbuffer,
+        volumes,
+    })
+}
+
+pub(super) fn create_plain(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create(ctx, false)
+}
+
+pub(super) fn create_stencil(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create(ctx, true)
+}
+
+impl Technique for Deferred {
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>> {
+        let classes = classify_lights(&f.setup, f.lights, self.stencil.is_some());
+        self.volumes.upload(f.device, f.queue, &classes);
+        let gbuffer_group = self.gbuffer.read_bind_group(f.device, f.targets);
+        let copy_group = self.volumes.copy_bind_group(f.device, &f.targets.depth);
+        let (encoder, timer) = enc.parts();
+        self.gbuffer.encode(f, encoder, timer);
+        let label = if self.stencil.is_some() {
+            "deferred lighting (stencil)"
+        } else {
+            "deferred lighting"
+        };
+        let clear = |c| wgpu::Operations {
+            load: wgpu::LoadOp::Clear(c),
+            store: wgpu::StoreOp::Store,
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &f.targets.hdr,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: clear(wgpu::Color::BLACK),
+                }),
+                f.count_blend.then(|| wgpu::RenderPassColorAttachment {
+                    view: &f.targets.counts,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: clear(wgpu::Color::TRANSPARENT),
+                }),
+            ],
+            depth_stencil_attachment: Some(self.volumes.attachment()),
+            timestamp_writes: timer.render_pass(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, f.scene_bind_group, &[]);
+        pass.set_pipeline(&self.copy);
+        pass.set_bind_group(1, &copy_group, &[]);
+        pass.draw(0..3, 0..1);
+        pass.set_bind_group(2, &gbuffer_group, &[]);
+        pass.set_pipeline(&self.base);
+        pass.draw(0..3, 0..1);
+        for (pipeline, draw) in [
+            (&self.front, VolumeDraw::Front),
+            (&self.back, VolumeDraw::Back),
+            (&self.full, VolumeDraw::Full),
+        ] {
+            pass.set_pipeline(pipeline);
+            self.volumes.draw(&mut pass, draw);
+        }
+        if let Some((mark, light)) = &self.stencil {
+            pass.set_stencil_reference(0);
+            for k in 0..self.volumes.stencil_count() {
+                pass.set_pipeline(mark);
+                self.volumes.draw_stencil_light(&mut pass, k);
+                pass.set_pipeline(light);
+                self.volumes.draw_stencil_light(&mut pass, k);
+            }
+        }
+        Ok(None)
+    }
+}
+
+/// Depth + four G-buffer targets + HDR + the volumes' depth-stencil copy. Per pixel: the
+/// G-buffer pass writes depth and G-buffer, the copy and base passes read depth and the base
+/// target and write the copy and HDR. Per lighting computation: read depth, three G-buffer
+/// targets and the light, blend into HDR (read + write).
+pub(super) fn memory(settings: &RenderSettings) -> MemoryModel {
+    let g = settings.gbuffer.bytes_per_target();
+    MemoryModel::new(
+        &[
+            ("depth", DEPTH_BYTES),
+            ("gbuffer (4 targets)", 4 * g),
+            ("hdr", HDR_BYTES),
+            ("volume depth-stencil", VOLUME_DEPTH_BYTES),
+        ],
+        Traffic {
+            write_per_pixel: DEPTH_BYTES + 4 * g + VOLUME_DEPTH_BYTES + HDR_BYTES,
+            read_per_pixel: 2 * DEPTH_BYTES + g,
+            write_per_lit: HDR_BYTES,
+            read_per_lit: DEPTH_BYTES + 3 * g + HDR_BYTES + LIGHT_BYTES,
+        },
+    )
+}
