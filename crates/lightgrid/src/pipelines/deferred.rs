@@ -5,10 +5,10 @@
 //! 2. One render pass into HDR + counts, depth-tested against a depth-stencil copy:
 //!    a. copy the scene depth (full screen);
 //!    b. the light-independent term (full screen);
-//!    c. `deferred`: each light's volume, additively blended (classes in `light_volumes.rs`);
-//!       `deferred_stencil`: per light, a two-sided z-fail stencil pass marks the samples inside
-//!       the volume, then the volume's back faces shade only marked samples and clear the mark.
-//!       Lights reaching the far plane fall back to the plain volume draws.
+//!    c. `deferred`: each light's volume, additively blended (classes in `light_volumes.rs`).
+//!    d. `deferred_stencil`: per light, a two-sided z-fail stencil pass marks the samples
+//!    inside the volume, then the volume's back faces shade only marked samples and clear the
+//!    mark. Lights reaching the far plane fall back to the plain volume draws of c.
 //!
 //! Groups: 0 scene, 1 depth-copy source (copy draw only), 2 G-buffer.
 
