@@ -84,6 +84,10 @@ struct SceneArgs {
     /// G-buffer channel precision in bits for deferred pipelines.
     #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
     gbuffer: GBufferFormat,
+    /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
+    /// shaders at first use, inside the first frame's GPU time).
+    #[arg(long, default_value_t = 1)]
+    warmup: u32,
 }
 
 fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
@@ -173,6 +177,7 @@ fn main() {
                     seed: 1,
                     tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                     gbuffer: GBufferFormat::F16,
+                    warmup: 1,
                 },
                 out_dir: PathBuf::from("out"),
             },
@@ -212,6 +217,9 @@ fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         .size
         .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
     let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
+    for _ in 0..a.scene.warmup {
+        renderer.render(&scene, a.scene.frame, &a.pipeline)?;
+    }
     let out = renderer.render(&scene, a.scene.frame, &a.pipeline)?;
     if let Some(path) = &a.out {
         save_png(&out.image, path)?;
@@ -285,7 +293,9 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let mut notes = Vec::new();
     let mut failed = Vec::new();
     for p in PIPELINES {
-        let out = match renderer.render(&scene, a.scene.frame, p.id) {
+        let warm = (0..a.scene.warmup)
+            .try_for_each(|_| renderer.render(&scene, a.scene.frame, p.id).map(drop));
+        let out = match warm.and_then(|_| renderer.render(&scene, a.scene.frame, p.id)) {
             Ok(o) => o,
             Err(e) => {
                 println!("{:<24} failed: {e}", p.id);
