@@ -4,6 +4,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
+use lightgrid::bench::{BenchConfig, FrameRange};
 use lightgrid::gpu::{list_adapters, GpuContext};
 use lightgrid::image_io::{check_writable, diff, load_image, save_png, write_atomic};
 use lightgrid::passes::GBufferFormat;
@@ -37,6 +38,9 @@ enum Command {
     Diff(DiffArgs),
     /// Render-target memory and the traffic model of every pipeline at a frame size.
     Memory(MemoryArgs),
+    /// Reproduce the papers' evaluations: frame times, lighting computations and memory over
+    /// scene animations, written as results.json/.csv, plots and summary.md.
+    Bench(BenchArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -135,6 +139,60 @@ struct CompareArgs {
     out_dir: PathBuf,
 }
 
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum Preset {
+    /// CI-sized smoke run: robots-many at 160x90, 4 frames, every pipeline.
+    Quick,
+    /// The papers' configurations: robots-many and robots-few, frames 0..259 every 5, 16- and
+    /// 32-bit G-buffers, at 1920x1080 on a hardware GPU or 640x360 on a software one.
+    Paper,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Start from a preset; flags given explicitly override it.
+    #[arg(long, value_enum)]
+    preset: Option<Preset>,
+    /// Scenes (repeat the flag or separate with commas). Default: robots-many.
+    #[arg(long = "scene", value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// `all` or a comma-separated list of pipeline ids.
+    #[arg(long)]
+    pipelines: Option<String>,
+    /// Frames A..B:STEP (inclusive). Default: 0..259:5, the paper's 5 fps sampling.
+    #[arg(long)]
+    frames: Option<String>,
+    /// Frame size WIDTHxHEIGHT (default: the scene's own size).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<Size>,
+    /// Screen tile edge in pixels.
+    #[arg(long)]
+    tile: Option<u32>,
+    /// MSAA sample count. Only 1 is supported until MSAA lands.
+    #[arg(long, default_value_t = 1)]
+    msaa: u32,
+    /// G-buffer precisions to measure: 16, 32 or 16,32.
+    #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
+    gbuffer: Vec<GBufferFormat>,
+    /// Measurements per frame; the median is kept and the spread recorded.
+    #[arg(long)]
+    repeat: Option<u32>,
+    /// Discarded renders before each pipeline's series.
+    #[arg(long)]
+    warmup: Option<u32>,
+    /// Light count for scenes that take one.
+    #[arg(long)]
+    lights: Option<u32>,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
+    #[arg(long)]
+    heatmap_frame: Option<u32>,
+    /// Output directory.
+    #[arg(long, default_value = "bench")]
+    out: PathBuf,
+}
+
 #[derive(Args)]
 struct MemoryArgs {
     /// Frame size WIDTHxHEIGHT.
@@ -186,6 +244,7 @@ fn main() {
         Some(Command::Compare(a)) => compare(cli.adapter.as_deref(), &a),
         Some(Command::Diff(a)) => diff_cmd(&a),
         Some(Command::Memory(a)) => memory(&a),
+        Some(Command::Bench(a)) => bench(cli.adapter.as_deref(), &a),
         Some(Command::List) => list(),
     };
     if let Err(e) = result {
@@ -402,6 +461,193 @@ fn diff_cmd(a: &DiffArgs) -> Result<()> {
     }
     if !over.is_empty() {
         bail!("images differ: {}", over.join(", "));
+    }
+    Ok(())
+}
+
+/// What a preset (or no preset) sets before explicit flags override it.
+struct BenchDefaults {
+    scenes: Vec<&'static str>,
+    frames: &'static str,
+    size: Option<(u32, u32)>,
+    gbuffers: Vec<GBufferFormat>,
+    repeat: u32,
+    pipelines: Vec<String>,
+}
+
+fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
+    if a.msaa != 1 {
+        bail!(
+            "--msaa {}: MSAA is not implemented yet; only --msaa 1 can be measured",
+            a.msaa
+        );
+    }
+    let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
+    let d = match a.preset {
+        None => BenchDefaults {
+            scenes: vec!["robots-many"],
+            frames: "0..259:5",
+            size: None,
+            gbuffers: vec![GBufferFormat::F16],
+            repeat: 1,
+            pipelines: all.clone(),
+        },
+        Some(Preset::Quick) => BenchDefaults {
+            scenes: vec!["robots-many"],
+            frames: "0..259:86",
+            size: Some((160, 90)),
+            gbuffers: vec![GBufferFormat::F16],
+            repeat: 1,
+            pipelines: all.clone(),
+        },
+        Some(Preset::Paper) => BenchDefaults {
+            scenes: vec!["robots-many", "robots-few"],
+            frames: "0..259:5",
+            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+            gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
+            repeat: if hardware { 3 } else { 1 },
+            // forward_mono only exists as light_prepass_mono's test reference.
+            pipelines: all
+                .iter()
+                .filter(|p| *p != "forward_mono")
+                .cloned()
+                .collect(),
+        },
+    };
+    let (scenes, frames, size, gbuffers, repeat, pipelines) = (
+        d.scenes,
+        d.frames,
+        d.size,
+        d.gbuffers,
+        d.repeat,
+        d.pipelines,
+    );
+    let pipelines = match a.pipelines.as_deref() {
+        None => pipelines,
+        Some("all") => all,
+        Some(list) => list
+            .split(',')
+            .map(|p| p.trim().to_string())
+            .filter(|p| !p.is_empty())
+            .collect(),
+    };
+    let config = BenchConfig {
+        scenes: if a.scenes.is_empty() {
+            scenes.iter().map(|s| s.to_string()).collect()
+        } else {
+            a.scenes.clone()
+        },
+        pipelines,
+        frames: FrameRange::parse(a.frames.as_deref().unwrap_or(frames))?,
+        size: a.size.map(|Size(w, h)| (w, h)).or(size),
+        tile_size: a.tile.unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
+        gbuffers: if a.gbuffer.is_empty() {
+            gbuffers
+        } else {
+            a.gbuffer.clone()
+        },
+        repeat: a.repeat.unwrap_or(repeat),
+        warmup: a.warmup.unwrap_or(1),
+        seed: a.seed,
+        lights: a.lights,
+        heatmap_frame: a.heatmap_frame,
+    };
+    config.validate()?;
+    Ok(config)
+}
+
+fn format_duration(secs: f64) -> String {
+    let s = secs.max(0.0).round() as u64;
+    if s >= 3600 {
+        format!("{}h{:02}m", s / 3600, (s % 3600) / 60)
+    } else if s >= 60 {
+        format!("{}m{:02}s", s / 60, s % 60)
+    } else {
+        format!("{s}s")
+    }
+}
+
+fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
+    check_writable(&a.out.join("results.json")).or_else(|_| {
+        std::fs::create_dir_all(&a.out)
+            .with_context(|| format!("cannot create {}", a.out.display()))
+    })?;
+    let ctx = GpuContext::new(adapter)?;
+    let config = bench_config(a, !ctx.is_software())?;
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || {
+            if stop.swap(true, std::sync::atomic::Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!(
+                "\nstopping after the current frame (Ctrl-C again to abort without writing)..."
+            );
+        })
+        .context("cannot install the Ctrl-C handler")?;
+    }
+    eprintln!(
+        "benchmark on {}: {} scene(s), {} pipeline(s), frames {}..{} every {}, writing to {}",
+        ctx.adapter_label(),
+        config.scenes.len(),
+        config.pipelines.len(),
+        config.frames.start,
+        config.frames.end,
+        config.frames.step,
+        a.out.display()
+    );
+    let start = std::time::Instant::now();
+    let mut last = std::time::Instant::now() - std::time::Duration::from_secs(1);
+    let mut progress = |p: &lightgrid::bench::Progress| {
+        if last.elapsed().as_millis() < 200 && p.done < p.total {
+            return;
+        }
+        last = std::time::Instant::now();
+        let frac = p.done as f64 / p.total.max(1) as f64;
+        let elapsed = start.elapsed().as_secs_f64();
+        let eta = if p.done > 0 {
+            format_duration(elapsed / frac - elapsed)
+        } else {
+            "?".into()
+        };
+        let filled = (frac * 30.0) as usize;
+        eprint!(
+            "\r[{}{}] {:>3.0}% {}/{} ETA {:<7} {:<48}",
+            "#".repeat(filled),
+            " ".repeat(30 - filled),
+            frac * 100.0,
+            p.done,
+            p.total,
+            eta,
+            p.label.chars().take(48).collect::<String>()
+        );
+    };
+    let mut results = lightgrid::bench::run(&ctx, &config, &stop, &mut progress)?;
+    eprintln!();
+    results.command = std::env::args().collect::<Vec<_>>().join(" ");
+    let written = lightgrid::bench::write_report(&a.out, &results)?;
+    let claims = lightgrid::bench::evaluate_claims(&results);
+    let held = claims
+        .iter()
+        .filter(|c| c.verdict == lightgrid::bench::Verdict::Held)
+        .count();
+    let measured = claims
+        .iter()
+        .filter(|c| c.verdict != lightgrid::bench::Verdict::NotMeasured)
+        .count();
+    println!(
+        "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
+        results.runs.len(),
+        format_duration(start.elapsed().as_secs_f64()),
+        written.len(),
+        a.out.display()
+    );
+    if results.interrupted {
+        bail!(
+            "interrupted: partial results written to {}",
+            a.out.display()
+        );
     }
     Ok(())
 }

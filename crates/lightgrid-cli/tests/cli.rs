@@ -325,3 +325,51 @@ fn memory_lists_every_pipeline_with_its_targets() {
     assert!(line.split_whitespace().nth(1) == Some("76"), "{line}");
     assert_fails_with(&["memory", "--size", "0x5"], "at least 1");
 }
+
+#[test]
+fn bench_quick_preset_writes_its_report() {
+    let dir = temp_dir("bench");
+    let o = lightgrid(&[
+        "bench",
+        "--preset",
+        "quick",
+        "--pipelines",
+        "forward,tiled_deferred,deferred",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in [
+        "results.json",
+        "results.csv",
+        "summary.md",
+        "frame_time_robots-many_g16.png",
+        "lighting_robots-many.svg",
+    ] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert!(
+        summary.contains("bench --preset quick"),
+        "summary records the command"
+    );
+    assert_fails_with(
+        &["bench", "--msaa", "4", "--out", dir.to_str().unwrap()],
+        "MSAA",
+    );
+    assert_fails_with(
+        &["bench", "--frames", "9..3", "--out", dir.to_str().unwrap()],
+        "--frames",
+    );
+    assert_fails_with(
+        &[
+            "bench",
+            "--pipelines",
+            "nope",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        "forward",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -4,6 +4,7 @@
 //! Start with [`gpu::GpuContext::new`], build a scene from [`scene::catalog`], and render it
 //! with a [`Renderer`] and a pipeline id from [`pipelines::PIPELINES`].
 
+pub mod bench;
 pub mod consts;
 pub mod culling;
 pub mod error;
@@ -14,6 +15,7 @@ pub mod image_io;
 pub mod memory;
 pub mod passes;
 pub mod pipelines;
+pub mod plot;
 mod renderer;
 pub mod scene;
 pub mod shader;

@@ -14,6 +14,16 @@ pub enum TimingSource {
     WallClock,
 }
 
+impl TimingSource {
+    /// The name used in JSON, CSV and tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            TimingSource::GpuTimestamps => "gpu-timestamps",
+            TimingSource::WallClock => "wall-clock",
+        }
+    }
+}
+
 /// Statistics of one rendered frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameStats {

@@ -1,0 +1,15 @@
+//! The benchmark (tiled-shading §8, forward-plus §5): every scene × G-buffer setting ×
+//! pipeline over a range of animation frames, recording per frame the GPU time per pass,
+//! lighting computations, the ideal count, lights per tile and the memory model; then
+//! `report` writes results.json / results.csv / plots / summary.md and `claims` checks the
+//! papers' claims against the measurements.
+
+mod claims;
+mod report;
+mod run;
+
+pub use claims::{evaluate_claims, Claim, Verdict};
+pub use report::{write_report, REPORT_FILES};
+pub use run::{
+    run, BenchConfig, BenchResults, FrameRange, FrameRecord, Progress, RunRecord, RunSummary, Stat,
+};

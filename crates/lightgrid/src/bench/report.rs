@@ -1,0 +1,387 @@
+//! Writing a benchmark's results: results.json, results.csv, plots (PNG + SVG) and
+//! summary.md. Every file is written whole or not at all.
+
+use super::{evaluate_claims, BenchResults, RunRecord};
+use crate::error::{Error, Result};
+use crate::image_io::{save_png, write_atomic};
+use crate::plot::{LineChart, Series, StackedBars};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Files every report has (plots and heatmaps are added per scene and G-buffer setting).
+pub const REPORT_FILES: &[&str] = &["results.json", "results.csv", "summary.md"];
+
+/// Version of the results.json layout (documented in README).
+pub const SCHEMA_VERSION: u32 = 1;
+
+fn run_name(r: &RunRecord) -> String {
+    match r.gbuffer_bits {
+        Some(b) => format!("{} (g{b})", r.pipeline),
+        None => r.pipeline.clone(),
+    }
+}
+
+fn csv(results: &BenchResults) -> String {
+    let mut s = String::from(
+        "scene,pipeline,gbuffer_bits,width,height,tile_size,timing,frame,gpu_ms,gpu_ms_min,gpu_ms_max,lighting_computations,ideal_lighting_computations,lights_per_tile_avg,lights_per_tile_max,grid_bytes,modelled_write_bytes,modelled_read_bytes,passes\n",
+    );
+    let opt = |v: Option<String>| v.unwrap_or_default();
+    for r in &results.runs {
+        for f in &r.frames {
+            let passes: Vec<String> = f
+                .passes
+                .iter()
+                .map(|p| format!("{}={:.4}", p.label, p.ms))
+                .collect();
+            let min = f
+                .gpu_ms_repeats
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
+            let max = f
+                .gpu_ms_repeats
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{},{},{},{},{},{},{},\"{}\"",
+                r.scene,
+                r.pipeline,
+                opt(r.gbuffer_bits.map(|b| b.to_string())),
+                r.width,
+                r.height,
+                r.tile_size,
+                r.timing.label(),
+                f.frame,
+                f.gpu_ms,
+                min,
+                max,
+                opt(f.lighting_computations.map(|n| n.to_string())),
+                f.ideal_lighting_computations,
+                opt(f.lights_per_tile_avg.map(|v| format!("{v:.3}"))),
+                opt(f.lights_per_tile_max.map(|v| v.to_string())),
+                opt(f.grid_bytes.map(|v| v.to_string())),
+                opt(f.modelled_write_bytes.map(|v| v.to_string())),
+                opt(f.modelled_read_bytes.map(|v| v.to_string())),
+                passes.join(";")
+            );
+        }
+    }
+    s
+}
+
+fn write_chart(
+    dir: &Path,
+    stem: &str,
+    svg: String,
+    png: image::RgbaImage,
+    written: &mut Vec<PathBuf>,
+) -> Result<()> {
+    let svg_path = dir.join(format!("{stem}.svg"));
+    write_atomic(&svg_path, svg.as_bytes())?;
+    let png_path = dir.join(format!("{stem}.png"));
+    save_png(&png, &png_path)?;
+    written.push(png_path);
+    written.push(svg_path);
+    Ok(())
+}
+
+/// Scenes in run order, and the G-buffer settings measured.
+fn scenes_and_bits(results: &BenchResults) -> (Vec<String>, Vec<u32>) {
+    let mut scenes: Vec<String> = Vec::new();
+    for r in &results.runs {
+        if !scenes.contains(&r.scene) {
+            scenes.push(r.scene.clone());
+        }
+    }
+    let bits = results.config.gbuffers.iter().map(|g| g.bits()).collect();
+    (scenes, bits)
+}
+
+fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Result<()> {
+    let (scenes, bits) = scenes_and_bits(results);
+    let (w, h) = results.runs.first().map_or((0, 0), |r| (r.width, r.height));
+    for scene in &scenes {
+        for &b in &bits {
+            let runs: Vec<&RunRecord> = results
+                .runs
+                .iter()
+                .filter(|r| &r.scene == scene && r.gbuffer_bits.unwrap_or(b) == b)
+                .collect();
+            let timing = if runs
+                .iter()
+                .all(|r| r.timing == crate::TimingSource::GpuTimestamps)
+            {
+                "GPU timestamps"
+            } else {
+                "wall clock"
+            };
+            let chart = LineChart {
+                title: format!(
+                    "{scene}: frame time over the animation ({w}x{h}, {b}-bit G-buffer)"
+                ),
+                x_label: "frame".into(),
+                y_label: format!("ms ({timing}, log scale)"),
+                log_y: true,
+                series: runs
+                    .iter()
+                    .map(|r| Series {
+                        name: r.pipeline.clone(),
+                        points: r
+                            .frames
+                            .iter()
+                            .map(|f| (f.frame as f64, f.gpu_ms))
+                            .collect(),
+                        emphasis: false,
+                    })
+                    .collect(),
+            };
+            write_chart(
+                dir,
+                &format!("frame_time_{scene}_g{b}"),
+                chart.svg(),
+                chart.png(),
+                written,
+            )?;
+            let bars = StackedBars {
+                title: format!("{scene}: average GPU time per pass ({b}-bit G-buffer)"),
+                y_label: "ms".into(),
+                bars: runs
+                    .iter()
+                    .filter_map(|r| {
+                        let s = r.summary.as_ref()?;
+                        Some((
+                            r.pipeline.clone(),
+                            s.passes.iter().map(|p| (p.label.clone(), p.ms)).collect(),
+                        ))
+                    })
+                    .collect(),
+            };
+            write_chart(
+                dir,
+                &format!("passes_{scene}_g{b}"),
+                bars.svg(),
+                bars.png(),
+                written,
+            )?;
+        }
+        // Lighting computations do not depend on the G-buffer precision: one chart per scene.
+        let first = bits.first().copied().unwrap_or(16);
+        let runs: Vec<&RunRecord> = results
+            .runs
+            .iter()
+            .filter(|r| &r.scene == scene && r.gbuffer_bits.unwrap_or(first) == first)
+            .collect();
+        let mut series: Vec<Series> = runs
+            .iter()
+            .filter(|r| r.frames.iter().all(|f| f.lighting_computations.is_some()))
+            .map(|r| Series {
+                name: r.pipeline.clone(),
+                points: r
+                    .frames
+                    .iter()
+                    .map(|f| (f.frame as f64, f.lighting_computations.unwrap_or(0) as f64))
+                    .collect(),
+                emphasis: false,
+            })
+            .collect();
+        if let Some(r) = runs.first() {
+            series.push(Series {
+                name: "ideal".into(),
+                points: r
+                    .frames
+                    .iter()
+                    .map(|f| (f.frame as f64, f.ideal_lighting_computations as f64))
+                    .collect(),
+                emphasis: true,
+            });
+        }
+        let chart = LineChart {
+            title: format!("{scene}: lighting computations per frame ({w}x{h})"),
+            x_label: "frame".into(),
+            y_label: "lighting computations (log scale)".into(),
+            log_y: true,
+            series,
+        };
+        write_chart(
+            dir,
+            &format!("lighting_{scene}"),
+            chart.svg(),
+            chart.png(),
+            written,
+        )?;
+    }
+    for (scene, pipeline, frame, img) in &results.heatmaps {
+        let p = dir.join(format!("heatmap_{scene}_{pipeline}_f{frame}.png"));
+        save_png(img, &p)?;
+        written.push(p);
+    }
+    Ok(())
+}
+
+fn mib(b: f64) -> f64 {
+    b / (1024.0 * 1024.0)
+}
+
+fn summary(results: &BenchResults) -> String {
+    let c = &results.config;
+    let mut s = String::from("# lightgrid benchmark\n\n");
+    let (w, h) = results.runs.first().map_or((0, 0), |r| (r.width, r.height));
+    let _ = writeln!(s, "- command: `{}`", results.command);
+    let _ = writeln!(
+        s,
+        "- adapter: **{}**{}",
+        results.adapter,
+        if results.software_adapter {
+            " (software rasterizer: compare shapes and ratios, not absolute times, with the papers' GPUs)"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(
+        s,
+        "- {w}x{h}, tile {}, frames {}..{} every {}, {} repeat(s) per frame (median kept), {} warm-up render(s) per series",
+        c.tile_size, c.frames.start, c.frames.end, c.frames.step, c.repeat, c.warmup
+    );
+    if results.interrupted {
+        s.push_str("- **interrupted**: the run was stopped early; incomplete series are marked\n");
+    }
+    s.push_str("\nTimes are GPU times from timestamp queries at pass boundaries where the adapter has them, else wall time after a device sync (column `timing`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
+    let (scenes, _) = scenes_and_bits(results);
+    for scene in &scenes {
+        let _ = writeln!(s, "\n## {scene}\n");
+        s.push_str("| pipeline | G-buffer | avg ms | min / max ms | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        for r in results.runs.iter().filter(|r| &r.scene == scene) {
+            let Some(m) = &r.summary else { continue };
+            let lc = m
+                .lighting_computations
+                .map_or("n/a".into(), |x| format!("{:.0}", x.avg));
+            let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
+                format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
+            });
+            let eff = m
+                .efficiency
+                .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0));
+            let tiles = match (m.lights_per_tile_avg, m.lights_per_tile_max) {
+                (Some(a), Some(x)) => format!("{a:.1} / {x}"),
+                _ => "-".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} |",
+                r.pipeline,
+                if r.complete { "" } else { " (incomplete)" },
+                r.gbuffer_bits.map_or("-".into(), |b| format!("{b}-bit")),
+                m.gpu_ms.avg,
+                m.gpu_ms.min,
+                m.gpu_ms.max,
+                lc,
+                ratio,
+                eff,
+                tiles,
+                m.bytes_per_pixel,
+                r.timing.label()
+            );
+        }
+        let ideal = results
+            .runs
+            .iter()
+            .find(|r| &r.scene == scene)
+            .and_then(|r| r.summary.as_ref())
+            .map(|m| m.ideal_lighting_computations.avg);
+        if let Some(i) = ideal {
+            let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
+        }
+        s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
+        for r in results.runs.iter().filter(|r| &r.scene == scene) {
+            let Some(m) = &r.summary else { continue };
+            let passes: Vec<String> = m
+                .passes
+                .iter()
+                .map(|p| format!("{} {:.2}", p.label, p.ms))
+                .collect();
+            let n = r.frames.len().max(1) as f64;
+            let avg = |f: &dyn Fn(&super::FrameRecord) -> Option<u64>| {
+                let v: Vec<u64> = r.frames.iter().filter_map(f).collect();
+                (v.len() == r.frames.len()).then(|| v.iter().sum::<u64>() as f64 / n)
+            };
+            let traffic = match (
+                avg(&|f| f.modelled_write_bytes),
+                avg(&|f| f.modelled_read_bytes),
+            ) {
+                (Some(wb), Some(rb)) => format!("{:.1} / {:.1}", mib(wb), mib(rb)),
+                _ => "n/a".into(),
+            };
+            let t1: Vec<_> = r
+                .frames
+                .iter()
+                .filter_map(|f| f.forward_plus_table1)
+                .collect();
+            let table1 = if t1.is_empty() {
+                "-".into()
+            } else {
+                let k = t1.len() as f64;
+                format!(
+                    "{:.1} / {:.1} (M {:.1})",
+                    mib(t1.iter().map(|t| t.forward_plus_bytes).sum::<f64>() / k),
+                    mib(t1.iter().map(|t| t.deferred_bytes).sum::<f64>() / k),
+                    t1.iter().map(|t| t.m).sum::<f64>() / k
+                )
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} |",
+                run_name(r),
+                passes.join(", "),
+                traffic,
+                table1
+            );
+        }
+    }
+    s.push_str("\n## The papers' claims on this adapter\n\n| scene | claim | source | measured | verdict |\n|---|---|---|---|---|\n");
+    for c in evaluate_claims(results) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | **{}** |",
+            c.scene,
+            c.statement,
+            c.source,
+            c.evidence,
+            c.verdict.label()
+        );
+    }
+    s.push_str("\nFiles: `results.json` (per-frame series and summaries), `results.csv` (one row per frame), `frame_time_*` (Fig. 2 style), `lighting_*` (Fig. 3 style, ideal dashed), `passes_*` (per-pass stacked bars), `heatmap_*` (lights per tile).\n");
+    s
+}
+
+/// Write every report file into `dir` (created if missing). Returns the paths written.
+pub fn write_report(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let mut written = Vec::new();
+    #[derive(serde::Serialize)]
+    struct File<'a> {
+        schema_version: u32,
+        #[serde(flatten)]
+        results: &'a BenchResults,
+    }
+    let json = serde_json::to_vec_pretty(&File {
+        schema_version: SCHEMA_VERSION,
+        results,
+    })
+    .map_err(|e| Error::invalid("results", e.to_string()))?;
+    for (name, bytes) in [
+        ("results.json", json),
+        ("results.csv", csv(results).into_bytes()),
+        ("summary.md", summary(results).into_bytes()),
+    ] {
+        let p = dir.join(name);
+        write_atomic(&p, &bytes)?;
+        written.push(p);
+    }
+    plots(dir, results, &mut written)?;
+    Ok(written)
+}

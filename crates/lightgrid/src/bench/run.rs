@@ -1,0 +1,452 @@
+//! Running the benchmark: the measurement loop, warm-up, repeats, cancellation.
+
+use crate::error::{Error, Result};
+use crate::gpu::{GpuContext, PassTiming};
+use crate::memory::ForwardPlusTable1;
+use crate::passes::GBufferFormat;
+use crate::pipelines::{self, RenderSettings};
+use crate::scene::catalog::{self, SceneParams};
+use crate::stats::TimingSource;
+use crate::Renderer;
+use image::RgbaImage;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Frames `start..=end` every `step` (clipped to the scene's animation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrameRange {
+    pub start: u32,
+    pub end: u32,
+    pub step: u32,
+}
+
+impl FrameRange {
+    /// Parse `A..B:STEP`, `A..B` or `N`.
+    pub fn parse(s: &str) -> Result<Self> {
+        let bad = || {
+            Error::invalid(
+                "--frames",
+                format!("'{s}' is not A..B:STEP, A..B or N (e.g. 0..259:5)"),
+            )
+        };
+        let num = |t: &str| t.trim().parse::<u32>().map_err(|_| bad());
+        let (range, step) = match s.split_once(':') {
+            Some((r, st)) => (r, num(st)?),
+            None => (s, 1),
+        };
+        let (start, end) = match range.split_once("..") {
+            Some((a, b)) => (num(a)?, num(b)?),
+            None => {
+                let n = num(range)?;
+                (n, n)
+            }
+        };
+        if step == 0 || end < start {
+            return Err(bad());
+        }
+        Ok(FrameRange { start, end, step })
+    }
+
+    pub fn frames(&self, frame_count: u32) -> Vec<u32> {
+        (self.start..=self.end.min(frame_count.saturating_sub(1)))
+            .step_by(self.step as usize)
+            .collect()
+    }
+}
+
+/// What to measure.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchConfig {
+    pub scenes: Vec<String>,
+    pub pipelines: Vec<String>,
+    pub frames: FrameRange,
+    /// None: each scene's own size.
+    pub size: Option<(u32, u32)>,
+    pub tile_size: u32,
+    pub gbuffers: Vec<GBufferFormat>,
+    /// Measurements per frame (the spread is kept).
+    pub repeat: u32,
+    /// Discarded renders of the first frame before each pipeline's series.
+    pub warmup: u32,
+    pub seed: u64,
+    /// For scenes with a variable light count.
+    pub lights: Option<u32>,
+    /// Frame whose lights-per-tile heatmap goes into the report (None: the middle one).
+    pub heatmap_frame: Option<u32>,
+}
+
+impl BenchConfig {
+    pub fn validate(&self) -> Result<()> {
+        if self.scenes.is_empty() || self.pipelines.is_empty() || self.gbuffers.is_empty() {
+            return Err(Error::invalid(
+                "bench",
+                "needs at least one scene, pipeline and G-buffer setting",
+            ));
+        }
+        for p in &self.pipelines {
+            pipelines::find(p)?;
+        }
+        for s in &self.scenes {
+            catalog::find(s)?;
+        }
+        if self.repeat == 0 {
+            return Err(Error::invalid("--repeat", "must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+/// One measured frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameRecord {
+    pub frame: u32,
+    /// Median over the repeats.
+    pub gpu_ms: f64,
+    pub gpu_ms_repeats: Vec<f64>,
+    /// Per-pass times of the median repeat.
+    pub passes: Vec<PassTiming>,
+    pub lighting_computations: Option<u64>,
+    pub ideal_lighting_computations: u64,
+    pub lights_per_tile_avg: Option<f64>,
+    pub lights_per_tile_max: Option<u32>,
+    pub grid_bytes: Option<u64>,
+    pub modelled_write_bytes: Option<u64>,
+    pub modelled_read_bytes: Option<u64>,
+    pub forward_plus_table1: Option<ForwardPlusTable1>,
+}
+
+/// min / avg / max of a series.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stat {
+    pub min: f64,
+    pub avg: f64,
+    pub max: f64,
+}
+
+impl Stat {
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Stat> {
+        let v: Vec<f64> = values.into_iter().collect();
+        if v.is_empty() {
+            return None;
+        }
+        Some(Stat {
+            min: v.iter().copied().fold(f64::INFINITY, f64::min),
+            avg: v.iter().sum::<f64>() / v.len() as f64,
+            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        })
+    }
+}
+
+/// Summaries of a run's per-frame series.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    pub gpu_ms: Stat,
+    pub lighting_computations: Option<Stat>,
+    pub ideal_lighting_computations: Stat,
+    /// Σ ideal ÷ Σ actual over the frames.
+    pub efficiency: Option<f64>,
+    pub lights_per_tile_avg: Option<f64>,
+    pub lights_per_tile_max: Option<u32>,
+    /// Average GPU time per pass label.
+    pub passes: Vec<PassTiming>,
+    pub bytes_per_pixel: u32,
+    pub target_bytes: u64,
+}
+
+impl RunSummary {
+    pub fn from_frames(
+        frames: &[FrameRecord],
+        bytes_per_pixel: u32,
+        target_bytes: u64,
+    ) -> Option<Self> {
+        let counts: Option<Vec<u64>> = frames.iter().map(|f| f.lighting_computations).collect();
+        let ideal: u64 = frames.iter().map(|f| f.ideal_lighting_computations).sum();
+        let mut passes: Vec<PassTiming> = Vec::new();
+        for f in frames {
+            for p in &f.passes {
+                match passes.iter_mut().find(|q| q.label == p.label) {
+                    Some(q) => q.ms += p.ms,
+                    None => passes.push(p.clone()),
+                }
+            }
+        }
+        for p in &mut passes {
+            p.ms /= frames.len() as f64;
+        }
+        let per_tile: Vec<f64> = frames
+            .iter()
+            .filter_map(|f| f.lights_per_tile_avg)
+            .collect();
+        Some(RunSummary {
+            gpu_ms: Stat::of(frames.iter().map(|f| f.gpu_ms))?,
+            lighting_computations: counts
+                .as_ref()
+                .and_then(|c| Stat::of(c.iter().map(|&n| n as f64))),
+            ideal_lighting_computations: Stat::of(
+                frames.iter().map(|f| f.ideal_lighting_computations as f64),
+            )?,
+            efficiency: counts
+                .map(|c| c.iter().sum::<u64>())
+                .filter(|&n| n > 0)
+                .map(|n| ideal as f64 / n as f64),
+            lights_per_tile_avg: (!per_tile.is_empty())
+                .then(|| per_tile.iter().sum::<f64>() / per_tile.len() as f64),
+            lights_per_tile_max: frames.iter().filter_map(|f| f.lights_per_tile_max).max(),
+            passes,
+            bytes_per_pixel,
+            target_bytes,
+        })
+    }
+}
+
+/// One scene × pipeline × setting.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    pub scene: String,
+    pub pipeline: String,
+    /// None for pipelines without a G-buffer (measured once).
+    pub gbuffer_bits: Option<u32>,
+    pub width: u32,
+    pub height: u32,
+    pub tile_size: u32,
+    pub timing: TimingSource,
+    /// False when the run was interrupted before its last frame.
+    pub complete: bool,
+    pub frames: Vec<FrameRecord>,
+    pub summary: Option<RunSummary>,
+}
+
+/// Everything a bench run measured.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BenchResults {
+    /// The command line that produced these results.
+    pub command: String,
+    pub adapter: String,
+    pub software_adapter: bool,
+    pub config: BenchConfig,
+    /// Stopped by the user (Ctrl-C) before the end.
+    pub interrupted: bool,
+    pub runs: Vec<RunRecord>,
+    /// Lights-per-tile heatmaps: (scene, pipeline, frame, image).
+    #[serde(skip)]
+    pub heatmaps: Vec<(String, String, u32, RgbaImage)>,
+}
+
+/// Progress of a run, for a progress bar.
+#[derive(Clone, Debug)]
+pub struct Progress {
+    pub done: u64,
+    pub total: u64,
+    pub label: String,
+}
+
+fn median(v: &[f64]) -> usize {
+    let mut idx: Vec<usize> = (0..v.len()).collect();
+    idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+    idx[idx.len() / 2]
+}
+
+/// Does the pipeline's memory depend on the G-buffer format (i.e. does it have one)?
+fn uses_gbuffer(p: &pipelines::PipelineInfo) -> bool {
+    let f16 = RenderSettings {
+        gbuffer: GBufferFormat::F16,
+        ..Default::default()
+    };
+    let f32 = RenderSettings {
+        gbuffer: GBufferFormat::F32,
+        ..Default::default()
+    };
+    (p.memory)(&f16) != (p.memory)(&f32)
+}
+
+/// Run the benchmark. `stop` is polled after every render; when set, the results so far are
+/// returned with `interrupted = true`.
+pub fn run(
+    ctx: &GpuContext,
+    config: &BenchConfig,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<BenchResults> {
+    config.validate()?;
+    let params = SceneParams {
+        seed: config.seed,
+        lights: config.lights,
+    };
+    let mut scenes = Vec::new();
+    for name in &config.scenes {
+        let params = SceneParams {
+            lights: if catalog::find(name)?.variable_lights {
+                params.lights
+            } else {
+                None
+            },
+            ..params
+        };
+        scenes.push(catalog::build(name, &params)?);
+    }
+    // The plan: (scene index, gbuffer, pipeline) combinations and their frames.
+    let mut plan = Vec::new();
+    for (si, scene) in scenes.iter().enumerate() {
+        let frames = config.frames.frames(scene.frame_count());
+        if frames.is_empty() {
+            return Err(Error::invalid(
+                "--frames",
+                format!("no frame of {} is in range", scene.name),
+            ));
+        }
+        for (gi, g) in config.gbuffers.iter().enumerate() {
+            for id in &config.pipelines {
+                let info = pipelines::find(id)?;
+                let g_used = uses_gbuffer(info);
+                if !g_used && gi > 0 {
+                    continue;
+                }
+                plan.push((si, *g, info, g_used, frames.clone()));
+            }
+        }
+    }
+    let total: u64 = plan
+        .iter()
+        .map(|p| u64::from(config.warmup) + p.4.len() as u64 * u64::from(config.repeat))
+        .sum();
+    let mut done = 0u64;
+    let mut results = BenchResults {
+        command: String::new(),
+        adapter: ctx.adapter_label(),
+        software_adapter: ctx.is_software(),
+        config: config.clone(),
+        interrupted: false,
+        runs: Vec::new(),
+        heatmaps: Vec::new(),
+    };
+    // The heatmap shows a depth-bounded grid when one is measured.
+    let heatmap_pipeline = config
+        .pipelines
+        .iter()
+        .find(|p| p.as_str() == "tiled_deferred")
+        .or_else(|| {
+            config
+                .pipelines
+                .iter()
+                .find(|p| pipelines::find(p).is_ok_and(|i| i.uses_grid))
+        })
+        .cloned();
+    let mut renderers: Vec<(usize, GBufferFormat, Renderer)> = Vec::new();
+    'plan: for (si, g, info, g_used, frames) in plan {
+        let scene = &scenes[si];
+        let (w, h) = config.size.unwrap_or(scene.default_size);
+        let settings = RenderSettings {
+            tile_size: config.tile_size,
+            gbuffer: g,
+        };
+        if !renderers.iter().any(|r| r.0 == si && r.1 == g) {
+            renderers.retain(|r| r.0 == si);
+            renderers.push((si, g, Renderer::new(ctx, w, h, settings)?));
+        }
+        let renderer = &mut renderers
+            .iter_mut()
+            .find(|r| r.0 == si && r.1 == g)
+            .expect("created above")
+            .2;
+        let label = |f: Option<u32>| {
+            let g = if g_used {
+                format!(" g{}", g.bits())
+            } else {
+                String::new()
+            };
+            match f {
+                Some(f) => format!("{} {}{g} frame {f}", scene.name, info.id),
+                None => format!("{} {}{g} warm-up", scene.name, info.id),
+            }
+        };
+        for _ in 0..config.warmup {
+            progress(&Progress {
+                done,
+                total,
+                label: label(None),
+            });
+            renderer.render(scene, frames[0], info.id)?;
+            done += 1;
+            if stop.load(Ordering::Relaxed) {
+                results.interrupted = true;
+                break 'plan;
+            }
+        }
+        let mut record = RunRecord {
+            scene: scene.name.clone(),
+            pipeline: info.id.to_string(),
+            gbuffer_bits: g_used.then_some(g.bits()),
+            width: w,
+            height: h,
+            tile_size: config.tile_size,
+            timing: TimingSource::WallClock,
+            complete: false,
+            frames: Vec::new(),
+            summary: None,
+        };
+        let heatmap_frame = config.heatmap_frame.unwrap_or(frames[frames.len() / 2]);
+        let mut bytes = (0, 0);
+        for &f in &frames {
+            let mut outs = Vec::new();
+            for _ in 0..config.repeat {
+                progress(&Progress {
+                    done,
+                    total,
+                    label: label(Some(f)),
+                });
+                outs.push(renderer.render(scene, f, info.id)?);
+                done += 1;
+                if stop.load(Ordering::Relaxed) {
+                    results.interrupted = true;
+                    break;
+                }
+            }
+            if results.interrupted && outs.len() < config.repeat as usize {
+                break;
+            }
+            let times: Vec<f64> = outs.iter().map(|o| o.stats.gpu_ms).collect();
+            let m = &outs[median(&times)];
+            let s = &m.stats;
+            record.timing = s.timing;
+            bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
+            let wanted = heatmap_pipeline.as_deref() == Some(info.id);
+            if f == heatmap_frame && wanted && !results.heatmaps.iter().any(|h| h.0 == scene.name) {
+                let map = crate::heatmap::heatmap(&m.image, &m.grid);
+                results
+                    .heatmaps
+                    .push((scene.name.clone(), info.id.to_string(), f, map));
+            }
+            record.frames.push(FrameRecord {
+                frame: f,
+                gpu_ms: s.gpu_ms,
+                gpu_ms_repeats: times.clone(),
+                passes: s.passes.clone(),
+                lighting_computations: s.lighting_computations,
+                ideal_lighting_computations: s.ideal_lighting_computations,
+                lights_per_tile_avg: s.lights_per_tile_avg,
+                lights_per_tile_max: s.lights_per_tile_max,
+                grid_bytes: s.memory.grid_bytes,
+                modelled_write_bytes: s.memory.modelled_write_bytes,
+                modelled_read_bytes: s.memory.modelled_read_bytes,
+                forward_plus_table1: s.memory.forward_plus_table1,
+            });
+            if results.interrupted {
+                break;
+            }
+        }
+        record.complete = !results.interrupted;
+        record.summary = RunSummary::from_frames(&record.frames, bytes.0, bytes.1);
+        if !record.frames.is_empty() {
+            results.runs.push(record);
+        }
+        if results.interrupted {
+            break;
+        }
+    }
+    progress(&Progress {
+        done,
+        total,
+        label: "done".into(),
+    });
+    Ok(results)
+}

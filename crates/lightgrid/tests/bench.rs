@@ -1,0 +1,257 @@
+//! The benchmark: a small run produces every file, results.json has the documented layout,
+//! summaries agree with the per-frame series, the ideal never exceeds any actual count, and a
+//! stopped run keeps what it measured.
+
+mod common;
+
+use lightgrid::bench::{evaluate_claims, run, write_report, BenchConfig, FrameRange, Verdict};
+use lightgrid::passes::GBufferFormat;
+use serde_json::Value;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+fn config() -> BenchConfig {
+    BenchConfig {
+        scenes: vec!["robots-many".into()],
+        pipelines: [
+            "forward",
+            "tiled_forward",
+            "tiled_forward_prez",
+            "tiled_deferred",
+            "deferred",
+            "deferred_stencil",
+            "light_prepass",
+        ]
+        .map(String::from)
+        .to_vec(),
+        frames: FrameRange::parse("0..259:129").unwrap(),
+        size: Some((96, 54)),
+        tile_size: 16,
+        gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
+        repeat: 2,
+        warmup: 1,
+        seed: 1,
+        lights: None,
+        heatmap_frame: None,
+    }
+}
+
+fn num(v: &Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} is not a number in {v}"))
+}
+
+#[test]
+fn a_run_writes_every_file_with_consistent_summaries() {
+    let ctx = common::gpu();
+    let cfg = config();
+    let stop = AtomicBool::new(false);
+    let mut calls = 0;
+    let results = run(&ctx, &cfg, &stop, &mut |p| {
+        calls += 1;
+        assert!(p.done <= p.total);
+    })
+    .unwrap();
+    assert!(calls > 0 && !results.interrupted);
+    let dir = std::env::temp_dir().join(format!("lightgrid-bench-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let written = write_report(&dir, &results).unwrap();
+    for f in [
+        "results.json",
+        "results.csv",
+        "summary.md",
+        "frame_time_robots-many_g16.png",
+        "frame_time_robots-many_g16.svg",
+        "frame_time_robots-many_g32.png",
+        "frame_time_robots-many_g32.svg",
+        "lighting_robots-many.png",
+        "lighting_robots-many.svg",
+        "passes_robots-many_g16.png",
+        "passes_robots-many_g32.svg",
+        "heatmap_robots-many_tiled_deferred_f129.png",
+    ] {
+        assert!(dir.join(f).exists(), "{f} missing");
+        assert!(
+            written.contains(&dir.join(f)),
+            "{f} not reported as written"
+        );
+    }
+
+    // Pipelines without a G-buffer are measured once, the others once per precision.
+    let runs_of = |p: &str| results.runs.iter().filter(|r| r.pipeline == p).count();
+    assert_eq!(
+        (
+            runs_of("forward"),
+            runs_of("tiled_forward_prez"),
+            runs_of("light_prepass")
+        ),
+        (1, 1, 1)
+    );
+    assert_eq!(
+        (
+            runs_of("tiled_deferred"),
+            runs_of("deferred"),
+            runs_of("deferred_stencil")
+        ),
+        (2, 2, 2)
+    );
+
+    // results.json: the documented layout.
+    let json: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("results.json")).unwrap()).unwrap();
+    assert_eq!(json["schema_version"], 1);
+    assert!(
+        json["adapter"].is_string() && json["command"].is_string() && json["interrupted"] == false
+    );
+    assert_eq!(json["config"]["repeat"], 2);
+    let runs = json["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), results.runs.len());
+    let mut csv_rows = 0;
+    for r in runs {
+        for key in ["scene", "pipeline", "timing"] {
+            assert!(r[key].is_string(), "{key} in {r}");
+        }
+        assert!(r["gbuffer_bits"].is_null() || r["gbuffer_bits"] == 16 || r["gbuffer_bits"] == 32);
+        assert_eq!(
+            (
+                r["width"].as_u64(),
+                r["height"].as_u64(),
+                r["tile_size"].as_u64()
+            ),
+            (Some(96), Some(54), Some(16))
+        );
+        assert_eq!(r["complete"], true);
+        let frames = r["frames"].as_array().unwrap();
+        assert_eq!(
+            frames
+                .iter()
+                .map(|f| f["frame"].as_u64().unwrap())
+                .collect::<Vec<_>>(),
+            vec![0, 129, 258]
+        );
+        csv_rows += frames.len();
+        let mut times = Vec::new();
+        let mut counts = Vec::new();
+        for f in frames {
+            let repeats: Vec<f64> = f["gpu_ms_repeats"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            assert_eq!(repeats.len(), 2);
+            assert!(
+                repeats.contains(&num(f, "gpu_ms")),
+                "gpu_ms is one of the repeats (the median)"
+            );
+            assert!(f["passes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|p| p["label"].is_string() && p["ms"].is_number()));
+            let actual = num(f, "lighting_computations");
+            let ideal = num(f, "ideal_lighting_computations");
+            assert!(
+                ideal > 0.0 && ideal <= actual,
+                "{} frame {}: ideal {ideal} > actual {actual}",
+                r["pipeline"],
+                f["frame"]
+            );
+            times.push(num(f, "gpu_ms"));
+            counts.push(actual);
+        }
+        // Summaries agree with the series.
+        let s = &r["summary"];
+        let check = |stat: &Value, v: &[f64]| {
+            let avg = v.iter().sum::<f64>() / v.len() as f64;
+            assert!(
+                (num(stat, "avg") - avg).abs() <= 1e-9 * avg.max(1.0),
+                "{stat} vs {v:?}"
+            );
+            assert_eq!(
+                num(stat, "min"),
+                v.iter().copied().fold(f64::INFINITY, f64::min)
+            );
+            assert_eq!(
+                num(stat, "max"),
+                v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            );
+        };
+        check(&s["gpu_ms"], &times);
+        check(&s["lighting_computations"], &counts);
+        let eff = num(s, "efficiency");
+        assert!(eff > 0.0 && eff <= 1.0, "{eff}");
+        assert!(num(s, "bytes_per_pixel") >= 12.0);
+    }
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        csv_rows + 1,
+        "one CSV row per frame plus the header"
+    );
+
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    for p in &cfg.pipelines {
+        assert!(summary.contains(&format!("| {p}")), "summary lacks {p}");
+    }
+    let claims = evaluate_claims(&results);
+    assert!(claims.len() >= 8);
+    // The G-buffer claim is measurable with both precisions; every verdict is in summary.md.
+    assert!(claims
+        .iter()
+        .any(|c| c.statement.contains("fatter G-buffer") && c.verdict != Verdict::NotMeasured));
+    for c in &claims {
+        assert!(
+            summary.contains(c.statement),
+            "summary lacks claim {}",
+            c.statement
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_stopped_run_keeps_what_it_measured() {
+    let ctx = common::gpu();
+    let mut cfg = config();
+    cfg.gbuffers = vec![GBufferFormat::F16];
+    cfg.repeat = 1;
+    let stop = AtomicBool::new(false);
+    let mut calls = 0;
+    let results = run(&ctx, &cfg, &stop, &mut |_| {
+        calls += 1;
+        if calls == 7 {
+            stop.store(true, Ordering::Relaxed);
+        }
+    })
+    .unwrap();
+    assert!(results.interrupted);
+    assert!(!results.runs.is_empty() && results.runs.len() < cfg.pipelines.len());
+    assert!(results
+        .runs
+        .last()
+        .is_some_and(|r| !r.complete && r.summary.is_some()));
+    let dir = std::env::temp_dir().join(format!("lightgrid-bench-stop-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    write_report(&dir, &results).unwrap();
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert!(summary.contains("interrupted") && summary.contains("(incomplete)"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn frame_ranges_parse_and_reject_nonsense() {
+    assert_eq!(FrameRange::parse("0..259:5").unwrap().frames(260).len(), 52);
+    assert_eq!(
+        FrameRange::parse("10..12").unwrap().frames(260),
+        vec![10, 11, 12]
+    );
+    assert_eq!(FrameRange::parse("7").unwrap().frames(260), vec![7]);
+    assert_eq!(
+        FrameRange::parse("0..1000:100").unwrap().frames(260).last(),
+        Some(&200)
+    );
+    for bad in ["5..1", "0..10:0", "a..b", "1..2:x", ""] {
+        assert!(FrameRange::parse(bad).is_err(), "{bad}");
+    }
+}
