@@ -41,6 +41,8 @@ enum Command {
     /// Reproduce the papers' evaluations: frame times, lighting computations and memory over
     /// scene animations, written as results.json/.csv, plots and summary.md.
     Bench(BenchArgs),
+    /// Rewrite a benchmark's summary.md and plots from its results.json.
+    Report(ReportArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -194,6 +196,12 @@ struct BenchArgs {
 }
 
 #[derive(Args)]
+struct ReportArgs {
+    /// The benchmark directory (reads results.json, writes the report files next to it).
+    dir: PathBuf,
+}
+
+#[derive(Args)]
 struct MemoryArgs {
     /// Frame size WIDTHxHEIGHT.
     #[arg(long, value_parser = parse_size, default_value = "1920x1080")]
@@ -245,6 +253,7 @@ fn main() {
         Some(Command::Diff(a)) => diff_cmd(&a),
         Some(Command::Memory(a)) => memory(&a),
         Some(Command::Bench(a)) => bench(cli.adapter.as_deref(), &a),
+        Some(Command::Report(a)) => report(&a),
         Some(Command::List) => list(),
     };
     if let Err(e) = result {
@@ -649,6 +658,17 @@ fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
             a.out.display()
         );
     }
+    Ok(())
+}
+
+fn report(a: &ReportArgs) -> Result<()> {
+    let results = lightgrid::bench::read_results(&a.dir.join("results.json"))?;
+    let written = lightgrid::bench::write_report(&a.dir, &results)?;
+    println!(
+        "{} files rewritten in {} (heatmaps are kept from the run)",
+        written.len(),
+        a.dir.display()
+    );
     Ok(())
 }
 

@@ -183,6 +183,10 @@ fn a_run_writes_every_file_with_consistent_summaries() {
         assert!(eff > 0.0 && eff <= 1.0, "{eff}");
         assert!(num(s, "bytes_per_pixel") >= 12.0);
     }
+    // results.json reads back to the same runs (what `lightgrid report` rebuilds from).
+    let back = lightgrid::bench::read_results(&dir.join("results.json")).unwrap();
+    assert_eq!(back.runs, results.runs);
+    assert_eq!(back.config, results.config);
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     assert_eq!(
         csv.lines().count(),

@@ -9,7 +9,7 @@ mod report;
 mod run;
 
 pub use claims::{evaluate_claims, Claim, Verdict};
-pub use report::{write_report, REPORT_FILES};
+pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     run, BenchConfig, BenchResults, FrameRange, FrameRecord, Progress, RunRecord, RunSummary, Stat,
 };

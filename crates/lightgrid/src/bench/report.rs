@@ -144,11 +144,14 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 chart.png(),
                 written,
             )?;
+            // The brute-force references would flatten every other bar; their time is in the
+            // frame-time chart.
             let bars = StackedBars {
-                title: format!("{scene}: average GPU time per pass ({b}-bit G-buffer)"),
+                title: format!("{scene}: average GPU time per pass ({b}-bit G-buffer; brute-force forward omitted)"),
                 y_label: "ms".into(),
                 bars: runs
                     .iter()
+                    .filter(|r| !crate::pipelines::find(&r.pipeline).is_ok_and(|p| p.reference == p.id))
                     .filter_map(|r| {
                         let s = r.summary.as_ref()?;
                         Some((
@@ -353,6 +356,30 @@ fn summary(results: &BenchResults) -> String {
     }
     s.push_str("\nFiles: `results.json` (per-frame series and summaries), `results.csv` (one row per frame), `frame_time_*` (Fig. 2 style), `lighting_*` (Fig. 3 style, ideal dashed), `passes_*` (per-pass stacked bars), `heatmap_*` (lights per tile).\n");
     s
+}
+
+/// Read a results.json written by [`write_report`] (heatmaps are not part of it).
+pub fn read_results(path: &Path) -> Result<BenchResults> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let v: serde_json::Value = serde_json::from_slice(&bytes)
+        .map_err(|e| Error::invalid("results", format!("{}: {e}", path.display())))?;
+    match v.get("schema_version").and_then(|x| x.as_u64()) {
+        Some(n) if n == u64::from(SCHEMA_VERSION) => {}
+        other => {
+            return Err(Error::invalid(
+                "results",
+                format!(
+                    "{}: schema_version {other:?}, expected {SCHEMA_VERSION}",
+                    path.display()
+                ),
+            ))
+        }
+    }
+    serde_json::from_value(v)
+        .map_err(|e| Error::invalid("results", format!("{}: {e}", path.display())))
 }
 
 /// Write every report file into `dir` (created if missing). Returns the paths written.

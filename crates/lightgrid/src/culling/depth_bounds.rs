@@ -7,7 +7,7 @@
 
 use super::{GridDims, ViewSetup};
 use crate::gpu::{read_buffer, PassTimer};
-use crate::shader::{compose, create_module, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 use crate::Result;
 
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
@@ -62,7 +62,6 @@ pub struct DepthBoundsPass {
 
 impl DepthBoundsPass {
     pub fn new(device: &wgpu::Device, dims: GridDims) -> Self {
-        let module = create_module(device, &shader());
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth bounds"),
             entries: &[
@@ -98,19 +97,7 @@ impl DepthBoundsPass {
                 },
             ],
         });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("depth bounds"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("depth bounds"),
-            layout: Some(&pl),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = compute_pipeline(device, "depth bounds", &shader(), &[Some(&layout)]);
         let size = (dims.tile_count() * 8) as u64;
         let buffer = |label, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {

@@ -71,23 +71,14 @@ impl GBuffer {
         let views = TARGET_NAMES
             .iter()
             .map(|name| {
-                device
-                    .create_texture(&wgpu::TextureDescriptor {
-                        label: Some(name),
-                        size: wgpu::Extent3d {
-                            width,
-                            height,
-                            depth_or_array_layers: 1,
-                        },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: tf,
-                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                            | wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
-                    })
-                    .create_view(&Default::default())
+                super::render_texture(
+                    device,
+                    name,
+                    tf,
+                    (width, height),
+                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                )
+                .create_view(&Default::default())
             })
             .collect();
         let module = create_module(device, &shader());
@@ -114,16 +105,7 @@ impl GBuffer {
     }
 
     fn read_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let tex = super::texture_entry;
         let float = wgpu::TextureSampleType::Float { filterable: false };
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer read (group 2)"),

@@ -143,22 +143,14 @@ impl LightVolumes {
             contents: bytemuck::cast_slice(&sphere.indices),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let depth = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("light volume depth-stencil"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: VOLUME_DEPTH_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default());
+        let depth = super::render_texture(
+            device,
+            "light volume depth-stencil",
+            VOLUME_DEPTH_FORMAT,
+            (width, height),
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
         let copy_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth copy source"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -381,6 +373,21 @@ impl LightVolumes {
                 resource: wgpu::BindingResource::TextureView(scene_depth),
             }],
         })
+    }
+
+    /// The first draw of a volume pass: copy the scene depth into [`Self::depth`] with the
+    /// pass's `copy_pipeline` and the source from `copy_bind_group`; binds group 0.
+    pub fn draw_depth_copy(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        scene_bind_group: &wgpu::BindGroup,
+        pipeline: &wgpu::RenderPipeline,
+        source: &wgpu::BindGroup,
+    ) {
+        pass.set_bind_group(0, scene_bind_group, &[]);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, source, &[]);
+        pass.draw(0..3, 0..1);
     }
 
     /// Depth-stencil attachment for a volume pass: cleared, then filled by the copy draw.

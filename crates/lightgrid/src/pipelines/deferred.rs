@@ -13,7 +13,7 @@
 //! Groups: 0 scene, 1 depth-copy source (copy draw only), 2 G-buffer.
 
 use super::RenderSettings;
-use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
+use super::{lighting_attachments, FrameEncoder, FrameInputs, PipelineContext, Technique};
 use crate::culling::LightGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::VOLUME_DEPTH_BYTES;
@@ -155,35 +155,16 @@ impl Technique for Deferred {
         } else {
             "deferred lighting"
         };
-        let clear = |c| wgpu::Operations {
-            load: wgpu::LoadOp::Clear(c),
-            store: wgpu::StoreOp::Store,
-        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
-            color_attachments: &[
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &f.targets.hdr,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: clear(wgpu::Color::BLACK),
-                }),
-                f.count_blend.then(|| wgpu::RenderPassColorAttachment {
-                    view: &f.targets.counts,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: clear(wgpu::Color::TRANSPARENT),
-                }),
-            ],
+            color_attachments: &lighting_attachments(f),
             depth_stencil_attachment: Some(self.volumes.attachment()),
             timestamp_writes: timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, f.scene_bind_group, &[]);
-        pass.set_pipeline(&self.copy);
-        pass.set_bind_group(1, &copy_group, &[]);
-        pass.draw(0..3, 0..1);
+        self.volumes
+            .draw_depth_copy(&mut pass, f.scene_bind_group, &self.copy, &copy_group);
         pass.set_bind_group(2, &gbuffer_group, &[]);
         pass.set_pipeline(&self.base);
         pass.draw(0..3, 0..1);

@@ -19,11 +19,11 @@ use super::{
 };
 use crate::culling::LightGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
-use crate::passes::VOLUME_DEPTH_BYTES;
 use crate::passes::{
     additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
     FULLSCREEN_WGSL, HDR_FORMAT, VOLUME_WGSL,
 };
+use crate::passes::{cleared, render_texture, texture_entry, VOLUME_DEPTH_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
 
@@ -60,42 +60,16 @@ fn texture_layout(
     label: &str,
     second: wgpu::TextureSampleType,
 ) -> wgpu::BindGroupLayout {
-    let entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    };
+    let first = wgpu::TextureSampleType::Float { filterable: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
-        entries: &[
-            entry(0, wgpu::TextureSampleType::Float { filterable: false }),
-            entry(1, second),
-        ],
+        entries: &[texture_entry(0, first), texture_entry(1, second)],
     })
 }
 
 fn target(device: &wgpu::Device, label: &str, w: u32, h: u32) -> wgpu::TextureView {
-    device
-        .create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: TARGET_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        })
-        .create_view(&Default::default())
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+    render_texture(device, label, TARGET_FORMAT, (w, h), usage).create_view(&Default::default())
 }
 
 fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
@@ -220,16 +194,7 @@ impl Technique for LightPrepass {
         let specular = self.specular_view.as_ref().unwrap_or(&self.diffuse_view);
         let irr_group = bind_two(f.device, &self.irr_layout, &self.diffuse_view, specular);
         let copy_group = self.volumes.copy_bind_group(f.device, &f.targets.depth);
-        let clear = |c| wgpu::Operations {
-            load: wgpu::LoadOp::Clear(c),
-            store: wgpu::StoreOp::Store,
-        };
-        let color = |view, c| wgpu::RenderPassColorAttachment {
-            view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: clear(c),
-        };
+        let color = cleared;
         let (encoder, timer) = enc.parts();
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -271,10 +236,8 @@ impl Technique for LightPrepass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, f.scene_bind_group, &[]);
-            pass.set_pipeline(&self.copy);
-            pass.set_bind_group(1, &copy_group, &[]);
-            pass.draw(0..3, 0..1);
+            self.volumes
+                .draw_depth_copy(&mut pass, f.scene_bind_group, &self.copy, &copy_group);
             pass.set_bind_group(2, &attr_group, &[]);
             for (pipeline, draw) in
                 self.irradiance

@@ -331,26 +331,9 @@ pub(crate) fn begin_lighting_pass<'e>(
     label: &str,
     depth_cleared: bool,
 ) -> wgpu::RenderPass<'e> {
-    let clear = |c| wgpu::Operations {
-        load: wgpu::LoadOp::Clear(c),
-        store: wgpu::StoreOp::Store,
-    };
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
-        color_attachments: &[
-            Some(wgpu::RenderPassColorAttachment {
-                view: &f.targets.hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: clear(wgpu::Color::BLACK),
-            }),
-            f.count_blend.then(|| wgpu::RenderPassColorAttachment {
-                view: &f.targets.counts,
-                depth_slice: None,
-                resolve_target: None,
-                ops: clear(wgpu::Color::TRANSPARENT),
-            }),
-        ],
+        color_attachments: &lighting_attachments(f),
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &f.targets.depth,
             depth_ops: Some(wgpu::Operations {
@@ -367,6 +350,17 @@ pub(crate) fn begin_lighting_pass<'e>(
         occlusion_query_set: None,
         multiview_mask: None,
     })
+}
+
+/// HDR (cleared to black) and, when countable, the count target (cleared to zero).
+pub(crate) fn lighting_attachments<'a>(
+    f: &'a FrameInputs,
+) -> [Option<wgpu::RenderPassColorAttachment<'a>>; 2] {
+    [
+        Some(crate::passes::cleared(&f.targets.hdr, wgpu::Color::BLACK)),
+        f.count_blend
+            .then(|| crate::passes::cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
+    ]
 }
 
 /// Colour targets of a forward lighting pipeline: HDR and (when countable) the count target.

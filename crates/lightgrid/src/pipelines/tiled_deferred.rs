@@ -20,7 +20,7 @@ use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, L
 use crate::passes::{
     compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
 };
-use crate::shader::{compose, create_module, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 use crate::Result;
 
 /// Shared modules of a deferred compute shader (no vertex stage).
@@ -46,28 +46,6 @@ pub(super) fn shaders_single() -> Vec<ComposedShader> {
     parts.push(TILE_DEPTH_WGSL);
     parts.push(include_str!("tiled_deferred_single.wgsl"));
     vec![compose("tiled_deferred_single", &parts)]
-}
-
-fn compute_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    shader: &ComposedShader,
-    layouts: &[Option<&wgpu::BindGroupLayout>],
-) -> wgpu::ComputePipeline {
-    let module = create_module(device, shader);
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: layouts,
-        immediate_size: 0,
-    });
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    })
 }
 
 enum Variant {

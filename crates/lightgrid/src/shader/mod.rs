@@ -74,3 +74,26 @@ pub fn all_shaders() -> Vec<ComposedShader> {
     }
     out
 }
+
+/// A compute pipeline with entry point `main` from a composed shader and explicit layouts.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &ComposedShader,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::ComputePipeline {
+    let module = create_module(device, shader);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: layouts,
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
