@@ -87,6 +87,9 @@ struct SceneArgs {
     /// Screen tile edge in pixels for grid pipelines (4 to 64).
     #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     tile: u32,
+    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256).
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
+    slices: u32,
     /// G-buffer channel precision in bits for deferred pipelines.
     #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
     gbuffer: GBufferFormat,
@@ -109,6 +112,7 @@ impl SceneArgs {
         RenderSettings {
             tile_size: self.tile,
             gbuffer: self.gbuffer,
+            slices: self.slices,
         }
     }
 }
@@ -170,6 +174,9 @@ struct BenchArgs {
     /// Screen tile edge in pixels.
     #[arg(long)]
     tile: Option<u32>,
+    /// View-depth slices of clustered pipelines.
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
+    slices: u32,
     /// MSAA sample count. Only 1 is supported until MSAA lands.
     #[arg(long, default_value_t = 1)]
     msaa: u32,
@@ -242,6 +249,7 @@ fn main() {
                     lights: None,
                     seed: 1,
                     tile: lightgrid::consts::DEFAULT_TILE_SIZE,
+                    slices: lightgrid::consts::DEFAULT_SLICES,
                     gbuffer: GBufferFormat::F16,
                     warmup: 1,
                 },
@@ -550,6 +558,7 @@ fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
         frames: FrameRange::parse(a.frames.as_deref().unwrap_or(frames))?,
         size: a.size.map(|Size(w, h)| (w, h)).or(size),
         tile_size: a.tile.unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
+        slices: a.slices,
         gbuffers: if a.gbuffer.is_empty() {
             gbuffers
         } else {
@@ -675,8 +684,8 @@ fn report(a: &ReportArgs) -> Result<()> {
 fn memory(a: &MemoryArgs) -> Result<()> {
     let Size(w, h) = a.size;
     let settings = RenderSettings {
-        tile_size: lightgrid::consts::DEFAULT_TILE_SIZE,
         gbuffer: a.gbuffer,
+        ..Default::default()
     };
     println!("render targets at {w}x{h}, {}-bit G-buffer (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
     println!(

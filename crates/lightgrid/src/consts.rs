@@ -11,6 +11,12 @@ pub const MAX_LIGHTS: u32 = 1 << 20;
 /// Default screen tile edge in pixels (tiled-shading §5 discusses 16 and 32).
 pub const DEFAULT_TILE_SIZE: u32 = 16;
 
+/// View-depth slices of the clustered grid (tiled-forward-shading §4.8), exponentially spaced
+/// between the camera's near and far planes.
+pub const DEFAULT_SLICES: u32 = 32;
+/// Most slices accepted by `--slices`.
+pub const MAX_SLICES: u32 = 256;
+
 /// Tile edges accepted by `--tile`. The single-kernel tiled deferred pipeline keeps
 /// (MAX_TILE_SIZE / TILE_THREADS)^2 accumulators per thread, so this bounds its registers.
 pub const MIN_TILE_SIZE: u32 = 4;

@@ -61,9 +61,14 @@ pub struct GridParams {
     pub tiles_x: u32,
     pub tiles_y: u32,
     pub slices: u32,
+    /// slice = floor(ln(view distance) * slice_scale + slice_bias), clamped (clusters only).
+    pub slice_scale: f32,
+    pub slice_bias: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 
-const _: () = assert!(std::mem::size_of::<GridParams>() == 16);
+const _: () = assert!(std::mem::size_of::<GridParams>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);

@@ -1,4 +1,5 @@
 //! The lights-per-tile view (forward-plus Fig. 2b style): each tile tinted by its light count
+//! (for a clustered grid, its fullest cluster)
 //! over a dimmed copy of the frame, with a colour legend (blue 0, green half, red the maximum)
 //! and its end values drawn underneath.
 
@@ -57,10 +58,11 @@ pub fn heatmap(frame: &RgbaImage, grid: &LightGrid) -> RgbaImage {
     let (w, h) = frame.dimensions();
     let scale = (w / 320).max(1);
     let legend_h = 14 * scale;
-    let max = grid.max_lights_per_cell().max(1);
+    let counts = grid.tile_max_counts();
+    let max = counts.iter().copied().max().unwrap_or(0).max(1);
     let mut out = RgbaImage::from_pixel(w, h + legend_h, Rgba([0, 0, 0, 255]));
     for (x, y, p) in frame.enumerate_pixels() {
-        let count = grid.cells[grid.dims.tile_of(x, y)][1];
+        let count = counts[grid.dims.tile_of(x, y)];
         let c = ramp(count as f32 / max as f32);
         let luma = (0.2 * p[0] as f32 + 0.6 * p[1] as f32 + 0.2 * p[2] as f32) / 255.0;
         let px = |i: usize| ((0.55 * c[i] + 0.45 * luma) * 255.0) as u8;

@@ -7,10 +7,10 @@ use crate::culling::{
     GridDims, LightGrid, ViewSetup,
 };
 use crate::error::{Error, Result};
-use crate::gpu::{read_buffer, scoped, wait_idle, GpuContext, PassTimer};
+use crate::gpu::{scoped, wait_idle, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
-use crate::passes::{scene_layout, Targets, Tonemap};
+use crate::passes::{scene_layout, Readback, Targets, Tonemap};
 use crate::pipelines::{
     self, FrameEncoder, FrameInputs, PipelineContext, RenderSettings, Technique,
 };
@@ -95,10 +95,9 @@ pub struct Renderer<'c> {
     techniques: HashMap<&'static str, Box<dyn Technique>>,
     settings: RenderSettings,
     dims: GridDims,
-    readback: wgpu::Buffer,
-    counts_readback: wgpu::Buffer,
-    depth_readback: wgpu::Buffer,
-    padded_row: u32,
+    readback: Readback,
+    counts_readback: Readback,
+    depth_readback: Readback,
 }
 
 /// The memory section of the stats: the pipeline's model applied to this frame.
@@ -171,17 +170,6 @@ impl<'c> Renderer<'c> {
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
             let scene_bind_group =
                 Self::bind_scene(device, &scene_layout, &uniforms, &lights, &materials);
-            let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-                * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-            // Display, count and depth targets all have 4 bytes per pixel.
-            let readback_buffer = |label| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size: u64::from(padded_row) * u64::from(height),
-                    usage: U::MAP_READ | U::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
             Renderer {
                 ctx,
                 targets,
@@ -197,10 +185,9 @@ impl<'c> Renderer<'c> {
                 techniques: HashMap::new(),
                 settings,
                 dims,
-                readback: readback_buffer("image readback"),
-                counts_readback: readback_buffer("counts readback"),
-                depth_readback: readback_buffer("depth readback"),
-                padded_row,
+                readback: Readback::new(device, "image readback", width, height),
+                counts_readback: Readback::new(device, "counts readback", width, height),
+                depth_readback: Readback::new(device, "depth readback", width, height),
             }
         })
     }
@@ -257,49 +244,6 @@ impl<'c> Renderer<'c> {
             self.techniques.insert(info.id, t);
         }
         Ok(())
-    }
-
-    /// Copy a 4-byte-per-pixel texture into a padded readback buffer.
-    fn copy_out(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        texture: &wgpu::Texture,
-        aspect: wgpu::TextureAspect,
-        to: &wgpu::Buffer,
-    ) {
-        let (width, height) = self.size();
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: to,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(self.padded_row),
-                    rows_per_image: Some(height),
-                },
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
-    }
-
-    /// Read a padded 4-byte-per-pixel buffer into tightly packed rows.
-    fn read_rows(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
-        let (width, _) = self.size();
-        let bytes = read_buffer(&self.ctx.device, buffer)?;
-        let row = (width * 4) as usize;
-        Ok(bytes
-            .chunks_exact(self.padded_row as usize)
-            .flat_map(|r| r[..row].iter().copied())
-            .collect())
     }
 
     /// Run the GPU depth-bounds kernel over the depth target as the last frame left it and
@@ -419,23 +363,20 @@ impl<'c> Renderer<'c> {
             &self.targets.hdr,
             &self.targets.ldr,
         );
-        self.copy_out(
+        self.readback.encode(
             &mut encoder,
             &self.targets.ldr_texture,
             wgpu::TextureAspect::All,
-            &self.readback,
         );
-        self.copy_out(
+        self.counts_readback.encode(
             &mut encoder,
             &self.targets.counts_texture,
             wgpu::TextureAspect::All,
-            &self.counts_readback,
         );
-        self.copy_out(
+        self.depth_readback.encode(
             &mut encoder,
             &self.targets.depth_texture,
             wgpu::TextureAspect::DepthOnly,
-            &self.depth_readback,
         );
         self.timer.resolve(&mut encoder);
         scoped(device, &format!("rendering with {}", info.id), || {
@@ -444,12 +385,11 @@ impl<'c> Renderer<'c> {
         wait_idle(device)?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
         let (passes, span) = self.timer.read(device)?;
-        let image = RgbaImage::from_raw(width, height, self.read_rows(&self.readback)?)
-            .expect("size matches");
-        let depth: Vec<f32> = bytemuck::cast_slice(&self.read_rows(&self.depth_readback)?).to_vec();
+        let image =
+            RgbaImage::from_raw(width, height, self.readback.read(device)?).expect("size matches");
+        let depth: Vec<f32> = self.depth_readback.read_f32(device)?;
         let lighting_computations = if self.ctx.count_blend {
-            let counts: Vec<f32> =
-                bytemuck::cast_slice(&self.read_rows(&self.counts_readback)?).to_vec();
+            let counts: Vec<f32> = self.counts_readback.read_f32(device)?;
             Some(counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64)
         } else {
             None

@@ -26,6 +26,7 @@ fn config() -> BenchConfig {
         frames: FrameRange::parse("0..259:129").unwrap(),
         size: Some((96, 54)),
         tile_size: 16,
+        slices: 32,
         gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
         repeat: 2,
         warmup: 1,

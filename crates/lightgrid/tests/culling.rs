@@ -5,8 +5,8 @@
 
 use glam::Vec3;
 use lightgrid::culling::{
-    assign_cpu, depth_bounds_cpu, oracle_tile_lights, project_sphere, to_view_bounds, DepthRange,
-    GridDims, ViewSetup,
+    assign_cpu, cluster_occupancy, depth_bounds_cpu, oracle_tile_lights, project_sphere,
+    to_view_bounds, DepthRange, GridDims, ViewSetup,
 };
 use lightgrid::scene::{Camera, PointLight, Rng};
 
@@ -190,6 +190,105 @@ fn cpu_assignment_contains_the_oracle_in_randomized_cases() {
         assigned_pairs < all_pairs / 2,
         "assignment barely culls: {assigned_pairs} of {all_pairs}"
     );
+}
+
+#[test]
+fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
+    let mut rng = Rng::new(99);
+    let mut oracle_pairs = 0usize;
+    let mut cluster_pairs = 0usize;
+    let mut tile_pairs = 0usize;
+    for case_index in 0..800 {
+        let case = random_case(&mut rng);
+        let depth = random_depth(&mut rng, &case);
+        let s = &case.setup;
+        let tile = TILES[case_index % TILES.len()];
+        let slices = [1, 4, 16, 32, 64][case_index % 5];
+        let tiles = GridDims::new(s.width, s.height, tile).unwrap();
+        let dims = tiles.clustered(slices, s.near, s.far).unwrap();
+        let view_distance: Vec<f32> = depth
+            .iter()
+            .map(|&d| {
+                if d < 1.0 {
+                    s.view_distance(d)
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
+        let bounds = to_view_bounds(s, &depth_bounds_cpu(&depth, &tiles));
+        let occupied = cluster_occupancy(s, &dims, &depth);
+        let grid = assign_cpu(
+            s,
+            &dims,
+            &case.lights,
+            DepthRange::Clusters {
+                tile_bounds: &bounds,
+                occupied: &occupied,
+            },
+        );
+        assert_eq!(grid.cells.len(), dims.cell_count());
+        for (c, must) in oracle.iter().enumerate() {
+            for l in must {
+                assert!(
+                    grid.cell(c).contains(l),
+                    "case {case_index}: cluster {c} (slice {} of {slices}) misses light {l}: {:?}, camera {:?}",
+                    c / dims.tile_count(),
+                    case.lights[*l as usize],
+                    case.camera
+                );
+            }
+            oracle_pairs += must.len();
+        }
+        // Per sample, a cluster never lists more lights than its depth-bounded tile.
+        let tiled = assign_cpu(s, &tiles, &case.lights, DepthRange::PerTile(&bounds));
+        for c in 0..dims.cell_count() {
+            let t = c % dims.tile_count();
+            assert!(
+                grid.cell(c).iter().all(|l| tiled.cell(t).contains(l)),
+                "case {case_index}: cluster {c} ⊄ tile"
+            );
+        }
+        cluster_pairs += grid.indices.len();
+        tile_pairs += tiled.indices.len();
+    }
+    assert!(oracle_pairs > 5_000, "only {oracle_pairs} hits");
+    assert!(cluster_pairs > 0 && tile_pairs > 0);
+}
+
+#[test]
+fn slices_are_exponential_and_match_their_ranges() {
+    let dims = GridDims::new(64, 64, 16)
+        .unwrap()
+        .clustered(16, 0.5, 800.0)
+        .unwrap();
+    assert_eq!(dims.cell_count(), 16 * 16);
+    for k in 0..16 {
+        let [lo, hi] = dims.slice_range(k);
+        let mid = if k == 0 {
+            0.6
+        } else if k == 15 {
+            900.0
+        } else {
+            (lo * hi).sqrt()
+        };
+        assert_eq!(dims.slice_of(mid), k, "slice {k} [{lo}, {hi}]");
+        if k > 0 && k < 15 {
+            assert!(
+                (hi / lo - (1600f32).powf(1.0 / 16.0)).abs() < 1e-3,
+                "exponential spacing"
+            );
+        }
+    }
+    assert!(GridDims::new(64, 64, 16)
+        .unwrap()
+        .clustered(0, 0.5, 800.0)
+        .is_err());
+    assert!(GridDims::new(64, 64, 16)
+        .unwrap()
+        .clustered(16, 0.0, 800.0)
+        .is_err());
 }
 
 #[test]

@@ -50,7 +50,16 @@ fn gpu_structs_match_wgsl() {
         &module,
         "GridParams",
         GridParams,
-        [tile_size, tiles_x, tiles_y, slices]
+        [
+            tile_size,
+            tiles_x,
+            tiles_y,
+            slices,
+            slice_scale,
+            slice_bias,
+            _pad0,
+            _pad1
+        ]
     );
     check_layout!(
         &module,

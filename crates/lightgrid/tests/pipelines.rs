@@ -39,6 +39,8 @@ const TOLERANCES: &[(&str, f64, f64, &str)] = &[
         "16-bit G-buffer normals and colours, and positions rebuilt from depth instead of interpolated",
     ),
     ("tiled_deferred_single", 0.1, 2.0, "as tiled_deferred"),
+    ("clustered_forward", 0.01, 1.0, "as tiled_forward_prez: same fragments, each cluster list holds every light reaching its samples"),
+    ("clustered_deferred", 0.1, 2.0, "as tiled_deferred"),
     (
         "deferred",
         0.5,
@@ -147,6 +149,10 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
         prez >= deferred && prez as f64 <= deferred as f64 * 1.01,
         "prez {prez} vs deferred {deferred}"
     );
+    // Clusters are tiles cut by depth slices (and clipped to the tiles' depth bounds): never
+    // more lights per sample than the depth-bounded tiles.
+    assert!(counts["clustered_forward"] <= counts["tiled_forward_prez"]);
+    assert!(counts["clustered_deferred"] <= counts["tiled_deferred"]);
     // The stencil test culls per sample: never more work than the plain volumes.
     assert!(counts["deferred_stencil"] <= counts["deferred"]);
     // Deferred lighting runs the light function on the same volume fragments as deferred.
@@ -157,7 +163,7 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
 fn settings(tile_size: u32) -> RenderSettings {
     RenderSettings {
         tile_size,
-        gbuffer: GBufferFormat::F16,
+        ..Default::default()
     }
 }
 
@@ -226,6 +232,7 @@ fn random_fps_tile_16_with_32_bit_gbuffer() {
         RenderSettings {
             tile_size: 16,
             gbuffer: GBufferFormat::F32,
+            slices: 24,
         },
     );
 }

@@ -63,6 +63,8 @@ pub struct BenchConfig {
     /// None: each scene's own size.
     pub size: Option<(u32, u32)>,
     pub tile_size: u32,
+    /// View-depth slices of clustered pipelines.
+    pub slices: u32,
     pub gbuffers: Vec<GBufferFormat>,
     /// Measurements per frame (the spread is kept).
     pub repeat: u32,
@@ -338,6 +340,7 @@ pub fn run(
         let settings = RenderSettings {
             tile_size: config.tile_size,
             gbuffer: g,
+            slices: config.slices,
         };
         if !renderers.iter().any(|r| r.0 == si && r.1 == g) {
             renderers.retain(|r| r.0 == si);

@@ -21,7 +21,7 @@ pub struct PixelRect {
     pub y1: u32,
 }
 
-/// Depth ranges the light must overlap to be inserted into a tile.
+/// Depth ranges the light must overlap to be inserted into a cell.
 #[derive(Clone, Copy, Debug)]
 pub enum DepthRange<'a> {
     /// No depth bounds: every tile spans near..far (tiled-shading §3, `tiled_forward`).
@@ -29,6 +29,36 @@ pub enum DepthRange<'a> {
     /// Per-tile view-distance `[min, max]` from a depth buffer (§6.3); `min > max` marks a
     /// tile without samples, which gets no lights.
     PerTile(&'a [[f32; 2]]),
+    /// A clustered grid (tiled-forward-shading §4.8): a light goes into the clusters of its
+    /// screen rectangle whose slice range, clipped to the tile's depth bounds, its view-depth
+    /// interval overlaps, and only into clusters that hold samples (`occupied`, per cell).
+    Clusters {
+        tile_bounds: &'a [[f32; 2]],
+        occupied: &'a [bool],
+    },
+}
+
+/// Cells holding at least one sample, from a depth buffer ([0, 1], 1 = none). A sample within
+/// round-off of a slice boundary marks both slices, since the GPU may place it in either.
+pub fn cluster_occupancy(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec<bool> {
+    let mut occupied = vec![false; dims.cell_count()];
+    for y in 0..dims.height {
+        for x in 0..dims.width {
+            let d = depth[(y * dims.width + x) as usize];
+            if d >= 1.0 {
+                continue;
+            }
+            let w = setup.view_distance(d);
+            let tile = dims.tile_of(x, y);
+            for k in [
+                dims.slice_of(w * (1.0 - DEPTH_SLACK)),
+                dims.slice_of(w * (1.0 + DEPTH_SLACK)),
+            ] {
+                occupied[k as usize * dims.tile_count() + tile] = true;
+            }
+        }
+    }
+    occupied
 }
 
 /// Relative slack for floating-point round-off in the depth test: assignment must be
@@ -142,33 +172,73 @@ pub fn assign_cpu(
             }
         }
     }
-    let lists: Vec<Vec<u32>> = rows
+    let tiles = dims.tile_count();
+    let overlaps = |p: &Placed, lo: f32, hi: f32| {
+        lo <= hi && p.w_max >= lo * (1.0 - DEPTH_SLACK) && p.w_min <= hi * (1.0 + DEPTH_SLACK)
+    };
+    // (cell, light) pairs per row; a cell belongs to one row and lights are visited in index
+    // order, so each cell's list comes out sorted.
+    let pairs: Vec<Vec<(u32, u32)>> = rows
         .par_iter()
         .enumerate()
-        .flat_map_iter(|(ty, row)| {
-            let mut tiles: Vec<Vec<u32>> = vec![Vec::new(); dims.tiles_x as usize];
+        .map(|(ty, row)| {
+            let mut out = Vec::new();
             for &l in row {
                 let p = placed[l as usize]
                     .as_ref()
                     .expect("bucketed lights are placed");
                 for tx in p.tx0..=p.tx1 {
                     let tile = ty * dims.tiles_x as usize + tx as usize;
-                    let reaches = match depth {
-                        DepthRange::NearFar => true,
+                    match depth {
+                        DepthRange::NearFar => out.push((tile as u32, l)),
                         DepthRange::PerTile(b) => {
-                            let [lo, hi] = b[tile];
-                            lo <= hi
-                                && p.w_max >= lo * (1.0 - DEPTH_SLACK)
-                                && p.w_min <= hi * (1.0 + DEPTH_SLACK)
+                            if overlaps(p, b[tile][0], b[tile][1]) {
+                                out.push((tile as u32, l));
+                            }
                         }
-                    };
-                    if reaches {
-                        tiles[tx as usize].push(l);
+                        DepthRange::Clusters {
+                            tile_bounds,
+                            occupied,
+                        } => {
+                            let [lo, hi] = tile_bounds[tile];
+                            if !overlaps(p, lo, hi) {
+                                continue;
+                            }
+                            let k0 = dims.slice_of(p.w_min.max(lo) * (1.0 - DEPTH_SLACK));
+                            let k1 = dims.slice_of(p.w_max.min(hi) * (1.0 + DEPTH_SLACK));
+                            for k in k0..=k1 {
+                                let cell = k as usize * tiles + tile;
+                                let [s0, s1] = dims.slice_range(k);
+                                if occupied[cell] && overlaps(p, s0.max(lo), s1.min(hi)) {
+                                    out.push((cell as u32, l));
+                                }
+                            }
+                        }
                     }
                 }
             }
-            tiles
+            out
         })
         .collect();
-    LightGrid::from_lists(*dims, &lists)
+    let mut counts = vec![0u32; dims.cell_count()];
+    for &(c, _) in pairs.iter().flatten() {
+        counts[c as usize] += 1;
+    }
+    let mut cells = Vec::with_capacity(counts.len());
+    let mut offset = 0u32;
+    for &n in &counts {
+        cells.push([offset, n]);
+        offset += n;
+    }
+    let mut indices = vec![0u32; offset as usize];
+    let mut cursor: Vec<u32> = cells.iter().map(|c| c[0]).collect();
+    for &(c, l) in pairs.iter().flatten() {
+        indices[cursor[c as usize] as usize] = l;
+        cursor[c as usize] += 1;
+    }
+    LightGrid {
+        dims: *dims,
+        cells,
+        indices,
+    }
 }

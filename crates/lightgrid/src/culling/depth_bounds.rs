@@ -110,7 +110,7 @@ impl DepthBoundsPass {
         use wgpu::BufferUsages as U;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("depth bounds params"),
-            size: 16,
+            size: std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
             usage: U::UNIFORM | U::COPY_DST,
             mapped_at_creation: false,
         });

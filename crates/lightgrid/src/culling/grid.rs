@@ -3,21 +3,27 @@
 //! grid is a clustered grid with one depth slice. Every builder produces a [`LightGrid`];
 //! every grid-reading shader reads it through `culling/light_grid.wgsl`.
 
-use crate::consts::{MAX_TILE_SIZE, MIN_TILE_SIZE};
+use crate::consts::{MAX_SLICES, MAX_TILE_SIZE, MIN_TILE_SIZE};
 use crate::error::{Error, Result};
 use crate::gpu_types::GridParams;
 
-/// The grid's shape for a frame size and tile size.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The grid's shape: screen tiles, and for a clustered grid view-depth slices spaced
+/// exponentially between `near` and `far`. Cell index = (slice * tiles_y + ty) * tiles_x + tx.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridDims {
     pub tile_size: u32,
     pub width: u32,
     pub height: u32,
     pub tiles_x: u32,
     pub tiles_y: u32,
+    /// 1 for a tiled grid.
+    pub slices: u32,
+    pub near: f32,
+    pub far: f32,
 }
 
 impl GridDims {
+    /// A tiled grid (one slice).
     pub fn new(width: u32, height: u32, tile_size: u32) -> Result<Self> {
         if !(MIN_TILE_SIZE..=MAX_TILE_SIZE).contains(&tile_size) {
             return Err(Error::invalid(
@@ -31,15 +37,88 @@ impl GridDims {
             height,
             tiles_x: width.div_ceil(tile_size),
             tiles_y: height.div_ceil(tile_size),
+            slices: 1,
+            near: 0.0,
+            far: 0.0,
         })
     }
 
+    /// A clustered grid: `slices` view-depth slices between `near` and `far`.
+    pub fn clustered(self, slices: u32, near: f32, far: f32) -> Result<Self> {
+        if !(1..=MAX_SLICES).contains(&slices) {
+            return Err(Error::invalid(
+                "slices",
+                format!("{slices}: must be between 1 and {MAX_SLICES}"),
+            ));
+        }
+        if !(near > 0.0 && far > near && far.is_finite()) {
+            return Err(Error::invalid(
+                "clusters",
+                format!("need 0 < near < far, got {near} and {far}"),
+            ));
+        }
+        Ok(GridDims {
+            slices,
+            near,
+            far,
+            ..self
+        })
+    }
+
+    /// Screen tiles (cells of one slice).
     pub fn tile_count(&self) -> usize {
         (self.tiles_x * self.tiles_y) as usize
     }
 
+    /// All cells: tiles × slices.
+    pub fn cell_count(&self) -> usize {
+        self.tile_count() * self.slices as usize
+    }
+
     pub fn tile_of(&self, x: u32, y: u32) -> usize {
         ((y / self.tile_size) * self.tiles_x + x / self.tile_size) as usize
+    }
+
+    fn slice_params(&self) -> (f32, f32) {
+        if self.slices <= 1 {
+            return (0.0, 0.0);
+        }
+        let s = self.slices as f32;
+        let span = (self.far / self.near).ln();
+        (s / span, -s * self.near.ln() / span)
+    }
+
+    /// Slice of view distance `w` (the same formula as `grid_slice` in light_grid.wgsl).
+    pub fn slice_of(&self, w: f32) -> u32 {
+        if self.slices <= 1 {
+            return 0;
+        }
+        let (scale, bias) = self.slice_params();
+        ((w.max(1e-6).ln() * scale + bias)
+            .floor()
+            .clamp(0.0, (self.slices - 1) as f32)) as u32
+    }
+
+    /// View-distance range `[lo, hi]` of slice `k`.
+    pub fn slice_range(&self, k: u32) -> [f32; 2] {
+        if self.slices <= 1 {
+            return [0.0, f32::INFINITY];
+        }
+        let ratio = self.far / self.near;
+        let at = |i: u32| self.near * ratio.powf(i as f32 / self.slices as f32);
+        [
+            if k == 0 { 0.0 } else { at(k) },
+            if k + 1 == self.slices {
+                f32::INFINITY
+            } else {
+                at(k + 1)
+            },
+        ]
+    }
+
+    /// Cell of the sample at pixel (x, y) with view distance `w`.
+    pub fn cell_of(&self, x: u32, y: u32, w: f32) -> usize {
+        self.slice_of(w) as usize * self.tile_count() + self.tile_of(x, y)
     }
 
     /// Pixel rectangle [x0, x1) × [y0, y1) of tile `t`, clipped to the frame.
@@ -55,11 +134,16 @@ impl GridDims {
     }
 
     pub fn params(&self) -> GridParams {
+        let (slice_scale, slice_bias) = self.slice_params();
         GridParams {
             tile_size: self.tile_size,
             tiles_x: self.tiles_x,
             tiles_y: self.tiles_y,
-            slices: 1,
+            slices: self.slices,
+            slice_scale,
+            slice_bias,
+            _pad0: 0,
+            _pad1: 0,
         }
     }
 }
@@ -102,6 +186,20 @@ impl LightGrid {
     pub fn max_lights_per_cell(&self) -> u32 {
         self.cells.iter().map(|c| c[1]).max().unwrap_or(0)
     }
+
+    /// Per screen tile, the longest list over its slices (the tile's own count for a tiled
+    /// grid): what the heatmap shows.
+    pub fn tile_max_counts(&self) -> Vec<u32> {
+        let t = self.dims.tile_count();
+        (0..t)
+            .map(|i| {
+                (0..self.dims.slices as usize)
+                    .map(|k| self.cells[k * t + i][1])
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect()
+    }
 }
 
 /// The grid on the GPU: group 1 of every grid-reading shader (`culling/light_grid.wgsl`).
@@ -138,7 +236,12 @@ impl GridBuffers {
 
     pub fn new(device: &wgpu::Device) -> Self {
         let layout = Self::layout(device);
-        let params = Self::buffer(device, "grid params", wgpu::BufferUsages::UNIFORM, 16);
+        let params = Self::buffer(
+            device,
+            "grid params",
+            wgpu::BufferUsages::UNIFORM,
+            std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
+        );
         let cells = Self::buffer(device, "grid cells", wgpu::BufferUsages::STORAGE, 1 << 14);
         let indices = Self::buffer(device, "grid indices", wgpu::BufferUsages::STORAGE, 1 << 16);
         let bind_group = Self::bind(device, &layout, &params, &cells, &indices);

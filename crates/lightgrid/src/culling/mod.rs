@@ -8,7 +8,7 @@ mod grid;
 mod oracle;
 mod view;
 
-pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
+pub use assign_cpu::{assign_cpu, cluster_occupancy, project_sphere, DepthRange, PixelRect};
 pub use depth_bounds::{depth_bounds_cpu, to_view_bounds, DepthBoundsPass};
 pub(crate) use depth_bounds::{shader as depth_bounds_shader, TILE_DEPTH_WGSL};
 pub use grid::{GridBuffers, GridDims, LightGrid};

@@ -6,8 +6,9 @@ use super::{GridDims, LightGrid, ViewSetup};
 use crate::scene::PointLight;
 use rayon::prelude::*;
 
-/// For every tile, the lights whose sphere contains at least one of the tile's samples.
-/// `view_distance[y * width + x]` is the sample's view distance; non-finite means no sample.
+/// For every cell (tile, or tile × slice), the lights whose sphere contains at least one of the
+/// cell's samples. `view_distance[y * width + x]` is the sample's view distance; non-finite
+/// means no sample.
 pub fn oracle_tile_lights(
     setup: &ViewSetup,
     dims: &GridDims,
@@ -15,31 +16,43 @@ pub fn oracle_tile_lights(
     view_distance: &[f32],
 ) -> Vec<Vec<u32>> {
     let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
-    (0..dims.tile_count())
+    let per_tile: Vec<Vec<Vec<u32>>> = (0..dims.tile_count())
         .into_par_iter()
         .map(|t| {
             let (x0, y0, x1, y1) = dims.tile_rect(t);
-            let mut samples = Vec::new();
+            let mut samples = vec![Vec::new(); dims.slices as usize];
             for y in y0..y1 {
                 for x in x0..x1 {
                     let w = view_distance[(y * dims.width + x) as usize];
                     if w.is_finite() {
-                        samples.push(setup.sample_position(x, y, w));
+                        samples[dims.slice_of(w) as usize].push(setup.sample_position(x, y, w));
                     }
                 }
             }
-            view_lights
+            samples
                 .iter()
-                .enumerate()
-                .filter(|(_, l)| {
-                    samples
+                .map(|s| {
+                    view_lights
                         .iter()
-                        .any(|p| p.distance_squared(l.center) < l.radius * l.radius)
+                        .enumerate()
+                        .filter(|(_, l)| {
+                            s.iter()
+                                .any(|p| p.distance_squared(l.center) < l.radius * l.radius)
+                        })
+                        .map(|(i, _)| i as u32)
+                        .collect()
                 })
-                .map(|(i, _)| i as u32)
                 .collect()
         })
-        .collect()
+        .collect();
+    // Reorder tile-major results into cell order (slice-major).
+    let mut cells = vec![Vec::new(); dims.cell_count()];
+    for (t, slices) in per_tile.into_iter().enumerate() {
+        for (k, list) in slices.into_iter().enumerate() {
+            cells[k * dims.tile_count() + t] = list;
+        }
+    }
+    cells
 }
 
 /// The ideal count: for every sample with a finite view distance, the number of lights whose
@@ -63,7 +76,7 @@ pub fn ideal_lighting_computations(
                     continue;
                 }
                 let p = setup.sample_position(x, y, w);
-                for &l in grid.cell(dims.tile_of(x, y)) {
+                for &l in grid.cell(dims.cell_of(x, y, w)) {
                     let v = &view_lights[l as usize];
                     if p.distance_squared(v.center) < v.radius * v.radius {
                         n += 1;

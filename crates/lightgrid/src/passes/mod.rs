@@ -3,6 +3,7 @@
 
 mod gbuffer;
 mod light_volumes;
+mod readback;
 mod tonemap;
 
 pub use gbuffer::{GBuffer, GBufferFormat, GBUFFER_READ_WGSL};
@@ -10,6 +11,7 @@ pub use light_volumes::{
     additive, classify_lights, LightVolumes, VolumeClasses, VolumeDraw, VolumePipelineDesc,
     VOLUME_DEPTH_BYTES, VOLUME_DEPTH_FORMAT, VOLUME_WGSL,
 };
+pub use readback::Readback;
 pub use tonemap::Tonemap;
 
 use crate::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GpuVertex};

@@ -23,6 +23,8 @@ pub struct RenderSettings {
     pub tile_size: u32,
     /// G-buffer channel precision (`--gbuffer 16|32`).
     pub gbuffer: GBufferFormat,
+    /// View-depth slices of clustered grids (`--slices`).
+    pub slices: u32,
 }
 
 impl Default for RenderSettings {
@@ -30,6 +32,7 @@ impl Default for RenderSettings {
         RenderSettings {
             tile_size: crate::consts::DEFAULT_TILE_SIZE,
             gbuffer: GBufferFormat::F16,
+            slices: crate::consts::DEFAULT_SLICES,
         }
     }
 }
@@ -195,6 +198,26 @@ pub const PIPELINES: &[PipelineInfo] = &[
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
         memory: tiled_deferred::memory_single,
+    },
+    PipelineInfo {
+        id: "clustered_forward",
+        description: "depth pre-pass read back, CPU grid of (tile, view-depth slice) clusters holding samples, forward shading",
+        paper: "tiled-forward-shading §4.8",
+        uses_grid: true,
+        reference: "forward",
+        shaders: tiled_forward::shaders,
+        create: tiled_forward::create_clustered,
+        memory: tiled_forward::memory_clustered,
+    },
+    PipelineInfo {
+        id: "clustered_deferred",
+        description: "G-buffer, depth read back, CPU cluster grid, one compute pass shading each sample from its cluster",
+        paper: "tiled-forward-shading §4.8",
+        uses_grid: true,
+        reference: "forward",
+        shaders: tiled_deferred::shaders,
+        create: tiled_deferred::create_clustered,
+        memory: tiled_deferred::memory_clustered,
     },
     PipelineInfo {
         id: "deferred",

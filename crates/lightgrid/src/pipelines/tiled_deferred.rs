@@ -1,4 +1,4 @@
-//! `tiled_deferred` and `tiled_deferred_single`.
+//! `tiled_deferred`, `tiled_deferred_single` and `clustered_deferred`.
 //!
 //! tiled_deferred (tiled-shading §2, §6): 1. G-buffer pass; 2. per-tile depth bounds on the
 //! GPU, read back; 3. CPU assignment pruned by the bounds; 4. upload; 5. compute pass, one
@@ -8,6 +8,10 @@
 //! tiled_deferred_single (§7): 1. G-buffer pass; 2. one kernel, one workgroup per tile:
 //! depth bounds, frustum culling of all lights into workgroup memory, shading.
 //! Groups: 0 scene, 1 tile params, 2 G-buffer, 3 outputs.
+//!
+//! clustered_deferred (tiled-forward-shading §4.8): as tiled_deferred, but step 2 reads the
+//! depth buffer back and step 3 assigns lights to (tile, view-depth slice) clusters that hold
+//! samples; the shading kernel is the same, the accessor finds each sample's cluster.
 
 use super::RenderSettings;
 use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
@@ -18,7 +22,8 @@ use crate::culling::{
 };
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
-    compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
+    compute_outputs, compute_outputs_layout, GBuffer, Readback, COMPUTE_OUTPUTS_WGSL,
+    GBUFFER_READ_WGSL,
 };
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 use crate::Result;
@@ -48,10 +53,18 @@ pub(super) fn shaders_single() -> Vec<ComposedShader> {
     vec![compose("tiled_deferred_single", &parts)]
 }
 
+/// Where a multi-pass variant's grid comes from.
+enum GridSource {
+    /// Tiles pruned by the GPU depth-bounds kernel.
+    TileBounds(Box<DepthBoundsPass>),
+    /// Clusters from the depth buffer read back (see `tiled_forward::assign_clusters`).
+    Clusters { readback: Readback, slices: u32 },
+}
+
 enum Variant {
-    /// Multi-pass: depth bounds kernel + CPU grid + shading kernel.
+    /// Multi-pass: CPU grid + shading kernel.
     Multi {
-        bounds: Box<DepthBoundsPass>,
+        source: GridSource,
         grid: GridBuffers,
     },
     /// Single kernel; group 1 holds the tile size.
@@ -70,6 +83,29 @@ struct TiledDeferred {
 }
 
 pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create_grid(
+        ctx,
+        GridSource::TileBounds(Box::new(DepthBoundsPass::new(ctx.device, ctx.dims))),
+    )
+}
+
+pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
+    let readback = Readback::new(
+        ctx.device,
+        "depth for clusters",
+        ctx.dims.width,
+        ctx.dims.height,
+    );
+    create_grid(
+        ctx,
+        GridSource::Clusters {
+            readback,
+            slices: ctx.settings.slices,
+        },
+    )
+}
+
+fn create_grid(ctx: &PipelineContext, source: GridSource) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
     let grid = GridBuffers::new(ctx.device);
@@ -85,12 +121,11 @@ pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
             Some(&outputs_layout),
         ],
     );
-    let bounds = Box::new(DepthBoundsPass::new(ctx.device, ctx.dims));
     Box::new(TiledDeferred {
         gbuffer,
         outputs_layout,
         shading,
-        variant: Variant::Multi { bounds, grid },
+        variant: Variant::Multi { source, grid },
         dims: ctx.dims,
     })
 }
@@ -116,7 +151,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
         });
     let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("tile params"),
-        size: 16,
+        size: std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
@@ -161,26 +196,41 @@ impl Technique for TiledDeferred {
         let read_group = self.gbuffer.read_bind_group(f.device, f.targets);
         let outputs = compute_outputs(f.device, &self.outputs_layout, f.targets);
         let (grid, group1, label, groups) = match &mut self.variant {
-            Variant::Multi { bounds, grid } => {
-                {
-                    let (encoder, timer) = enc.parts();
-                    bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
-                }
-                enc.submit_and_wait()?;
-                let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
-                let built =
-                    assign_cpu(&f.setup, &dims, f.lights, DepthRange::PerTile(&view_bounds));
+            Variant::Multi { source, grid } => {
+                let built = match source {
+                    GridSource::TileBounds(bounds) => {
+                        let (encoder, timer) = enc.parts();
+                        bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
+                        enc.submit_and_wait()?;
+                        let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
+                        assign_cpu(&f.setup, &dims, f.lights, DepthRange::PerTile(&view_bounds))
+                    }
+                    GridSource::Clusters { readback, slices } => {
+                        let (encoder, _) = enc.parts();
+                        readback.encode(
+                            encoder,
+                            &f.targets.depth_texture,
+                            wgpu::TextureAspect::DepthOnly,
+                        );
+                        enc.submit_and_wait()?;
+                        super::tiled_forward::assign_clusters(
+                            f,
+                            dims,
+                            *slices,
+                            &readback.read_f32(f.device)?,
+                        )?
+                    }
+                };
                 grid.upload(f.device, f.queue, &built);
                 let groups = (
                     dims.width.div_ceil(SCREEN_WORKGROUP),
                     dims.height.div_ceil(SCREEN_WORKGROUP),
                 );
-                (
-                    Some(built),
-                    grid.bind_group(),
-                    "tiled deferred shading",
-                    groups,
-                )
+                let label = match source {
+                    GridSource::TileBounds(_) => "tiled deferred shading",
+                    GridSource::Clusters { .. } => "clustered deferred shading",
+                };
+                (Some(built), grid.bind_group(), label, groups)
             }
             Variant::Single {
                 params,
@@ -237,4 +287,9 @@ pub(super) fn memory_single(settings: &RenderSettings) -> MemoryModel {
     let mut m = memory_multi(settings);
     m.traffic.read_per_lit = LIGHT_BYTES;
     m
+}
+
+/// As `memory_multi`; the depth buffer is read back instead of the bounds.
+pub(super) fn memory_clustered(settings: &RenderSettings) -> MemoryModel {
+    memory_multi(settings)
 }

@@ -10,12 +10,6 @@ const PIXELS_PER_THREAD: u32 = (MAX_TILE_SIZE / TILE_THREADS) * (MAX_TILE_SIZE /
 var<workgroup> batch: array<u32, TILE_LIGHT_BATCH>;
 var<workgroup> batch_count: atomic<u32>;
 
-// View distance (-z) of a depth-buffer value.
-fn view_distance(depth: f32) -> f32 {
-    let r = frame.far / (frame.near - frame.far);
-    return r * frame.near / (depth + r);
-}
-
 struct TileFrustum {
     planes: array<vec3<f32>, 4>,  // inward normals of the side planes (through the eye)
     w_min: f32,
@@ -56,8 +50,8 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     f.planes[1] = normalize(vec3<f32>(-1.0, 0.0, -ndc_hi.x / p00));
     f.planes[2] = normalize(vec3<f32>(0.0, 1.0, ndc_hi.y / p11));
     f.planes[3] = normalize(vec3<f32>(0.0, -1.0, -ndc_lo.y / p11));
-    f.w_min = view_distance(range.x);
-    f.w_max = view_distance(range.y);
+    f.w_min = view_distance_from_depth(range.x);
+    f.w_max = view_distance_from_depth(range.y);
 
     // 3. This thread's samples: pixels lid + (i, j) * TILE_THREADS of the tile.
     let per_edge = (tile.tile_size + TILE_THREADS - 1u) / TILE_THREADS;

@@ -1,4 +1,5 @@
-//! `tiled_forward` and `tiled_forward_prez`: forward shading reading a CPU-built tile grid.
+//! `tiled_forward`, `tiled_forward_prez` and `clustered_forward`: forward shading reading a
+//! CPU-built light grid.
 //!
 //! tiled_forward (tiled-shading §3): 1. CPU assignment against near..far; 2. upload;
 //! 3. lighting pass (depth test Less, writes depth).
@@ -6,6 +7,10 @@
 //! bounds on the GPU, read back; 3. CPU assignment pruned by the bounds; 4. upload;
 //! 5. lighting pass with depth test LessEqual against the pre-pass depth, no depth writes, so
 //! early-Z shades each visible sample once.
+//! clustered_forward (tiled-forward-shading §4.8): 1. depth pre-pass; 2. the depth buffer read
+//! back; 3. on the CPU: tile depth bounds, the clusters holding samples, and assignment to
+//! (tile, view-depth slice) clusters; 4. upload; 5. lighting pass as in 5. above, each fragment
+//! reading its cluster's list.
 
 use super::RenderSettings;
 use super::{
@@ -13,9 +18,11 @@ use super::{
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
 use crate::culling::{
-    assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GridBuffers, GridDims, LightGrid,
+    assign_cpu, cluster_occupancy, depth_bounds_cpu, to_view_bounds, DepthBoundsPass, DepthRange,
+    GridBuffers, GridDims, LightGrid,
 };
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
+use crate::passes::Readback;
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
 
@@ -26,38 +33,51 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
     vec![compose("tiled_forward", &parts)]
 }
 
+/// How the grid is built.
+enum Mode {
+    Plain,
+    PreZ(Box<DepthBoundsPass>),
+    Clustered { readback: Readback, slices: u32 },
+}
+
 struct TiledForward {
-    prez: Option<(wgpu::RenderPipeline, DepthBoundsPass)>,
+    mode: Mode,
+    /// The depth pre-pass (pre-Z and clustered).
+    depth_only: Option<wgpu::RenderPipeline>,
     shading: wgpu::RenderPipeline,
     grid: GridBuffers,
     dims: GridDims,
 }
 
-fn create(ctx: &PipelineContext, prez: bool) -> Box<dyn Technique> {
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Plain,
+    PreZ,
+    Clustered,
+}
+
+fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let grid = GridBuffers::new(ctx.device);
+    let prepass = kind != Kind::Plain;
     let shading = geometry_pipeline(
         ctx.device,
         &GeometryPipelineDesc {
-            label: if prez {
-                "tiled forward shading (pre-z)"
-            } else {
-                "tiled forward shading"
-            },
+            label: "tiled forward shading",
             module: &module,
             fragment_entry: Some("fs_main"),
             layouts: &[Some(ctx.scene_layout), Some(&grid.layout)],
             color_targets: &lighting_targets(ctx.count_blend),
-            depth_write: !prez,
-            depth_compare: if prez {
+            depth_write: !prepass,
+            depth_compare: if prepass {
                 wgpu::CompareFunction::LessEqual
             } else {
                 wgpu::CompareFunction::Less
             },
         },
     );
-    let prez = prez.then(|| {
-        let depth_only = geometry_pipeline(
+    let depth_only = prepass.then(|| {
+        geometry_pipeline(
             ctx.device,
             &GeometryPipelineDesc {
                 label: "depth pre-pass",
@@ -68,11 +88,24 @@ fn create(ctx: &PipelineContext, prez: bool) -> Box<dyn Technique> {
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Less,
             },
-        );
-        (depth_only, DepthBoundsPass::new(ctx.device, ctx.dims))
+        )
     });
+    let mode = match kind {
+        Kind::Plain => Mode::Plain,
+        Kind::PreZ => Mode::PreZ(Box::new(DepthBoundsPass::new(ctx.device, ctx.dims))),
+        Kind::Clustered => Mode::Clustered {
+            readback: Readback::new(
+                ctx.device,
+                "depth for clusters",
+                ctx.dims.width,
+                ctx.dims.height,
+            ),
+            slices: ctx.settings.slices,
+        },
+    };
     Box::new(TiledForward {
-        prez,
+        mode,
+        depth_only,
         shading,
         grid,
         dims: ctx.dims,
@@ -80,57 +113,94 @@ fn create(ctx: &PipelineContext, prez: bool) -> Box<dyn Technique> {
 }
 
 pub(super) fn create_plain(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create(ctx, false)
+    create(ctx, Kind::Plain)
 }
 
 pub(super) fn create_prez(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create(ctx, true)
+    create(ctx, Kind::PreZ)
+}
+
+pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create(ctx, Kind::Clustered)
+}
+
+/// Clustered assignment from a depth buffer read back to the CPU: tile depth bounds, the
+/// clusters that hold samples, then the lights per cluster.
+pub(super) fn assign_clusters(
+    f: &FrameInputs,
+    tiles: GridDims,
+    slices: u32,
+    depth: &[f32],
+) -> Result<LightGrid> {
+    let dims = tiles.clustered(slices, f.setup.near, f.setup.far)?;
+    let bounds = to_view_bounds(&f.setup, &depth_bounds_cpu(depth, &tiles));
+    let occupied = cluster_occupancy(&f.setup, &dims, depth);
+    Ok(assign_cpu(
+        &f.setup,
+        &dims,
+        f.lights,
+        DepthRange::Clusters {
+            tile_bounds: &bounds,
+            occupied: &occupied,
+        },
+    ))
 }
 
 impl Technique for TiledForward {
     fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>> {
-        let dims = self.dims;
-        let grid = match &self.prez {
-            None => assign_cpu(&f.setup, &dims, f.lights, DepthRange::NearFar),
-            Some((depth_only, bounds)) => {
-                {
-                    let (encoder, timer) = enc.parts();
-                    {
-                        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                            label: Some("depth pre-pass"),
-                            color_attachments: &[],
-                            depth_stencil_attachment: Some(
-                                wgpu::RenderPassDepthStencilAttachment {
-                                    view: &f.targets.depth,
-                                    depth_ops: Some(wgpu::Operations {
-                                        load: wgpu::LoadOp::Clear(1.0),
-                                        store: wgpu::StoreOp::Store,
-                                    }),
-                                    stencil_ops: None,
-                                },
-                            ),
-                            timestamp_writes: timer.render_pass("depth pre-pass"),
-                            occlusion_query_set: None,
-                            multiview_mask: None,
-                        });
-                        pass.set_pipeline(depth_only);
-                        draw_scene(&mut pass, f, &[]);
-                    }
-                    bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
-                }
+        if let Some(depth_only) = &self.depth_only {
+            let (encoder, timer) = enc.parts();
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("depth pre-pass"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &f.targets.depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: timer.render_pass("depth pre-pass"),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(depth_only);
+            draw_scene(&mut pass, f, &[]);
+        }
+        let grid = match &self.mode {
+            Mode::Plain => assign_cpu(&f.setup, &self.dims, f.lights, DepthRange::NearFar),
+            Mode::PreZ(bounds) => {
+                let (encoder, timer) = enc.parts();
+                bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
                 enc.submit_and_wait()?;
                 let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
-                assign_cpu(&f.setup, &dims, f.lights, DepthRange::PerTile(&view_bounds))
+                assign_cpu(
+                    &f.setup,
+                    &self.dims,
+                    f.lights,
+                    DepthRange::PerTile(&view_bounds),
+                )
+            }
+            Mode::Clustered { readback, slices } => {
+                let (encoder, _) = enc.parts();
+                readback.encode(
+                    encoder,
+                    &f.targets.depth_texture,
+                    wgpu::TextureAspect::DepthOnly,
+                );
+                enc.submit_and_wait()?;
+                assign_clusters(f, self.dims, *slices, &readback.read_f32(f.device)?)?
             }
         };
         self.grid.upload(f.device, f.queue, &grid);
         let (encoder, timer) = enc.parts();
-        let label = if self.prez.is_some() {
-            "tiled forward shading (pre-z)"
-        } else {
-            "tiled forward shading"
+        let label = match self.mode {
+            Mode::Plain => "tiled forward shading",
+            Mode::PreZ(_) => "tiled forward shading (pre-z)",
+            Mode::Clustered { .. } => "clustered forward shading",
         };
-        let mut pass = begin_lighting_pass(encoder, timer, f, label, self.prez.is_none());
+        let mut pass = begin_lighting_pass(encoder, timer, f, label, self.depth_only.is_none());
         pass.set_pipeline(&self.shading);
         draw_scene(&mut pass, f, &[self.grid.bind_group()]);
         drop(pass);
@@ -157,4 +227,9 @@ pub(super) fn memory_prez(settings: &RenderSettings) -> MemoryModel {
     let mut m = memory_plain(settings);
     m.traffic.read_per_pixel += DEPTH_BYTES;
     m
+}
+
+/// As `memory_prez`: the whole depth buffer is read back instead of the bounds.
+pub(super) fn memory_clustered(settings: &RenderSettings) -> MemoryModel {
+    memory_prez(settings)
 }

@@ -17,3 +17,9 @@ fn world_from_depth(p: vec2<u32>, depth: f32) -> vec3<f32> {
     let h = frame.inv_view_proj * ndc;
     return h.xyz / h.w;
 }
+
+// View distance (-z in view space) of a depth-buffer value (the projection's inverse).
+fn view_distance_from_depth(depth: f32) -> f32 {
+    let r = frame.far / (frame.near - frame.far);
+    return r * frame.near / (depth + r);
+}

@@ -36,4 +36,8 @@ struct GridParams {
     tiles_x: u32,
     tiles_y: u32,
     slices: u32,
+    slice_scale: f32,
+    slice_bias: f32,
+    _pad0: u32,
+    _pad1: u32,
 }
