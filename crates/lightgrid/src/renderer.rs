@@ -154,7 +154,8 @@ impl<'c> Renderer<'c> {
         validate_size(ctx, width, height)?;
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
-        scoped(device, "creating render targets", || {
+        let on_gl = ctx.info.backend == wgpu::Backend::Gl;
+        let created = scoped(device, "creating render targets", || {
             let targets = Targets::new(device, width, height);
             let scene_layout = scene_layout(device);
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
@@ -189,6 +190,16 @@ impl<'c> Renderer<'c> {
                 counts_readback: Readback::new(device, "counts readback", width, height),
                 depth_readback: Readback::new(device, "depth readback", width, height),
             }
+        });
+        created.map_err(|e| match e {
+            Error::Gpu { stage, message } if on_gl => Error::Gpu {
+                stage,
+                message: format!(
+                    "{message}\nThe GL backend (llvmpipe GL) lacks features lightgrid's render targets need; \
+                     use a Vulkan adapter (`sudo apt-get install -y mesa-vulkan-drivers libvulkan1`, then --adapter vulkan)"
+                ),
+            },
+            e => e,
         })
     }
 
