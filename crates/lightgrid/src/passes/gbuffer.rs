@@ -163,14 +163,7 @@ impl GBuffer {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &f.targets.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: Some(crate::passes::cleared_depth(&f.targets.depth)),
             timestamp_writes: timer.render_pass("gbuffer"),
             occlusion_query_set: None,
             multiview_mask: None,

@@ -201,6 +201,18 @@ pub fn cleared(
     }
 }
 
+/// The scene depth attachment, cleared to the far plane and stored.
+pub fn cleared_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
 /// The frame's render targets.
 pub struct Targets {
     pub width: u32,

@@ -200,14 +200,7 @@ impl Technique for LightPrepass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("light pre-pass attributes"),
                 color_attachments: &[Some(color(&self.attr_view, wgpu::Color::TRANSPARENT))],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &f.targets.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(crate::passes::cleared_depth(&f.targets.depth)),
                 timestamp_writes: timer.render_pass("light pre-pass attributes"),
                 occlusion_query_set: None,
                 multiview_mask: None,

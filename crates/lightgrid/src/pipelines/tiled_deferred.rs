@@ -206,19 +206,7 @@ impl Technique for TiledDeferred {
                         assign_cpu(&f.setup, &dims, f.lights, DepthRange::PerTile(&view_bounds))
                     }
                     GridSource::Clusters { readback, slices } => {
-                        let (encoder, _) = enc.parts();
-                        readback.encode(
-                            encoder,
-                            &f.targets.depth_texture,
-                            wgpu::TextureAspect::DepthOnly,
-                        );
-                        enc.submit_and_wait()?;
-                        super::tiled_forward::assign_clusters(
-                            f,
-                            dims,
-                            *slices,
-                            &readback.read_f32(f.device)?,
-                        )?
+                        super::tiled_forward::assign_clusters(f, enc, readback, dims, *slices)?
                     }
                 };
                 grid.upload(f.device, f.queue, &built);

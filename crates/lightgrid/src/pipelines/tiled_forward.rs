@@ -124,14 +124,24 @@ pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
     create(ctx, Kind::Clustered)
 }
 
-/// Clustered assignment from a depth buffer read back to the CPU: tile depth bounds, the
-/// clusters that hold samples, then the lights per cluster.
+/// Clustered assignment: submit what is recorded, read the depth buffer back, then on the CPU
+/// the tile depth bounds, the clusters that hold samples, and the lights per cluster.
 pub(super) fn assign_clusters(
     f: &FrameInputs,
+    enc: &mut FrameEncoder,
+    readback: &Readback,
     tiles: GridDims,
     slices: u32,
-    depth: &[f32],
 ) -> Result<LightGrid> {
+    let (encoder, _) = enc.parts();
+    readback.encode(
+        encoder,
+        &f.targets.depth_texture,
+        wgpu::TextureAspect::DepthOnly,
+    );
+    enc.submit_and_wait()?;
+    let depth = readback.read_f32(f.device)?;
+    let depth = depth.as_slice();
     let dims = tiles.clustered(slices, f.setup.near, f.setup.far)?;
     let bounds = to_view_bounds(&f.setup, &depth_bounds_cpu(depth, &tiles));
     let occupied = cluster_occupancy(&f.setup, &dims, depth);
@@ -153,14 +163,7 @@ impl Technique for TiledForward {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("depth pre-pass"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &f.targets.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(crate::passes::cleared_depth(&f.targets.depth)),
                 timestamp_writes: timer.render_pass("depth pre-pass"),
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -183,14 +186,7 @@ impl Technique for TiledForward {
                 )
             }
             Mode::Clustered { readback, slices } => {
-                let (encoder, _) = enc.parts();
-                readback.encode(
-                    encoder,
-                    &f.targets.depth_texture,
-                    wgpu::TextureAspect::DepthOnly,
-                );
-                enc.submit_and_wait()?;
-                assign_clusters(f, self.dims, *slices, &readback.read_f32(f.device)?)?
+                assign_clusters(f, enc, readback, self.dims, *slices)?
             }
         };
         self.grid.upload(f.device, f.queue, &grid);
