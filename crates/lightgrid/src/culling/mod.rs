@@ -11,6 +11,9 @@ mod view;
 pub use assign_cpu::{assign_cpu, cluster_occupancy, project_sphere, DepthRange, PixelRect};
 pub use depth_bounds::{depth_bounds_cpu, to_view_bounds, DepthBoundsPass};
 pub(crate) use depth_bounds::{shader as depth_bounds_shader, TILE_DEPTH_WGSL};
+
+/// `tile_frustum` / `light_in_tile` (needs the scene bindings).
+pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
 pub use grid::{GridBuffers, GridDims, LightGrid};
 pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
 pub use view::{ViewLight, ViewSetup};

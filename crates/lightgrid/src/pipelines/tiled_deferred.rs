@@ -49,6 +49,7 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 pub(super) fn shaders_single() -> Vec<ComposedShader> {
     let mut parts = deferred_parts();
     parts.push(TILE_DEPTH_WGSL);
+    parts.push(crate::culling::TILE_FRUSTUM_WGSL);
     parts.push(include_str!("tiled_deferred_single.wgsl"));
     vec![compose("tiled_deferred_single", &parts)]
 }

@@ -10,48 +10,14 @@ const PIXELS_PER_THREAD: u32 = (MAX_TILE_SIZE / TILE_THREADS) * (MAX_TILE_SIZE /
 var<workgroup> batch: array<u32, TILE_LIGHT_BATCH>;
 var<workgroup> batch_count: atomic<u32>;
 
-struct TileFrustum {
-    planes: array<vec3<f32>, 4>,  // inward normals of the side planes (through the eye)
-    w_min: f32,
-    w_max: f32,
-}
-
-fn light_in_tile(f: TileFrustum, light: Light) -> bool {
-    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
-    let r = light.range;
-    let w = -c.z;
-    if (w + r < f.w_min * (1.0 - 1e-4) || w - r > f.w_max * (1.0 + 1e-4)) {
-        return false;
-    }
-    for (var i = 0u; i < 4u; i = i + 1u) {
-        if (dot(f.planes[i], c) < -r) {
-            return false;
-        }
-    }
-    return true;
-}
-
 @compute @workgroup_size(TILE_THREADS, TILE_THREADS)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     // 1. Depth bounds of the tile.
     let range = reduce_tile_depth(gb_depth, wg.xy, tile.tile_size, lid.xy, li);
-    let has_samples = range.x <= range.y;
 
-    // 2. The tile's frustum in view space.
+    // 2. The tile's frustum in view space (empty when the tile has no samples).
+    let f = tile_frustum(wg.xy, tile.tile_size, range);
     let size = frame.viewport;
-    let lo = vec2<f32>(wg.xy * tile.tile_size);
-    let hi = min(lo + vec2<f32>(f32(tile.tile_size)), size);
-    let ndc_lo = vec2<f32>(lo.x / size.x * 2.0 - 1.0, 1.0 - lo.y / size.y * 2.0);  // left, top
-    let ndc_hi = vec2<f32>(hi.x / size.x * 2.0 - 1.0, 1.0 - hi.y / size.y * 2.0);  // right, bottom
-    let p00 = frame.proj[0][0];
-    let p11 = frame.proj[1][1];
-    var f: TileFrustum;
-    f.planes[0] = normalize(vec3<f32>(1.0, 0.0, ndc_lo.x / p00));
-    f.planes[1] = normalize(vec3<f32>(-1.0, 0.0, -ndc_hi.x / p00));
-    f.planes[2] = normalize(vec3<f32>(0.0, 1.0, ndc_hi.y / p11));
-    f.planes[3] = normalize(vec3<f32>(0.0, -1.0, -ndc_lo.y / p11));
-    f.w_min = view_distance_from_depth(range.x);
-    f.w_max = view_distance_from_depth(range.y);
 
     // 3. This thread's samples: pixels lid + (i, j) * TILE_THREADS of the tile.
     let per_edge = (tile.tile_size + TILE_THREADS - 1u) / TILE_THREADS;
@@ -71,7 +37,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         workgroupBarrier();
         for (var i = li; i < TILE_LIGHT_BATCH; i = i + TILE_THREADS * TILE_THREADS) {
             let l = first + i;
-            if (has_samples && l < frame.light_count && light_in_tile(f, lights[l])) {
+            if (l < frame.light_count && light_in_tile(f, lights[l])) {
                 batch[atomicAdd(&batch_count, 1u)] = l;
             }
         }
