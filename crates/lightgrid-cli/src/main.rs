@@ -47,6 +47,22 @@ enum Command {
     List,
 }
 
+/// `--assign` values.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum AssignArg {
+    Cpu,
+    Gather,
+}
+
+impl From<AssignArg> for lightgrid::pipelines::Assign {
+    fn from(a: AssignArg) -> Self {
+        match a {
+            AssignArg::Cpu => lightgrid::pipelines::Assign::Cpu,
+            AssignArg::Gather => lightgrid::pipelines::Assign::Gather,
+        }
+    }
+}
+
 /// Frame size as WIDTHxHEIGHT.
 #[derive(Clone, Copy, Debug)]
 struct Size(u32, u32);
@@ -90,6 +106,10 @@ struct SceneArgs {
     /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256).
     #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
     slices: u32,
+    /// Who builds the light grid: cpu, or gather (GPU, one workgroup per tile; for
+    /// tiled_forward_prez and tiled_deferred).
+    #[arg(long, value_enum, default_value = "cpu")]
+    assign: AssignArg,
     /// G-buffer channel precision in bits for deferred pipelines.
     #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
     gbuffer: GBufferFormat,
@@ -113,6 +133,7 @@ impl SceneArgs {
             tile_size: self.tile,
             gbuffer: self.gbuffer,
             slices: self.slices,
+            assign: self.assign.into(),
         }
     }
 }
@@ -177,6 +198,9 @@ struct BenchArgs {
     /// View-depth slices of clustered pipelines.
     #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
     slices: u32,
+    /// Grid builder for pipelines that can use GPU gather (cpu or gather).
+    #[arg(long, value_enum, default_value = "cpu")]
+    assign: AssignArg,
     /// MSAA sample count. Only 1 is supported until MSAA lands.
     #[arg(long, default_value_t = 1)]
     msaa: u32,
@@ -250,6 +274,7 @@ fn main() {
                     seed: 1,
                     tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                     slices: lightgrid::consts::DEFAULT_SLICES,
+                    assign: AssignArg::Cpu,
                     gbuffer: GBufferFormat::F16,
                     warmup: 1,
                 },
@@ -559,6 +584,7 @@ fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
         size: a.size.map(|Size(w, h)| (w, h)).or(size),
         tile_size: a.tile.unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
         slices: a.slices,
+        assign: a.assign.into(),
         gbuffers: if a.gbuffer.is_empty() {
             gbuffers
         } else {

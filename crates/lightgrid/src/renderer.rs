@@ -240,6 +240,20 @@ impl<'c> Renderer<'c> {
 
     fn prepare_technique(&mut self, id: &str) -> Result<()> {
         let info = pipelines::find(id)?;
+        if self.settings.assign == pipelines::Assign::Gather && info.uses_grid && !info.gpu_gather {
+            let able: Vec<&str> = pipelines::PIPELINES
+                .iter()
+                .filter(|p| p.gpu_gather)
+                .map(|p| p.id)
+                .collect();
+            return Err(Error::invalid(
+                "--assign",
+                format!(
+                    "{id} cannot build its grid with GPU gather yet; pipelines that can: {}",
+                    able.join(", ")
+                ),
+            ));
+        }
         if !self.techniques.contains_key(info.id) {
             let device = &self.ctx.device;
             let ctx = PipelineContext {

@@ -5,8 +5,8 @@
 
 use glam::Vec3;
 use lightgrid::culling::{
-    assign_cpu, cluster_occupancy, depth_bounds_cpu, oracle_tile_lights, project_sphere,
-    to_view_bounds, DepthRange, GridDims, ViewSetup,
+    assign_cpu, assign_gather_cpu, cluster_occupancy, depth_bounds_cpu, oracle_tile_lights,
+    project_sphere, to_view_bounds, DepthRange, GridDims, ViewSetup,
 };
 use lightgrid::scene::{Camera, PointLight, Rng};
 
@@ -255,6 +255,42 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
     }
     assert!(oracle_pairs > 5_000, "only {oracle_pairs} hits");
     assert!(cluster_pairs > 0 && tile_pairs > 0);
+}
+
+#[test]
+fn gather_twin_contains_the_oracle_in_randomized_cases() {
+    let mut rng = Rng::new(4242);
+    let mut hits = 0usize;
+    for case_index in 0..800 {
+        let case = random_case(&mut rng);
+        let depth = random_depth(&mut rng, &case);
+        let s = &case.setup;
+        let dims = GridDims::new(s.width, s.height, TILES[case_index % TILES.len()]).unwrap();
+        let view_distance: Vec<f32> = depth
+            .iter()
+            .map(|&d| {
+                if d < 1.0 {
+                    s.view_distance(d)
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
+        let gather = assign_gather_cpu(s, &dims, &case.lights, &depth_bounds_cpu(&depth, &dims));
+        for (t, must) in oracle.iter().enumerate() {
+            for l in must {
+                assert!(
+                    gather.cell(t).contains(l),
+                    "case {case_index}: gather misses light {l} in tile {t}: {:?}, camera {:?}",
+                    case.lights[*l as usize],
+                    case.camera
+                );
+            }
+            hits += must.len();
+        }
+    }
+    assert!(hits > 5_000, "only {hits} hits");
 }
 
 #[test]

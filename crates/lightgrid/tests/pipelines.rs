@@ -233,6 +233,7 @@ fn random_fps_tile_16_with_32_bit_gbuffer() {
             tile_size: 16,
             gbuffer: GBufferFormat::F32,
             slices: 24,
+            assign: Default::default(),
         },
     );
 }
@@ -262,6 +263,91 @@ fn gpu_depth_bounds_equal_the_cpu_reduction() {
         );
         assert_eq!(out.grid, expected);
     }
+}
+
+/// GPU gather builds, per tile, the same set of lights as its CPU twin (fed with the same depth
+/// bounds), apart from lights whose test is within round-off of a frustum plane; and shading
+/// with it reproduces the reference.
+fn check_gather(scene: &str, frame: u32, (w, h): (u32, u32), tile: u32) {
+    use lightgrid::culling::{assign_gather_cpu, gather_margins};
+    use lightgrid::pipelines::Assign;
+    let ctx = common::gpu();
+    let s = catalog::build(scene, &SceneParams::default()).unwrap();
+    let gather = RenderSettings {
+        tile_size: tile,
+        assign: Assign::Gather,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&ctx, w, h, gather).unwrap();
+    let reference = r.render(&s, frame, REFERENCE).unwrap();
+    let state = s.frame(frame);
+    let setup = ViewSetup::new(&state.camera, w, h);
+    for id in ["tiled_forward_prez", "tiled_deferred"] {
+        let out = r.render(&s, frame, id).unwrap();
+        assert!(out.grid_is_pipelines);
+        let dims = GridDims::new(w, h, tile).unwrap();
+        let bounds = depth_bounds_cpu(&out.depth, &dims);
+        let twin = assign_gather_cpu(&setup, &dims, &state.lights, &bounds);
+        let margins = gather_margins(&setup, &dims, &state.lights, &bounds);
+        let mut ambiguous = 0;
+        for t in 0..dims.tile_count() {
+            let mut gpu: Vec<u32> = out.grid.cell(t).to_vec();
+            gpu.sort_unstable();
+            let cpu = twin.cell(t);
+            for l in 0..state.lights.len() as u32 {
+                let (g, c) = (gpu.binary_search(&l).is_ok(), cpu.contains(&l));
+                if g != c {
+                    let m = margins[t][l as usize];
+                    assert!(
+                        m.abs() <= 1e-3 * state.lights[l as usize].range.max(1.0),
+                        "{scene} {id} tile {t} light {l}: GPU {g}, CPU twin {c}, margin {m}"
+                    );
+                    ambiguous += 1;
+                }
+            }
+            assert_eq!(gpu.len(), out.grid.cells[t][1] as usize);
+        }
+        assert!(ambiguous <= 2, "{ambiguous} round-off disagreements");
+        let (d, _) = diff(&reference.image, &out.image).unwrap();
+        let (max_mean, max_p99) = tolerance(id);
+        assert!(
+            d.mean <= max_mean && d.p99 <= max_p99,
+            "{scene} {id} with gather: {d:?}"
+        );
+        let n = out.stats.lighting_computations.unwrap();
+        assert!(n >= out.stats.ideal_lighting_computations);
+    }
+}
+
+#[test]
+fn gpu_gather_matches_its_cpu_twin_robots_many() {
+    check_gather("robots-many", 200, (160, 90), 16);
+}
+
+#[test]
+fn gpu_gather_matches_its_cpu_twin_odd_sizes() {
+    check_gather("robots-many", 0, (150, 86), 7);
+    check_gather("robots-few", 200, (170, 100), 32);
+}
+
+#[test]
+fn gather_is_refused_where_it_is_not_implemented() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let settings = RenderSettings {
+        assign: lightgrid::pipelines::Assign::Gather,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&ctx, 32, 32, settings).unwrap();
+    assert!(
+        r.render(&s, 0, "clustered_forward").is_err(),
+        "a grid pipeline without GPU gather"
+    );
+    assert!(r.render(&s, 0, "tiled_deferred").is_ok());
+    assert!(
+        r.render(&s, 0, "deferred").is_ok(),
+        "no grid: the setting does not apply"
+    );
 }
 
 #[test]

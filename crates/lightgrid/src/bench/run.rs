@@ -65,6 +65,8 @@ pub struct BenchConfig {
     pub tile_size: u32,
     /// View-depth slices of clustered pipelines.
     pub slices: u32,
+    /// Who builds the grids of pipelines that can use GPU gather (the others use the CPU).
+    pub assign: crate::pipelines::Assign,
     pub gbuffers: Vec<GBufferFormat>,
     /// Measurements per frame (the spread is kept).
     pub repeat: u32,
@@ -333,7 +335,8 @@ pub fn run(
                 .find(|p| pipelines::find(p).is_ok_and(|i| i.uses_grid))
         })
         .cloned();
-    let mut renderers: Vec<(usize, GBufferFormat, Renderer)> = Vec::new();
+    // Renderers by (scene, settings); pipelines that cannot gather on the GPU use the CPU.
+    let mut renderers: Vec<(usize, RenderSettings, Renderer)> = Vec::new();
     'plan: for (si, g, info, g_used, frames) in plan {
         let scene = &scenes[si];
         let (w, h) = config.size.unwrap_or(scene.default_size);
@@ -341,14 +344,19 @@ pub fn run(
             tile_size: config.tile_size,
             gbuffer: g,
             slices: config.slices,
+            assign: if info.gpu_gather {
+                config.assign
+            } else {
+                crate::pipelines::Assign::Cpu
+            },
         };
-        if !renderers.iter().any(|r| r.0 == si && r.1 == g) {
+        if !renderers.iter().any(|r| r.0 == si && r.1 == settings) {
             renderers.retain(|r| r.0 == si);
-            renderers.push((si, g, Renderer::new(ctx, w, h, settings)?));
+            renderers.push((si, settings, Renderer::new(ctx, w, h, settings)?));
         }
         let renderer = &mut renderers
             .iter_mut()
-            .find(|r| r.0 == si && r.1 == g)
+            .find(|r| r.0 == si && r.1 == settings)
             .expect("created above")
             .2;
         let label = |f: Option<u32>| {

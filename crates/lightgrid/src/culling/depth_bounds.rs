@@ -97,7 +97,8 @@ impl DepthBoundsPass {
                 },
             ],
         });
-        let pipeline = compute_pipeline(device, "depth bounds", &shader(), &[Some(&layout)]);
+        let pipeline =
+            compute_pipeline(device, "depth bounds", &shader(), "main", &[Some(&layout)]);
         let size = (dims.tile_count() * 8) as u64;
         let buffer = |label, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -162,6 +163,11 @@ impl DepthBoundsPass {
             pass.dispatch_workgroups(self.dims.tiles_x, self.dims.tiles_y, 1);
         }
         encoder.copy_buffer_to_buffer(&self.bounds, 0, &self.readback, 0, self.bounds.size());
+    }
+
+    /// The per-tile bounds on the GPU (written by `encode`).
+    pub fn bounds_buffer(&self) -> &wgpu::Buffer {
+        &self.bounds
     }
 
     /// Read the bounds written by the last submitted `encode` (waits for the GPU).

@@ -263,7 +263,7 @@ impl GridBuffers {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: size.max(16),
-            usage: usage | wgpu::BufferUsages::COPY_DST,
+            usage: usage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         })
     }
@@ -336,5 +336,59 @@ impl GridBuffers {
 
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         &self.bind_group
+    }
+
+    /// For a grid built on the GPU: write the shape and make sure `cells` and `indices` hold
+    /// at least the given counts (growing, never truncating).
+    pub fn ensure(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        dims: &GridDims,
+        cells: usize,
+        indices: usize,
+    ) {
+        let (cb, ib) = ((cells * 8) as u64, (indices.max(1) * 4) as u64);
+        let mut rebind = false;
+        if cb > self.cells.size() {
+            self.cells = Self::buffer(
+                device,
+                "grid cells",
+                wgpu::BufferUsages::STORAGE,
+                cb.next_power_of_two(),
+            );
+            rebind = true;
+        }
+        if ib > self.indices.size() {
+            self.indices = Self::buffer(
+                device,
+                "grid indices",
+                wgpu::BufferUsages::STORAGE,
+                ib.next_power_of_two(),
+            );
+            rebind = true;
+        }
+        if rebind {
+            self.bind_group = Self::bind(
+                device,
+                &self.layout,
+                &self.params,
+                &self.cells,
+                &self.indices,
+            );
+        }
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
+    }
+
+    pub fn params_buffer(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
+    pub fn cells_buffer(&self) -> &wgpu::Buffer {
+        &self.cells
+    }
+
+    pub fn indices_buffer(&self) -> &wgpu::Buffer {
+        &self.indices
     }
 }

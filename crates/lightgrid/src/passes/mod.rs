@@ -36,6 +36,7 @@ pub fn shaders() -> Vec<ComposedShader> {
         tonemap::shader(),
         gbuffer::shader(),
         crate::culling::depth_bounds_shader(),
+        crate::culling::gather_shader(),
     ]
 }
 

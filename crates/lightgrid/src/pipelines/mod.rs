@@ -16,6 +16,26 @@ use crate::scene::PointLight;
 use crate::shader::ComposedShader;
 use crate::Error;
 
+/// Who builds the light grid (`--assign`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Assign {
+    /// On the CPU (`culling/assign_cpu.rs`).
+    #[default]
+    Cpu,
+    /// GPU gather (`culling/gather.rs`): one workgroup per tile.
+    Gather,
+}
+
+impl Assign {
+    pub fn name(self) -> &'static str {
+        match self {
+            Assign::Cpu => "cpu",
+            Assign::Gather => "gather",
+        }
+    }
+}
+
 /// Settings every pipeline of a renderer shares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RenderSettings {
@@ -25,6 +45,8 @@ pub struct RenderSettings {
     pub gbuffer: GBufferFormat,
     /// View-depth slices of clustered grids (`--slices`).
     pub slices: u32,
+    /// Who builds the grid (`--assign`).
+    pub assign: Assign,
 }
 
 impl Default for RenderSettings {
@@ -33,6 +55,7 @@ impl Default for RenderSettings {
             tile_size: crate::consts::DEFAULT_TILE_SIZE,
             gbuffer: GBufferFormat::F16,
             slices: crate::consts::DEFAULT_SLICES,
+            assign: Assign::Cpu,
         }
     }
 }
@@ -127,6 +150,8 @@ pub struct PipelineInfo {
     pub paper: &'static str,
     /// Reads a light grid. `forward` never does: it is the reference.
     pub uses_grid: bool,
+    /// Can build its grid with GPU gather (`--assign gather`).
+    pub gpu_gather: bool,
     /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
     /// same approximations (e.g. `forward_mono`).
     pub reference: &'static str,
@@ -144,6 +169,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "every light evaluated for every fragment; the reference image",
         paper: "all (brute force)",
         uses_grid: false,
+        gpu_gather: false,
         reference: "forward",
         shaders: forward::shaders,
         create: forward::create,
@@ -154,6 +180,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "forward with the light pre-pass's monochrome specular; the reference for light_prepass_mono",
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
+        gpu_gather: false,
         reference: "forward_mono",
         shaders: forward::shaders,
         create: forward::create_mono,
@@ -164,6 +191,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "CPU-built tile grid without depth bounds, read by forward shading",
         paper: "tiled-shading §3",
         uses_grid: true,
+        gpu_gather: false,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
@@ -174,6 +202,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "depth pre-pass, per-tile depth bounds (GPU), CPU grid, forward shading with early-Z",
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
+        gpu_gather: true,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
@@ -184,6 +213,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "G-buffer, depth bounds (GPU), CPU grid, one compute pass shading each tile's samples",
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
+        gpu_gather: true,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
@@ -194,6 +224,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "G-buffer, then one kernel per tile: depth bounds, cull all lights in workgroup memory, shade",
         paper: "tiled-shading §7",
         uses_grid: true,
+        gpu_gather: false,
         reference: "forward",
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
@@ -204,6 +235,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "depth pre-pass read back, CPU grid of (tile, view-depth slice) clusters holding samples, forward shading",
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
+        gpu_gather: false,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_clustered,
@@ -214,6 +246,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "G-buffer, depth read back, CPU cluster grid, one compute pass shading each sample from its cluster",
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
+        gpu_gather: false,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_clustered,
@@ -224,6 +257,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "G-buffer, then each light's volume rasterized with additive blending",
         paper: "tiled-shading §1.1, §8 (Deferred)",
         uses_grid: false,
+        gpu_gather: false,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_plain,
@@ -234,6 +268,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "as deferred, with a two-sided stencil pass per light so only samples inside its volume are shaded",
         paper: "tiled-shading §8 (Deferred-Stencil)",
         uses_grid: false,
+        gpu_gather: false,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_stencil,
@@ -244,6 +279,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "deferred lighting: normal+exponent, diffuse and specular irradiance per light volume, second geometry pass",
         paper: "deferred-shading-vs-deferred-lighting",
         uses_grid: false,
+        gpu_gather: false,
         reference: "forward",
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
@@ -254,6 +290,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "light pre-pass with monochrome specular irradiance in the diffuse target's alpha",
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
+        gpu_gather: false,
         reference: "forward_mono",
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,

@@ -18,7 +18,8 @@ use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
 use crate::consts::SCREEN_WORKGROUP;
 use crate::culling::TILE_DEPTH_WGSL;
 use crate::culling::{
-    assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GridBuffers, GridDims, LightGrid,
+    assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GatherPass, GridBuffers, GridDims,
+    LightGrid,
 };
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
@@ -57,7 +58,7 @@ pub(super) fn shaders_single() -> Vec<ComposedShader> {
 /// Where a multi-pass variant's grid comes from.
 enum GridSource {
     /// Tiles pruned by the GPU depth-bounds kernel.
-    TileBounds(Box<DepthBoundsPass>),
+    TileBounds(Box<DepthBoundsPass>, Option<Box<GatherPass>>),
     /// Clusters from the depth buffer read back (see `tiled_forward::assign_clusters`).
     Clusters { readback: Readback, slices: u32 },
 }
@@ -86,7 +87,11 @@ struct TiledDeferred {
 pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
     create_grid(
         ctx,
-        GridSource::TileBounds(Box::new(DepthBoundsPass::new(ctx.device, ctx.dims))),
+        GridSource::TileBounds(
+            Box::new(DepthBoundsPass::new(ctx.device, ctx.dims)),
+            (ctx.settings.assign == super::Assign::Gather)
+                .then(|| Box::new(GatherPass::new(ctx.device, ctx.scene_layout, ctx.dims))),
+        ),
     )
 }
 
@@ -115,6 +120,7 @@ fn create_grid(ctx: &PipelineContext, source: GridSource) -> Box<dyn Technique> 
         ctx.device,
         "tiled deferred shading",
         &shaders()[0],
+        "main",
         &[
             Some(ctx.scene_layout),
             Some(&grid.layout),
@@ -168,6 +174,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
         ctx.device,
         "tiled deferred single kernel",
         &shaders_single()[0],
+        "main",
         &[
             Some(ctx.scene_layout),
             Some(&params_layout),
@@ -199,24 +206,36 @@ impl Technique for TiledDeferred {
         let (grid, group1, label, groups) = match &mut self.variant {
             Variant::Multi { source, grid } => {
                 let built = match source {
-                    GridSource::TileBounds(bounds) => {
+                    GridSource::TileBounds(bounds, gather) => {
                         let (encoder, timer) = enc.parts();
                         bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
-                        enc.submit_and_wait()?;
-                        let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
-                        assign_cpu(&f.setup, &dims, f.lights, DepthRange::PerTile(&view_bounds))
+                        match gather {
+                            Some(g) => g.run(f, enc, bounds, grid)?,
+                            None => {
+                                enc.submit_and_wait()?;
+                                let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
+                                assign_cpu(
+                                    &f.setup,
+                                    &dims,
+                                    f.lights,
+                                    DepthRange::PerTile(&view_bounds),
+                                )
+                            }
+                        }
                     }
                     GridSource::Clusters { readback, slices } => {
                         super::tiled_forward::assign_clusters(f, enc, readback, dims, *slices)?
                     }
                 };
-                grid.upload(f.device, f.queue, &built);
+                if !matches!(source, GridSource::TileBounds(_, Some(_))) {
+                    grid.upload(f.device, f.queue, &built);
+                }
                 let groups = (
                     dims.width.div_ceil(SCREEN_WORKGROUP),
                     dims.height.div_ceil(SCREEN_WORKGROUP),
                 );
                 let label = match source {
-                    GridSource::TileBounds(_) => "tiled deferred shading",
+                    GridSource::TileBounds(..) => "tiled deferred shading",
                     GridSource::Clusters { .. } => "clustered deferred shading",
                 };
                 (Some(built), grid.bind_group(), label, groups)

@@ -12,14 +12,14 @@
 //! (tile, view-depth slice) clusters; 4. upload; 5. lighting pass as in 5. above, each fragment
 //! reading its cluster's list.
 
-use super::RenderSettings;
 use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
+use super::{Assign, RenderSettings};
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
 use crate::culling::{
     assign_cpu, cluster_occupancy, depth_bounds_cpu, to_view_bounds, DepthBoundsPass, DepthRange,
-    GridBuffers, GridDims, LightGrid,
+    GatherPass, GridBuffers, GridDims, LightGrid,
 };
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::Readback;
@@ -36,7 +36,7 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 /// How the grid is built.
 enum Mode {
     Plain,
-    PreZ(Box<DepthBoundsPass>),
+    PreZ(Box<DepthBoundsPass>, Option<Box<GatherPass>>),
     Clustered { readback: Readback, slices: u32 },
 }
 
@@ -92,7 +92,11 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     });
     let mode = match kind {
         Kind::Plain => Mode::Plain,
-        Kind::PreZ => Mode::PreZ(Box::new(DepthBoundsPass::new(ctx.device, ctx.dims))),
+        Kind::PreZ => Mode::PreZ(
+            Box::new(DepthBoundsPass::new(ctx.device, ctx.dims)),
+            (ctx.settings.assign == Assign::Gather)
+                .then(|| Box::new(GatherPass::new(ctx.device, ctx.scene_layout, ctx.dims))),
+        ),
         Kind::Clustered => Mode::Clustered {
             readback: Readback::new(
                 ctx.device,
@@ -171,29 +175,36 @@ impl Technique for TiledForward {
             pass.set_pipeline(depth_only);
             draw_scene(&mut pass, f, &[]);
         }
-        let grid = match &self.mode {
+        let grid = match &mut self.mode {
             Mode::Plain => assign_cpu(&f.setup, &self.dims, f.lights, DepthRange::NearFar),
-            Mode::PreZ(bounds) => {
+            Mode::PreZ(bounds, gather) => {
                 let (encoder, timer) = enc.parts();
                 bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
-                enc.submit_and_wait()?;
-                let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
-                assign_cpu(
-                    &f.setup,
-                    &self.dims,
-                    f.lights,
-                    DepthRange::PerTile(&view_bounds),
-                )
+                match gather {
+                    Some(g) => g.run(f, enc, bounds, &mut self.grid)?,
+                    None => {
+                        enc.submit_and_wait()?;
+                        let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
+                        assign_cpu(
+                            &f.setup,
+                            &self.dims,
+                            f.lights,
+                            DepthRange::PerTile(&view_bounds),
+                        )
+                    }
+                }
             }
             Mode::Clustered { readback, slices } => {
                 assign_clusters(f, enc, readback, self.dims, *slices)?
             }
         };
-        self.grid.upload(f.device, f.queue, &grid);
+        if !matches!(self.mode, Mode::PreZ(_, Some(_))) {
+            self.grid.upload(f.device, f.queue, &grid);
+        }
         let (encoder, timer) = enc.parts();
         let label = match self.mode {
             Mode::Plain => "tiled forward shading",
-            Mode::PreZ(_) => "tiled forward shading (pre-z)",
+            Mode::PreZ(..) => "tiled forward shading (pre-z)",
             Mode::Clustered { .. } => "clustered forward shading",
         };
         let mut pass = begin_lighting_pass(encoder, timer, f, label, self.depth_only.is_none());

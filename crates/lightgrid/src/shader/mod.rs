@@ -75,11 +75,12 @@ pub fn all_shaders() -> Vec<ComposedShader> {
     out
 }
 
-/// A compute pipeline with entry point `main` from a composed shader and explicit layouts.
+/// A compute pipeline from a composed shader's `entry` point and explicit layouts.
 pub fn compute_pipeline(
     device: &wgpu::Device,
     label: &str,
     shader: &ComposedShader,
+    entry: &str,
     layouts: &[Option<&wgpu::BindGroupLayout>],
 ) -> wgpu::ComputePipeline {
     let module = create_module(device, shader);
@@ -92,7 +93,7 @@ pub fn compute_pipeline(
         label: Some(label),
         layout: Some(&layout),
         module: &module,
-        entry_point: Some("main"),
+        entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
     })
