@@ -27,6 +27,7 @@ fn config() -> BenchConfig {
         size: Some((96, 54)),
         tile_size: 16,
         slices: 32,
+        assign: Default::default(),
         gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
         repeat: 2,
         warmup: 1,

@@ -290,14 +290,14 @@ fn check_gather(scene: &str, frame: u32, (w, h): (u32, u32), tile: u32) {
         let twin = assign_gather_cpu(&setup, &dims, &state.lights, &bounds);
         let margins = gather_margins(&setup, &dims, &state.lights, &bounds);
         let mut ambiguous = 0;
-        for t in 0..dims.tile_count() {
+        for (t, tile_margins) in margins.iter().enumerate() {
             let mut gpu: Vec<u32> = out.grid.cell(t).to_vec();
             gpu.sort_unstable();
             let cpu = twin.cell(t);
             for l in 0..state.lights.len() as u32 {
                 let (g, c) = (gpu.binary_search(&l).is_ok(), cpu.contains(&l));
                 if g != c {
-                    let m = margins[t][l as usize];
+                    let m = tile_margins[l as usize];
                     assert!(
                         m.abs() <= 1e-3 * state.lights[l as usize].range.max(1.0),
                         "{scene} {id} tile {t} light {l}: GPU {g}, CPU twin {c}, margin {m}"
