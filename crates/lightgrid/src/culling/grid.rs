@@ -297,37 +297,15 @@ impl GridBuffers {
 
     /// Upload a grid; buffers grow (never truncate) to fit its index list.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, grid: &LightGrid) {
+        self.ensure(
+            device,
+            queue,
+            &grid.dims,
+            grid.cells.len(),
+            grid.indices.len(),
+        );
         let cells: &[u8] = bytemuck::cast_slice(&grid.cells);
         let indices: &[u8] = bytemuck::cast_slice(&grid.indices);
-        let mut rebind = false;
-        if cells.len() as u64 > self.cells.size() {
-            self.cells = Self::buffer(
-                device,
-                "grid cells",
-                wgpu::BufferUsages::STORAGE,
-                (cells.len() as u64).next_power_of_two(),
-            );
-            rebind = true;
-        }
-        if indices.len() as u64 > self.indices.size() {
-            self.indices = Self::buffer(
-                device,
-                "grid indices",
-                wgpu::BufferUsages::STORAGE,
-                (indices.len() as u64).next_power_of_two(),
-            );
-            rebind = true;
-        }
-        if rebind {
-            self.bind_group = Self::bind(
-                device,
-                &self.layout,
-                &self.params,
-                &self.cells,
-                &self.indices,
-            );
-        }
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&grid.dims.params()));
         queue.write_buffer(&self.cells, 0, cells);
         if !indices.is_empty() {
             queue.write_buffer(&self.indices, 0, indices);
@@ -338,8 +316,9 @@ impl GridBuffers {
         &self.bind_group
     }
 
-    /// For a grid built on the GPU: write the shape and make sure `cells` and `indices` hold
-    /// at least the given counts (growing, never truncating).
+    /// Write the shape and make sure `cells` and `indices` hold at least the given counts
+    /// (growing, never truncating). A grid built on the GPU calls this directly; `upload`
+    /// calls it before writing a CPU grid.
     pub fn ensure(
         &mut self,
         device: &wgpu::Device,
