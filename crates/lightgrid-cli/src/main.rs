@@ -50,15 +50,27 @@ enum Command {
 /// `--assign` values.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 enum AssignArg {
+    /// cpu up to 4096 lights, bvh above.
+    Auto,
+    /// On the CPU: projected sphere rectangles, per-cell depth test; grid uploaded.
     Cpu,
+    /// GPU: one workgroup per cell tests every light.
     Gather,
+    /// GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell.
+    Scatter,
+    /// Light hierarchy built on the CPU each frame, walked per cell on the GPU.
+    Bvh,
 }
 
 impl From<AssignArg> for lightgrid::pipelines::Assign {
     fn from(a: AssignArg) -> Self {
+        use lightgrid::pipelines::Assign;
         match a {
-            AssignArg::Cpu => lightgrid::pipelines::Assign::Cpu,
-            AssignArg::Gather => lightgrid::pipelines::Assign::Gather,
+            AssignArg::Auto => Assign::Auto,
+            AssignArg::Cpu => Assign::Cpu,
+            AssignArg::Gather => Assign::Gather,
+            AssignArg::Scatter => Assign::Scatter,
+            AssignArg::Bvh => Assign::Bvh,
         }
     }
 }
@@ -106,9 +118,9 @@ struct SceneArgs {
     /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256).
     #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
     slices: u32,
-    /// Who builds the light grid: cpu, or gather (GPU, one workgroup per tile; for
-    /// tiled_forward_prez and tiled_deferred).
-    #[arg(long, value_enum, default_value = "cpu")]
+    /// Who builds the light grid of grid pipelines (tiled_deferred_single culls inside its
+    /// kernel and ignores this).
+    #[arg(long, value_enum, default_value = "auto")]
     assign: AssignArg,
     /// G-buffer channel precision in bits for deferred pipelines.
     #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
@@ -198,8 +210,8 @@ struct BenchArgs {
     /// View-depth slices of clustered pipelines.
     #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
     slices: u32,
-    /// Grid builder for pipelines that can use GPU gather (cpu or gather).
-    #[arg(long, value_enum, default_value = "cpu")]
+    /// Who builds the light grid of grid pipelines.
+    #[arg(long, value_enum, default_value = "auto")]
     assign: AssignArg,
     /// MSAA sample count. Only 1 is supported until MSAA lands.
     #[arg(long, default_value_t = 1)]
@@ -274,7 +286,7 @@ fn main() {
                     seed: 1,
                     tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                     slices: lightgrid::consts::DEFAULT_SLICES,
-                    assign: AssignArg::Cpu,
+                    assign: AssignArg::Auto,
                     gbuffer: GBufferFormat::F16,
                     warmup: 1,
                 },
@@ -354,10 +366,21 @@ fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
             .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0)),
         match (s.lights_per_tile_avg, s.lights_per_tile_max) {
             (Some(avg), Some(max)) =>
-                format!(", lights per {}px tile avg {avg:.1} max {max}", s.tile_size),
+                format!(", lights per {}px cell avg {avg:.1} max {max}", s.tile_size),
             _ => String::new(),
         }
     );
+    if let (Some(assign), Some(indices)) = (&s.assign, s.grid_indices) {
+        println!(
+            "light assignment {assign}: {} GPU ms{}, {indices} index entries in {} cells ({} with samples)",
+            s.assign_gpu_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
+            s.assign_cpu_ms
+                .filter(|&ms| ms > 0.0)
+                .map_or(String::new(), |ms| format!(" + {ms:.2} CPU ms")),
+            s.grid_cells.unwrap_or(0),
+            s.grid_cells_occupied.unwrap_or(0),
+        );
+    }
     Ok(())
 }
 

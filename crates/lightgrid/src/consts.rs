@@ -30,6 +30,25 @@ pub const TILE_THREADS: u32 = 16;
 /// time. More lights per tile are handled in further batches, never dropped.
 pub const TILE_LIGHT_BATCH: u32 = 1024;
 
+/// Relative slack of every depth comparison in light assignment (CPU and GPU): a light is
+/// kept when its view-depth interval misses a cell's by less than this fraction, so f32
+/// round-off can never drop a light that reaches a sample.
+pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
+
+/// Invocations per workgroup of the one-thread-per-item assignment kernels (scatter per light,
+/// radix sort blocks, prefix sums).
+pub const ASSIGN_THREADS: u32 = 256;
+
+/// Branching factor of the light BVH (tiled-forward-shading §4.4 uses 32): a leaf holds up to
+/// 32 lights, an inner node up to 32 children, and one traversal workgroup has 32 invocations,
+/// one per child.
+pub const BVH_WIDTH: u32 = 32;
+/// Flag in `BvhNode::count` marking a leaf (its children are lights).
+pub const BVH_LEAF: u32 = 1 << 31;
+/// Traversal stack entries per workgroup: a depth-first walk holds at most 31 siblings per
+/// level plus one; 2^20 lights make at most 4 inner levels, so 160 is ample.
+pub const BVH_STACK: u32 = 160;
+
 /// Largest accepted frame edge, before the adapter's own texture limit is applied.
 pub const MAX_FRAME_EDGE: u32 = 16384;
 
@@ -61,6 +80,12 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
+    ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
+    ("ASSIGN_THREADS", WgslConst::U32(ASSIGN_THREADS)),
+    ("MAX_SLICES", WgslConst::U32(MAX_SLICES)),
+    ("BVH_WIDTH", WgslConst::U32(BVH_WIDTH)),
+    ("BVH_LEAF", WgslConst::U32(BVH_LEAF)),
+    ("BVH_STACK", WgslConst::U32(BVH_STACK)),
     (
         "MATERIAL_FLAG_TRANSPARENT",
         WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),

@@ -3,8 +3,8 @@
 
 use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
 use crate::culling::{
-    assign_cpu, depth_bounds_cpu, ideal_lighting_computations, to_view_bounds, DepthRange,
-    GridDims, LightGrid, ViewSetup,
+    assign_cpu, cell_bounds_cpu, ideal_lighting_computations, DepthRange, GridDims, LightGrid,
+    ViewSetup,
 };
 use crate::error::{Error, Result};
 use crate::gpu::{scoped, wait_idle, GpuContext, PassTimer};
@@ -21,16 +21,19 @@ use std::collections::HashMap;
 use std::time::Instant;
 
 /// Most passes one frame may record (timestamp slots).
-const MAX_PASSES: u32 = 32;
+const MAX_PASSES: u32 = 128;
 
 /// An image, its statistics, and what the analysis saw.
 pub struct FrameOutput {
     pub image: RgbaImage,
     pub stats: FrameStats,
-    /// The grid the pipeline shaded with; for pipelines that build none on the CPU, the
-    /// depth-bounded CPU grid used for the ideal count (see `grid_is_pipelines`).
+    /// The grid the pipeline shaded with; for pipelines that build none, the depth-bounded
+    /// CPU tile grid used for the ideal count (see `grid_is_pipelines`).
     pub grid: LightGrid,
     pub grid_is_pipelines: bool,
+    /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
+    /// their CPU twin); None for pipelines without a grid.
+    pub cell_bounds: Option<Vec<[f32; 2]>>,
     /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry).
     pub depth: Vec<f32>,
 }
@@ -240,20 +243,6 @@ impl<'c> Renderer<'c> {
 
     fn prepare_technique(&mut self, id: &str) -> Result<()> {
         let info = pipelines::find(id)?;
-        if self.settings.assign == pipelines::Assign::Gather && info.uses_grid && !info.gpu_gather {
-            let able: Vec<&str> = pipelines::PIPELINES
-                .iter()
-                .filter(|p| p.gpu_gather)
-                .map(|p| p.id)
-                .collect();
-            return Err(Error::invalid(
-                "--assign",
-                format!(
-                    "{id} cannot build its grid with GPU gather yet; pipelines that can: {}",
-                    able.join(", ")
-                ),
-            ));
-        }
         if !self.techniques.contains_key(info.id) {
             let device = &self.ctx.device;
             let ctx = PipelineContext {
@@ -269,27 +258,6 @@ impl<'c> Renderer<'c> {
             self.techniques.insert(info.id, t);
         }
         Ok(())
-    }
-
-    /// Run the GPU depth-bounds kernel over the depth target as the last frame left it and
-    /// read the per-tile `[min, max]` back (for tests and debugging: the GPU half of the
-    /// depth-bounds twin pair).
-    pub fn gpu_depth_bounds(&self) -> Result<Vec<[f32; 2]>> {
-        let device = &self.ctx.device;
-        let pass = crate::culling::DepthBoundsPass::new(device, self.dims);
-        let mut timer = PassTimer::new(self.ctx, 1);
-        let mut encoder = device.create_command_encoder(&Default::default());
-        scoped(device, "depth bounds", || {
-            pass.encode(
-                device,
-                &self.ctx.queue,
-                &mut encoder,
-                &mut timer,
-                &self.targets.depth,
-            );
-            self.ctx.queue.submit([encoder.finish()]);
-        })?;
-        pass.read(device)
     }
 
     /// Render `frame` of `scene` with pipeline `pipeline_id`.
@@ -432,12 +400,12 @@ impl<'c> Renderer<'c> {
                 }
             })
             .collect();
-        let bounds = to_view_bounds(&setup, &depth_bounds_cpu(&depth, &self.dims));
+        let bounds = cell_bounds_cpu(&setup, &self.dims, &depth);
         let bounded = assign_cpu(
             &setup,
             &self.dims,
             &state.lights,
-            DepthRange::PerTile(&bounds),
+            DepthRange::Cells(&bounds),
         );
         let ideal = ideal_lighting_computations(&setup, &bounded, &state.lights, &view_distance);
         let (gpu_ms, timing) = match span {
@@ -445,7 +413,23 @@ impl<'c> Renderer<'c> {
             None => (wall_ms, TimingSource::WallClock),
         };
         let grid_is_pipelines = pipeline_grid.is_some();
-        let grid = pipeline_grid.unwrap_or(bounded);
+        let assign_gpu_ms = passes
+            .iter()
+            .filter(|p| p.label.starts_with("assign:"))
+            .map(|p| p.ms)
+            .reduce(|a, b| a + b);
+        let (grid, cell_bounds, assign, assign_cpu_ms) = match pipeline_grid {
+            Some(b) => (
+                b.grid,
+                Some(b.cell_bounds),
+                Some(b.assign.name().to_string()),
+                Some(b.cpu_ms),
+            ),
+            None => (bounded, None, None, None),
+        };
+        let occupied = cell_bounds
+            .as_ref()
+            .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
         let memory = frame_memory(
             (info.memory)(&self.settings),
             (width, height),
@@ -477,10 +461,16 @@ impl<'c> Renderer<'c> {
                 lights_per_tile_avg: grid_is_pipelines.then(|| grid.average_lights_per_cell()),
                 lights_per_tile_max: grid_is_pipelines.then(|| grid.max_lights_per_cell()),
                 grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
+                grid_cells: grid_is_pipelines.then_some(grid.cells.len() as u64),
+                grid_cells_occupied: occupied,
+                assign,
+                assign_gpu_ms: assign_gpu_ms.filter(|_| grid_is_pipelines),
+                assign_cpu_ms,
                 memory,
             },
             grid,
             grid_is_pipelines,
+            cell_bounds,
             depth,
         })
     }

@@ -56,11 +56,27 @@ pub struct FrameStats {
     pub ideal_lighting_computations: u64,
     /// ideal / actual (1.0 is perfect culling).
     pub efficiency: Option<f64>,
-    /// Lights per tile of the grid this pipeline shaded with (None: it built none on the CPU).
+    /// Lights per cell (tile, or cluster) of the grid this pipeline shaded with (None: it
+    /// builds no grid).
     pub lights_per_tile_avg: Option<f64>,
     pub lights_per_tile_max: Option<u32>,
     /// Total entries of the grid's index lists.
     pub grid_indices: Option<u64>,
+    /// Cells of the grid (tiles × slices) and how many hold samples (non-empty bounds).
+    #[serde(default)]
+    pub grid_cells: Option<u64>,
+    #[serde(default)]
+    pub grid_cells_occupied: Option<u64>,
+    /// The light-assignment strategy that built the grid (`--assign`, `auto` resolved).
+    #[serde(default)]
+    pub assign: Option<String>,
+    /// GPU time of the assignment passes (cell bounds, and for GPU strategies the
+    /// assignment kernels), from timestamps: the passes labelled `assign: ...`.
+    #[serde(default)]
+    pub assign_gpu_ms: Option<f64>,
+    /// CPU time of the assignment: `assign_cpu` for `cpu`, the hierarchy build for `bvh`.
+    #[serde(default)]
+    pub assign_cpu_ms: Option<f64>,
     /// Render targets, grid size and the traffic models (`memory.rs`).
     pub memory: FrameMemory,
 }

@@ -335,7 +335,7 @@ pub fn run(
                 .find(|p| pipelines::find(p).is_ok_and(|i| i.uses_grid))
         })
         .cloned();
-    // Renderers by (scene, settings); pipelines that cannot gather on the GPU use the CPU.
+    // Renderers by (scene, settings); pipelines without a grid builder ignore `assign`.
     let mut renderers: Vec<(usize, RenderSettings, Renderer)> = Vec::new();
     'plan: for (si, g, info, g_used, frames) in plan {
         let scene = &scenes[si];
@@ -344,10 +344,10 @@ pub fn run(
             tile_size: config.tile_size,
             gbuffer: g,
             slices: config.slices,
-            assign: if info.gpu_gather {
+            assign: if info.assign {
                 config.assign
             } else {
-                crate::pipelines::Assign::Cpu
+                crate::pipelines::Assign::default()
             },
         };
         if !renderers.iter().any(|r| r.0 == si && r.1 == settings) {

@@ -3,12 +3,16 @@
 //!    crosses the near plane, lies behind the camera or contains it (per axis, the extremes of
 //!    u/w over the sphere clipped to w >= near: tangent points from the eye where they are in
 //!    front of the near plane, else the sphere's intersection with the near plane);
-//! 2. bucket lights by tile row, then, in parallel over rows, insert each light into the tiles
-//!    its rectangle covers whose depth range its view-depth interval overlaps.
+//! 2. bucket lights by tile row, then, in parallel over rows, insert each light into the cells
+//!    of the tiles its rectangle covers whose sample depth bounds its view-depth interval
+//!    overlaps.
+//!
+//! GPU scatter (`scatter.wgsl`) runs exactly this test, so this is also its CPU twin.
 //!
 //! The brute-force oracle in `oracle.rs` checks that nothing is ever missed.
 
 use super::{GridDims, LightGrid, ViewLight, ViewSetup};
+use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::scene::PointLight;
 use rayon::prelude::*;
 
@@ -26,44 +30,13 @@ pub struct PixelRect {
 pub enum DepthRange<'a> {
     /// No depth bounds: every tile spans near..far (tiled-shading §3, `tiled_forward`).
     NearFar,
-    /// Per-tile view-distance `[min, max]` from a depth buffer (§6.3); `min > max` marks a
-    /// tile without samples, which gets no lights.
-    PerTile(&'a [[f32; 2]]),
-    /// A clustered grid (tiled-forward-shading §4.8): a light goes into the clusters of its
-    /// screen rectangle whose slice range, clipped to the tile's depth bounds, its view-depth
-    /// interval overlaps, and only into clusters that hold samples (`occupied`, per cell).
-    Clusters {
-        tile_bounds: &'a [[f32; 2]],
-        occupied: &'a [bool],
-    },
+    /// Per cell, the view-distance `[min, max]` of its samples (`cell_bounds.rs`; min > max
+    /// marks a cell without samples, which gets no lights). For a tiled grid these are the
+    /// tile depth bounds (§6.3); for a clustered grid (tiled-forward-shading §4.8) a light
+    /// goes into the clusters of its rectangle whose slices its view-depth interval spans and
+    /// whose samples' bounds it overlaps.
+    Cells(&'a [[f32; 2]]),
 }
-
-/// Cells holding at least one sample, from a depth buffer ([0, 1], 1 = none). A sample within
-/// round-off of a slice boundary marks both slices, since the GPU may place it in either.
-pub fn cluster_occupancy(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec<bool> {
-    let mut occupied = vec![false; dims.cell_count()];
-    for y in 0..dims.height {
-        for x in 0..dims.width {
-            let d = depth[(y * dims.width + x) as usize];
-            if d >= 1.0 {
-                continue;
-            }
-            let w = setup.view_distance(d);
-            let tile = dims.tile_of(x, y);
-            for k in [
-                dims.slice_of(w * (1.0 - DEPTH_SLACK)),
-                dims.slice_of(w * (1.0 + DEPTH_SLACK)),
-            ] {
-                occupied[k as usize * dims.tile_count() + tile] = true;
-            }
-        }
-    }
-    occupied
-}
-
-/// Relative slack for floating-point round-off in the depth test: assignment must be
-/// conservative, never tight enough to drop a light that reaches a sample.
-const DEPTH_SLACK: f32 = 1e-4;
 
 /// Range of s = u / w over the disc (centre (cu, cw), radius r) clipped to w >= near, where u
 /// is view x or y and w the view distance. None when nothing is in front of the near plane.
@@ -191,25 +164,13 @@ pub fn assign_cpu(
                     let tile = ty * dims.tiles_x as usize + tx as usize;
                     match depth {
                         DepthRange::NearFar => out.push((tile as u32, l)),
-                        DepthRange::PerTile(b) => {
-                            if overlaps(p, b[tile][0], b[tile][1]) {
-                                out.push((tile as u32, l));
-                            }
-                        }
-                        DepthRange::Clusters {
-                            tile_bounds,
-                            occupied,
-                        } => {
-                            let [lo, hi] = tile_bounds[tile];
-                            if !overlaps(p, lo, hi) {
-                                continue;
-                            }
-                            let k0 = dims.slice_of(p.w_min.max(lo) * (1.0 - DEPTH_SLACK));
-                            let k1 = dims.slice_of(p.w_max.min(hi) * (1.0 + DEPTH_SLACK));
+                        DepthRange::Cells(bounds) => {
+                            let k0 = dims.slice_of(p.w_min * (1.0 - DEPTH_SLACK));
+                            let k1 = dims.slice_of(p.w_max * (1.0 + DEPTH_SLACK));
                             for k in k0..=k1 {
                                 let cell = k as usize * tiles + tile;
-                                let [s0, s1] = dims.slice_range(k);
-                                if occupied[cell] && overlaps(p, s0.max(lo), s1.min(hi)) {
+                                let [lo, hi] = bounds[cell];
+                                if overlaps(p, lo, hi) {
                                     out.push((cell as u32, l));
                                 }
                             }

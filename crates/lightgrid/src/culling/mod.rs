@@ -1,22 +1,43 @@
-//! Light assignment: the light grid contract (tiled-shading §6.2), its CPU builder, the
-//! brute-force oracle that proves the builder never misses a light, and per-tile depth bounds
-//! (GPU kernel and its CPU twin).
+//! Light assignment: the light grid contract (tiled-shading §6.2), the cell bounds every
+//! strategy reads, the strategies (CPU; GPU gather, scatter and BVH) with their CPU twins,
+//! [`GridBuilder`] which runs the one `--assign` names, and the brute-force oracle that proves
+//! nothing is ever missed.
 
 mod assign_cpu;
-mod depth_bounds;
+mod builder;
+mod bvh;
+mod cell_bounds;
 mod gather;
+mod gpu_assign;
 mod grid;
 mod oracle;
+mod radix_sort;
+mod scan;
+mod scatter;
 mod view;
 
-pub use assign_cpu::{assign_cpu, cluster_occupancy, project_sphere, DepthRange, PixelRect};
-pub use depth_bounds::{depth_bounds_cpu, to_view_bounds, DepthBoundsPass};
-pub(crate) use depth_bounds::{shader as depth_bounds_shader, TILE_DEPTH_WGSL};
-
-/// `tile_frustum` / `light_in_tile` (needs the scene bindings).
-pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
-pub(crate) use gather::shader as gather_shader;
-pub use gather::{assign_gather_cpu, gather_margins, GatherPass};
+pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
+pub use builder::{Assign, BuiltGrid, CellSource, GridBuilder, AUTO_CPU_MAX_LIGHTS};
+pub use bvh::{build_bvh, morton_code, BvhNode, LightBvh};
+pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
+pub use gather::{assign_gather_cpu, gather_margins};
 pub use grid::{GridBuffers, GridDims, LightGrid};
 pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
 pub use view::{ViewLight, ViewSetup};
+
+/// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
+pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
+/// `tile_frustum` / `light_in_tile` (needs the scene bindings).
+pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
+
+/// Every assignment shader, for the validation test.
+pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
+    vec![
+        cell_bounds::shader(),
+        scan::shader(),
+        radix_sort::shader(),
+        gpu_assign::gather_shader(),
+        gpu_assign::bvh_shader(),
+        scatter::shader(),
+    ]
+}

@@ -1,6 +1,6 @@
-// A screen tile's frustum in view space: four side planes through the eye and the view-depth
-// range of its samples. Used by the single-kernel tiled deferred pipeline and GPU gather;
-// `culling/gather.rs` has the CPU twin of both functions.
+// A screen tile's frustum in view space: four side planes through the eye and a view-distance
+// range. Used by GPU light assignment (gather, BVH traversal) and the single-kernel tiled
+// deferred pipeline; `culling/gather.rs` has the CPU twin of both functions.
 
 struct TileFrustum {
     planes: array<vec3<f32>, 4>,  // inward unit normals of the side planes
@@ -8,9 +8,9 @@ struct TileFrustum {
     w_max: f32,
 }
 
-// `tile`: tile coordinates; `depth_range`: the tile's [min, max] depth-buffer values
-// (min > max for a tile without samples, which then contains no light).
-fn tile_frustum(tile: vec2<u32>, tile_size: u32, depth_range: vec2<f32>) -> TileFrustum {
+// `tile`: tile coordinates; `w_range`: the view-distance [min, max] of the samples the frustum
+// must cover (min > max: no samples, the frustum contains no light).
+fn tile_frustum(tile: vec2<u32>, tile_size: u32, w_range: vec2<f32>) -> TileFrustum {
     let size = frame.viewport;
     let lo = vec2<f32>(tile * tile_size);
     let hi = min(lo + vec2<f32>(f32(tile_size)), size);
@@ -23,16 +23,21 @@ fn tile_frustum(tile: vec2<u32>, tile_size: u32, depth_range: vec2<f32>) -> Tile
     f.planes[1] = normalize(vec3<f32>(-1.0, 0.0, -ndc_hi.x / p00));
     f.planes[2] = normalize(vec3<f32>(0.0, 1.0, ndc_hi.y / p11));
     f.planes[3] = normalize(vec3<f32>(0.0, -1.0, -ndc_lo.y / p11));
-    f.w_min = view_distance_from_depth(depth_range.x);
-    f.w_max = view_distance_from_depth(depth_range.y);
+    f.w_min = w_range.x;
+    f.w_max = w_range.y;
     return f;
 }
 
-fn light_in_tile(f: TileFrustum, light: Light) -> bool {
-    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
-    let r = light.range;
+// View-distance range of a tile's [min, max] depth-buffer values (an empty tile stays empty:
+// the map is monotonic).
+fn depth_to_w_range(depth_range: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(view_distance_from_depth(depth_range.x), view_distance_from_depth(depth_range.y));
+}
+
+// Does the view-space sphere (c, r) reach into the frustum (side planes and depth range)?
+fn sphere_in_tile(f: TileFrustum, c: vec3<f32>, r: f32) -> bool {
     let w = -c.z;
-    if (f.w_min > f.w_max || w + r < f.w_min * (1.0 - 1e-4) || w - r > f.w_max * (1.0 + 1e-4)) {
+    if (f.w_min > f.w_max || w + r < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK) || w - r > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)) {
         return false;
     }
     for (var i = 0u; i < 4u; i = i + 1u) {
@@ -41,4 +46,8 @@ fn light_in_tile(f: TileFrustum, light: Light) -> bool {
         }
     }
     return true;
+}
+
+fn light_in_tile(f: TileFrustum, light: Light) -> bool {
+    return sphere_in_tile(f, (frame.view * vec4<f32>(light.position, 1.0)).xyz, light.range);
 }

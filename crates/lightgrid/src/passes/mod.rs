@@ -32,12 +32,9 @@ pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Every shader of the shared passes, for validation.
 pub fn shaders() -> Vec<ComposedShader> {
-    vec![
-        tonemap::shader(),
-        gbuffer::shader(),
-        crate::culling::depth_bounds_shader(),
-        crate::culling::gather_shader(),
-    ]
+    let mut out = vec![tonemap::shader(), gbuffer::shader()];
+    out.extend(crate::culling::shaders());
+    out
 }
 
 /// `fullscreen_position(vertex_index)`: a screen-covering triangle.

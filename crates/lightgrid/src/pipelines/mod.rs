@@ -7,7 +7,7 @@ mod light_prepass;
 mod tiled_deferred;
 mod tiled_forward;
 
-use crate::culling::{GridDims, LightGrid, ViewSetup};
+use crate::culling::{BuiltGrid, GridDims, ViewSetup};
 use crate::error::Result;
 use crate::gpu::{scoped, wait_idle, PassTimer};
 use crate::memory::MemoryModel;
@@ -16,25 +16,7 @@ use crate::scene::PointLight;
 use crate::shader::ComposedShader;
 use crate::Error;
 
-/// Who builds the light grid (`--assign`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Assign {
-    /// On the CPU (`culling/assign_cpu.rs`).
-    #[default]
-    Cpu,
-    /// GPU gather (`culling/gather.rs`): one workgroup per tile.
-    Gather,
-}
-
-impl Assign {
-    pub fn name(self) -> &'static str {
-        match self {
-            Assign::Cpu => "cpu",
-            Assign::Gather => "gather",
-        }
-    }
-}
+pub use crate::culling::Assign;
 
 /// Settings every pipeline of a renderer shares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,7 +37,7 @@ impl Default for RenderSettings {
             tile_size: crate::consts::DEFAULT_TILE_SIZE,
             gbuffer: GBufferFormat::F16,
             slices: crate::consts::DEFAULT_SLICES,
-            assign: Assign::Cpu,
+            assign: Assign::default(),
         }
     }
 }
@@ -137,8 +119,8 @@ impl<'a> FrameEncoder<'a> {
 /// A rendering technique: fills `targets.hdr`, `targets.depth` and `targets.counts`.
 pub trait Technique {
     /// Record (and possibly submit part of) the frame. Returns the light grid the pipeline
-    /// shaded with, when it built one on the CPU.
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>>;
+    /// shaded with, when it builds one.
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>>;
 }
 
 /// One registry row.
@@ -150,8 +132,8 @@ pub struct PipelineInfo {
     pub paper: &'static str,
     /// Reads a light grid. `forward` never does: it is the reference.
     pub uses_grid: bool,
-    /// Can build its grid with GPU gather (`--assign gather`).
-    pub gpu_gather: bool,
+    /// Builds its grid with the strategy `--assign` names (a `GridBuilder`).
+    pub assign: bool,
     /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
     /// same approximations (e.g. `forward_mono`).
     pub reference: &'static str,
@@ -169,7 +151,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "every light evaluated for every fragment; the reference image",
         paper: "all (brute force)",
         uses_grid: false,
-        gpu_gather: false,
+        assign: false,
         reference: "forward",
         shaders: forward::shaders,
         create: forward::create,
@@ -180,7 +162,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "forward with the light pre-pass's monochrome specular; the reference for light_prepass_mono",
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
-        gpu_gather: false,
+        assign: false,
         reference: "forward_mono",
         shaders: forward::shaders,
         create: forward::create_mono,
@@ -188,10 +170,10 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "tiled_forward",
-        description: "CPU-built tile grid without depth bounds, read by forward shading",
+        description: "tile grid without depth bounds (every tile spans near..far), read by forward shading",
         paper: "tiled-shading §3",
         uses_grid: true,
-        gpu_gather: false,
+        assign: true,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
@@ -199,10 +181,10 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "tiled_forward_prez",
-        description: "depth pre-pass, per-tile depth bounds (GPU), CPU grid, forward shading with early-Z",
+        description: "depth pre-pass, per-tile depth bounds, tile grid, forward shading with early-Z",
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
-        gpu_gather: true,
+        assign: true,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
@@ -210,10 +192,10 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "tiled_deferred",
-        description: "G-buffer, depth bounds (GPU), CPU grid, one compute pass shading each tile's samples",
+        description: "G-buffer, per-tile depth bounds, tile grid, one compute pass shading each sample",
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
-        gpu_gather: true,
+        assign: true,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
@@ -224,7 +206,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "G-buffer, then one kernel per tile: depth bounds, cull all lights in workgroup memory, shade",
         paper: "tiled-shading §7",
         uses_grid: true,
-        gpu_gather: false,
+        assign: false,
         reference: "forward",
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
@@ -232,10 +214,10 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "clustered_forward",
-        description: "depth pre-pass read back, CPU grid of (tile, view-depth slice) clusters holding samples, forward shading",
+        description: "depth pre-pass, per-cluster sample bounds, grid of (tile, view-depth slice) clusters holding samples, forward shading",
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
-        gpu_gather: false,
+        assign: true,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_clustered,
@@ -243,10 +225,10 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "clustered_deferred",
-        description: "G-buffer, depth read back, CPU cluster grid, one compute pass shading each sample from its cluster",
+        description: "G-buffer, per-cluster sample bounds, cluster grid, one compute pass shading each sample from its cluster",
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
-        gpu_gather: false,
+        assign: true,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_clustered,
@@ -257,7 +239,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "G-buffer, then each light's volume rasterized with additive blending",
         paper: "tiled-shading §1.1, §8 (Deferred)",
         uses_grid: false,
-        gpu_gather: false,
+        assign: false,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_plain,
@@ -268,7 +250,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "as deferred, with a two-sided stencil pass per light so only samples inside its volume are shaded",
         paper: "tiled-shading §8 (Deferred-Stencil)",
         uses_grid: false,
-        gpu_gather: false,
+        assign: false,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_stencil,
@@ -279,7 +261,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "deferred lighting: normal+exponent, diffuse and specular irradiance per light volume, second geometry pass",
         paper: "deferred-shading-vs-deferred-lighting",
         uses_grid: false,
-        gpu_gather: false,
+        assign: false,
         reference: "forward",
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
@@ -290,7 +272,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         description: "light pre-pass with monochrome specular irradiance in the diffuse target's alpha",
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
-        gpu_gather: false,
+        assign: false,
         reference: "forward_mono",
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,

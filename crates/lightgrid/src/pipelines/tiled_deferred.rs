@@ -1,30 +1,26 @@
 //! `tiled_deferred`, `tiled_deferred_single` and `clustered_deferred`.
 //!
-//! tiled_deferred (tiled-shading §2, §6): 1. G-buffer pass; 2. per-tile depth bounds on the
-//! GPU, read back; 3. CPU assignment pruned by the bounds; 4. upload; 5. compute pass, one
-//! invocation per sample: read the G-buffer once, loop the tile's lights in registers.
+//! tiled_deferred (tiled-shading §2, §6): 1. G-buffer pass; 2. per-tile depth bounds and the
+//! tile grid (`GridBuilder`, the strategy `--assign` names); 3. compute pass, one invocation
+//! per sample: read the G-buffer once, loop the tile's lights in registers.
 //! Groups: 0 scene, 1 grid, 2 G-buffer, 3 outputs.
 //!
 //! tiled_deferred_single (§7): 1. G-buffer pass; 2. one kernel, one workgroup per tile:
 //! depth bounds, frustum culling of all lights into workgroup memory, shading.
 //! Groups: 0 scene, 1 tile params, 2 G-buffer, 3 outputs.
 //!
-//! clustered_deferred (tiled-forward-shading §4.8): as tiled_deferred, but step 2 reads the
-//! depth buffer back and step 3 assigns lights to (tile, view-depth slice) clusters that hold
-//! samples; the shading kernel is the same, the accessor finds each sample's cluster.
+//! clustered_deferred (tiled-forward-shading §4.8): as tiled_deferred, but step 2 bounds each
+//! (tile, view-depth slice) cluster by its own samples and assigns lights to the clusters that
+//! hold samples; the shading kernel is the same, the accessor finds each sample's cluster.
 
 use super::RenderSettings;
 use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
 use crate::consts::SCREEN_WORKGROUP;
 use crate::culling::TILE_DEPTH_WGSL;
-use crate::culling::{
-    assign_cpu, to_view_bounds, DepthBoundsPass, DepthRange, GatherPass, GridBuffers, GridDims,
-    LightGrid,
-};
+use crate::culling::{BuiltGrid, CellSource, GridBuilder, GridDims};
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
-    compute_outputs, compute_outputs_layout, GBuffer, Readback, COMPUTE_OUTPUTS_WGSL,
-    GBUFFER_READ_WGSL,
+    compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
 };
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 use crate::Result;
@@ -55,19 +51,11 @@ pub(super) fn shaders_single() -> Vec<ComposedShader> {
     vec![compose("tiled_deferred_single", &parts)]
 }
 
-/// Where a multi-pass variant's grid comes from.
-enum GridSource {
-    /// Tiles pruned by the GPU depth-bounds kernel.
-    TileBounds(Box<DepthBoundsPass>, Option<Box<GatherPass>>),
-    /// Clusters from the depth buffer read back (see `tiled_forward::assign_clusters`).
-    Clusters { readback: Readback, slices: u32 },
-}
-
 enum Variant {
-    /// Multi-pass: CPU grid + shading kernel.
+    /// Multi-pass: grid + shading kernel.
     Multi {
-        source: GridSource,
-        grid: GridBuffers,
+        builder: Box<GridBuilder>,
+        label: &'static str,
     },
     /// Single kernel; group 1 holds the tile size.
     Single {
@@ -85,36 +73,24 @@ struct TiledDeferred {
 }
 
 pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create_grid(
-        ctx,
-        GridSource::TileBounds(
-            Box::new(DepthBoundsPass::new(ctx.device, ctx.dims)),
-            (ctx.settings.assign == super::Assign::Gather)
-                .then(|| Box::new(GatherPass::new(ctx.device, ctx.scene_layout, ctx.dims))),
-        ),
-    )
+    create_grid(ctx, 1, "tiled deferred shading")
 }
 
 pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
-    let readback = Readback::new(
-        ctx.device,
-        "depth for clusters",
-        ctx.dims.width,
-        ctx.dims.height,
-    );
-    create_grid(
-        ctx,
-        GridSource::Clusters {
-            readback,
-            slices: ctx.settings.slices,
-        },
-    )
+    create_grid(ctx, ctx.settings.slices, "clustered deferred shading")
 }
 
-fn create_grid(ctx: &PipelineContext, source: GridSource) -> Box<dyn Technique> {
+fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
-    let grid = GridBuffers::new(ctx.device);
+    let builder = GridBuilder::new(
+        ctx.device,
+        ctx.scene_layout,
+        ctx.dims,
+        slices,
+        CellSource::Depth,
+        ctx.settings.assign,
+    );
     let outputs_layout = compute_outputs_layout(ctx.device);
     let shading = compute_pipeline(
         ctx.device,
@@ -123,7 +99,7 @@ fn create_grid(ctx: &PipelineContext, source: GridSource) -> Box<dyn Technique> 
         "main",
         &[
             Some(ctx.scene_layout),
-            Some(&grid.layout),
+            Some(builder.layout()),
             Some(&gbuffer.read_layout),
             Some(&outputs_layout),
         ],
@@ -132,7 +108,10 @@ fn create_grid(ctx: &PipelineContext, source: GridSource) -> Box<dyn Technique> 
         gbuffer,
         outputs_layout,
         shading,
-        variant: Variant::Multi { source, grid },
+        variant: Variant::Multi {
+            builder: Box::new(builder),
+            label,
+        },
         dims: ctx.dims,
     })
 }
@@ -195,7 +174,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 impl Technique for TiledDeferred {
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<LightGrid>> {
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
         let dims = self.dims;
         {
             let (encoder, timer) = enc.parts();
@@ -204,41 +183,13 @@ impl Technique for TiledDeferred {
         let read_group = self.gbuffer.read_bind_group(f.device, f.targets);
         let outputs = compute_outputs(f.device, &self.outputs_layout, f.targets);
         let (grid, group1, label, groups) = match &mut self.variant {
-            Variant::Multi { source, grid } => {
-                let built = match source {
-                    GridSource::TileBounds(bounds, gather) => {
-                        let (encoder, timer) = enc.parts();
-                        bounds.encode(f.device, f.queue, encoder, timer, &f.targets.depth);
-                        match gather {
-                            Some(g) => g.run(f, enc, bounds, grid)?,
-                            None => {
-                                enc.submit_and_wait()?;
-                                let view_bounds = to_view_bounds(&f.setup, &bounds.read(f.device)?);
-                                assign_cpu(
-                                    &f.setup,
-                                    &dims,
-                                    f.lights,
-                                    DepthRange::PerTile(&view_bounds),
-                                )
-                            }
-                        }
-                    }
-                    GridSource::Clusters { readback, slices } => {
-                        super::tiled_forward::assign_clusters(f, enc, readback, dims, *slices)?
-                    }
-                };
-                if !matches!(source, GridSource::TileBounds(_, Some(_))) {
-                    grid.upload(f.device, f.queue, &built);
-                }
+            Variant::Multi { builder, label } => {
+                let built = builder.build(f, enc)?;
                 let groups = (
                     dims.width.div_ceil(SCREEN_WORKGROUP),
                     dims.height.div_ceil(SCREEN_WORKGROUP),
                 );
-                let label = match source {
-                    GridSource::TileBounds(..) => "tiled deferred shading",
-                    GridSource::Clusters { .. } => "clustered deferred shading",
-                };
-                (Some(built), grid.bind_group(), label, groups)
+                (Some(built), builder.bind_group(), *label, groups)
             }
             Variant::Single {
                 params,
@@ -271,8 +222,8 @@ impl Technique for TiledDeferred {
 }
 
 /// Depth + four G-buffer targets + HDR; the shading kernel reads depth and the G-buffer once
-/// per sample, the bounds kernel depth once more; each lighting computation reads an index
-/// and a light.
+/// per sample, the cell-bounds kernel depth once more; each lighting computation reads an
+/// index and a light.
 pub(super) fn memory_multi(settings: &RenderSettings) -> MemoryModel {
     let g = settings.gbuffer.bytes_per_target();
     MemoryModel::new(
@@ -297,7 +248,7 @@ pub(super) fn memory_single(settings: &RenderSettings) -> MemoryModel {
     m
 }
 
-/// As `memory_multi`; the depth buffer is read back instead of the bounds.
+/// As `memory_multi` (the cell-bounds kernel reads depth once, for any number of slices).
 pub(super) fn memory_clustered(settings: &RenderSettings) -> MemoryModel {
     memory_multi(settings)
 }

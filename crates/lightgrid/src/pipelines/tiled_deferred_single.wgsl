@@ -16,7 +16,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     let range = reduce_tile_depth(gb_depth, wg.xy, tile.tile_size, lid.xy, li);
 
     // 2. The tile's frustum in view space (empty when the tile has no samples).
-    let f = tile_frustum(wg.xy, tile.tile_size, range);
+    let f = tile_frustum(wg.xy, tile.tile_size, depth_to_w_range(range));
     let size = frame.viewport;
 
     // 3. This thread's samples: pixels lid + (i, j) * TILE_THREADS of the tile.

@@ -10,7 +10,13 @@ pub mod src {
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
     pub const LIGHTING: &str = include_str!("../shading/lighting.wgsl");
     pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
-    pub const LIGHT_GRID: &str = include_str!("../culling/light_grid.wgsl");
+    /// Cell addressing (`grid_slice`, `grid_cell`); needs a `grid` binding.
+    pub const GRID_CELL: &str = include_str!("../culling/grid_cell.wgsl");
+    /// Group-1 grid bindings and the shading accessor (includes `GRID_CELL`).
+    pub const LIGHT_GRID: &str = concat!(
+        include_str!("../culling/grid_cell.wgsl"),
+        include_str!("../culling/light_grid.wgsl")
+    );
     pub const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
 }
 

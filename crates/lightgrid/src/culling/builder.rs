@@ -1,0 +1,273 @@
+//! [`GridBuilder`]: how every grid-reading pipeline gets its light grid. One frame:
+//! 1. the cell bounds (`cell_bounds.rs`): from the depth buffer on the GPU, or `[near, far]`
+//!    for a pipeline without a depth pre-pass;
+//! 2. light assignment by the strategy `--assign` names (resolved per frame for `auto`):
+//!    - `cpu`: bounds read back, [`assign_cpu`], grid uploaded;
+//!    - `gather`: one workgroup per cell tests every light (`gpu_assign.rs`);
+//!    - `scatter`: one invocation per light emits (cell, light) pairs, radix sort by cell
+//!      (`scatter.rs`);
+//!    - `bvh`: the light hierarchy built on the CPU (`bvh.rs`), one workgroup per cell walks it;
+//! 3. the grid is left in [`GridBuffers`] (group 1 of the shading pass) and read back for
+//!    statistics and tests.
+
+use super::bvh::{build_bvh, BvhBuffers};
+use super::cell_bounds::CellBoundsPass;
+use super::gpu_assign::{bvh_shader, gather_shader, AssignCommon, CellKernels};
+use super::scatter::ScatterPass;
+use super::{assign_cpu, DepthRange, GridBuffers, GridDims, LightGrid};
+use crate::error::Result;
+use crate::pipelines::{FrameEncoder, FrameInputs};
+use std::time::Instant;
+
+/// Who builds the light grid (`--assign`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Assign {
+    /// On the CPU (`assign_cpu.rs`): projected sphere rectangles, per-cell depth test.
+    Cpu,
+    /// GPU gather: one workgroup per cell tests every light against the cell's frustum.
+    Gather,
+    /// GPU scatter: one invocation per light emits (cell, light) pairs, radix-sorted by cell.
+    Scatter,
+    /// Light BVH rebuilt each frame on the CPU, traversed on the GPU per cell.
+    Bvh,
+    /// By light count: see [`Assign::resolve`].
+    #[default]
+    Auto,
+}
+
+/// `auto` uses the CPU up to this many lights.
+pub const AUTO_CPU_MAX_LIGHTS: usize = 4096;
+/// `auto` uses the BVH above AUTO_CPU_MAX_LIGHTS.
+impl Assign {
+    pub const ALL: [Assign; 5] = [
+        Assign::Cpu,
+        Assign::Gather,
+        Assign::Scatter,
+        Assign::Bvh,
+        Assign::Auto,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Assign::Cpu => "cpu",
+            Assign::Gather => "gather",
+            Assign::Scatter => "scatter",
+            Assign::Bvh => "bvh",
+            Assign::Auto => "auto",
+        }
+    }
+
+    /// The strategy used for a frame with `lights` lights: `auto` picks the CPU up to
+    /// [`AUTO_CPU_MAX_LIGHTS`] and the BVH above (measured: README, "Light assignment
+    /// scaling").
+    pub fn resolve(self, lights: usize) -> Assign {
+        match self {
+            Assign::Auto if lights <= AUTO_CPU_MAX_LIGHTS => Assign::Cpu,
+            Assign::Auto => Assign::Bvh,
+            other => other,
+        }
+    }
+}
+
+/// Where the cell bounds come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellSource {
+    /// No depth information: every cell spans near..far (`tiled_forward`).
+    NearFar,
+    /// The frame's depth buffer (`targets.depth`), reduced on the GPU.
+    Depth,
+}
+
+/// A built grid and what went into it.
+pub struct BuiltGrid {
+    pub grid: LightGrid,
+    /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
+    pub cell_bounds: Vec<[f32; 2]>,
+    /// The strategy that ran (`auto` resolved).
+    pub assign: Assign,
+    /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
+    pub cpu_ms: f64,
+}
+
+pub struct GridBuilder {
+    tiles: GridDims,
+    slices: u32,
+    source: CellSource,
+    assign: Assign,
+    scene_layout: wgpu::BindGroupLayout,
+    bounds: CellBoundsPass,
+    buffers: GridBuffers,
+    common: Option<AssignCommon>,
+    gather: Option<CellKernels>,
+    bvh: Option<(CellKernels, BvhBuffers)>,
+    scatter: Option<ScatterPass>,
+}
+
+impl GridBuilder {
+    /// `slices` 1 builds a tiled grid, more a clustered one (slices between the camera's near
+    /// and far planes each frame).
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        tiles: GridDims,
+        slices: u32,
+        source: CellSource,
+        assign: Assign,
+    ) -> Self {
+        GridBuilder {
+            tiles,
+            slices,
+            source,
+            assign,
+            scene_layout: scene_layout.clone(),
+            bounds: CellBoundsPass::new(device, scene_layout),
+            buffers: GridBuffers::new(device),
+            common: None,
+            gather: None,
+            bvh: None,
+            scatter: None,
+        }
+    }
+
+    /// Group 1 of the shading pass (`culling/light_grid.wgsl`).
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.buffers.layout
+    }
+
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        self.buffers.bind_group()
+    }
+
+    /// Build this frame's grid. With `CellSource::Depth`, `f.targets.depth` must hold the
+    /// frame's depth in what `enc` has recorded so far.
+    pub fn build(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<BuiltGrid> {
+        let (device, queue) = (f.device, f.queue);
+        let dims = if self.slices > 1 {
+            self.tiles
+                .clustered(self.slices, f.setup.near, f.setup.far)?
+        } else {
+            self.tiles
+        };
+        let near_far = [f.setup.near, f.setup.far];
+        match self.source {
+            CellSource::Depth => {
+                let (encoder, timer) = enc.parts();
+                self.bounds.encode(
+                    device,
+                    queue,
+                    encoder,
+                    timer,
+                    f.scene_bind_group,
+                    &dims,
+                    &f.targets.depth,
+                );
+            }
+            CellSource::NearFar => self.bounds.fill(device, queue, &dims, near_far),
+        }
+        let assign = self.assign.resolve(f.lights.len());
+        let mut cpu_ms = 0.0;
+        let light_count = f.lights.len() as u32;
+        let grid = match assign {
+            Assign::Cpu | Assign::Auto => {
+                enc.submit_and_wait()?;
+                let bounds = self.bounds.read(device, queue)?;
+                let start = Instant::now();
+                let range = match self.source {
+                    CellSource::NearFar => DepthRange::NearFar,
+                    CellSource::Depth => DepthRange::Cells(&bounds),
+                };
+                let grid = assign_cpu(&f.setup, &dims, f.lights, range);
+                cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+                self.buffers.upload(device, queue, &grid);
+                return Ok(BuiltGrid {
+                    grid,
+                    cell_bounds: bounds,
+                    assign,
+                    cpu_ms,
+                });
+            }
+            Assign::Gather => {
+                let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
+                let kernels = self.gather.get_or_insert_with(|| {
+                    CellKernels::new(
+                        device,
+                        "gather",
+                        &gather_shader(),
+                        &[Some(&self.scene_layout), Some(&common.layout)],
+                    )
+                });
+                kernels.run(
+                    device,
+                    queue,
+                    enc,
+                    f.scene_bind_group,
+                    common,
+                    &mut self.buffers,
+                    &self.bounds,
+                    &dims,
+                    &[],
+                )?
+            }
+            Assign::Bvh => {
+                let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
+                let (kernels, buffers) = self.bvh.get_or_insert_with(|| {
+                    let buffers = BvhBuffers::new(device);
+                    let kernels = CellKernels::new(
+                        device,
+                        "bvh",
+                        &bvh_shader(),
+                        &[
+                            Some(&self.scene_layout),
+                            Some(&common.layout),
+                            Some(&buffers.layout),
+                        ],
+                    );
+                    (kernels, buffers)
+                });
+                let start = Instant::now();
+                let bvh = build_bvh(&f.setup, f.lights);
+                cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+                let group = buffers.upload(device, queue, &bvh);
+                kernels.run(
+                    device,
+                    queue,
+                    enc,
+                    f.scene_bind_group,
+                    common,
+                    &mut self.buffers,
+                    &self.bounds,
+                    &dims,
+                    &[&group],
+                )?
+            }
+            Assign::Scatter => {
+                let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
+                let scatter = self
+                    .scatter
+                    .get_or_insert_with(|| ScatterPass::new(device, &self.scene_layout, common));
+                scatter.run(
+                    device,
+                    queue,
+                    enc,
+                    f.scene_bind_group,
+                    common,
+                    &mut self.buffers,
+                    &self.bounds,
+                    &dims,
+                    light_count,
+                )?
+            }
+        };
+        let cell_bounds = match self.source {
+            CellSource::NearFar => vec![near_far; dims.cell_count()],
+            CellSource::Depth => self.bounds.read(device, queue)?,
+        };
+        Ok(BuiltGrid {
+            grid,
+            cell_bounds,
+            assign,
+            cpu_ms,
+        })
+    }
+}

@@ -1,0 +1,203 @@
+//! The light hierarchy (tiled-forward-shading §4.4): a BVH over the frame's lights in view
+//! space, rebuilt every frame, with BVH_WIDTH (32) children per node so one traversal
+//! workgroup tests all children of a node at once (`bvh.wgsl`).
+//!
+//! Build (CPU, [`build_bvh`]): lights sorted by the Morton code of their view-space centre
+//! (quantized to 10 bits per axis within the centres' bounding box), cut into leaves of 32
+//! consecutive lights, each level above grouping 32 consecutive nodes. Nodes are stored root
+//! first, level by level; each node's box contains its children's (for a leaf: its lights'
+//! spheres, padded for round-off), so the traversal never prunes a light the gather test
+//! would keep, and the lists it builds equal gather's.
+
+use super::ViewSetup;
+use crate::consts::{BVH_LEAF, BVH_WIDTH};
+use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, STORAGE_READ};
+use crate::scene::PointLight;
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// One node: 32 bytes, the layout of `BvhNode` in bvh.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct BvhNode {
+    pub lo: [f32; 3],
+    /// First child node, or for a leaf the first slot of `order`.
+    pub first: u32,
+    pub hi: [f32; 3],
+    /// Number of children, `| BVH_LEAF` for a leaf.
+    pub count: u32,
+}
+
+impl BvhNode {
+    pub fn is_leaf(&self) -> bool {
+        self.count & BVH_LEAF != 0
+    }
+
+    pub fn children(&self) -> std::ops::Range<u32> {
+        self.first..self.first + (self.count & !BVH_LEAF)
+    }
+}
+
+/// The hierarchy: `nodes[0]` is the root; `order[slot]` is the light a leaf slot refers to.
+#[derive(Clone, Debug, Default)]
+pub struct LightBvh {
+    pub nodes: Vec<BvhNode>,
+    pub order: Vec<u32>,
+}
+
+/// Spread the low 10 bits of `v` so that two zero bits follow each.
+fn spread_bits(v: u32) -> u32 {
+    let mut x = v & 0x3ff;
+    x = (x | (x << 16)) & 0x0300_00ff;
+    x = (x | (x << 8)) & 0x0300_f00f;
+    x = (x | (x << 4)) & 0x030c_30c3;
+    (x | (x << 2)) & 0x0924_9249
+}
+
+/// 30-bit Morton code of `p` inside the box `[lo, lo + extent]`.
+pub fn morton_code(p: Vec3, lo: Vec3, extent: Vec3) -> u32 {
+    let q =
+        ((p - lo) / extent.max(Vec3::splat(1e-20)) * 1023.0).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+    spread_bits(q.x as u32) | (spread_bits(q.y as u32) << 1) | (spread_bits(q.z as u32) << 2)
+}
+
+/// Padding added to every light's box: view-space positions computed on the GPU may differ
+/// from the CPU's by a few ulps of the distance from the eye.
+fn pad(center: Vec3, r: f32) -> f32 {
+    r * 1e-4 + center.abs().max_element() * 1e-5 + 1e-5
+}
+
+fn union(nodes: &[BvhNode]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for n in nodes {
+        lo = lo.min(Vec3::from(n.lo));
+        hi = hi.max(Vec3::from(n.hi));
+    }
+    (lo.to_array(), hi.to_array())
+}
+
+/// Build the hierarchy over `lights` as seen by `setup`'s camera.
+pub fn build_bvh(setup: &ViewSetup, lights: &[PointLight]) -> LightBvh {
+    if lights.is_empty() {
+        return LightBvh::default();
+    }
+    let centers: Vec<Vec3> = lights
+        .par_iter()
+        .map(|l| setup.view.transform_point3(l.position))
+        .collect();
+    let (lo, hi) = centers.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &c| (lo.min(c), hi.max(c)),
+    );
+    let mut keys: Vec<u64> = centers
+        .par_iter()
+        .enumerate()
+        .map(|(i, &c)| (u64::from(morton_code(c, lo, hi - lo)) << 32) | i as u64)
+        .collect();
+    keys.par_sort_unstable();
+    let order: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
+    let width = BVH_WIDTH as usize;
+    // Levels bottom-up; children indices are fixed once the top-down layout is known.
+    let leaves: Vec<BvhNode> = order
+        .par_chunks(width)
+        .enumerate()
+        .map(|(j, chunk)| {
+            let mut lo = Vec3::splat(f32::INFINITY);
+            let mut hi = Vec3::splat(f32::NEG_INFINITY);
+            for &l in chunk {
+                let c = centers[l as usize];
+                let r = lights[l as usize].range;
+                let e = Vec3::splat(r + pad(c, r));
+                lo = lo.min(c - e);
+                hi = hi.max(c + e);
+            }
+            BvhNode {
+                lo: lo.to_array(),
+                first: (j * width) as u32,
+                hi: hi.to_array(),
+                count: chunk.len() as u32 | BVH_LEAF,
+            }
+        })
+        .collect();
+    let mut levels = vec![leaves];
+    while levels.last().expect("at least the leaves").len() > 1 {
+        let below = levels.last().expect("non-empty");
+        let level: Vec<BvhNode> = below
+            .chunks(width)
+            .enumerate()
+            .map(|(j, chunk)| {
+                let (lo, hi) = union(chunk);
+                BvhNode {
+                    lo,
+                    first: (j * width) as u32, // index within the level below, fixed below
+                    hi,
+                    count: chunk.len() as u32,
+                }
+            })
+            .collect();
+        levels.push(level);
+    }
+    // Root first: level k's nodes follow those of every level above it.
+    let mut nodes = Vec::with_capacity(levels.iter().map(Vec::len).sum());
+    let mut offsets = vec![0u32; levels.len()];
+    let mut at = 0u32;
+    for (i, level) in levels.iter().enumerate().rev() {
+        offsets[i] = at;
+        at += level.len() as u32;
+    }
+    for (i, level) in levels.iter().enumerate().rev() {
+        for n in level {
+            let mut n = *n;
+            if i > 0 {
+                n.first += offsets[i - 1];
+            }
+            nodes.push(n);
+        }
+    }
+    LightBvh { nodes, order }
+}
+
+/// The hierarchy's GPU buffers (group 2 of the traversal kernels).
+pub struct BvhBuffers {
+    pub layout: wgpu::BindGroupLayout,
+    nodes: wgpu::Buffer,
+    order: wgpu::Buffer,
+}
+
+impl BvhBuffers {
+    pub fn new(device: &wgpu::Device) -> Self {
+        BvhBuffers {
+            layout: buffer_layout(device, "light bvh (group 2)", &[STORAGE_READ, STORAGE_READ]),
+            nodes: storage_buffer(device, "bvh nodes", 1 << 12),
+            order: storage_buffer(device, "bvh order", 1 << 12),
+        }
+    }
+
+    /// Upload a hierarchy and bind it.
+    pub fn upload(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        bvh: &LightBvh,
+    ) -> wgpu::BindGroup {
+        let nodes: &[u8] = bytemuck::cast_slice(&bvh.nodes);
+        let order: &[u8] = bytemuck::cast_slice(&bvh.order);
+        grow_storage(device, &mut self.nodes, "bvh nodes", nodes.len() as u64);
+        grow_storage(device, &mut self.order, "bvh order", order.len() as u64);
+        if !nodes.is_empty() {
+            queue.write_buffer(&self.nodes, 0, nodes);
+            queue.write_buffer(&self.order, 0, order);
+        }
+        bind_resources(
+            device,
+            "light bvh",
+            &self.layout,
+            &[
+                self.nodes.as_entire_binding(),
+                self.order.as_entire_binding(),
+            ],
+        )
+    }
+}

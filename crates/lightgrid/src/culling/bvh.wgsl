@@ -1,0 +1,89 @@
+// Light BVH traversal (tiled-forward-shading §4.4): one workgroup of BVH_WIDTH invocations per
+// occupied cell walks the hierarchy depth first. Each step pops one node; invocation i tests child i
+// (an inner node's child box, or a leaf's light) against the cell's frustum; boxes that pass
+// are pushed, lights that pass are recorded. The final test is the gather test, so the lists
+// equal gather's; the boxes only prune. Run twice (count, then write), like gather.
+
+struct BvhNode {
+    lo: vec3<f32>,
+    first: u32,   // first child node, or for a leaf the first slot of `bvh_order`
+    hi: vec3<f32>,
+    count: u32,   // number of children | BVH_LEAF for a leaf
+}
+
+@group(2) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(2) @binding(1) var<storage, read> bvh_order: array<u32>;
+
+var<workgroup> bvh_stack: array<u32, BVH_STACK>;
+var<workgroup> bvh_top: u32;
+var<workgroup> bvh_pushed: atomic<u32>;
+
+// Does the view-space box reach into the frustum? (Conservative: the box's farthest corner
+// along each plane's normal.)
+fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let w_lo = -hi.z;
+    let w_hi = -lo.z;
+    if (f.w_min > f.w_max || w_hi < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK) || w_lo > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)) {
+        return false;
+    }
+    for (var i = 0u; i < 4u; i = i + 1u) {
+        let n = f.planes[i];
+        if (dot(n, select(lo, hi, n > vec3<f32>(0.0))) < 0.0) {
+            return false;
+        }
+    }
+    return true;
+}
+
+fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, write: bool) {
+    let c = cell_of_group(wg, nwg);
+    let f = cell_frustum(c);
+    if (li == 0u) {
+        atomicStore(&cell_hits, 0u);
+        bvh_stack[0] = 0u;
+        bvh_top = select(0u, 1u, frame.light_count > 0u && box_in_cell(f, bvh_nodes[0].lo, bvh_nodes[0].hi));
+    }
+    loop {
+        let top = workgroupUniformLoad(&bvh_top);
+        if (top == 0u) {
+            break;
+        }
+        let node = bvh_nodes[bvh_stack[top - 1u]];
+        if (li == 0u) {
+            atomicStore(&bvh_pushed, 0u);
+        }
+        workgroupBarrier();
+        if (li < (node.count & ~BVH_LEAF)) {
+            if ((node.count & BVH_LEAF) != 0u) {
+                let l = bvh_order[node.first + li];
+                if (light_in_tile(f, lights[l])) {
+                    record_hit(c, l, write);
+                }
+            } else {
+                let child = node.first + li;
+                let b = bvh_nodes[child];
+                if (box_in_cell(f, b.lo, b.hi)) {
+                    let s = atomicAdd(&bvh_pushed, 1u);
+                    bvh_stack[top - 1u + s] = child;
+                }
+            }
+        }
+        workgroupBarrier();
+        if (li == 0u) {
+            bvh_top = top - 1u + atomicLoad(&bvh_pushed);
+        }
+    }
+    if (li == 0u) {
+        finish_cell(c, atomicLoad(&cell_hits), write);
+    }
+}
+
+@compute @workgroup_size(BVH_WIDTH)
+fn count_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    traverse_cell(wg, nwg, li, false);
+}
+
+@compute @workgroup_size(BVH_WIDTH)
+fn write_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    traverse_cell(wg, nwg, li, true);
+}

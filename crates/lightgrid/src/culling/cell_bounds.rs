@@ -1,0 +1,218 @@
+//! Cell bounds: for every cell of the grid (a tile, or a tile × view-depth slice), the
+//! view-distance `[min, max]` of the samples in it. This is the one input every light
+//! assignment strategy (CPU, gather, scatter, BVH) reads besides the lights and the camera; a
+//! cell without samples has `min > max` (`[+inf, 0]`) and receives no lights. For a tiled grid
+//! these are the tile depth bounds of tiled-shading §6.3; for a clustered grid they are the
+//! bounds of the samples inside each cluster (tighter than the slice's own range, and empty
+//! for clusters holding no samples: tiled-forward-shading §4.8's "only occupied clusters").
+//!
+//! GPU kernel: `cell_bounds.wgsl`, one workgroup per tile. CPU twin: [`cell_bounds_cpu`].
+//! Without a depth pre-pass (`tiled_forward`) every cell gets `[near, far]` instead.
+
+use super::{GridDims, ViewSetup};
+use crate::consts::ASSIGN_DEPTH_SLACK;
+use crate::gpu::{bind_resources, download, grow_storage, storage_buffer, PassTimer};
+use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::Result;
+
+pub(crate) fn shader() -> ComposedShader {
+    compose(
+        "cell_bounds",
+        &[
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            src::GRID_CELL,
+            include_str!("cell_bounds.wgsl"),
+        ],
+    )
+}
+
+/// The bounds of a cell without samples.
+pub const EMPTY_CELL: [f32; 2] = [f32::INFINITY, 0.0];
+
+/// CPU twin of the kernel: the same inputs (depth-buffer values in [0, 1], 1 = no sample,
+/// row-major) and the same output.
+pub fn cell_bounds_cpu(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec<[f32; 2]> {
+    let mut bounds = vec![EMPTY_CELL; dims.cell_count()];
+    let mut include = |cell: usize, w: f32| {
+        let b = &mut bounds[cell];
+        b[0] = b[0].min(w);
+        b[1] = b[1].max(w);
+    };
+    for y in 0..dims.height {
+        for x in 0..dims.width {
+            let d = depth[(y * dims.width + x) as usize];
+            if d >= 1.0 {
+                continue;
+            }
+            let w = setup.view_distance(d);
+            let tile = dims.tile_of(x, y);
+            let k0 = dims.slice_of(w * (1.0 - ASSIGN_DEPTH_SLACK));
+            let k1 = dims.slice_of(w * (1.0 + ASSIGN_DEPTH_SLACK));
+            include(k0 as usize * dims.tile_count() + tile, w);
+            if k1 != k0 {
+                include(k1 as usize * dims.tile_count() + tile, w);
+            }
+        }
+    }
+    bounds
+}
+
+/// The GPU kernel and the bounds buffer it fills.
+pub struct CellBoundsPass {
+    pipeline: wgpu::ComputePipeline,
+    args: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    bounds: wgpu::Buffer,
+    occupied: wgpu::Buffer,
+    occupancy: wgpu::Buffer,
+    cells: usize,
+}
+
+impl CellBoundsPass {
+    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cell bounds (group 1)"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                crate::gpu::buffer_entry(1, crate::gpu::UNIFORM),
+                crate::gpu::buffer_entry(2, crate::gpu::STORAGE_RW),
+                crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),
+                crate::gpu::buffer_entry(4, crate::gpu::STORAGE_RW),
+            ],
+        });
+        let s = shader();
+        let layouts = [Some(scene_layout), Some(&layout)];
+        let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
+        let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cell bounds params"),
+            size: std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        CellBoundsPass {
+            pipeline,
+            args,
+            layout,
+            params,
+            bounds: storage_buffer(device, "cell bounds", 1 << 14),
+            occupied: storage_buffer(device, "occupied cells", 1 << 13),
+            occupancy: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("occupancy"),
+                size: 16,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            cells: 0,
+        }
+    }
+
+    fn ensure(&mut self, device: &wgpu::Device, dims: &GridDims) {
+        self.cells = dims.cell_count();
+        grow_storage(
+            device,
+            &mut self.bounds,
+            "cell bounds",
+            (self.cells * 8) as u64,
+        );
+        grow_storage(
+            device,
+            &mut self.occupied,
+            "occupied cells",
+            (self.cells * 4) as u64,
+        );
+    }
+
+    /// Record the kernel over `depth` (group 0 = the scene, for the camera's near/far).
+    pub fn encode(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut PassTimer,
+        scene: &wgpu::BindGroup,
+        dims: &GridDims,
+        depth: &wgpu::TextureView,
+    ) {
+        self.ensure(device, dims);
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
+        let group = bind_resources(
+            device,
+            "cell bounds",
+            &self.layout,
+            &[
+                wgpu::BindingResource::TextureView(depth),
+                self.params.as_entire_binding(),
+                self.bounds.as_entire_binding(),
+                self.occupied.as_entire_binding(),
+                self.occupancy.as_entire_binding(),
+            ],
+        );
+        encoder.clear_buffer(&self.occupancy, 0, None);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("assign: cell bounds"),
+            timestamp_writes: timer.compute_pass("assign: cell bounds"),
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, scene, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        pass.dispatch_workgroups(dims.tiles_x, dims.tiles_y, 1);
+        pass.set_pipeline(&self.args);
+        pass.dispatch_workgroups(1, 1, 1);
+    }
+
+    /// Without depth: every cell spans `[near, far]` (and counts as occupied).
+    pub fn fill(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        dims: &GridDims,
+        range: [f32; 2],
+    ) {
+        self.ensure(device, dims);
+        let all = vec![range; self.cells];
+        queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&all));
+        let list: Vec<u32> = (0..self.cells as u32).collect();
+        queue.write_buffer(&self.occupied, 0, bytemuck::cast_slice(&list));
+        let n = self.cells as u32;
+        let (x, y) = crate::gpu::groups_1d(n);
+        queue.write_buffer(&self.occupancy, 0, bytemuck::cast_slice(&[n, x, y, 1]));
+    }
+
+    /// The bounds on the GPU (`array<vec2<f32>>`, one per cell).
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.bounds
+    }
+
+    /// The occupied cells (`array<u32>`, in no particular order).
+    pub fn occupied_buffer(&self) -> &wgpu::Buffer {
+        &self.occupied
+    }
+
+    /// `[count, x, y, z]`: the occupied-cell count and, from byte 4, indirect dispatch
+    /// arguments of one workgroup per occupied cell.
+    pub fn occupancy_buffer(&self) -> &wgpu::Buffer {
+        &self.occupancy
+    }
+
+    /// The bounds of the last recorded frame (submits nothing itself: call after the frame's
+    /// work is submitted).
+    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<[f32; 2]>> {
+        let bytes = download(device, queue, &self.bounds, (self.cells * 8) as u64)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+}

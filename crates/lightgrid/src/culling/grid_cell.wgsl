@@ -1,0 +1,20 @@
+// Cell addressing of the light grid, shared by the shading accessor (light_grid.wgsl) and the
+// cell-bounds kernel. Needs a `grid: GridParams` binding from the including shader.
+// Cell index = (slice * tiles_y + tile_y) * tiles_x + tile_x; a tiled grid has one slice.
+
+// Depth slice of a sample at view distance `w`: exponential spacing between near and far
+// (tiled-forward-shading §4.8). A tiled grid has one slice.
+fn grid_slice(w: f32) -> u32 {
+    if (grid.slices <= 1u) {
+        return 0u;
+    }
+    let s = floor(log(max(w, 1e-6)) * grid.slice_scale + grid.slice_bias);
+    return u32(clamp(s, 0.0, f32(grid.slices - 1u)));
+}
+
+// Cell of the sample at framebuffer position `pixel` and view distance `w`.
+fn grid_cell(pixel: vec2<f32>, w: f32) -> u32 {
+    let t = min(vec2<u32>(pixel) / grid.tile_size, vec2<u32>(grid.tiles_x - 1u, grid.tiles_y - 1u));
+    return (grid_slice(w) * grid.tiles_y + t.y) * grid.tiles_x + t.x;
+}
+
