@@ -372,11 +372,12 @@ fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     );
     if let (Some(assign), Some(indices)) = (&s.assign, s.grid_indices) {
         println!(
-            "light assignment {assign}: {} GPU ms{}, {indices} index entries in {} cells ({} with samples)",
+            "light assignment {assign}: {} ms wall ({} ms GPU timestamps{}), {indices} index entries in {} cells ({} with samples)",
+            s.assign_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
             s.assign_gpu_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
             s.assign_cpu_ms
                 .filter(|&ms| ms > 0.0)
-                .map_or(String::new(), |ms| format!(" + {ms:.2} CPU ms")),
+                .map_or(String::new(), |ms| format!(", {ms:.2} ms on the CPU")),
             s.grid_cells.unwrap_or(0),
             s.grid_cells_occupied.unwrap_or(0),
         );

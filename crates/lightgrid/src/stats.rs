@@ -77,6 +77,12 @@ pub struct FrameStats {
     /// CPU time of the assignment: `assign_cpu` for `cpu`, the hierarchy build for `bvh`.
     #[serde(default)]
     pub assign_cpu_ms: Option<f64>,
+    /// Wall time of the whole assignment strategy, from the cell bounds being ready on the
+    /// GPU to the grid being ready on the GPU (GPU passes, CPU work and the syncs between
+    /// them). On lavapipe the timestamps of some compute passes come out far too small, so
+    /// this is the figure to compare strategies by there.
+    #[serde(default)]
+    pub assign_ms: Option<f64>,
     /// Render targets, grid size and the traffic models (`memory.rs`).
     pub memory: FrameMemory,
 }

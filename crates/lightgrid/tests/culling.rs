@@ -5,8 +5,8 @@
 
 use glam::Vec3;
 use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu, cluster_occupancy, depth_bounds_cpu, oracle_tile_lights,
-    project_sphere, to_view_bounds, DepthRange, GridDims, ViewSetup,
+    assign_cpu, assign_gather_cpu, build_bvh, cell_bounds_cpu, oracle_tile_lights, project_sphere,
+    traverse_bvh_cpu, DepthRange, GridDims, ViewSetup, EMPTY_CELL,
 };
 use lightgrid::scene::{Camera, PointLight, Rng};
 
@@ -155,8 +155,8 @@ fn cpu_assignment_contains_the_oracle_in_randomized_cases() {
             })
             .collect();
         let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
-        let bounds = to_view_bounds(s, &depth_bounds_cpu(&depth, &dims));
-        let bounded = assign_cpu(s, &dims, &case.lights, DepthRange::PerTile(&bounds));
+        let bounds = cell_bounds_cpu(s, &dims, &depth);
+        let bounded = assign_cpu(s, &dims, &case.lights, DepthRange::Cells(&bounds));
         let plain = assign_cpu(s, &dims, &case.lights, DepthRange::NearFar);
         for (t, must) in oracle.iter().enumerate() {
             for l in must {
@@ -217,17 +217,8 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
             })
             .collect();
         let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
-        let bounds = to_view_bounds(s, &depth_bounds_cpu(&depth, &tiles));
-        let occupied = cluster_occupancy(s, &dims, &depth);
-        let grid = assign_cpu(
-            s,
-            &dims,
-            &case.lights,
-            DepthRange::Clusters {
-                tile_bounds: &bounds,
-                occupied: &occupied,
-            },
-        );
+        let bounds = cell_bounds_cpu(s, &dims, &depth);
+        let grid = assign_cpu(s, &dims, &case.lights, DepthRange::Cells(&bounds));
         assert_eq!(grid.cells.len(), dims.cell_count());
         for (c, must) in oracle.iter().enumerate() {
             for l in must {
@@ -242,7 +233,8 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
             oracle_pairs += must.len();
         }
         // Per sample, a cluster never lists more lights than its depth-bounded tile.
-        let tiled = assign_cpu(s, &tiles, &case.lights, DepthRange::PerTile(&bounds));
+        let tile_bounds = cell_bounds_cpu(s, &tiles, &depth);
+        let tiled = assign_cpu(s, &tiles, &case.lights, DepthRange::Cells(&tile_bounds));
         for c in 0..dims.cell_count() {
             let t = c % dims.tile_count();
             assert!(
@@ -257,15 +249,36 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
     assert!(cluster_pairs > 0 && tile_pairs > 0);
 }
 
+/// The CPU twins of GPU gather and of the BVH traversal contain the oracle, on tiles and
+/// clusters; the traversal (which only prunes with boxes) lists exactly what gather lists.
 #[test]
-fn gather_twin_contains_the_oracle_in_randomized_cases() {
+fn gather_and_bvh_twins_contain_the_oracle_in_randomized_cases() {
     let mut rng = Rng::new(4242);
     let mut hits = 0usize;
     for case_index in 0..800 {
-        let case = random_case(&mut rng);
+        let mut case = random_case(&mut rng);
+        // Enough lights for a hierarchy with inner nodes now and then.
+        if case_index % 4 == 0 {
+            let extra = case.lights.clone();
+            for _ in 0..50 {
+                case.lights.extend(extra.iter().map(|l| PointLight {
+                    position: l.position
+                        + Vec3::new(
+                            rng.range(-9.0, 9.0),
+                            rng.range(-9.0, 9.0),
+                            rng.range(-9.0, 9.0),
+                        ),
+                    range: l.range * rng.range(0.1, 1.0),
+                    ..*l
+                }));
+            }
+        }
         let depth = random_depth(&mut rng, &case);
         let s = &case.setup;
-        let dims = GridDims::new(s.width, s.height, TILES[case_index % TILES.len()]).unwrap();
+        let tiles = GridDims::new(s.width, s.height, TILES[case_index % TILES.len()]).unwrap();
+        let dims = tiles
+            .clustered([1, 8, 32][case_index % 3], s.near, s.far)
+            .unwrap();
         let view_distance: Vec<f32> = depth
             .iter()
             .map(|&d| {
@@ -277,20 +290,117 @@ fn gather_twin_contains_the_oracle_in_randomized_cases() {
             })
             .collect();
         let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
-        let gather = assign_gather_cpu(s, &dims, &case.lights, &depth_bounds_cpu(&depth, &dims));
-        for (t, must) in oracle.iter().enumerate() {
+        let bounds = cell_bounds_cpu(s, &dims, &depth);
+        let gather = assign_gather_cpu(s, &dims, &case.lights, &bounds);
+        for (c, must) in oracle.iter().enumerate() {
             for l in must {
                 assert!(
-                    gather.cell(t).contains(l),
-                    "case {case_index}: gather misses light {l} in tile {t}: {:?}, camera {:?}",
+                    gather.cell(c).contains(l),
+                    "case {case_index}: gather misses light {l} in cell {c}: {:?}, camera {:?}",
                     case.lights[*l as usize],
                     case.camera
                 );
             }
             hits += must.len();
         }
+        let bvh = build_bvh(s, &case.lights);
+        let walked = traverse_bvh_cpu(s, &dims, &case.lights, &bounds, &bvh);
+        assert_eq!(walked, gather, "case {case_index}: the BVH pruned a light");
     }
     assert!(hits > 5_000, "only {hits} hits");
+}
+
+/// The hierarchy's structure: root first, every light in exactly one leaf, at most 32
+/// children, every box containing its children's boxes and its lights' spheres.
+#[test]
+fn light_bvh_is_well_formed() {
+    let mut rng = Rng::new(7);
+    let camera = Camera {
+        eye: Vec3::new(0.0, 2.0, 10.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y: 1.0,
+        near: 0.1,
+        far: 300.0,
+    };
+    let setup = ViewSetup::new(&camera, 64, 64);
+    for n in [0usize, 1, 31, 32, 33, 1025, 40_000] {
+        let lights: Vec<PointLight> = (0..n)
+            .map(|_| PointLight {
+                position: Vec3::new(
+                    rng.range(-80.0, 80.0),
+                    rng.range(-5.0, 30.0),
+                    rng.range(-80.0, 80.0),
+                ),
+                color: Vec3::ONE,
+                intensity: 1.0,
+                range: rng.range(0.05, 6.0),
+            })
+            .collect();
+        let bvh = build_bvh(&setup, &lights);
+        if n == 0 {
+            assert!(bvh.nodes.is_empty() && bvh.order.is_empty());
+            continue;
+        }
+        let mut seen = vec![0u32; n];
+        let mut visited = vec![false; bvh.nodes.len()];
+        let mut stack = vec![0usize];
+        let contains = |outer: &lightgrid::culling::BvhNode, lo: Vec3, hi: Vec3| {
+            Vec3::from(outer.lo).cmple(lo).all() && Vec3::from(outer.hi).cmpge(hi).all()
+        };
+        while let Some(i) = stack.pop() {
+            assert!(!visited[i], "node {i} reached twice");
+            visited[i] = true;
+            let node = bvh.nodes[i];
+            let kids = node.children();
+            assert!(
+                (1..=32).contains(&kids.len()),
+                "{n} lights: node {i} has {} children",
+                kids.len()
+            );
+            for k in kids {
+                if node.is_leaf() {
+                    let l = bvh.order[k as usize] as usize;
+                    seen[l] += 1;
+                    let c = setup.view.transform_point3(lights[l].position);
+                    let r = Vec3::splat(lights[l].range);
+                    assert!(
+                        contains(&node, c - r, c + r),
+                        "leaf {i} box misses light {l}"
+                    );
+                } else {
+                    let child = bvh.nodes[k as usize];
+                    assert!(k as usize > i, "children come after their parent");
+                    assert!(contains(&node, Vec3::from(child.lo), Vec3::from(child.hi)));
+                    stack.push(k as usize);
+                }
+            }
+        }
+        assert!(visited.iter().all(|&v| v), "{n} lights: unreachable nodes");
+        assert!(
+            seen.iter().all(|&k| k == 1),
+            "{n} lights: a light is not in exactly one leaf"
+        );
+    }
+}
+
+/// Lights near each other get nearby Morton codes; the code is monotone along each axis.
+#[test]
+fn morton_codes_interleave_axes() {
+    use lightgrid::culling::morton_code;
+    let (lo, ext) = (Vec3::ZERO, Vec3::splat(1.0));
+    assert_eq!(morton_code(Vec3::ZERO, lo, ext), 0);
+    assert_eq!(morton_code(Vec3::ONE, lo, ext), (1 << 30) - 1);
+    assert_eq!(morton_code(Vec3::new(1.0, 0.0, 0.0), lo, ext), 0x0924_9249);
+    assert_eq!(
+        morton_code(Vec3::new(0.0, 1.0, 0.0), lo, ext),
+        0x0924_9249 << 1
+    );
+    let a = morton_code(Vec3::new(0.2, 0.5, 0.5), lo, ext);
+    let b = morton_code(Vec3::new(0.7, 0.5, 0.5), lo, ext);
+    assert!(a < b);
+    // Outside the box clamps instead of wrapping.
+    assert_eq!(morton_code(Vec3::splat(5.0), lo, ext), (1 << 30) - 1);
 }
 
 #[test]
@@ -415,17 +525,49 @@ fn lights_entirely_behind_the_camera_or_beyond_far_are_culled() {
 }
 
 #[test]
-fn depth_bounds_cpu_ignores_sky_and_marks_empty_tiles() {
-    let dims = GridDims::new(10, 5, 4).unwrap();
-    assert_eq!((dims.tiles_x, dims.tiles_y), (3, 2));
+fn cell_bounds_ignore_sky_mark_empty_cells_and_cover_slice_boundaries() {
+    let camera = Camera {
+        eye: Vec3::ZERO,
+        target: -Vec3::Z,
+        up: Vec3::Y,
+        fov_y: 1.0,
+        near: 0.5,
+        far: 100.0,
+    };
+    let s = ViewSetup::new(&camera, 10, 5);
+    let tiles = GridDims::new(10, 5, 4).unwrap();
+    assert_eq!((tiles.tiles_x, tiles.tiles_y), (3, 2));
+    let to_depth = |w: f32| {
+        let r = s.far / (s.near - s.far);
+        r * s.near / w - r
+    };
     let mut depth = vec![1.0f32; 50];
-    depth[0] = 0.5;
-    depth[13] = 0.25; // (3, 1): tile 0
-    depth[9] = 0.75; // (9, 0): tile 2, a partial tile
-    let b = depth_bounds_cpu(&depth, &dims);
-    assert_eq!(b[0], [0.25, 0.5]);
-    assert_eq!(b[2], [0.75, 0.75]);
-    assert!(b[1][0] > b[1][1], "tile without samples is empty");
+    depth[0] = to_depth(2.0);
+    depth[13] = to_depth(1.0); // (3, 1): tile 0
+    depth[9] = to_depth(50.0); // (9, 0): tile 2, a partial tile
+    let b = cell_bounds_cpu(&s, &tiles, &depth);
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * b;
+    assert!(close(b[0][0], 1.0) && close(b[0][1], 2.0), "{:?}", b[0]);
+    assert!(close(b[2][0], 50.0) && close(b[2][1], 50.0));
+    assert_eq!(b[1], EMPTY_CELL, "tile without samples is empty");
+    // Clustered: each sample lands in its slice; one on a slice boundary in both.
+    let dims = tiles.clustered(8, s.near, s.far).unwrap();
+    let boundary = dims.slice_range(3)[0];
+    depth[1] = to_depth(boundary);
+    let c = cell_bounds_cpu(&s, &dims, &depth);
+    let cell = |k: u32, t: usize| c[k as usize * tiles.tile_count() + t];
+    assert!(close(cell(dims.slice_of(1.0), 0)[0], 1.0));
+    assert!(
+        cell(2, 0)[0] <= cell(2, 0)[1] && cell(3, 0)[0] <= cell(3, 0)[1],
+        "both sides of the boundary"
+    );
+    let occupied = c.iter().filter(|[lo, hi]| lo <= hi).count();
+    // Slices 1 (w = 1), 2 (w = 2 and the boundary sample), 3 (the boundary sample), 6 (w = 50).
+    assert_eq!(occupied, 4, "{c:?}");
+    assert!(
+        close(cell(2, 0)[1], boundary),
+        "the boundary sample widens the slice below it"
+    );
     assert!(GridDims::new(10, 5, 0).is_err() && GridDims::new(10, 5, 65).is_err());
 }
 

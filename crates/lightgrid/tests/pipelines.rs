@@ -1,17 +1,20 @@
 //! GPU: every registry pipeline's image equals the `forward` reference within its stated
 //! tolerance, on two catalog scenes, two tile sizes and a resolution that is not a multiple
-//! of the tile size; lighting-computation counts are never below the ideal; the GPU depth
-//! bounds equal the CPU reduction of the same depth buffer.
+//! of the tile size; lighting-computation counts are never below the ideal; every light
+//! assignment strategy (CPU, GPU gather, scatter, BVH) builds, on every grid pipeline, the grid
+//! its CPU twin builds from the same cell bounds, and the GPU cell bounds equal their twin's.
 
 mod common;
 
 use lightgrid::culling::{
-    assign_cpu, depth_bounds_cpu, to_view_bounds, DepthRange, GridDims, ViewSetup,
+    assign_cpu, assign_gather_cpu, cell_bounds_cpu, DepthRange, LightGrid, ViewSetup,
 };
 use lightgrid::image_io::{diff, save_png};
 use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::Assign;
 use lightgrid::pipelines::{PipelineInfo, PIPELINES, REFERENCE};
 use lightgrid::scene::catalog::{self, SceneParams};
+use lightgrid::scene::{PointLight, Scene};
 use lightgrid::{RenderSettings, Renderer};
 
 /// Per-pipeline tolerance against `forward`, in 8-bit sRGB levels: (id, max mean, max p99,
@@ -238,116 +241,256 @@ fn random_fps_tile_16_with_32_bit_gbuffer() {
     );
 }
 
-#[test]
-fn gpu_depth_bounds_equal_the_cpu_reduction() {
-    let ctx = common::gpu();
-    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
-    for (tile, (w, h)) in [(16, (160, 90)), (13, (101, 67))] {
-        let mut r = Renderer::new(&ctx, w, h, settings(tile)).unwrap();
-        let out = r.render(&s, 200, "tiled_deferred").unwrap();
-        let dims = GridDims::new(w, h, tile).unwrap();
-        let cpu = depth_bounds_cpu(&out.depth, &dims);
-        let gpu = r.gpu_depth_bounds().unwrap();
-        assert_eq!(gpu, cpu, "tile {tile}");
-        assert!(
-            cpu.iter().any(|b| b[0] > b[1]) && cpu.iter().any(|b| b[0] <= b[1]),
-            "sky and geometry tiles"
-        );
-        // And the pipeline's grid is the CPU assignment fed with those bounds.
-        let setup = ViewSetup::new(&s.frame(200).camera, w, h);
-        let expected = assign_cpu(
-            &setup,
-            &dims,
-            &s.frame(200).lights,
-            DepthRange::PerTile(&to_view_bounds(&setup, &cpu)),
-        );
-        assert_eq!(out.grid, expected);
+/// The grid a strategy's CPU twin builds from the given cell bounds.
+fn twin(
+    assign: Assign,
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[PointLight],
+    bounds: &[[f32; 2]],
+    near_far: bool,
+) -> LightGrid {
+    let dims = &grid.dims;
+    match assign {
+        Assign::Cpu | Assign::Scatter if near_far => {
+            assign_cpu(setup, dims, lights, DepthRange::NearFar)
+        }
+        Assign::Cpu | Assign::Scatter => assign_cpu(setup, dims, lights, DepthRange::Cells(bounds)),
+        Assign::Gather | Assign::Bvh => assign_gather_cpu(setup, dims, lights, bounds),
+        Assign::Auto => unreachable!("resolved by the renderer"),
     }
 }
 
-/// GPU gather builds, per tile, the same set of lights as its CPU twin (fed with the same depth
-/// bounds), apart from lights whose test is within round-off of a frustum plane; and shading
-/// with it reproduces the reference.
-fn check_gather(scene: &str, frame: u32, (w, h): (u32, u32), tile: u32) {
-    use lightgrid::culling::{assign_gather_cpu, gather_margins};
-    use lightgrid::pipelines::Assign;
-    let ctx = common::gpu();
-    let s = catalog::build(scene, &SceneParams::default()).unwrap();
-    let gather = RenderSettings {
-        tile_size: tile,
-        assign: Assign::Gather,
-        ..Default::default()
-    };
-    let mut r = Renderer::new(&ctx, w, h, gather).unwrap();
-    let reference = r.render(&s, frame, REFERENCE).unwrap();
+fn with_ranges_scaled(lights: &[PointLight], f: f32) -> Vec<PointLight> {
+    lights
+        .iter()
+        .map(|l| PointLight {
+            range: l.range * f,
+            ..*l
+        })
+        .collect()
+}
+
+/// Render `id` with `settings` and check its grid against the CPU twin of the strategy that
+/// built it, fed with the pipeline's own cell bounds: equal for the CPU strategy; for GPU
+/// strategies every cell's set lies between the twin's with all light ranges 0.1% smaller and
+/// 0.1% larger (f32 round-off of the view transform and frustum planes differs between the GPU
+/// and the CPU), and differs from the exact twin in at most a handful of (cell, light) pairs.
+/// Also: the GPU cell bounds equal `cell_bounds_cpu` of the frame's depth, the grid is well
+/// formed, the image matches the reference and the count is never below the ideal.
+fn check_assign(
+    r: &mut Renderer,
+    s: &Scene,
+    frame: u32,
+    id: &str,
+    reference: &image::RgbaImage,
+) -> LightGrid {
+    let (w, h) = r.size();
+    let out = r.render(s, frame, id).unwrap();
     let state = s.frame(frame);
     let setup = ViewSetup::new(&state.camera, w, h);
-    for id in ["tiled_forward_prez", "tiled_deferred"] {
-        let out = r.render(&s, frame, id).unwrap();
-        assert!(out.grid_is_pipelines);
-        let dims = GridDims::new(w, h, tile).unwrap();
-        let bounds = depth_bounds_cpu(&out.depth, &dims);
-        let twin = assign_gather_cpu(&setup, &dims, &state.lights, &bounds);
-        let margins = gather_margins(&setup, &dims, &state.lights, &bounds);
-        let mut ambiguous = 0;
-        for (t, tile_margins) in margins.iter().enumerate() {
-            let mut gpu: Vec<u32> = out.grid.cell(t).to_vec();
-            gpu.sort_unstable();
-            let cpu = twin.cell(t);
-            for l in 0..state.lights.len() as u32 {
-                let (g, c) = (gpu.binary_search(&l).is_ok(), cpu.contains(&l));
-                if g != c {
-                    let m = tile_margins[l as usize];
-                    assert!(
-                        m.abs() <= 1e-3 * state.lights[l as usize].range.max(1.0),
-                        "{scene} {id} tile {t} light {l}: GPU {g}, CPU twin {c}, margin {m}"
-                    );
-                    ambiguous += 1;
-                }
+    let assign = r.settings().assign.resolve(state.lights.len());
+    let what = format!("{} {id} --assign {} {w}x{h}", s.name, assign.name());
+    assert_eq!(out.stats.assign.as_deref(), Some(assign.name()), "{what}");
+    let bounds = out
+        .cell_bounds
+        .clone()
+        .expect("a grid pipeline reports its cell bounds");
+    let grid = &out.grid;
+    let dims = grid.dims;
+    let near_far = id == "tiled_forward";
+    // Cell bounds: the GPU kernel against its twin on the same depth buffer.
+    if !near_far {
+        let cpu = cell_bounds_cpu(&setup, &dims, &out.depth);
+        let mut emptiness = 0;
+        for (c, (g, b)) in bounds.iter().zip(&cpu).enumerate() {
+            match (g[0] <= g[1], b[0] <= b[1]) {
+                (true, true) => assert!(
+                    (g[0] - b[0]).abs() <= 1e-5 * b[0] && (g[1] - b[1]).abs() <= 1e-5 * b[1],
+                    "{what}: cell {c} bounds {g:?} vs twin {b:?}"
+                ),
+                (false, false) => {}
+                _ => emptiness += 1, // a sample within round-off of a slice boundary
             }
-            assert_eq!(gpu.len(), out.grid.cells[t][1] as usize);
         }
-        assert!(ambiguous <= 2, "{ambiguous} round-off disagreements");
-        let (d, _) = diff(&reference.image, &out.image).unwrap();
-        let (max_mean, max_p99) = tolerance(id);
         assert!(
-            d.mean <= max_mean && d.p99 <= max_p99,
-            "{scene} {id} with gather: {d:?}"
+            emptiness <= 2,
+            "{what}: {emptiness} cells differ in occupancy"
         );
-        let n = out.stats.lighting_computations.unwrap();
-        assert!(n >= out.stats.ideal_lighting_computations);
+        assert!(
+            bounds.iter().any(|b| b[0] <= b[1]),
+            "{what}: no cell holds samples"
+        );
+        if dims.slices > 1 {
+            assert!(
+                bounds.iter().any(|b| b[0] > b[1]),
+                "{what}: every cluster occupied"
+            );
+        }
+    }
+    // Well formed: counts add up, lists inside the index array, no light twice in a cell.
+    let total: u64 = grid.cells.iter().map(|c| u64::from(c[1])).sum();
+    assert_eq!(total, grid.indices.len() as u64, "{what}");
+    let mut sets = Vec::with_capacity(grid.cells.len());
+    for c in 0..grid.cells.len() {
+        let mut list = grid.cell(c).to_vec();
+        list.sort_unstable();
+        let n = list.len();
+        list.dedup();
+        assert_eq!(n, list.len(), "{what}: cell {c} lists a light twice");
+        sets.push(list);
+    }
+    let exact = twin(assign, &setup, grid, &state.lights, &bounds, near_far);
+    if assign == Assign::Cpu {
+        assert_eq!(grid, &exact, "{what}");
+    } else {
+        let lo = twin(
+            assign,
+            &setup,
+            grid,
+            &with_ranges_scaled(&state.lights, 0.999),
+            &bounds,
+            near_far,
+        );
+        let hi = twin(
+            assign,
+            &setup,
+            grid,
+            &with_ranges_scaled(&state.lights, 1.001),
+            &bounds,
+            near_far,
+        );
+        let mut differing = 0;
+        for (c, set) in sets.iter().enumerate() {
+            assert!(
+                lo.cell(c).iter().all(|l| set.binary_search(l).is_ok()),
+                "{what}: cell {c} misses a light"
+            );
+            assert!(
+                set.iter().all(|l| hi.cell(c).contains(l)),
+                "{what}: cell {c} lists a light out of reach"
+            );
+            differing += set.len().abs_diff(exact.cell(c).len());
+        }
+        assert!(
+            differing <= 4,
+            "{what}: {differing} round-off disagreements with the twin"
+        );
+    }
+    let (d, _) = diff(reference, &out.image).unwrap();
+    let (max_mean, max_p99) = tolerance(id);
+    assert!(d.mean <= max_mean && d.p99 <= max_p99, "{what}: {d:?}");
+    let n = out.stats.lighting_computations.unwrap();
+    assert!(n >= out.stats.ideal_lighting_computations, "{what}");
+    out.grid
+}
+
+const GRID_PIPELINES: [&str; 5] = [
+    "tiled_forward",
+    "tiled_forward_prez",
+    "tiled_deferred",
+    "clustered_forward",
+    "clustered_deferred",
+];
+const STRATEGIES: [Assign; 4] = [Assign::Cpu, Assign::Gather, Assign::Scatter, Assign::Bvh];
+
+fn check_strategies(
+    scene: &Scene,
+    frame: u32,
+    (w, h): (u32, u32),
+    tile: u32,
+    slices: u32,
+    ids: &[&str],
+) {
+    let ctx = common::gpu();
+    let reference = Renderer::new(&ctx, w, h, settings(tile))
+        .unwrap()
+        .render(scene, frame, REFERENCE)
+        .unwrap()
+        .image;
+    for assign in STRATEGIES {
+        let settings = RenderSettings {
+            tile_size: tile,
+            slices,
+            assign,
+            ..Default::default()
+        };
+        let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
+        for id in ids {
+            check_assign(&mut r, scene, frame, id, &reference);
+        }
     }
 }
 
 #[test]
-fn gpu_gather_matches_its_cpu_twin_robots_many() {
-    check_gather("robots-many", 200, (160, 90), 16);
+fn every_strategy_matches_its_twin_on_every_grid_pipeline() {
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    check_strategies(&s, 200, (160, 90), 16, 32, &GRID_PIPELINES);
 }
 
 #[test]
-fn gpu_gather_matches_its_cpu_twin_odd_sizes() {
-    check_gather("robots-many", 0, (150, 86), 7);
-    check_gather("robots-few", 200, (170, 100), 32);
+fn strategies_at_odd_sizes_and_tiles() {
+    let few = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    check_strategies(
+        &few,
+        200,
+        (150, 86),
+        7,
+        16,
+        &["tiled_deferred", "clustered_deferred"],
+    );
+    let many = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    check_strategies(
+        &many,
+        0,
+        (170, 100),
+        32,
+        8,
+        &["tiled_forward_prez", "clustered_forward"],
+    );
 }
 
+/// Enough lights for a BVH with inner levels, a sort over several blocks and cells with
+/// hundreds of lights.
 #[test]
-fn gather_is_refused_where_it_is_not_implemented() {
-    let ctx = common::gpu();
-    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
-    let settings = RenderSettings {
-        assign: lightgrid::pipelines::Assign::Gather,
+fn strategies_with_twenty_thousand_lights() {
+    let params = SceneParams {
+        lights: Some(20_000),
         ..Default::default()
     };
-    let mut r = Renderer::new(&ctx, 32, 32, settings).unwrap();
-    assert!(
-        r.render(&s, 0, "clustered_forward").is_err(),
-        "a grid pipeline without GPU gather"
+    let s = catalog::build("stress", &params).unwrap();
+    check_strategies(
+        &s,
+        0,
+        (128, 72),
+        16,
+        32,
+        &["clustered_deferred", "tiled_deferred"],
     );
-    assert!(r.render(&s, 0, "tiled_deferred").is_ok());
-    assert!(
-        r.render(&s, 0, "deferred").is_ok(),
-        "no grid: the setting does not apply"
-    );
+}
+
+#[test]
+fn strategies_agree_with_each_other_and_pipelines_without_a_grid_ignore_them() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let mut lists = Vec::new();
+    for assign in STRATEGIES {
+        let settings = RenderSettings {
+            assign,
+            ..Default::default()
+        };
+        let mut r = Renderer::new(&ctx, 96, 64, settings).unwrap();
+        let out = r.render(&s, 100, "clustered_deferred").unwrap();
+        lists.push(out.stats.grid_indices.unwrap());
+        for id in ["deferred", "tiled_deferred_single", "forward"] {
+            let out = r.render(&s, 100, id).unwrap();
+            assert_eq!(out.stats.assign, None, "{id} builds no grid");
+            assert!(out.cell_bounds.is_none());
+        }
+    }
+    // CPU and scatter run the same test; gather and BVH the same (plane-based) test.
+    assert_eq!(lists[0], lists[2], "cpu vs scatter");
+    assert_eq!(lists[1], lists[3], "gather vs bvh");
 }
 
 #[test]

@@ -12,7 +12,7 @@
 
 use super::bvh::{build_bvh, BvhBuffers};
 use super::cell_bounds::CellBoundsPass;
-use super::gpu_assign::{bvh_shader, gather_shader, AssignCommon, CellKernels};
+use super::gpu_assign::{bvh_shader, gather_shader, read_grid, AssignCommon, CellKernels};
 use super::scatter::ScatterPass;
 use super::{assign_cpu, DepthRange, GridBuffers, GridDims, LightGrid};
 use crate::error::Result;
@@ -88,6 +88,10 @@ pub struct BuiltGrid {
     pub assign: Assign,
     /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
     pub cpu_ms: f64,
+    /// Wall time from the cell bounds being ready on the GPU to the grid being ready on the
+    /// GPU: the whole strategy, GPU passes, CPU work and the syncs between them, but not
+    /// the statistics readback.
+    pub wall_ms: f64,
 }
 
 pub struct GridBuilder {
@@ -151,26 +155,17 @@ impl GridBuilder {
         };
         let near_far = [f.setup.near, f.setup.far];
         match self.source {
-            CellSource::Depth => {
-                let (encoder, timer) = enc.parts();
-                self.bounds.encode(
-                    device,
-                    queue,
-                    encoder,
-                    timer,
-                    f.scene_bind_group,
-                    &dims,
-                    &f.targets.depth,
-                );
-            }
+            CellSource::Depth => self.bounds.encode(f, enc, &dims),
             CellSource::NearFar => self.bounds.fill(device, queue, &dims, near_far),
         }
         let assign = self.assign.resolve(f.lights.len());
+        // Everything before assignment (the depth, the bounds) finishes outside the clock.
+        enc.submit_and_wait()?;
+        let wall = Instant::now();
         let mut cpu_ms = 0.0;
         let light_count = f.lights.len() as u32;
-        let grid = match assign {
+        let total = match assign {
             Assign::Cpu | Assign::Auto => {
-                enc.submit_and_wait()?;
                 let bounds = self.bounds.read(device, queue)?;
                 let start = Instant::now();
                 let range = match self.source {
@@ -180,11 +175,13 @@ impl GridBuilder {
                 let grid = assign_cpu(&f.setup, &dims, f.lights, range);
                 cpu_ms = start.elapsed().as_secs_f64() * 1e3;
                 self.buffers.upload(device, queue, &grid);
+                enc.submit_and_wait()?;
                 return Ok(BuiltGrid {
                     grid,
                     cell_bounds: bounds,
                     assign,
                     cpu_ms,
+                    wall_ms: wall.elapsed().as_secs_f64() * 1e3,
                 });
             }
             Assign::Gather => {
@@ -259,6 +256,8 @@ impl GridBuilder {
                 )?
             }
         };
+        let wall_ms = wall.elapsed().as_secs_f64() * 1e3;
+        let grid = read_grid(device, queue, &self.buffers, &dims, total)?;
         let cell_bounds = match self.source {
             CellSource::NearFar => vec![near_far; dims.cell_count()],
             CellSource::Depth => self.bounds.read(device, queue)?,
@@ -268,6 +267,7 @@ impl GridBuilder {
             cell_bounds,
             assign,
             cpu_ms,
+            wall_ms,
         })
     }
 }

@@ -9,8 +9,9 @@
 //! spheres, padded for round-off), so the traversal never prunes a light the gather test
 //! would keep, and the lists it builds equal gather's.
 
-use super::ViewSetup;
-use crate::consts::{BVH_LEAF, BVH_WIDTH};
+use super::gather::{cpu_frustum, margin, CpuFrustum};
+use super::{GridDims, LightGrid, ViewSetup};
+use crate::consts::{ASSIGN_DEPTH_SLACK, BVH_LEAF, BVH_WIDTH};
 use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, STORAGE_READ};
 use crate::scene::PointLight;
 use bytemuck::{Pod, Zeroable};
@@ -157,6 +158,63 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[PointLight]) -> LightBvh {
         }
     }
     LightBvh { nodes, order }
+}
+
+/// `box_in_cell` of bvh.wgsl: does the view-space box reach into the frustum?
+fn box_in_cell(f: &CpuFrustum, n: &BvhNode) -> bool {
+    let (lo, hi) = (Vec3::from(n.lo), Vec3::from(n.hi));
+    let (w_lo, w_hi) = (-hi.z, -lo.z);
+    if f.w_min > f.w_max
+        || w_hi < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK)
+        || w_lo > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)
+    {
+        return false;
+    }
+    f.planes
+        .iter()
+        .all(|p| p.dot(Vec3::select(p.cmpgt(Vec3::ZERO), hi, lo)) >= 0.0)
+}
+
+/// CPU twin of the GPU traversal (`bvh.wgsl`): per cell, walk `bvh` pruning boxes outside the
+/// cell's frustum and keep the leaves' lights that pass the gather test. Lists in light
+/// order. Equal to [`super::assign_gather_cpu`] whenever the boxes are conservative, which is
+/// what the tests check.
+pub fn traverse_bvh_cpu(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    lights: &[PointLight],
+    cell_bounds: &[[f32; 2]],
+    bvh: &LightBvh,
+) -> LightGrid {
+    let lists: Vec<Vec<u32>> = (0..dims.cell_count())
+        .into_par_iter()
+        .map(|c| {
+            let f = cpu_frustum(setup, dims, c % dims.tile_count(), cell_bounds[c]);
+            let mut out = Vec::new();
+            let mut stack = Vec::new();
+            if bvh.nodes.first().is_some_and(|root| box_in_cell(&f, root)) {
+                stack.push(0u32);
+            }
+            while let Some(i) = stack.pop() {
+                let node = &bvh.nodes[i as usize];
+                for child in node.children() {
+                    if node.is_leaf() {
+                        let l = bvh.order[child as usize];
+                        let light = &lights[l as usize];
+                        let center = setup.view.transform_point3(light.position);
+                        if margin(&f, center, light.range) >= 0.0 {
+                            out.push(l);
+                        }
+                    } else if box_in_cell(&f, &bvh.nodes[child as usize]) {
+                        stack.push(child);
+                    }
+                }
+            }
+            out.sort_unstable();
+            out
+        })
+        .collect();
+    LightGrid::from_lists(*dims, &lists)
 }
 
 /// The hierarchy's GPU buffers (group 2 of the traversal kernels).

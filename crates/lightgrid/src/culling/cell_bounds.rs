@@ -11,7 +11,8 @@
 
 use super::{GridDims, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
-use crate::gpu::{bind_resources, download, grow_storage, storage_buffer, PassTimer};
+use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
+use crate::pipelines::{FrameEncoder, FrameInputs};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 use crate::Result;
 
@@ -137,17 +138,12 @@ impl CellBoundsPass {
         );
     }
 
-    /// Record the kernel over `depth` (group 0 = the scene, for the camera's near/far).
-    pub fn encode(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut PassTimer,
-        scene: &wgpu::BindGroup,
-        dims: &GridDims,
-        depth: &wgpu::TextureView,
-    ) {
+    /// Record the kernel over the frame's depth target (`f.targets.depth`, as recorded in
+    /// `enc` so far).
+    pub fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder, dims: &GridDims) {
+        let (device, queue, scene, depth) =
+            (f.device, f.queue, f.scene_bind_group, &f.targets.depth);
+        let (encoder, timer) = enc.parts();
         self.ensure(device, dims);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
         let group = bind_resources(
@@ -213,6 +209,6 @@ impl CellBoundsPass {
     /// work is submitted).
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<[f32; 2]>> {
         let bytes = download(device, queue, &self.bounds, (self.cells * 8) as u64)?;
-        Ok(bytemuck::cast_slice(&bytes).to_vec())
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 }

@@ -10,13 +10,18 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// A tile's frustum on the CPU, computed exactly as `tile_frustum` in WGSL.
-struct CpuFrustum {
-    planes: [Vec3; 4],
-    w_min: f32,
-    w_max: f32,
+pub(super) struct CpuFrustum {
+    pub planes: [Vec3; 4],
+    pub w_min: f32,
+    pub w_max: f32,
 }
 
-fn cpu_frustum(setup: &ViewSetup, dims: &GridDims, t: usize, w_bounds: [f32; 2]) -> CpuFrustum {
+pub(super) fn cpu_frustum(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    t: usize,
+    w_bounds: [f32; 2],
+) -> CpuFrustum {
     let (x0, y0, _, _) = dims.tile_rect(t);
     let size = (setup.width as f32, setup.height as f32);
     let ts = dims.tile_size as f32;
@@ -38,7 +43,7 @@ fn cpu_frustum(setup: &ViewSetup, dims: &GridDims, t: usize, w_bounds: [f32; 2])
 
 /// How far inside the cell's frustum the light is (≥ 0: inside, as `sphere_in_tile` decides);
 /// `-inf` for a cell without samples. Tests use its size to recognise round-off cases.
-fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
+pub(super) fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
     if f.w_min > f.w_max {
         return f32::NEG_INFINITY;
     }

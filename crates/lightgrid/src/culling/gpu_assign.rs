@@ -158,8 +158,8 @@ pub fn read_grid(
     let indices = download(device, queue, grid.indices_buffer(), u64::from(total) * 4)?;
     Ok(LightGrid {
         dims: *dims,
-        cells: bytemuck::cast_slice(&cells).to_vec(),
-        indices: bytemuck::cast_slice(&indices).to_vec(),
+        cells: bytemuck::pod_collect_to_vec(&cells),
+        indices: bytemuck::pod_collect_to_vec(&indices),
     })
 }
 
@@ -196,7 +196,8 @@ impl CellKernels {
         }
     }
 
-    /// Count, prefix sum, grow, write: leaves the grid in `grid` and returns it read back.
+    /// Count, prefix sum, grow, write: leaves the grid in `grid` (waits for it) and returns
+    /// the number of index entries.
     /// Groups: 0 the scene, 1 `common`'s, 2.. `extra`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
@@ -210,7 +211,7 @@ impl CellKernels {
         bounds: &CellBoundsPass,
         dims: &GridDims,
         extra: &[&wgpu::BindGroup],
-    ) -> Result<LightGrid> {
+    ) -> Result<u32> {
         grid.ensure(device, queue, dims, dims.cell_count(), 1);
         let group = common.bind(device, grid, bounds, dims);
         let cell_bytes = (dims.cell_count() * 4) as u64;
@@ -264,14 +265,17 @@ impl CellKernels {
         dispatch(enc, &self.write, &group, &format!("assign: {name} write"));
         enc.submit_and_wait()?;
         common.check_overflow(device, queue, name)?;
-        read_grid(device, queue, grid, dims, total)
+        Ok(total)
     }
 }
 
 /// Index lists longer than the device can bind are an error, never a truncated list.
 pub fn check_index_capacity(device: &wgpu::Device, entries: u64, stage: &str) -> Result<()> {
     let limits = device.limits();
-    let max = u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size) / 4;
+    let max = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+        / 4;
     if entries > max {
         return Err(Error::invalid(
             "--assign",

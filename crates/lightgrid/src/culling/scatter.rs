@@ -6,9 +6,9 @@
 //! ([`super::assign_cpu`] with the same cell bounds) builds it.
 
 use super::cell_bounds::CellBoundsPass;
-use super::gpu_assign::{check_index_capacity, read_grid, AssignCommon};
+use super::gpu_assign::{check_index_capacity, AssignCommon};
 use super::radix_sort::RadixSort;
-use super::{GridBuffers, GridDims, LightGrid};
+use super::{GridBuffers, GridDims};
 use crate::consts::ASSIGN_THREADS;
 use crate::error::Result;
 use crate::gpu::STORAGE_RW;
@@ -84,8 +84,8 @@ impl ScatterPass {
         )
     }
 
-    /// Build the grid from the cell bounds in `bounds`; leaves it in `grid` and returns it
-    /// read back.
+    /// Build the grid from the cell bounds in `bounds`; leaves it in `grid` (waits for it)
+    /// and returns the number of index entries.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -98,7 +98,7 @@ impl ScatterPass {
         bounds: &CellBoundsPass,
         dims: &GridDims,
         light_count: u32,
-    ) -> Result<LightGrid> {
+    ) -> Result<u32> {
         let lights = u64::from(light_count.max(1)) * 4;
         grow_storage(
             device,
@@ -214,6 +214,6 @@ impl ScatterPass {
         }
         enc.submit_and_wait()?;
         common.check_overflow(device, queue, "scatter")?;
-        read_grid(device, queue, grid, dims, total)
+        Ok(total)
     }
 }

@@ -71,6 +71,6 @@ impl Readback {
 
     /// As [`Self::read`], as 32-bit floats (depth or counts).
     pub fn read_f32(&self, device: &wgpu::Device) -> Result<Vec<f32>> {
-        Ok(bytemuck::cast_slice(&self.read(device)?).to_vec())
+        Ok(bytemuck::pod_collect_to_vec(&self.read(device)?))
     }
 }
