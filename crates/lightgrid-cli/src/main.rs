@@ -43,6 +43,9 @@ enum Command {
     Bench(BenchArgs),
     /// Rewrite a benchmark's summary.md and plots from its results.json.
     Report(ReportArgs),
+    /// Light-assignment scaling: assignment time, index-list size and lighting computations
+    /// per strategy (cpu, gather, scatter, bvh) on `stress` from 1k to 1M lights.
+    Scaling(ScalingArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -129,6 +132,55 @@ struct SceneArgs {
     /// shaders at first use, inside the first frame's GPU time).
     #[arg(long, default_value_t = 1)]
     warmup: u32,
+}
+
+#[derive(Args)]
+struct ScalingArgs {
+    /// Light counts to measure.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1000,4000,16000,64000,256000,1000000"
+    )]
+    lights: Vec<u32>,
+    /// Strategies to measure.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "cpu,gather,scatter,bvh"
+    )]
+    assign: Vec<AssignArg>,
+    /// Grid pipeline to render with.
+    #[arg(long, default_value = "clustered_deferred")]
+    pipeline: String,
+    /// Scene with a variable light count.
+    #[arg(long, default_value = "stress")]
+    scene: String,
+    /// Frame size WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x360", value_parser = parse_size)]
+    size: Size,
+    /// Screen tile edge in pixels.
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    tile: u32,
+    /// View-depth slices of clustered pipelines.
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
+    slices: u32,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Measured renders per point (the median assignment time is kept).
+    #[arg(long, default_value_t = 1)]
+    runs: u32,
+    /// Discarded renders before each point (shader compilation, buffer growth).
+    #[arg(long, default_value_t = 1)]
+    warmup: u32,
+    /// A strategy whose assignment takes longer than this many seconds is not run at larger
+    /// light counts.
+    #[arg(long = "budget", default_value_t = 15.0)]
+    budget_s: f64,
+    /// Output directory.
+    #[arg(long, default_value = "scaling")]
+    out: PathBuf,
 }
 
 fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
@@ -299,6 +351,7 @@ fn main() {
         Some(Command::Memory(a)) => memory(&a),
         Some(Command::Bench(a)) => bench(cli.adapter.as_deref(), &a),
         Some(Command::Report(a)) => report(&a),
+        Some(Command::Scaling(a)) => scaling(cli.adapter.as_deref(), &a),
         Some(Command::List) => list(),
     };
     if let Err(e) = result {
@@ -642,19 +695,7 @@ fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     })?;
     let ctx = GpuContext::new(adapter)?;
     let config = bench_config(a, !ctx.is_software())?;
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        ctrlc::set_handler(move || {
-            if stop.swap(true, std::sync::atomic::Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-            eprintln!(
-                "\nstopping after the current frame (Ctrl-C again to abort without writing)..."
-            );
-        })
-        .context("cannot install the Ctrl-C handler")?;
-    }
+    let stop = stop_on_ctrl_c()?;
     eprintln!(
         "benchmark on {}: {} scene(s), {} pipeline(s), frames {}..{} every {}, writing to {}",
         ctx.adapter_label(),
@@ -666,8 +707,56 @@ fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         a.out.display()
     );
     let start = std::time::Instant::now();
+    let mut progress = progress_bar();
+    let mut results = lightgrid::bench::run(&ctx, &config, &stop, &mut progress)?;
+    eprintln!();
+    results.command = std::env::args().collect::<Vec<_>>().join(" ");
+    let written = lightgrid::bench::write_report(&a.out, &results)?;
+    let claims = lightgrid::bench::evaluate_claims(&results);
+    let held = claims
+        .iter()
+        .filter(|c| c.verdict == lightgrid::bench::Verdict::Held)
+        .count();
+    let measured = claims
+        .iter()
+        .filter(|c| c.verdict != lightgrid::bench::Verdict::NotMeasured)
+        .count();
+    println!(
+        "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
+        results.runs.len(),
+        format_duration(start.elapsed().as_secs_f64()),
+        written.len(),
+        a.out.display()
+    );
+    if results.interrupted {
+        bail!(
+            "interrupted: partial results written to {}",
+            a.out.display()
+        );
+    }
+    Ok(())
+}
+
+/// A flag set by the first Ctrl-C (long runs stop after the current frame and keep their
+/// results); a second Ctrl-C exits at once.
+fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = stop.clone();
+    ctrlc::set_handler(move || {
+        if flag.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("\nstopping after the current frame (Ctrl-C again to abort without writing)...");
+    })
+    .context("cannot install the Ctrl-C handler")?;
+    Ok(stop)
+}
+
+/// A progress bar with an ETA on stderr, redrawn at most every 200 ms.
+fn progress_bar() -> impl FnMut(&lightgrid::bench::Progress) {
+    let start = std::time::Instant::now();
     let mut last = std::time::Instant::now() - std::time::Duration::from_secs(1);
-    let mut progress = |p: &lightgrid::bench::Progress| {
+    move |p: &lightgrid::bench::Progress| {
         if last.elapsed().as_millis() < 200 && p.done < p.total {
             return;
         }
@@ -690,25 +779,51 @@ fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
             eta,
             p.label.chars().take(48).collect::<String>()
         );
+    }
+}
+
+fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("cannot create {}", a.out.display()))?;
+    check_writable(&a.out.join("scaling.json"))?;
+    let config = lightgrid::bench::ScalingConfig {
+        scene: a.scene.clone(),
+        pipeline: a.pipeline.clone(),
+        lights: a.lights.clone(),
+        strategies: a.assign.iter().map(|&s| s.into()).collect(),
+        size: (a.size.0, a.size.1),
+        tile_size: a.tile,
+        slices: a.slices,
+        seed: a.seed,
+        runs: a.runs,
+        warmup: a.warmup,
+        budget_ms: a.budget_s * 1e3,
     };
-    let mut results = lightgrid::bench::run(&ctx, &config, &stop, &mut progress)?;
+    config.validate()?;
+    let ctx = GpuContext::new(adapter)?;
+    let stop = stop_on_ctrl_c()?;
+    eprintln!(
+        "light assignment scaling on {}: {} at {}x{}, {} light counts x {} strategies, writing to {}",
+        ctx.adapter_label(),
+        config.pipeline,
+        a.size.0,
+        a.size.1,
+        config.lights.len(),
+        config.strategies.len(),
+        a.out.display()
+    );
+    let start = std::time::Instant::now();
+    let mut progress = progress_bar();
+    let mut results = lightgrid::bench::run_scaling(&ctx, &config, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
-    let written = lightgrid::bench::write_report(&a.out, &results)?;
-    let claims = lightgrid::bench::evaluate_claims(&results);
-    let held = claims
-        .iter()
-        .filter(|c| c.verdict == lightgrid::bench::Verdict::Held)
-        .count();
-    let measured = claims
-        .iter()
-        .filter(|c| c.verdict != lightgrid::bench::Verdict::NotMeasured)
-        .count();
+    lightgrid::bench::write_scaling(&results, &a.out)?;
+    println!("{}", lightgrid::bench::scaling_table(&results));
     println!(
-        "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
-        results.runs.len(),
+        "{} points in {}; {} in {}",
+        results.points.len(),
         format_duration(start.elapsed().as_secs_f64()),
-        written.len(),
+        lightgrid::bench::SCALING_FILES.join(", "),
         a.out.display()
     );
     if results.interrupted {

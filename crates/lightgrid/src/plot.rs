@@ -1,4 +1,4 @@
-//! Small self-contained charts for the benchmark: line charts (linear or log y) and stacked
+//! Small self-contained charts for the benchmark: line charts (linear or log axes) and stacked
 //! bars, each rendered to SVG (text as SVG text) and to PNG (a built-in 5×7 pixel font), so
 //! plots need no font files or system libraries.
 
@@ -20,6 +20,7 @@ pub struct LineChart {
     pub title: String,
     pub x_label: String,
     pub y_label: String,
+    pub log_x: bool,
     pub log_y: bool,
     pub series: Vec<Series>,
 }
@@ -271,7 +272,7 @@ impl LineChart {
             self.series
                 .iter()
                 .flat_map(|s| s.points.iter().map(|q| q.0)),
-            false,
+            self.log_x,
         );
         y_ticks(&ys, &mut p);
         let (x0, x1, y0, y1) = (LEFT, W - RIGHT, TOP, H - BOTTOM);
@@ -299,6 +300,7 @@ impl LineChart {
                 .points
                 .iter()
                 .filter(|q| q.1.is_finite() && (!self.log_y || q.1 > 0.0))
+                .filter(|q| !self.log_x || q.0 > 0.0)
                 .map(|q| (x0 + xs.frac(q.0) * (x1 - x0), y1 - ys.frac(q.1) * (y1 - y0)))
                 .collect();
             for w in pts.windows(2) {

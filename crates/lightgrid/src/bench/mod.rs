@@ -2,14 +2,20 @@
 //! pipeline over a range of animation frames, recording per frame the GPU time per pass,
 //! lighting computations, the ideal count, lights per tile and the memory model; then
 //! `report` writes results.json / results.csv / plots / summary.md and `claims` checks the
-//! papers' claims against the measurements.
+//! papers' claims against the measurements. `scaling` measures light assignment strategies
+//! against the light count.
 
 mod claims;
 mod report;
 mod run;
+mod scaling;
 
 pub use claims::{evaluate_claims, Claim, Verdict};
 pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     run, BenchConfig, BenchResults, FrameRange, FrameRecord, Progress, RunRecord, RunSummary, Stat,
+};
+pub use scaling::{
+    run_scaling, scaling_table, write_scaling, ScalingConfig, ScalingPoint, ScalingResults,
+    SCALING_FILES,
 };

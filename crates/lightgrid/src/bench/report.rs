@@ -123,6 +123,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 ),
                 x_label: "frame".into(),
                 y_label: format!("ms ({timing}, log scale)"),
+                log_x: false,
                 log_y: true,
                 series: runs
                     .iter()
@@ -204,6 +205,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
             title: format!("{scene}: lighting computations per frame ({w}x{h})"),
             x_label: "frame".into(),
             y_label: "lighting computations (log scale)".into(),
+            log_x: false,
             log_y: true,
             series,
         };

@@ -1,0 +1,394 @@
+//! The light-assignment scaling benchmark (tiled-forward-shading §4.4: brute force is fine to
+//! ~10k lights, a light hierarchy scales to a million): one grid pipeline on the `stress`
+//! scene at increasing light counts, once per assignment strategy, recording per point the
+//! assignment time (wall clock between GPU syncs, GPU timestamps, CPU time), the index-list
+//! size, occupied cells and lighting computations. `write_scaling` writes scaling.json,
+//! scaling.csv, scaling.md (the table) and scaling.svg/.png (assignment time against lights).
+
+use super::run::Progress;
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::image_io::write_atomic;
+use crate::pipelines::{self, Assign, RenderSettings};
+use crate::plot::{LineChart, Series};
+use crate::scene::catalog::{self, SceneParams};
+use crate::Renderer;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// What to measure.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScalingConfig {
+    pub scene: String,
+    pub pipeline: String,
+    pub lights: Vec<u32>,
+    pub strategies: Vec<Assign>,
+    pub size: (u32, u32),
+    pub tile_size: u32,
+    pub slices: u32,
+    pub seed: u64,
+    /// Measured renders per point (the median assignment time is kept).
+    pub runs: u32,
+    /// Discarded renders before each point (shader compilation, buffer growth).
+    pub warmup: u32,
+    /// A strategy whose assignment took longer than this at one light count is not run at
+    /// larger ones (recorded as skipped).
+    pub budget_ms: f64,
+}
+
+impl Default for ScalingConfig {
+    fn default() -> Self {
+        ScalingConfig {
+            scene: "stress".into(),
+            pipeline: "clustered_deferred".into(),
+            lights: vec![1_000, 4_000, 16_000, 64_000, 256_000, 1_000_000],
+            strategies: vec![Assign::Cpu, Assign::Gather, Assign::Scatter, Assign::Bvh],
+            size: (640, 360),
+            tile_size: crate::consts::DEFAULT_TILE_SIZE,
+            slices: crate::consts::DEFAULT_SLICES,
+            seed: 1,
+            runs: 1,
+            warmup: 1,
+            budget_ms: 15_000.0,
+        }
+    }
+}
+
+/// One (light count, strategy) point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScalingPoint {
+    pub lights: u32,
+    pub assign: String,
+    /// Why the point was not measured (the strategy exceeded the budget at a smaller count).
+    pub skipped: Option<String>,
+    /// Median wall time of the assignment (cell bounds ready → grid ready on the GPU).
+    pub assign_ms: Option<f64>,
+    pub assign_ms_runs: Vec<f64>,
+    /// GPU timestamps of the assignment passes (cell bounds included).
+    pub assign_gpu_ms: Option<f64>,
+    /// CPU share: `assign_cpu`, or the BVH build.
+    pub assign_cpu_ms: Option<f64>,
+    /// The whole frame's GPU time (timestamps, first pass start to last pass end).
+    pub frame_gpu_ms: Option<f64>,
+    pub grid_indices: Option<u64>,
+    pub grid_bytes: Option<u64>,
+    pub grid_cells: Option<u64>,
+    pub grid_cells_occupied: Option<u64>,
+    pub lights_per_cell_max: Option<u32>,
+    pub lighting_computations: Option<u64>,
+    pub ideal_lighting_computations: Option<u64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ScalingResults {
+    pub command: String,
+    pub adapter: String,
+    pub software_adapter: bool,
+    pub config: ScalingConfig,
+    pub interrupted: bool,
+    pub points: Vec<ScalingPoint>,
+}
+
+impl ScalingConfig {
+    pub fn validate(&self) -> Result<()> {
+        let info = pipelines::find(&self.pipeline)?;
+        if !info.assign {
+            return Err(Error::invalid(
+                "--pipeline",
+                format!(
+                    "{} builds no grid through --assign; use one of: {}",
+                    info.id,
+                    pipelines::PIPELINES
+                        .iter()
+                        .filter(|p| p.assign)
+                        .map(|p| p.id)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        if !catalog::find(&self.scene)?.variable_lights {
+            return Err(Error::invalid(
+                "--scene",
+                format!("{} has a fixed light count; use stress", self.scene),
+            ));
+        }
+        if self.lights.is_empty() || self.strategies.is_empty() || self.runs == 0 {
+            return Err(Error::invalid(
+                "scaling",
+                "needs at least one light count, one strategy and one run",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[s.len() / 2]
+}
+
+/// Run the scaling benchmark; `stop` is polled after every render.
+pub fn run_scaling(
+    ctx: &GpuContext,
+    config: &ScalingConfig,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ScalingResults> {
+    config.validate()?;
+    let mut lights = config.lights.clone();
+    lights.sort_unstable();
+    lights.dedup();
+    let per_point = u64::from(config.warmup + config.runs);
+    let total = per_point * (lights.len() * config.strategies.len()) as u64;
+    let mut done = 0;
+    let mut results = ScalingResults {
+        command: String::new(),
+        adapter: ctx.adapter_label(),
+        software_adapter: ctx.is_software(),
+        config: config.clone(),
+        interrupted: false,
+        points: Vec::new(),
+    };
+    let (w, h) = config.size;
+    let mut over_budget: Vec<Option<(u32, f64)>> = vec![None; config.strategies.len()];
+    'counts: for &n in &lights {
+        let params = SceneParams {
+            seed: config.seed,
+            lights: Some(n),
+        };
+        let scene = catalog::build(&config.scene, &params)?;
+        for (si, &assign) in config.strategies.iter().enumerate() {
+            let mut point = ScalingPoint {
+                lights: n,
+                assign: assign.resolve(n as usize).name().to_string(),
+                skipped: None,
+                assign_ms: None,
+                assign_ms_runs: Vec::new(),
+                assign_gpu_ms: None,
+                assign_cpu_ms: None,
+                frame_gpu_ms: None,
+                grid_indices: None,
+                grid_bytes: None,
+                grid_cells: None,
+                grid_cells_occupied: None,
+                lights_per_cell_max: None,
+                lighting_computations: None,
+                ideal_lighting_computations: None,
+            };
+            if let Some((at, ms)) = over_budget[si] {
+                point.skipped = Some(format!(
+                    "took {:.1} s at {at} lights (budget {:.1} s)",
+                    ms / 1e3,
+                    config.budget_ms / 1e3
+                ));
+                done += per_point;
+                results.points.push(point);
+                continue;
+            }
+            let settings = RenderSettings {
+                tile_size: config.tile_size,
+                slices: config.slices,
+                assign,
+                ..Default::default()
+            };
+            let mut renderer = Renderer::new(ctx, w, h, settings)?;
+            let mut outs = Vec::new();
+            for i in 0..per_point {
+                progress(&Progress {
+                    done,
+                    total,
+                    label: format!(
+                        "{n} lights, {} ({})",
+                        assign.name(),
+                        if i < u64::from(config.warmup) {
+                            "warm-up"
+                        } else {
+                            "measuring"
+                        }
+                    ),
+                });
+                let out = renderer.render(&scene, 0, &config.pipeline)?;
+                if i >= u64::from(config.warmup) {
+                    outs.push(out);
+                }
+                done += 1;
+                if stop.load(Ordering::Relaxed) {
+                    results.interrupted = true;
+                    break;
+                }
+            }
+            if let Some(last) = outs.last() {
+                let times: Vec<f64> = outs.iter().filter_map(|o| o.stats.assign_ms).collect();
+                let s = &last.stats;
+                point.assign_ms = (!times.is_empty()).then(|| median(&times));
+                point.assign_ms_runs = times;
+                point.assign_gpu_ms = s.assign_gpu_ms;
+                point.assign_cpu_ms = s.assign_cpu_ms;
+                point.frame_gpu_ms = Some(s.gpu_ms);
+                point.grid_indices = s.grid_indices;
+                point.grid_bytes = s.memory.grid_bytes;
+                point.grid_cells = s.grid_cells;
+                point.grid_cells_occupied = s.grid_cells_occupied;
+                point.lights_per_cell_max = s.lights_per_tile_max;
+                point.lighting_computations = s.lighting_computations;
+                point.ideal_lighting_computations = Some(s.ideal_lighting_computations);
+                if let Some(ms) = point.assign_ms.filter(|&ms| ms > config.budget_ms) {
+                    over_budget[si] = Some((n, ms));
+                }
+                results.points.push(point);
+            }
+            if results.interrupted {
+                break 'counts;
+            }
+        }
+    }
+    progress(&Progress {
+        done: total,
+        total,
+        label: "done".into(),
+    });
+    Ok(results)
+}
+
+fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
+    v.map_or(String::new(), |v| v.to_string())
+}
+
+fn ms(v: Option<f64>) -> String {
+    v.map_or("–".into(), |v| format!("{v:.1}"))
+}
+
+/// The table (Markdown), as README shows it.
+pub fn scaling_table(r: &ScalingResults) -> String {
+    let c = &r.config;
+    let mut out = format!(
+        "`{}` on `{}` at {}x{}, tile {}, {} slices; {}\n\n",
+        c.pipeline, c.scene, c.size.0, c.size.1, c.tile_size, c.slices, r.adapter
+    );
+    out.push_str(
+        "| lights | assign | assign ms (wall) | GPU ms (timestamps) | CPU ms | index entries | grid MiB | cells with samples | max lights/cell | lighting computations | × ideal |\n",
+    );
+    out.push_str("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for p in &r.points {
+        if let Some(why) = &p.skipped {
+            let _ = writeln!(
+                out,
+                "| {} | {} | skipped: {why} | | | | | | | | |",
+                p.lights, p.assign
+            );
+            continue;
+        }
+        let ratio = match (p.lighting_computations, p.ideal_lighting_computations) {
+            (Some(n), Some(i)) if i > 0 => format!("{:.1}", n as f64 / i as f64),
+            _ => "–".into(),
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            p.lights,
+            p.assign,
+            ms(p.assign_ms),
+            ms(p.assign_gpu_ms),
+            ms(p.assign_cpu_ms.filter(|&v| v > 0.0)),
+            opt(p.grid_indices),
+            p.grid_bytes
+                .map_or("–".into(), |b| format!("{:.2}", b as f64 / 1048576.0)),
+            opt(p.grid_cells_occupied),
+            opt(p.lights_per_cell_max),
+            opt(p.lighting_computations),
+            ratio
+        );
+    }
+    out
+}
+
+/// Files `write_scaling` produces.
+pub const SCALING_FILES: [&str; 5] = [
+    "scaling.json",
+    "scaling.csv",
+    "scaling.md",
+    "scaling.svg",
+    "scaling.png",
+];
+
+/// Write scaling.json, scaling.csv, scaling.md and the chart into `dir`.
+pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let json =
+        serde_json::to_vec_pretty(r).map_err(|e| Error::invalid("scaling", e.to_string()))?;
+    write_atomic(&dir.join("scaling.json"), &json)?;
+    let mut csv = String::from(
+        "lights,assign,skipped,assign_ms,assign_gpu_ms,assign_cpu_ms,frame_gpu_ms,grid_indices,grid_bytes,grid_cells,grid_cells_occupied,lights_per_cell_max,lighting_computations,ideal_lighting_computations\n",
+    );
+    for p in &r.points {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            p.lights,
+            p.assign,
+            p.skipped.as_deref().unwrap_or("").replace(',', ";"),
+            opt(p.assign_ms),
+            opt(p.assign_gpu_ms),
+            opt(p.assign_cpu_ms),
+            opt(p.frame_gpu_ms),
+            opt(p.grid_indices),
+            opt(p.grid_bytes),
+            opt(p.grid_cells),
+            opt(p.grid_cells_occupied),
+            opt(p.lights_per_cell_max),
+            opt(p.lighting_computations),
+            opt(p.ideal_lighting_computations),
+        );
+    }
+    write_atomic(&dir.join("scaling.csv"), csv.as_bytes())?;
+    let md = format!(
+        "# Light assignment scaling\n\n`{}`\n\n{}",
+        r.command,
+        scaling_table(r)
+    );
+    write_atomic(&dir.join("scaling.md"), md.as_bytes())?;
+    let mut names: Vec<&str> = Vec::new();
+    for p in &r.points {
+        if !names.contains(&p.assign.as_str()) {
+            names.push(&p.assign);
+        }
+    }
+    let chart = LineChart {
+        title: format!(
+            "Light assignment time, {} at {}x{}",
+            r.config.pipeline, r.config.size.0, r.config.size.1
+        ),
+        x_label: "lights".into(),
+        y_label: "assignment ms (wall)".into(),
+        log_x: true,
+        log_y: true,
+        series: names
+            .iter()
+            .map(|name| Series {
+                name: name.to_string(),
+                points: r
+                    .points
+                    .iter()
+                    .filter(|p| p.assign == *name)
+                    .filter_map(|p| Some((f64::from(p.lights), p.assign_ms?)))
+                    .collect(),
+                emphasis: false,
+            })
+            .collect(),
+    };
+    write_atomic(&dir.join("scaling.svg"), chart.svg().as_bytes())?;
+    let mut png = Vec::new();
+    chart
+        .png()
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| Error::invalid("scaling", e.to_string()))?;
+    write_atomic(&dir.join("scaling.png"), &png)?;
+    Ok(())
+}
