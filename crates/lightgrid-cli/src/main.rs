@@ -63,6 +63,8 @@ enum AssignArg {
     Scatter,
     /// Light hierarchy built on the CPU each frame, walked per cell on the GPU.
     Bvh,
+    /// Light hierarchy built on the GPU each frame (Morton codes, radix sort), walked as bvh.
+    BvhGpu,
 }
 
 impl From<AssignArg> for lightgrid::pipelines::Assign {
@@ -74,6 +76,7 @@ impl From<AssignArg> for lightgrid::pipelines::Assign {
             AssignArg::Gather => Assign::Gather,
             AssignArg::Scatter => Assign::Scatter,
             AssignArg::Bvh => Assign::Bvh,
+            AssignArg::BvhGpu => Assign::BvhGpu,
         }
     }
 }

@@ -256,7 +256,9 @@ fn twin(
             assign_cpu(setup, dims, lights, DepthRange::NearFar)
         }
         Assign::Cpu | Assign::Scatter => assign_cpu(setup, dims, lights, DepthRange::Cells(bounds)),
-        Assign::Gather | Assign::Bvh => assign_gather_cpu(setup, dims, lights, bounds),
+        Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
+            assign_gather_cpu(setup, dims, lights, bounds)
+        }
         Assign::Auto => unreachable!("resolved by the renderer"),
     }
 }
@@ -392,7 +394,13 @@ const GRID_PIPELINES: [&str; 5] = [
     "clustered_forward",
     "clustered_deferred",
 ];
-const STRATEGIES: [Assign; 4] = [Assign::Cpu, Assign::Gather, Assign::Scatter, Assign::Bvh];
+const STRATEGIES: [Assign; 5] = [
+    Assign::Cpu,
+    Assign::Gather,
+    Assign::Scatter,
+    Assign::Bvh,
+    Assign::BvhGpu,
+];
 
 fn check_strategies(
     scene: &Scene,
@@ -488,9 +496,10 @@ fn strategies_agree_with_each_other_and_pipelines_without_a_grid_ignore_them() {
             assert!(out.cell_bounds.is_none());
         }
     }
-    // CPU and scatter run the same test; gather and BVH the same (plane-based) test.
+    // CPU and scatter run the same test; gather and both BVHs the same (plane-based) test.
     assert_eq!(lists[0], lists[2], "cpu vs scatter");
     assert_eq!(lists[1], lists[3], "gather vs bvh");
+    assert_eq!(lists[1], lists[4], "gather vs bvh-gpu");
 }
 
 #[test]

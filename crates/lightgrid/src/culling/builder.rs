@@ -7,15 +7,18 @@
 //!    - `scatter`: one invocation per light emits (cell, light) pairs, radix sort by cell
 //!      (`scatter.rs`);
 //!    - `bvh`: the light hierarchy built on the CPU (`bvh.rs`), one workgroup per cell walks it;
+//!    - `bvh-gpu`: the same hierarchy built on the GPU (`bvh_gpu.rs`), walked the same way;
 //! 3. the grid is left in [`GridBuffers`] (group 1 of the shading pass) and read back for
 //!    statistics and tests.
 
 use super::bvh::{build_bvh, BvhBuffers};
+use super::bvh_gpu::GpuBvhBuild;
 use super::cell_bounds::CellBoundsPass;
 use super::gpu_assign::{bvh_shader, gather_shader, read_grid, AssignCommon, CellKernels};
 use super::scatter::ScatterPass;
 use super::{assign_cpu, DepthRange, GridBuffers, GridDims, LightGrid};
 use crate::error::Result;
+use crate::gpu::bind_resources;
 use crate::pipelines::{FrameEncoder, FrameInputs};
 use std::time::Instant;
 
@@ -31,6 +34,10 @@ pub enum Assign {
     Scatter,
     /// Light BVH rebuilt each frame on the CPU, traversed on the GPU per cell.
     Bvh,
+    /// Light BVH rebuilt each frame on the GPU (Morton codes, radix sort, node boxes),
+    /// traversed as `Bvh`.
+    #[serde(rename = "bvh-gpu")]
+    BvhGpu,
     /// By light count: see [`Assign::resolve`].
     #[default]
     Auto,
@@ -40,11 +47,12 @@ pub enum Assign {
 pub const AUTO_CPU_MAX_LIGHTS: usize = 4096;
 /// `auto` uses the BVH above AUTO_CPU_MAX_LIGHTS.
 impl Assign {
-    pub const ALL: [Assign; 5] = [
+    pub const ALL: [Assign; 6] = [
         Assign::Cpu,
         Assign::Gather,
         Assign::Scatter,
         Assign::Bvh,
+        Assign::BvhGpu,
         Assign::Auto,
     ];
 
@@ -54,6 +62,7 @@ impl Assign {
             Assign::Gather => "gather",
             Assign::Scatter => "scatter",
             Assign::Bvh => "bvh",
+            Assign::BvhGpu => "bvh-gpu",
             Assign::Auto => "auto",
         }
     }
@@ -105,6 +114,7 @@ pub struct GridBuilder {
     common: Option<AssignCommon>,
     gather: Option<CellKernels>,
     bvh: Option<(CellKernels, BvhBuffers)>,
+    bvh_gpu: Option<GpuBvhBuild>,
     scatter: Option<ScatterPass>,
 }
 
@@ -130,6 +140,7 @@ impl GridBuilder {
             common: None,
             gather: None,
             bvh: None,
+            bvh_gpu: None,
             scatter: None,
         }
     }
@@ -206,7 +217,7 @@ impl GridBuilder {
                     &[],
                 )?
             }
-            Assign::Bvh => {
+            Assign::Bvh | Assign::BvhGpu => {
                 let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
                 let (kernels, buffers) = self.bvh.get_or_insert_with(|| {
                     let buffers = BvhBuffers::new(device);
@@ -222,10 +233,24 @@ impl GridBuilder {
                     );
                     (kernels, buffers)
                 });
-                let start = Instant::now();
-                let bvh = build_bvh(&f.setup, f.lights);
-                cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-                let group = buffers.upload(device, queue, &bvh);
+                let group = if assign == Assign::Bvh {
+                    let start = Instant::now();
+                    let bvh = build_bvh(&f.setup, f.lights);
+                    cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+                    buffers.upload(device, queue, &bvh)
+                } else {
+                    let build = self
+                        .bvh_gpu
+                        .get_or_insert_with(|| GpuBvhBuild::new(device, &self.scene_layout));
+                    build.encode(f, enc, &common.scan);
+                    let (nodes, order) = build.buffers();
+                    bind_resources(
+                        device,
+                        "light bvh (gpu build)",
+                        &buffers.layout,
+                        &[nodes.as_entire_binding(), order.as_entire_binding()],
+                    )
+                };
                 kernels.run(
                     device,
                     queue,

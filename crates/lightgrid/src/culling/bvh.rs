@@ -79,6 +79,28 @@ fn union(nodes: &[BvhNode]) -> ([f32; 3], [f32; 3]) {
     (lo.to_array(), hi.to_array())
 }
 
+/// The node layout for `lights` lights: per level, bottom-up (leaves first), the index of its
+/// first node and its node count. Nodes are stored root first, so the last level listed
+/// starts at 0.
+pub fn bvh_levels(lights: usize) -> Vec<(u32, u32)> {
+    let mut counts = Vec::new();
+    let mut n = lights.div_ceil(BVH_WIDTH as usize);
+    while n > 0 {
+        counts.push(n as u32);
+        if n == 1 {
+            break;
+        }
+        n = n.div_ceil(BVH_WIDTH as usize);
+    }
+    let mut at = 0u32;
+    let mut firsts = vec![0u32; counts.len()];
+    for (i, &c) in counts.iter().enumerate().rev() {
+        firsts[i] = at;
+        at += c;
+    }
+    firsts.into_iter().zip(counts).collect()
+}
+
 /// Build the hierarchy over `lights` as seen by `setup`'s camera.
 pub fn build_bvh(setup: &ViewSetup, lights: &[PointLight]) -> LightBvh {
     if lights.is_empty() {
@@ -142,12 +164,8 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[PointLight]) -> LightBvh {
     }
     // Root first: level k's nodes follow those of every level above it.
     let mut nodes = Vec::with_capacity(levels.iter().map(Vec::len).sum());
-    let mut offsets = vec![0u32; levels.len()];
-    let mut at = 0u32;
-    for (i, level) in levels.iter().enumerate().rev() {
-        offsets[i] = at;
-        at += level.len() as u32;
-    }
+    let offsets: Vec<u32> = bvh_levels(lights.len()).iter().map(|l| l.0).collect();
+    debug_assert_eq!(offsets.len(), levels.len());
     for (i, level) in levels.iter().enumerate().rev() {
         for n in level {
             let mut n = *n;

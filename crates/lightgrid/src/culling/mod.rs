@@ -6,6 +6,7 @@
 mod assign_cpu;
 mod builder;
 mod bvh;
+mod bvh_gpu;
 mod cell_bounds;
 mod gather;
 mod gpu_assign;
@@ -18,7 +19,7 @@ mod view;
 
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
 pub use builder::{Assign, BuiltGrid, CellSource, GridBuilder, AUTO_CPU_MAX_LIGHTS};
-pub use bvh::{build_bvh, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
+pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
 pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use grid::{GridBuffers, GridDims, LightGrid};
@@ -38,6 +39,7 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
         radix_sort::shader(),
         gpu_assign::gather_shader(),
         gpu_assign::bvh_shader(),
+        bvh_gpu::shader(),
         scatter::shader(),
     ]
 }

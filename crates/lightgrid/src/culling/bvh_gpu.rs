@@ -1,0 +1,183 @@
+//! The light BVH built on the GPU (`bvh_build.wgsl`): centre bounding box, Morton codes, the
+//! radix sort shared with scatter, then leaf and per-level node boxes. Produces the same
+//! layout as the CPU build ([`super::build_bvh`], its twin) and binds as the traversal's
+//! group 2 (`bvh_order` is the sorted value array itself).
+
+use super::bvh::{bvh_levels, BvhNode};
+use super::radix_sort::RadixSort;
+use super::scan::ScanPass;
+use crate::consts::ASSIGN_THREADS;
+use crate::gpu::{
+    bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, STORAGE_RW, UNIFORM,
+};
+use crate::pipelines::{FrameEncoder, FrameInputs};
+use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use std::num::NonZeroU64;
+
+pub(crate) fn shader() -> ComposedShader {
+    compose(
+        "bvh build",
+        &[
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            include_str!("bvh_build.wgsl"),
+        ],
+    )
+}
+
+/// Uniform slots for the per-level parameters, at the minimum uniform offset alignment.
+const SLOT: u64 = 256;
+const MAX_LEVELS: u64 = 8;
+
+pub struct GpuBvhBuild {
+    layout: wgpu::BindGroupLayout,
+    box_pass: wgpu::ComputePipeline,
+    morton: wgpu::ComputePipeline,
+    leaves: wgpu::ComputePipeline,
+    inner: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    centre_box: wgpu::Buffer,
+    sort: RadixSort,
+}
+
+impl GpuBvhBuild {
+    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+        let layout = buffer_layout(
+            device,
+            "bvh build (group 1)",
+            &[UNIFORM, STORAGE_RW, STORAGE_RW, STORAGE_RW, STORAGE_RW],
+        );
+        let s = shader();
+        let layouts = [Some(scene_layout), Some(&layout)];
+        let pipeline = |entry: &str| {
+            compute_pipeline(device, &format!("bvh build {entry}"), &s, entry, &layouts)
+        };
+        GpuBvhBuild {
+            box_pass: pipeline("box_main"),
+            morton: pipeline("morton_main"),
+            leaves: pipeline("leaves_main"),
+            inner: pipeline("inner_main"),
+            layout,
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("bvh build levels"),
+                size: SLOT * MAX_LEVELS,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            nodes: storage_buffer(device, "bvh nodes (gpu build)", 1 << 12),
+            centre_box: storage_buffer(device, "bvh centre box", 32),
+            sort: RadixSort::new(device),
+        }
+    }
+
+    /// Record the build for the frame's lights. The hierarchy is ready for the passes
+    /// recorded after it; [`GpuBvhBuild::buffers`] binds it.
+    pub fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder, scan: &ScanPass) {
+        let device = f.device;
+        let n = f.lights.len() as u32;
+        if n == 0 {
+            return;
+        }
+        let levels = bvh_levels(n as usize);
+        let node_count: u32 = levels.iter().map(|l| l.1).sum();
+        grow_storage(
+            device,
+            &mut self.nodes,
+            "bvh nodes (gpu build)",
+            u64::from(node_count) * std::mem::size_of::<BvhNode>() as u64,
+        );
+        self.sort.ensure(device, u64::from(n));
+        let mut slots = vec![0u8; (SLOT * MAX_LEVELS) as usize];
+        for (i, &(first, count)) in levels.iter().enumerate() {
+            let (child_first, child_count) = if i > 0 { levels[i - 1] } else { (0, n) };
+            let at = i * SLOT as usize;
+            slots[at..at + 16].copy_from_slice(bytemuck::cast_slice(&[
+                first,
+                count,
+                child_first,
+                child_count,
+            ]));
+        }
+        f.queue.write_buffer(&self.params, 0, &slots);
+        let group = |slot: usize| {
+            bind_resources(
+                device,
+                "bvh build",
+                &self.layout,
+                &[
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.params,
+                        offset: SLOT * slot as u64,
+                        size: NonZeroU64::new(16),
+                    }),
+                    self.sort.keys.as_entire_binding(),
+                    self.sort.vals.as_entire_binding(),
+                    self.nodes.as_entire_binding(),
+                    self.centre_box.as_entire_binding(),
+                ],
+            )
+        };
+        let (encoder, timer) = enc.parts();
+        encoder.clear_buffer(&self.centre_box, 0, None);
+        let run = |encoder: &mut wgpu::CommandEncoder,
+                   timer: &mut crate::gpu::PassTimer,
+                   pipeline: &wgpu::ComputePipeline,
+                   group: &wgpu::BindGroup,
+                   label: &str,
+                   items: u32| {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: timer.compute_pass(label),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(1, group, &[]);
+            let (x, y) = groups_1d(items.div_ceil(ASSIGN_THREADS));
+            pass.dispatch_workgroups(x, y, 1);
+        };
+        let g0 = group(0);
+        run(
+            encoder,
+            timer,
+            &self.box_pass,
+            &g0,
+            "assign: bvh build box",
+            n,
+        );
+        run(
+            encoder,
+            timer,
+            &self.morton,
+            &g0,
+            "assign: bvh build morton",
+            n,
+        );
+        self.sort
+            .encode(device, f.queue, encoder, timer, scan, n, 30);
+        run(
+            encoder,
+            timer,
+            &self.leaves,
+            &g0,
+            "assign: bvh build leaves",
+            levels[0].1,
+        );
+        for (i, level) in levels.iter().enumerate().skip(1) {
+            let g = group(i);
+            run(
+                encoder,
+                timer,
+                &self.inner,
+                &g,
+                "assign: bvh build levels",
+                level.1,
+            );
+        }
+    }
+
+    /// (nodes, order) for the traversal's group 2.
+    pub fn buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        (&self.nodes, &self.sort.vals)
+    }
+}
