@@ -114,7 +114,7 @@ fn inner_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         return;
     }
     let first = level.child_first + j * BVH_WIDTH;
-    let count = min(BVH_WIDTH, level.child_count - j * BVH_WIDTH) - 1u;
+    let count = min(BVH_WIDTH, level.child_count - j * BVH_WIDTH);
     var lo = vec3<f32>(3.0e38);
     var hi = vec3<f32>(-3.0e38);
     for (var k = 0u; k < count; k = k + 1u) {
