@@ -251,6 +251,7 @@ impl<'c> Renderer<'c> {
                 dims: self.dims,
                 settings: self.settings,
                 count_blend: self.ctx.count_blend,
+                software_adapter: self.ctx.is_software(),
             };
             let t = scoped(device, &format!("creating pipeline {}", info.id), || {
                 (info.create)(&ctx)

@@ -610,3 +610,33 @@ fn light_volume_classes_follow_the_clip_planes() {
         (vec![0, 1], vec![3], vec![2])
     );
 }
+
+#[test]
+fn auto_assignment_resolves_by_adapter_and_light_count() {
+    use lightgrid::culling::{Assign, AUTO_GATHER_MAX_LIGHTS};
+    for n in [0, 1, 1000, 1_000_000] {
+        assert_eq!(
+            Assign::Auto.resolve(n, true),
+            Assign::Cpu,
+            "software, {n} lights"
+        );
+    }
+    assert_eq!(Assign::Auto.resolve(100, false), Assign::Gather);
+    assert_eq!(
+        Assign::Auto.resolve(AUTO_GATHER_MAX_LIGHTS, false),
+        Assign::Gather
+    );
+    assert_eq!(
+        Assign::Auto.resolve(AUTO_GATHER_MAX_LIGHTS + 1, false),
+        Assign::BvhGpu
+    );
+    for a in Assign::ALL.into_iter().filter(|&a| a != Assign::Auto) {
+        assert_eq!(a.resolve(5, true), a);
+        assert_eq!(a.resolve(5_000_000, false), a);
+    }
+    let names: Vec<&str> = Assign::ALL.iter().map(|a| a.name()).collect();
+    assert_eq!(
+        names,
+        ["cpu", "gather", "scatter", "bvh", "bvh-gpu", "auto"]
+    );
+}

@@ -291,7 +291,12 @@ fn check_assign(
     let out = r.render(s, frame, id).unwrap();
     let state = s.frame(frame);
     let setup = ViewSetup::new(&state.camera, w, h);
-    let assign = r.settings().assign.resolve(state.lights.len());
+    let assign = r.settings().assign;
+    assert_ne!(
+        assign,
+        Assign::Auto,
+        "check_assign takes an explicit strategy"
+    );
     let what = format!("{} {id} --assign {} {w}x{h}", s.name, assign.name());
     assert_eq!(out.stats.assign.as_deref(), Some(assign.name()), "{what}");
     let bounds = out
@@ -496,6 +501,11 @@ fn strategies_agree_with_each_other_and_pipelines_without_a_grid_ignore_them() {
             assert!(out.cell_bounds.is_none());
         }
     }
+    // `auto` resolves by adapter and light count, and says what it chose.
+    let mut r = Renderer::new(&ctx, 96, 64, RenderSettings::default()).unwrap();
+    let out = r.render(&s, 100, "tiled_deferred").unwrap();
+    let chosen = Assign::Auto.resolve(s.frame(100).lights.len(), ctx.is_software());
+    assert_eq!(out.stats.assign.as_deref(), Some(chosen.name()));
     // CPU and scatter run the same test; gather and both BVHs the same (plane-based) test.
     assert_eq!(lists[0], lists[2], "cpu vs scatter");
     assert_eq!(lists[1], lists[3], "gather vs bvh");

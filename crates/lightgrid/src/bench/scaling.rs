@@ -57,7 +57,7 @@ impl Default for ScalingConfig {
             seed: 1,
             runs: 1,
             warmup: 1,
-            budget_ms: 15_000.0,
+            budget_ms: 5_000.0,
         }
     }
 }
@@ -170,7 +170,10 @@ pub fn run_scaling(
         for (si, &assign) in config.strategies.iter().enumerate() {
             let mut point = ScalingPoint {
                 lights: n,
-                assign: assign.resolve(n as usize).name().to_string(),
+                assign: assign
+                    .resolve(n as usize, ctx.is_software())
+                    .name()
+                    .to_string(),
                 skipped: None,
                 assign_ms: None,
                 assign_ms_runs: Vec::new(),

@@ -43,9 +43,10 @@ pub enum Assign {
     Auto,
 }
 
-/// `auto` uses the CPU up to this many lights.
-pub const AUTO_CPU_MAX_LIGHTS: usize = 4096;
-/// `auto` uses the BVH above AUTO_CPU_MAX_LIGHTS.
+/// On a hardware GPU, `auto` gathers up to this many lights and walks a GPU-built BVH above
+/// (tiled-forward-shading §4.4: brute force holds to about 10k lights).
+pub const AUTO_GATHER_MAX_LIGHTS: usize = 8192;
+
 impl Assign {
     pub const ALL: [Assign; 6] = [
         Assign::Cpu,
@@ -67,13 +68,16 @@ impl Assign {
         }
     }
 
-    /// The strategy used for a frame with `lights` lights: `auto` picks the CPU up to
-    /// [`AUTO_CPU_MAX_LIGHTS`] and the BVH above (measured: README, "Light assignment
-    /// scaling").
-    pub fn resolve(self, lights: usize) -> Assign {
+    /// The strategy used for a frame with `lights` lights. `auto` on a software adapter
+    /// (lavapipe, which shares the CPU's cores) is `cpu` at every count: measured fastest from
+    /// 1k to 1M lights (README, "Light assignment scaling"). On a hardware GPU it is `gather`
+    /// up to [`AUTO_GATHER_MAX_LIGHTS`] and `bvh-gpu` above, which keeps the grid on the GPU
+    /// (the paper's crossover; no hardware GPU was available to measure it).
+    pub fn resolve(self, lights: usize, software_adapter: bool) -> Assign {
         match self {
-            Assign::Auto if lights <= AUTO_CPU_MAX_LIGHTS => Assign::Cpu,
-            Assign::Auto => Assign::Bvh,
+            Assign::Auto if software_adapter => Assign::Cpu,
+            Assign::Auto if lights <= AUTO_GATHER_MAX_LIGHTS => Assign::Gather,
+            Assign::Auto => Assign::BvhGpu,
             other => other,
         }
     }
@@ -108,6 +112,7 @@ pub struct GridBuilder {
     slices: u32,
     source: CellSource,
     assign: Assign,
+    software_adapter: bool,
     scene_layout: wgpu::BindGroupLayout,
     bounds: CellBoundsPass,
     buffers: GridBuffers,
@@ -121,19 +126,14 @@ pub struct GridBuilder {
 impl GridBuilder {
     /// `slices` 1 builds a tiled grid, more a clustered one (slices between the camera's near
     /// and far planes each frame).
-    pub fn new(
-        device: &wgpu::Device,
-        scene_layout: &wgpu::BindGroupLayout,
-        tiles: GridDims,
-        slices: u32,
-        source: CellSource,
-        assign: Assign,
-    ) -> Self {
+    pub fn new(ctx: &crate::pipelines::PipelineContext, slices: u32, source: CellSource) -> Self {
+        let (device, scene_layout) = (ctx.device, ctx.scene_layout);
         GridBuilder {
-            tiles,
+            tiles: ctx.dims,
             slices,
             source,
-            assign,
+            assign: ctx.settings.assign,
+            software_adapter: ctx.software_adapter,
             scene_layout: scene_layout.clone(),
             bounds: CellBoundsPass::new(device, scene_layout),
             buffers: GridBuffers::new(device),
@@ -169,7 +169,7 @@ impl GridBuilder {
             CellSource::Depth => self.bounds.encode(f, enc, &dims),
             CellSource::NearFar => self.bounds.fill(device, queue, &dims, near_far),
         }
-        let assign = self.assign.resolve(f.lights.len());
+        let assign = self.assign.resolve(f.lights.len(), self.software_adapter);
         // Everything before assignment (the depth, the bounds) finishes outside the clock.
         enc.submit_and_wait()?;
         let wall = Instant::now();

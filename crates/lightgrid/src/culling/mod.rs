@@ -18,7 +18,7 @@ mod scatter;
 mod view;
 
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
-pub use builder::{Assign, BuiltGrid, CellSource, GridBuilder, AUTO_CPU_MAX_LIGHTS};
+pub use builder::{Assign, BuiltGrid, CellSource, GridBuilder, AUTO_GATHER_MAX_LIGHTS};
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
 pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
 pub use gather::{assign_gather_cpu, gather_margins};

@@ -51,6 +51,8 @@ pub struct PipelineContext<'a> {
     pub settings: RenderSettings,
     /// The adapter can blend into the R32Float count target.
     pub count_blend: bool,
+    /// A CPU-emulated adapter (lavapipe): `--assign auto` keeps assignment on the CPU.
+    pub software_adapter: bool,
 }
 
 /// What a pipeline reads to render one frame.

@@ -83,14 +83,7 @@ pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
 fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
-    let builder = GridBuilder::new(
-        ctx.device,
-        ctx.scene_layout,
-        ctx.dims,
-        slices,
-        CellSource::Depth,
-        ctx.settings.assign,
-    );
+    let builder = GridBuilder::new(ctx, slices, CellSource::Depth);
     let outputs_layout = compute_outputs_layout(ctx.device);
     let shading = compute_pipeline(
         ctx.device,

@@ -45,9 +45,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let prepass = kind != Kind::Plain;
     let builder = GridBuilder::new(
-        ctx.device,
-        ctx.scene_layout,
-        ctx.dims,
+        ctx,
         if kind == Kind::Clustered {
             ctx.settings.slices
         } else {
@@ -58,7 +56,6 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
         } else {
             CellSource::NearFar
         },
-        ctx.settings.assign,
     );
     let shading = geometry_pipeline(
         ctx.device,
