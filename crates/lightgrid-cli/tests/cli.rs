@@ -373,3 +373,94 @@ fn bench_quick_preset_writes_its_report() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn render_with_each_assignment_strategy_reports_it() {
+    let dir = temp_dir("assign");
+    for assign in ["cpu", "gather", "scatter", "bvh", "bvh-gpu"] {
+        let json = dir.join(format!("{assign}.json"));
+        let o = lightgrid(&[
+            "render",
+            "--scene",
+            "stress",
+            "--lights",
+            "3000",
+            "--pipeline",
+            "clustered_forward",
+            "--size",
+            "96x54",
+            "--assign",
+            assign,
+            "--stats",
+            json.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{assign}: {}", stderr(&o));
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            out.contains(&format!("light assignment {assign}:")),
+            "{out}"
+        );
+        let stats: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        assert_eq!(stats["assign"], assign);
+        assert!(stats["assign_ms"].as_f64().unwrap() > 0.0);
+        assert!(stats["grid_indices"].as_u64().unwrap() > 0);
+        assert!(stats["grid_cells_occupied"].as_u64().unwrap() > 0);
+    }
+    assert_fails_with(&["render", "--assign", "magic"], "possible values");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scaling_writes_its_table_and_files() {
+    let dir = temp_dir("scaling");
+    let o = lightgrid(&[
+        "scaling",
+        "--lights",
+        "500,2000",
+        "--assign",
+        "cpu,bvh",
+        "--size",
+        "96x54",
+        "--warmup",
+        "0",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("| 2000 | bvh |"), "{out}");
+    for f in [
+        "scaling.json",
+        "scaling.csv",
+        "scaling.md",
+        "scaling.svg",
+        "scaling.png",
+    ] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scaling.json")).unwrap()).unwrap();
+    assert_eq!(json["points"].as_array().unwrap().len(), 4);
+    assert_fails_with(
+        &[
+            "scaling",
+            "--pipeline",
+            "deferred",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        "builds no grid",
+    );
+    assert_fails_with(
+        &[
+            "scaling",
+            "--scene",
+            "robots-many",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        "fixed light count",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
