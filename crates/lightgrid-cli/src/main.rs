@@ -473,6 +473,7 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     // Reference images by id; `forward` is rendered first (registry order).
     let mut references: std::collections::HashMap<&str, image::RgbaImage> = Default::default();
     let mut notes = Vec::new();
+    let mut assigned_by: Option<String> = None;
     let mut failed = Vec::new();
     for p in PIPELINES {
         let warm = (0..a.scene.warmup)
@@ -535,6 +536,9 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             (Some(avg), Some(max)) => format!("{avg:.1}/{max}"),
             _ => "-".into(),
         };
+        if let Some(assign) = &s.assign {
+            assigned_by.get_or_insert_with(|| assign.clone());
+        }
         println!(
             "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
             p.id, time, mean, p99, max, comps, ratio, per_tile
@@ -550,8 +554,9 @@ fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         println!("* wall clock: this adapter has no timestamp queries");
     }
     println!(
-        "diff in 8-bit sRGB levels vs {REFERENCE}; 'x ideal' = lighting computations / ideal (one per light reaching a visible sample); lights/tile = avg/max of the pipeline's CPU grid ({}px tiles)",
-        a.scene.tile
+        "diff in 8-bit sRGB levels vs {REFERENCE}; 'x ideal' = lighting computations / ideal (one per light reaching a visible sample); lights/tile = avg/max per cell of the pipeline's grid ({}px tiles; clusters for clustered_*), built by --assign {}",
+        a.scene.tile,
+        assigned_by.as_deref().unwrap_or("-")
     );
     println!("images and stats in {}", a.out_dir.display());
     if !failed.is_empty() {
