@@ -39,6 +39,11 @@ pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 /// radix sort blocks, prefix sums).
 pub const ASSIGN_THREADS: u32 = 256;
 
+/// Light indices one per-cell assignment workgroup (gather, BVH walk) collects in workgroup
+/// memory before flushing them to the global index list. A cell with more lights "spills": a
+/// second pass writes its whole list straight to global memory (nothing is ever dropped).
+pub const CELL_LIST_CAPACITY: u32 = 512;
+
 /// Branching factor of the light BVH (tiled-forward-shading §4.4 uses 32): a leaf holds up to
 /// 32 lights, an inner node up to 32 children, and one traversal workgroup has 32 invocations,
 /// one per child.
@@ -82,6 +87,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
     ("ASSIGN_THREADS", WgslConst::U32(ASSIGN_THREADS)),
+    ("CELL_LIST_CAPACITY", WgslConst::U32(CELL_LIST_CAPACITY)),
     ("MAX_SLICES", WgslConst::U32(MAX_SLICES)),
     ("BVH_WIDTH", WgslConst::U32(BVH_WIDTH)),
     ("BVH_LEAF", WgslConst::U32(BVH_LEAF)),

@@ -419,16 +419,18 @@ impl<'c> Renderer<'c> {
             .filter(|p| p.label.starts_with("assign:"))
             .map(|p| p.ms)
             .reduce(|a, b| a + b);
-        let (grid, cell_bounds, assign, assign_cpu_ms, assign_ms) = match pipeline_grid {
-            Some(b) => (
-                b.grid,
-                Some(b.cell_bounds),
-                Some(b.assign.name().to_string()),
-                Some(b.cpu_ms),
-                Some(b.wall_ms),
-            ),
-            None => (bounded, None, None, None, None),
-        };
+        let (grid, cell_bounds, assign, assign_cpu_ms, assign_ms, assign_reruns) =
+            match pipeline_grid {
+                Some(b) => (
+                    b.grid,
+                    Some(b.cell_bounds),
+                    Some(b.assign.name().to_string()),
+                    Some(b.cpu_ms),
+                    Some(b.wall_ms),
+                    Some(b.reruns),
+                ),
+                None => (bounded, None, None, None, None, None),
+            };
         let occupied = cell_bounds
             .as_ref()
             .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
@@ -469,6 +471,7 @@ impl<'c> Renderer<'c> {
                 assign_gpu_ms: assign_gpu_ms.filter(|_| grid_is_pipelines),
                 assign_cpu_ms,
                 assign_ms,
+                assign_reruns,
                 memory,
             },
             grid,

@@ -83,6 +83,10 @@ pub struct FrameStats {
     /// this is the figure to compare strategies by there.
     #[serde(default)]
     pub assign_ms: Option<f64>,
+    /// Times the gather or BVH pass ran again this frame because the index list, sized from
+    /// earlier frames, was too small (grown to the needed size first: nothing is dropped).
+    #[serde(default)]
+    pub assign_reruns: Option<u32>,
     /// Render targets, grid size and the traffic models (`memory.rs`).
     pub memory: FrameMemory,
 }

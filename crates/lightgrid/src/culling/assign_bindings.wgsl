@@ -1,25 +1,42 @@
-// Group 1 of the GPU light-assignment kernels (gather, BVH traversal, scatter): the grid being
-// built, each cell's view-distance bounds (cell_bounds.wgsl) and the count/offset arrays of the
-// count -> prefix sum -> write scheme. Rust side: `culling/gpu_assign.rs`.
+// Group 1 of the GPU light-assignment kernels (gather, BVH walk, scatter): the grid being
+// built, each cell's view-distance bounds (cell_bounds.wgsl), the occupied-cell list, and the
+// counters of the single-pass scheme the per-cell kernels use (Rust side: gpu_assign.rs):
+// a workgroup appends its cell's lights to a workgroup-memory list, then reserves the cell's
+// range of the global index list with one atomicAdd on a cursor and copies the list there.
+// A cell with more than CELL_LIST_CAPACITY lights keeps its reservation and is queued for the
+// spill pass, which writes its whole list straight to global memory. A reservation past the
+// end of the index buffer is counted (the CPU grows the buffer to the cursor and reruns).
 
 @group(1) @binding(0) var<uniform> grid: GridParams;
 @group(1) @binding(1) var<storage, read> cell_bounds: array<vec2<f32>>;
 @group(1) @binding(2) var<storage, read_write> cells: array<vec2<u32>>;   // (offset, count)
 @group(1) @binding(3) var<storage, read_write> indices: array<u32>;
-// [0]: hits that did not fit their counted list (must stay 0; reported as an error).
-@group(1) @binding(4) var<storage, read_write> overflow: array<atomic<u32>, 4>;
-@group(1) @binding(5) var<storage, read_write> cell_counts: array<u32>;
-@group(1) @binding(6) var<storage, read_write> cell_offsets: array<u32>;
+// [0] cursor: index entries reserved (= needed); [1] entries that did not fit the buffer;
+// [2] cells queued for the spill pass; [3] hits beyond a counted length (spill pass, scatter's
+// write pass; must stay 0); [4..7] the spill pass's indirect dispatch arguments.
+@group(1) @binding(4) var<storage, read_write> counters: array<atomic<u32>, 8>;
+@group(1) @binding(5) var<storage, read_write> spill_cells: array<u32>;
 // The cells holding samples and their number (cell_bounds.wgsl); per-cell kernels are
 // dispatched indirectly, one workgroup per entry.
-@group(1) @binding(7) var<storage, read> occupied_cells: array<u32>;
-@group(1) @binding(8) var<storage, read> occupancy: array<u32, 4>;
+@group(1) @binding(6) var<storage, read> occupied_cells: array<u32>;
+@group(1) @binding(7) var<storage, read> occupancy: array<u32, 4>;
 
-// The cell a per-cell workgroup works on, or NO_CELL for a workgroup past the end of the
-// list (the dispatch is rounded up to whole rows).
+const CURSOR: u32 = 0u;
+const OUT_OF_ROOM: u32 = 1u;
+const SPILLS: u32 = 2u;
+const WRITE_OVERFLOW: u32 = 3u;
+
+// The cell a per-cell workgroup works on, or NO_CELL for a workgroup past the end of its list
+// (the dispatch is rounded up to whole rows). `spill`: the spill pass's list.
 const NO_CELL: u32 = 0xffffffffu;
-fn cell_of_group(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
+fn cell_of_group(wg: vec3<u32>, nwg: vec3<u32>, spill: bool) -> u32 {
     let i = wg.y * nwg.x + wg.x;
+    if (spill) {
+        if (i >= atomicLoad(&counters[SPILLS])) {
+            return NO_CELL;
+        }
+        return spill_cells[i];
+    }
     if (i >= occupancy[0]) {
         return NO_CELL;
     }
@@ -37,30 +54,68 @@ fn cell_frustum(c: u32) -> TileFrustum {
     return tile_frustum(xy, grid.tile_size, cell_bounds[c]);
 }
 
-// Lights found so far for the workgroup's cell (per-cell kernels).
 var<workgroup> cell_hits: atomic<u32>;
+var<workgroup> cell_list: array<u32, CELL_LIST_CAPACITY>;
+var<workgroup> cell_base: u32;
 
-// Record that `light` is in cell `c`: in the count pass only `cell_hits` grows; in the write
-// pass the light goes to that slot of the cell's list, which the count pass sized.
-fn record_hit(c: u32, light: u32, write: bool) {
+// Call from uniform control flow before the cell's lights are tested.
+fn begin_cell(li: u32) {
+    if (li == 0u) {
+        atomicStore(&cell_hits, 0u);
+    }
+    workgroupBarrier();
+}
+
+// Light `light` reaches cell `c`: append it to the workgroup list (first pass) or write it to
+// the cell's reserved range (spill pass).
+fn record_hit(c: u32, light: u32, spill: bool) {
     let slot = atomicAdd(&cell_hits, 1u);
-    if (write) {
-        if (slot < cell_counts[c]) {
-            indices[cell_offsets[c] + slot] = light;
+    if (!spill) {
+        if (slot < CELL_LIST_CAPACITY) {
+            cell_list[slot] = light;
+        }
+    } else if (slot < cells[c].y) {
+        indices[cells[c].x + slot] = light;
+    } else {
+        atomicAdd(&counters[WRITE_OVERFLOW], 1u);
+    }
+}
+
+// Call from uniform control flow after every hit is recorded: the first pass reserves the
+// cell's range and copies the workgroup list into it (queueing the cell for the spill pass
+// when the list was too short).
+fn end_cell(c: u32, li: u32, spill: bool) {
+    workgroupBarrier();
+    let n = atomicLoad(&cell_hits);
+    let flush = !spill && c != NO_CELL;
+    if (flush && li == 0u) {
+        let base = atomicAdd(&counters[CURSOR], n);
+        if (base + n > arrayLength(&indices)) {
+            atomicAdd(&counters[OUT_OF_ROOM], n);
+            cell_base = NO_CELL;
         } else {
-            atomicAdd(&overflow[0], 1u);
+            cell_base = base;
+            cells[c] = vec2<u32>(base, n);
+            if (n > CELL_LIST_CAPACITY) {
+                spill_cells[atomicAdd(&counters[SPILLS], 1u)] = c;
+            }
+        }
+    }
+    workgroupBarrier();
+    let base = cell_base;
+    if (flush && base != NO_CELL && n <= CELL_LIST_CAPACITY) {
+        for (var i = li; i < n; i = i + WORKGROUP_SIZE) {
+            indices[base + i] = cell_list[i];
         }
     }
 }
 
-// After a cell's hits are recorded (called by one invocation): the count, or the grid entry.
-fn finish_cell(c: u32, hits: u32, write: bool) {
-    if (c == NO_CELL) {
-        return;
-    }
-    if (write) {
-        cells[c] = vec2<u32>(cell_offsets[c], cell_counts[c]);
-    } else {
-        cell_counts[c] = hits;
-    }
+// One invocation: the spill pass's indirect dispatch arguments (x at most 65535).
+@compute @workgroup_size(1)
+fn spill_args_main() {
+    let n = atomicLoad(&counters[SPILLS]);
+    let x = min(max(n, 1u), 65535u);
+    atomicStore(&counters[4], x);
+    atomicStore(&counters[5], (n + x - 1u) / x);
+    atomicStore(&counters[6], 1u);
 }

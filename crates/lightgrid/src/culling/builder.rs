@@ -14,7 +14,7 @@
 use super::bvh::{build_bvh, BvhBuffers};
 use super::bvh_gpu::GpuBvhBuild;
 use super::cell_bounds::CellBoundsPass;
-use super::gpu_assign::{bvh_shader, gather_shader, read_grid, AssignCommon, CellKernels};
+use super::gpu_assign::{bvh_shader, gather_shader, read_grid, AssignCommon, CellKernels, CellRun};
 use super::scatter::ScatterPass;
 use super::{assign_cpu, DepthRange, GridBuffers, GridDims, LightGrid};
 use crate::error::Result;
@@ -105,6 +105,9 @@ pub struct BuiltGrid {
     /// GPU: the whole strategy, GPU passes, CPU work and the syncs between them, but not
     /// the statistics readback.
     pub wall_ms: f64,
+    /// Times a per-cell GPU strategy reran because the index buffer, sized from earlier
+    /// frames, was too small (it is grown to fit first; nothing is dropped).
+    pub reruns: u32,
 }
 
 pub struct GridBuilder {
@@ -175,7 +178,7 @@ impl GridBuilder {
         let wall = Instant::now();
         let mut cpu_ms = 0.0;
         let light_count = f.lights.len() as u32;
-        let total = match assign {
+        let run = match assign {
             Assign::Cpu | Assign::Auto => {
                 let bounds = self.bounds.read(device, queue)?;
                 let start = Instant::now();
@@ -193,6 +196,7 @@ impl GridBuilder {
                     assign,
                     cpu_ms,
                     wall_ms: wall.elapsed().as_secs_f64() * 1e3,
+                    reruns: 0,
                 });
             }
             Assign::Gather => {
@@ -268,7 +272,7 @@ impl GridBuilder {
                 let scatter = self
                     .scatter
                     .get_or_insert_with(|| ScatterPass::new(device, &self.scene_layout, common));
-                scatter.run(
+                let total = scatter.run(
                     device,
                     queue,
                     enc,
@@ -278,11 +282,12 @@ impl GridBuilder {
                     &self.bounds,
                     &dims,
                     light_count,
-                )?
+                )?;
+                CellRun { total, reruns: 0 }
             }
         };
         let wall_ms = wall.elapsed().as_secs_f64() * 1e3;
-        let grid = read_grid(device, queue, &self.buffers, &dims, total)?;
+        let grid = read_grid(device, queue, &self.buffers, &dims, run.total)?;
         let cell_bounds = match self.source {
             CellSource::NearFar => vec![near_far; dims.cell_count()],
             CellSource::Depth => self.bounds.read(device, queue)?,
@@ -293,6 +298,7 @@ impl GridBuilder {
             assign,
             cpu_ms,
             wall_ms,
+            reruns: run.reruns,
         })
     }
 }

@@ -2,7 +2,10 @@
 // occupied cell walks the hierarchy depth first. Each step pops one node; invocation i tests child i
 // (an inner node's child box, or a leaf's light) against the cell's frustum; boxes that pass
 // are pushed, lights that pass are recorded. The final test is the gather test, so the lists
-// equal gather's; the boxes only prune. Run twice (count, then write), like gather.
+// equal gather's; the boxes only prune. Hits go through the same workgroup list, flush and
+// spill pass as gather's (assign_bindings.wgsl).
+
+const WORKGROUP_SIZE: u32 = BVH_WIDTH;
 
 struct BvhNode {
     lo: vec3<f32>,
@@ -35,11 +38,11 @@ fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     return true;
 }
 
-fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, write: bool) {
-    let c = cell_of_group(wg, nwg);
+fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, spill: bool) {
+    let c = cell_of_group(wg, nwg, spill);
     let f = cell_frustum(c);
+    begin_cell(li);
     if (li == 0u) {
-        atomicStore(&cell_hits, 0u);
         bvh_stack[0] = 0u;
         bvh_top = select(0u, 1u, frame.light_count > 0u && box_in_cell(f, bvh_nodes[0].lo, bvh_nodes[0].hi));
     }
@@ -57,7 +60,7 @@ fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, write: bool) {
             if ((node.count & BVH_LEAF) != 0u) {
                 let l = bvh_order[node.first + li];
                 if (light_in_tile(f, lights[l])) {
-                    record_hit(c, l, write);
+                    record_hit(c, l, spill);
                 }
             } else {
                 let child = node.first + li;
@@ -73,17 +76,15 @@ fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, write: bool) {
             bvh_top = top - 1u + atomicLoad(&bvh_pushed);
         }
     }
-    if (li == 0u) {
-        finish_cell(c, atomicLoad(&cell_hits), write);
-    }
+    end_cell(c, li, spill);
 }
 
 @compute @workgroup_size(BVH_WIDTH)
-fn count_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     traverse_cell(wg, nwg, li, false);
 }
 
 @compute @workgroup_size(BVH_WIDTH)
-fn write_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+fn spill_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     traverse_cell(wg, nwg, li, true);
 }

@@ -1,14 +1,17 @@
 //! The machinery the GPU assignment strategies share (group 1 of their kernels,
 //! `assign_bindings.wgsl`) and the two per-cell strategies built on it:
-//! - **gather** (forward-plus §4): one workgroup per cell tests every light;
-//! - **BVH** (tiled-forward-shading §4.4): one workgroup per cell walks the light hierarchy.
+//! - **gather** (forward-plus §4): one workgroup per occupied cell tests every light;
+//! - **BVH walk** (tiled-forward-shading §4.4): one workgroup per occupied cell walks the light
+//!   hierarchy.
 //!
-//! Both run the count → prefix sum → write scheme: the count pass stores each cell's number of
-//! lights, [`ScanPass`] turns counts into offsets and a total, the CPU reads the total and grows
-//! the index buffer to fit, and the write pass fills the lists. A hit that does not fit its
-//! counted list is counted in `overflow` and turned into an error, never dropped silently.
-//! Only cells with samples get lights: the kernels run one workgroup per occupied cell
-//! (indirect dispatch from the list the cell-bounds pass builds).
+//! Both run in one pass (indirect dispatch over the occupied cells the cell-bounds pass
+//! listed): a workgroup appends its cell's lights to a workgroup-memory list, reserves the
+//! cell's range of the global index list with an atomic cursor and copies the list there.
+//! Cells whose list overflowed (more than CELL_LIST_CAPACITY lights) keep their range and are
+//! finished by a spill pass that writes straight to global memory. The index buffer is sized
+//! from the previous frame's total; ranges that do not fit are counted, and the CPU, which
+//! reads the counters back once per frame, grows the buffer to the needed total and reruns the
+//! pass (reported as `assign_reruns` in the stats): the grid is never missing a light.
 
 use super::cell_bounds::CellBoundsPass;
 use super::scan::ScanPass;
@@ -43,14 +46,22 @@ pub(crate) fn bvh_shader() -> ComposedShader {
     cell_shader("bvh traversal", include_str!("bvh.wgsl"))
 }
 
-/// Group 1 layout and the per-cell count/offset buffers.
+/// Counter slots of `assign_bindings.wgsl`.
+const CURSOR: usize = 0;
+const OUT_OF_ROOM: usize = 1;
+const WRITE_OVERFLOW: usize = 3;
+/// Byte offset of the spill pass's indirect arguments in the counters buffer.
+const SPILL_ARGS: u64 = 16;
+
+/// Group 1 layout, the counters and the spill list.
 pub struct AssignCommon {
     pub layout: wgpu::BindGroupLayout,
     pub scan: ScanPass,
-    overflow: wgpu::Buffer,
-    cell_counts: wgpu::Buffer,
-    cell_offsets: wgpu::Buffer,
-    total: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    /// The spill pass's arguments, copied out of `counters` (a buffer bound for storage
+    /// cannot also feed an indirect dispatch).
+    spill_args: wgpu::Buffer,
+    spill_cells: wgpu::Buffer,
 }
 
 impl AssignCommon {
@@ -65,7 +76,6 @@ impl AssignCommon {
                 STORAGE_RW,
                 STORAGE_RW,
                 STORAGE_RW,
-                STORAGE_RW,
                 STORAGE_READ,
                 STORAGE_READ,
             ],
@@ -73,14 +83,25 @@ impl AssignCommon {
         AssignCommon {
             layout,
             scan: ScanPass::new(device),
-            overflow: storage_buffer(device, "assign overflow", 16),
-            cell_counts: storage_buffer(device, "cell counts", 1 << 14),
-            cell_offsets: storage_buffer(device, "cell offsets", 1 << 14),
-            total: storage_buffer(device, "assign total", 16),
+            counters: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("assign counters"),
+                size: 32,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            spill_args: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("spill pass arguments"),
+                size: 16,
+                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            spill_cells: storage_buffer(device, "spill cells", 1 << 12),
         }
     }
 
-    /// Group 1 for a frame: grow the per-cell arrays, bind the grid and the cell bounds.
+    /// Group 1 for a frame: grow the spill list, bind the grid and the cell bounds.
     pub fn bind(
         &mut self,
         device: &wgpu::Device,
@@ -89,8 +110,7 @@ impl AssignCommon {
         dims: &GridDims,
     ) -> wgpu::BindGroup {
         let bytes = (dims.cell_count() * 4) as u64;
-        grow_storage(device, &mut self.cell_counts, "cell counts", bytes);
-        grow_storage(device, &mut self.cell_offsets, "cell offsets", bytes);
+        grow_storage(device, &mut self.spill_cells, "spill cells", bytes);
         bind_resources(
             device,
             "light assignment",
@@ -100,29 +120,28 @@ impl AssignCommon {
                 bounds.buffer().as_entire_binding(),
                 grid.cells_buffer().as_entire_binding(),
                 grid.indices_buffer().as_entire_binding(),
-                self.overflow.as_entire_binding(),
-                self.cell_counts.as_entire_binding(),
-                self.cell_offsets.as_entire_binding(),
+                self.counters.as_entire_binding(),
+                self.spill_cells.as_entire_binding(),
                 bounds.occupied_buffer().as_entire_binding(),
                 bounds.occupancy_buffer().as_entire_binding(),
             ],
         )
     }
 
-    /// Zero the overflow counter (record before the frame's write pass).
-    pub fn clear_overflow(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.clear_buffer(&self.overflow, 0, None);
+    /// Zero the counters (record before the frame's assignment passes).
+    pub fn clear_counters(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.counters, 0, None);
     }
 
-    /// Read the overflow counter and fail if anything did not fit.
-    pub fn check_overflow(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        stage: &str,
-    ) -> Result<()> {
-        let bytes = download(device, queue, &self.overflow, 4)?;
-        let n = u32::from_le_bytes(bytes[..4].try_into().expect("4 bytes"));
+    /// The counters after the submitted passes.
+    pub fn read_counters(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<[u32; 4]> {
+        let bytes = download(device, queue, &self.counters, 16)?;
+        Ok(bytemuck::pod_read_unaligned(&bytes[..16]))
+    }
+
+    /// Fail if a write went past a counted length (the passes disagree: a bug, never silent).
+    pub fn check_write_overflow(counters: &[u32; 4], stage: &str) -> Result<()> {
+        let n = counters[WRITE_OVERFLOW];
         if n > 0 {
             return Err(Error::Gpu {
                 stage: stage.into(),
@@ -132,12 +151,6 @@ impl AssignCommon {
             });
         }
         Ok(())
-    }
-
-    /// Read the total written by the last scan.
-    pub fn read_total(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<u32> {
-        let bytes = download(device, queue, &self.total, 4)?;
-        Ok(u32::from_le_bytes(bytes[..4].try_into().expect("4 bytes")))
     }
 }
 
@@ -163,11 +176,21 @@ pub fn read_grid(
     })
 }
 
-/// A per-cell strategy's two kernels (count, write), with their extra bind group layout.
+/// A per-cell strategy's kernels (first pass, spill arguments, spill pass).
 pub struct CellKernels {
-    count: wgpu::ComputePipeline,
-    write: wgpu::ComputePipeline,
+    main: wgpu::ComputePipeline,
+    spill_args: wgpu::ComputePipeline,
+    spill: wgpu::ComputePipeline,
     name: &'static str,
+}
+
+/// What a per-cell strategy's run produced.
+pub struct CellRun {
+    /// Index entries of the grid.
+    pub total: u32,
+    /// Times the pass ran again because the index buffer (sized from earlier frames) was too
+    /// small.
+    pub reruns: u32,
 }
 
 impl CellKernels {
@@ -177,28 +200,19 @@ impl CellKernels {
         shader: &ComposedShader,
         layouts: &[Option<&wgpu::BindGroupLayout>],
     ) -> Self {
+        let pipeline = |entry: &str| {
+            compute_pipeline(device, &format!("{name} {entry}"), shader, entry, layouts)
+        };
         CellKernels {
-            count: compute_pipeline(
-                device,
-                &format!("{name} count"),
-                shader,
-                "count_main",
-                layouts,
-            ),
-            write: compute_pipeline(
-                device,
-                &format!("{name} write"),
-                shader,
-                "write_main",
-                layouts,
-            ),
+            main: pipeline("main"),
+            spill_args: pipeline("spill_args_main"),
+            spill: pipeline("spill_main"),
             name,
         }
     }
 
-    /// Count, prefix sum, grow, write: leaves the grid in `grid` (waits for it) and returns
-    /// the number of index entries.
-    /// Groups: 0 the scene, 1 `common`'s, 2.. `extra`.
+    /// Build the grid into `grid` (waits for it). Groups: 0 the scene, 1 `common`'s, 2..
+    /// `extra`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
@@ -211,61 +225,62 @@ impl CellKernels {
         bounds: &CellBoundsPass,
         dims: &GridDims,
         extra: &[&wgpu::BindGroup],
-    ) -> Result<u32> {
-        grid.ensure(device, queue, dims, dims.cell_count(), 1);
-        let group = common.bind(device, grid, bounds, dims);
-        let cell_bytes = (dims.cell_count() * 4) as u64;
-        // Cells without samples are never visited: their counts (and later grid entries)
-        // stay zero.
-        enc.parts()
-            .0
-            .clear_buffer(&common.cell_counts, 0, Some(cell_bytes));
-        let dispatch = |enc: &mut crate::pipelines::FrameEncoder,
-                        pipeline: &wgpu::ComputePipeline,
-                        group: &wgpu::BindGroup,
-                        label: &str| {
-            let (encoder, timer) = enc.parts();
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: timer.compute_pass(label),
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, scene, &[]);
-            pass.set_bind_group(1, group, &[]);
-            for (i, g) in extra.iter().enumerate() {
-                pass.set_bind_group(2 + i as u32, *g, &[]);
-            }
-            pass.dispatch_workgroups_indirect(bounds.occupancy_buffer(), 4);
-        };
+    ) -> Result<CellRun> {
         let name = self.name;
-        dispatch(enc, &self.count, &group, &format!("assign: {name} count"));
-        {
+        let mut reruns = 0;
+        grid.ensure(device, queue, dims, dims.cell_count(), 1);
+        loop {
+            let group = common.bind(device, grid, bounds, dims);
             let (encoder, timer) = enc.parts();
-            common.clear_overflow(encoder);
-            common.scan.encode(
-                device,
-                encoder,
-                timer,
-                &format!("assign: {name} scan"),
-                &common.cell_counts,
-                &common.cell_offsets,
-                dims.cell_count() as u64,
-                (&common.total, 0),
-            );
+            common.clear_counters(encoder);
+            // Cells without samples are never visited: their entries stay (0, 0).
+            encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
+            let pass = |encoder: &mut wgpu::CommandEncoder,
+                        timer: &mut crate::gpu::PassTimer,
+                        label: &str,
+                        run: &dyn Fn(&mut wgpu::ComputePass)| {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(label),
+                    timestamp_writes: timer.compute_pass(label),
+                });
+                pass.set_bind_group(0, scene, &[]);
+                pass.set_bind_group(1, &group, &[]);
+                for (i, g) in extra.iter().enumerate() {
+                    pass.set_bind_group(2 + i as u32, *g, &[]);
+                }
+                run(&mut pass);
+            };
+            pass(encoder, timer, &format!("assign: {name}"), &|p| {
+                p.set_pipeline(&self.main);
+                p.dispatch_workgroups_indirect(bounds.occupancy_buffer(), 4);
+                p.set_pipeline(&self.spill_args);
+                p.dispatch_workgroups(1, 1, 1);
+            });
+            encoder.copy_buffer_to_buffer(&common.counters, SPILL_ARGS, &common.spill_args, 0, 12);
+            pass(encoder, timer, &format!("assign: {name} spill"), &|p| {
+                p.set_pipeline(&self.spill);
+                p.dispatch_workgroups_indirect(&common.spill_args, 0);
+            });
+            enc.submit_and_wait()?;
+            let counters = common.read_counters(device, queue)?;
+            AssignCommon::check_write_overflow(&counters, name)?;
+            let total = counters[CURSOR];
+            if counters[OUT_OF_ROOM] == 0 {
+                return Ok(CellRun { total, reruns });
+            }
+            // The cursor counted every reservation: grow to it and run again.
+            check_index_capacity(device, u64::from(total), name)?;
+            grid.ensure(device, queue, dims, dims.cell_count(), total as usize);
+            reruns += 1;
+            if reruns > 2 {
+                return Err(Error::Gpu {
+                    stage: name.into(),
+                    message: format!(
+                        "the index list still did not fit after growing it to {total} entries"
+                    ),
+                });
+            }
         }
-        enc.submit_and_wait()?;
-        let total = common.read_total(device, queue)?;
-        check_index_capacity(device, total as u64, name)?;
-        // Grow the index list to the counted total; the bind group follows the buffers.
-        grid.ensure(device, queue, dims, dims.cell_count(), total as usize);
-        let group = common.bind(device, grid, bounds, dims);
-        enc.parts()
-            .0
-            .clear_buffer(grid.cells_buffer(), 0, Some(cell_bytes * 2));
-        dispatch(enc, &self.write, &group, &format!("assign: {name} write"));
-        enc.submit_and_wait()?;
-        common.check_overflow(device, queue, name)?;
-        Ok(total)
     }
 }
 

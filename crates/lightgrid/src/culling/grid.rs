@@ -212,6 +212,9 @@ pub struct GridBuffers {
 }
 
 impl GridBuffers {
+    /// Index entries a new grid's buffer holds; it grows (never shrinks) to fit.
+    pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 14;
+
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -243,7 +246,12 @@ impl GridBuffers {
             std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
         );
         let cells = Self::buffer(device, "grid cells", wgpu::BufferUsages::STORAGE, 1 << 14);
-        let indices = Self::buffer(device, "grid indices", wgpu::BufferUsages::STORAGE, 1 << 16);
+        let indices = Self::buffer(
+            device,
+            "grid indices",
+            wgpu::BufferUsages::STORAGE,
+            u64::from(Self::INITIAL_INDEX_CAPACITY) * 4,
+        );
         let bind_group = Self::bind(device, &layout, &params, &cells, &indices);
         GridBuffers {
             layout,

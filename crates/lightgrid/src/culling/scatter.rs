@@ -142,7 +142,7 @@ impl ScatterPass {
         );
         {
             let (encoder, timer) = enc.parts();
-            common.clear_overflow(encoder);
+            common.clear_counters(encoder);
             common.scan.encode(
                 device,
                 encoder,
@@ -213,7 +213,7 @@ impl ScatterPass {
             );
         }
         enc.submit_and_wait()?;
-        common.check_overflow(device, queue, "scatter")?;
+        AssignCommon::check_write_overflow(&common.read_counters(device, queue)?, "scatter")?;
         Ok(total)
     }
 }

@@ -12,6 +12,7 @@
 @group(2) @binding(3) var<storage, read_write> pair_vals: array<u32>;
 @group(2) @binding(4) var<storage, read_write> pair_total: array<u32>;
 
+const WORKGROUP_SIZE: u32 = ASSIGN_THREADS;
 const NO_RANGE: vec3<f32> = vec3<f32>(0.0, 0.0, 0.0);
 const BIG: f32 = 1e30;
 
@@ -113,7 +114,7 @@ fn scatter_light(l: u32, write: bool) -> u32 {
                             pair_keys[first + n] = cell;
                             pair_vals[first + n] = l;
                         } else {
-                            atomicAdd(&overflow[0], 1u);
+                            atomicAdd(&counters[WRITE_OVERFLOW], 1u);
                         }
                     }
                     n = n + 1u;
@@ -148,7 +149,7 @@ fn write_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 @compute @workgroup_size(ASSIGN_THREADS)
 fn bounds_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = light_of(gid, nwg);
-    let n = pair_total[0];
+    let n = pair_total[0];  // set by the scan of light counts
     if (i >= n) {
         return;
     }
