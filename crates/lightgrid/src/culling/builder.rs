@@ -199,61 +199,56 @@ impl GridBuilder {
                     reruns: 0,
                 });
             }
-            Assign::Gather => {
+            Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
                 let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
-                let kernels = self.gather.get_or_insert_with(|| {
-                    CellKernels::new(
-                        device,
-                        "gather",
-                        &gather_shader(),
-                        &[Some(&self.scene_layout), Some(&common.layout)],
-                    )
-                });
-                kernels.run(
-                    device,
-                    queue,
-                    enc,
-                    f.scene_bind_group,
-                    common,
-                    &mut self.buffers,
-                    &self.bounds,
-                    &dims,
-                    &[],
-                )?
-            }
-            Assign::Bvh | Assign::BvhGpu => {
-                let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
-                let (kernels, buffers) = self.bvh.get_or_insert_with(|| {
-                    let buffers = BvhBuffers::new(device);
-                    let kernels = CellKernels::new(
-                        device,
-                        "bvh",
-                        &bvh_shader(),
-                        &[
-                            Some(&self.scene_layout),
-                            Some(&common.layout),
-                            Some(&buffers.layout),
-                        ],
-                    );
-                    (kernels, buffers)
-                });
-                let group = if assign == Assign::Bvh {
-                    let start = Instant::now();
-                    let bvh = build_bvh(&f.setup, f.lights);
-                    cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-                    buffers.upload(device, queue, &bvh)
-                } else {
-                    let build = self
-                        .bvh_gpu
-                        .get_or_insert_with(|| GpuBvhBuild::new(device, &self.scene_layout));
-                    build.encode(f, enc, &common.scan);
-                    let (nodes, order) = build.buffers();
-                    bind_resources(
-                        device,
-                        "light bvh (gpu build)",
-                        &buffers.layout,
-                        &[nodes.as_entire_binding(), order.as_entire_binding()],
-                    )
+                let scene_layout = &self.scene_layout;
+                let (kernels, extra) = match assign {
+                    Assign::Gather => {
+                        let kernels = self.gather.get_or_insert_with(|| {
+                            CellKernels::new(
+                                device,
+                                "gather",
+                                &gather_shader(),
+                                &[Some(scene_layout), Some(&common.layout)],
+                            )
+                        });
+                        (&*kernels, None)
+                    }
+                    _ => {
+                        let (kernels, buffers) = self.bvh.get_or_insert_with(|| {
+                            let buffers = BvhBuffers::new(device);
+                            let kernels = CellKernels::new(
+                                device,
+                                "bvh",
+                                &bvh_shader(),
+                                &[
+                                    Some(scene_layout),
+                                    Some(&common.layout),
+                                    Some(&buffers.layout),
+                                ],
+                            );
+                            (kernels, buffers)
+                        });
+                        let group = if assign == Assign::Bvh {
+                            let start = Instant::now();
+                            let bvh = build_bvh(&f.setup, f.lights);
+                            cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+                            buffers.upload(device, queue, &bvh)
+                        } else {
+                            let build = self
+                                .bvh_gpu
+                                .get_or_insert_with(|| GpuBvhBuild::new(device, scene_layout));
+                            build.encode(f, enc, &common.scan);
+                            let (nodes, order) = build.buffers();
+                            bind_resources(
+                                device,
+                                "light bvh (gpu build)",
+                                &buffers.layout,
+                                &[nodes.as_entire_binding(), order.as_entire_binding()],
+                            )
+                        };
+                        (&*kernels, Some(group))
+                    }
                 };
                 kernels.run(
                     device,
@@ -264,7 +259,7 @@ impl GridBuilder {
                     &mut self.buffers,
                     &self.bounds,
                     &dims,
-                    &[&group],
+                    &extra.iter().collect::<Vec<_>>(),
                 )?
             }
             Assign::Scatter => {

@@ -8,11 +8,11 @@ use super::radix_sort::RadixSort;
 use super::scan::ScanPass;
 use crate::consts::ASSIGN_THREADS;
 use crate::gpu::{
-    bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, STORAGE_RW, UNIFORM,
+    bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, UniformSlots,
+    STORAGE_RW, UNIFORM,
 };
 use crate::pipelines::{FrameEncoder, FrameInputs};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
-use std::num::NonZeroU64;
 
 pub(crate) fn shader() -> ComposedShader {
     compose(
@@ -25,8 +25,7 @@ pub(crate) fn shader() -> ComposedShader {
     )
 }
 
-/// Uniform slots for the per-level parameters, at the minimum uniform offset alignment.
-const SLOT: u64 = 256;
+/// Most BVH levels (2^20 lights make 5).
 const MAX_LEVELS: u64 = 8;
 
 pub struct GpuBvhBuild {
@@ -35,7 +34,7 @@ pub struct GpuBvhBuild {
     morton: wgpu::ComputePipeline,
     leaves: wgpu::ComputePipeline,
     inner: wgpu::ComputePipeline,
-    params: wgpu::Buffer,
+    params: UniformSlots,
     nodes: wgpu::Buffer,
     centre_box: wgpu::Buffer,
     sort: RadixSort,
@@ -59,12 +58,7 @@ impl GpuBvhBuild {
             leaves: pipeline("leaves_main"),
             inner: pipeline("inner_main"),
             layout,
-            params: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("bvh build levels"),
-                size: SLOT * MAX_LEVELS,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            params: UniformSlots::new(device, "bvh build levels", MAX_LEVELS),
             nodes: storage_buffer(device, "bvh nodes (gpu build)", 1 << 12),
             centre_box: storage_buffer(device, "bvh centre box", 32),
             sort: RadixSort::new(device),
@@ -88,29 +82,22 @@ impl GpuBvhBuild {
             u64::from(node_count) * std::mem::size_of::<BvhNode>() as u64,
         );
         self.sort.ensure(device, u64::from(n));
-        let mut slots = vec![0u8; (SLOT * MAX_LEVELS) as usize];
-        for (i, &(first, count)) in levels.iter().enumerate() {
-            let (child_first, child_count) = if i > 0 { levels[i - 1] } else { (0, n) };
-            let at = i * SLOT as usize;
-            slots[at..at + 16].copy_from_slice(bytemuck::cast_slice(&[
-                first,
-                count,
-                child_first,
-                child_count,
-            ]));
-        }
-        f.queue.write_buffer(&self.params, 0, &slots);
+        let records: Vec<[u32; 4]> = levels
+            .iter()
+            .enumerate()
+            .map(|(i, &(first, count))| {
+                let (child_first, child_count) = if i > 0 { levels[i - 1] } else { (0, n) };
+                [first, count, child_first, child_count]
+            })
+            .collect();
+        self.params.write(f.queue, &records);
         let group = |slot: usize| {
             bind_resources(
                 device,
                 "bvh build",
                 &self.layout,
                 &[
-                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.params,
-                        offset: SLOT * slot as u64,
-                        size: NonZeroU64::new(16),
-                    }),
+                    self.params.binding(slot),
                     self.sort.keys.as_entire_binding(),
                     self.sort.vals.as_entire_binding(),
                     self.nodes.as_entire_binding(),

@@ -6,22 +6,21 @@
 use super::scan::ScanPass;
 use crate::consts::ASSIGN_THREADS;
 use crate::gpu::{bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer};
-use crate::gpu::{PassTimer, STORAGE_RW, UNIFORM};
+use crate::gpu::{PassTimer, UniformSlots, STORAGE_RW, UNIFORM};
 use crate::shader::{compose, compute_pipeline, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
     compose("radix sort", &[include_str!("radix_sort.wgsl")])
 }
 
-/// Uniform slots, one per pass, at the minimum uniform offset alignment.
-const PARAM_STRIDE: u64 = 256;
-const MAX_PASSES: u64 = 8;
+/// Most 4-bit passes (32-bit keys).
+const MAX_PASSES: u32 = 8;
 
 pub struct RadixSort {
     layout: wgpu::BindGroupLayout,
     local: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
-    params: wgpu::Buffer,
+    params: UniformSlots,
     pub keys: wgpu::Buffer,
     pub vals: wgpu::Buffer,
     tmp_keys: wgpu::Buffer,
@@ -54,12 +53,7 @@ impl RadixSort {
             local: pipeline("local_main"),
             scatter: pipeline("scatter_main"),
             layout,
-            params: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("radix sort params"),
-                size: PARAM_STRIDE * MAX_PASSES,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            params: UniformSlots::new(device, "radix sort params", MAX_PASSES.into()),
             keys: storage_buffer(device, "sort keys", 1 << 12),
             vals: storage_buffer(device, "sort values", 1 << 12),
             tmp_keys: storage_buffer(device, "sort keys (tmp)", 1 << 12),
@@ -107,14 +101,10 @@ impl RadixSort {
         if n <= 1 {
             return;
         }
-        let passes = bits.div_ceil(4).clamp(1, MAX_PASSES as u32);
+        let passes = bits.div_ceil(4).clamp(1, MAX_PASSES);
         let blocks = n.div_ceil(ASSIGN_THREADS);
-        let mut slots = vec![0u8; (PARAM_STRIDE * u64::from(passes)) as usize];
-        for p in 0..passes {
-            let at = (PARAM_STRIDE * u64::from(p)) as usize;
-            slots[at..at + 16].copy_from_slice(bytemuck::cast_slice(&[n, p * 4, blocks, 0u32]));
-        }
-        queue.write_buffer(&self.params, 0, &slots);
+        let records: Vec<[u32; 4]> = (0..passes).map(|p| [n, p * 4, blocks, 0]).collect();
+        self.params.write(queue, &records);
         let groups = groups_1d(blocks);
         for p in 0..passes {
             let group = bind_resources(
@@ -122,11 +112,7 @@ impl RadixSort {
                 "radix sort",
                 &self.layout,
                 &[
-                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.params,
-                        offset: PARAM_STRIDE * u64::from(p),
-                        size: std::num::NonZeroU64::new(16),
-                    }),
+                    self.params.binding(p as usize),
                     self.keys.as_entire_binding(),
                     self.vals.as_entire_binding(),
                     self.tmp_keys.as_entire_binding(),

@@ -181,3 +181,50 @@ pub fn groups_1d(groups: u32) -> (u32, u32) {
         (MAX, groups.div_ceil(MAX))
     }
 }
+
+/// A uniform buffer of 16-byte parameter records, one per pass of a multi-pass stage, each at
+/// the minimum uniform offset alignment so a pass binds its own record (every record is
+/// written before the command buffer runs, so the passes cannot share one).
+pub struct UniformSlots {
+    buffer: wgpu::Buffer,
+    slots: u64,
+}
+
+impl UniformSlots {
+    const STRIDE: u64 = 256;
+
+    pub fn new(device: &wgpu::Device, label: &str, slots: u64) -> Self {
+        UniformSlots {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: Self::STRIDE * slots,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            slots,
+        }
+    }
+
+    /// Write `records[i]` to slot i (at most `slots` records).
+    pub fn write(&self, queue: &wgpu::Queue, records: &[[u32; 4]]) {
+        assert!(
+            records.len() as u64 <= self.slots,
+            "more records than slots"
+        );
+        let mut bytes = vec![0u8; (Self::STRIDE as usize) * records.len()];
+        for (i, r) in records.iter().enumerate() {
+            let at = i * Self::STRIDE as usize;
+            bytes[at..at + 16].copy_from_slice(bytemuck::cast_slice(r));
+        }
+        queue.write_buffer(&self.buffer, 0, &bytes);
+    }
+
+    /// The binding of slot `i`.
+    pub fn binding(&self, i: usize) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.buffer,
+            offset: Self::STRIDE * i as u64,
+            size: std::num::NonZeroU64::new(16),
+        })
+    }
+}
