@@ -14,6 +14,7 @@
 
 use super::RenderSettings;
 use super::{lighting_attachments, FrameEncoder, FrameInputs, PipelineContext, Technique};
+use crate::culling::BuiltGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::VOLUME_DEPTH_BYTES;
 use crate::passes::{
@@ -142,11 +143,7 @@ pub(super) fn create_stencil(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 impl Technique for Deferred {
-    fn render(
-        &mut self,
-        f: &FrameInputs,
-        enc: &mut FrameEncoder,
-    ) -> Result<Option<crate::culling::BuiltGrid>> {
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
         let classes = classify_lights(&f.setup, f.lights, self.stencil.is_some());
         self.volumes.upload(f.device, f.queue, &classes);
         let gbuffer_group = self.gbuffer.read_bind_group(f.device, f.targets);

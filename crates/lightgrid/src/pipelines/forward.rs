@@ -7,6 +7,7 @@ use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
+use crate::culling::BuiltGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
@@ -48,11 +49,7 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
 }
 
 impl Technique for Forward {
-    fn render(
-        &mut self,
-        f: &FrameInputs,
-        enc: &mut FrameEncoder,
-    ) -> Result<Option<crate::culling::BuiltGrid>> {
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
         let (encoder, timer) = enc.parts();
         let mut pass = begin_lighting_pass(encoder, timer, f, "forward shading", true);
         pass.set_pipeline(&self.pipeline);

@@ -17,6 +17,7 @@ use super::{
     draw_scene, geometry_pipeline, FrameEncoder, FrameInputs, GeometryPipelineDesc,
     PipelineContext, Technique,
 };
+use crate::culling::BuiltGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::{
     additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
@@ -180,11 +181,7 @@ fn bind_two(
 }
 
 impl Technique for LightPrepass {
-    fn render(
-        &mut self,
-        f: &FrameInputs,
-        enc: &mut FrameEncoder,
-    ) -> Result<Option<crate::culling::BuiltGrid>> {
+    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
         let classes = classify_lights(&f.setup, f.lights, false);
         self.volumes.upload(f.device, f.queue, &classes);
         let attr_group = bind_two(
