@@ -828,6 +828,7 @@ fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
     lightgrid::bench::write_scaling(&results, &a.out)?;
     println!("{}", lightgrid::bench::scaling_table(&results));
+    println!("{}", lightgrid::bench::scaling_growth(&results));
     println!(
         "{} points in {}; {} in {}",
         results.points.len(),

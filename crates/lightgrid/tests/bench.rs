@@ -261,3 +261,59 @@ fn frame_ranges_parse_and_reject_nonsense() {
         assert!(FrameRange::parse(bad).is_err(), "{bad}");
     }
 }
+
+#[test]
+fn scaling_growth_reports_slopes_and_the_fastest_strategy() {
+    use lightgrid::bench::{
+        scaling_growth, scaling_table, ScalingConfig, ScalingPoint, ScalingResults,
+    };
+    let point = |lights: u32, assign: &str, ms: Option<f64>| ScalingPoint {
+        lights,
+        assign: assign.into(),
+        skipped: ms.is_none().then(|| "over budget".into()),
+        assign_ms: ms,
+        assign_ms_runs: ms.into_iter().collect(),
+        assign_gpu_ms: None,
+        assign_cpu_ms: None,
+        frame_gpu_ms: None,
+        grid_indices: ms.map(|_| 10),
+        grid_bytes: None,
+        grid_cells: None,
+        grid_cells_occupied: None,
+        lights_per_cell_max: None,
+        lighting_computations: Some(200),
+        ideal_lighting_computations: Some(100),
+    };
+    let r = ScalingResults {
+        command: "lightgrid scaling".into(),
+        adapter: "test".into(),
+        software_adapter: true,
+        config: ScalingConfig::default(),
+        interrupted: false,
+        points: vec![
+            point(1000, "linear", Some(10.0)),
+            point(1000, "cheap", Some(5.0)),
+            point(1000, "slow", Some(20.0)),
+            point(1_000_000, "linear", Some(10_000.0)),
+            point(1_000_000, "cheap", Some(50.0)),
+            point(1_000_000, "slow", None),
+        ],
+    };
+    let g = scaling_growth(&r);
+    assert!(g.contains("- linear: 10.0 ms at 1000 lights to 10000.0 ms at 1000000 (1000x for 1000x the lights; log-log slope 1.00)"), "{g}");
+    assert!(g.contains("log-log slope 0.33"), "{g}");
+    assert!(
+        !g.contains("- slow"),
+        "one measured point has no growth: {g}"
+    );
+    assert!(
+        g.contains("1000: cheap (5.0 ms); 1000000: cheap (50.0 ms)"),
+        "{g}"
+    );
+    let t = scaling_table(&r);
+    assert!(
+        t.contains("| 1000000 | slow | skipped: over budget |"),
+        "{t}"
+    );
+    assert!(t.contains("| 1000 | linear | 10.0 |"), "{t}");
+}

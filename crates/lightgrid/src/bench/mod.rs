@@ -16,6 +16,6 @@ pub use run::{
     run, BenchConfig, BenchResults, FrameRange, FrameRecord, Progress, RunRecord, RunSummary, Stat,
 };
 pub use scaling::{
-    run_scaling, scaling_table, write_scaling, ScalingConfig, ScalingPoint, ScalingResults,
-    SCALING_FILES,
+    run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,
+    ScalingResults, SCALING_FILES,
 };

@@ -3,7 +3,8 @@
 //! scene at increasing light counts, once per assignment strategy, recording per point the
 //! assignment time (wall clock between GPU syncs, GPU timestamps, CPU time), the index-list
 //! size, occupied cells and lighting computations. `write_scaling` writes scaling.json,
-//! scaling.csv, scaling.md (the table) and scaling.svg/.png (assignment time against lights).
+//! scaling.csv, scaling.md (the table and how each strategy's time grows) and scaling.svg/.png
+//! (assignment time against lights).
 
 use super::run::Progress;
 use crate::error::{Error, Result};
@@ -315,6 +316,63 @@ pub fn scaling_table(r: &ScalingResults) -> String {
     out
 }
 
+/// How each strategy's assignment time grows: from its smallest to its largest measured light
+/// count, the factor and the log-log slope (1 = linear in the light count); then the fastest
+/// strategy at each count.
+pub fn scaling_growth(r: &ScalingResults) -> String {
+    let mut names: Vec<&str> = Vec::new();
+    for p in &r.points {
+        if !names.contains(&p.assign.as_str()) {
+            names.push(&p.assign);
+        }
+    }
+    let mut out = String::from(
+        "Growth of the assignment time (wall):
+
+",
+    );
+    for name in &names {
+        let measured: Vec<(u32, f64)> = r
+            .points
+            .iter()
+            .filter(|p| p.assign == *name)
+            .filter_map(|p| Some((p.lights, p.assign_ms?)))
+            .filter(|&(_, ms)| ms > 0.0)
+            .collect();
+        if let (Some(&(n0, t0)), Some(&(n1, t1))) = (measured.first(), measured.last()) {
+            if n1 > n0 {
+                let slope = (t1 / t0).ln() / (f64::from(n1) / f64::from(n0)).ln();
+                let _ = writeln!(
+                    out,
+                    "- {name}: {t0:.1} ms at {n0} lights to {t1:.1} ms at {n1} ({:.0}x for {:.0}x the lights; log-log slope {slope:.2})",
+                    t1 / t0,
+                    f64::from(n1) / f64::from(n0)
+                );
+            }
+        }
+    }
+    out.push_str(
+        "
+Fastest at each light count:",
+    );
+    let mut counts: Vec<u32> = r.points.iter().map(|p| p.lights).collect();
+    counts.dedup();
+    for n in counts {
+        let best = r
+            .points
+            .iter()
+            .filter(|p| p.lights == n)
+            .filter_map(|p| Some((p.assign.as_str(), p.assign_ms?)))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((name, ms)) = best {
+            let _ = write!(out, " {n}: {name} ({ms:.1} ms);");
+        }
+    }
+    out.pop();
+    out.push('\n');
+    out
+}
+
 /// Files `write_scaling` produces.
 pub const SCALING_FILES: [&str; 5] = [
     "scaling.json",
@@ -358,9 +416,10 @@ pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
     }
     write_atomic(&dir.join("scaling.csv"), csv.as_bytes())?;
     let md = format!(
-        "# Light assignment scaling\n\n`{}`\n\n{}",
+        "# Light assignment scaling\n\n`{}`\n\n{}\n{}",
         r.command,
-        scaling_table(r)
+        scaling_table(r),
+        scaling_growth(r)
     );
     write_atomic(&dir.join("scaling.md"), md.as_bytes())?;
     let mut names: Vec<&str> = Vec::new();
