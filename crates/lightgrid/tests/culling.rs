@@ -640,3 +640,22 @@ fn auto_assignment_resolves_by_adapter_and_light_count() {
         ["cpu", "gather", "scatter", "bvh", "bvh-gpu", "auto"]
     );
 }
+
+/// Dispatches above the per-dimension limit fold into two dimensions that cover every item.
+#[test]
+fn one_dimensional_dispatches_fold_past_the_workgroup_limit() {
+    use lightgrid::gpu::groups_1d;
+    assert_eq!(groups_1d(0), (1, 1));
+    assert_eq!(groups_1d(1), (1, 1));
+    assert_eq!(groups_1d(65_535), (65_535, 1));
+    assert_eq!(groups_1d(65_536), (65_535, 2));
+    for n in [65_536u32, 200_000, 4_000_000] {
+        let (x, y) = groups_1d(n);
+        assert!(x <= 65_535 && y <= 65_535);
+        assert!(u64::from(x) * u64::from(y) >= u64::from(n));
+        assert!(
+            u64::from(x) * u64::from(y - 1) < u64::from(n),
+            "no spare row"
+        );
+    }
+}

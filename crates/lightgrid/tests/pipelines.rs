@@ -519,3 +519,22 @@ fn bad_tile_sizes_are_rejected() {
     assert!(Renderer::new(&ctx, 64, 64, settings(3)).is_err());
     assert!(Renderer::new(&ctx, 64, 64, settings(65)).is_err());
 }
+
+/// A grid longer than the device can bind is refused with a message, never truncated.
+#[test]
+fn index_lists_beyond_the_device_limit_are_refused() {
+    let ctx = common::gpu();
+    let limits = ctx.device.limits();
+    let max = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+        / 4;
+    assert!(lightgrid::culling::check_index_capacity(&ctx.device, max, "test").is_ok());
+    let err = lightgrid::culling::check_index_capacity(&ctx.device, max + 1, "scatter")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("scatter") && err.contains("more than"),
+        "{err}"
+    );
+}

@@ -22,6 +22,7 @@ pub use builder::{Assign, BuiltGrid, CellSource, GridBuilder, AUTO_GATHER_MAX_LI
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
 pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
 pub use gather::{assign_gather_cpu, gather_margins};
+pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, LightGrid};
 pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
 pub use view::{ViewLight, ViewSetup};
