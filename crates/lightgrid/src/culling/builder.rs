@@ -14,7 +14,9 @@
 use super::bvh::{build_bvh, BvhBuffers};
 use super::bvh_gpu::GpuBvhBuild;
 use super::cell_bounds::CellBoundsPass;
-use super::gpu_assign::{bvh_shader, gather_shader, read_grid, AssignCommon, CellKernels, CellRun};
+use super::gpu_assign::{
+    bvh_shader, gather_shader, read_grid, AssignCommon, AssignFrame, CellKernels, CellRun,
+};
 use super::scatter::ScatterPass;
 use super::{assign_cpu, DepthRange, GridBuffers, GridDims, LightGrid};
 use crate::error::Result;
@@ -250,34 +252,32 @@ impl GridBuilder {
                         (&*kernels, Some(group))
                     }
                 };
-                kernels.run(
+                let frame = AssignFrame {
                     device,
                     queue,
-                    enc,
-                    f.scene_bind_group,
+                    scene: f.scene_bind_group,
                     common,
-                    &mut self.buffers,
-                    &self.bounds,
-                    &dims,
-                    &extra.iter().collect::<Vec<_>>(),
-                )?
+                    grid: &mut self.buffers,
+                    bounds: &self.bounds,
+                    dims: &dims,
+                };
+                kernels.run(frame, enc, &extra.iter().collect::<Vec<_>>())?
             }
             Assign::Scatter => {
                 let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
                 let scatter = self
                     .scatter
                     .get_or_insert_with(|| ScatterPass::new(device, &self.scene_layout, common));
-                let total = scatter.run(
+                let frame = AssignFrame {
                     device,
                     queue,
-                    enc,
-                    f.scene_bind_group,
+                    scene: f.scene_bind_group,
                     common,
-                    &mut self.buffers,
-                    &self.bounds,
-                    &dims,
-                    light_count,
-                )?;
+                    grid: &mut self.buffers,
+                    bounds: &self.bounds,
+                    dims: &dims,
+                };
+                let total = scatter.run(frame, enc, light_count)?;
                 CellRun { total, reruns: 0 }
             }
         };

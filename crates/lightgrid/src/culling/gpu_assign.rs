@@ -46,6 +46,18 @@ pub(crate) fn bvh_shader() -> ComposedShader {
     cell_shader("bvh traversal", include_str!("bvh.wgsl"))
 }
 
+/// What a GPU strategy works on in one frame: the device, the scene (group 0), the shared
+/// group-1 state, the grid it fills and the cell bounds it reads.
+pub struct AssignFrame<'a> {
+    pub device: &'a wgpu::Device,
+    pub queue: &'a wgpu::Queue,
+    pub scene: &'a wgpu::BindGroup,
+    pub common: &'a mut AssignCommon,
+    pub grid: &'a mut GridBuffers,
+    pub bounds: &'a CellBoundsPass,
+    pub dims: &'a GridDims,
+}
+
 /// Counter slots of `assign_bindings.wgsl`.
 const CURSOR: usize = 0;
 const OUT_OF_ROOM: usize = 1;
@@ -211,21 +223,23 @@ impl CellKernels {
         }
     }
 
-    /// Build the grid into `grid` (waits for it). Groups: 0 the scene, 1 `common`'s, 2..
-    /// `extra`.
-    #[allow(clippy::too_many_arguments)]
+    /// Build the grid into `a.grid` (waits for it). Groups: 0 the scene, 1 `a.common`'s,
+    /// 2.. `extra`.
     pub fn run(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        a: AssignFrame,
         enc: &mut crate::pipelines::FrameEncoder,
-        scene: &wgpu::BindGroup,
-        common: &mut AssignCommon,
-        grid: &mut GridBuffers,
-        bounds: &CellBoundsPass,
-        dims: &GridDims,
         extra: &[&wgpu::BindGroup],
     ) -> Result<CellRun> {
+        let AssignFrame {
+            device,
+            queue,
+            scene,
+            common,
+            grid,
+            bounds,
+            dims,
+        } = a;
         let name = self.name;
         let mut reruns = 0;
         grid.ensure(device, queue, dims, dims.cell_count(), 1);

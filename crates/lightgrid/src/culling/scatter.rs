@@ -5,10 +5,8 @@
 //! stable, so every cell's list comes out in light order, exactly as the CPU twin
 //! ([`super::assign_cpu`] with the same cell bounds) builds it.
 
-use super::cell_bounds::CellBoundsPass;
-use super::gpu_assign::{check_index_capacity, AssignCommon};
+use super::gpu_assign::{check_index_capacity, AssignCommon, AssignFrame};
 use super::radix_sort::RadixSort;
-use super::{GridBuffers, GridDims};
 use crate::consts::ASSIGN_THREADS;
 use crate::error::Result;
 use crate::gpu::STORAGE_RW;
@@ -86,19 +84,16 @@ impl ScatterPass {
 
     /// Build the grid from the cell bounds in `bounds`; leaves it in `grid` (waits for it)
     /// and returns the number of index entries.
-    #[allow(clippy::too_many_arguments)]
-    pub fn run(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        enc: &mut FrameEncoder,
-        scene: &wgpu::BindGroup,
-        common: &mut AssignCommon,
-        grid: &mut GridBuffers,
-        bounds: &CellBoundsPass,
-        dims: &GridDims,
-        light_count: u32,
-    ) -> Result<u32> {
+    pub fn run(&mut self, a: AssignFrame, enc: &mut FrameEncoder, light_count: u32) -> Result<u32> {
+        let AssignFrame {
+            device,
+            queue,
+            scene,
+            common,
+            grid,
+            bounds,
+            dims,
+        } = a;
         let lights = u64::from(light_count.max(1)) * 4;
         grow_storage(
             device,
