@@ -917,5 +917,9 @@ fn list() -> Result<()> {
     for p in PIPELINES {
         println!("  {:<24} {} ({})", p.id, p.description, p.paper);
     }
+    println!("light assignment (--assign, for grid pipelines):");
+    for a in lightgrid::culling::Assign::ALL {
+        println!("  {:<10} {}", a.name(), a.description());
+    }
     Ok(())
 }

@@ -214,6 +214,8 @@ fn list_names_adapters_scenes_and_pipelines() {
         "random-fps",
         "stress",
         "forward",
+        "bvh-gpu ",
+        "scatter ",
     ] {
         assert!(out.contains(s), "list lacks {s}");
     }

@@ -70,6 +70,18 @@ impl Assign {
         }
     }
 
+    /// One line on how the strategy works (`lightgrid list`).
+    pub fn description(self) -> &'static str {
+        match self {
+            Assign::Cpu => "CPU: projected sphere rectangles, per-cell depth test (rayon); grid uploaded",
+            Assign::Gather => "GPU: one workgroup per occupied cell tests every light (forward-plus §4)",
+            Assign::Scatter => "GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell (forward-plus §4)",
+            Assign::Bvh => "light BVH built on the CPU each frame, walked per occupied cell on the GPU (tiled-forward-shading §4.4)",
+            Assign::BvhGpu => "the same BVH built on the GPU (Morton codes, radix sort), walked the same way",
+            Assign::Auto => "software adapter: cpu; hardware GPU: gather up to 8192 lights, bvh-gpu above",
+        }
+    }
+
     /// The strategy used for a frame with `lights` lights. `auto` on a software adapter
     /// (lavapipe, which shares the CPU's cores) is `cpu` at every count: measured fastest from
     /// 1k to 1M lights (README, "Light assignment scaling"). On a hardware GPU it is `gather`
