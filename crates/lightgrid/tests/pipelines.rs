@@ -538,3 +538,74 @@ fn index_lists_beyond_the_device_limit_are_refused() {
         "{err}"
     );
 }
+
+/// Randomized edge cases on the GPU: a catalog frame's geometry and camera with lights placed
+/// relative to that camera (behind it, containing it, crossing the near plane, centred just
+/// outside a screen edge, and scattered in front), at resolutions that are not multiples of the
+/// tile size; every strategy on every grid pipeline against its CPU twin.
+#[test]
+fn strategies_on_randomized_edge_case_lights() {
+    use glam::Vec3;
+    use lightgrid::scene::{LightAnchor, Rng, SceneLight};
+    let mut rng = Rng::new(77);
+    let cases = [
+        ("random-fps", (97, 61), 13, 32),
+        ("robots-many", (130, 77), 8, 16),
+        ("random-top", (151, 83), 31, 8),
+    ];
+    for (name, (w, h), tile, slices) in cases {
+        let mut scene = catalog::build(name, &SceneParams::default()).unwrap();
+        let frame = rng.below(scene.frame_count());
+        let camera = scene.frame(frame).camera;
+        let setup = ViewSetup::new(&camera, w, h);
+        let world = setup.view.inverse();
+        let mut lights = Vec::new();
+        for k in 0..240 {
+            let r = rng.range(0.3, 10.0);
+            let v = match k % 6 {
+                0 => Vec3::new(rng.range(-r, r), rng.range(-r, r), rng.range(-r, r)) * 0.5,
+                1 => Vec3::new(
+                    rng.range(-r, r),
+                    rng.range(-r, r),
+                    -camera.near + rng.range(-r, r),
+                ),
+                2 => Vec3::new(
+                    rng.range(-3.0, 3.0),
+                    rng.range(-3.0, 3.0),
+                    rng.range(0.0, r),
+                ),
+                3 => {
+                    let depth = rng.range(1.0, 60.0);
+                    let edge = if rng.unit() < 0.5 { -1.0 } else { 1.0 } * rng.range(0.95, 1.15);
+                    let other = rng.range(-1.1, 1.1);
+                    let (sx, sy) = if k % 12 < 6 {
+                        (edge, other)
+                    } else {
+                        (other, edge)
+                    };
+                    Vec3::new(sx / setup.p00 * depth, sy / setup.p11 * depth, -depth)
+                }
+                _ => {
+                    let depth = rng.range(0.5, 80.0);
+                    Vec3::new(
+                        rng.range(-1.0, 1.0) / setup.p00 * depth,
+                        rng.range(-1.0, 1.0) / setup.p11 * depth,
+                        -depth,
+                    )
+                }
+            };
+            lights.push(SceneLight {
+                light: PointLight {
+                    position: world.transform_point3(v),
+                    color: Vec3::new(rng.unit(), rng.unit(), rng.unit()),
+                    intensity: rng.range(0.5, 3.0),
+                    range: r,
+                },
+                anchor: LightAnchor::World,
+            });
+        }
+        scene.lights = lights;
+        scene.validate().unwrap();
+        check_strategies(&scene, frame, (w, h), tile, slices, &GRID_PIPELINES);
+    }
+}
