@@ -171,6 +171,15 @@ impl GridBuilder {
         self.buffers.bind_group()
     }
 
+    /// The cell bounds this frame's assignment read: `[near, far]` everywhere, or those the
+    /// GPU computed (downloaded; call after the frame's work is submitted).
+    fn cell_bounds(&self, f: &FrameInputs, dims: &GridDims) -> Result<Vec<[f32; 2]>> {
+        match self.source {
+            CellSource::NearFar => Ok(vec![[f.setup.near, f.setup.far]; dims.cell_count()]),
+            CellSource::Depth => self.bounds.read(f.device, f.queue),
+        }
+    }
+
     /// Build this frame's grid. With `CellSource::Depth`, `f.targets.depth` must hold the
     /// frame's depth in what `enc` has recorded so far.
     pub fn build(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<BuiltGrid> {
@@ -181,10 +190,12 @@ impl GridBuilder {
         } else {
             self.tiles
         };
-        let near_far = [f.setup.near, f.setup.far];
         match self.source {
             CellSource::Depth => self.bounds.encode(f, enc, &dims),
-            CellSource::NearFar => self.bounds.fill(device, queue, &dims, near_far),
+            CellSource::NearFar => {
+                self.bounds
+                    .fill(device, queue, &dims, [f.setup.near, f.setup.far])
+            }
         }
         let assign = self.assign.resolve(f.lights.len(), self.software_adapter);
         // Everything before assignment (the depth, the bounds) finishes outside the clock.
@@ -194,7 +205,7 @@ impl GridBuilder {
         let light_count = f.lights.len() as u32;
         let run = match assign {
             Assign::Cpu | Assign::Auto => {
-                let bounds = self.bounds.read(device, queue)?;
+                let bounds = self.cell_bounds(f, &dims)?;
                 let start = Instant::now();
                 let range = match self.source {
                     CellSource::NearFar => DepthRange::NearFar,
@@ -295,10 +306,7 @@ impl GridBuilder {
         };
         let wall_ms = wall.elapsed().as_secs_f64() * 1e3;
         let grid = read_grid(device, queue, &self.buffers, &dims, run.total)?;
-        let cell_bounds = match self.source {
-            CellSource::NearFar => vec![near_far; dims.cell_count()],
-            CellSource::Depth => self.bounds.read(device, queue)?,
-        };
+        let cell_bounds = self.cell_bounds(f, &dims)?;
         Ok(BuiltGrid {
             grid,
             cell_bounds,

@@ -5,6 +5,7 @@
 
 use crate::consts::{MAX_SLICES, MAX_TILE_SIZE, MIN_TILE_SIZE};
 use crate::error::{Error, Result};
+use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::gpu_types::GridParams;
 
 /// The grid's shape: screen tiles, and for a clustered grid view-depth slices spaced
@@ -239,17 +240,16 @@ impl GridBuffers {
 
     pub fn new(device: &wgpu::Device) -> Self {
         let layout = Self::layout(device);
-        let params = Self::buffer(
-            device,
-            "grid params",
-            wgpu::BufferUsages::UNIFORM,
-            std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
-        );
-        let cells = Self::buffer(device, "grid cells", wgpu::BufferUsages::STORAGE, 1 << 14);
-        let indices = Self::buffer(
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("grid params"),
+            size: std::mem::size_of::<crate::gpu_types::GridParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let cells = storage_buffer(device, "grid cells", 1 << 14);
+        let indices = storage_buffer(
             device,
             "grid indices",
-            wgpu::BufferUsages::STORAGE,
             u64::from(Self::INITIAL_INDEX_CAPACITY) * 4,
         );
         let bind_group = Self::bind(device, &layout, &params, &cells, &indices);
@@ -262,20 +262,6 @@ impl GridBuffers {
         }
     }
 
-    fn buffer(
-        device: &wgpu::Device,
-        label: &str,
-        usage: wgpu::BufferUsages,
-        size: u64,
-    ) -> wgpu::Buffer {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: size.max(16),
-            usage: usage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        })
-    }
-
     fn bind(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
@@ -283,24 +269,16 @@ impl GridBuffers {
         cells: &wgpu::Buffer,
         indices: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("light grid"),
+        bind_resources(
+            device,
+            "light grid",
             layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: cells.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: indices.as_entire_binding(),
-                },
+            &[
+                params.as_entire_binding(),
+                cells.as_entire_binding(),
+                indices.as_entire_binding(),
             ],
-        })
+        )
     }
 
     /// Upload a grid; buffers grow (never truncate) to fit its index list.
@@ -336,26 +314,9 @@ impl GridBuffers {
         indices: usize,
     ) {
         let (cb, ib) = ((cells * 8) as u64, (indices.max(1) * 4) as u64);
-        let mut rebind = false;
-        if cb > self.cells.size() {
-            self.cells = Self::buffer(
-                device,
-                "grid cells",
-                wgpu::BufferUsages::STORAGE,
-                cb.next_power_of_two(),
-            );
-            rebind = true;
-        }
-        if ib > self.indices.size() {
-            self.indices = Self::buffer(
-                device,
-                "grid indices",
-                wgpu::BufferUsages::STORAGE,
-                ib.next_power_of_two(),
-            );
-            rebind = true;
-        }
-        if rebind {
+        let grown_cells = grow_storage(device, &mut self.cells, "grid cells", cb);
+        let grown_indices = grow_storage(device, &mut self.indices, "grid indices", ib);
+        if grown_cells || grown_indices {
             self.bind_group = Self::bind(
                 device,
                 &self.layout,
