@@ -39,6 +39,14 @@ pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 /// radix sort blocks, prefix sums).
 pub const ASSIGN_THREADS: u32 = 256;
 
+/// Loop iterations llvmpipe (lavapipe) lets one shader invocation run: its infinite-loop guard
+/// is one counter per invocation across all loops, and when it runs out the loops simply end,
+/// without an error (measured: `forward` with 65,536 lights is exact, with 66,000 it misses
+/// light; splitting the loop into chunks does not help). A frame whose per-sample light loop
+/// would exceed it is refused on that adapter instead of rendered wrong (`renderer.rs`,
+/// `culling/builder.rs`).
+pub const SOFTWARE_LOOP_BUDGET: u64 = 65_536;
+
 /// Light indices one per-cell assignment workgroup (gather, BVH walk) collects in workgroup
 /// memory before flushing them to the global index list. A cell with more lights "spills": a
 /// second pass writes its whole list straight to global memory (nothing is ever dropped).

@@ -37,6 +37,21 @@ pub enum Error {
 }
 
 impl Error {
+    /// A frame whose per-sample light loop (`loop_length` iterations) would exceed the
+    /// adapter's loop budget (`GpuContext::loop_budget`): refused rather than rendered with
+    /// lights silently missing.
+    pub(crate) fn loop_budget(pipeline: &str, loop_length: u64, budget: u64) -> Self {
+        Error::invalid(
+            "lights",
+            format!(
+                "{pipeline} would loop over {loop_length} lights for one sample, but this adapter \
+                 (llvmpipe) silently ends a shader's loops after {budget} iterations, which would \
+                 drop lights from the image; use fewer lights, a pipeline with smaller light \
+                 lists (e.g. clustered_deferred), or a hardware GPU"
+            ),
+        )
+    }
+
     pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> Self {
         Error::Invalid {
             what,

@@ -1,7 +1,7 @@
 //! The renderer: owns the targets and scene buffers, runs one registry pipeline for one frame
 //! of a scene, tonemaps, reads the image back and collects the frame's statistics.
 
-use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
+use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS, TILE_LIGHT_BATCH};
 use crate::culling::{
     assign_cpu, cell_bounds_cpu, ideal_lighting_computations, DepthRange, GridDims, LightGrid,
     ViewSetup,
@@ -252,6 +252,7 @@ impl<'c> Renderer<'c> {
                 settings: self.settings,
                 count_blend: self.ctx.count_blend,
                 software_adapter: self.ctx.is_software(),
+                loop_budget: self.ctx.loop_budget(),
             };
             let t = scoped(device, &format!("creating pipeline {}", info.id), || {
                 (info.create)(&ctx)
@@ -331,6 +332,13 @@ impl<'c> Renderer<'c> {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
 
         let info = pipelines::find(pipeline_id)?;
+        let budget = self.ctx.loop_budget();
+        if let Some(budget) = budget {
+            let lights = state.lights.len() as u64;
+            if info.light_loop == pipelines::LightLoop::AllLights && lights > budget {
+                return Err(Error::loop_budget(info.id, lights, budget));
+            }
+        }
         let setup = ViewSetup::new(&state.camera, width, height);
         let technique = self.techniques.get_mut(info.id).expect("prepared above");
         self.timer.reset();
@@ -409,6 +417,18 @@ impl<'c> Renderer<'c> {
             DepthRange::Cells(&bounds),
         );
         let ideal = ideal_lighting_computations(&setup, &bounded, &state.lights, &view_distance);
+        if let Some(budget) =
+            budget.filter(|_| info.light_loop == pipelines::LightLoop::TileBatches)
+        {
+            // The kernel loops over its tile's list plus a few iterations per batch. Its own
+            // list comes from a slightly looser test than the depth-bounded CPU grid's, so the
+            // estimate keeps a 10% margin below the budget.
+            let batches = (state.lights.len() as u64).div_ceil(u64::from(TILE_LIGHT_BATCH));
+            let estimate = u64::from(bounded.max_lights_per_cell()) + 6 * batches;
+            if estimate > budget * 9 / 10 {
+                return Err(Error::loop_budget(info.id, estimate, budget));
+            }
+        }
         let (gpu_ms, timing) = match span {
             Some(ms) => (ms, TimingSource::GpuTimestamps),
             None => (wall_ms, TimingSource::WallClock),

@@ -609,3 +609,63 @@ fn strategies_on_randomized_edge_case_lights() {
         check_strategies(&scene, frame, (w, h), tile, slices, &GRID_PIPELINES);
     }
 }
+
+/// On llvmpipe a shader invocation's loops end silently after SOFTWARE_LOOP_BUDGET iterations:
+/// below it `forward` is exact (equal to a grid pipeline), above it every pipeline whose
+/// per-sample light loop would run longer is refused with a message instead of rendering an
+/// image with lights missing, while one with short enough lists still renders.
+#[test]
+fn light_loops_beyond_the_adapters_budget_are_refused() {
+    let ctx = common::gpu();
+    let settings = RenderSettings {
+        tile_size: 64,
+        assign: Assign::Cpu,
+        ..Default::default()
+    };
+    let scene = |n| {
+        let params = SceneParams {
+            lights: Some(n),
+            ..Default::default()
+        };
+        catalog::build("stress", &params).unwrap()
+    };
+    let mut r = Renderer::new(&ctx, 32, 18, settings).unwrap();
+    let below = scene(65_000);
+    let forward = r.render(&below, 0, "forward").unwrap();
+    let tiled = r.render(&below, 0, "tiled_forward").unwrap();
+    let (d, _) = diff(&forward.image, &tiled.image).unwrap();
+    assert!(d.max <= 1.0, "forward below the budget must be exact: {d:?}");
+    let above = scene(100_000);
+    match ctx.loop_budget() {
+        Some(budget) => {
+            for id in [
+                "forward",
+                "forward_mono",
+                "tiled_forward",
+                "tiled_deferred_single",
+            ] {
+                let err = r.render(&above, 0, id).err().unwrap_or_else(|| {
+                    panic!("{id} with 100,000 lights in one 64px tile must be refused")
+                });
+                let msg = err.to_string();
+                assert!(
+                    msg.contains(&budget.to_string()) && msg.contains(id),
+                    "{msg}"
+                );
+            }
+            let clustered = r.render(&above, 0, "clustered_deferred").unwrap();
+            assert!(u64::from(clustered.grid.max_lights_per_cell()) <= budget);
+        }
+        None => {
+            for id in ["forward", "tiled_forward", "clustered_deferred"] {
+                r.render(&above, 0, id).unwrap();
+            }
+        }
+    }
+    if std::env::var("CI").is_ok() {
+        assert!(
+            ctx.loop_budget().is_some(),
+            "CI runs on lavapipe, which has the budget"
+        );
+    }
+}

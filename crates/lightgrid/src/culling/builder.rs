@@ -130,6 +130,8 @@ pub struct GridBuilder {
     source: CellSource,
     assign: Assign,
     software_adapter: bool,
+    loop_budget: Option<u64>,
+    pipeline: &'static str,
     scene_layout: wgpu::BindGroupLayout,
     bounds: CellBoundsPass,
     buffers: GridBuffers,
@@ -143,7 +145,13 @@ pub struct GridBuilder {
 impl GridBuilder {
     /// `slices` 1 builds a tiled grid, more a clustered one (slices between the camera's near
     /// and far planes each frame).
-    pub fn new(ctx: &crate::pipelines::PipelineContext, slices: u32, source: CellSource) -> Self {
+    /// `pipeline`: the id named in errors.
+    pub fn new(
+        ctx: &crate::pipelines::PipelineContext,
+        pipeline: &'static str,
+        slices: u32,
+        source: CellSource,
+    ) -> Self {
         let (device, scene_layout) = (ctx.device, ctx.scene_layout);
         GridBuilder {
             tiles: ctx.dims,
@@ -151,6 +159,8 @@ impl GridBuilder {
             source,
             assign: ctx.settings.assign,
             software_adapter: ctx.software_adapter,
+            loop_budget: ctx.loop_budget,
+            pipeline,
             scene_layout: scene_layout.clone(),
             bounds: CellBoundsPass::new(device, scene_layout),
             buffers: GridBuffers::new(device),
@@ -169,6 +179,17 @@ impl GridBuilder {
 
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         self.buffers.bind_group()
+    }
+
+    /// Refuse to shade when a cell's list is longer than the adapter lets one sample loop.
+    fn check_loop_budget(&self, grid: &LightGrid) -> Result<()> {
+        let longest = u64::from(grid.max_lights_per_cell());
+        match self.loop_budget {
+            Some(budget) if longest > budget => {
+                Err(crate::Error::loop_budget(self.pipeline, longest, budget))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// The cell bounds this frame's assignment read: `[near, far]` everywhere, or those the
@@ -213,6 +234,7 @@ impl GridBuilder {
                 };
                 let grid = assign_cpu(&f.setup, &dims, f.lights, range);
                 cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+                self.check_loop_budget(&grid)?;
                 self.buffers.upload(device, queue, &grid);
                 enc.submit_and_wait()?;
                 return Ok(BuiltGrid {
@@ -306,6 +328,7 @@ impl GridBuilder {
         };
         let wall_ms = wall.elapsed().as_secs_f64() * 1e3;
         let grid = read_grid(device, queue, &self.buffers, &dims, run.total)?;
+        self.check_loop_budget(&grid)?;
         let cell_bounds = self.cell_bounds(f, &dims)?;
         Ok(BuiltGrid {
             grid,

@@ -181,6 +181,15 @@ impl GpuContext {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
+    /// Loop iterations one shader invocation may run before the driver silently ends its loops
+    /// (`consts::SOFTWARE_LOOP_BUDGET` on llvmpipe); None where no such limit is known.
+    pub fn loop_budget(&self) -> Option<u64> {
+        self.info
+            .name
+            .contains("llvmpipe")
+            .then_some(crate::consts::SOFTWARE_LOOP_BUDGET)
+    }
+
     /// Largest 2D texture edge the device accepts.
     pub fn max_texture_edge(&self) -> u32 {
         self.device.limits().max_texture_dimension_2d

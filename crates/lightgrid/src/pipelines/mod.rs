@@ -53,6 +53,8 @@ pub struct PipelineContext<'a> {
     pub count_blend: bool,
     /// A CPU-emulated adapter (lavapipe): `--assign auto` keeps assignment on the CPU.
     pub software_adapter: bool,
+    /// `GpuContext::loop_budget`: longest light loop a sample may run on this adapter.
+    pub loop_budget: Option<u64>,
 }
 
 /// What a pipeline reads to render one frame.
@@ -125,6 +127,19 @@ pub trait Technique {
     fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>>;
 }
 
+/// What bounds the light loop one sample runs (checked against the adapter's loop budget).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightLoop {
+    /// No loop over lights (light volumes: one draw per light).
+    None,
+    /// Every light of the frame.
+    AllLights,
+    /// The sample's cell list (`GridBuilder` checks it before shading).
+    GridCell,
+    /// The tile's list, culled in batches of TILE_LIGHT_BATCH inside the kernel.
+    TileBatches,
+}
+
 /// One registry row.
 pub struct PipelineInfo {
     /// The id used on the command line and in stats.
@@ -136,6 +151,8 @@ pub struct PipelineInfo {
     pub uses_grid: bool,
     /// Builds its grid with the strategy `--assign` names (a `GridBuilder`).
     pub assign: bool,
+    /// What bounds the per-sample light loop.
+    pub light_loop: LightLoop,
     /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
     /// same approximations (e.g. `forward_mono`).
     pub reference: &'static str,
@@ -154,6 +171,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "all (brute force)",
         uses_grid: false,
         assign: false,
+        light_loop: LightLoop::AllLights,
         reference: "forward",
         shaders: forward::shaders,
         create: forward::create,
@@ -165,6 +183,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
         assign: false,
+        light_loop: LightLoop::AllLights,
         reference: "forward_mono",
         shaders: forward::shaders,
         create: forward::create_mono,
@@ -176,6 +195,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §3",
         uses_grid: true,
         assign: true,
+        light_loop: LightLoop::GridCell,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
@@ -187,6 +207,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
         assign: true,
+        light_loop: LightLoop::GridCell,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
@@ -198,6 +219,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
         assign: true,
+        light_loop: LightLoop::GridCell,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
@@ -209,6 +231,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §7",
         uses_grid: true,
         assign: false,
+        light_loop: LightLoop::TileBatches,
         reference: "forward",
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
@@ -220,6 +243,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
         assign: true,
+        light_loop: LightLoop::GridCell,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_clustered,
@@ -231,6 +255,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
         assign: true,
+        light_loop: LightLoop::GridCell,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_clustered,
@@ -242,6 +267,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §1.1, §8 (Deferred)",
         uses_grid: false,
         assign: false,
+        light_loop: LightLoop::None,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_plain,
@@ -253,6 +279,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §8 (Deferred-Stencil)",
         uses_grid: false,
         assign: false,
+        light_loop: LightLoop::None,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_stencil,
@@ -264,6 +291,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting",
         uses_grid: false,
         assign: false,
+        light_loop: LightLoop::None,
         reference: "forward",
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
@@ -275,6 +303,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
         assign: false,
+        light_loop: LightLoop::None,
         reference: "forward_mono",
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,

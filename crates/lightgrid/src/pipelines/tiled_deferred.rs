@@ -73,17 +73,27 @@ struct TiledDeferred {
 }
 
 pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create_grid(ctx, 1, "tiled deferred shading")
+    create_grid(ctx, "tiled_deferred", 1, "tiled deferred shading")
 }
 
 pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create_grid(ctx, ctx.settings.slices, "clustered deferred shading")
+    create_grid(
+        ctx,
+        "clustered_deferred",
+        ctx.settings.slices,
+        "clustered deferred shading",
+    )
 }
 
-fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
+fn create_grid(
+    ctx: &PipelineContext,
+    id: &'static str,
+    slices: u32,
+    label: &'static str,
+) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
-    let builder = GridBuilder::new(ctx, slices, CellSource::Depth);
+    let builder = GridBuilder::new(ctx, id, slices, CellSource::Depth);
     let outputs_layout = compute_outputs_layout(ctx.device);
     let shading = compute_pipeline(
         ctx.device,

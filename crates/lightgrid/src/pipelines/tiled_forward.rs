@@ -44,8 +44,14 @@ enum Kind {
 fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let prepass = kind != Kind::Plain;
+    let id = match kind {
+        Kind::Plain => "tiled_forward",
+        Kind::PreZ => "tiled_forward_prez",
+        Kind::Clustered => "clustered_forward",
+    };
     let builder = GridBuilder::new(
         ctx,
+        id,
         if kind == Kind::Clustered {
             ctx.settings.slices
         } else {
