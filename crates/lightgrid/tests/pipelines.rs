@@ -634,7 +634,10 @@ fn light_loops_beyond_the_adapters_budget_are_refused() {
     let forward = r.render(&below, 0, "forward").unwrap();
     let tiled = r.render(&below, 0, "tiled_forward").unwrap();
     let (d, _) = diff(&forward.image, &tiled.image).unwrap();
-    assert!(d.max <= 1.0, "forward below the budget must be exact: {d:?}");
+    assert!(
+        d.max <= 1.0,
+        "forward below the budget must be exact: {d:?}"
+    );
     let above = scene(100_000);
     match ctx.loop_budget() {
         Some(budget) => {
