@@ -42,10 +42,34 @@ pub const ASSIGN_THREADS: u32 = 256;
 /// Loop iterations llvmpipe (lavapipe) lets one shader invocation run: its infinite-loop guard
 /// is one counter per invocation across all loops, and when it runs out the loops simply end,
 /// without an error (measured: `forward` with 65,536 lights is exact, with 66,000 it misses
-/// light; splitting the loop into chunks does not help). A frame whose per-sample light loop
-/// would exceed it is refused on that adapter instead of rendered wrong (`renderer.rs`,
-/// `culling/builder.rs`).
+/// light; splitting the loop into chunks does not help). Every data-dependent shader loop
+/// checks after it ends that it reached its bound and counts a miss in
+/// [`COUNTER_TRUNCATED_LOOPS`]; this number only sizes kernels and tests.
 pub const SOFTWARE_LOOP_BUDGET: u64 = 65_536;
+
+/// Slots of the frame counters (group 0, binding 3: `frame_counters` in
+/// `shading/scene_bindings.wgsl`), cleared at the start of every frame and read back after it
+/// (asynchronously in real-time frames, `gpu/counters.rs`).
+/// Data-dependent shader loops that ended before their bound (llvmpipe's loop guard).
+pub const COUNTER_TRUNCATED_LOOPS: u32 = 0;
+/// Index-list entries the per-cell assignment kernels reserved: what the grid needs.
+pub const COUNTER_INDEX_NEEDED: u32 = 1;
+/// Of those, entries that did not fit the index buffer (sized from earlier frames).
+pub const COUNTER_INDEX_OUT_OF_ROOM: u32 = 2;
+/// Cells queued for the spill pass (more than CELL_LIST_CAPACITY lights).
+pub const COUNTER_SPILLS: u32 = 3;
+/// Hits beyond a counted length (spill pass): count and write passes disagree; must stay 0.
+pub const COUNTER_WRITE_OVERFLOW: u32 = 4;
+/// (cell, light) pairs the scatter strategy emitted: what its pair buffer needs.
+pub const COUNTER_PAIRS_NEEDED: u32 = 5;
+/// Of those, pairs that did not fit the pair buffer (sized from earlier frames).
+pub const COUNTER_PAIRS_OUT_OF_ROOM: u32 = 6;
+/// Three slots: the spill pass's indirect dispatch arguments (x, y, z).
+pub const COUNTER_SPILL_ARGS: u32 = 8;
+/// Three slots: the scatter emit pass's indirect dispatch arguments (x, y, z).
+pub const COUNTER_ITEM_ARGS: u32 = 12;
+/// Number of slots.
+pub const COUNTER_SLOTS: u32 = 16;
 
 /// Light indices one per-cell assignment workgroup (gather, BVH walk) collects in workgroup
 /// memory before flushing them to the global index list. A cell with more lights "spills": a
@@ -100,6 +124,28 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("BVH_WIDTH", WgslConst::U32(BVH_WIDTH)),
     ("BVH_LEAF", WgslConst::U32(BVH_LEAF)),
     ("BVH_STACK", WgslConst::U32(BVH_STACK)),
+    (
+        "COUNTER_TRUNCATED_LOOPS",
+        WgslConst::U32(COUNTER_TRUNCATED_LOOPS),
+    ),
+    ("COUNTER_INDEX_NEEDED", WgslConst::U32(COUNTER_INDEX_NEEDED)),
+    (
+        "COUNTER_INDEX_OUT_OF_ROOM",
+        WgslConst::U32(COUNTER_INDEX_OUT_OF_ROOM),
+    ),
+    ("COUNTER_SPILLS", WgslConst::U32(COUNTER_SPILLS)),
+    (
+        "COUNTER_WRITE_OVERFLOW",
+        WgslConst::U32(COUNTER_WRITE_OVERFLOW),
+    ),
+    ("COUNTER_PAIRS_NEEDED", WgslConst::U32(COUNTER_PAIRS_NEEDED)),
+    (
+        "COUNTER_PAIRS_OUT_OF_ROOM",
+        WgslConst::U32(COUNTER_PAIRS_OUT_OF_ROOM),
+    ),
+    ("COUNTER_SPILL_ARGS", WgslConst::U32(COUNTER_SPILL_ARGS)),
+    ("COUNTER_ITEM_ARGS", WgslConst::U32(COUNTER_ITEM_ARGS)),
+    ("COUNTER_SLOTS", WgslConst::U32(COUNTER_SLOTS)),
     (
         "MATERIAL_FLAG_TRANSPARENT",
         WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),

@@ -31,27 +31,24 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// Shader loops of a frame ended before their bound (llvmpipe ends an invocation's loops
+    /// after 65,536 iterations without an error): the image is missing work, so it is refused.
+    #[error(
+        "{pipeline}: {count} shader loops ended before their bound (this adapter silently cuts \
+         long loops short), so the image would be missing light; use fewer lights, a larger \
+         --tile or more --slices, a pipeline with shorter light lists (e.g. clustered_deferred), \
+         or a hardware GPU"
+    )]
+    TruncatedLoops { pipeline: String, count: u32 },
+    /// The light lists of a frame did not fit their buffers even after growing them.
+    #[error("{pipeline}: {reason}")]
+    Overflow { pipeline: String, reason: String },
     /// An image that could not be decoded or encoded.
     #[error("{path}: {reason}")]
     Image { path: String, reason: String },
 }
 
 impl Error {
-    /// A frame whose per-sample light loop (`loop_length` iterations) would exceed the
-    /// adapter's loop budget (`GpuContext::loop_budget`): refused rather than rendered with
-    /// lights silently missing.
-    pub(crate) fn loop_budget(pipeline: &str, loop_length: u64, budget: u64) -> Self {
-        Error::invalid(
-            "lights",
-            format!(
-                "{pipeline} would loop over {loop_length} lights for one sample, but this adapter \
-                 (llvmpipe) silently ends a shader's loops after {budget} iterations, which would \
-                 drop lights from the image; use fewer lights, a pipeline with smaller light \
-                 lists (e.g. clustered_deferred), or a hardware GPU"
-            ),
-        )
-    }
-
     pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> Self {
         Error::Invalid {
             what,

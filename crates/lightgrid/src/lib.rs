@@ -4,10 +4,12 @@
 //! Start with [`gpu::GpuContext::new`], build a scene from [`scene::catalog`], and render it
 //! with a [`Renderer`] and a pipeline id from [`pipelines::PIPELINES`].
 
+pub mod analysis;
 pub mod bench;
 pub mod consts;
 pub mod culling;
 pub mod error;
+pub mod frame;
 pub mod gpu;
 pub mod gpu_types;
 pub mod heatmap;
@@ -22,6 +24,8 @@ pub mod shader;
 pub mod stats;
 
 pub use error::{Error, Result};
-pub use pipelines::RenderSettings;
-pub use renderer::{validate_size, FrameOutput, Renderer};
+pub use frame::RenderSettings;
+pub use renderer::{
+    validate_size, FinishedFrame, FrameOutput, Renderer, SubmittedFrame, MAX_FRAMES_IN_FLIGHT,
+};
 pub use stats::{FrameStats, TimingSource};

@@ -1,42 +1,42 @@
-//! The renderer: owns the targets and scene buffers, runs one registry pipeline for one frame
-//! of a scene, tonemaps, reads the image back and collects the frame's statistics.
+//! The renderer: owns the targets and scene buffers and renders frames of a scene with a
+//! registry pipeline, in three steps:
+//! 1. **upload** ([`Renderer::upload`]): lights and uniforms every frame, the static geometry
+//!    and materials once per scene, the moving objects every frame; everything is validated
+//!    here, once;
+//! 2. **encode** (`encode_frame`): the pipeline's passes, the tonemap and the copy of the
+//!    frame counters, recorded into one [`FrameEncoder`] and submitted once, without waiting
+//!    (only the `cpu` strategy with depth bounds reads the cell bounds back part-way);
+//! 3. **analyze** (`analysis.rs`, only when asked: [`Renderer::render`]): image, depth and
+//!    counts read back, the ideal count, the grid downloaded, [`FrameStats`] filled.
+//!
+//! [`Renderer::render_frame`] is the real-time path (steps 1-2): frames stay in flight, their
+//! counters and timestamps come back asynchronously ([`Renderer::poll_finished`]), list sizes
+//! follow them a frame later, and a frame they show to be wrong is reported in its
+//! [`FinishedFrame`].
 
-use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS, TILE_LIGHT_BATCH};
-use crate::culling::{
-    assign_cpu, cell_bounds_cpu, ideal_lighting_computations, DepthRange, GridDims, LightGrid,
-    ViewSetup,
-};
+use crate::analysis::{self, AnalysisReadbacks};
+use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
+use crate::culling::{GridDims, ViewSetup};
 use crate::error::{Error, Result};
-use crate::gpu::{scoped, wait_idle, GpuContext, PassTimer};
-use crate::gpu_types::{FrameUniforms, GpuLight};
-use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
-use crate::passes::{scene_layout, Readback, Targets, Tonemap};
-use crate::pipelines::{
-    self, FrameEncoder, FrameInputs, PipelineContext, RenderSettings, Technique,
+use crate::frame::{FrameEncoder, FrameInputs, FrameIo, PipelineContext, RenderSettings};
+use crate::gpu::{
+    scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, PassTimer, PassTiming,
 };
-use crate::scene::Scene;
-use crate::stats::{FrameStats, TimingSource};
-use image::RgbaImage;
-use std::collections::HashMap;
+use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::passes::{scene_layout, Targets, Tonemap};
+use crate::pipelines::{self, Technique};
+use crate::scene::{FrameState, Scene};
+use std::collections::{HashMap, VecDeque};
 use std::time::Instant;
+
+pub use crate::analysis::FrameOutput;
 
 /// Most passes one frame may record (timestamp slots).
 const MAX_PASSES: u32 = 128;
 
-/// An image, its statistics, and what the analysis saw.
-pub struct FrameOutput {
-    pub image: RgbaImage,
-    pub stats: FrameStats,
-    /// The grid the pipeline shaded with; for pipelines that build none, the depth-bounded
-    /// CPU tile grid used for the ideal count (see `grid_is_pipelines`).
-    pub grid: LightGrid,
-    pub grid_is_pipelines: bool,
-    /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
-    /// their CPU twin); None for pipelines without a grid.
-    pub cell_bounds: Option<Vec<[f32; 2]>>,
-    /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry).
-    pub depth: Vec<f32>,
-}
+/// Frames the real-time path keeps in flight before it waits for the oldest (a game's
+/// swap chain does the same).
+pub const MAX_FRAMES_IN_FLIGHT: usize = 3;
 
 /// A storage/vertex/index buffer that grows to fit.
 struct GrowBuffer {
@@ -66,20 +66,68 @@ impl GrowBuffer {
         }
     }
 
-    /// Upload `bytes`, reallocating when too small. Returns true when the buffer was replaced.
-    fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, bytes: &[u8]) -> bool {
-        let grown = bytes.len() as u64 > self.buffer.size();
+    /// Make room for `bytes`, reallocating (contents lost) when too small. Returns true when
+    /// the buffer was replaced.
+    fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
+        let grown = bytes > self.buffer.size();
         if grown {
-            *self = GrowBuffer::new(
-                device,
-                self.label,
-                self.usage,
-                (bytes.len() as u64).next_power_of_two(),
-            );
+            *self = GrowBuffer::new(device, self.label, self.usage, bytes.next_power_of_two());
         }
-        queue.write_buffer(&self.buffer, 0, bytes);
         grown
     }
+
+    /// Upload `bytes` at `offset` (the buffer must hold them: [`GrowBuffer::reserve`]).
+    fn write(&self, queue: &wgpu::Queue, offset: u64, bytes: &[u8]) {
+        if !bytes.is_empty() {
+            queue.write_buffer(&self.buffer, offset, bytes);
+        }
+    }
+}
+
+/// What the GPU holds of the current scene: the static geometry (uploaded once) and where the
+/// moving geometry follows it.
+struct SceneUpload {
+    fingerprint: u64,
+    static_vertices: u32,
+    static_indices: u32,
+}
+
+/// What one frame uploaded.
+struct Uploaded {
+    state: FrameState,
+    setup: ViewSetup,
+    index_count: u32,
+    /// Bytes written to the GPU for this frame.
+    upload_bytes: u64,
+}
+
+/// A frame submitted by [`Renderer::render_frame`].
+#[derive(Clone, Copy, Debug)]
+pub struct SubmittedFrame {
+    /// The renderer's frame number (counts every submitted frame).
+    pub serial: u64,
+    /// Submissions, blocking readbacks and CPU waits the frame made.
+    pub io: FrameIo,
+    /// CPU time spent waiting for older frames before this one could be queued
+    /// (more than [`MAX_FRAMES_IN_FLIGHT`] in flight).
+    pub throttle_ms: f64,
+    /// Bytes uploaded for the frame (lights, uniforms, moving geometry).
+    pub upload_bytes: u64,
+}
+
+/// What the GPU reported about a finished real-time frame (read back without waiting).
+#[derive(Clone, Debug)]
+pub struct FinishedFrame {
+    pub serial: u64,
+    pub pipeline: &'static str,
+    /// Sum of the frame's pass durations (GPU work only); None without timestamps.
+    pub gpu_ms: Option<f64>,
+    pub passes: Vec<PassTiming>,
+    /// Shader loops that ended before their bound: the frame is wrong when non-zero.
+    pub truncated_loops: u32,
+    /// Some light list did not fit its buffer (sized from earlier frames): the frame is
+    /// missing lights; the buffers have grown for the next one.
+    pub overflowed: bool,
 }
 
 /// Renders frames at one size on one device.
@@ -93,40 +141,17 @@ pub struct Renderer<'c> {
     vertices: GrowBuffer,
     indices: GrowBuffer,
     scene_bind_group: wgpu::BindGroup,
+    scene: Option<SceneUpload>,
     tonemap: Tonemap,
     timer: PassTimer,
+    counters: FrameCounters,
     techniques: HashMap<&'static str, Box<dyn Technique>>,
     settings: RenderSettings,
     dims: GridDims,
-    readback: Readback,
-    counts_readback: Readback,
-    depth_readback: Readback,
-}
-
-/// The memory section of the stats: the pipeline's model applied to this frame.
-fn frame_memory(
-    model: MemoryModel,
-    (width, height): (u32, u32),
-    lighting_computations: Option<u64>,
-    grid: Option<&LightGrid>,
-) -> FrameMemory {
-    let pixels = u64::from(width) * u64::from(height);
-    let t = model.traffic;
-    let modelled = |per_pixel: u32, per_lit: u32| {
-        lighting_computations.map(|n| u64::from(per_pixel) * pixels + u64::from(per_lit) * n)
-    };
-    FrameMemory {
-        bytes_per_pixel: model.bytes_per_pixel(),
-        target_bytes: model.target_bytes(width, height),
-        grid_bytes: grid
-            .map(|g| (g.cells.len() * 8 + g.indices.len() * INDEX_BYTES as usize) as u64),
-        modelled_write_bytes: modelled(t.write_per_pixel, t.write_per_lit),
-        modelled_read_bytes: modelled(t.read_per_pixel, t.read_per_lit),
-        forward_plus_table1: grid
-            .map(|g| ForwardPlusTable1::new(pixels, g.average_lights_per_cell(), g.dims.tile_size)),
-        targets: model.targets,
-        traffic: t,
-    }
+    readbacks: AnalysisReadbacks,
+    serial: u64,
+    in_flight: VecDeque<wgpu::SubmissionIndex>,
+    finished: Vec<FinishedFrame>,
 }
 
 /// Check a frame size against lightgrid's and the adapter's limits.
@@ -172,13 +197,21 @@ impl<'c> Renderer<'c> {
             let materials = GrowBuffer::new(device, "materials", U::STORAGE, 1 << 12);
             let vertices = GrowBuffer::new(device, "vertices", U::VERTEX, 1 << 20);
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
-            let scene_bind_group =
-                Self::bind_scene(device, &scene_layout, &uniforms, &lights, &materials);
+            let counters = FrameCounters::new(device, MAX_PASSES);
+            let scene_bind_group = Self::bind_scene(
+                device,
+                &scene_layout,
+                &uniforms,
+                &lights,
+                &materials,
+                counters.buffer(),
+            );
             Renderer {
                 ctx,
                 targets,
                 tonemap: Tonemap::new(device),
                 timer: PassTimer::new(ctx, MAX_PASSES),
+                counters,
                 scene_layout,
                 uniforms,
                 lights,
@@ -186,12 +219,14 @@ impl<'c> Renderer<'c> {
                 vertices,
                 indices,
                 scene_bind_group,
+                scene: None,
                 techniques: HashMap::new(),
                 settings,
                 dims,
-                readback: Readback::new(device, "image readback", width, height),
-                counts_readback: Readback::new(device, "counts readback", width, height),
-                depth_readback: Readback::new(device, "depth readback", width, height),
+                readbacks: AnalysisReadbacks::new(device, width, height),
+                serial: 0,
+                in_flight: VecDeque::new(),
+                finished: Vec::new(),
             }
         });
         created.map_err(|e| match e {
@@ -212,25 +247,19 @@ impl<'c> Renderer<'c> {
         uniforms: &wgpu::Buffer,
         lights: &GrowBuffer,
         materials: &GrowBuffer,
+        counters: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene (group 0)"),
+        crate::gpu::bind_resources(
+            device,
+            "scene (group 0)",
             layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniforms.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: lights.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: materials.buffer.as_entire_binding(),
-                },
+            &[
+                uniforms.as_entire_binding(),
+                lights.buffer.as_entire_binding(),
+                materials.buffer.as_entire_binding(),
+                counters.as_entire_binding(),
             ],
-        })
+        )
     }
 
     pub fn size(&self) -> (u32, u32) {
@@ -241,8 +270,11 @@ impl<'c> Renderer<'c> {
         self.settings
     }
 
-    fn prepare_technique(&mut self, id: &str) -> Result<()> {
-        let info = pipelines::find(id)?;
+    pub(crate) fn ctx(&self) -> &GpuContext {
+        self.ctx
+    }
+
+    fn prepare_technique(&mut self, info: &'static pipelines::PipelineInfo) -> Result<()> {
         if !self.techniques.contains_key(info.id) {
             let device = &self.ctx.device;
             let ctx = PipelineContext {
@@ -252,7 +284,6 @@ impl<'c> Renderer<'c> {
                 settings: self.settings,
                 count_blend: self.ctx.count_blend,
                 software_adapter: self.ctx.is_software(),
-                loop_budget: self.ctx.loop_budget(),
             };
             let t = scoped(device, &format!("creating pipeline {}", info.id), || {
                 (info.create)(&ctx)
@@ -262,8 +293,8 @@ impl<'c> Renderer<'c> {
         Ok(())
     }
 
-    /// Render `frame` of `scene` with pipeline `pipeline_id`.
-    pub fn render(&mut self, scene: &Scene, frame: u32, pipeline_id: &str) -> Result<FrameOutput> {
+    /// Step 1: validate `frame` of `scene` and upload what the frame needs.
+    fn upload(&mut self, scene: &Scene, frame: u32) -> Result<Uploaded> {
         let frames = scene.frame_count();
         if frame >= frames {
             return Err(Error::invalid(
@@ -288,8 +319,77 @@ impl<'c> Renderer<'c> {
         for (i, l) in state.lights.iter().enumerate() {
             l.validate(i)?;
         }
-        let (vertices, indices) = scene.geometry(&state);
         let (width, height) = self.size();
+        let device = &self.ctx.device;
+        let queue = &self.ctx.queue;
+        let mut upload_bytes = 0u64;
+        let mut rebind = false;
+
+        // Static geometry and materials: once per scene.
+        let fingerprint = scene.static_fingerprint();
+        if self.scene.as_ref().map(|s| s.fingerprint) != Some(fingerprint) {
+            let (vertices, indices) = scene.static_geometry();
+            let materials = scene.materials_gpu();
+            let vb: &[u8] = bytemuck::cast_slice(&vertices);
+            let ib: &[u8] = bytemuck::cast_slice(&indices);
+            let mb: &[u8] = bytemuck::cast_slice(&materials);
+            // Room for the moving objects too, so the buffers rarely grow later.
+            let (mv, mi) = scene.moving_geometry(&state, vertices.len() as u32);
+            self.vertices.reserve(
+                device,
+                (vb.len() + std::mem::size_of_val(mv.as_slice())) as u64,
+            );
+            self.indices.reserve(
+                device,
+                (ib.len() + std::mem::size_of_val(mi.as_slice())) as u64,
+            );
+            rebind |= self.materials.reserve(device, mb.len() as u64);
+            self.vertices.write(queue, 0, vb);
+            self.indices.write(queue, 0, ib);
+            self.materials.write(queue, 0, mb);
+            upload_bytes += (vb.len() + ib.len() + mb.len()) as u64;
+            self.scene = Some(SceneUpload {
+                fingerprint,
+                static_vertices: vertices.len() as u32,
+                static_indices: indices.len() as u32,
+            });
+        }
+        let upload = self.scene.as_ref().expect("uploaded above");
+        let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
+
+        // Moving geometry: every frame, after the static part.
+        let (vertices, indices) = scene.moving_geometry(&state, static_vertices);
+        let vb: &[u8] = bytemuck::cast_slice(&vertices);
+        let ib: &[u8] = bytemuck::cast_slice(&indices);
+        let (v_off, i_off) = (
+            u64::from(static_vertices) * std::mem::size_of::<crate::gpu_types::GpuVertex>() as u64,
+            u64::from(static_indices) * 4,
+        );
+        if self.vertices.reserve(device, v_off + vb.len() as u64)
+            || self.indices.reserve(device, i_off + ib.len() as u64)
+        {
+            // A grown buffer lost the static part: upload it again.
+            self.scene = None;
+            return self.upload(scene, frame);
+        }
+        self.vertices.write(queue, v_off, vb);
+        self.indices.write(queue, i_off, ib);
+        upload_bytes += (vb.len() + ib.len()) as u64;
+
+        let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
+        let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
+        rebind |= self.lights.reserve(device, lb.len() as u64);
+        self.lights.write(queue, 0, lb);
+        if rebind {
+            self.scene_bind_group = Self::bind_scene(
+                device,
+                &self.scene_layout,
+                &self.uniforms,
+                &self.lights,
+                &self.materials,
+                self.counters.buffer(),
+            );
+        }
         let view = state.camera.view();
         let proj = state.camera.proj(width as f32 / height as f32);
         let view_proj = proj * view;
@@ -304,200 +404,243 @@ impl<'c> Renderer<'c> {
             near: state.camera.near,
             far: state.camera.far,
         };
-        let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
-        let materials = scene.materials_gpu();
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        upload_bytes += (lb.len() + std::mem::size_of::<FrameUniforms>()) as u64;
+        Ok(Uploaded {
+            setup: ViewSetup::new(&state.camera, width, height),
+            index_count: static_indices + indices.len() as u32,
+            state,
+            upload_bytes,
+        })
+    }
 
-        self.prepare_technique(pipeline_id)?;
+    /// Step 2: record the frame (pipeline, tonemap, `analysis` readback copies when given,
+    /// the frame counters) and submit it once. Returns what the frame cost and its submission.
+    fn encode_frame(
+        &mut self,
+        info: &'static pipelines::PipelineInfo,
+        up: &Uploaded,
+        analysis: bool,
+    ) -> Result<(u64, FrameIo, wgpu::SubmissionIndex)> {
         let device = &self.ctx.device;
         let queue = &self.ctx.queue;
-        let mut rebind = self
-            .lights
-            .upload(device, queue, bytemuck::cast_slice(&gpu_lights));
-        rebind |= self
-            .materials
-            .upload(device, queue, bytemuck::cast_slice(&materials));
-        if rebind {
-            self.scene_bind_group = Self::bind_scene(
-                device,
-                &self.scene_layout,
-                &self.uniforms,
-                &self.lights,
-                &self.materials,
-            );
-        }
-        self.vertices
-            .upload(device, queue, bytemuck::cast_slice(&vertices));
-        self.indices
-            .upload(device, queue, bytemuck::cast_slice(&indices));
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-
-        let info = pipelines::find(pipeline_id)?;
-        let budget = self.ctx.loop_budget();
-        if let Some(budget) = budget {
-            let lights = state.lights.len() as u64;
-            if info.light_loop == pipelines::LightLoop::AllLights && lights > budget {
-                return Err(Error::loop_budget(info.id, lights, budget));
-            }
-        }
-        let setup = ViewSetup::new(&state.camera, width, height);
-        let technique = self.techniques.get_mut(info.id).expect("prepared above");
+        let technique = self.techniques.get_mut(info.id).expect("prepared");
         self.timer.reset();
-        let start = Instant::now();
         let inputs = FrameInputs {
             device,
             queue,
             scene_bind_group: &self.scene_bind_group,
+            counters: self.counters.buffer(),
             vertices: &self.vertices.buffer,
             indices: &self.indices.buffer,
-            index_count: indices.len() as u32,
+            index_count: up.index_count,
             targets: &self.targets,
-            setup,
-            lights: &state.lights,
+            setup: up.setup,
+            lights: &up.state.lights,
             count_blend: self.ctx.count_blend,
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
-        let pipeline_grid = technique.render(&inputs, &mut enc)?;
-        let mut encoder = enc.finish();
-        self.tonemap.encode(
-            device,
-            &mut encoder,
-            &mut self.timer,
-            &self.targets.hdr,
-            &self.targets.ldr,
-        );
-        self.readback.encode(
-            &mut encoder,
-            &self.targets.ldr_texture,
-            wgpu::TextureAspect::All,
-        );
-        self.counts_readback.encode(
-            &mut encoder,
-            &self.targets.counts_texture,
-            wgpu::TextureAspect::All,
-        );
-        self.depth_readback.encode(
-            &mut encoder,
-            &self.targets.depth_texture,
-            wgpu::TextureAspect::DepthOnly,
-        );
-        self.timer.resolve(&mut encoder);
-        scoped(device, &format!("rendering with {}", info.id), || {
-            queue.submit([encoder.finish()])
-        })?;
-        wait_idle(device)?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let (passes, span) = self.timer.read(device)?;
-        let image =
-            RgbaImage::from_raw(width, height, self.readback.read(device)?).expect("size matches");
-        let depth: Vec<f32> = self.depth_readback.read_f32(device)?;
-        let lighting_computations = if self.ctx.count_blend {
-            let counts: Vec<f32> = self.counts_readback.read_f32(device)?;
-            Some(counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64)
-        } else {
-            None
+        self.counters.clear(enc.parts().0);
+        if let Err(e) = technique.encode(&inputs, &mut enc) {
+            return Err(e);
+        }
+        let (encoder, timer) = enc.parts();
+        self.tonemap
+            .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
+        if analysis {
+            self.readbacks.encode(encoder, &self.targets);
+        }
+        self.serial += 1;
+        let tag = FrameTag {
+            serial: self.serial,
+            pipeline: info.id,
+            pass_labels: timer.labels().to_vec(),
         };
-
-        // The ideal: for each visible sample, the lights reaching it. The depth-bounded CPU
-        // grid narrows the search (it provably contains every such light).
-        let view_distance: Vec<f32> = depth
-            .iter()
-            .map(|&d| {
-                if d < 1.0 {
-                    setup.view_distance(d)
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
-        let bounds = cell_bounds_cpu(&setup, &self.dims, &depth);
-        let bounded = assign_cpu(
-            &setup,
-            &self.dims,
-            &state.lights,
-            DepthRange::Cells(&bounds),
-        );
-        let ideal = ideal_lighting_computations(&setup, &bounded, &state.lights, &view_distance);
-        if let Some(budget) =
-            budget.filter(|_| info.light_loop == pipelines::LightLoop::TileBatches)
-        {
-            // The kernel loops over its tile's list plus a few iterations per batch. Its own
-            // list comes from a slightly looser test than the depth-bounded CPU grid's, so the
-            // estimate keeps a 10% margin below the budget.
-            let batches = (state.lights.len() as u64).div_ceil(u64::from(TILE_LIGHT_BATCH));
-            let estimate = u64::from(bounded.max_lights_per_cell()) + 6 * batches;
-            if estimate > budget * 9 / 10 {
-                return Err(Error::loop_budget(info.id, estimate, budget));
+        let timer: &PassTimer = timer;
+        // `timer` and `encoder` borrow `enc`; the copy needs both.
+        self.counters.encode_copy(device, encoder, timer, tag);
+        match enc.submit(&format!("rendering with {}", info.id)) {
+            Ok((io, index)) => {
+                self.counters.after_submit();
+                Ok((self.serial, io, index))
+            }
+            Err(e) => {
+                self.counters.abandon();
+                Err(e)
             }
         }
-        let (gpu_ms, timing) = match span {
-            Some(ms) => (ms, TimingSource::GpuTimestamps),
-            None => (wall_ms, TimingSource::WallClock),
-        };
-        let grid_is_pipelines = pipeline_grid.is_some();
-        let assign_gpu_ms = passes
-            .iter()
-            .filter(|p| p.label.starts_with("assign:"))
-            .map(|p| p.ms)
-            .reduce(|a, b| a + b);
-        let (grid, cell_bounds, assign, assign_cpu_ms, assign_ms, assign_reruns) =
-            match pipeline_grid {
-                Some(b) => (
-                    b.grid,
-                    Some(b.cell_bounds),
-                    Some(b.assign.name().to_string()),
-                    Some(b.cpu_ms),
-                    Some(b.wall_ms),
-                    Some(b.reruns),
+    }
+
+    /// Hand a finished frame's counters to the technique that rendered it (its grid builder
+    /// sizes its lists from them) and turn them into a report.
+    fn observe(&mut self, r: &FrameReadback) -> Result<FinishedFrame> {
+        if let Some(builder) = self
+            .techniques
+            .get_mut(r.tag.pipeline)
+            .and_then(|t| t.grid_builder())
+        {
+            builder.observe(&self.ctx.device, &r.values)?;
+        }
+        let write_overflow = r.values.write_overflow();
+        if write_overflow > 0 {
+            return Err(Error::Gpu {
+                stage: r.tag.pipeline.into(),
+                message: format!(
+                    "{write_overflow} light indices did not fit the counted lists (count and write passes disagree)"
                 ),
-                None => (bounded, None, None, None, None, None),
-            };
-        let occupied = cell_bounds
-            .as_ref()
-            .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
-        let memory = frame_memory(
-            (info.memory)(&self.settings),
-            (width, height),
-            lighting_computations,
-            grid_is_pipelines.then_some(&grid),
-        );
-        Ok(FrameOutput {
-            image,
-            stats: FrameStats {
-                scene: scene.name.clone(),
-                pipeline: info.id.to_string(),
-                adapter: self.ctx.adapter_label(),
-                width,
-                height,
-                frame,
-                lights: state.lights.len() as u32,
-                triangles: (indices.len() / 3) as u32,
-                gpu_ms,
-                timing,
-                wall_ms,
-                passes,
-                tile_size: self.settings.tile_size,
-                gbuffer_bits: self.settings.gbuffer.bits(),
-                lighting_computations,
-                ideal_lighting_computations: ideal,
-                efficiency: lighting_computations
-                    .filter(|&n| n > 0)
-                    .map(|n| ideal as f64 / n as f64),
-                lights_per_tile_avg: grid_is_pipelines.then(|| grid.average_lights_per_cell()),
-                lights_per_tile_max: grid_is_pipelines.then(|| grid.max_lights_per_cell()),
-                grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
-                grid_cells: grid_is_pipelines.then_some(grid.cells.len() as u64),
-                grid_cells_occupied: occupied,
-                assign,
-                assign_gpu_ms: assign_gpu_ms.filter(|_| grid_is_pipelines),
-                assign_cpu_ms,
-                assign_ms,
-                assign_reruns,
-                memory,
-            },
-            grid,
-            grid_is_pipelines,
-            cell_bounds,
-            depth,
+            });
+        }
+        let (passes, gpu_ms) = self.timer.timings(&r.tag.pass_labels, &r.ticks);
+        Ok(FinishedFrame {
+            serial: r.tag.serial,
+            pipeline: r.tag.pipeline,
+            gpu_ms,
+            passes,
+            truncated_loops: r.values.truncated_loops(),
+            overflowed: r.values.overflowed(),
         })
+    }
+
+    /// Collect the frames the GPU has finished, without waiting.
+    fn collect(&mut self, wait: bool) -> Result<()> {
+        let device = &self.ctx.device;
+        let done = if wait {
+            self.counters.wait(device)?
+        } else {
+            self.counters.poll(device)?
+        };
+        for r in &done {
+            let f = self.observe(r)?;
+            self.finished.push(f);
+        }
+        Ok(())
+    }
+
+    /// Real time: render `frame` of `scene` with `pipeline_id` and return once it is
+    /// submitted, without waiting for it (nor for anything of this frame). Frames finished
+    /// meanwhile are collected for [`Renderer::poll_finished`]; with more than
+    /// [`MAX_FRAMES_IN_FLIGHT`] in flight this waits for the oldest first.
+    pub fn render_frame(
+        &mut self,
+        scene: &Scene,
+        frame: u32,
+        pipeline_id: &str,
+    ) -> Result<SubmittedFrame> {
+        let info = pipelines::find(pipeline_id)?;
+        self.prepare_technique(info)?;
+        let mut throttle_ms = 0.0;
+        if self.in_flight.len() >= MAX_FRAMES_IN_FLIGHT {
+            let oldest = self.in_flight.pop_front().expect("non-empty");
+            let start = Instant::now();
+            self.ctx
+                .device
+                .poll(wgpu::PollType::Wait {
+                    submission_index: Some(oldest),
+                    timeout: None,
+                })
+                .map_err(|e| Error::Gpu {
+                    stage: "waiting for an older frame".into(),
+                    message: e.to_string(),
+                })?;
+            throttle_ms = start.elapsed().as_secs_f64() * 1e3;
+        }
+        self.collect(false)?;
+        let up = self.upload(scene, frame)?;
+        let (serial, io, index) = self.encode_frame(info, &up, false)?;
+        self.in_flight.push_back(index);
+        while self.in_flight.len() > MAX_FRAMES_IN_FLIGHT {
+            self.in_flight.pop_front();
+        }
+        Ok(SubmittedFrame {
+            serial,
+            io,
+            throttle_ms,
+            upload_bytes: up.upload_bytes,
+        })
+    }
+
+    /// The real-time frames finished since the last call, oldest first (no waiting).
+    pub fn poll_finished(&mut self) -> Result<Vec<FinishedFrame>> {
+        self.collect(false)?;
+        Ok(std::mem::take(&mut self.finished))
+    }
+
+    /// Wait for every frame in flight and return the reports not collected yet.
+    pub fn finish(&mut self) -> Result<Vec<FinishedFrame>> {
+        self.collect(true)?;
+        self.in_flight.clear();
+        Ok(std::mem::take(&mut self.finished))
+    }
+
+    /// Analysis: render `frame` of `scene` with `pipeline_id`, wait for it, read back image,
+    /// depth and counts, download the grid and compute the ideal count ([`FrameOutput`]).
+    /// A frame whose lists did not fit is rerun after growing them (`assign_reruns`); a frame
+    /// with truncated shader loops is an error ([`Error::TruncatedLoops`]).
+    pub fn render(&mut self, scene: &Scene, frame: u32, pipeline_id: &str) -> Result<FrameOutput> {
+        let info = pipelines::find(pipeline_id)?;
+        self.prepare_technique(info)?;
+        // Earlier real-time frames first, so this frame's counters are its own.
+        self.finish()?;
+        let mut reruns = 0u32;
+        loop {
+            let up = self.upload(scene, frame)?;
+            let start = Instant::now();
+            let (serial, io, _) = self.encode_frame(info, &up, true)?;
+            let done = self.counters.wait(&self.ctx.device)?;
+            let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+            let readback = done
+                .into_iter()
+                .find(|r| r.tag.serial == serial)
+                .ok_or_else(|| Error::Gpu {
+                    stage: "frame counters".into(),
+                    message: "the frame's counters did not come back".into(),
+                })?;
+            let finished = self.observe(&readback)?;
+            if finished.truncated_loops > 0 {
+                return Err(Error::TruncatedLoops {
+                    pipeline: info.id.to_string(),
+                    count: finished.truncated_loops,
+                });
+            }
+            if finished.overflowed {
+                reruns += 1;
+                if reruns > 2 {
+                    return Err(Error::Overflow {
+                        pipeline: info.id.to_string(),
+                        reason: "the light lists still did not fit after growing them twice".into(),
+                    });
+                }
+                continue;
+            }
+            let grid = match self
+                .techniques
+                .get_mut(info.id)
+                .and_then(|t| t.grid_builder())
+            {
+                Some(b) => Some(b.download(&self.ctx.device, &self.ctx.queue, &readback.values)?),
+                None => None,
+            };
+            return analysis::analyze(analysis::AnalysisInput {
+                renderer: self,
+                scene,
+                info,
+                up_state: &up.state,
+                setup: up.setup,
+                triangles: up.index_count / 3,
+                finished,
+                grid,
+                io,
+                reruns,
+                wall_ms,
+            });
+        }
+    }
+
+    pub(crate) fn readbacks(&self) -> &AnalysisReadbacks {
+        &self.readbacks
+    }
+
+    pub(crate) fn dims(&self) -> GridDims {
+        self.dims
     }
 }

@@ -8,9 +8,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TimingSource {
-    /// Timestamp queries at pass boundaries: first pass start to last pass end.
+    /// Timestamp queries at pass boundaries: the sum of the frame's pass durations (GPU work
+    /// only; CPU waits between submissions are not in it).
     GpuTimestamps,
-    /// No timestamp queries: wall time from submit until the device is idle.
+    /// No timestamp queries: wall time from the first submission until the device is idle
+    /// (CPU waits included).
     WallClock,
 }
 
@@ -38,8 +40,23 @@ pub struct FrameStats {
     /// GPU time of the frame in milliseconds (see `timing`).
     pub gpu_ms: f64,
     pub timing: TimingSource,
-    /// Wall time from submit until the device was idle, including readback.
+    /// Wall time from the frame's first submission until the device was idle (analysis
+    /// copies included).
     pub wall_ms: f64,
+    /// CPU time the frame itself waited for the GPU (the `cpu` strategy's read-back of the
+    /// cell bounds; 0 for a frame in one submission). The analysis wait is not in it.
+    #[serde(default)]
+    pub cpu_wait_ms: f64,
+    /// Queue submissions the frame made (1, or 2 for `cpu` with depth bounds).
+    #[serde(default)]
+    pub submits: u32,
+    /// Bytes the frame itself read back with a wait (analysis readbacks not counted).
+    #[serde(default)]
+    pub readback_bytes: u64,
+    /// Shader loops that ended before their bound (llvmpipe's loop guard). An analysis run
+    /// refuses a frame where this is non-zero, so a written file always says 0.
+    #[serde(default)]
+    pub truncated_loops: u32,
     /// GPU time per pass, when timestamps are available.
     pub passes: Vec<PassTiming>,
     /// Screen tile edge in pixels used by grid pipelines (and for the ideal count's grid).
@@ -77,14 +94,12 @@ pub struct FrameStats {
     /// CPU time of the assignment: `assign_cpu` for `cpu`, the hierarchy build for `bvh`.
     #[serde(default)]
     pub assign_cpu_ms: Option<f64>,
-    /// Wall time of the whole assignment strategy, from the cell bounds being ready on the
-    /// GPU to the grid being ready on the GPU (GPU passes, CPU work and the syncs between
-    /// them). On lavapipe the timestamps of some compute passes come out far too small, so
-    /// this is the figure to compare strategies by there.
+    /// The whole assignment strategy's cost: `assign_gpu_ms` + `assign_cpu_ms` + the CPU
+    /// waits of the frame (the `cpu` strategy's read-back of the cell bounds).
     #[serde(default)]
     pub assign_ms: Option<f64>,
-    /// Times the gather or BVH pass ran again this frame because the index list, sized from
-    /// earlier frames, was too small (grown to the needed size first: nothing is dropped).
+    /// Times the analysis frame was rendered again because a light list, sized from earlier
+    /// frames, was too small (grown to the needed size first: nothing is dropped).
     #[serde(default)]
     pub assign_reruns: Option<u32>,
     /// Render targets, grid size and the traffic models (`memory.rs`).

@@ -2,8 +2,9 @@
 //! (no GPU needed), and every shader starts with the constants prelude.
 
 use lightgrid::consts::WGSL_CONSTS;
+use lightgrid::pipelines::all_shaders;
 use lightgrid::pipelines::PIPELINES;
-use lightgrid::shader::{all_shaders, validate};
+use lightgrid::shader::validate;
 
 #[test]
 fn every_composed_shader_validates() {

@@ -5,26 +5,20 @@
 // range of the global index list with one atomicAdd on a cursor and copies the list there.
 // A cell with more than CELL_LIST_CAPACITY lights keeps its reservation and is queued for the
 // spill pass, which writes its whole list straight to global memory. A reservation past the
-// end of the index buffer is counted (the CPU grows the buffer to the cursor and reruns).
+// end of the index buffer is counted; the CPU, reading the frame counters back (without
+// waiting, a frame later), grows the buffer to the cursor and reports the frame as one whose
+// lists did not fit (an analysis run grows and reruns it at once). The counters are group 0's
+// `frame_counters` (slots COUNTER_* from consts.rs).
 
 @group(1) @binding(0) var<uniform> grid: GridParams;
 @group(1) @binding(1) var<storage, read> cell_bounds: array<vec2<f32>>;
 @group(1) @binding(2) var<storage, read_write> cells: array<vec2<u32>>;   // (offset, count)
 @group(1) @binding(3) var<storage, read_write> indices: array<u32>;
-// [0] cursor: index entries reserved (= needed); [1] entries that did not fit the buffer;
-// [2] cells queued for the spill pass; [3] hits beyond a counted length (spill pass, scatter's
-// write pass; must stay 0); [4..7] the spill pass's indirect dispatch arguments.
-@group(1) @binding(4) var<storage, read_write> counters: array<atomic<u32>, 8>;
-@group(1) @binding(5) var<storage, read_write> spill_cells: array<u32>;
+@group(1) @binding(4) var<storage, read_write> spill_cells: array<u32>;
 // The cells holding samples and their number (cell_bounds.wgsl); per-cell kernels are
 // dispatched indirectly, one workgroup per entry.
-@group(1) @binding(6) var<storage, read> occupied_cells: array<u32>;
-@group(1) @binding(7) var<storage, read> occupancy: array<u32, 4>;
-
-const CURSOR: u32 = 0u;
-const OUT_OF_ROOM: u32 = 1u;
-const SPILLS: u32 = 2u;
-const WRITE_OVERFLOW: u32 = 3u;
+@group(1) @binding(5) var<storage, read> occupied_cells: array<u32>;
+@group(1) @binding(6) var<storage, read> occupancy: array<u32, 4>;
 
 // The cell a per-cell workgroup works on, or NO_CELL for a workgroup past the end of its list
 // (the dispatch is rounded up to whole rows). `spill`: the spill pass's list.
@@ -32,7 +26,7 @@ const NO_CELL: u32 = 0xffffffffu;
 fn cell_of_group(wg: vec3<u32>, nwg: vec3<u32>, spill: bool) -> u32 {
     let i = wg.y * nwg.x + wg.x;
     if (spill) {
-        if (i >= atomicLoad(&counters[SPILLS])) {
+        if (i >= atomicLoad(&frame_counters[COUNTER_SPILLS])) {
             return NO_CELL;
         }
         return spill_cells[i];
@@ -77,7 +71,7 @@ fn record_hit(c: u32, light: u32, spill: bool) {
     } else if (slot < cells[c].y) {
         indices[cells[c].x + slot] = light;
     } else {
-        atomicAdd(&counters[WRITE_OVERFLOW], 1u);
+        atomicAdd(&frame_counters[COUNTER_WRITE_OVERFLOW], 1u);
     }
 }
 
@@ -89,33 +83,35 @@ fn end_cell(c: u32, li: u32, spill: bool) {
     let n = atomicLoad(&cell_hits);
     let flush = !spill && c != NO_CELL;
     if (flush && li == 0u) {
-        let base = atomicAdd(&counters[CURSOR], n);
+        let base = atomicAdd(&frame_counters[COUNTER_INDEX_NEEDED], n);
         if (base + n > arrayLength(&indices)) {
-            atomicAdd(&counters[OUT_OF_ROOM], n);
+            atomicAdd(&frame_counters[COUNTER_INDEX_OUT_OF_ROOM], n);
             cell_base = NO_CELL;
         } else {
             cell_base = base;
             cells[c] = vec2<u32>(base, n);
             if (n > CELL_LIST_CAPACITY) {
-                spill_cells[atomicAdd(&counters[SPILLS], 1u)] = c;
+                spill_cells[atomicAdd(&frame_counters[COUNTER_SPILLS], 1u)] = c;
             }
         }
     }
     workgroupBarrier();
     let base = cell_base;
     if (flush && base != NO_CELL && n <= CELL_LIST_CAPACITY) {
-        for (var i = li; i < n; i = i + WORKGROUP_SIZE) {
+        var i = li;
+        for (; i < n; i = i + WORKGROUP_SIZE) {
             indices[base + i] = cell_list[i];
         }
+        check_loop(i, n);
     }
 }
 
 // One invocation: the spill pass's indirect dispatch arguments (x at most 65535).
 @compute @workgroup_size(1)
 fn spill_args_main() {
-    let n = atomicLoad(&counters[SPILLS]);
+    let n = atomicLoad(&frame_counters[COUNTER_SPILLS]);
     let x = min(max(n, 1u), 65535u);
-    atomicStore(&counters[4], x);
-    atomicStore(&counters[5], (n + x - 1u) / x);
-    atomicStore(&counters[6], 1u);
+    atomicStore(&frame_counters[COUNTER_SPILL_ARGS], x);
+    atomicStore(&frame_counters[COUNTER_SPILL_ARGS + 1u], (n + x - 1u) / x);
+    atomicStore(&frame_counters[COUNTER_SPILL_ARGS + 2u], 1u);
 }

@@ -11,10 +11,15 @@
 //!
 //! The brute-force oracle in `oracle.rs` checks that nothing is ever missed.
 
-use super::{GridDims, LightGrid, ViewLight, ViewSetup};
+use super::gpu_assign::check_index_capacity;
+use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
+use super::{CellSource, GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
+use crate::error::Result;
+use crate::frame::FrameEncoder;
 use crate::scene::PointLight;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Pixels covered by a projected light: inclusive pixel index ranges, clipped to the frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -201,5 +206,41 @@ pub fn assign_cpu(
         dims: *dims,
         cells,
         indices,
+    }
+}
+
+/// `--assign cpu`: the papers' CPU pipeline (tiled-shading §6.3: a CPU-built grid "cannot be
+/// completely pipelined"). With depth bounds the frame is submitted part-way and the bounds
+/// are read back (the one wait a real-time frame makes); without them (`tiled_forward`) the
+/// grid needs nothing from the GPU. The grid is uploaded before the rest of the frame.
+struct CpuStrategy;
+
+pub(super) fn create_strategy(_: &StrategyContext) -> Box<dyn AssignStrategy> {
+    Box::new(CpuStrategy)
+}
+
+impl AssignStrategy for CpuStrategy {
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
+        let cell_bounds: Option<Vec<[f32; 2]>> = match a.source {
+            CellSource::NearFar => None,
+            CellSource::Depth => {
+                let bytes = enc.download(a.bounds.buffer(), (a.dims.cell_count() * 8) as u64)?;
+                Some(bytemuck::pod_collect_to_vec(&bytes))
+            }
+        };
+        let start = Instant::now();
+        let range = match &cell_bounds {
+            None => DepthRange::NearFar,
+            Some(b) => DepthRange::Cells(b),
+        };
+        let grid = assign_cpu(&a.f.setup, a.dims, a.f.lights, range);
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        check_index_capacity(a.f.device, grid.indices.len() as u64, "cpu")?;
+        a.grid.upload(a.f.device, a.f.queue, &grid);
+        Ok(StrategyRun {
+            cpu_ms,
+            cpu_grid: Some(grid),
+            cell_bounds,
+        })
     }
 }

@@ -1,28 +1,21 @@
 //! [`GridBuilder`]: how every grid-reading pipeline gets its light grid. One frame:
 //! 1. the cell bounds (`cell_bounds.rs`): from the depth buffer on the GPU, or `[near, far]`
 //!    for a pipeline without a depth pre-pass;
-//! 2. light assignment by the strategy `--assign` names (resolved per frame for `auto`):
-//!    - `cpu`: bounds read back, [`assign_cpu`], grid uploaded;
-//!    - `gather`: one workgroup per cell tests every light (`gpu_assign.rs`);
-//!    - `scatter`: one invocation per light emits (cell, light) pairs, radix sort by cell
-//!      (`scatter.rs`);
-//!    - `bvh`: the light hierarchy built on the CPU (`bvh.rs`), one workgroup per cell walks it;
-//!    - `bvh-gpu`: the same hierarchy built on the GPU (`bvh_gpu.rs`), walked the same way;
-//! 3. the grid is left in [`GridBuffers`] (group 1 of the shading pass) and read back for
-//!    statistics and tests.
+//! 2. light assignment by the strategy `--assign` names (resolved per frame for `auto`), one
+//!    [`AssignStrategy`] per registry row in `strategy.rs`: `cpu` (`assign_cpu.rs`, reads the
+//!    bounds back: the papers' CPU pipeline), `gather` (`gather.rs`), `scatter` (`scatter.rs`),
+//!    `bvh` (`bvh.rs`), `bvh-gpu` (`bvh_gpu.rs`); the GPU ones record into the frame's one
+//!    submission;
+//! 3. the grid is left in [`GridBuffers`] (group 1 of the shading pass). Analysis downloads it
+//!    ([`GridBuilder::download`]); rendering alone never does.
 
-use super::bvh::{build_bvh, BvhBuffers};
-use super::bvh_gpu::GpuBvhBuild;
 use super::cell_bounds::CellBoundsPass;
-use super::gpu_assign::{
-    bvh_shader, gather_shader, read_grid, AssignCommon, AssignFrame, CellKernels, CellRun,
-};
-use super::scatter::ScatterPass;
-use super::{assign_cpu, DepthRange, GridBuffers, GridDims, LightGrid};
-use crate::error::Result;
-use crate::gpu::bind_resources;
-use crate::pipelines::{FrameEncoder, FrameInputs};
-use std::time::Instant;
+use super::gpu_assign::read_grid;
+use super::strategy::{find_strategy, AssignFrame, AssignStrategy, StrategyContext};
+use super::{GridBuffers, GridDims, LightGrid};
+use crate::error::{Error, Result};
+use crate::frame::{FrameEncoder, FrameInputs, PipelineContext};
+use crate::gpu::CounterValues;
 
 /// Who builds the light grid (`--assign`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -106,7 +99,7 @@ pub enum CellSource {
     Depth,
 }
 
-/// A built grid and what went into it.
+/// A built grid and what went into it (analysis).
 pub struct BuiltGrid {
     pub grid: LightGrid,
     /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
@@ -115,13 +108,17 @@ pub struct BuiltGrid {
     pub assign: Assign,
     /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
     pub cpu_ms: f64,
-    /// Wall time from the cell bounds being ready on the GPU to the grid being ready on the
-    /// GPU: the whole strategy, GPU passes, CPU work and the syncs between them, but not
-    /// the statistics readback.
-    pub wall_ms: f64,
-    /// Times a per-cell GPU strategy reran because the index buffer, sized from earlier
-    /// frames, was too small (it is grown to fit first; nothing is dropped).
-    pub reruns: u32,
+}
+
+/// What the last recorded frame's assignment was.
+struct LastFrame {
+    dims: GridDims,
+    assign: Assign,
+    cpu_ms: f64,
+    cpu_grid: Option<LightGrid>,
+    cell_bounds: Option<Vec<[f32; 2]>>,
+    /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
+    near_far: [f32; 2],
 }
 
 pub struct GridBuilder {
@@ -130,28 +127,18 @@ pub struct GridBuilder {
     source: CellSource,
     assign: Assign,
     software_adapter: bool,
-    loop_budget: Option<u64>,
-    pipeline: &'static str,
     scene_layout: wgpu::BindGroupLayout,
     bounds: CellBoundsPass,
     buffers: GridBuffers,
-    common: Option<AssignCommon>,
-    gather: Option<CellKernels>,
-    bvh: Option<(CellKernels, BvhBuffers)>,
-    bvh_gpu: Option<GpuBvhBuild>,
-    scatter: Option<ScatterPass>,
+    /// Strategies created so far (on first use).
+    strategies: Vec<(Assign, Box<dyn AssignStrategy>)>,
+    last: Option<LastFrame>,
 }
 
 impl GridBuilder {
     /// `slices` 1 builds a tiled grid, more a clustered one (slices between the camera's near
     /// and far planes each frame).
-    /// `pipeline`: the id named in errors.
-    pub fn new(
-        ctx: &crate::pipelines::PipelineContext,
-        pipeline: &'static str,
-        slices: u32,
-        source: CellSource,
-    ) -> Self {
+    pub fn new(ctx: &PipelineContext, slices: u32, source: CellSource) -> Self {
         let (device, scene_layout) = (ctx.device, ctx.scene_layout);
         GridBuilder {
             tiles: ctx.dims,
@@ -159,16 +146,11 @@ impl GridBuilder {
             source,
             assign: ctx.settings.assign,
             software_adapter: ctx.software_adapter,
-            loop_budget: ctx.loop_budget,
-            pipeline,
             scene_layout: scene_layout.clone(),
             bounds: CellBoundsPass::new(device, scene_layout),
             buffers: GridBuffers::new(device),
-            common: None,
-            gather: None,
-            bvh: None,
-            bvh_gpu: None,
-            scatter: None,
+            strategies: Vec::new(),
+            last: None,
         }
     }
 
@@ -181,30 +163,39 @@ impl GridBuilder {
         self.buffers.bind_group()
     }
 
-    /// Refuse to shade when a cell's list is longer than the adapter lets one sample loop.
-    fn check_loop_budget(&self, grid: &LightGrid) -> Result<()> {
-        let longest = u64::from(grid.max_lights_per_cell());
-        match self.loop_budget {
-            Some(budget) if longest > budget => {
-                Err(crate::Error::loop_budget(self.pipeline, longest, budget))
+    fn strategy(
+        &mut self,
+        device: &wgpu::Device,
+        assign: Assign,
+    ) -> Result<&mut dyn AssignStrategy> {
+        let i = match self.strategies.iter().position(|(a, _)| *a == assign) {
+            Some(i) => i,
+            None => {
+                let info = find_strategy(assign).ok_or_else(|| {
+                    Error::invalid(
+                        "--assign",
+                        format!("no strategy registered for {}", assign.name()),
+                    )
+                })?;
+                let ctx = StrategyContext {
+                    device,
+                    scene_layout: &self.scene_layout,
+                };
+                let created = crate::gpu::scoped(
+                    device,
+                    &format!("creating the {} strategy", assign.name()),
+                    || (info.create)(&ctx),
+                )?;
+                self.strategies.push((assign, created));
+                self.strategies.len() - 1
             }
-            _ => Ok(()),
-        }
+        };
+        Ok(self.strategies[i].1.as_mut())
     }
 
-    /// The cell bounds this frame's assignment read: `[near, far]` everywhere, or those the
-    /// GPU computed (downloaded; call after the frame's work is submitted).
-    fn cell_bounds(&self, f: &FrameInputs, dims: &GridDims) -> Result<Vec<[f32; 2]>> {
-        match self.source {
-            CellSource::NearFar => Ok(vec![[f.setup.near, f.setup.far]; dims.cell_count()]),
-            CellSource::Depth => self.bounds.read(f.device, f.queue),
-        }
-    }
-
-    /// Build this frame's grid. With `CellSource::Depth`, `f.targets.depth` must hold the
+    /// Record this frame's grid. With `CellSource::Depth`, `f.targets.depth` must hold the
     /// frame's depth in what `enc` has recorded so far.
-    pub fn build(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<BuiltGrid> {
-        let (device, queue) = (f.device, f.queue);
+    pub fn build(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let dims = if self.slices > 1 {
             self.tiles
                 .clustered(self.slices, f.setup.near, f.setup.far)?
@@ -215,128 +206,93 @@ impl GridBuilder {
             CellSource::Depth => self.bounds.encode(f, enc, &dims),
             CellSource::NearFar => {
                 self.bounds
-                    .fill(device, queue, &dims, [f.setup.near, f.setup.far])
+                    .fill(f.device, f.queue, &dims, [f.setup.near, f.setup.far])
             }
         }
         let assign = self.assign.resolve(f.lights.len(), self.software_adapter);
-        // Everything before assignment (the depth, the bounds) finishes outside the clock.
-        enc.submit_and_wait()?;
-        let wall = Instant::now();
-        let mut cpu_ms = 0.0;
-        let light_count = f.lights.len() as u32;
-        let run = match assign {
-            Assign::Cpu | Assign::Auto => {
-                let bounds = self.cell_bounds(f, &dims)?;
-                let start = Instant::now();
-                let range = match self.source {
-                    CellSource::NearFar => DepthRange::NearFar,
-                    CellSource::Depth => DepthRange::Cells(&bounds),
-                };
-                let grid = assign_cpu(&f.setup, &dims, f.lights, range);
-                cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-                self.check_loop_budget(&grid)?;
-                self.buffers.upload(device, queue, &grid);
-                enc.submit_and_wait()?;
-                return Ok(BuiltGrid {
-                    grid,
-                    cell_bounds: bounds,
-                    assign,
-                    cpu_ms,
-                    wall_ms: wall.elapsed().as_secs_f64() * 1e3,
-                    reruns: 0,
-                });
-            }
-            Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
-                let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
-                let scene_layout = &self.scene_layout;
-                let (kernels, extra) = match assign {
-                    Assign::Gather => {
-                        let kernels = self.gather.get_or_insert_with(|| {
-                            CellKernels::new(
-                                device,
-                                "gather",
-                                &gather_shader(),
-                                &[Some(scene_layout), Some(&common.layout)],
-                            )
-                        });
-                        (&*kernels, None)
-                    }
-                    _ => {
-                        let (kernels, buffers) = self.bvh.get_or_insert_with(|| {
-                            let buffers = BvhBuffers::new(device);
-                            let kernels = CellKernels::new(
-                                device,
-                                "bvh",
-                                &bvh_shader(),
-                                &[
-                                    Some(scene_layout),
-                                    Some(&common.layout),
-                                    Some(&buffers.layout),
-                                ],
-                            );
-                            (kernels, buffers)
-                        });
-                        let group = if assign == Assign::Bvh {
-                            let start = Instant::now();
-                            let bvh = build_bvh(&f.setup, f.lights);
-                            cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-                            buffers.upload(device, queue, &bvh)
-                        } else {
-                            let build = self
-                                .bvh_gpu
-                                .get_or_insert_with(|| GpuBvhBuild::new(device, scene_layout));
-                            build.encode(f, enc, &common.scan);
-                            let (nodes, order) = build.buffers();
-                            bind_resources(
-                                device,
-                                "light bvh (gpu build)",
-                                &buffers.layout,
-                                &[nodes.as_entire_binding(), order.as_entire_binding()],
-                            )
-                        };
-                        (&*kernels, Some(group))
-                    }
-                };
-                let frame = AssignFrame {
+        let source = self.source;
+        // Disjoint borrows: the strategy list, the grid buffers and the bounds.
+        self.strategy(f.device, assign)?;
+        let strategy = self
+            .strategies
+            .iter_mut()
+            .find(|(a, _)| *a == assign)
+            .map(|(_, s)| s.as_mut())
+            .expect("created above");
+        let run = strategy.encode(
+            AssignFrame {
+                f,
+                grid: &mut self.buffers,
+                bounds: &self.bounds,
+                dims: &dims,
+                source,
+            },
+            enc,
+        )?;
+        self.last = Some(LastFrame {
+            dims,
+            assign,
+            cpu_ms: run.cpu_ms,
+            cpu_grid: run.cpu_grid,
+            cell_bounds: run.cell_bounds,
+            near_far: [f.setup.near, f.setup.far],
+        });
+        Ok(())
+    }
+
+    /// A finished frame's counters: the strategy that built its grid sizes its lists from
+    /// them.
+    /// Every strategy created sees them (each reads only its own slots), so one that the
+    /// frame did not use only grows harmlessly.
+    pub fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        for (_, s) in &mut self.strategies {
+            s.observe(device, values)?;
+        }
+        Ok(())
+    }
+
+    /// The last recorded frame's grid and cell bounds (analysis; waits for the GPU). `values`
+    /// are that frame's counters.
+    pub fn download(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        values: &CounterValues,
+    ) -> Result<BuiltGrid> {
+        let last = self.last.as_ref().ok_or_else(|| Error::Gpu {
+            stage: "grid download".into(),
+            message: "no frame was recorded".into(),
+        })?;
+        let grid = match &last.cpu_grid {
+            Some(g) => g.clone(),
+            None => {
+                let strategy = self
+                    .strategies
+                    .iter()
+                    .find(|(a, _)| *a == last.assign)
+                    .map(|(_, s)| s)
+                    .expect("the last frame's strategy exists");
+                read_grid(
                     device,
                     queue,
-                    scene: f.scene_bind_group,
-                    common,
-                    grid: &mut self.buffers,
-                    bounds: &self.bounds,
-                    dims: &dims,
-                };
-                kernels.run(frame, enc, &extra.iter().collect::<Vec<_>>())?
-            }
-            Assign::Scatter => {
-                let common = self.common.get_or_insert_with(|| AssignCommon::new(device));
-                let scatter = self
-                    .scatter
-                    .get_or_insert_with(|| ScatterPass::new(device, &self.scene_layout, common));
-                let frame = AssignFrame {
-                    device,
-                    queue,
-                    scene: f.scene_bind_group,
-                    common,
-                    grid: &mut self.buffers,
-                    bounds: &self.bounds,
-                    dims: &dims,
-                };
-                let total = scatter.run(frame, enc, light_count)?;
-                CellRun { total, reruns: 0 }
+                    &self.buffers,
+                    &last.dims,
+                    strategy.grid_entries(values),
+                )?
             }
         };
-        let wall_ms = wall.elapsed().as_secs_f64() * 1e3;
-        let grid = read_grid(device, queue, &self.buffers, &dims, run.total)?;
-        self.check_loop_budget(&grid)?;
-        let cell_bounds = self.cell_bounds(f, &dims)?;
+        let cell_bounds = match (&last.cell_bounds, self.source) {
+            (Some(b), _) => b.clone(),
+            (None, CellSource::NearFar) => {
+                vec![last.near_far; last.dims.cell_count()]
+            }
+            (None, CellSource::Depth) => self.bounds.read(device, queue)?,
+        };
         Ok(BuiltGrid {
             grid,
             cell_bounds,
-            assign,
-            cpu_ms,
-            wall_ms,
-            reruns: run.reruns,
+            assign: last.assign,
+            cpu_ms: last.cpu_ms,
         })
     }
 }

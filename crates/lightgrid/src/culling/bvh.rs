@@ -10,13 +10,19 @@
 //! would keep, and the lists it builds equal gather's.
 
 use super::gather::{cpu_frustum, margin, CpuFrustum};
+use super::gpu_assign::{bvh_shader, CellKernels};
+use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use super::{GridDims, LightGrid, ViewSetup};
 use crate::consts::{ASSIGN_DEPTH_SLACK, BVH_LEAF, BVH_WIDTH};
+use crate::error::Result;
+use crate::frame::FrameEncoder;
+use crate::gpu::CounterValues;
 use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, STORAGE_READ};
 use crate::scene::PointLight;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// One node: 32 bytes, the layout of `BvhNode` in bvh.wgsl.
 #[repr(C)]
@@ -275,5 +281,42 @@ impl BvhBuffers {
                 self.order.as_entire_binding(),
             ],
         )
+    }
+}
+
+/// `--assign bvh`: the hierarchy built on the CPU every frame from the lights alone (no wait
+/// for the GPU), uploaded, and walked by one workgroup per occupied cell (`bvh.wgsl`).
+struct CpuBvhStrategy {
+    kernels: CellKernels,
+    buffers: BvhBuffers,
+}
+
+pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> {
+    let buffers = BvhBuffers::new(ctx.device);
+    Box::new(CpuBvhStrategy {
+        kernels: CellKernels::new(ctx, "bvh", &bvh_shader(), &[&buffers.layout]),
+        buffers,
+    })
+}
+
+impl AssignStrategy for CpuBvhStrategy {
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
+        let start = Instant::now();
+        let bvh = build_bvh(&a.f.setup, a.f.lights);
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        let group = self.buffers.upload(a.f.device, a.f.queue, &bvh);
+        self.kernels.encode(a, enc, &[&group]);
+        Ok(StrategyRun {
+            cpu_ms,
+            ..Default::default()
+        })
+    }
+
+    fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        self.kernels.observe(device, values)
+    }
+
+    fn grid_entries(&self, values: &CounterValues) -> u32 {
+        values.index_needed()
     }
 }

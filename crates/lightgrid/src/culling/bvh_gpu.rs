@@ -3,15 +3,19 @@
 //! layout as the CPU build ([`super::build_bvh`], its twin) and binds as the traversal's
 //! group 2 (`bvh_order` is the sorted value array itself).
 
-use super::bvh::{bvh_levels, BvhNode};
+use super::bvh::{bvh_levels, BvhBuffers, BvhNode};
+use super::gpu_assign::{bvh_shader, CellKernels};
 use super::radix_sort::RadixSort;
 use super::scan::ScanPass;
+use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use crate::consts::ASSIGN_THREADS;
+use crate::error::Result;
+use crate::frame::{FrameEncoder, FrameInputs};
+use crate::gpu::CounterValues;
 use crate::gpu::{
     bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, UniformSlots,
     STORAGE_RW, UNIFORM,
 };
-use crate::pipelines::{FrameEncoder, FrameInputs};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
@@ -166,5 +170,45 @@ impl GpuBvhBuild {
     /// (nodes, order) for the traversal's group 2.
     pub fn buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
         (&self.nodes, &self.sort.vals)
+    }
+}
+
+/// `--assign bvh-gpu`: the hierarchy built on the GPU ([`GpuBvhBuild`]) and walked like
+/// `bvh`'s, all in the frame's one submission.
+struct GpuBvhStrategy {
+    kernels: CellKernels,
+    layout: wgpu::BindGroupLayout,
+    build: GpuBvhBuild,
+}
+
+pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> {
+    let layout = BvhBuffers::new(ctx.device).layout;
+    Box::new(GpuBvhStrategy {
+        kernels: CellKernels::new(ctx, "bvh", &bvh_shader(), &[&layout]),
+        build: GpuBvhBuild::new(ctx.device, ctx.scene_layout),
+        layout,
+    })
+}
+
+impl AssignStrategy for GpuBvhStrategy {
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
+        self.build.encode(a.f, enc, self.kernels.scan());
+        let (nodes, order) = self.build.buffers();
+        let group = bind_resources(
+            a.f.device,
+            "light bvh (gpu build)",
+            &self.layout,
+            &[nodes.as_entire_binding(), order.as_entire_binding()],
+        );
+        self.kernels.encode(a, enc, &[&group]);
+        Ok(StrategyRun::default())
+    }
+
+    fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        self.kernels.observe(device, values)
+    }
+
+    fn grid_entries(&self, values: &CounterValues) -> u32 {
+        values.index_needed()
     }
 }

@@ -11,8 +11,8 @@
 
 use super::{GridDims, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
+use crate::frame::{FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
-use crate::pipelines::{FrameEncoder, FrameInputs};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 use crate::Result;
 

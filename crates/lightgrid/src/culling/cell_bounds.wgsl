@@ -33,8 +33,10 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     workgroupBarrier();
     let size = textureDimensions(depth_tex);
     let origin = wg.xy * grid.tile_size;
-    for (var y = lid.y; y < grid.tile_size; y = y + TILE_THREADS) {
-        for (var x = lid.x; x < grid.tile_size; x = x + TILE_THREADS) {
+    var y = lid.y;
+    for (; y < grid.tile_size; y = y + TILE_THREADS) {
+        var x = lid.x;
+        for (; x < grid.tile_size; x = x + TILE_THREADS) {
             let p = origin + vec2<u32>(x, y);
             if (p.x < size.x && p.y < size.y) {
                 let d = textureLoad(depth_tex, p, 0);
@@ -50,7 +52,9 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
                 }
             }
         }
+        check_loop(x, grid.tile_size);
     }
+    check_loop(y, grid.tile_size);
     workgroupBarrier();
     let tile = wg.y * grid.tiles_x + wg.x;
     let tiles = grid.tiles_x * grid.tiles_y;

@@ -3,8 +3,13 @@
 //! tile's four side planes and its samples' view-distance bounds), computed exactly as
 //! `tile_frustum` / `sphere_in_tile` in `tile_frustum.wgsl`, in the same f32 arithmetic.
 
+use super::gpu_assign::{gather_shader, CellKernels};
+use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use super::{GridDims, LightGrid, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
+use crate::error::Result;
+use crate::frame::FrameEncoder;
+use crate::gpu::CounterValues;
 use crate::scene::PointLight;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -96,4 +101,31 @@ pub fn assign_gather_cpu(
         })
         .collect();
     LightGrid::from_lists(*dims, &lists)
+}
+
+/// `--assign gather` (forward-plus §4): one workgroup per occupied cell tests every light
+/// (`gather.wgsl` on `assign_bindings.wgsl`, run by [`CellKernels`]).
+struct GatherStrategy {
+    kernels: CellKernels,
+}
+
+pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> {
+    Box::new(GatherStrategy {
+        kernels: CellKernels::new(ctx, "gather", &gather_shader(), &[]),
+    })
+}
+
+impl AssignStrategy for GatherStrategy {
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
+        self.kernels.encode(a, enc, &[]);
+        Ok(StrategyRun::default())
+    }
+
+    fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        self.kernels.observe(device, values)
+    }
+
+    fn grid_entries(&self, values: &CounterValues) -> u32 {
+        values.index_needed()
+    }
 }

@@ -10,11 +10,13 @@ fn gather_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, spill: bool) {
     let f = cell_frustum(c);
     begin_cell(li);
     if (f.w_min <= f.w_max) {
-        for (var l = li; l < frame.light_count; l = l + WORKGROUP_SIZE) {
+        var l = li;
+        for (; l < frame.light_count; l = l + WORKGROUP_SIZE) {
             if (light_in_tile(f, lights[l])) {
                 record_hit(c, l, spill);
             }
         }
+        check_loop(l, frame.light_count);
     }
     end_cell(c, li, spill);
 }

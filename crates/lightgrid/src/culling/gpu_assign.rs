@@ -9,17 +9,21 @@
 //! cell's range of the global index list with an atomic cursor and copies the list there.
 //! Cells whose list overflowed (more than CELL_LIST_CAPACITY lights) keep their range and are
 //! finished by a spill pass that writes straight to global memory. The index buffer is sized
-//! from the previous frame's total; ranges that do not fit are counted, and the CPU, which
-//! reads the counters back once per frame, grows the buffer to the needed total and reruns the
-//! pass (reported as `assign_reruns` in the stats): the grid is never missing a light.
+//! from earlier frames' totals (the frame counters, read back without waiting); ranges that
+//! do not fit are counted, the frame is reported as one whose lists did not fit, and the
+//! buffer grows to the needed total for the next frame (an analysis run reruns the frame at
+//! once: `assign_reruns` in the stats). A frame missing a light is never passed off as right.
 
 use super::cell_bounds::CellBoundsPass;
 use super::scan::ScanPass;
+use super::strategy::{AssignFrame, ListCapacity, StrategyContext};
 use super::{GridBuffers, GridDims, LightGrid};
+use crate::consts::COUNTER_SPILL_ARGS;
 use crate::error::{Error, Result};
+use crate::frame::FrameEncoder;
 use crate::gpu::{
-    bind_resources, buffer_layout, download, grow_storage, storage_buffer, STORAGE_READ,
-    STORAGE_RW, UNIFORM,
+    bind_resources, buffer_layout, download, grow_storage, storage_buffer, CounterValues,
+    PassTimer, STORAGE_READ, STORAGE_RW, UNIFORM,
 };
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
@@ -46,32 +50,12 @@ pub(crate) fn bvh_shader() -> ComposedShader {
     cell_shader("bvh traversal", include_str!("bvh.wgsl"))
 }
 
-/// What a GPU strategy works on in one frame: the device, the scene (group 0), the shared
-/// group-1 state, the grid it fills and the cell bounds it reads.
-pub struct AssignFrame<'a> {
-    pub device: &'a wgpu::Device,
-    pub queue: &'a wgpu::Queue,
-    pub scene: &'a wgpu::BindGroup,
-    pub common: &'a mut AssignCommon,
-    pub grid: &'a mut GridBuffers,
-    pub bounds: &'a CellBoundsPass,
-    pub dims: &'a GridDims,
-}
-
-/// Counter slots of `assign_bindings.wgsl`.
-const CURSOR: usize = 0;
-const OUT_OF_ROOM: usize = 1;
-const WRITE_OVERFLOW: usize = 3;
-/// Byte offset of the spill pass's indirect arguments in the counters buffer.
-const SPILL_ARGS: u64 = 16;
-
-/// Group 1 layout, the counters and the spill list.
+/// Group 1 layout (`assign_bindings.wgsl`), the spill list and the spill pass's arguments.
 pub struct AssignCommon {
     pub layout: wgpu::BindGroupLayout,
     pub scan: ScanPass,
-    counters: wgpu::Buffer,
-    /// The spill pass's arguments, copied out of `counters` (a buffer bound for storage
-    /// cannot also feed an indirect dispatch).
+    /// The spill pass's arguments, copied out of the frame counters (a buffer bound for
+    /// storage cannot also feed an indirect dispatch).
     spill_args: wgpu::Buffer,
     spill_cells: wgpu::Buffer,
 }
@@ -87,7 +71,6 @@ impl AssignCommon {
                 STORAGE_RW,
                 STORAGE_RW,
                 STORAGE_RW,
-                STORAGE_RW,
                 STORAGE_READ,
                 STORAGE_READ,
             ],
@@ -95,20 +78,7 @@ impl AssignCommon {
         AssignCommon {
             layout,
             scan: ScanPass::new(device),
-            counters: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("assign counters"),
-                size: 32,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            spill_args: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("spill pass arguments"),
-                size: 16,
-                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            spill_args: indirect_args_buffer(device, "spill pass arguments"),
             spill_cells: storage_buffer(device, "spill cells", 1 << 12),
         }
     }
@@ -132,38 +102,33 @@ impl AssignCommon {
                 bounds.buffer().as_entire_binding(),
                 grid.cells_buffer().as_entire_binding(),
                 grid.indices_buffer().as_entire_binding(),
-                self.counters.as_entire_binding(),
                 self.spill_cells.as_entire_binding(),
                 bounds.occupied_buffer().as_entire_binding(),
                 bounds.occupancy_buffer().as_entire_binding(),
             ],
         )
     }
+}
 
-    /// Zero the counters (record before the frame's assignment passes).
-    pub fn clear_counters(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.clear_buffer(&self.counters, 0, None);
-    }
+/// A 16-byte INDIRECT buffer that dispatch arguments written into the frame counters are
+/// copied to.
+pub fn indirect_args_buffer(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: 16,
+        usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
 
-    /// The counters after the submitted passes.
-    pub fn read_counters(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<[u32; 4]> {
-        let bytes = download(device, queue, &self.counters, 16)?;
-        Ok(bytemuck::pod_read_unaligned(&bytes[..16]))
-    }
-
-    /// Fail if a write went past a counted length (the passes disagree: a bug, never silent).
-    pub fn check_write_overflow(counters: &[u32; 4], stage: &str) -> Result<()> {
-        let n = counters[WRITE_OVERFLOW];
-        if n > 0 {
-            return Err(Error::Gpu {
-                stage: stage.into(),
-                message: format!(
-                    "{n} light indices did not fit the counted lists (count and write passes disagree)"
-                ),
-            });
-        }
-        Ok(())
-    }
+/// Record the copy of three dispatch arguments from frame-counter slot `slot` on.
+pub fn copy_dispatch_args(
+    encoder: &mut wgpu::CommandEncoder,
+    counters: &wgpu::Buffer,
+    slot: u32,
+    dst: &wgpu::Buffer,
+) {
+    encoder.copy_buffer_to_buffer(counters, u64::from(slot) * 4, dst, 0, 12);
 }
 
 /// The grid as built on the GPU, read back (for statistics, heatmaps and the tests).
@@ -188,123 +153,123 @@ pub fn read_grid(
     })
 }
 
-/// A per-cell strategy's kernels (first pass, spill arguments, spill pass).
+/// A per-cell strategy's kernels (first pass, spill arguments, spill pass) and the index
+/// capacity it sizes from earlier frames.
 pub struct CellKernels {
     main: wgpu::ComputePipeline,
     spill_args: wgpu::ComputePipeline,
     spill: wgpu::ComputePipeline,
     name: &'static str,
-}
-
-/// What a per-cell strategy's run produced.
-pub struct CellRun {
-    /// Index entries of the grid.
-    pub total: u32,
-    /// Times the pass ran again because the index buffer (sized from earlier frames) was too
-    /// small.
-    pub reruns: u32,
+    common: AssignCommon,
+    capacity: ListCapacity,
 }
 
 impl CellKernels {
+    /// `extra`: the layouts of groups 2.. (the BVH).
     pub fn new(
-        device: &wgpu::Device,
+        ctx: &StrategyContext,
         name: &'static str,
         shader: &ComposedShader,
-        layouts: &[Option<&wgpu::BindGroupLayout>],
+        extra: &[&wgpu::BindGroupLayout],
     ) -> Self {
+        let device = ctx.device;
+        let common = AssignCommon::new(device);
+        let mut layouts = vec![Some(ctx.scene_layout), Some(&common.layout)];
+        layouts.extend(extra.iter().map(|l| Some(*l)));
         let pipeline = |entry: &str| {
-            compute_pipeline(device, &format!("{name} {entry}"), shader, entry, layouts)
+            compute_pipeline(device, &format!("{name} {entry}"), shader, entry, &layouts)
         };
         CellKernels {
             main: pipeline("main"),
             spill_args: pipeline("spill_args_main"),
             spill: pipeline("spill_main"),
             name,
+            capacity: ListCapacity::new(name, u64::from(GridBuffers::INITIAL_INDEX_CAPACITY)),
+            common,
         }
     }
 
-    /// Build the grid into `a.grid` (waits for it). Groups: 0 the scene, 1 `a.common`'s,
-    /// 2.. `extra`.
-    pub fn run(
-        &self,
-        a: AssignFrame,
-        enc: &mut crate::pipelines::FrameEncoder,
-        extra: &[&wgpu::BindGroup],
-    ) -> Result<CellRun> {
+    /// The scan pass (shared with a GPU BVH build's sort).
+    pub fn scan(&self) -> &ScanPass {
+        &self.common.scan
+    }
+
+    /// Record the grid's construction into `a.grid`: no wait, no readback. Index ranges that
+    /// do not fit the capacity (sized from earlier frames) are counted in the frame counters
+    /// (`COUNTER_INDEX_OUT_OF_ROOM`). Groups: 0 the scene, 1 the common group, 2.. `extra`.
+    pub fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder, extra: &[&wgpu::BindGroup]) {
         let AssignFrame {
-            device,
-            queue,
-            scene,
-            common,
+            f,
             grid,
             bounds,
             dims,
+            ..
         } = a;
+        let device = f.device;
         let name = self.name;
-        let mut reruns = 0;
-        grid.ensure(device, queue, dims, dims.cell_count(), 1);
-        loop {
-            let group = common.bind(device, grid, bounds, dims);
-            let (encoder, timer) = enc.parts();
-            common.clear_counters(encoder);
-            // Cells without samples are never visited: their entries stay (0, 0).
-            encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
-            let pass = |encoder: &mut wgpu::CommandEncoder,
-                        timer: &mut crate::gpu::PassTimer,
-                        label: &str,
-                        run: &dyn Fn(&mut wgpu::ComputePass)| {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(label),
-                    timestamp_writes: timer.compute_pass(label),
-                });
-                pass.set_bind_group(0, scene, &[]);
-                pass.set_bind_group(1, &group, &[]);
-                for (i, g) in extra.iter().enumerate() {
-                    pass.set_bind_group(2 + i as u32, *g, &[]);
-                }
-                run(&mut pass);
-            };
-            pass(encoder, timer, &format!("assign: {name}"), &|p| {
-                p.set_pipeline(&self.main);
-                p.dispatch_workgroups_indirect(bounds.occupancy_buffer(), 4);
-                p.set_pipeline(&self.spill_args);
-                p.dispatch_workgroups(1, 1, 1);
+        grid.ensure(
+            device,
+            f.queue,
+            dims,
+            dims.cell_count(),
+            self.capacity.entries as usize,
+        );
+        let group = self.common.bind(device, grid, bounds, dims);
+        let (encoder, timer) = enc.parts();
+        // Cells without samples are never visited: their entries stay (0, 0).
+        encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
+        let pass = |encoder: &mut wgpu::CommandEncoder,
+                    timer: &mut PassTimer,
+                    label: &str,
+                    run: &dyn Fn(&mut wgpu::ComputePass)| {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: timer.compute_pass(label),
             });
-            encoder.copy_buffer_to_buffer(&common.counters, SPILL_ARGS, &common.spill_args, 0, 12);
-            pass(encoder, timer, &format!("assign: {name} spill"), &|p| {
-                p.set_pipeline(&self.spill);
-                p.dispatch_workgroups_indirect(&common.spill_args, 0);
-            });
-            enc.submit_and_wait()?;
-            let counters = common.read_counters(device, queue)?;
-            AssignCommon::check_write_overflow(&counters, name)?;
-            let total = counters[CURSOR];
-            if counters[OUT_OF_ROOM] == 0 {
-                return Ok(CellRun { total, reruns });
+            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(1, &group, &[]);
+            for (i, g) in extra.iter().enumerate() {
+                pass.set_bind_group(2 + i as u32, *g, &[]);
             }
-            // The cursor counted every reservation: grow to it and run again.
-            check_index_capacity(device, u64::from(total), name)?;
-            grid.ensure(device, queue, dims, dims.cell_count(), total as usize);
-            reruns += 1;
-            if reruns > 2 {
-                return Err(Error::Gpu {
-                    stage: name.into(),
-                    message: format!(
-                        "the index list still did not fit after growing it to {total} entries"
-                    ),
-                });
-            }
-        }
+            run(&mut pass);
+        };
+        pass(encoder, timer, &format!("assign: {name}"), &|p| {
+            p.set_pipeline(&self.main);
+            p.dispatch_workgroups_indirect(bounds.occupancy_buffer(), 4);
+            p.set_pipeline(&self.spill_args);
+            p.dispatch_workgroups(1, 1, 1);
+        });
+        copy_dispatch_args(
+            encoder,
+            f.counters,
+            COUNTER_SPILL_ARGS,
+            &self.common.spill_args,
+        );
+        pass(encoder, timer, &format!("assign: {name} spill"), &|p| {
+            p.set_pipeline(&self.spill);
+            p.dispatch_workgroups_indirect(&self.common.spill_args, 0);
+        });
     }
+
+    /// Grow the index capacity to what a finished frame reserved.
+    pub fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        self.capacity
+            .observe(device, u64::from(values.index_needed()))
+    }
+}
+
+/// Most u32 entries one storage binding of this device holds.
+pub fn max_index_entries(device: &wgpu::Device) -> u64 {
+    let limits = device.limits();
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+        / 4
 }
 
 /// Index lists longer than the device can bind are an error, never a truncated list.
 pub fn check_index_capacity(device: &wgpu::Device, entries: u64, stage: &str) -> Result<()> {
-    let limits = device.limits();
-    let max = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size)
-        / 4;
+    let max = max_index_entries(device);
     if entries > max {
         return Err(Error::invalid(
             "--assign",

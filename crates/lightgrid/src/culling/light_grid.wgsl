@@ -19,8 +19,10 @@ fn grid_light(cell: u32, i: u32) -> Light {
 fn grid_shade(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec3<f32> {
     var acc = vec3<f32>(0.0);
     let count = grid_cell_count(cell);
-    for (var i = 0u; i < count; i = i + 1u) {
+    var i = 0u;
+    for (; i < count; i = i + 1u) {
         acc += shade_light(s, view_dir, grid_light(cell, i));
     }
+    check_loop(i, count);
     return acc;
 }

@@ -15,6 +15,7 @@ mod oracle;
 mod radix_sort;
 mod scan;
 mod scatter;
+mod strategy;
 mod view;
 
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
@@ -25,6 +26,7 @@ pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, LightGrid};
 pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
+pub use strategy::{find_strategy, AssignStrategy, StrategyInfo, STRATEGIES};
 pub use view::{ViewLight, ViewSetup};
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).

@@ -1,6 +1,9 @@
 // Exclusive prefix sum of `scan_src` (its bound length) into `scan_dst`, and the total into
 // `scan_total`, by one workgroup: each invocation sums a contiguous chunk, a Hillis-Steele scan
 // combines the chunk sums, and each invocation writes its chunk's running offsets.
+// The chunk loops are bounded by the buffers, not by frame data: at most 2^20 lights or
+// 2^25 / 16 sort histogram entries (a 128 MiB pair buffer), so 2 x 8192 iterations per
+// invocation, well below llvmpipe's loop guard (65,536); this pass binds no frame counters.
 
 @group(0) @binding(0) var<storage, read> scan_src: array<u32>;
 @group(0) @binding(1) var<storage, read_write> scan_dst: array<u32>;

@@ -1,19 +1,24 @@
-//! GPU scatter (forward-plus §4): one invocation per light emits a (cell, light) pair for
-//! every cell it overlaps, a radix sort orders the pairs by cell, and each cell's offset and
-//! count are read off the sorted keys (`scatter.wgsl`, `radix_sort.wgsl`). Pairs are sized
-//! from counts (count pass → prefix sum → write pass), so nothing is ever dropped; the sort is
-//! stable, so every cell's list comes out in light order, exactly as the CPU twin
-//! ([`super::assign_cpu`] with the same cell bounds) builds it.
+//! GPU scatter (forward-plus §4): every light emits a (cell, light) pair for every cell it
+//! overlaps, a radix sort orders the pairs by cell, and each cell's offset and count are read
+//! off the sorted keys (`scatter.wgsl`, `radix_sort.wgsl`; its steps are numbered there). A
+//! light's cells are spread over one invocation per tile of its rectangle, so no invocation
+//! loops over a whole screen of cells (llvmpipe ends loops after 65,536 iterations). Pairs
+//! are appended at an atomic cursor into a buffer sized from earlier frames' frame counters;
+//! pairs that do not fit are counted and the frame reported, never passed off as right. The
+//! lists hold what the CPU twin ([`super::assign_cpu`] with the same cell bounds) builds, in
+//! the cursor's order (the tests compare them as sets).
 
-use super::gpu_assign::{check_index_capacity, AssignCommon, AssignFrame};
+use super::gpu_assign::{copy_dispatch_args, indirect_args_buffer, AssignCommon};
 use super::radix_sort::RadixSort;
-use crate::consts::ASSIGN_THREADS;
+use super::strategy::{AssignFrame, AssignStrategy, ListCapacity, StrategyContext, StrategyRun};
+use super::GridBuffers;
+use crate::consts::{ASSIGN_THREADS, COUNTER_ITEM_ARGS};
 use crate::error::Result;
-use crate::gpu::STORAGE_RW;
+use crate::frame::FrameEncoder;
 use crate::gpu::{
-    bind_resources, buffer_layout, download, groups_1d, grow_storage, storage_buffer,
+    bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, CounterValues,
+    PassTimer, STORAGE_RW,
 };
-use crate::pipelines::FrameEncoder;
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
@@ -30,185 +35,201 @@ pub(crate) fn shader() -> ComposedShader {
     )
 }
 
-pub struct ScatterPass {
+/// `--assign scatter`.
+struct ScatterStrategy {
+    common: AssignCommon,
     layout: wgpu::BindGroupLayout,
-    count: wgpu::ComputePipeline,
-    write: wgpu::ComputePipeline,
+    rect: wgpu::ComputePipeline,
+    items_args: wgpu::ComputePipeline,
+    emit: wgpu::ComputePipeline,
+    pad: wgpu::ComputePipeline,
     bounds: wgpu::ComputePipeline,
     counts: wgpu::ComputePipeline,
-    light_counts: wgpu::Buffer,
-    light_offsets: wgpu::Buffer,
-    pair_total: wgpu::Buffer,
+    light_items: wgpu::Buffer,
+    item_offsets: wgpu::Buffer,
+    item_total: wgpu::Buffer,
+    light_rects: wgpu::Buffer,
+    /// The emit pass's indirect arguments, copied out of the frame counters.
+    item_args: wgpu::Buffer,
+    /// (cell, light) pairs the pair buffer holds, sized from earlier frames.
+    pairs: ListCapacity,
     sort: RadixSort,
 }
 
-impl ScatterPass {
-    pub fn new(
-        device: &wgpu::Device,
-        scene_layout: &wgpu::BindGroupLayout,
-        common: &AssignCommon,
-    ) -> Self {
-        let layout = buffer_layout(device, "scatter (group 2)", &[STORAGE_RW; 5]);
-        let s = shader();
-        let layouts = [Some(scene_layout), Some(&common.layout), Some(&layout)];
-        let pipeline = |entry: &str| {
-            compute_pipeline(device, &format!("scatter {entry}"), &s, entry, &layouts)
-        };
-        ScatterPass {
-            count: pipeline("count_main"),
-            write: pipeline("write_main"),
-            bounds: pipeline("bounds_main"),
-            counts: pipeline("counts_main"),
-            layout,
-            light_counts: storage_buffer(device, "scatter light counts", 1 << 12),
-            light_offsets: storage_buffer(device, "scatter light offsets", 1 << 12),
-            pair_total: storage_buffer(device, "scatter pair total", 16),
-            sort: RadixSort::new(device),
-        }
-    }
+pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> {
+    let device = ctx.device;
+    let common = AssignCommon::new(device);
+    let layout = buffer_layout(device, "scatter (group 2)", &[STORAGE_RW; 6]);
+    let s = shader();
+    let layouts = [Some(ctx.scene_layout), Some(&common.layout), Some(&layout)];
+    let pipeline =
+        |entry: &str| compute_pipeline(device, &format!("scatter {entry}"), &s, entry, &layouts);
+    Box::new(ScatterStrategy {
+        rect: pipeline("rect_main"),
+        items_args: pipeline("items_args_main"),
+        emit: pipeline("emit_main"),
+        pad: pipeline("pad_main"),
+        bounds: pipeline("bounds_main"),
+        counts: pipeline("counts_main"),
+        layout,
+        common,
+        light_items: storage_buffer(device, "scatter light items", 1 << 12),
+        item_offsets: storage_buffer(device, "scatter item offsets", 1 << 12),
+        item_total: storage_buffer(device, "scatter item total", 16),
+        light_rects: storage_buffer(device, "scatter light rects", 1 << 14),
+        item_args: indirect_args_buffer(device, "scatter emit arguments"),
+        pairs: ListCapacity::new("scatter", u64::from(GridBuffers::INITIAL_INDEX_CAPACITY)),
+        sort: RadixSort::new(device),
+    })
+}
 
+impl ScatterStrategy {
     fn bind(&self, device: &wgpu::Device) -> wgpu::BindGroup {
         bind_resources(
             device,
             "scatter",
             &self.layout,
             &[
-                self.light_counts.as_entire_binding(),
-                self.light_offsets.as_entire_binding(),
+                self.light_items.as_entire_binding(),
+                self.item_offsets.as_entire_binding(),
                 self.sort.keys.as_entire_binding(),
                 self.sort.vals.as_entire_binding(),
-                self.pair_total.as_entire_binding(),
+                self.item_total.as_entire_binding(),
+                self.light_rects.as_entire_binding(),
             ],
         )
     }
+}
 
-    /// Build the grid from the cell bounds in `bounds`; leaves it in `grid` (waits for it)
-    /// and returns the number of index entries.
-    pub fn run(&mut self, a: AssignFrame, enc: &mut FrameEncoder, light_count: u32) -> Result<u32> {
+/// A compute pass of one pipeline with groups 0..=2.
+fn pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    timer: &mut PassTimer,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    groups: [&wgpu::BindGroup; 3],
+) -> wgpu::ComputePass<'e> {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: timer.compute_pass(label),
+    });
+    pass.set_pipeline(pipeline);
+    for (i, g) in groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, *g, &[]);
+    }
+    pass
+}
+
+/// Dispatch one invocation per item of `items`.
+fn dispatch_items(pass: &mut wgpu::ComputePass, items: u64) {
+    let (x, y) = groups_1d((items.div_ceil(u64::from(ASSIGN_THREADS)) as u32).max(1));
+    pass.dispatch_workgroups(x, y, 1);
+}
+
+impl AssignStrategy for ScatterStrategy {
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
         let AssignFrame {
-            device,
-            queue,
-            scene,
-            common,
+            f,
             grid,
             bounds,
             dims,
+            ..
         } = a;
-        let lights = u64::from(light_count.max(1)) * 4;
+        let device = f.device;
+        let lights = f.lights.len() as u64;
         grow_storage(
             device,
-            &mut self.light_counts,
-            "scatter light counts",
-            lights,
+            &mut self.light_items,
+            "scatter light items",
+            lights.max(1) * 4,
         );
         grow_storage(
             device,
-            &mut self.light_offsets,
-            "scatter light offsets",
+            &mut self.item_offsets,
+            "scatter item offsets",
+            lights.max(1) * 4,
+        );
+        grow_storage(
+            device,
+            &mut self.light_rects,
+            "scatter light rects",
+            lights.max(1) * 16,
+        );
+        self.sort.ensure(device, self.pairs.entries);
+        // The whole pair buffer is sorted: its bound length is what the kernels see.
+        let slots = self.sort.keys.size() / 4;
+        grid.ensure(device, f.queue, dims, dims.cell_count(), slots as usize);
+        let common = self.common.bind(device, grid, bounds, dims);
+        let own = self.bind(device);
+        let groups = [f.scene_bind_group, &common, &own];
+        let (encoder, timer) = enc.parts();
+        // 1. Tile rectangles and items per light; 2. their offsets; 3. dispatch arguments.
+        {
+            let mut p = pass(encoder, timer, "assign: scatter rects", &self.rect, groups);
+            dispatch_items(&mut p, lights);
+        }
+        self.common.scan.encode(
+            device,
+            encoder,
+            timer,
+            "assign: scatter scan",
+            &self.light_items,
+            &self.item_offsets,
             lights,
-        );
-        grid.ensure(device, queue, dims, dims.cell_count(), 1);
-        let common_group = common.bind(device, grid, bounds, dims);
-        let dispatch = |enc: &mut FrameEncoder,
-                        pipeline: &wgpu::ComputePipeline,
-                        groups: [&wgpu::BindGroup; 2],
-                        label: &str,
-                        items: u32| {
-            let (encoder, timer) = enc.parts();
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: timer.compute_pass(label),
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, scene, &[]);
-            pass.set_bind_group(1, groups[0], &[]);
-            pass.set_bind_group(2, groups[1], &[]);
-            let (x, y) = groups_1d(items.div_ceil(ASSIGN_THREADS));
-            pass.dispatch_workgroups(x, y, 1);
-        };
-        // 1. Pairs per light, and their offsets.
-        let group = self.bind(device);
-        dispatch(
-            enc,
-            &self.count,
-            [&common_group, &group],
-            "assign: scatter count",
-            light_count,
+            (&self.item_total, 0),
         );
         {
-            let (encoder, timer) = enc.parts();
-            common.clear_counters(encoder);
-            common.scan.encode(
-                device,
+            let mut p = pass(
                 encoder,
                 timer,
-                "assign: scatter scan",
-                &self.light_counts,
-                &self.light_offsets,
-                u64::from(light_count),
-                (&self.pair_total, 0),
+                "assign: scatter args",
+                &self.items_args,
+                groups,
             );
+            p.dispatch_workgroups(1, 1, 1);
         }
-        enc.submit_and_wait()?;
-        let total = u32::from_le_bytes(
-            download(device, queue, &self.pair_total, 4)?[..4]
-                .try_into()
-                .expect("4 bytes"),
-        );
-        check_index_capacity(device, u64::from(total), "scatter")?;
-        // 2. The pairs (buffers grown to the counted total; bind groups follow them).
-        self.sort.ensure(device, u64::from(total));
-        grid.ensure(device, queue, dims, dims.cell_count(), total as usize);
-        let common_group = common.bind(device, grid, bounds, dims);
-        let group = self.bind(device);
-        dispatch(
-            enc,
-            &self.write,
-            [&common_group, &group],
-            "assign: scatter write",
-            light_count,
-        );
-        // 3. Sort by cell, 4. cell offsets and counts from the sorted keys.
-        let cell_bits = u32::BITS - (dims.cell_count().max(2) as u32 - 1).leading_zeros();
+        copy_dispatch_args(encoder, f.counters, COUNTER_ITEM_ARGS, &self.item_args);
+        // 4. Pairs, one invocation per (light, tile); 5. padding past the pairs.
         {
-            let (encoder, timer) = enc.parts();
-            self.sort.encode(
-                device,
-                queue,
+            let mut p = pass(encoder, timer, "assign: scatter emit", &self.emit, groups);
+            p.dispatch_workgroups_indirect(&self.item_args, 0);
+            p.set_pipeline(&self.pad);
+            dispatch_items(&mut p, slots);
+        }
+        // 6. Sort by cell (keys 0xffffffff past the pairs sort last: enough bits for the
+        // cell count itself), 7. cell offsets and counts from the sorted keys.
+        let cell_bits = u32::BITS - (dims.cell_count() as u32).leading_zeros();
+        self.sort.encode(
+            device,
+            f.queue,
+            encoder,
+            timer,
+            &self.common.scan,
+            slots as u32,
+            cell_bits,
+        );
+        encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
+        {
+            let mut p = pass(
                 encoder,
                 timer,
-                &common.scan,
-                total,
-                cell_bits,
+                "assign: scatter cell ranges",
+                &self.bounds,
+                groups,
             );
-            encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
+            dispatch_items(&mut p, slots);
+            p.set_pipeline(&self.counts);
+            dispatch_items(&mut p, dims.cell_count() as u64);
         }
-        dispatch(
-            enc,
-            &self.bounds,
-            [&common_group, &group],
-            "assign: scatter cell ranges",
-            total,
-        );
-        dispatch(
-            enc,
-            &self.counts,
-            [&common_group, &group],
-            "assign: scatter cell counts",
-            dims.cell_count() as u32,
-        );
-        if total > 0 {
-            let (encoder, _) = enc.parts();
-            encoder.copy_buffer_to_buffer(
-                &self.sort.vals,
-                0,
-                grid.indices_buffer(),
-                0,
-                u64::from(total) * 4,
-            );
-        }
-        enc.submit_and_wait()?;
-        AssignCommon::check_write_overflow(&common.read_counters(device, queue)?, "scatter")?;
-        Ok(total)
+        encoder.copy_buffer_to_buffer(&self.sort.vals, 0, grid.indices_buffer(), 0, slots * 4);
+        Ok(StrategyRun::default())
+    }
+
+    fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        self.pairs.observe(device, u64::from(values.pairs_needed()))
+    }
+
+    fn grid_entries(&self, values: &CounterValues) -> u32 {
+        values.pairs_needed()
     }
 }

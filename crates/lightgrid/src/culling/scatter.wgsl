@@ -1,17 +1,29 @@
-// GPU scatter (forward-plus §4): one invocation per light finds the cells it overlaps (the
-// tiles under its projected sphere, the depth slices its view-depth interval spans, kept where
-// the cell's sample bounds overlap that interval) and emits (cell, light) pairs; the pairs are
+// GPU scatter (forward-plus §4): each light finds the cells it overlaps (the tiles under its
+// projected sphere, the depth slices its view-depth interval spans, kept where the cell's
+// sample bounds overlap that interval) and emits (cell, light) pairs; the pairs are
 // radix-sorted by cell and each cell's offset and count read off the sorted keys. The test is
 // the CPU assignment's, line for line (`assign_cpu.rs`), so that is this stage's CPU twin.
-// count_main sizes each light's run of pairs; a prefix sum gives the offsets; write_main
-// fills them.
+// A light's work is spread over one invocation per tile of its rectangle, so no invocation
+// loops over more than one tile's slices (a light covering the screen would otherwise run a
+// loop of tiles x slices iterations, past llvmpipe's loop guard):
+// 1. rect_main: per light, its tile rectangle and the number of tiles in it (items);
+// 2. (prefix sum of the items: item offsets and the total);
+// 3. items_args_main: indirect dispatch arguments for one invocation per item;
+// 4. emit_main: per item, find its light (binary search of the offsets), test the tile's
+//    slices, append pairs at an atomic cursor (COUNTER_PAIRS_NEEDED); pairs past the end of
+//    the pair buffer (sized from earlier frames) are counted (COUNTER_PAIRS_OUT_OF_ROOM);
+// 5. pad_main: keys past the emitted pairs become 0xffffffff, so they sort last;
+// 6. (radix sort of the whole pair buffer by cell);
+// 7. bounds_main / counts_main: each cell's (offset, count) from the sorted keys.
 
-@group(2) @binding(0) var<storage, read_write> light_counts: array<u32>;
-@group(2) @binding(1) var<storage, read_write> light_offsets: array<u32>;
+@group(2) @binding(0) var<storage, read_write> light_items: array<u32>;
+@group(2) @binding(1) var<storage, read_write> item_offsets: array<u32>;
 @group(2) @binding(2) var<storage, read_write> pair_keys: array<u32>;
 @group(2) @binding(3) var<storage, read_write> pair_vals: array<u32>;
-@group(2) @binding(4) var<storage, read_write> pair_total: array<u32>;
+@group(2) @binding(4) var<storage, read_write> item_total: array<u32>;
+@group(2) @binding(5) var<storage, read_write> light_rects: array<vec4<i32>>;
 
+// The workgroup size assign_bindings.wgsl's helpers stride by.
 const WORKGROUP_SIZE: u32 = ASSIGN_THREADS;
 const NO_RANGE: vec3<f32> = vec3<f32>(0.0, 0.0, 0.0);
 const BIG: f32 = 1e30;
@@ -84,72 +96,113 @@ fn light_tiles(c: vec3<f32>, r: f32) -> vec4<i32> {
     return vec4<i32>(i32(px0) / t, i32(py0) / t, i32(px1) / t, i32(py1) / t);
 }
 
-// Visit (or count) the cells light `l` overlaps; in write mode emit pairs from `first` on.
-fn scatter_light(l: u32, write: bool) -> u32 {
-    let light = lights[l];
-    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
-    let r = light.range;
-    let rect = light_tiles(c, r);
-    let w_min = -c.z - r;
-    let w_max = -c.z + r;
-    let k0 = grid_slice(w_min * (1.0 - ASSIGN_DEPTH_SLACK));
-    let k1 = grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
-    let tiles = grid.tiles_x * grid.tiles_y;
-    var n = 0u;
-    var first = 0u;
-    var room = 0u;
-    if (write) {
-        first = light_offsets[l];
-        room = light_counts[l];
-    }
-    for (var ty = rect.y; ty <= rect.w; ty = ty + 1) {
-        for (var tx = rect.x; tx <= rect.z; tx = tx + 1) {
-            let tile = u32(ty) * grid.tiles_x + u32(tx);
-            for (var k = k0; k <= k1; k = k + 1u) {
-                let cell = k * tiles + tile;
-                let b = cell_bounds[cell];
-                if (b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK)) {
-                    if (write) {
-                        if (n < room) {
-                            pair_keys[first + n] = cell;
-                            pair_vals[first + n] = l;
-                        } else {
-                            atomicAdd(&counters[WRITE_OVERFLOW], 1u);
-                        }
-                    }
-                    n = n + 1u;
-                }
-            }
-        }
-    }
-    return n;
-}
-
-fn light_of(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+fn flat_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.y * nwg.x * ASSIGN_THREADS + gid.x;
 }
 
+// 1. The light's tile rectangle (x0 > x1: none) and its number of tiles.
 @compute @workgroup_size(ASSIGN_THREADS)
-fn count_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let l = light_of(gid, nwg);
-    if (l < frame.light_count) {
-        light_counts[l] = scatter_light(l, false);
+fn rect_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let l = flat_index(gid, nwg);
+    if (l >= frame.light_count) {
+        return;
+    }
+    let light = lights[l];
+    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
+    let rect = light_tiles(c, light.range);
+    light_rects[l] = rect;
+    var n = 0u;
+    if (rect.x <= rect.z && rect.y <= rect.w) {
+        n = u32(rect.z - rect.x + 1) * u32(rect.w - rect.y + 1);
+    }
+    light_items[l] = n;
+}
+
+// 3. One invocation per item, folded into two dimensions past 65535 workgroups.
+@compute @workgroup_size(1)
+fn items_args_main() {
+    let blocks = (item_total[0] + ASSIGN_THREADS - 1u) / ASSIGN_THREADS;
+    let x = min(max(blocks, 1u), 65535u);
+    atomicStore(&frame_counters[COUNTER_ITEM_ARGS], x);
+    atomicStore(&frame_counters[COUNTER_ITEM_ARGS + 1u], (blocks + x - 1u) / x);
+    atomicStore(&frame_counters[COUNTER_ITEM_ARGS + 2u], 1u);
+}
+
+// Bisection steps that find any light among MAX_LIGHTS (2^20): ceil(log2(2^20 + 1)).
+const SEARCH_STEPS: u32 = 21u;
+
+// 4. Item i: the light whose run of items holds i (the last light with offset <= i; lights
+// without items share the next light's offset), the tile, and its slices.
+@compute @workgroup_size(ASSIGN_THREADS)
+fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat_index(gid, nwg);
+    if (i >= item_total[0]) {
+        return;
+    }
+    var lo = 0u;
+    var hi = frame.light_count;
+    var step = 0u;
+    for (; step < SEARCH_STEPS; step = step + 1u) {
+        if (lo < hi) {
+            let mid = (lo + hi) / 2u;
+            if (item_offsets[mid] <= i) {
+                lo = mid + 1u;
+            } else {
+                hi = mid;
+            }
+        }
+    }
+    check_loop(step, SEARCH_STEPS);
+    let l = lo - 1u;
+    let rect = light_rects[l];
+    let k = i - item_offsets[l];
+    let width = u32(rect.z - rect.x + 1);
+    let tile = u32(rect.y + i32(k / width)) * grid.tiles_x + u32(rect.x + i32(k % width));
+
+    let light = lights[l];
+    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
+    let w_min = -c.z - light.range;
+    let w_max = -c.z + light.range;
+    let k0 = grid_slice(w_min * (1.0 - ASSIGN_DEPTH_SLACK));
+    let k1 = grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
+    let tiles = grid.tiles_x * grid.tiles_y;
+    let capacity = arrayLength(&pair_keys);
+    var s = k0;
+    for (; s <= k1; s = s + 1u) {
+        let cell = s * tiles + tile;
+        let b = cell_bounds[cell];
+        if (b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK)) {
+            let slot = atomicAdd(&frame_counters[COUNTER_PAIRS_NEEDED], 1u);
+            if (slot < capacity) {
+                pair_keys[slot] = cell;
+                pair_vals[slot] = l;
+            } else {
+                atomicAdd(&frame_counters[COUNTER_PAIRS_OUT_OF_ROOM], 1u);
+            }
+        }
+    }
+    check_loop(s, k1 + 1u);
+}
+
+// The pairs emitted and kept: the cursor, clamped to the buffer.
+fn pair_count() -> u32 {
+    return min(atomicLoad(&frame_counters[COUNTER_PAIRS_NEEDED]), arrayLength(&pair_keys));
+}
+
+// 5. Keys past the pairs sort last (the sort uses enough bits to hold the cell count itself).
+@compute @workgroup_size(ASSIGN_THREADS)
+fn pad_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat_index(gid, nwg);
+    if (i >= pair_count() && i < arrayLength(&pair_keys)) {
+        pair_keys[i] = 0xffffffffu;
     }
 }
 
-@compute @workgroup_size(ASSIGN_THREADS)
-fn write_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let l = light_of(gid, nwg);
-    if (l < frame.light_count) {
-        scatter_light(l, true);
-    }
-}
-
-// After the sort: the first pair of a cell's run writes the cell's offset, the last its end.
+// 7. After the sort: the first pair of a cell's run writes the cell's offset, the last its end.
 @compute @workgroup_size(ASSIGN_THREADS)
 fn bounds_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = light_of(gid, nwg);
-    let n = pair_total[0];  // set by the scan of light counts
+    let i = flat_index(gid, nwg);
+    let n = pair_count();
     if (i >= n) {
         return;
     }
@@ -165,7 +218,7 @@ fn bounds_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 // Then (end, start) -> (offset, count); untouched cells stay (0, 0).
 @compute @workgroup_size(ASSIGN_THREADS)
 fn counts_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let c = light_of(gid, nwg);
+    let c = flat_index(gid, nwg);
     if (c < grid.tiles_x * grid.tiles_y * grid.slices) {
         cells[c].y = cells[c].y - cells[c].x;
     }

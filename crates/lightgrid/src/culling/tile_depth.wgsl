@@ -17,8 +17,10 @@ fn reduce_tile_depth(depth_tex: texture_depth_2d, tile: vec2<u32>, tile_size: u3
     let origin = tile * tile_size;
     var lo = 1.0;
     var hi = 0.0;
-    for (var y = lid.y; y < tile_size; y = y + TILE_THREADS) {
-        for (var x = lid.x; x < tile_size; x = x + TILE_THREADS) {
+    var y = lid.y;
+    for (; y < tile_size; y = y + TILE_THREADS) {
+        var x = lid.x;
+        for (; x < tile_size; x = x + TILE_THREADS) {
             let p = origin + vec2<u32>(x, y);
             if (p.x < dims.x && p.y < dims.y) {
                 let d = textureLoad(depth_tex, p, 0);
@@ -28,7 +30,9 @@ fn reduce_tile_depth(depth_tex: texture_depth_2d, tile: vec2<u32>, tile_size: u3
                 }
             }
         }
+        check_loop(x, tile_size);
     }
+    check_loop(y, tile_size);
     atomicMin(&tile_depth_min, bitcast<u32>(lo));
     atomicMax(&tile_depth_max, bitcast<u32>(hi));
     workgroupBarrier();

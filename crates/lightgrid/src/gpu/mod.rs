@@ -1,9 +1,11 @@
 //! Adapter and device selection, GPU timing and readback.
 
 mod context;
+mod counters;
 mod timing;
 
 pub use context::{list_adapters, AdapterSummary, GpuContext};
+pub use counters::{CounterValues, FrameCounters, FrameReadback, FrameTag, COUNTER_BYTES};
 pub use timing::{PassTimer, PassTiming};
 
 use crate::error::{Error, Result};

@@ -2,8 +2,7 @@
 //! that lavapipe measures accurately; ECOSYSTEM.md). Without TIMESTAMP_QUERY the timer
 //! records nothing and callers fall back to wall time after a device sync.
 
-use super::{read_buffer, GpuContext};
-use crate::error::Result;
+use super::GpuContext;
 
 /// GPU time of one pass.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -12,9 +11,10 @@ pub struct PassTiming {
     pub ms: f64,
 }
 
-/// Hands out begin/end timestamp slots to passes and reads them back after the frame.
+/// Hands out begin/end timestamp slots to passes; [`PassTimer::resolve_into`] copies the
+/// frame's timestamps into a buffer the frame counters read back (`gpu/counters.rs`).
 pub struct PassTimer {
-    queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     labels: Vec<String>,
     capacity: u32,
     period_ns: f64,
@@ -30,20 +30,13 @@ impl PassTimer {
                 ty: wgpu::QueryType::Timestamp,
                 count,
             });
-            let size = u64::from(count) * 8;
             let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamp resolve"),
-                size,
+                size: Self::bytes_for(max_passes),
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamp readback"),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            (set, resolve, readback)
+            (set, resolve)
         });
         Self {
             queries,
@@ -51,6 +44,11 @@ impl PassTimer {
             capacity: max_passes,
             period_ns: f64::from(ctx.queue.get_timestamp_period()),
         }
+    }
+
+    /// Bytes of the timestamps of `passes` passes.
+    pub fn bytes_for(passes: u32) -> u64 {
+        u64::from(passes) * 16
     }
 
     /// Does this timer measure GPU time (false: wall time must be used)?
@@ -63,8 +61,13 @@ impl PassTimer {
         self.labels.clear();
     }
 
+    /// The passes recorded this frame, in order.
+    pub fn labels(&self) -> &[String] {
+        &self.labels
+    }
+
     fn slot(&mut self, label: &str) -> Option<(&wgpu::QuerySet, u32)> {
-        let (set, _, _) = self.queries.as_ref()?;
+        let (set, _) = self.queries.as_ref()?;
         let index = self.labels.len() as u32;
         assert!(
             index < self.capacity,
@@ -95,35 +98,32 @@ impl PassTimer {
             })
     }
 
-    /// Record the resolve of this frame's queries; call once, after the last pass.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let Some((set, resolve, readback)) = &self.queries {
+    /// Record the resolve of this frame's queries and their copy into `dst` at `offset`
+    /// (room for [`PassTimer::bytes_for`] the recorded passes); call once, after the last pass.
+    pub fn resolve_into(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        dst: &wgpu::Buffer,
+        offset: u64,
+    ) {
+        if let Some((set, resolve)) = &self.queries {
             let n = self.labels.len() as u32 * 2;
             if n == 0 {
                 return;
             }
             encoder.resolve_query_set(set, 0..n, resolve, 0);
-            encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, u64::from(n) * 8);
+            encoder.copy_buffer_to_buffer(resolve, 0, dst, offset, u64::from(n) * 8);
         }
     }
 
-    /// Per-pass GPU times of the frame just submitted, and the frame's span from the first
-    /// pass's start to the last pass's end. Empty when timestamps are unavailable.
-    pub fn read(&self, device: &wgpu::Device) -> Result<(Vec<PassTiming>, Option<f64>)> {
-        let Some((_, _, readback)) = &self.queries else {
-            return Ok((Vec::new(), None));
-        };
-        if self.labels.is_empty() {
-            return Ok((Vec::new(), None));
+    /// Per-pass GPU times from the raw timestamps of `labels`' passes (two ticks per pass),
+    /// and their sum: the frame's GPU work, CPU stalls between submissions excluded.
+    pub fn timings(&self, labels: &[String], ticks: &[u64]) -> (Vec<PassTiming>, Option<f64>) {
+        if self.queries.is_none() || labels.is_empty() || ticks.len() < labels.len() * 2 {
+            return (Vec::new(), None);
         }
-        let bytes = read_buffer(device, readback)?;
-        let ticks: Vec<u64> = bytes
-            .chunks_exact(8)
-            .map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect();
         let to_ms = |t: u64| t as f64 * self.period_ns / 1.0e6;
-        let passes = self
-            .labels
+        let passes: Vec<PassTiming> = labels
             .iter()
             .enumerate()
             .map(|(i, label)| PassTiming {
@@ -131,8 +131,7 @@ impl PassTimer {
                 ms: to_ms(ticks[2 * i + 1].saturating_sub(ticks[2 * i])),
             })
             .collect();
-        let first = ticks[0];
-        let last = ticks[self.labels.len() * 2 - 1];
-        Ok((passes, Some(to_ms(last.saturating_sub(first)))))
+        let sum = passes.iter().map(|p| p.ms).sum();
+        (passes, Some(sum))
     }
 }

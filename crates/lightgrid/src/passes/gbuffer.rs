@@ -2,9 +2,10 @@
 //! (`gbuffer_read.wgsl`). Four colour targets of four channels, 16-bit float by default or
 //! 32-bit (`--gbuffer 32`), as tiled-shading §8 measures both; depth is the shared target.
 
+use super::geometry::{draw_scene, geometry_pipeline, GeometryPipelineDesc};
 use super::Targets;
+use crate::frame::FrameInputs;
 use crate::gpu::PassTimer;
-use crate::pipelines::{draw_scene, geometry_pipeline, FrameInputs, GeometryPipelineDesc};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 
 /// Bits per G-buffer channel.

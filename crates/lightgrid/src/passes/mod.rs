@@ -2,6 +2,7 @@
 //! the scene bind group (group 0) and the tonemap pass.
 
 mod gbuffer;
+pub(crate) mod geometry;
 mod light_volumes;
 mod readback;
 mod tonemap;
@@ -138,6 +139,18 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             },
             storage(1, std::mem::size_of::<GpuLight>()),
             storage(2, std::mem::size_of::<GpuMaterial>()),
+            // The frame counters (`gpu/counters.rs`): written by fragment and compute stages
+            // (a vertex stage may not write storage).
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(crate::gpu::COUNTER_BYTES),
+                },
+                count: None,
+            },
         ],
     })
 }

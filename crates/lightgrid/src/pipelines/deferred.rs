@@ -14,7 +14,6 @@
 
 use super::RenderSettings;
 use super::{lighting_attachments, FrameEncoder, FrameInputs, PipelineContext, Technique};
-use crate::culling::BuiltGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::VOLUME_DEPTH_BYTES;
 use crate::passes::{
@@ -143,7 +142,7 @@ pub(super) fn create_stencil(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 impl Technique for Deferred {
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
+    fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let classes = classify_lights(&f.setup, f.lights, self.stencil.is_some());
         self.volumes.upload(f.device, f.queue, &classes);
         let gbuffer_group = self.gbuffer.read_bind_group(f.device, f.targets);
@@ -185,7 +184,7 @@ impl Technique for Deferred {
                 self.volumes.draw_stencil_light(&mut pass, k);
             }
         }
-        Ok(None)
+        Ok(())
     }
 }
 

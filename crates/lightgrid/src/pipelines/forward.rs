@@ -7,7 +7,6 @@ use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
-use crate::culling::BuiltGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
@@ -49,12 +48,12 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
 }
 
 impl Technique for Forward {
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
+    fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let (encoder, timer) = enc.parts();
         let mut pass = begin_lighting_pass(encoder, timer, f, "forward shading", true);
         pass.set_pipeline(&self.pipeline);
         draw_scene(&mut pass, f, &[]);
-        Ok(None)
+        Ok(())
     }
 }
 

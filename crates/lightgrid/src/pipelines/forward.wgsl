@@ -5,9 +5,11 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let view_dir = view_dir_to(s.position);
     var color = surface_base(s);
-    for (var i = 0u; i < frame.light_count; i = i + 1u) {
+    var i = 0u;
+    for (; i < frame.light_count; i = i + 1u) {
         color += shade_light(s, view_dir, lights[i]);
     }
+    check_loop(i, frame.light_count);
     return lit(color, frame.light_count);
 }
 
@@ -19,11 +21,13 @@ fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let view_dir = view_dir_to(s.position);
     var diffuse = vec3<f32>(0.0);
     var specular = 0.0;
-    for (var i = 0u; i < frame.light_count; i = i + 1u) {
+    var i = 0u;
+    for (; i < frame.light_count; i = i + 1u) {
         let t = light_terms(s, view_dir, lights[i]);
         diffuse += t.diffuse;
         specular += luminance(t.specular);
     }
+    check_loop(i, frame.light_count);
     let color = surface_base(s) + diffuse * s.diffuse + mono_specular(diffuse, specular) * s.specular;
     return lit(color, frame.light_count);
 }

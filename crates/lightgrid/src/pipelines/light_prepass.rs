@@ -17,7 +17,6 @@ use super::{
     draw_scene, geometry_pipeline, FrameEncoder, FrameInputs, GeometryPipelineDesc,
     PipelineContext, Technique,
 };
-use crate::culling::BuiltGrid;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::{
     additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
@@ -181,7 +180,7 @@ fn bind_two(
 }
 
 impl Technique for LightPrepass {
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
+    fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let classes = classify_lights(&f.setup, f.lights, false);
         self.volumes.upload(f.device, f.queue, &classes);
         let attr_group = bind_two(
@@ -258,7 +257,7 @@ impl Technique for LightPrepass {
         });
         pass.set_pipeline(&self.shade);
         draw_scene(&mut pass, f, &[&irr_group]);
-        Ok(None)
+        Ok(())
     }
 }
 

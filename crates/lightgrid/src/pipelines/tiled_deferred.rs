@@ -15,9 +15,9 @@
 
 use super::RenderSettings;
 use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
-use crate::consts::SCREEN_WORKGROUP;
+use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
-use crate::culling::{BuiltGrid, CellSource, GridBuilder, GridDims};
+use crate::culling::{CellSource, GridBuilder, GridDims};
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
     compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
@@ -73,27 +73,17 @@ struct TiledDeferred {
 }
 
 pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create_grid(ctx, "tiled_deferred", 1, "tiled deferred shading")
+    create_grid(ctx, 1, "tiled deferred shading")
 }
 
 pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create_grid(
-        ctx,
-        "clustered_deferred",
-        ctx.settings.slices,
-        "clustered deferred shading",
-    )
+    create_grid(ctx, ctx.settings.slices, "clustered deferred shading")
 }
 
-fn create_grid(
-    ctx: &PipelineContext,
-    id: &'static str,
-    slices: u32,
-    label: &'static str,
-) -> Box<dyn Technique> {
+fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
-    let builder = GridBuilder::new(ctx, id, slices, CellSource::Depth);
+    let builder = GridBuilder::new(ctx, slices, CellSource::Depth);
     let outputs_layout = compute_outputs_layout(ctx.device);
     let shading = compute_pipeline(
         ctx.device,
@@ -177,7 +167,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 impl Technique for TiledDeferred {
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
+    fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let dims = self.dims;
         {
             let (encoder, timer) = enc.parts();
@@ -185,14 +175,14 @@ impl Technique for TiledDeferred {
         }
         let read_group = self.gbuffer.read_bind_group(f.device, f.targets);
         let outputs = compute_outputs(f.device, &self.outputs_layout, f.targets);
-        let (grid, group1, label, groups) = match &mut self.variant {
+        let (group1, label, groups) = match &mut self.variant {
             Variant::Multi { builder, label } => {
-                let built = builder.build(f, enc)?;
+                builder.build(f, enc)?;
                 let groups = (
                     dims.width.div_ceil(SCREEN_WORKGROUP),
                     dims.height.div_ceil(SCREEN_WORKGROUP),
                 );
-                (Some(built), builder.bind_group(), *label, groups)
+                (builder.bind_group(), *label, groups)
             }
             Variant::Single {
                 params,
@@ -200,11 +190,13 @@ impl Technique for TiledDeferred {
             } => {
                 f.queue
                     .write_buffer(params, 0, bytemuck::bytes_of(&dims.params()));
+                // One workgroup per TILE_THREADS x TILE_THREADS block of a tile, so each
+                // invocation shades one sample (tiled_deferred_single.wgsl).
+                let blocks = dims.tile_size.div_ceil(TILE_THREADS);
                 (
-                    None,
                     &*params_group,
                     "tiled deferred single kernel",
-                    (dims.tiles_x, dims.tiles_y),
+                    (dims.tiles_x * blocks, dims.tiles_y * blocks),
                 )
             }
         };
@@ -220,7 +212,14 @@ impl Technique for TiledDeferred {
         pass.set_bind_group(3, &outputs, &[]);
         pass.dispatch_workgroups(groups.0, groups.1, 1);
         drop(pass);
-        Ok(grid)
+        Ok(())
+    }
+
+    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+        match &mut self.variant {
+            Variant::Multi { builder, .. } => Some(builder),
+            Variant::Single { .. } => None,
+        }
     }
 }
 

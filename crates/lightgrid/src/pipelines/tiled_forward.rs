@@ -14,7 +14,7 @@ use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique};
-use crate::culling::{BuiltGrid, CellSource, GridBuilder};
+use crate::culling::{CellSource, GridBuilder};
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 use crate::Result;
@@ -44,14 +44,8 @@ enum Kind {
 fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let prepass = kind != Kind::Plain;
-    let id = match kind {
-        Kind::Plain => "tiled_forward",
-        Kind::PreZ => "tiled_forward_prez",
-        Kind::Clustered => "clustered_forward",
-    };
     let builder = GridBuilder::new(
         ctx,
-        id,
         if kind == Kind::Clustered {
             ctx.settings.slices
         } else {
@@ -118,7 +112,7 @@ pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 impl Technique for TiledForward {
-    fn render(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<Option<BuiltGrid>> {
+    fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         if let Some(depth_only) = &self.depth_only {
             let (encoder, timer) = enc.parts();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -132,14 +126,18 @@ impl Technique for TiledForward {
             pass.set_pipeline(depth_only);
             draw_scene(&mut pass, f, &[]);
         }
-        let built = self.builder.build(f, enc)?;
+        self.builder.build(f, enc)?;
         let (encoder, timer) = enc.parts();
         let mut pass =
             begin_lighting_pass(encoder, timer, f, self.label, self.depth_only.is_none());
         pass.set_pipeline(&self.shading);
         draw_scene(&mut pass, f, &[self.builder.bind_group()]);
         drop(pass);
-        Ok(Some(built))
+        Ok(())
+    }
+
+    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+        Some(&mut self.builder)
     }
 }
 

@@ -158,6 +158,13 @@ pub struct Object {
     pub motion: Motion,
 }
 
+impl Object {
+    /// Does the object stay where `local` puts it?
+    pub fn is_static(&self) -> bool {
+        matches!(self.motion, Motion::Static)
+    }
+}
+
 /// Where a light sits: fixed in the world, or carried by an object.
 #[derive(Clone, Copy, Debug)]
 pub enum LightAnchor {
@@ -246,25 +253,76 @@ impl Scene {
         }
     }
 
-    /// All objects of the frame in world space, as one vertex and index list.
+    /// All objects of the frame in world space, as one vertex and index list: the static
+    /// objects first ([`Scene::static_geometry`]), then the moving ones.
     pub fn geometry(&self, state: &FrameState) -> (Vec<GpuVertex>, Vec<u32>) {
-        let mut vertices = Vec::new();
-        let mut indices = Vec::new();
-        for (o, m) in self.objects.iter().zip(&state.transforms) {
-            let mesh = &self.meshes[o.mesh];
-            let base = vertices.len() as u32;
-            let nm = glam::Mat3::from_mat4(*m).inverse().transpose();
-            for i in 0..mesh.positions.len() {
-                vertices.push(GpuVertex {
-                    position: m.transform_point3(mesh.positions[i]).to_array(),
-                    normal: (nm * mesh.normals[i]).normalize_or_zero().to_array(),
-                    uv: mesh.uvs[i].to_array(),
-                    material: o.material as u32,
-                });
-            }
-            indices.extend(mesh.indices.iter().map(|i| i + base));
-        }
+        let (mut vertices, mut indices) = self.static_geometry();
+        let (v, i) = self.moving_geometry(state, vertices.len() as u32);
+        vertices.extend(v);
+        indices.extend(i);
         (vertices, indices)
+    }
+
+    /// The objects that never move, in world space: the same every frame, so a renderer
+    /// uploads them once.
+    pub fn static_geometry(&self) -> (Vec<GpuVertex>, Vec<u32>) {
+        let mut out = (Vec::new(), Vec::new());
+        for o in self.objects.iter().filter(|o| o.is_static()) {
+            self.bake(o, o.local, 0, &mut out);
+        }
+        out
+    }
+
+    /// The moving objects at `state`'s frame, in world space, with indices starting at
+    /// vertex `base` (where they follow the static geometry).
+    pub fn moving_geometry(&self, state: &FrameState, base: u32) -> (Vec<GpuVertex>, Vec<u32>) {
+        let mut out = (Vec::new(), Vec::new());
+        for (o, m) in self.objects.iter().zip(&state.transforms) {
+            if !o.is_static() {
+                self.bake(o, *m, base, &mut out);
+            }
+        }
+        out
+    }
+
+    /// A fingerprint of everything [`Scene::static_geometry`] depends on (objects, meshes,
+    /// materials): equal fingerprints mean equal static geometry.
+    pub fn static_fingerprint(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        let words = |h: &mut std::collections::hash_map::DefaultHasher, v: &[f32]| {
+            bytemuck::cast_slice::<f32, u32>(v).hash(h)
+        };
+        self.meshes.len().hash(&mut h);
+        for o in self.objects.iter().filter(|o| o.is_static()) {
+            (o.mesh, o.material).hash(&mut h);
+            words(&mut h, &o.local.to_cols_array());
+            let mesh = &self.meshes[o.mesh];
+            mesh.indices.hash(&mut h);
+            words(&mut h, bytemuck::cast_slice(&mesh.positions));
+            words(&mut h, bytemuck::cast_slice(&mesh.normals));
+            words(&mut h, bytemuck::cast_slice(&mesh.uvs));
+        }
+        for m in &self.materials {
+            words(&mut h, bytemuck::cast_slice(&[m.to_gpu()]));
+        }
+        h.finish()
+    }
+
+    fn bake(&self, o: &Object, m: Mat4, base: u32, out: &mut (Vec<GpuVertex>, Vec<u32>)) {
+        let (vertices, indices) = out;
+        let mesh = &self.meshes[o.mesh];
+        let first = base + vertices.len() as u32;
+        let nm = glam::Mat3::from_mat4(m).inverse().transpose();
+        for i in 0..mesh.positions.len() {
+            vertices.push(GpuVertex {
+                position: m.transform_point3(mesh.positions[i]).to_array(),
+                normal: (nm * mesh.normals[i]).normalize_or_zero().to_array(),
+                uv: mesh.uvs[i].to_array(),
+                material: o.material as u32,
+            });
+        }
+        indices.extend(mesh.indices.iter().map(|i| i + first));
     }
 
     /// Check the scene is renderable: lights valid and within [`MAX_LIGHTS`], indices in

@@ -71,16 +71,6 @@ pub fn create_module(device: &wgpu::Device, shader: &ComposedShader) -> wgpu::Sh
     })
 }
 
-/// Every shader the library can create, for the validation test: the registry's pipelines
-/// plus the shared passes.
-pub fn all_shaders() -> Vec<ComposedShader> {
-    let mut out = crate::passes::shaders();
-    for p in crate::pipelines::PIPELINES {
-        out.extend((p.shaders)());
-    }
-    out
-}
-
 /// A compute pipeline from a composed shader's `entry` point and explicit layouts.
 pub fn compute_pipeline(
     device: &wgpu::Device,

@@ -4,6 +4,18 @@
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var<storage, read> materials: array<Material>;
+// The frame counters (slots COUNTER_* from consts.rs), cleared at the start of every frame and
+// read back after it: truncated loops, index-list and pair sizes, indirect dispatch arguments.
+@group(0) @binding(3) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;
+
+// No loop ends silently (llvmpipe ends an invocation's loops after 65,536 iterations without a
+// word): call after every data-dependent loop with the index it stopped at and its bound; a
+// loop that stopped short is counted, and the frame is reported wrong, never passed off as right.
+fn check_loop(stopped: u32, bound: u32) {
+    if (stopped < bound) {
+        atomicAdd(&frame_counters[COUNTER_TRUNCATED_LOOPS], 1u);
+    }
+}
 
 // Unit vector from a world-space point to the eye.
 fn view_dir_to(world: vec3<f32>) -> vec3<f32> {

@@ -1,0 +1,217 @@
+//! Analysis: what only a measuring run asks for (`render --stats`, `compare`, `bench`, the
+//! tests), never the real-time path. The frame's image, depth and lighting counts are copied
+//! out in the frame's own submission ([`AnalysisReadbacks`]); after the wait the ideal count
+//! is computed on the CPU, the grid the pipeline shaded with is downloaded
+//! (`GridBuilder::download`) and everything lands in [`FrameStats`].
+
+use crate::culling::{
+    assign_cpu, cell_bounds_cpu, ideal_lighting_computations, BuiltGrid, DepthRange, LightGrid,
+    ViewSetup,
+};
+use crate::error::Result;
+use crate::frame::FrameIo;
+use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
+use crate::passes::{Readback, Targets};
+use crate::pipelines::PipelineInfo;
+use crate::renderer::{FinishedFrame, Renderer};
+use crate::scene::{FrameState, Scene};
+use crate::stats::{FrameStats, TimingSource};
+use image::RgbaImage;
+
+/// An image, its statistics, and what the analysis saw.
+pub struct FrameOutput {
+    pub image: RgbaImage,
+    pub stats: FrameStats,
+    /// The grid the pipeline shaded with; for pipelines that build none, the depth-bounded
+    /// CPU tile grid used for the ideal count (see `grid_is_pipelines`).
+    pub grid: LightGrid,
+    pub grid_is_pipelines: bool,
+    /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
+    /// their CPU twin); None for pipelines without a grid.
+    pub cell_bounds: Option<Vec<[f32; 2]>>,
+    /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry).
+    pub depth: Vec<f32>,
+}
+
+/// The staging buffers an analysis frame copies its image, counts and depth into.
+pub struct AnalysisReadbacks {
+    image: Readback,
+    counts: Readback,
+    depth: Readback,
+}
+
+impl AnalysisReadbacks {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        AnalysisReadbacks {
+            image: Readback::new(device, "image readback", width, height),
+            counts: Readback::new(device, "counts readback", width, height),
+            depth: Readback::new(device, "depth readback", width, height),
+        }
+    }
+
+    /// Record the copies (after the tonemap).
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
+        let all = wgpu::TextureAspect::All;
+        self.image.encode(encoder, &targets.ldr_texture, all);
+        self.counts.encode(encoder, &targets.counts_texture, all);
+        self.depth.encode(
+            encoder,
+            &targets.depth_texture,
+            wgpu::TextureAspect::DepthOnly,
+        );
+    }
+}
+
+/// The memory section of the stats: the pipeline's model applied to this frame.
+fn frame_memory(
+    model: MemoryModel,
+    (width, height): (u32, u32),
+    lighting_computations: Option<u64>,
+    grid: Option<&LightGrid>,
+) -> FrameMemory {
+    let pixels = u64::from(width) * u64::from(height);
+    let t = model.traffic;
+    let modelled = |per_pixel: u32, per_lit: u32| {
+        lighting_computations.map(|n| u64::from(per_pixel) * pixels + u64::from(per_lit) * n)
+    };
+    FrameMemory {
+        bytes_per_pixel: model.bytes_per_pixel(),
+        target_bytes: model.target_bytes(width, height),
+        grid_bytes: grid
+            .map(|g| (g.cells.len() * 8 + g.indices.len() * INDEX_BYTES as usize) as u64),
+        modelled_write_bytes: modelled(t.write_per_pixel, t.write_per_lit),
+        modelled_read_bytes: modelled(t.read_per_pixel, t.read_per_lit),
+        forward_plus_table1: grid
+            .map(|g| ForwardPlusTable1::new(pixels, g.average_lights_per_cell(), g.dims.tile_size)),
+        targets: model.targets,
+        traffic: t,
+    }
+}
+
+/// What [`analyze`] works from: a finished, waited-for analysis frame.
+pub(crate) struct AnalysisInput<'r, 'c> {
+    pub renderer: &'r Renderer<'c>,
+    pub scene: &'r Scene,
+    pub info: &'static PipelineInfo,
+    pub up_state: &'r FrameState,
+    pub setup: ViewSetup,
+    pub triangles: u32,
+    pub finished: FinishedFrame,
+    pub grid: Option<BuiltGrid>,
+    pub io: FrameIo,
+    pub reruns: u32,
+    pub wall_ms: f64,
+}
+
+/// Read the frame's copies back and compute its statistics.
+pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
+    let r = a.renderer;
+    let ctx = r.ctx();
+    let device = &ctx.device;
+    let (width, height) = r.size();
+    let dims = r.dims();
+    let settings = r.settings();
+    let lights = &a.up_state.lights;
+    let image = RgbaImage::from_raw(width, height, r.readbacks().image.read(device)?)
+        .expect("size matches");
+    let depth: Vec<f32> = r.readbacks().depth.read_f32(device)?;
+    let lighting_computations = if ctx.count_blend {
+        let counts: Vec<f32> = r.readbacks().counts.read_f32(device)?;
+        Some(counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64)
+    } else {
+        None
+    };
+
+    // The ideal: for each visible sample, the lights reaching it. The depth-bounded CPU
+    // grid narrows the search (it provably contains every such light).
+    let setup = a.setup;
+    let view_distance: Vec<f32> = depth
+        .iter()
+        .map(|&d| {
+            if d < 1.0 {
+                setup.view_distance(d)
+            } else {
+                f32::INFINITY
+            }
+        })
+        .collect();
+    let bounds = cell_bounds_cpu(&setup, &dims, &depth);
+    let bounded = assign_cpu(&setup, &dims, lights, DepthRange::Cells(&bounds));
+    let ideal = ideal_lighting_computations(&setup, &bounded, lights, &view_distance);
+
+    let passes = a.finished.passes;
+    let (gpu_ms, timing) = match a.finished.gpu_ms {
+        Some(ms) => (ms, TimingSource::GpuTimestamps),
+        None => (a.wall_ms, TimingSource::WallClock),
+    };
+    let grid_is_pipelines = a.grid.is_some();
+    let assign_gpu_ms = passes
+        .iter()
+        .filter(|p| p.label.starts_with("assign:"))
+        .map(|p| p.ms)
+        .reduce(|x, y| x + y)
+        .filter(|_| grid_is_pipelines);
+    let (grid, cell_bounds, assign, assign_cpu_ms) = match a.grid {
+        Some(b) => (
+            b.grid,
+            Some(b.cell_bounds),
+            Some(b.assign.name().to_string()),
+            Some(b.cpu_ms),
+        ),
+        None => (bounded, None, None, None),
+    };
+    // The strategy's whole cost: its GPU passes, its CPU work and the waits it made.
+    let assign_ms = assign_cpu_ms.map(|cpu| cpu + assign_gpu_ms.unwrap_or(0.0) + a.io.cpu_wait_ms);
+    let occupied = cell_bounds
+        .as_ref()
+        .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
+    let memory = frame_memory(
+        (a.info.memory)(&settings),
+        (width, height),
+        lighting_computations,
+        grid_is_pipelines.then_some(&grid),
+    );
+    Ok(FrameOutput {
+        image,
+        stats: FrameStats {
+            scene: a.scene.name.clone(),
+            pipeline: a.info.id.to_string(),
+            adapter: ctx.adapter_label(),
+            width,
+            height,
+            frame: a.up_state.frame,
+            lights: lights.len() as u32,
+            triangles: a.triangles,
+            gpu_ms,
+            timing,
+            wall_ms: a.wall_ms,
+            cpu_wait_ms: a.io.cpu_wait_ms,
+            submits: a.io.submits,
+            readback_bytes: a.io.readback_bytes,
+            truncated_loops: a.finished.truncated_loops,
+            passes,
+            tile_size: settings.tile_size,
+            gbuffer_bits: settings.gbuffer.bits(),
+            lighting_computations,
+            ideal_lighting_computations: ideal,
+            efficiency: lighting_computations
+                .filter(|&n| n > 0)
+                .map(|n| ideal as f64 / n as f64),
+            lights_per_tile_avg: grid_is_pipelines.then(|| grid.average_lights_per_cell()),
+            lights_per_tile_max: grid_is_pipelines.then(|| grid.max_lights_per_cell()),
+            grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
+            grid_cells: grid_is_pipelines.then_some(grid.cells.len() as u64),
+            grid_cells_occupied: occupied,
+            assign,
+            assign_gpu_ms,
+            assign_cpu_ms,
+            assign_ms,
+            assign_reruns: grid_is_pipelines.then_some(a.reruns),
+            memory,
+        },
+        grid,
+        grid_is_pipelines,
+        cell_bounds,
+        depth,
+    })
+}

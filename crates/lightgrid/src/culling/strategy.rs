@@ -1,0 +1,120 @@
+//! Light-assignment strategies behind one trait, one file and one registry row each (like the
+//! pipelines): [`STRATEGIES`] maps every `--assign` value to the type that records it.
+//!
+//! A strategy reads the cell bounds (`cell_bounds.rs`), the lights and the camera, and leaves
+//! the frame's grid in [`GridBuffers`] (the paper's three arrays, group 1 of the shading pass).
+//! GPU strategies record everything into the frame's one submission; their buffers are sized
+//! from the frame counters of earlier frames ([`AssignStrategy::observe`]), and a frame whose
+//! lists did not fit is reported by those counters, never passed off as right.
+
+use super::builder::CellSource;
+use super::cell_bounds::CellBoundsPass;
+use super::{Assign, GridBuffers, GridDims, LightGrid};
+use crate::error::Result;
+use crate::frame::{FrameEncoder, FrameInputs};
+use crate::gpu::CounterValues;
+
+/// What a strategy works on in one frame.
+pub struct AssignFrame<'a, 'f> {
+    pub f: &'a FrameInputs<'f>,
+    /// The grid it fills.
+    pub grid: &'a mut GridBuffers,
+    /// The cell bounds it reads (recorded before it in the same encoder).
+    pub bounds: &'a CellBoundsPass,
+    pub dims: &'a GridDims,
+    /// Where the bounds came from (`NearFar`: every cell spans near..far).
+    pub source: CellSource,
+}
+
+/// What a strategy produced on the CPU side of a frame.
+#[derive(Default)]
+pub struct StrategyRun {
+    /// CPU time of the assignment itself (`assign_cpu`, the BVH build).
+    pub cpu_ms: f64,
+    /// The grid, when the CPU built it (analysis reads it instead of downloading it).
+    pub cpu_grid: Option<LightGrid>,
+    /// The cell bounds, when the strategy read them back.
+    pub cell_bounds: Option<Vec<[f32; 2]>>,
+}
+
+/// One light-assignment strategy.
+pub trait AssignStrategy {
+    /// Record this frame's assignment into `enc` (after the cell bounds).
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun>;
+    /// Size buffers from a finished frame's counters (an earlier frame's, read back without
+    /// waiting, or in analysis the frame's own). Errors when the grid cannot fit the device.
+    fn observe(&mut self, _device: &wgpu::Device, _values: &CounterValues) -> Result<()> {
+        Ok(())
+    }
+    /// Index entries of the grid a finished frame built (its counters).
+    fn grid_entries(&self, _values: &CounterValues) -> u32 {
+        0
+    }
+}
+
+/// What a strategy needs to create its GPU objects.
+pub struct StrategyContext<'a> {
+    pub device: &'a wgpu::Device,
+    pub scene_layout: &'a wgpu::BindGroupLayout,
+}
+
+/// One registry row.
+pub struct StrategyInfo {
+    pub assign: Assign,
+    pub create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
+}
+
+/// The registry: every strategy `--assign` can name (`auto` resolves to one of them).
+pub const STRATEGIES: &[StrategyInfo] = &[
+    StrategyInfo {
+        assign: Assign::Cpu,
+        create: super::assign_cpu::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::Gather,
+        create: super::gather::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::Scatter,
+        create: super::scatter::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::Bvh,
+        create: super::bvh::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::BvhGpu,
+        create: super::bvh_gpu::create_strategy,
+    },
+];
+
+/// The registry row of a (resolved) strategy.
+pub fn find_strategy(assign: Assign) -> Option<&'static StrategyInfo> {
+    STRATEGIES.iter().find(|s| s.assign == assign)
+}
+
+/// Capacity of a list sized from earlier frames: grows to 5/4 of what a frame needed, never
+/// shrinks, and refuses sizes the device cannot bind.
+pub struct ListCapacity {
+    pub entries: u64,
+    stage: &'static str,
+}
+
+impl ListCapacity {
+    pub fn new(stage: &'static str, initial: u64) -> Self {
+        ListCapacity {
+            entries: initial,
+            stage,
+        }
+    }
+
+    /// A frame needed `needed` entries: grow to fit it with headroom.
+    pub fn observe(&mut self, device: &wgpu::Device, needed: u64) -> Result<()> {
+        super::gpu_assign::check_index_capacity(device, needed, self.stage)?;
+        if needed > self.entries {
+            let limit = super::gpu_assign::max_index_entries(device);
+            self.entries = (needed + needed / 4).min(limit);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,117 @@
+//! The geometry passes every pipeline shares: a render pipeline over the scene's vertices with
+//! the shared vertex stage, the draw of the whole scene, and the forward lighting pass into
+//! HDR + counts.
+
+use crate::frame::FrameInputs;
+use crate::gpu::PassTimer;
+
+/// A render pipeline drawing the scene geometry with the shared vertex stage.
+pub(crate) struct GeometryPipelineDesc<'a> {
+    pub label: &'a str,
+    pub module: &'a wgpu::ShaderModule,
+    /// None for a depth-only pass.
+    pub fragment_entry: Option<&'a str>,
+    pub layouts: &'a [Option<&'a wgpu::BindGroupLayout>],
+    pub color_targets: &'a [Option<wgpu::ColorTargetState>],
+    pub depth_write: bool,
+    pub depth_compare: wgpu::CompareFunction,
+}
+
+pub(crate) fn geometry_pipeline(
+    device: &wgpu::Device,
+    d: &GeometryPipelineDesc,
+) -> wgpu::RenderPipeline {
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(d.label),
+        bind_group_layouts: d.layouts,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(d.label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: d.module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(crate::passes::vertex_layout())],
+        },
+        // No culling: thin and open geometry is shaded two-sided (see geometry.wgsl).
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: crate::passes::DEPTH_FORMAT,
+            depth_write_enabled: Some(d.depth_write),
+            depth_compare: Some(d.depth_compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: d.fragment_entry.map(|entry| wgpu::FragmentState {
+            module: d.module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: d.color_targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Bind group 0 (+ `extra` from group 1 on), the scene's buffers, and draw everything.
+pub(crate) fn draw_scene(pass: &mut wgpu::RenderPass, f: &FrameInputs, extra: &[&wgpu::BindGroup]) {
+    pass.set_bind_group(0, f.scene_bind_group, &[]);
+    for (i, g) in extra.iter().enumerate() {
+        pass.set_bind_group(1 + i as u32, *g, &[]);
+    }
+    pass.set_vertex_buffer(0, f.vertices.slice(..));
+    pass.set_index_buffer(f.indices.slice(..), wgpu::IndexFormat::Uint32);
+    pass.draw_indexed(0..f.index_count, 0, 0..1);
+}
+
+/// A forward lighting pass into HDR + counts. `depth_cleared`: clear and write depth (no
+/// pre-pass) or load the pre-pass depth.
+pub(crate) fn begin_lighting_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    timer: &mut PassTimer,
+    f: &FrameInputs,
+    label: &str,
+    depth_cleared: bool,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &lighting_attachments(f),
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &f.targets.depth,
+            depth_ops: Some(wgpu::Operations {
+                load: if depth_cleared {
+                    wgpu::LoadOp::Clear(1.0)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: timer.render_pass(label),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// HDR (cleared to black) and, when countable, the count target (cleared to zero).
+pub(crate) fn lighting_attachments<'a>(
+    f: &'a FrameInputs,
+) -> [Option<wgpu::RenderPassColorAttachment<'a>>; 2] {
+    [
+        Some(crate::passes::cleared(&f.targets.hdr, wgpu::Color::BLACK)),
+        f.count_blend
+            .then(|| crate::passes::cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
+    ]
+}
+
+/// Colour targets of a forward lighting pipeline: HDR and (when countable) the count target.
+pub(crate) fn lighting_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
+    [
+        Some(crate::passes::HDR_FORMAT.into()),
+        crate::passes::count_target(count_blend),
+    ]
+}
