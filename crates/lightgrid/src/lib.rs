@@ -18,6 +18,7 @@ pub mod memory;
 pub mod passes;
 pub mod pipelines;
 pub mod plot;
+pub mod realtime;
 mod renderer;
 pub mod scene;
 pub mod shader;

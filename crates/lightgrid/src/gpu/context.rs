@@ -182,7 +182,9 @@ impl GpuContext {
     }
 
     /// Loop iterations one shader invocation may run before the driver silently ends its loops
-    /// (`consts::SOFTWARE_LOOP_BUDGET` on llvmpipe); None where no such limit is known.
+    /// (`consts::SOFTWARE_LOOP_BUDGET` on llvmpipe); None where no such limit is known. Only
+    /// informative (tests, messages): frames detect truncated loops on the GPU
+    /// (`FrameStats::truncated_loops`).
     pub fn loop_budget(&self) -> Option<u64> {
         self.info
             .name

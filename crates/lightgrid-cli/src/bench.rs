@@ -1,0 +1,232 @@
+//! `lightgrid bench` and `lightgrid report`: the papers' evaluations and their report.
+
+use crate::args::{
+    format_duration, parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size,
+};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use lightgrid::bench::{BenchConfig, FrameRange};
+use lightgrid::gpu::GpuContext;
+use lightgrid::image_io::check_writable;
+use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::PIPELINES;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub(crate) enum Preset {
+    /// CI-sized smoke run: robots-many at 160x90, 4 frames, every pipeline.
+    Quick,
+    /// The papers' configurations: robots-many and robots-few, frames 0..259 every 5, 16- and
+    /// 32-bit G-buffers, at 1920x1080 on a hardware GPU or 640x360 on a software one.
+    Paper,
+}
+
+#[derive(Args)]
+pub(crate) struct BenchArgs {
+    /// Start from a preset; flags given explicitly override it.
+    #[arg(long, value_enum)]
+    pub(crate) preset: Option<Preset>,
+    /// Scenes (repeat the flag or separate with commas). Default: robots-many.
+    #[arg(long = "scene", value_delimiter = ',')]
+    pub(crate) scenes: Vec<String>,
+    /// `all` or a comma-separated list of pipeline ids.
+    #[arg(long)]
+    pub(crate) pipelines: Option<String>,
+    /// Frames A..B:STEP (inclusive). Default: 0..259:5, the paper's 5 fps sampling.
+    #[arg(long)]
+    pub(crate) frames: Option<String>,
+    /// Frame size WIDTHxHEIGHT (default: the scene's own size).
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<Size>,
+    /// Screen tile edge in pixels.
+    #[arg(long)]
+    pub(crate) tile: Option<u32>,
+    /// View-depth slices of clustered pipelines.
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
+    pub(crate) slices: u32,
+    /// Who builds the light grid of grid pipelines.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub(crate) assign: AssignArg,
+    /// MSAA sample count. Only 1 is supported until MSAA lands.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) msaa: u32,
+    /// G-buffer precisions to measure: 16, 32 or 16,32.
+    #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
+    pub(crate) gbuffer: Vec<GBufferFormat>,
+    /// Measurements per frame; the median is kept and the spread recorded.
+    #[arg(long)]
+    pub(crate) repeat: Option<u32>,
+    /// Discarded renders before each pipeline's series.
+    #[arg(long)]
+    pub(crate) warmup: Option<u32>,
+    /// Light count for scenes that take one.
+    #[arg(long)]
+    pub(crate) lights: Option<u32>,
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
+    #[arg(long)]
+    pub(crate) heatmap_frame: Option<u32>,
+    /// Output directory.
+    #[arg(long, default_value = "bench")]
+    pub(crate) out: PathBuf,
+}
+
+#[derive(Args)]
+pub(crate) struct ReportArgs {
+    /// The benchmark directory (reads results.json, writes the report files next to it).
+    pub(crate) dir: PathBuf,
+}
+
+/// What a preset (or no preset) sets before explicit flags override it.
+pub(crate) struct BenchDefaults {
+    pub(crate) scenes: Vec<&'static str>,
+    pub(crate) frames: &'static str,
+    pub(crate) size: Option<(u32, u32)>,
+    pub(crate) gbuffers: Vec<GBufferFormat>,
+    pub(crate) repeat: u32,
+    pub(crate) pipelines: Vec<String>,
+}
+
+pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
+    if a.msaa != 1 {
+        bail!(
+            "--msaa {}: MSAA is not implemented yet; only --msaa 1 can be measured",
+            a.msaa
+        );
+    }
+    let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
+    let d = match a.preset {
+        None => BenchDefaults {
+            scenes: vec!["robots-many"],
+            frames: "0..259:5",
+            size: None,
+            gbuffers: vec![GBufferFormat::F16],
+            repeat: 1,
+            pipelines: all.clone(),
+        },
+        Some(Preset::Quick) => BenchDefaults {
+            scenes: vec!["robots-many"],
+            frames: "0..259:86",
+            size: Some((160, 90)),
+            gbuffers: vec![GBufferFormat::F16],
+            repeat: 1,
+            pipelines: all.clone(),
+        },
+        Some(Preset::Paper) => BenchDefaults {
+            scenes: vec!["robots-many", "robots-few"],
+            frames: "0..259:5",
+            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+            gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
+            repeat: if hardware { 3 } else { 1 },
+            // forward_mono only exists as light_prepass_mono's test reference.
+            pipelines: all
+                .iter()
+                .filter(|p| *p != "forward_mono")
+                .cloned()
+                .collect(),
+        },
+    };
+    let (scenes, frames, size, gbuffers, repeat, pipelines) = (
+        d.scenes,
+        d.frames,
+        d.size,
+        d.gbuffers,
+        d.repeat,
+        d.pipelines,
+    );
+    let pipelines = match a.pipelines.as_deref() {
+        None => pipelines,
+        Some("all") => all,
+        Some(list) => list
+            .split(',')
+            .map(|p| p.trim().to_string())
+            .filter(|p| !p.is_empty())
+            .collect(),
+    };
+    let config = BenchConfig {
+        scenes: if a.scenes.is_empty() {
+            scenes.iter().map(|s| s.to_string()).collect()
+        } else {
+            a.scenes.clone()
+        },
+        pipelines,
+        frames: FrameRange::parse(a.frames.as_deref().unwrap_or(frames))?,
+        size: a.size.map(|Size(w, h)| (w, h)).or(size),
+        tile_size: a.tile.unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
+        slices: a.slices,
+        assign: a.assign.into(),
+        gbuffers: if a.gbuffer.is_empty() {
+            gbuffers
+        } else {
+            a.gbuffer.clone()
+        },
+        repeat: a.repeat.unwrap_or(repeat),
+        warmup: a.warmup.unwrap_or(1),
+        seed: a.seed,
+        lights: a.lights,
+        heatmap_frame: a.heatmap_frame,
+    };
+    config.validate()?;
+    Ok(config)
+}
+
+pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
+    check_writable(&a.out.join("results.json")).or_else(|_| {
+        std::fs::create_dir_all(&a.out)
+            .with_context(|| format!("cannot create {}", a.out.display()))
+    })?;
+    let ctx = GpuContext::new(adapter)?;
+    let config = bench_config(a, !ctx.is_software())?;
+    let stop = stop_on_ctrl_c()?;
+    eprintln!(
+        "benchmark on {}: {} scene(s), {} pipeline(s), frames {}..{} every {}, writing to {}",
+        ctx.adapter_label(),
+        config.scenes.len(),
+        config.pipelines.len(),
+        config.frames.start,
+        config.frames.end,
+        config.frames.step,
+        a.out.display()
+    );
+    let start = std::time::Instant::now();
+    let mut progress = progress_bar();
+    let mut results = lightgrid::bench::run(&ctx, &config, &stop, &mut progress)?;
+    eprintln!();
+    results.command = std::env::args().collect::<Vec<_>>().join(" ");
+    let written = lightgrid::bench::write_report(&a.out, &results)?;
+    let claims = lightgrid::bench::evaluate_claims(&results);
+    let held = claims
+        .iter()
+        .filter(|c| c.verdict == lightgrid::bench::Verdict::Held)
+        .count();
+    let measured = claims
+        .iter()
+        .filter(|c| c.verdict != lightgrid::bench::Verdict::NotMeasured)
+        .count();
+    println!(
+        "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
+        results.runs.len(),
+        format_duration(start.elapsed().as_secs_f64()),
+        written.len(),
+        a.out.display()
+    );
+    if results.interrupted {
+        bail!(
+            "interrupted: partial results written to {}",
+            a.out.display()
+        );
+    }
+    Ok(())
+}
+
+pub(crate) fn report(a: &ReportArgs) -> Result<()> {
+    let results = lightgrid::bench::read_results(&a.dir.join("results.json"))?;
+    let written = lightgrid::bench::write_report(&a.dir, &results)?;
+    println!(
+        "{} files rewritten in {} (heatmaps are kept from the run)",
+        written.len(),
+        a.dir.display()
+    );
+    Ok(())
+}

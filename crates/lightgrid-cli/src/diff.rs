@@ -1,0 +1,52 @@
+//! `lightgrid diff`: the per-pixel difference of two images.
+
+use anyhow::{bail, Result};
+use clap::Args;
+use lightgrid::image_io::{diff, load_image, save_png};
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub(crate) struct DiffArgs {
+    pub(crate) a: PathBuf,
+    pub(crate) b: PathBuf,
+    /// Print a JSON object {"mean", "p99", "max"} instead of text.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Exit with status 1 when the mean difference is above this.
+    #[arg(long)]
+    pub(crate) max_mean: Option<f64>,
+    /// Exit with status 1 when the 99th-percentile difference is above this.
+    #[arg(long)]
+    pub(crate) max_p99: Option<f64>,
+    /// Write a visual diff image (PNG) here.
+    #[arg(long)]
+    pub(crate) diff_image: Option<PathBuf>,
+}
+
+pub(crate) fn diff_cmd(a: &DiffArgs) -> Result<()> {
+    let img_a = load_image(&a.a)?;
+    let img_b = load_image(&a.b)?;
+    let (d, vis) = diff(&img_a, &img_b)?;
+    if let Some(p) = &a.diff_image {
+        save_png(&vis, p)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string(&d)?);
+    } else {
+        println!(
+            "mean {:.4}  p99 {}  max {}  (8-bit sRGB levels, largest channel per pixel)",
+            d.mean, d.p99, d.max
+        );
+    }
+    let mut over = Vec::new();
+    if let Some(m) = a.max_mean.filter(|&m| d.mean > m) {
+        over.push(format!("mean {:.4} > {m}", d.mean));
+    }
+    if let Some(m) = a.max_p99.filter(|&m| d.p99 > m) {
+        over.push(format!("p99 {} > {m}", d.p99));
+    }
+    if !over.is_empty() {
+        bail!("images differ: {}", over.join(", "));
+    }
+    Ok(())
+}

@@ -1,0 +1,59 @@
+//! `lightgrid memory`: render targets and the traffic model of every pipeline.
+
+use crate::args::{parse_gbuffer, parse_size, Size};
+use anyhow::Result;
+use clap::Args;
+use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::PIPELINES;
+use lightgrid::RenderSettings;
+
+#[derive(Args)]
+pub(crate) struct MemoryArgs {
+    /// Frame size WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_size, default_value = "1920x1080")]
+    pub(crate) size: Size,
+    /// G-buffer channel precision in bits for deferred pipelines.
+    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
+    pub(crate) gbuffer: GBufferFormat,
+}
+
+pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
+    let Size(w, h) = a.size;
+    let settings = RenderSettings {
+        gbuffer: a.gbuffer,
+        ..Default::default()
+    };
+    println!("render targets at {w}x{h}, {}-bit G-buffer (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
+    println!(
+        "{:<22} {:>6} {:>10}   {:>9} {:>9} {:>9} {:>9}   targets",
+        "pipeline", "B/px", "total MiB", "wr B/px", "rd B/px", "wr B/lit", "rd B/lit"
+    );
+    for p in PIPELINES {
+        let m = (p.memory)(&settings);
+        let t = m.traffic;
+        let targets: Vec<String> = m
+            .targets
+            .iter()
+            .map(|t| format!("{} {}", t.name, t.bytes_per_pixel))
+            .collect();
+        println!(
+            "{:<22} {:>6} {:>10.2}   {:>9} {:>9} {:>9} {:>9}   {}",
+            p.id,
+            m.bytes_per_pixel(),
+            m.target_bytes(w, h) as f64 / (1024.0 * 1024.0),
+            t.write_per_pixel,
+            t.read_per_pixel,
+            t.write_per_lit,
+            t.read_per_lit,
+            targets.join(", ")
+        );
+    }
+    println!(
+        "traffic model (deferred-shading-vs-deferred-lighting): render-target bytes per pixel and per lit pixel \
+         (one lighting computation); blending counts as read + write; light data {} B per light, grid indices {} B; \
+         tiled pipelines also upload their grid each frame (see --stats memory.grid_bytes)",
+        lightgrid::memory::LIGHT_BYTES,
+        lightgrid::memory::INDEX_BYTES
+    );
+    Ok(())
+}

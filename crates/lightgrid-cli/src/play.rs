@@ -1,0 +1,253 @@
+//! `lightgrid play`: a scene's animation rendered back to back on the real-time path (one
+//! queue submission per frame, frames in flight, no analysis), with frames per second and
+//! the frame-time distribution (`lightgrid::realtime`).
+
+use crate::args::{parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use lightgrid::bench::{FrameRange, Progress};
+use lightgrid::gpu::GpuContext;
+use lightgrid::image_io::{check_writable, write_atomic};
+use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::{self, REFERENCE};
+use lightgrid::realtime::{play as play_frames, Distribution, PlayPlan, PlayRun};
+use lightgrid::scene::catalog::{self, SceneParams};
+use lightgrid::{RenderSettings, Renderer};
+use serde::Serialize;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub(crate) struct PlayArgs {
+    /// Scene from the catalog (see `lightgrid list`).
+    #[arg(long, default_value = "robots-many")]
+    pub(crate) scene: String,
+    /// Pipeline id (see `lightgrid list`).
+    #[arg(long, default_value = REFERENCE)]
+    pub(crate) pipeline: String,
+    /// Who builds the light grid of grid pipelines.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub(crate) assign: AssignArg,
+    /// Animation frames A..B (inclusive; A..B:STEP or N also work). Default: the whole
+    /// animation.
+    #[arg(long)]
+    pub(crate) frames: Option<String>,
+    /// Frame size WIDTHxHEIGHT (default: the scene's own size).
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<Size>,
+    /// Passes over the frames.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) loops: u32,
+    /// Frames rendered first and not measured (shader compilation, list growth).
+    #[arg(long, default_value_t = 3)]
+    pub(crate) warmup: u32,
+    /// Write the results as JSON here.
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
+    /// Screen tile edge in pixels for grid pipelines (4 to 64).
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    pub(crate) tile: u32,
+    /// View-depth slices of clustered pipelines (1 to 256).
+    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
+    pub(crate) slices: u32,
+    /// G-buffer channel precision in bits for deferred pipelines.
+    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
+    pub(crate) gbuffer: GBufferFormat,
+    /// Light count, for scenes that take one (stress: 1 to 1000000).
+    #[arg(long)]
+    pub(crate) lights: Option<u32>,
+    /// Seed of the scene's random placement.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+}
+
+/// The `--json` file.
+#[derive(Serialize)]
+struct PlayJson<'a> {
+    scene: &'a str,
+    pipeline: &'a str,
+    /// The strategy that built the grid (`auto` resolved); null for pipelines without one.
+    assign: Option<&'static str>,
+    adapter: String,
+    width: u32,
+    height: u32,
+    /// Frames measured (the animation frames times the loops).
+    frames: usize,
+    first_frame: u32,
+    last_frame: u32,
+    loops: u32,
+    warmup: u32,
+    fps: f64,
+    /// Wall time from one frame's start to the next's: what a game would see.
+    frame_ms: Option<Distribution>,
+    /// GPU work per frame: the sum of its pass durations from timestamps resolved without
+    /// waiting; null where the adapter has no timestamps.
+    gpu_ms: Option<Distribution>,
+    submits_per_frame: f64,
+    /// Bytes read back with a wait per frame (0 but for `--assign cpu` with depth bounds).
+    readback_bytes_per_frame: f64,
+    upload_bytes_per_frame: f64,
+    /// Frames whose light lists did not fit (sized from earlier frames; grown after).
+    overflow_frames: usize,
+    /// Frames with shader loops cut short (wrong frames; `play` exits non-zero).
+    truncated_frames: usize,
+    interrupted: bool,
+    per_frame: &'a [lightgrid::realtime::PlayedFrame],
+}
+
+pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
+    let info = pipelines::find(&a.pipeline)?;
+    if let Some(path) = &a.json {
+        check_writable(path).context("--json is not writable")?;
+    }
+    if a.loops == 0 {
+        bail!("--loops must be at least 1");
+    }
+    let variable = catalog::find(&a.scene)?.variable_lights;
+    let scene = catalog::build(
+        &a.scene,
+        &SceneParams {
+            seed: a.seed,
+            lights: if variable { a.lights } else { None },
+        },
+    )?;
+    if a.lights.is_some() && !variable {
+        bail!("--lights: {} has a fixed light count", a.scene);
+    }
+    let range = match &a.frames {
+        Some(s) => FrameRange::parse(s)?,
+        None => FrameRange {
+            start: 0,
+            end: scene.frame_count() - 1,
+            step: 1,
+        },
+    };
+    if range.end >= scene.frame_count() {
+        bail!(
+            "--frames {}..{}: {} has frames 0..={}",
+            range.start,
+            range.end,
+            scene.name,
+            scene.frame_count() - 1
+        );
+    }
+    let frames = range.frames(scene.frame_count());
+    let ctx = GpuContext::new(adapter)?;
+    let Size(w, h) = a
+        .size
+        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let settings = RenderSettings {
+        tile_size: a.tile,
+        gbuffer: a.gbuffer,
+        slices: a.slices,
+        assign: a.assign.into(),
+    };
+    let mut renderer = Renderer::new(&ctx, w, h, settings)?;
+    let assign = info.assign.then(|| {
+        settings
+            .assign
+            .resolve(scene.lights.len(), ctx.is_software())
+            .name()
+    });
+    let stop = stop_on_ctrl_c()?;
+    eprintln!(
+        "playing {} frames {}..{} x {} with {}{} at {w}x{h} on {}",
+        scene.name,
+        range.start,
+        range.end,
+        a.loops,
+        info.id,
+        assign.map_or(String::new(), |s| format!(" (assign {s})")),
+        ctx.adapter_label()
+    );
+    if a.warmup > 0 {
+        let warm: Vec<u32> = frames
+            .iter()
+            .copied()
+            .cycle()
+            .take(a.warmup as usize)
+            .collect();
+        let plan = PlayPlan {
+            scene: &scene,
+            pipeline: info.id,
+            frames: &warm,
+            passes: 1,
+        };
+        play_frames(&mut renderer, &plan, &stop, &mut |_, _| {})?;
+    }
+    let plan = PlayPlan {
+        scene: &scene,
+        pipeline: info.id,
+        frames: &frames,
+        passes: a.loops,
+    };
+    let mut bar = progress_bar();
+    let run = play_frames(&mut renderer, &plan, &stop, &mut |done, total| {
+        bar(&Progress {
+            done,
+            total,
+            label: format!("{} {}", scene.name, info.id),
+        })
+    })?;
+    eprintln!();
+    print_summary(&run);
+    if let Some(path) = &a.json {
+        let json = PlayJson {
+            scene: &scene.name,
+            pipeline: info.id,
+            assign,
+            adapter: ctx.adapter_label(),
+            width: w,
+            height: h,
+            frames: run.frames.len(),
+            first_frame: range.start,
+            last_frame: *frames.last().expect("non-empty"),
+            loops: a.loops,
+            warmup: a.warmup,
+            fps: run.fps(),
+            frame_ms: run.frame_ms(),
+            gpu_ms: run.gpu_ms(),
+            submits_per_frame: run.submits_per_frame(),
+            readback_bytes_per_frame: run.readback_bytes_per_frame(),
+            upload_bytes_per_frame: run.upload_bytes_per_frame(),
+            overflow_frames: run.overflow_frames(),
+            truncated_frames: run.truncated_frames(),
+            interrupted: run.interrupted,
+            per_frame: &run.frames,
+        };
+        write_atomic(path, &serde_json::to_vec_pretty(&json)?)?;
+    }
+    if run.truncated_frames() > 0 {
+        bail!(
+            "{} of {} frames had shader loops cut short by the adapter (their images miss light); \
+             use fewer lights, a larger --tile or more --slices, or a hardware GPU",
+            run.truncated_frames(),
+            run.frames.len()
+        );
+    }
+    if run.interrupted {
+        bail!("interrupted after {} frames", run.frames.len());
+    }
+    Ok(())
+}
+
+fn print_summary(run: &PlayRun) {
+    let dist = |d: Option<Distribution>| {
+        d.map_or("n/a".into(), |d| {
+            format!(
+                "mean {:.2}  median {:.2}  p95 {:.2}  max {:.2}",
+                d.mean, d.median, d.p95, d.max
+            )
+        })
+    };
+    println!("{} frames, {:.2} fps", run.frames.len(), run.fps());
+    println!("frame ms (wall, frame to frame): {}", dist(run.frame_ms()));
+    println!("GPU ms (sum of pass timestamps):  {}", dist(run.gpu_ms()));
+    println!(
+        "per frame: {:.2} submissions, {:.0} bytes read back, {:.0} bytes uploaded; {} frames overflowed their lists, {} had truncated loops",
+        run.submits_per_frame(),
+        run.readback_bytes_per_frame(),
+        run.upload_bytes_per_frame(),
+        run.overflow_frames(),
+        run.truncated_frames()
+    );
+}

@@ -1,0 +1,97 @@
+//! `lightgrid render`: one frame of a scene with one pipeline (an analysis run: image,
+//! statistics, heatmap).
+
+use crate::args::{build_scene, timing_label, SceneArgs, Size};
+use anyhow::{Context, Result};
+use clap::Args;
+use lightgrid::gpu::GpuContext;
+use lightgrid::image_io::{check_writable, save_png, write_atomic};
+use lightgrid::pipelines::{self, REFERENCE};
+use lightgrid::Renderer;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub(crate) struct RenderArgs {
+    #[command(flatten)]
+    pub(crate) scene: SceneArgs,
+    /// Pipeline id (see `lightgrid list`).
+    #[arg(long, default_value = REFERENCE)]
+    pub(crate) pipeline: String,
+    /// Image to write (PNG).
+    #[arg(long)]
+    pub(crate) out: Option<PathBuf>,
+    /// Statistics to write (JSON).
+    #[arg(long)]
+    pub(crate) stats: Option<PathBuf>,
+    /// Lights-per-tile heatmap to write (PNG): the pipeline's own grid, or for pipelines
+    /// without a CPU grid the depth-bounded grid used for the ideal count.
+    #[arg(long)]
+    pub(crate) heatmap: Option<PathBuf>,
+}
+
+pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
+    pipelines::find(&a.pipeline)?;
+    for path in a.out.iter().chain(a.stats.iter()).chain(a.heatmap.iter()) {
+        check_writable(path).context("output is not writable")?;
+    }
+    let scene = build_scene(&a.scene)?;
+    let ctx = GpuContext::new(adapter)?;
+    let Size(w, h) = a
+        .scene
+        .size
+        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
+    for _ in 0..a.scene.warmup {
+        renderer.render(&scene, a.scene.frame, &a.pipeline)?;
+    }
+    let out = renderer.render(&scene, a.scene.frame, &a.pipeline)?;
+    if let Some(path) = &a.out {
+        save_png(&out.image, path)?;
+    }
+    if let Some(path) = &a.heatmap {
+        save_png(&lightgrid::heatmap::heatmap(&out.image, &out.grid), path)?;
+    }
+    if let Some(path) = &a.stats {
+        let json = serde_json::to_vec_pretty(&out.stats)?;
+        write_atomic(path, &json)?;
+    }
+    let s = &out.stats;
+    println!(
+        "{} / {} frame {} at {}x{}: {} lights, {:.2} ms ({}) on {}",
+        s.scene,
+        s.pipeline,
+        s.frame,
+        s.width,
+        s.height,
+        s.lights,
+        s.gpu_ms,
+        timing_label(s.timing),
+        s.adapter
+    );
+    println!(
+        "lighting computations {} (ideal {}, efficiency {}){}",
+        s.lighting_computations
+            .map_or("n/a".into(), |n| n.to_string()),
+        s.ideal_lighting_computations,
+        s.efficiency
+            .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0)),
+        match (s.lights_per_tile_avg, s.lights_per_tile_max) {
+            (Some(avg), Some(max)) =>
+                format!(", lights per {}px cell avg {avg:.1} max {max}", s.tile_size),
+            _ => String::new(),
+        }
+    );
+    if let (Some(assign), Some(indices)) = (&s.assign, s.grid_indices) {
+        println!(
+            "light assignment {assign}: {} ms wall ({} ms GPU timestamps{}), {indices} index entries in {} cells ({} with samples)",
+            s.assign_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
+            s.assign_gpu_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
+            s.assign_cpu_ms
+                .filter(|&ms| ms > 0.0)
+                .map_or(String::new(), |ms| format!(", {ms:.2} ms on the CPU")),
+            s.grid_cells.unwrap_or(0),
+            s.grid_cells_occupied.unwrap_or(0),
+        );
+    }
+    Ok(())
+}

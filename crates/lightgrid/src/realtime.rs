@@ -1,0 +1,199 @@
+//! The real-time frame loop: a scene's animation rendered back to back the way a game would
+//! ([`Renderer::render_frame`]: one submission per frame, frames in flight, no analysis), with
+//! each frame's period on the CPU and its GPU time from timestamps resolved asynchronously.
+//! `lightgrid play` prints it; `lightgrid bench` takes its frame times from it.
+
+use crate::error::{Error, Result};
+use crate::gpu::PassTiming;
+use crate::renderer::{FinishedFrame, Renderer};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// One frame of a real-time run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlayedFrame {
+    /// The animation frame.
+    pub frame: u32,
+    /// Which pass over the frames (0-based).
+    pub pass: u32,
+    /// Wall time from this frame's start to the next one's (the last: to the end of the run):
+    /// the frame period a game would see.
+    pub frame_ms: f64,
+    /// GPU work of the frame (sum of its pass durations); None without timestamps.
+    pub gpu_ms: Option<f64>,
+    pub passes: Vec<PassTiming>,
+    /// CPU time spent waiting for older frames (more than `MAX_FRAMES_IN_FLIGHT` in flight).
+    pub throttle_ms: f64,
+    /// CPU time the frame itself waited on the GPU (the `cpu` strategy's read-back).
+    pub cpu_wait_ms: f64,
+    pub submits: u32,
+    pub readback_bytes: u64,
+    pub upload_bytes: u64,
+    /// Some light list did not fit (the frame is missing lights; lists grew for later ones).
+    pub overflowed: bool,
+    /// Shader loops that ended before their bound (the frame is wrong).
+    pub truncated_loops: u32,
+}
+
+/// A whole real-time run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlayRun {
+    pub frames: Vec<PlayedFrame>,
+    /// Wall time from the first frame's start until the GPU finished the last.
+    pub wall_ms: f64,
+    /// Stopped (Ctrl-C) before the end.
+    pub interrupted: bool,
+}
+
+/// mean / median / 95th percentile / max of a series.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Distribution {
+    pub mean: f64,
+    pub median: f64,
+    pub p95: f64,
+    pub max: f64,
+}
+
+impl Distribution {
+    pub fn of(values: &[f64]) -> Option<Distribution> {
+        if values.is_empty() {
+            return None;
+        }
+        let mut v = values.to_vec();
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        Some(Distribution {
+            mean: v.iter().sum::<f64>() / v.len() as f64,
+            median: at(0.5),
+            p95: at(0.95),
+            max: v[v.len() - 1],
+        })
+    }
+}
+
+impl PlayRun {
+    pub fn frame_ms(&self) -> Option<Distribution> {
+        Distribution::of(&self.frames.iter().map(|f| f.frame_ms).collect::<Vec<_>>())
+    }
+
+    /// None when any frame lacks a GPU time (no timestamps).
+    pub fn gpu_ms(&self) -> Option<Distribution> {
+        let v: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
+        Distribution::of(&v?)
+    }
+
+    /// Frames per second over the whole run.
+    pub fn fps(&self) -> f64 {
+        if self.wall_ms > 0.0 {
+            self.frames.len() as f64 / (self.wall_ms / 1e3)
+        } else {
+            0.0
+        }
+    }
+
+    fn per_frame(&self, f: impl Fn(&PlayedFrame) -> f64) -> f64 {
+        if self.frames.is_empty() {
+            return 0.0;
+        }
+        self.frames.iter().map(f).sum::<f64>() / self.frames.len() as f64
+    }
+
+    pub fn submits_per_frame(&self) -> f64 {
+        self.per_frame(|f| f64::from(f.submits))
+    }
+
+    pub fn readback_bytes_per_frame(&self) -> f64 {
+        self.per_frame(|f| f.readback_bytes as f64)
+    }
+
+    pub fn upload_bytes_per_frame(&self) -> f64 {
+        self.per_frame(|f| f.upload_bytes as f64)
+    }
+
+    pub fn overflow_frames(&self) -> usize {
+        self.frames.iter().filter(|f| f.overflowed).count()
+    }
+
+    pub fn truncated_frames(&self) -> usize {
+        self.frames.iter().filter(|f| f.truncated_loops > 0).count()
+    }
+}
+
+/// What to play.
+pub struct PlayPlan<'a> {
+    pub scene: &'a Scene,
+    pub pipeline: &'a str,
+    /// Animation frames, in order; played `passes` times.
+    pub frames: &'a [u32],
+    pub passes: u32,
+}
+
+/// Render `plan` back to back on the real-time path. `stop` is polled between frames;
+/// `progress(done, total)` is called after each submission.
+pub fn play(
+    renderer: &mut Renderer,
+    plan: &PlayPlan,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<PlayRun> {
+    if plan.frames.is_empty() || plan.passes == 0 {
+        return Err(Error::invalid("frames", "nothing to play"));
+    }
+    // Frames of an earlier use of the renderer are not this run's.
+    renderer.finish()?;
+    let total = plan.frames.len() as u64 * u64::from(plan.passes);
+    let mut run = PlayRun::default();
+    let mut serials = Vec::new();
+    let mut finished: Vec<FinishedFrame> = Vec::new();
+    let start = Instant::now();
+    let mut last_start = start;
+    'passes: for pass in 0..plan.passes {
+        for &frame in plan.frames {
+            if stop.load(Ordering::Relaxed) {
+                run.interrupted = true;
+                break 'passes;
+            }
+            let now = Instant::now();
+            if let Some(prev) = run.frames.last_mut() {
+                prev.frame_ms = (now - last_start).as_secs_f64() * 1e3;
+            }
+            last_start = now;
+            let s = renderer.render_frame(plan.scene, frame, plan.pipeline)?;
+            serials.push(s.serial);
+            run.frames.push(PlayedFrame {
+                frame,
+                pass,
+                frame_ms: 0.0,
+                gpu_ms: None,
+                passes: Vec::new(),
+                throttle_ms: s.throttle_ms,
+                cpu_wait_ms: s.io.cpu_wait_ms,
+                submits: s.io.submits,
+                readback_bytes: s.io.readback_bytes,
+                upload_bytes: s.upload_bytes,
+                overflowed: false,
+                truncated_loops: 0,
+            });
+            finished.extend(renderer.poll_finished()?);
+            progress(run.frames.len() as u64, total);
+        }
+    }
+    finished.extend(renderer.finish()?);
+    let end = Instant::now();
+    if let Some(prev) = run.frames.last_mut() {
+        prev.frame_ms = (end - last_start).as_secs_f64() * 1e3;
+    }
+    run.wall_ms = (end - start).as_secs_f64() * 1e3;
+    for f in finished {
+        if let Some(i) = serials.iter().position(|&s| s == f.serial) {
+            let p = &mut run.frames[i];
+            p.gpu_ms = f.gpu_ms;
+            p.passes = f.passes;
+            p.overflowed = f.overflowed;
+            p.truncated_loops = f.truncated_loops;
+        }
+    }
+    Ok(run)
+}
