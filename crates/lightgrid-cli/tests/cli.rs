@@ -466,3 +466,109 @@ fn scaling_writes_its_table_and_files() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn play_reports_one_submission_and_no_readback_per_frame() {
+    let dir = temp_dir("play");
+    let json = dir.join("p.json");
+    let o = lightgrid(&[
+        "play",
+        "--scene",
+        "robots-many",
+        "--pipeline",
+        "clustered_deferred",
+        "--assign",
+        "gather",
+        "--size",
+        "96x54",
+        "--frames",
+        "195..204",
+        "--loops",
+        "2",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("fps") && out.contains("frame ms"), "{out}");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    for key in ["scene", "pipeline", "assign", "adapter"] {
+        assert!(v[key].is_string(), "{key}: {v}");
+    }
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(96), Some(54))
+    );
+    assert_eq!(v["assign"], "gather");
+    assert_eq!(v["frames"], 20, "10 frames x 2 loops");
+    assert!(v["fps"].as_f64().unwrap() > 0.0);
+    for key in ["frame_ms", "gpu_ms"] {
+        let d = &v[key];
+        let (mean, median, p95, max) = (
+            d["mean"].as_f64().unwrap(),
+            d["median"].as_f64().unwrap(),
+            d["p95"].as_f64().unwrap(),
+            d["max"].as_f64().unwrap(),
+        );
+        assert!(
+            mean > 0.0 && median <= p95 && p95 <= max && mean <= max,
+            "{key}: {d}"
+        );
+    }
+    assert_eq!(v["submits_per_frame"], 1.0);
+    assert_eq!(v["readback_bytes_per_frame"], 0.0);
+    assert_eq!(v["overflow_frames"], 0, "warm-up frames size the lists");
+    assert_eq!(v["truncated_frames"], 0);
+    assert_eq!(v["per_frame"].as_array().unwrap().len(), 20);
+
+    // The papers' CPU pipeline reads the cell bounds back: two submissions, bytes read.
+    let o = lightgrid(&[
+        "play",
+        "--scene",
+        "robots-few",
+        "--pipeline",
+        "tiled_forward_prez",
+        "--assign",
+        "cpu",
+        "--size",
+        "64x32",
+        "--frames",
+        "0..3",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["submits_per_frame"], 2.0);
+    assert_eq!(
+        v["readback_bytes_per_frame"],
+        4.0 * 2.0 * 8.0,
+        "4x2 tiles of [min, max]"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn play_rejects_bad_input() {
+    let dir = temp_dir("play-bad");
+    let d = dir.to_str().unwrap();
+    let base = ["play", "--scene", "robots-few", "--size", "32x16"];
+    let with = |extra: &[&'static str]| {
+        let mut v: Vec<&str> = base.to_vec();
+        v.extend_from_slice(extra);
+        v
+    };
+    assert_fails_with(&with(&["--loops", "0"]), "--loops");
+    assert_fails_with(&with(&["--loops", "-1"]), "-1");
+    assert_fails_with(&with(&["--frames", "5..1"]), "--frames");
+    assert_fails_with(&with(&["--frames", "0..100000"]), "has frames");
+    assert_fails_with(&with(&["--frames", "nan"]), "--frames");
+    assert_fails_with(&with(&["--pipeline", "nope"]), "forward");
+    assert_fails_with(&with(&["--lights", "5"]), "fixed light count");
+    let mut v = with(&["--json"]);
+    v.push(d);
+    assert_fails_with(&v, "not writable");
+    // Nothing was created in the directory the bad --json named.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -4,7 +4,9 @@
 
 mod common;
 
-use lightgrid::bench::{evaluate_claims, run, write_report, BenchConfig, FrameRange, Verdict};
+use lightgrid::bench::{
+    evaluate_claims, run, write_report, BenchConfig, FrameRange, TimesFrom, Verdict,
+};
 use lightgrid::passes::GBufferFormat;
 use serde_json::Value;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -101,11 +103,24 @@ fn a_run_writes_every_file_with_consistent_summaries() {
     // results.json: the documented layout.
     let json: Value =
         serde_json::from_slice(&std::fs::read(dir.join("results.json")).unwrap()).unwrap();
-    assert_eq!(json["schema_version"], 1);
+    assert_eq!(json["schema_version"], 2);
     assert!(
         json["adapter"].is_string() && json["command"].is_string() && json["interrupted"] == false
     );
     assert_eq!(json["config"]["repeat"], 2);
+    // Which figure came from where: times from the real-time path, counts from analysis.
+    let sources = json["sources"].as_array().unwrap();
+    let source = |key: &str| {
+        sources
+            .iter()
+            .find(|s| s[0] == key)
+            .and_then(|s| s[1].as_str())
+            .unwrap_or_else(|| panic!("no source for {key}"))
+            .to_string()
+    };
+    assert!(source("gpu_ms").starts_with("real-time path"));
+    assert!(source("frame_ms").starts_with("real-time path"));
+    assert!(source("lighting_computations").starts_with("analysis"));
     let runs = json["runs"].as_array().unwrap();
     assert_eq!(runs.len(), results.runs.len());
     let mut csv_rows = 0;
@@ -123,6 +138,17 @@ fn a_run_writes_every_file_with_consistent_summaries() {
             (Some(96), Some(54), Some(16))
         );
         assert_eq!(r["complete"], true);
+        assert_eq!(r["times_from"], "real-time");
+        assert_eq!(r["overflow_frames"], 0);
+        for f in r["frames"].as_array().unwrap() {
+            assert!(f["frame_ms"].as_f64().unwrap() > 0.0, "{f}");
+            assert!(f["analysis_gpu_ms"].as_f64().unwrap() > 0.0, "{f}");
+            assert_eq!(
+                f["gpu_ms_repeats"].as_array().unwrap().len(),
+                2,
+                "--repeat 2"
+            );
+        }
         let frames = r["frames"].as_array().unwrap();
         assert_eq!(
             frames
@@ -216,8 +242,10 @@ fn a_run_writes_every_file_with_consistent_summaries() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-#[test]
-fn a_stopped_run_keeps_what_it_measured() {
+/// Per run the progress callback sees 1 warm-up, 3 analysis renders and 3 real-time frames
+/// (frames 0, 129, 258): a stop at call `at` lands in the analysis renders of the second run
+/// (10) or in the real-time pass of the first (6).
+fn stopped_at(at: u32) -> lightgrid::bench::BenchResults {
     let ctx = common::gpu();
     let mut cfg = config();
     cfg.gbuffers = vec![GBufferFormat::F16];
@@ -226,7 +254,7 @@ fn a_stopped_run_keeps_what_it_measured() {
     let mut calls = 0;
     let results = run(&ctx, &cfg, &stop, &mut |_| {
         calls += 1;
-        if calls == 7 {
+        if calls == at {
             stop.store(true, Ordering::Relaxed);
         }
     })
@@ -237,12 +265,38 @@ fn a_stopped_run_keeps_what_it_measured() {
         .runs
         .last()
         .is_some_and(|r| !r.complete && r.summary.is_some()));
+    results
+}
+
+#[test]
+fn a_stopped_run_keeps_what_it_measured() {
+    let results = stopped_at(10);
+    assert_eq!(results.runs.len(), 2);
+    let last = results.runs.last().unwrap();
+    assert_eq!(
+        last.times_from,
+        TimesFrom::Analysis,
+        "stopped before its real-time pass"
+    );
+    assert_eq!(last.frames.len(), 2);
+    assert_eq!(results.runs[0].times_from, TimesFrom::RealTime);
     let dir = std::env::temp_dir().join(format!("lightgrid-bench-stop-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     write_report(&dir, &results).unwrap();
     let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
-    assert!(summary.contains("interrupted") && summary.contains("(incomplete)"));
+    assert!(summary.contains("interrupted") && summary.contains("(incomplete; analysis times)"));
     std::fs::remove_dir_all(&dir).unwrap();
+
+    // Stopped in the real-time pass: the frames it timed keep their real-time figures.
+    let results = stopped_at(6);
+    assert_eq!(results.runs.len(), 1);
+    let r = &results.runs[0];
+    assert_eq!(r.times_from, TimesFrom::RealTime);
+    assert_eq!(r.frames.len(), 2);
+    assert!(r
+        .frames
+        .iter()
+        .all(|f| f.frame_ms > 0.0 && f.gpu_ms_repeats.len() == 1));
 }
 
 #[test]

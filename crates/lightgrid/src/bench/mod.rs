@@ -14,6 +14,7 @@ pub use claims::{evaluate_claims, Claim, Verdict};
 pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     run, BenchConfig, BenchResults, FrameRange, FrameRecord, Progress, RunRecord, RunSummary, Stat,
+    TimesFrom, SOURCES,
 };
 pub use scaling::{
     run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 pub const REPORT_FILES: &[&str] = &["results.json", "results.csv", "summary.md"];
 
 /// Version of the results.json layout (documented in README).
-pub const SCHEMA_VERSION: u32 = 1;
+pub const SCHEMA_VERSION: u32 = 2;
 
 fn run_name(r: &RunRecord) -> String {
     match r.gbuffer_bits {
@@ -21,9 +21,26 @@ fn run_name(r: &RunRecord) -> String {
     }
 }
 
+/// Frames per second of a run's real-time path (1000 / mean frame period).
+fn fps(r: &super::run::RunRecord) -> String {
+    let periods: Vec<f64> = r
+        .frames
+        .iter()
+        .map(|f| f.frame_ms)
+        .filter(|&m| m > 0.0)
+        .collect();
+    if periods.is_empty() {
+        return "-".into();
+    }
+    format!(
+        "{:.1}",
+        1e3 * periods.len() as f64 / periods.iter().sum::<f64>()
+    )
+}
+
 fn csv(results: &BenchResults) -> String {
     let mut s = String::from(
-        "scene,pipeline,gbuffer_bits,width,height,tile_size,timing,frame,gpu_ms,gpu_ms_min,gpu_ms_max,lighting_computations,ideal_lighting_computations,lights_per_tile_avg,lights_per_tile_max,grid_bytes,modelled_write_bytes,modelled_read_bytes,passes\n",
+        "scene,pipeline,gbuffer_bits,width,height,tile_size,timing,frame,gpu_ms,gpu_ms_min,gpu_ms_max,frame_ms,analysis_gpu_ms,lighting_computations,ideal_lighting_computations,lights_per_tile_avg,lights_per_tile_max,grid_bytes,modelled_write_bytes,modelled_read_bytes,passes\n",
     );
     let opt = |v: Option<String>| v.unwrap_or_default();
     for r in &results.runs {
@@ -45,7 +62,7 @@ fn csv(results: &BenchResults) -> String {
                 .fold(f64::NEG_INFINITY, f64::max);
             let _ = writeln!(
                 s,
-                "{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{},{},{},{},{},{},{},\"{}\"",
+                "{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{},{},{},{},{},{},\"{}\"",
                 r.scene,
                 r.pipeline,
                 opt(r.gbuffer_bits.map(|b| b.to_string())),
@@ -57,6 +74,8 @@ fn csv(results: &BenchResults) -> String {
                 f.gpu_ms,
                 min,
                 max,
+                f.frame_ms,
+                f.analysis_gpu_ms,
                 opt(f.lighting_computations.map(|n| n.to_string())),
                 f.ideal_lighting_computations,
                 opt(f.lights_per_tile_avg.map(|v| format!("{v:.3}"))),
@@ -252,11 +271,11 @@ fn summary(results: &BenchResults) -> String {
     if results.interrupted {
         s.push_str("- **interrupted**: the run was stopped early; incomplete series are marked\n");
     }
-    s.push_str("\nTimes are GPU times from timestamp queries at pass boundaries where the adapter has them, else wall time after a device sync (column `timing`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
+    s.push_str("\nTimes come from the real-time path (`lightgrid play`: the frames rendered back to back, one queue submission each, no analysis): the sum of each frame's pass durations from timestamp queries where the adapter has them, else the wall time from one frame to the next (column `timing`); *real-time fps* is frames per second of that path. Counts come from an analysis render of each frame (results.json `sources`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
     let (scenes, _) = scenes_and_bits(results);
     for scene in &scenes {
         let _ = writeln!(s, "\n## {scene}\n");
-        s.push_str("| pipeline | G-buffer | avg ms | min / max ms | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        s.push_str("| pipeline | G-buffer | avg ms | min / max ms | real-time fps | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };
             let lc = m
@@ -274,13 +293,18 @@ fn summary(results: &BenchResults) -> String {
             };
             let _ = writeln!(
                 s,
-                "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} |",
+                "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} | {} |",
                 r.pipeline,
-                if r.complete { "" } else { " (incomplete)" },
+                match (r.complete, r.times_from) {
+                    (true, _) => "",
+                    (false, super::run::TimesFrom::RealTime) => " (incomplete)",
+                    (false, super::run::TimesFrom::Analysis) => " (incomplete; analysis times)",
+                },
                 r.gbuffer_bits.map_or("-".into(), |b| format!("{b}-bit")),
                 m.gpu_ms.avg,
                 m.gpu_ms.min,
                 m.gpu_ms.max,
+                fps(r),
                 lc,
                 ratio,
                 eff,

@@ -5,6 +5,7 @@ use crate::gpu::{GpuContext, PassTiming};
 use crate::memory::ForwardPlusTable1;
 use crate::passes::GBufferFormat;
 use crate::pipelines::{self, RenderSettings};
+use crate::realtime::{play, PlayPlan, PlayedFrame};
 use crate::scene::catalog::{self, SceneParams};
 use crate::stats::TimingSource;
 use crate::Renderer;
@@ -100,13 +101,22 @@ impl BenchConfig {
     }
 }
 
-/// One measured frame.
+/// One measured frame. Times come from the real-time path (`realtime::play`: the frames
+/// rendered back to back, one submission each, no analysis), counts from an analysis render
+/// of the same frame ([`SOURCES`] in results.json says so).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
     pub frame: u32,
-    /// Median over the repeats.
+    /// GPU time on the real-time path (sum of pass timestamps; wall frame time without
+    /// timestamps), median over the repeats.
     pub gpu_ms: f64,
     pub gpu_ms_repeats: Vec<f64>,
+    /// Wall time from this frame's start to the next one's on the real-time path (median).
+    #[serde(default)]
+    pub frame_ms: f64,
+    /// GPU time of the analysis render of the frame (for comparison; not what a game sees).
+    #[serde(default)]
+    pub analysis_gpu_ms: f64,
     /// Per-pass times of the median repeat.
     pub passes: Vec<PassTiming>,
     pub lighting_computations: Option<u64>,
@@ -203,6 +213,17 @@ impl RunSummary {
     }
 }
 
+/// Which renders a run's times were measured on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimesFrom {
+    /// `realtime::play`: frames back to back, one submission each (what a game sees).
+    #[default]
+    RealTime,
+    /// The analysis renders (only a run stopped before its real-time pass).
+    Analysis,
+}
+
 /// One scene × pipeline × setting.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunRecord {
@@ -216,6 +237,13 @@ pub struct RunRecord {
     pub timing: TimingSource,
     /// False when the run was interrupted before its last frame.
     pub complete: bool,
+    /// Real-time frames whose light lists did not fit (sized from earlier frames).
+    #[serde(default)]
+    pub overflow_frames: u32,
+    /// Where the run's `gpu_ms` come from: the real-time path, or (a run interrupted before
+    /// its real-time pass) its analysis renders.
+    #[serde(default)]
+    pub times_from: TimesFrom,
     pub frames: Vec<FrameRecord>,
     pub summary: Option<RunSummary>,
 }
@@ -230,11 +258,26 @@ pub struct BenchResults {
     pub config: BenchConfig,
     /// Stopped by the user (Ctrl-C) before the end.
     pub interrupted: bool,
+    /// Where each figure comes from (figure, source), [`SOURCES`].
+    #[serde(default)]
+    pub sources: Vec<(String, String)>,
     pub runs: Vec<RunRecord>,
     /// Lights-per-tile heatmaps: (scene, pipeline, frame, image).
     #[serde(skip)]
     pub heatmaps: Vec<(String, String, u32, RgbaImage)>,
 }
+
+/// Where the figures of results.json come from.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("gpu_ms", "real-time path (lightgrid play): sum of the frame's pass timestamps, median over --repeat passes over the frames"),
+    ("frame_ms", "real-time path: wall time from one frame's start to the next's, median over the passes"),
+    ("passes", "real-time path: pass timestamps of the median pass"),
+    ("analysis_gpu_ms", "analysis render of the same frame (readbacks recorded in the frame)"),
+    ("lighting_computations", "analysis render: the GPU's count target"),
+    ("ideal_lighting_computations", "analysis render: depth read back, every visible sample against the lights reaching it"),
+    ("lights_per_tile_avg, lights_per_tile_max, grid_bytes", "analysis render: the grid downloaded"),
+    ("modelled_write_bytes, modelled_read_bytes, forward_plus_table1", "analysis render: the memory model applied to its counts"),
+];
 
 /// Progress of a run, for a progress bar.
 #[derive(Clone, Debug)]
@@ -309,9 +352,10 @@ pub fn run(
             }
         }
     }
+    // Per frame one analysis render, then `repeat` real-time passes over the frames.
     let total: u64 = plan
         .iter()
-        .map(|p| u64::from(config.warmup) + p.4.len() as u64 * u64::from(config.repeat))
+        .map(|p| u64::from(config.warmup) + p.4.len() as u64 * u64::from(1 + config.repeat))
         .sum();
     let mut done = 0u64;
     let mut results = BenchResults {
@@ -320,6 +364,10 @@ pub fn run(
         software_adapter: ctx.is_software(),
         config: config.clone(),
         interrupted: false,
+        sources: SOURCES
+            .iter()
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+            .collect(),
         runs: Vec::new(),
         heatmaps: Vec::new(),
     };
@@ -392,37 +440,28 @@ pub fn run(
             tile_size: config.tile_size,
             timing: TimingSource::WallClock,
             complete: false,
+            overflow_frames: 0,
+            times_from: TimesFrom::Analysis,
             frames: Vec::new(),
             summary: None,
         };
         let heatmap_frame = config.heatmap_frame.unwrap_or(frames[frames.len() / 2]);
         let mut bytes = (0, 0);
+        // 1. Counts: one analysis render per frame.
         for &f in &frames {
-            let mut outs = Vec::new();
-            for _ in 0..config.repeat {
-                progress(&Progress {
-                    done,
-                    total,
-                    label: label(Some(f)),
-                });
-                outs.push(renderer.render(scene, f, info.id)?);
-                done += 1;
-                if stop.load(Ordering::Relaxed) {
-                    results.interrupted = true;
-                    break;
-                }
-            }
-            if results.interrupted && outs.len() < config.repeat as usize {
-                break;
-            }
-            let times: Vec<f64> = outs.iter().map(|o| o.stats.gpu_ms).collect();
-            let m = &outs[median(&times)];
-            let s = &m.stats;
+            progress(&Progress {
+                done,
+                total,
+                label: label(Some(f)),
+            });
+            let out = renderer.render(scene, f, info.id)?;
+            done += 1;
+            let s = &out.stats;
             record.timing = s.timing;
             bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
             let wanted = heatmap_pipeline.as_deref() == Some(info.id);
             if f == heatmap_frame && wanted && !results.heatmaps.iter().any(|h| h.0 == scene.name) {
-                let map = crate::heatmap::heatmap(&m.image, &m.grid);
+                let map = crate::heatmap::heatmap(&out.image, &out.grid);
                 results
                     .heatmaps
                     .push((scene.name.clone(), info.id.to_string(), f, map));
@@ -430,7 +469,9 @@ pub fn run(
             record.frames.push(FrameRecord {
                 frame: f,
                 gpu_ms: s.gpu_ms,
-                gpu_ms_repeats: times.clone(),
+                gpu_ms_repeats: Vec::new(),
+                frame_ms: 0.0,
+                analysis_gpu_ms: s.gpu_ms,
                 passes: s.passes.clone(),
                 lighting_computations: s.lighting_computations,
                 ideal_lighting_computations: s.ideal_lighting_computations,
@@ -441,8 +482,59 @@ pub fn run(
                 modelled_read_bytes: s.memory.modelled_read_bytes,
                 forward_plus_table1: s.memory.forward_plus_table1,
             });
-            if results.interrupted {
+            if stop.load(Ordering::Relaxed) {
+                results.interrupted = true;
                 break;
+            }
+        }
+        // 2. Times: the frames back to back on the real-time path, `repeat` times.
+        if !results.interrupted {
+            let plan = PlayPlan {
+                scene,
+                pipeline: info.id,
+                frames: &frames,
+                passes: config.repeat,
+            };
+            let base = done;
+            let run = play(renderer, &plan, stop, &mut |n, _| {
+                progress(&Progress {
+                    done: base + n,
+                    total,
+                    label: label(None).replace("warm-up", "real-time"),
+                })
+            })?;
+            done = base + run.frames.len() as u64;
+            results.interrupted = run.interrupted;
+            record.overflow_frames = run.overflow_frames() as u32;
+            let timestamps = run.frames.iter().all(|p| p.gpu_ms.is_some());
+            record.timing = if timestamps {
+                TimingSource::GpuTimestamps
+            } else {
+                TimingSource::WallClock
+            };
+            for (i, rec) in record.frames.iter_mut().enumerate() {
+                let played: Vec<&PlayedFrame> =
+                    run.frames.iter().skip(i).step_by(frames.len()).collect();
+                if played.is_empty() {
+                    continue;
+                }
+                let times: Vec<f64> = played
+                    .iter()
+                    .map(|p| p.gpu_ms.unwrap_or(p.frame_ms))
+                    .collect();
+                let m = median(&times);
+                rec.gpu_ms = times[m];
+                rec.gpu_ms_repeats = times.clone();
+                rec.passes = played[m].passes.clone();
+                let periods: Vec<f64> = played.iter().map(|p| p.frame_ms).collect();
+                rec.frame_ms = periods[median(&periods)];
+            }
+            // Frames the interrupted real-time run did not reach carry no real-time figure;
+            // with none measured the run keeps its analysis times (and says so).
+            let measured = run.frames.len().min(frames.len());
+            if measured > 0 {
+                record.frames.truncate(measured);
+                record.times_from = TimesFrom::RealTime;
             }
         }
         record.complete = !results.interrupted;
