@@ -156,10 +156,10 @@ pub(crate) fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::Atomi
 }
 
 /// A progress bar with an ETA on stderr, redrawn at most every 200 ms.
-pub(crate) fn progress_bar() -> impl FnMut(&lightgrid::bench::Progress) {
+pub(crate) fn progress_bar() -> impl FnMut(&lightgrid_bench::Progress) {
     let start = std::time::Instant::now();
     let mut last = std::time::Instant::now() - std::time::Duration::from_secs(1);
-    move |p: &lightgrid::bench::Progress| {
+    move |p: &lightgrid_bench::Progress| {
         if last.elapsed().as_millis() < 200 && p.done < p.total {
             return;
         }

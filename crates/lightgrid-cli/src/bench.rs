@@ -5,11 +5,11 @@ use crate::args::{
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use lightgrid::bench::{BenchConfig, FrameRange};
 use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::check_writable;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::PIPELINES;
+use lightgrid_bench::{BenchConfig, FrameRange};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -191,18 +191,18 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     );
     let start = std::time::Instant::now();
     let mut progress = progress_bar();
-    let mut results = lightgrid::bench::run(&ctx, &config, &stop, &mut progress)?;
+    let mut results = lightgrid_bench::run(&ctx, &config, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
-    let written = lightgrid::bench::write_report(&a.out, &results)?;
-    let claims = lightgrid::bench::evaluate_claims(&results);
+    let written = lightgrid_bench::write_report(&a.out, &results)?;
+    let claims = lightgrid_bench::evaluate_claims(&results);
     let held = claims
         .iter()
-        .filter(|c| c.verdict == lightgrid::bench::Verdict::Held)
+        .filter(|c| c.verdict == lightgrid_bench::Verdict::Held)
         .count();
     let measured = claims
         .iter()
-        .filter(|c| c.verdict != lightgrid::bench::Verdict::NotMeasured)
+        .filter(|c| c.verdict != lightgrid_bench::Verdict::NotMeasured)
         .count();
     println!(
         "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
@@ -221,8 +221,8 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
 }
 
 pub(crate) fn report(a: &ReportArgs) -> Result<()> {
-    let results = lightgrid::bench::read_results(&a.dir.join("results.json"))?;
-    let written = lightgrid::bench::write_report(&a.dir, &results)?;
+    let results = lightgrid_bench::read_results(&a.dir.join("results.json"))?;
+    let written = lightgrid_bench::write_report(&a.dir, &results)?;
     println!(
         "{} files rewritten in {} (heatmaps are kept from the run)",
         written.len(),

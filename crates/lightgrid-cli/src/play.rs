@@ -5,7 +5,6 @@
 use crate::args::{parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use lightgrid::bench::{FrameRange, Progress};
 use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::{check_writable, write_atomic};
 use lightgrid::passes::GBufferFormat;
@@ -13,6 +12,7 @@ use lightgrid::pipelines::{self, REFERENCE};
 use lightgrid::realtime::{play as play_frames, Distribution, PlayPlan, PlayRun};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::{RenderSettings, Renderer};
+use lightgrid_bench::{FrameRange, Progress};
 use serde::Serialize;
 use std::path::PathBuf;
 

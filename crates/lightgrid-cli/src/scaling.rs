@@ -60,7 +60,7 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))?;
     check_writable(&a.out.join("scaling.json"))?;
-    let config = lightgrid::bench::ScalingConfig {
+    let config = lightgrid_bench::ScalingConfig {
         scene: a.scene.clone(),
         pipeline: a.pipeline.clone(),
         lights: a.lights.clone(),
@@ -88,17 +88,17 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     );
     let start = std::time::Instant::now();
     let mut progress = progress_bar();
-    let mut results = lightgrid::bench::run_scaling(&ctx, &config, &stop, &mut progress)?;
+    let mut results = lightgrid_bench::run_scaling(&ctx, &config, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
-    lightgrid::bench::write_scaling(&results, &a.out)?;
-    println!("{}", lightgrid::bench::scaling_table(&results));
-    println!("{}", lightgrid::bench::scaling_growth(&results));
+    lightgrid_bench::write_scaling(&results, &a.out)?;
+    println!("{}", lightgrid_bench::scaling_table(&results));
+    println!("{}", lightgrid_bench::scaling_growth(&results));
     println!(
         "{} points in {}; {} in {}",
         results.points.len(),
         format_duration(start.elapsed().as_secs_f64()),
-        lightgrid::bench::SCALING_FILES.join(", "),
+        lightgrid_bench::SCALING_FILES.join(", "),
         a.out.display()
     );
     if results.interrupted {

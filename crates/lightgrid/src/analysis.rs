@@ -5,15 +5,15 @@
 //! (`GridBuilder::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
-    assign_cpu, cell_bounds_cpu, ideal_lighting_computations, BuiltGrid, DepthRange, LightGrid,
-    ViewSetup,
+    assign_cpu, cell_bounds_cpu, ideal_lighting_computations, BuiltGrid, DepthRange, GridDims,
+    LightGrid, ViewSetup,
 };
 use crate::error::Result;
-use crate::frame::FrameIo;
+use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
+use crate::gpu::GpuContext;
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
 use crate::passes::{Readback, Targets};
 use crate::pipelines::PipelineInfo;
-use crate::renderer::{FinishedFrame, Renderer};
 use crate::scene::{FrameState, Scene};
 use crate::stats::{FrameStats, TimingSource};
 use image::RgbaImage;
@@ -89,8 +89,12 @@ fn frame_memory(
 }
 
 /// What [`analyze`] works from: a finished, waited-for analysis frame.
-pub(crate) struct AnalysisInput<'r, 'c> {
-    pub renderer: &'r Renderer<'c>,
+pub(crate) struct AnalysisInput<'r> {
+    pub ctx: &'r GpuContext,
+    pub size: (u32, u32),
+    pub dims: GridDims,
+    pub settings: RenderSettings,
+    pub readbacks: &'r AnalysisReadbacks,
     pub scene: &'r Scene,
     pub info: &'static PipelineInfo,
     pub up_state: &'r FrameState,
@@ -105,18 +109,16 @@ pub(crate) struct AnalysisInput<'r, 'c> {
 
 /// Read the frame's copies back and compute its statistics.
 pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
-    let r = a.renderer;
-    let ctx = r.ctx();
+    let ctx = a.ctx;
     let device = &ctx.device;
-    let (width, height) = r.size();
-    let dims = r.dims();
-    let settings = r.settings();
+    let (width, height) = a.size;
+    let (dims, settings) = (a.dims, a.settings);
     let lights = &a.up_state.lights;
-    let image = RgbaImage::from_raw(width, height, r.readbacks().image.read(device)?)
-        .expect("size matches");
-    let depth: Vec<f32> = r.readbacks().depth.read_f32(device)?;
+    let image =
+        RgbaImage::from_raw(width, height, a.readbacks.image.read(device)?).expect("size matches");
+    let depth: Vec<f32> = a.readbacks.depth.read_f32(device)?;
     let lighting_computations = if ctx.count_blend {
-        let counts: Vec<f32> = r.readbacks().counts.read_f32(device)?;
+        let counts: Vec<f32> = a.readbacks.counts.read_f32(device)?;
         Some(counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64)
     } else {
         None

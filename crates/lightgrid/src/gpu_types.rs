@@ -73,3 +73,44 @@ const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 288);
+
+/// One node of the light BVH: 32 bytes (`BvhNode` in `shading/types.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BvhNode {
+    pub lo: [f32; 3],
+    /// First child node, or for a leaf the first slot of `order`.
+    pub first: u32,
+    pub hi: [f32; 3],
+    /// Number of children, `| BVH_LEAF` for a leaf.
+    pub count: u32,
+}
+
+/// One pass of the radix sort (`SortParams`, `culling/radix_sort.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SortParams {
+    /// Pairs sorted.
+    pub n: u32,
+    /// Lowest key bit of this pass's 4-bit digit.
+    pub shift: u32,
+    /// Blocks of ASSIGN_THREADS pairs.
+    pub blocks: u32,
+    pub _pad: u32,
+}
+
+/// One level of the GPU BVH build (`LevelParams`, `culling/bvh_build.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LevelParams {
+    /// This level's first node and its number of nodes.
+    pub first: u32,
+    pub count: u32,
+    /// The level below's first node and its number of nodes (lights for the leaves).
+    pub child_first: u32,
+    pub child_count: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
+const _: () = assert!(std::mem::size_of::<SortParams>() == 16);
+const _: () = assert!(std::mem::size_of::<LevelParams>() == 16);

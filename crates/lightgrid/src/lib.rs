@@ -5,7 +5,6 @@
 //! with a [`Renderer`] and a pipeline id from [`pipelines::PIPELINES`].
 
 pub mod analysis;
-pub mod bench;
 pub mod consts;
 pub mod culling;
 pub mod error;
@@ -17,16 +16,14 @@ pub mod image_io;
 pub mod memory;
 pub mod passes;
 pub mod pipelines;
-pub mod plot;
 pub mod realtime;
 mod renderer;
 pub mod scene;
 pub mod shader;
 pub mod stats;
 
+pub use analysis::FrameOutput;
 pub use error::{Error, Result};
-pub use frame::RenderSettings;
-pub use renderer::{
-    validate_size, FinishedFrame, FrameOutput, Renderer, SubmittedFrame, MAX_FRAMES_IN_FLIGHT,
-};
+pub use frame::{FinishedFrame, RenderSettings, SubmittedFrame};
+pub use renderer::{validate_size, Renderer, MAX_FRAMES_IN_FLIGHT};
 pub use stats::{FrameStats, TimingSource};

@@ -4,8 +4,9 @@
 //! `lightgrid play` prints it; `lightgrid bench` takes its frame times from it.
 
 use crate::error::{Error, Result};
+use crate::frame::FinishedFrame;
 use crate::gpu::PassTiming;
-use crate::renderer::{FinishedFrame, Renderer};
+use crate::renderer::Renderer;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};

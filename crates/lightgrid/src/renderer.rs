@@ -18,18 +18,18 @@ use crate::analysis::{self, AnalysisReadbacks};
 use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
 use crate::culling::{GridDims, ViewSetup};
 use crate::error::{Error, Result};
-use crate::frame::{FrameEncoder, FrameInputs, FrameIo, PipelineContext, RenderSettings};
-use crate::gpu::{
-    scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, PassTimer, PassTiming,
+use crate::frame::{
+    FinishedFrame, FrameEncoder, FrameInputs, FrameIo, RenderSettings, SubmittedFrame,
 };
+use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::{scene_layout, Targets, Tonemap};
-use crate::pipelines::{self, Technique};
+use crate::pipelines::{self, PipelineContext, Technique};
 use crate::scene::{FrameState, Scene};
 use std::collections::{HashMap, VecDeque};
 use std::time::Instant;
 
-pub use crate::analysis::FrameOutput;
+use crate::analysis::FrameOutput;
 
 /// Most passes one frame may record (timestamp slots).
 const MAX_PASSES: u32 = 128;
@@ -99,35 +99,6 @@ struct Uploaded {
     index_count: u32,
     /// Bytes written to the GPU for this frame.
     upload_bytes: u64,
-}
-
-/// A frame submitted by [`Renderer::render_frame`].
-#[derive(Clone, Copy, Debug)]
-pub struct SubmittedFrame {
-    /// The renderer's frame number (counts every submitted frame).
-    pub serial: u64,
-    /// Submissions, blocking readbacks and CPU waits the frame made.
-    pub io: FrameIo,
-    /// CPU time spent waiting for older frames before this one could be queued
-    /// (more than [`MAX_FRAMES_IN_FLIGHT`] in flight).
-    pub throttle_ms: f64,
-    /// Bytes uploaded for the frame (lights, uniforms, moving geometry).
-    pub upload_bytes: u64,
-}
-
-/// What the GPU reported about a finished real-time frame (read back without waiting).
-#[derive(Clone, Debug)]
-pub struct FinishedFrame {
-    pub serial: u64,
-    pub pipeline: &'static str,
-    /// Sum of the frame's pass durations (GPU work only); None without timestamps.
-    pub gpu_ms: Option<f64>,
-    pub passes: Vec<PassTiming>,
-    /// Shader loops that ended before their bound: the frame is wrong when non-zero.
-    pub truncated_loops: u32,
-    /// Some light list did not fit its buffer (sized from earlier frames): the frame is
-    /// missing lights; the buffers have grown for the next one.
-    pub overflowed: bool,
 }
 
 /// Renders frames at one size on one device.
@@ -268,10 +239,6 @@ impl<'c> Renderer<'c> {
 
     pub fn settings(&self) -> RenderSettings {
         self.settings
-    }
-
-    pub(crate) fn ctx(&self) -> &GpuContext {
-        self.ctx
     }
 
     fn prepare_technique(&mut self, info: &'static pipelines::PipelineInfo) -> Result<()> {
@@ -441,9 +408,7 @@ impl<'c> Renderer<'c> {
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
         self.counters.clear(enc.parts().0);
-        if let Err(e) = technique.encode(&inputs, &mut enc) {
-            return Err(e);
-        }
+        technique.encode(&inputs, &mut enc)?;
         let (encoder, timer) = enc.parts();
         self.tonemap
             .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
@@ -621,7 +586,11 @@ impl<'c> Renderer<'c> {
                 None => None,
             };
             return analysis::analyze(analysis::AnalysisInput {
-                renderer: self,
+                ctx: self.ctx,
+                size: self.size(),
+                dims: self.dims,
+                settings: self.settings,
+                readbacks: &self.readbacks,
                 scene,
                 info,
                 up_state: &up.state,
@@ -634,13 +603,5 @@ impl<'c> Renderer<'c> {
                 wall_ms,
             });
         }
-    }
-
-    pub(crate) fn readbacks(&self) -> &AnalysisReadbacks {
-        &self.readbacks
-    }
-
-    pub(crate) fn dims(&self) -> GridDims {
-        self.dims
     }
 }

@@ -1,6 +1,8 @@
 //! Rust structs in gpu_types.rs and their WGSL twins agree on size and every field offset.
 
-use lightgrid::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GridParams};
+use lightgrid::gpu_types::{
+    BvhNode, FrameUniforms, GpuLight, GpuMaterial, GridParams, LevelParams, SortParams,
+};
 use lightgrid::shader::{compose, src, validate};
 use std::mem::{offset_of, size_of};
 
@@ -67,6 +69,14 @@ fn gpu_structs_match_wgsl() {
         GpuMaterial,
         [diffuse, alpha, specular, shininess, emissive, flags, ambient, _pad]
     );
+    check_layout!(&module, "BvhNode", BvhNode, [lo, first, hi, count]);
+    check_layout!(&module, "SortParams", SortParams, [n, shift, blocks, _pad]);
+    check_layout!(
+        &module,
+        "LevelParams",
+        LevelParams,
+        [first, count, child_first, child_count]
+    );
     check_layout!(
         &module,
         "FrameUniforms",
@@ -100,4 +110,23 @@ fn vertex_layout_matches_gpu_vertex() {
             offset_of!(GpuVertex, material) as u64,
         ]
     );
+}
+
+/// The memory model's byte sizes are the formats' and structs' own, not numbers kept in sync
+/// by hand.
+#[test]
+fn memory_model_sizes_match_the_formats_and_structs() {
+    use lightgrid::memory::{DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
+    use lightgrid::passes::{GBufferFormat, DEPTH_FORMAT, HDR_FORMAT};
+    let texel = |f: wgpu::TextureFormat| f.block_copy_size(None).unwrap();
+    assert_eq!(texel(HDR_FORMAT), HDR_BYTES);
+    assert_eq!(
+        DEPTH_FORMAT.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)),
+        Some(DEPTH_BYTES)
+    );
+    for g in [GBufferFormat::F16, GBufferFormat::F32] {
+        assert_eq!(texel(g.texture_format()), g.bytes_per_target());
+    }
+    assert_eq!(LIGHT_BYTES as usize, size_of::<GpuLight>());
+    assert_eq!(INDEX_BYTES as usize, size_of::<u32>());
 }

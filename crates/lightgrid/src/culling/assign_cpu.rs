@@ -11,9 +11,10 @@
 //!
 //! The brute-force oracle in `oracle.rs` checks that nothing is ever missed.
 
-use super::gpu_assign::check_index_capacity;
+use super::strategy::check_index_capacity;
+use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{CellSource, GridDims, LightGrid, ViewLight, ViewSetup};
+use super::{GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;

@@ -11,92 +11,25 @@
 
 use super::cell_bounds::CellBoundsPass;
 use super::gpu_assign::read_grid;
-use super::strategy::{find_strategy, AssignFrame, AssignStrategy, StrategyContext};
+use super::registry::find_strategy;
+pub use super::strategy::CellSource;
+use super::strategy::{AssignFrame, AssignStrategy, StrategyContext};
 use super::{GridBuffers, GridDims, LightGrid};
 use crate::error::{Error, Result};
-use crate::frame::{FrameEncoder, FrameInputs, PipelineContext};
+use crate::frame::{Assign, FrameEncoder, FrameInputs};
 use crate::gpu::CounterValues;
 
-/// Who builds the light grid (`--assign`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Assign {
-    /// On the CPU (`assign_cpu.rs`): projected sphere rectangles, per-cell depth test.
-    Cpu,
-    /// GPU gather: one workgroup per cell tests every light against the cell's frustum.
-    Gather,
-    /// GPU scatter: one invocation per light emits (cell, light) pairs, radix-sorted by cell.
-    Scatter,
-    /// Light BVH rebuilt each frame on the CPU, traversed on the GPU per cell.
-    Bvh,
-    /// Light BVH rebuilt each frame on the GPU (Morton codes, radix sort, node boxes),
-    /// traversed as `Bvh`.
-    #[serde(rename = "bvh-gpu")]
-    BvhGpu,
-    /// By light count: see [`Assign::resolve`].
-    #[default]
-    Auto,
-}
-
-/// On a hardware GPU, `auto` gathers up to this many lights and walks a GPU-built BVH above
-/// (tiled-forward-shading §4.4: brute force holds to about 10k lights).
-pub const AUTO_GATHER_MAX_LIGHTS: usize = 8192;
-
-impl Assign {
-    pub const ALL: [Assign; 6] = [
-        Assign::Cpu,
-        Assign::Gather,
-        Assign::Scatter,
-        Assign::Bvh,
-        Assign::BvhGpu,
-        Assign::Auto,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Assign::Cpu => "cpu",
-            Assign::Gather => "gather",
-            Assign::Scatter => "scatter",
-            Assign::Bvh => "bvh",
-            Assign::BvhGpu => "bvh-gpu",
-            Assign::Auto => "auto",
-        }
-    }
-
-    /// One line on how the strategy works (`lightgrid list`).
-    pub fn description(self) -> &'static str {
-        match self {
-            Assign::Cpu => "CPU: projected sphere rectangles, per-cell depth test (rayon); grid uploaded",
-            Assign::Gather => "GPU: one workgroup per occupied cell tests every light (forward-plus §4)",
-            Assign::Scatter => "GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell (forward-plus §4)",
-            Assign::Bvh => "light BVH built on the CPU each frame, walked per occupied cell on the GPU (tiled-forward-shading §4.4)",
-            Assign::BvhGpu => "the same BVH built on the GPU (Morton codes, radix sort), walked the same way",
-            Assign::Auto => "software adapter: cpu; hardware GPU: gather up to 8192 lights, bvh-gpu above",
-        }
-    }
-
-    /// The strategy used for a frame with `lights` lights. `auto` on a software adapter
-    /// (lavapipe, which shares the CPU's cores) is `cpu` at every count: measured fastest from
-    /// 1k to 1M lights (README, "Light assignment scaling"). On a hardware GPU it is `gather`
-    /// up to [`AUTO_GATHER_MAX_LIGHTS`] and `bvh-gpu` above, which keeps the grid on the GPU
-    /// (the paper's crossover; no hardware GPU was available to measure it).
-    pub fn resolve(self, lights: usize, software_adapter: bool) -> Assign {
-        match self {
-            Assign::Auto if software_adapter => Assign::Cpu,
-            Assign::Auto if lights <= AUTO_GATHER_MAX_LIGHTS => Assign::Gather,
-            Assign::Auto => Assign::BvhGpu,
-            other => other,
-        }
-    }
-}
-
-/// Where the cell bounds come from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CellSource {
-    /// No depth information: every cell spans near..far (`tiled_forward`).
-    NearFar,
-    /// The frame's depth buffer (`targets.depth`), reduced on the GPU.
-    Depth,
+/// What a [`GridBuilder`] is created from.
+pub struct GridSetup<'a> {
+    pub device: &'a wgpu::Device,
+    /// Group 0 layout, shared by all pipelines.
+    pub scene_layout: &'a wgpu::BindGroupLayout,
+    /// The frame's tile grid (one slice).
+    pub tiles: GridDims,
+    /// `--assign` (`auto` resolved per frame).
+    pub assign: Assign,
+    /// A CPU-emulated adapter (`auto` picks `cpu` there).
+    pub software_adapter: bool,
 }
 
 /// A built grid and what went into it (analysis).
@@ -138,13 +71,13 @@ pub struct GridBuilder {
 impl GridBuilder {
     /// `slices` 1 builds a tiled grid, more a clustered one (slices between the camera's near
     /// and far planes each frame).
-    pub fn new(ctx: &PipelineContext, slices: u32, source: CellSource) -> Self {
+    pub fn new(ctx: &GridSetup, slices: u32, source: CellSource) -> Self {
         let (device, scene_layout) = (ctx.device, ctx.scene_layout);
         GridBuilder {
-            tiles: ctx.dims,
+            tiles: ctx.tiles,
             slices,
             source,
-            assign: ctx.settings.assign,
+            assign: ctx.assign,
             software_adapter: ctx.software_adapter,
             scene_layout: scene_layout.clone(),
             bounds: CellBoundsPass::new(device, scene_layout),

@@ -19,22 +19,11 @@ use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
 use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, STORAGE_READ};
 use crate::scene::PointLight;
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// One node: 32 bytes, the layout of `BvhNode` in bvh.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct BvhNode {
-    pub lo: [f32; 3],
-    /// First child node, or for a leaf the first slot of `order`.
-    pub first: u32,
-    pub hi: [f32; 3],
-    /// Number of children, `| BVH_LEAF` for a leaf.
-    pub count: u32,
-}
+pub use crate::gpu_types::BvhNode;
 
 impl BvhNode {
     pub fn is_leaf(&self) -> bool {

@@ -7,13 +7,6 @@
 
 const WORKGROUP_SIZE: u32 = BVH_WIDTH;
 
-struct BvhNode {
-    lo: vec3<f32>,
-    first: u32,   // first child node, or for a leaf the first slot of `bvh_order`
-    hi: vec3<f32>,
-    count: u32,   // number of children | BVH_LEAF for a leaf
-}
-
 @group(2) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(2) @binding(1) var<storage, read> bvh_order: array<u32>;
 

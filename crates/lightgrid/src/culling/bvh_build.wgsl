@@ -7,20 +7,6 @@
 // 4. inner_main, once per level bottom-up: one invocation per node boxes its 32 children.
 // The node layout (root first, level by level) is fixed by the light count, as on the CPU.
 
-struct BvhNode {
-    lo: vec3<f32>,
-    first: u32,
-    hi: vec3<f32>,
-    count: u32,
-}
-
-struct LevelParams {
-    first: u32,        // this level's first node
-    count: u32,        // its nodes
-    child_first: u32,  // the level below's first node
-    child_count: u32,  // its nodes
-}
-
 @group(1) @binding(0) var<uniform> level: LevelParams;
 @group(1) @binding(1) var<storage, read_write> keys: array<u32>;
 @group(1) @binding(2) var<storage, read_write> vals: array<u32>;

@@ -16,6 +16,7 @@ use crate::gpu::{
     bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, UniformSlots,
     STORAGE_RW, UNIFORM,
 };
+use crate::gpu_types::LevelParams;
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
@@ -62,7 +63,7 @@ impl GpuBvhBuild {
             leaves: pipeline("leaves_main"),
             inner: pipeline("inner_main"),
             layout,
-            params: UniformSlots::new(device, "bvh build levels", MAX_LEVELS),
+            params: UniformSlots::new::<LevelParams>(device, "bvh build levels", MAX_LEVELS),
             nodes: storage_buffer(device, "bvh nodes (gpu build)", 1 << 12),
             centre_box: storage_buffer(device, "bvh centre box", 32),
             sort: RadixSort::new(device),
@@ -86,12 +87,17 @@ impl GpuBvhBuild {
             u64::from(node_count) * std::mem::size_of::<BvhNode>() as u64,
         );
         self.sort.ensure(device, u64::from(n));
-        let records: Vec<[u32; 4]> = levels
+        let records: Vec<LevelParams> = levels
             .iter()
             .enumerate()
             .map(|(i, &(first, count))| {
                 let (child_first, child_count) = if i > 0 { levels[i - 1] } else { (0, n) };
-                [first, count, child_first, child_count]
+                LevelParams {
+                    first,
+                    count,
+                    child_first,
+                    child_count,
+                }
             })
             .collect();
         self.params.write(f.queue, &records);

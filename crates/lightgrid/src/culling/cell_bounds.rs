@@ -11,10 +11,10 @@
 
 use super::{GridDims, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
+use crate::error::Result;
 use crate::frame::{FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
-use crate::Result;
 
 pub(crate) fn shader() -> ComposedShader {
     compose(

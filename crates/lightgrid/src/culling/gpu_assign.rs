@@ -16,10 +16,11 @@
 
 use super::cell_bounds::CellBoundsPass;
 use super::scan::ScanPass;
+pub use super::strategy::check_index_capacity;
 use super::strategy::{AssignFrame, ListCapacity, StrategyContext};
 use super::{GridBuffers, GridDims, LightGrid};
 use crate::consts::COUNTER_SPILL_ARGS;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
     bind_resources, buffer_layout, download, grow_storage, storage_buffer, CounterValues,
@@ -256,27 +257,4 @@ impl CellKernels {
         self.capacity
             .observe(device, u64::from(values.index_needed()))
     }
-}
-
-/// Most u32 entries one storage binding of this device holds.
-pub fn max_index_entries(device: &wgpu::Device) -> u64 {
-    let limits = device.limits();
-    limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size)
-        / 4
-}
-
-/// Index lists longer than the device can bind are an error, never a truncated list.
-pub fn check_index_capacity(device: &wgpu::Device, entries: u64, stage: &str) -> Result<()> {
-    let max = max_index_entries(device);
-    if entries > max {
-        return Err(Error::invalid(
-            "--assign",
-            format!(
-                "{stage}: the light grid needs {entries} index entries, more than the {max} this device can bind; use fewer lights, a larger --tile or fewer --slices"
-            ),
-        ));
-    }
-    Ok(())
 }

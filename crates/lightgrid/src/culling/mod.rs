@@ -13,21 +13,23 @@ mod gpu_assign;
 mod grid;
 mod oracle;
 mod radix_sort;
+mod registry;
 mod scan;
 mod scatter;
 mod strategy;
-mod view;
 
+pub use crate::frame::{Assign, AUTO_GATHER_MAX_LIGHTS};
+pub use crate::scene::{ViewLight, ViewSetup};
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
-pub use builder::{Assign, BuiltGrid, CellSource, GridBuilder, AUTO_GATHER_MAX_LIGHTS};
+pub use builder::{BuiltGrid, CellSource, GridBuilder, GridSetup};
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
 pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, LightGrid};
 pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
-pub use strategy::{find_strategy, AssignStrategy, StrategyInfo, STRATEGIES};
-pub use view::{ViewLight, ViewSetup};
+pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
+pub use strategy::AssignStrategy;
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");

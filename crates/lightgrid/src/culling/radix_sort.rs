@@ -7,10 +7,14 @@ use super::scan::ScanPass;
 use crate::consts::ASSIGN_THREADS;
 use crate::gpu::{bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer};
 use crate::gpu::{PassTimer, UniformSlots, STORAGE_RW, UNIFORM};
+use crate::gpu_types::SortParams;
 use crate::shader::{compose, compute_pipeline, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
-    compose("radix sort", &[include_str!("radix_sort.wgsl")])
+    compose(
+        "radix sort",
+        &[crate::shader::src::TYPES, include_str!("radix_sort.wgsl")],
+    )
 }
 
 /// Most 4-bit passes (32-bit keys).
@@ -53,7 +57,7 @@ impl RadixSort {
             local: pipeline("local_main"),
             scatter: pipeline("scatter_main"),
             layout,
-            params: UniformSlots::new(device, "radix sort params", MAX_PASSES.into()),
+            params: UniformSlots::new::<SortParams>(device, "radix sort params", MAX_PASSES.into()),
             keys: storage_buffer(device, "sort keys", 1 << 12),
             vals: storage_buffer(device, "sort values", 1 << 12),
             tmp_keys: storage_buffer(device, "sort keys (tmp)", 1 << 12),
@@ -103,7 +107,14 @@ impl RadixSort {
         }
         let passes = bits.div_ceil(4).clamp(1, MAX_PASSES);
         let blocks = n.div_ceil(ASSIGN_THREADS);
-        let records: Vec<[u32; 4]> = (0..passes).map(|p| [n, p * 4, blocks, 0]).collect();
+        let records: Vec<SortParams> = (0..passes)
+            .map(|p| SortParams {
+                n,
+                shift: p * 4,
+                blocks,
+                _pad: 0,
+            })
+            .collect();
         self.params.write(queue, &records);
         let groups = groups_1d(blocks);
         for p in 0..passes {

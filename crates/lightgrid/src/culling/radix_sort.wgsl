@@ -5,13 +5,6 @@
 // every (digit, block) its output offset; scatter_main moves each pair there from tmp.
 // Positions past `n` in the last block carry key 0xffffffff, sort last and are never written.
 
-struct SortParams {
-    n: u32,
-    shift: u32,
-    blocks: u32,
-    _pad: u32,
-}
-
 @group(0) @binding(0) var<uniform> sp: SortParams;
 @group(0) @binding(1) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(2) var<storage, read_write> vals: array<u32>;

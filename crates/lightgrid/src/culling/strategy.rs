@@ -1,5 +1,5 @@
 //! Light-assignment strategies behind one trait, one file and one registry row each (like the
-//! pipelines): [`STRATEGIES`] maps every `--assign` value to the type that records it.
+//! pipelines): `registry.rs` maps every `--assign` value to the type that records it.
 //!
 //! A strategy reads the cell bounds (`cell_bounds.rs`), the lights and the camera, and leaves
 //! the frame's grid in [`GridBuffers`] (the paper's three arrays, group 1 of the shading pass).
@@ -7,10 +7,9 @@
 //! from the frame counters of earlier frames ([`AssignStrategy::observe`]), and a frame whose
 //! lists did not fit is reported by those counters, never passed off as right.
 
-use super::builder::CellSource;
 use super::cell_bounds::CellBoundsPass;
-use super::{Assign, GridBuffers, GridDims, LightGrid};
-use crate::error::Result;
+use super::{GridBuffers, GridDims, LightGrid};
+use crate::error::{Error, Result};
 use crate::frame::{FrameEncoder, FrameInputs};
 use crate::gpu::CounterValues;
 
@@ -58,41 +57,6 @@ pub struct StrategyContext<'a> {
     pub scene_layout: &'a wgpu::BindGroupLayout,
 }
 
-/// One registry row.
-pub struct StrategyInfo {
-    pub assign: Assign,
-    pub create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
-}
-
-/// The registry: every strategy `--assign` can name (`auto` resolves to one of them).
-pub const STRATEGIES: &[StrategyInfo] = &[
-    StrategyInfo {
-        assign: Assign::Cpu,
-        create: super::assign_cpu::create_strategy,
-    },
-    StrategyInfo {
-        assign: Assign::Gather,
-        create: super::gather::create_strategy,
-    },
-    StrategyInfo {
-        assign: Assign::Scatter,
-        create: super::scatter::create_strategy,
-    },
-    StrategyInfo {
-        assign: Assign::Bvh,
-        create: super::bvh::create_strategy,
-    },
-    StrategyInfo {
-        assign: Assign::BvhGpu,
-        create: super::bvh_gpu::create_strategy,
-    },
-];
-
-/// The registry row of a (resolved) strategy.
-pub fn find_strategy(assign: Assign) -> Option<&'static StrategyInfo> {
-    STRATEGIES.iter().find(|s| s.assign == assign)
-}
-
 /// Capacity of a list sized from earlier frames: grows to 5/4 of what a frame needed, never
 /// shrinks, and refuses sizes the device cannot bind.
 pub struct ListCapacity {
@@ -110,11 +74,43 @@ impl ListCapacity {
 
     /// A frame needed `needed` entries: grow to fit it with headroom.
     pub fn observe(&mut self, device: &wgpu::Device, needed: u64) -> Result<()> {
-        super::gpu_assign::check_index_capacity(device, needed, self.stage)?;
+        check_index_capacity(device, needed, self.stage)?;
         if needed > self.entries {
-            let limit = super::gpu_assign::max_index_entries(device);
+            let limit = max_index_entries(device);
             self.entries = (needed + needed / 4).min(limit);
         }
         Ok(())
     }
+}
+
+/// Where the cell bounds come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellSource {
+    /// No depth information: every cell spans near..far (`tiled_forward`).
+    NearFar,
+    /// The frame's depth buffer (`targets.depth`), reduced on the GPU.
+    Depth,
+}
+
+/// Most u32 entries one storage binding of this device holds.
+pub fn max_index_entries(device: &wgpu::Device) -> u64 {
+    let limits = device.limits();
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+        / 4
+}
+
+/// Index lists longer than the device can bind are an error, never a truncated list.
+pub fn check_index_capacity(device: &wgpu::Device, entries: u64, stage: &str) -> Result<()> {
+    let max = max_index_entries(device);
+    if entries > max {
+        return Err(Error::invalid(
+            "--assign",
+            format!(
+                "{stage}: the light grid needs {entries} index entries, more than the {max} this device can bind; use fewer lights, a larger --tile or fewer --slices"
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -190,13 +190,19 @@ pub fn groups_1d(groups: u32) -> (u32, u32) {
 pub struct UniformSlots {
     buffer: wgpu::Buffer,
     slots: u64,
+    /// Bytes of one record (the binding's size).
+    record: u64,
 }
 
 impl UniformSlots {
     const STRIDE: u64 = 256;
 
-    pub fn new(device: &wgpu::Device, label: &str, slots: u64) -> Self {
+    /// Slots for records of type `T` (a `gpu_types` struct).
+    pub fn new<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, slots: u64) -> Self {
+        let record = std::mem::size_of::<T>() as u64;
+        assert!(record <= Self::STRIDE, "a record fills at most one slot");
         UniformSlots {
+            record,
             buffer: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: Self::STRIDE * slots,
@@ -207,8 +213,13 @@ impl UniformSlots {
         }
     }
 
-    /// Write `records[i]` to slot i (at most `slots` records).
-    pub fn write(&self, queue: &wgpu::Queue, records: &[[u32; 4]]) {
+    /// Write `records[i]` to slot i (at most `slots` records of at most 256 bytes).
+    pub fn write<T: bytemuck::Pod>(&self, queue: &wgpu::Queue, records: &[T]) {
+        let size = std::mem::size_of::<T>();
+        assert_eq!(
+            size as u64, self.record,
+            "records of the type the slots were made for"
+        );
         assert!(
             records.len() as u64 <= self.slots,
             "more records than slots"
@@ -216,7 +227,7 @@ impl UniformSlots {
         let mut bytes = vec![0u8; (Self::STRIDE as usize) * records.len()];
         for (i, r) in records.iter().enumerate() {
             let at = i * Self::STRIDE as usize;
-            bytes[at..at + 16].copy_from_slice(bytemuck::cast_slice(r));
+            bytes[at..at + size].copy_from_slice(bytemuck::bytes_of(r));
         }
         queue.write_buffer(&self.buffer, 0, &bytes);
     }
@@ -226,7 +237,7 @@ impl UniformSlots {
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
             buffer: &self.buffer,
             offset: Self::STRIDE * i as u64,
-            size: std::num::NonZeroU64::new(16),
+            size: std::num::NonZeroU64::new(self.record),
         })
     }
 }

@@ -8,34 +8,7 @@ use crate::frame::FrameInputs;
 use crate::gpu::PassTimer;
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 
-/// Bits per G-buffer channel.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum GBufferFormat {
-    #[default]
-    F16,
-    F32,
-}
-
-impl GBufferFormat {
-    pub fn texture_format(self) -> wgpu::TextureFormat {
-        match self {
-            GBufferFormat::F16 => wgpu::TextureFormat::Rgba16Float,
-            GBufferFormat::F32 => wgpu::TextureFormat::Rgba32Float,
-        }
-    }
-
-    /// Bytes per pixel of one four-channel G-buffer target.
-    pub fn bytes_per_target(self) -> u32 {
-        4 * self.bits() / 8
-    }
-
-    pub fn bits(self) -> u32 {
-        match self {
-            GBufferFormat::F16 => 16,
-            GBufferFormat::F32 => 32,
-        }
-    }
-}
+pub use crate::frame::GBufferFormat;
 
 pub(crate) fn shader() -> ComposedShader {
     let mut parts = SCENE_PARTS.to_vec();

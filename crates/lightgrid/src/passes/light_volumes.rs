@@ -18,7 +18,7 @@
 //! a full-screen pass at the start, because they also sample the scene depth to rebuild
 //! positions, and a texture cannot be a written stencil attachment and sampled in one pass.
 
-use crate::culling::ViewSetup;
+use crate::scene::ViewSetup;
 use crate::scene::{Mesh, PointLight};
 use std::ops::Range;
 

@@ -1,7 +1,7 @@
 //! Reading a 4-byte-per-pixel texture (display, counts, depth) back to the CPU.
 
+use crate::error::Result;
 use crate::gpu::read_buffer;
-use crate::Result;
 
 /// A MAP_READ buffer sized for one texture, with rows padded to the copy alignment.
 pub struct Readback {

@@ -14,6 +14,7 @@
 
 use super::RenderSettings;
 use super::{lighting_attachments, FrameEncoder, FrameInputs, PipelineContext, Technique};
+use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::VOLUME_DEPTH_BYTES;
 use crate::passes::{
@@ -22,7 +23,6 @@ use crate::passes::{
 };
 use crate::passes::{GBuffer, COUNT_FORMAT, FULLSCREEN_WGSL, GBUFFER_READ_WGSL, HDR_FORMAT};
 use crate::shader::{compose, create_module, src, ComposedShader};
-use crate::Result;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
     vec![compose(

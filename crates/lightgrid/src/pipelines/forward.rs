@@ -7,9 +7,9 @@ use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
+use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
-use crate::Result;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
     let mut parts = SCENE_PARTS.to_vec();

@@ -17,6 +17,7 @@ use super::{
     draw_scene, geometry_pipeline, FrameEncoder, FrameInputs, GeometryPipelineDesc,
     PipelineContext, Technique,
 };
+use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::{
     additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
@@ -24,7 +25,6 @@ use crate::passes::{
 };
 use crate::passes::{cleared, render_texture, texture_entry, VOLUME_DEPTH_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
-use crate::Result;
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
 /// rounded up to what every adapter renders and blends.

@@ -7,14 +7,40 @@ mod light_prepass;
 mod tiled_deferred;
 mod tiled_forward;
 
-use crate::culling::GridBuilder;
+use crate::culling::{GridBuilder, GridDims, GridSetup};
+use crate::error::Error;
 use crate::error::Result;
 use crate::memory::MemoryModel;
 use crate::shader::ComposedShader;
-use crate::Error;
 
 pub use crate::culling::Assign;
-pub use crate::frame::{FrameEncoder, FrameInputs, PipelineContext, RenderSettings};
+pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings};
+
+/// What a pipeline needs to create its GPU objects.
+pub struct PipelineContext<'a> {
+    pub device: &'a wgpu::Device,
+    /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
+    pub scene_layout: &'a wgpu::BindGroupLayout,
+    pub dims: GridDims,
+    pub settings: RenderSettings,
+    /// The adapter can blend into the R32Float count target.
+    pub count_blend: bool,
+    /// A CPU-emulated adapter (lavapipe): `--assign auto` keeps assignment on the CPU.
+    pub software_adapter: bool,
+}
+
+impl PipelineContext<'_> {
+    /// What a grid pipeline's [`GridBuilder`] is created from.
+    pub fn grid_setup(&self) -> GridSetup<'_> {
+        GridSetup {
+            device: self.device,
+            scene_layout: self.scene_layout,
+            tiles: self.dims,
+            assign: self.settings.assign,
+            software_adapter: self.software_adapter,
+        }
+    }
+}
 
 /// A rendering technique: records a frame that fills `targets.hdr`, `targets.depth` and
 /// `targets.counts`, with no readback and no wait (the frame's one submission is the
@@ -190,6 +216,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
 /// plus the shared passes.
 pub fn all_shaders() -> Vec<ComposedShader> {
     let mut out = crate::passes::shaders();
+    out.extend(crate::culling::shaders());
     for p in PIPELINES {
         out.extend((p.shaders)());
     }

@@ -18,12 +18,12 @@ use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
 use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
 use crate::culling::{CellSource, GridBuilder, GridDims};
+use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
     compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
 };
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
-use crate::Result;
 
 /// Shared modules of a deferred compute shader (no vertex stage).
 fn deferred_parts() -> Vec<&'static str> {
@@ -83,7 +83,7 @@ pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
 fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
-    let builder = GridBuilder::new(ctx, slices, CellSource::Depth);
+    let builder = GridBuilder::new(&ctx.grid_setup(), slices, CellSource::Depth);
     let outputs_layout = compute_outputs_layout(ctx.device);
     let shading = compute_pipeline(
         ctx.device,

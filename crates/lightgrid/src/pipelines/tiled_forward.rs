@@ -15,9 +15,9 @@ use super::{
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique};
 use crate::culling::{CellSource, GridBuilder};
+use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
-use crate::Result;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
     let mut parts = SCENE_PARTS.to_vec();
@@ -45,7 +45,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let prepass = kind != Kind::Plain;
     let builder = GridBuilder::new(
-        ctx,
+        &ctx.grid_setup(),
         if kind == Kind::Clustered {
             ctx.settings.slices
         } else {

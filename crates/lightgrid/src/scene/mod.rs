@@ -6,11 +6,13 @@ mod camera;
 pub mod catalog;
 mod mesh;
 mod rng;
+mod view;
 
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use mesh::Mesh;
 pub use rng::Rng;
+pub use view::{ViewLight, ViewSetup};
 
 use crate::consts::{MATERIAL_FLAG_TRANSPARENT, MAX_LIGHTS};
 use crate::error::{Error, Result};

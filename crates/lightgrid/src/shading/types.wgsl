@@ -41,3 +41,27 @@ struct GridParams {
     _pad0: u32,
     _pad1: u32,
 }
+
+// The light BVH (culling/bvh.rs): built by bvh_build.wgsl, walked by bvh.wgsl.
+struct BvhNode {
+    lo: vec3<f32>,
+    first: u32,   // first child node, or for a leaf the first slot of the light order
+    hi: vec3<f32>,
+    count: u32,   // number of children | BVH_LEAF for a leaf
+}
+
+// One pass of the radix sort (radix_sort.wgsl).
+struct SortParams {
+    n: u32,
+    shift: u32,
+    blocks: u32,
+    _pad: u32,
+}
+
+// One level of the GPU BVH build (bvh_build.wgsl).
+struct LevelParams {
+    first: u32,        // this level's first node
+    count: u32,        // its nodes
+    child_first: u32,  // the level below's first node
+    child_count: u32,  // its nodes (lights, for the leaves)
+}

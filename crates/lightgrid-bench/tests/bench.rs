@@ -4,10 +4,10 @@
 
 mod common;
 
-use lightgrid::bench::{
+use lightgrid::passes::GBufferFormat;
+use lightgrid_bench::{
     evaluate_claims, run, write_report, BenchConfig, FrameRange, TimesFrom, Verdict,
 };
-use lightgrid::passes::GBufferFormat;
 use serde_json::Value;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -212,7 +212,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
         assert!(num(s, "bytes_per_pixel") >= 12.0);
     }
     // results.json reads back to the same runs (what `lightgrid report` rebuilds from).
-    let back = lightgrid::bench::read_results(&dir.join("results.json")).unwrap();
+    let back = lightgrid_bench::read_results(&dir.join("results.json")).unwrap();
     assert_eq!(back.runs, results.runs);
     assert_eq!(back.config, results.config);
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
@@ -245,7 +245,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
 /// Per run the progress callback sees 1 warm-up, 3 analysis renders and 3 real-time frames
 /// (frames 0, 129, 258): a stop at call `at` lands in the analysis renders of the second run
 /// (10) or in the real-time pass of the first (6).
-fn stopped_at(at: u32) -> lightgrid::bench::BenchResults {
+fn stopped_at(at: u32) -> lightgrid_bench::BenchResults {
     let ctx = common::gpu();
     let mut cfg = config();
     cfg.gbuffers = vec![GBufferFormat::F16];
@@ -318,7 +318,7 @@ fn frame_ranges_parse_and_reject_nonsense() {
 
 #[test]
 fn scaling_growth_reports_slopes_and_the_fastest_strategy() {
-    use lightgrid::bench::{
+    use lightgrid_bench::{
         scaling_growth, scaling_table, ScalingConfig, ScalingPoint, ScalingResults,
     };
     let point = |lights: u32, assign: &str, ms: Option<f64>| ScalingPoint {

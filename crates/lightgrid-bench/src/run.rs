@@ -1,15 +1,16 @@
 //! Running the benchmark: the measurement loop, warm-up, repeats, cancellation.
 
-use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, PassTiming};
-use crate::memory::ForwardPlusTable1;
-use crate::passes::GBufferFormat;
-use crate::pipelines::{self, RenderSettings};
-use crate::realtime::{play, PlayPlan, PlayedFrame};
-use crate::scene::catalog::{self, SceneParams};
-use crate::stats::TimingSource;
-use crate::Renderer;
+use crate::invalid;
 use image::RgbaImage;
+use lightgrid::error::Result;
+use lightgrid::gpu::{GpuContext, PassTiming};
+use lightgrid::memory::ForwardPlusTable1;
+use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::{self, RenderSettings};
+use lightgrid::realtime::{play, PlayPlan, PlayedFrame};
+use lightgrid::scene::catalog::{self, SceneParams};
+use lightgrid::stats::TimingSource;
+use lightgrid::Renderer;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -25,7 +26,7 @@ impl FrameRange {
     /// Parse `A..B:STEP`, `A..B` or `N`.
     pub fn parse(s: &str) -> Result<Self> {
         let bad = || {
-            Error::invalid(
+            invalid(
                 "--frames",
                 format!("'{s}' is not A..B:STEP, A..B or N (e.g. 0..259:5)"),
             )
@@ -67,7 +68,7 @@ pub struct BenchConfig {
     /// View-depth slices of clustered pipelines.
     pub slices: u32,
     /// Who builds the grids of pipelines that can use GPU gather (the others use the CPU).
-    pub assign: crate::pipelines::Assign,
+    pub assign: lightgrid::pipelines::Assign,
     pub gbuffers: Vec<GBufferFormat>,
     /// Measurements per frame (the spread is kept).
     pub repeat: u32,
@@ -83,7 +84,7 @@ pub struct BenchConfig {
 impl BenchConfig {
     pub fn validate(&self) -> Result<()> {
         if self.scenes.is_empty() || self.pipelines.is_empty() || self.gbuffers.is_empty() {
-            return Err(Error::invalid(
+            return Err(invalid(
                 "bench",
                 "needs at least one scene, pipeline and G-buffer setting",
             ));
@@ -95,7 +96,7 @@ impl BenchConfig {
             catalog::find(s)?;
         }
         if self.repeat == 0 {
-            return Err(Error::invalid("--repeat", "must be at least 1"));
+            return Err(invalid("--repeat", "must be at least 1"));
         }
         Ok(())
     }
@@ -336,7 +337,7 @@ pub fn run(
     for (si, scene) in scenes.iter().enumerate() {
         let frames = config.frames.frames(scene.frame_count());
         if frames.is_empty() {
-            return Err(Error::invalid(
+            return Err(invalid(
                 "--frames",
                 format!("no frame of {} is in range", scene.name),
             ));
@@ -395,7 +396,7 @@ pub fn run(
             assign: if info.assign {
                 config.assign
             } else {
-                crate::pipelines::Assign::default()
+                lightgrid::pipelines::Assign::default()
             },
         };
         if !renderers.iter().any(|r| r.0 == si && r.1 == settings) {
@@ -461,7 +462,7 @@ pub fn run(
             bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
             let wanted = heatmap_pipeline.as_deref() == Some(info.id);
             if f == heatmap_frame && wanted && !results.heatmaps.iter().any(|h| h.0 == scene.name) {
-                let map = crate::heatmap::heatmap(&out.image, &out.grid);
+                let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
                 results
                     .heatmaps
                     .push((scene.name.clone(), info.id.to_string(), f, map));

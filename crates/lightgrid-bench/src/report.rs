@@ -2,9 +2,11 @@
 //! summary.md. Every file is written whole or not at all.
 
 use super::{evaluate_claims, BenchResults, RunRecord};
-use crate::error::{Error, Result};
-use crate::image_io::{save_png, write_atomic};
+use crate::invalid;
 use crate::plot::{LineChart, Series, StackedBars};
+use lightgrid::error::{Error, Result};
+use lightgrid::image_io::{save_png, write_atomic};
+use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -38,56 +40,128 @@ fn fps(r: &super::run::RunRecord) -> String {
     )
 }
 
-fn csv(results: &BenchResults) -> String {
-    let mut s = String::from(
-        "scene,pipeline,gbuffer_bits,width,height,tile_size,timing,frame,gpu_ms,gpu_ms_min,gpu_ms_max,frame_ms,analysis_gpu_ms,lighting_computations,ideal_lighting_computations,lights_per_tile_avg,lights_per_tile_max,grid_bytes,modelled_write_bytes,modelled_read_bytes,passes\n",
-    );
-    let opt = |v: Option<String>| v.unwrap_or_default();
-    for r in &results.runs {
-        for f in &r.frames {
-            let passes: Vec<String> = f
-                .passes
-                .iter()
-                .map(|p| format!("{}={:.4}", p.label, p.ms))
-                .collect();
-            let min = f
-                .gpu_ms_repeats
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min);
-            let max = f
-                .gpu_ms_repeats
-                .iter()
-                .copied()
-                .fold(f64::NEG_INFINITY, f64::max);
-            let _ = writeln!(
-                s,
-                "{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{},{},{},{},{},{},\"{}\"",
-                r.scene,
-                r.pipeline,
-                opt(r.gbuffer_bits.map(|b| b.to_string())),
-                r.width,
-                r.height,
-                r.tile_size,
-                r.timing.label(),
-                f.frame,
-                f.gpu_ms,
-                min,
-                max,
-                f.frame_ms,
-                f.analysis_gpu_ms,
-                opt(f.lighting_computations.map(|n| n.to_string())),
-                f.ideal_lighting_computations,
-                opt(f.lights_per_tile_avg.map(|v| format!("{v:.3}"))),
-                opt(f.lights_per_tile_max.map(|v| v.to_string())),
-                opt(f.grid_bytes.map(|v| v.to_string())),
-                opt(f.modelled_write_bytes.map(|v| v.to_string())),
-                opt(f.modelled_read_bytes.map(|v| v.to_string())),
-                passes.join(";")
-            );
-        }
+/// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
+const RESULTS_CSV_COLUMNS: [&str; 21] = [
+    "scene",
+    "pipeline",
+    "gbuffer_bits",
+    "width",
+    "height",
+    "tile_size",
+    "timing",
+    "frame",
+    "gpu_ms",
+    "gpu_ms_min",
+    "gpu_ms_max",
+    "frame_ms",
+    "analysis_gpu_ms",
+    "lighting_computations",
+    "ideal_lighting_computations",
+    "lights_per_tile_avg",
+    "lights_per_tile_max",
+    "grid_bytes",
+    "modelled_write_bytes",
+    "modelled_read_bytes",
+    "passes",
+];
+
+/// One row of results.csv: one frame of one run. Empty fields are `None`; times keep four
+/// decimals, the average lights per tile three.
+#[derive(Default, Serialize)]
+struct ResultsRow<'a> {
+    scene: &'a str,
+    pipeline: &'a str,
+    gbuffer_bits: Option<u32>,
+    width: u32,
+    height: u32,
+    tile_size: u32,
+    timing: &'a str,
+    frame: u32,
+    #[serde(serialize_with = "fixed4")]
+    gpu_ms: f64,
+    #[serde(serialize_with = "fixed4")]
+    gpu_ms_min: f64,
+    #[serde(serialize_with = "fixed4")]
+    gpu_ms_max: f64,
+    #[serde(serialize_with = "fixed4")]
+    frame_ms: f64,
+    #[serde(serialize_with = "fixed4")]
+    analysis_gpu_ms: f64,
+    lighting_computations: Option<u64>,
+    ideal_lighting_computations: u64,
+    #[serde(serialize_with = "fixed3_opt")]
+    lights_per_tile_avg: Option<f64>,
+    lights_per_tile_max: Option<u32>,
+    grid_bytes: Option<u64>,
+    modelled_write_bytes: Option<u64>,
+    modelled_read_bytes: Option<u64>,
+    /// `label=ms` per pass, `;`-separated.
+    passes: String,
+}
+
+fn fixed4<S: serde::Serializer>(v: &f64, s: S) -> std::result::Result<S::Ok, S::Error> {
+    s.collect_str(&format_args!("{v:.4}"))
+}
+
+fn fixed3_opt<S: serde::Serializer>(v: &Option<f64>, s: S) -> std::result::Result<S::Ok, S::Error> {
+    match v {
+        Some(v) => s.collect_str(&format_args!("{v:.3}")),
+        None => s.serialize_none(),
     }
-    s
+}
+
+/// Rows serialized after a header line of `columns` (also written when there are no rows).
+pub(crate) fn csv_bytes<R: Serialize>(
+    what: &'static str,
+    columns: &[&str],
+    rows: impl IntoIterator<Item = R>,
+) -> Result<Vec<u8>> {
+    let err = |e: csv::Error| invalid(what, e.to_string());
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(Vec::new());
+    w.write_record(columns).map_err(err)?;
+    for row in rows {
+        w.serialize(row).map_err(err)?;
+    }
+    w.into_inner().map_err(|e| invalid(what, e.to_string()))
+}
+
+fn csv(results: &BenchResults) -> Result<Vec<u8>> {
+    let rows = results.runs.iter().flat_map(|r| {
+        r.frames.iter().map(move |f| {
+            let repeats = || f.gpu_ms_repeats.iter().copied();
+            ResultsRow {
+                scene: &r.scene,
+                pipeline: &r.pipeline,
+                gbuffer_bits: r.gbuffer_bits,
+                width: r.width,
+                height: r.height,
+                tile_size: r.tile_size,
+                timing: r.timing.label(),
+                frame: f.frame,
+                gpu_ms: f.gpu_ms,
+                gpu_ms_min: repeats().fold(f64::INFINITY, f64::min),
+                gpu_ms_max: repeats().fold(f64::NEG_INFINITY, f64::max),
+                frame_ms: f.frame_ms,
+                analysis_gpu_ms: f.analysis_gpu_ms,
+                lighting_computations: f.lighting_computations,
+                ideal_lighting_computations: f.ideal_lighting_computations,
+                lights_per_tile_avg: f.lights_per_tile_avg,
+                lights_per_tile_max: f.lights_per_tile_max,
+                grid_bytes: f.grid_bytes,
+                modelled_write_bytes: f.modelled_write_bytes,
+                modelled_read_bytes: f.modelled_read_bytes,
+                passes: f
+                    .passes
+                    .iter()
+                    .map(|p| format!("{}={:.4}", p.label, p.ms))
+                    .collect::<Vec<_>>()
+                    .join(";"),
+            }
+        })
+    });
+    csv_bytes("results", &RESULTS_CSV_COLUMNS, rows)
 }
 
 fn write_chart(
@@ -130,7 +204,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 .collect();
             let timing = if runs
                 .iter()
-                .all(|r| r.timing == crate::TimingSource::GpuTimestamps)
+                .all(|r| r.timing == lightgrid::TimingSource::GpuTimestamps)
             {
                 "GPU timestamps"
             } else {
@@ -171,7 +245,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 y_label: "ms".into(),
                 bars: runs
                     .iter()
-                    .filter(|r| !crate::pipelines::find(&r.pipeline).is_ok_and(|p| p.reference == p.id))
+                    .filter(|r| !lightgrid::pipelines::find(&r.pipeline).is_ok_and(|p| p.reference == p.id))
                     .filter_map(|r| {
                         let s = r.summary.as_ref()?;
                         Some((
@@ -391,11 +465,11 @@ pub fn read_results(path: &Path) -> Result<BenchResults> {
         source,
     })?;
     let v: serde_json::Value = serde_json::from_slice(&bytes)
-        .map_err(|e| Error::invalid("results", format!("{}: {e}", path.display())))?;
+        .map_err(|e| invalid("results", format!("{}: {e}", path.display())))?;
     match v.get("schema_version").and_then(|x| x.as_u64()) {
         Some(n) if n == u64::from(SCHEMA_VERSION) => {}
         other => {
-            return Err(Error::invalid(
+            return Err(invalid(
                 "results",
                 format!(
                     "{}: schema_version {other:?}, expected {SCHEMA_VERSION}",
@@ -404,8 +478,7 @@ pub fn read_results(path: &Path) -> Result<BenchResults> {
             ))
         }
     }
-    serde_json::from_value(v)
-        .map_err(|e| Error::invalid("results", format!("{}: {e}", path.display())))
+    serde_json::from_value(v).map_err(|e| invalid("results", format!("{}: {e}", path.display())))
 }
 
 /// Write every report file into `dir` (created if missing). Returns the paths written.
@@ -425,10 +498,10 @@ pub fn write_report(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> 
         schema_version: SCHEMA_VERSION,
         results,
     })
-    .map_err(|e| Error::invalid("results", e.to_string()))?;
+    .map_err(|e| invalid("results", e.to_string()))?;
     for (name, bytes) in [
         ("results.json", json),
-        ("results.csv", csv(results).into_bytes()),
+        ("results.csv", csv(results)?),
         ("summary.md", summary(results).into_bytes()),
     ] {
         let p = dir.join(name);
@@ -437,4 +510,39 @@ pub fn write_report(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> 
     }
     plots(dir, results, &mut written)?;
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_results_header_is_what_the_row_serializes_to() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(ResultsRow::default()).unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        assert_eq!(
+            text.lines().next(),
+            Some(RESULTS_CSV_COLUMNS.join(",").as_str())
+        );
+        let bytes = csv_bytes(
+            "results",
+            &RESULTS_CSV_COLUMNS,
+            [ResultsRow {
+                gbuffer_bits: Some(16),
+                lights_per_tile_avg: Some(1.5),
+                passes: "gbuffer=0.1000;shade=0.2000".into(),
+                ..Default::default()
+            }],
+        )
+        .unwrap();
+        let text = String::from_utf8(bytes).unwrap();
+        let row = text.lines().nth(1).unwrap();
+        assert_eq!(
+            row,
+            ",,16,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,1.500,,,,,gbuffer=0.1000;shade=0.2000"
+        );
+        let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
+        assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);
+    }
 }

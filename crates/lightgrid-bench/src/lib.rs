@@ -3,9 +3,13 @@
 //! lighting computations, the ideal count, lights per tile and the memory model; then
 //! `report` writes results.json / results.csv / plots / summary.md and `claims` checks the
 //! papers' claims against the measurements. `scaling` measures light assignment strategies
-//! against the light count.
+//! against the light count. [`plot`] draws the charts (plotters, with an embedded font).
+//!
+//! Everything renders through the `lightgrid` library; this crate only plans, measures and
+//! writes.
 
 mod claims;
+pub mod plot;
 mod report;
 mod run;
 mod scaling;
@@ -20,3 +24,11 @@ pub use scaling::{
     run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,
     ScalingResults, SCALING_FILES,
 };
+
+/// `lightgrid::Error::Invalid` with a reason (the library's own shorthand is crate-private).
+pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> lightgrid::Error {
+    lightgrid::Error::Invalid {
+        what,
+        reason: reason.into(),
+    }
+}

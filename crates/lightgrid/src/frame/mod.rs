@@ -1,55 +1,22 @@
 //! What one frame carries, below `pipelines/`, `passes/` and `culling/` (which all use it):
-//! the settings every pipeline shares, what a pipeline needs to create its GPU objects
-//! ([`PipelineContext`]), what it reads to record a frame ([`FrameInputs`]), and the frame's
-//! command encoder ([`FrameEncoder`]), which counts the queue submissions, blocking readbacks
-//! and CPU waits the frame makes ([`FrameIo`]): a real-time frame makes one submission and no
-//! blocking readback; only the `cpu` strategy with depth bounds waits part-way (the papers'
-//! CPU pipeline reads the tile bounds back).
+//! the settings every pipeline shares (`settings.rs`), the render targets (`targets.rs`),
+//! what a pipeline reads to record a frame ([`FrameInputs`]), the frame's command encoder
+//! ([`FrameEncoder`]), which counts the queue submissions, blocking readbacks and CPU waits
+//! the frame makes ([`FrameIo`]), and what the renderer reports about a frame once submitted
+//! ([`SubmittedFrame`]) and once the GPU has finished it ([`FinishedFrame`]). A real-time
+//! frame makes one submission and no blocking readback; only the `cpu` strategy with depth
+//! bounds waits part-way (the papers' CPU pipeline reads the tile bounds back).
 
-use crate::culling::{Assign, GridDims, ViewSetup};
+mod settings;
+pub mod targets;
+
+pub use settings::{Assign, GBufferFormat, RenderSettings, AUTO_GATHER_MAX_LIGHTS};
+pub use targets::Targets;
+
 use crate::error::Result;
-use crate::gpu::{read_buffer, scoped, PassTimer};
-use crate::passes::{GBufferFormat, Targets};
-use crate::scene::PointLight;
+use crate::gpu::{read_buffer, scoped, PassTimer, PassTiming};
+use crate::scene::{PointLight, ViewSetup};
 use std::time::Instant;
-
-/// Settings every pipeline of a renderer shares.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderSettings {
-    /// Screen tile edge in pixels (`--tile`).
-    pub tile_size: u32,
-    /// G-buffer channel precision (`--gbuffer 16|32`).
-    pub gbuffer: GBufferFormat,
-    /// View-depth slices of clustered grids (`--slices`).
-    pub slices: u32,
-    /// Who builds the grid (`--assign`).
-    pub assign: Assign,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            tile_size: crate::consts::DEFAULT_TILE_SIZE,
-            gbuffer: GBufferFormat::F16,
-            slices: crate::consts::DEFAULT_SLICES,
-            assign: Assign::default(),
-        }
-    }
-}
-
-/// What a pipeline needs to create its GPU objects.
-/// (Built by the renderer for each registry row it is asked to render.)
-pub struct PipelineContext<'a> {
-    pub device: &'a wgpu::Device,
-    /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
-    pub scene_layout: &'a wgpu::BindGroupLayout,
-    pub dims: GridDims,
-    pub settings: RenderSettings,
-    /// The adapter can blend into the R32Float count target.
-    pub count_blend: bool,
-    /// A CPU-emulated adapter (lavapipe): `--assign auto` keeps assignment on the CPU.
-    pub software_adapter: bool,
-}
 
 /// What a pipeline reads to render one frame.
 pub struct FrameInputs<'a> {
@@ -152,4 +119,33 @@ impl<'a> FrameEncoder<'a> {
         let index = self.submit_recorded(stage)?;
         Ok((self.io, index))
     }
+}
+
+/// A frame submitted by `Renderer::render_frame`.
+#[derive(Clone, Copy, Debug)]
+pub struct SubmittedFrame {
+    /// The renderer's frame number (counts every submitted frame).
+    pub serial: u64,
+    /// Submissions, blocking readbacks and CPU waits the frame made.
+    pub io: FrameIo,
+    /// CPU time spent waiting for older frames before this one could be queued
+    /// (more than `MAX_FRAMES_IN_FLIGHT` in flight).
+    pub throttle_ms: f64,
+    /// Bytes uploaded for the frame (lights, uniforms, moving geometry).
+    pub upload_bytes: u64,
+}
+
+/// What the GPU reported about a finished real-time frame (read back without waiting).
+#[derive(Clone, Debug)]
+pub struct FinishedFrame {
+    pub serial: u64,
+    pub pipeline: &'static str,
+    /// Sum of the frame's pass durations (GPU work only); None without timestamps.
+    pub gpu_ms: Option<f64>,
+    pub passes: Vec<PassTiming>,
+    /// Shader loops that ended before their bound: the frame is wrong when non-zero.
+    pub truncated_loops: u32,
+    /// Some light list did not fit its buffer (sized from earlier frames): the frame is
+    /// missing lights; the buffers have grown for the next one.
+    pub overflowed: bool,
 }

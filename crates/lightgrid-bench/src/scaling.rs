@@ -7,13 +7,15 @@
 //! (assignment time against lights).
 
 use super::run::Progress;
-use crate::error::{Error, Result};
-use crate::gpu::GpuContext;
-use crate::image_io::write_atomic;
-use crate::pipelines::{self, Assign, RenderSettings};
+use crate::invalid;
 use crate::plot::{LineChart, Series};
-use crate::scene::catalog::{self, SceneParams};
-use crate::Renderer;
+use crate::report::csv_bytes;
+use lightgrid::error::{Error, Result};
+use lightgrid::gpu::GpuContext;
+use lightgrid::image_io::write_atomic;
+use lightgrid::pipelines::{self, Assign, RenderSettings};
+use lightgrid::scene::catalog::{self, SceneParams};
+use lightgrid::Renderer;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -53,8 +55,8 @@ impl Default for ScalingConfig {
                 Assign::BvhGpu,
             ],
             size: (640, 360),
-            tile_size: crate::consts::DEFAULT_TILE_SIZE,
-            slices: crate::consts::DEFAULT_SLICES,
+            tile_size: lightgrid::consts::DEFAULT_TILE_SIZE,
+            slices: lightgrid::consts::DEFAULT_SLICES,
             seed: 1,
             runs: 1,
             warmup: 1,
@@ -102,7 +104,7 @@ impl ScalingConfig {
     pub fn validate(&self) -> Result<()> {
         let info = pipelines::find(&self.pipeline)?;
         if !info.assign {
-            return Err(Error::invalid(
+            return Err(invalid(
                 "--pipeline",
                 format!(
                     "{} builds no grid through --assign; use one of: {}",
@@ -117,13 +119,13 @@ impl ScalingConfig {
             ));
         }
         if !catalog::find(&self.scene)?.variable_lights {
-            return Err(Error::invalid(
+            return Err(invalid(
                 "--scene",
                 format!("{} has a fixed light count; use stress", self.scene),
             ));
         }
         if self.lights.is_empty() || self.strategies.is_empty() || self.runs == 0 {
-            return Err(Error::invalid(
+            return Err(invalid(
                 "scaling",
                 "needs at least one light count, one strategy and one run",
             ));
@@ -382,39 +384,69 @@ pub const SCALING_FILES: [&str; 5] = [
     "scaling.png",
 ];
 
+/// The columns of scaling.csv, in order (the header [`ScalingRow`] serializes to).
+const SCALING_CSV_COLUMNS: [&str; 14] = [
+    "lights",
+    "assign",
+    "skipped",
+    "assign_ms",
+    "assign_gpu_ms",
+    "assign_cpu_ms",
+    "frame_gpu_ms",
+    "grid_indices",
+    "grid_bytes",
+    "grid_cells",
+    "grid_cells_occupied",
+    "lights_per_cell_max",
+    "lighting_computations",
+    "ideal_lighting_computations",
+];
+
+/// One row of scaling.csv: one (light count, strategy) point; what was not measured is empty.
+#[derive(Default, Serialize)]
+struct ScalingRow<'a> {
+    lights: u32,
+    assign: &'a str,
+    skipped: Option<&'a str>,
+    assign_ms: Option<f64>,
+    assign_gpu_ms: Option<f64>,
+    assign_cpu_ms: Option<f64>,
+    frame_gpu_ms: Option<f64>,
+    grid_indices: Option<u64>,
+    grid_bytes: Option<u64>,
+    grid_cells: Option<u64>,
+    grid_cells_occupied: Option<u64>,
+    lights_per_cell_max: Option<u32>,
+    lighting_computations: Option<u64>,
+    ideal_lighting_computations: Option<u64>,
+}
+
 /// Write scaling.json, scaling.csv, scaling.md and the chart into `dir`.
 pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|source| Error::Io {
         path: dir.display().to_string(),
         source,
     })?;
-    let json =
-        serde_json::to_vec_pretty(r).map_err(|e| Error::invalid("scaling", e.to_string()))?;
+    let json = serde_json::to_vec_pretty(r).map_err(|e| invalid("scaling", e.to_string()))?;
     write_atomic(&dir.join("scaling.json"), &json)?;
-    let mut csv = String::from(
-        "lights,assign,skipped,assign_ms,assign_gpu_ms,assign_cpu_ms,frame_gpu_ms,grid_indices,grid_bytes,grid_cells,grid_cells_occupied,lights_per_cell_max,lighting_computations,ideal_lighting_computations\n",
-    );
-    for p in &r.points {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            p.lights,
-            p.assign,
-            p.skipped.as_deref().unwrap_or("").replace(',', ";"),
-            opt(p.assign_ms),
-            opt(p.assign_gpu_ms),
-            opt(p.assign_cpu_ms),
-            opt(p.frame_gpu_ms),
-            opt(p.grid_indices),
-            opt(p.grid_bytes),
-            opt(p.grid_cells),
-            opt(p.grid_cells_occupied),
-            opt(p.lights_per_cell_max),
-            opt(p.lighting_computations),
-            opt(p.ideal_lighting_computations),
-        );
-    }
-    write_atomic(&dir.join("scaling.csv"), csv.as_bytes())?;
+    let rows = r.points.iter().map(|p| ScalingRow {
+        lights: p.lights,
+        assign: &p.assign,
+        skipped: p.skipped.as_deref(),
+        assign_ms: p.assign_ms,
+        assign_gpu_ms: p.assign_gpu_ms,
+        assign_cpu_ms: p.assign_cpu_ms,
+        frame_gpu_ms: p.frame_gpu_ms,
+        grid_indices: p.grid_indices,
+        grid_bytes: p.grid_bytes,
+        grid_cells: p.grid_cells,
+        grid_cells_occupied: p.grid_cells_occupied,
+        lights_per_cell_max: p.lights_per_cell_max,
+        lighting_computations: p.lighting_computations,
+        ideal_lighting_computations: p.ideal_lighting_computations,
+    });
+    let csv = csv_bytes("scaling", &SCALING_CSV_COLUMNS, rows)?;
+    write_atomic(&dir.join("scaling.csv"), &csv)?;
     let md = format!(
         "# Light assignment scaling\n\n`{}`\n\n{}\n{}",
         r.command,
@@ -456,7 +488,46 @@ pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
     chart
         .png()
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| Error::invalid("scaling", e.to_string()))?;
+        .map_err(|e| invalid("scaling", e.to_string()))?;
     write_atomic(&dir.join("scaling.png"), &png)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_scaling_header_is_what_the_row_serializes_to() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(ScalingRow::default()).unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        assert_eq!(
+            text.lines().next(),
+            Some(SCALING_CSV_COLUMNS.join(",").as_str())
+        );
+        let rows = [
+            ScalingRow {
+                lights: 1000,
+                assign: "cpu",
+                assign_ms: Some(1.5),
+                grid_indices: Some(12),
+                ..Default::default()
+            },
+            ScalingRow {
+                lights: 4000,
+                assign: "bvh",
+                skipped: Some("took 6.0 s at 1000 lights, over budget"),
+                ..Default::default()
+            },
+        ];
+        let text =
+            String::from_utf8(csv_bytes("scaling", &SCALING_CSV_COLUMNS, rows).unwrap()).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[1], "1000,cpu,,1.5,,,,12,,,,,,");
+        assert_eq!(
+            lines[2],
+            "4000,bvh,\"took 6.0 s at 1000 lights, over budget\",,,,,,,,,,,"
+        );
+    }
 }

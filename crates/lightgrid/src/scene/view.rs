@@ -3,7 +3,7 @@
 //!
 //! View space is right-handed with the camera looking down -z; "view distance" `w = -z`.
 
-use crate::scene::{Camera, PointLight};
+use super::{Camera, PointLight};
 use glam::{Mat4, Vec3};
 
 #[derive(Clone, Copy, Debug)]

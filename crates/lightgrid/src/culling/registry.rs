@@ -1,0 +1,42 @@
+//! The light-assignment registry: one row per `--assign` strategy (`auto` resolves to one of
+//! them, `Assign::resolve`). Adding a strategy is one file implementing
+//! [`AssignStrategy`](super::strategy::AssignStrategy) and one row here; the tests iterate
+//! the rows.
+
+use super::strategy::{AssignStrategy, StrategyContext};
+use crate::frame::Assign;
+
+/// One registry row.
+pub struct StrategyInfo {
+    pub assign: Assign,
+    pub create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
+}
+
+/// The registry: every strategy `--assign` can name (`auto` resolves to one of them).
+pub const STRATEGIES: &[StrategyInfo] = &[
+    StrategyInfo {
+        assign: Assign::Cpu,
+        create: super::assign_cpu::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::Gather,
+        create: super::gather::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::Scatter,
+        create: super::scatter::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::Bvh,
+        create: super::bvh::create_strategy,
+    },
+    StrategyInfo {
+        assign: Assign::BvhGpu,
+        create: super::bvh_gpu::create_strategy,
+    },
+];
+
+/// The registry row of a (resolved) strategy.
+pub fn find_strategy(assign: Assign) -> Option<&'static StrategyInfo> {
+    STRATEGIES.iter().find(|s| s.assign == assign)
+}

@@ -1,0 +1,128 @@
+//! The settings every pipeline of a renderer shares (`--tile`, `--gbuffer`, `--slices`,
+//! `--assign`): plain values, below everything that reads them.
+
+/// Settings every pipeline of a renderer shares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderSettings {
+    /// Screen tile edge in pixels (`--tile`).
+    pub tile_size: u32,
+    /// G-buffer channel precision (`--gbuffer 16|32`).
+    pub gbuffer: GBufferFormat,
+    /// View-depth slices of clustered grids (`--slices`).
+    pub slices: u32,
+    /// Who builds the grid (`--assign`).
+    pub assign: Assign,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            tile_size: crate::consts::DEFAULT_TILE_SIZE,
+            gbuffer: GBufferFormat::F16,
+            slices: crate::consts::DEFAULT_SLICES,
+            assign: Assign::default(),
+        }
+    }
+}
+
+/// Bits per G-buffer channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum GBufferFormat {
+    #[default]
+    F16,
+    F32,
+}
+
+impl GBufferFormat {
+    pub fn texture_format(self) -> wgpu::TextureFormat {
+        match self {
+            GBufferFormat::F16 => wgpu::TextureFormat::Rgba16Float,
+            GBufferFormat::F32 => wgpu::TextureFormat::Rgba32Float,
+        }
+    }
+
+    /// Bytes per pixel of one four-channel G-buffer target.
+    pub fn bytes_per_target(self) -> u32 {
+        4 * self.bits() / 8
+    }
+
+    pub fn bits(self) -> u32 {
+        match self {
+            GBufferFormat::F16 => 16,
+            GBufferFormat::F32 => 32,
+        }
+    }
+}
+
+/// Who builds the light grid (`--assign`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Assign {
+    /// On the CPU (`assign_cpu.rs`): projected sphere rectangles, per-cell depth test.
+    Cpu,
+    /// GPU gather: one workgroup per cell tests every light against the cell's frustum.
+    Gather,
+    /// GPU scatter: one invocation per light emits (cell, light) pairs, radix-sorted by cell.
+    Scatter,
+    /// Light BVH rebuilt each frame on the CPU, traversed on the GPU per cell.
+    Bvh,
+    /// Light BVH rebuilt each frame on the GPU (Morton codes, radix sort, node boxes),
+    /// traversed as `Bvh`.
+    #[serde(rename = "bvh-gpu")]
+    BvhGpu,
+    /// By light count: see [`Assign::resolve`].
+    #[default]
+    Auto,
+}
+
+/// On a hardware GPU, `auto` gathers up to this many lights and walks a GPU-built BVH above
+/// (tiled-forward-shading §4.4: brute force holds to about 10k lights).
+pub const AUTO_GATHER_MAX_LIGHTS: usize = 8192;
+
+impl Assign {
+    pub const ALL: [Assign; 6] = [
+        Assign::Cpu,
+        Assign::Gather,
+        Assign::Scatter,
+        Assign::Bvh,
+        Assign::BvhGpu,
+        Assign::Auto,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Assign::Cpu => "cpu",
+            Assign::Gather => "gather",
+            Assign::Scatter => "scatter",
+            Assign::Bvh => "bvh",
+            Assign::BvhGpu => "bvh-gpu",
+            Assign::Auto => "auto",
+        }
+    }
+
+    /// One line on how the strategy works (`lightgrid list`).
+    pub fn description(self) -> &'static str {
+        match self {
+            Assign::Cpu => "CPU: projected sphere rectangles, per-cell depth test (rayon); grid uploaded",
+            Assign::Gather => "GPU: one workgroup per occupied cell tests every light (forward-plus §4)",
+            Assign::Scatter => "GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell (forward-plus §4)",
+            Assign::Bvh => "light BVH built on the CPU each frame, walked per occupied cell on the GPU (tiled-forward-shading §4.4)",
+            Assign::BvhGpu => "the same BVH built on the GPU (Morton codes, radix sort), walked the same way",
+            Assign::Auto => "software adapter: cpu; hardware GPU: gather up to 8192 lights, bvh-gpu above",
+        }
+    }
+
+    /// The strategy used for a frame with `lights` lights. `auto` on a software adapter
+    /// (lavapipe, which shares the CPU's cores) is `cpu` at every count: measured fastest from
+    /// 1k to 1M lights (README, "Light assignment scaling"). On a hardware GPU it is `gather`
+    /// up to [`AUTO_GATHER_MAX_LIGHTS`] and `bvh-gpu` above, which keeps the grid on the GPU
+    /// (the paper's crossover; no hardware GPU was available to measure it).
+    pub fn resolve(self, lights: usize, software_adapter: bool) -> Assign {
+        match self {
+            Assign::Auto if software_adapter => Assign::Cpu,
+            Assign::Auto if lights <= AUTO_GATHER_MAX_LIGHTS => Assign::Gather,
+            Assign::Auto => Assign::BvhGpu,
+            other => other,
+        }
+    }
+}

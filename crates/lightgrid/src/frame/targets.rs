@@ -1,0 +1,114 @@
+//! The frame's render targets and their formats: HDR colour, depth, the lighting-count
+//! target and the sRGB display target every pipeline renders into.
+
+/// HDR colour target every pipeline accumulates light into.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Scene depth buffer.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Display target: the tonemap pass writes linear values and the format encodes sRGB.
+pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+/// Per-pixel lighting-computation counts: every lighting shader adds the number of times it
+/// ran the light function for the sample (additive blending or a storage write), and the
+/// renderer sums the target. 32-bit float holds integers exactly up to 2^24 per pixel.
+pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// A single-sample 2D texture of the frame's size.
+pub fn render_texture(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    (width, height): (u32, u32),
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// A colour attachment cleared to `color` at the start of the pass and stored.
+pub fn cleared(
+    view: &wgpu::TextureView,
+    color: wgpu::Color,
+) -> wgpu::RenderPassColorAttachment<'_> {
+    wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Clear(color),
+            store: wgpu::StoreOp::Store,
+        },
+    }
+}
+
+/// The scene depth attachment, cleared to the far plane and stored.
+pub fn cleared_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+/// The frame's render targets.
+pub struct Targets {
+    pub width: u32,
+    pub height: u32,
+    pub hdr: wgpu::TextureView,
+    pub depth_texture: wgpu::Texture,
+    pub depth: wgpu::TextureView,
+    pub counts_texture: wgpu::Texture,
+    pub counts: wgpu::TextureView,
+    pub ldr_texture: wgpu::Texture,
+    pub ldr: wgpu::TextureView,
+}
+
+impl Targets {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        let make =
+            |label, format, usage| render_texture(device, label, format, (width, height), usage);
+        use wgpu::TextureUsages as U;
+        let hdr = make(
+            "hdr",
+            HDR_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING,
+        );
+        let depth_texture = make(
+            "depth",
+            DEPTH_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        let counts_texture = make(
+            "lighting counts",
+            COUNT_FORMAT,
+            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::COPY_SRC,
+        );
+        let ldr_texture = make("ldr", LDR_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+        Targets {
+            width,
+            height,
+            hdr: hdr.create_view(&Default::default()),
+            depth: depth_texture.create_view(&Default::default()),
+            depth_texture,
+            counts: counts_texture.create_view(&Default::default()),
+            counts_texture,
+            ldr: ldr_texture.create_view(&Default::default()),
+            ldr_texture,
+        }
+    }
+}
