@@ -83,7 +83,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     );
     if let (Some(assign), Some(indices)) = (&s.assign, s.grid_indices) {
         println!(
-            "light assignment {assign}: {} ms wall ({} ms GPU timestamps{}), {indices} index entries in {} cells ({} with samples)",
+            "light assignment {assign}: {} ms ({} ms GPU timestamps{}), {indices} index entries in {} cells ({} with samples)",
             s.assign_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
             s.assign_gpu_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
             s.assign_cpu_ms
@@ -93,5 +93,16 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
             s.grid_cells_occupied.unwrap_or(0),
         );
     }
+    println!(
+        "frame: {} queue submission(s), {} bytes read back and {:.2} ms waited inside the frame{}",
+        s.submits,
+        s.readback_bytes,
+        s.cpu_wait_ms,
+        if s.submits > 1 {
+            " (--assign cpu reads the cell bounds back)"
+        } else {
+            ""
+        }
+    );
     Ok(())
 }

@@ -262,6 +262,20 @@ impl<'c> Renderer<'c> {
 
     /// Step 1: validate `frame` of `scene` and upload what the frame needs.
     fn upload(&mut self, scene: &Scene, frame: u32) -> Result<Uploaded> {
+        let state = Self::validated_frame(scene, frame)?;
+        let (mut upload_bytes, index_count) = self.upload_geometry(scene, &state)?;
+        upload_bytes += self.upload_frame_data(&state);
+        let (width, height) = self.size();
+        Ok(Uploaded {
+            setup: ViewSetup::new(&state.camera, width, height),
+            index_count,
+            state,
+            upload_bytes,
+        })
+    }
+
+    /// The animation at `frame`, with its lights checked (count, NaN, ranges).
+    fn validated_frame(scene: &Scene, frame: u32) -> Result<FrameState> {
         let frames = scene.frame_count();
         if frame >= frames {
             return Err(Error::invalid(
@@ -286,13 +300,15 @@ impl<'c> Renderer<'c> {
         for (i, l) in state.lights.iter().enumerate() {
             l.validate(i)?;
         }
-        let (width, height) = self.size();
-        let device = &self.ctx.device;
-        let queue = &self.ctx.queue;
-        let mut upload_bytes = 0u64;
-        let mut rebind = false;
+        Ok(state)
+    }
 
-        // Static geometry and materials: once per scene.
+    /// The static geometry and materials once per scene (by fingerprint), the moving objects
+    /// every frame after them. Returns the bytes written and the frame's index count.
+    fn upload_geometry(&mut self, scene: &Scene, state: &FrameState) -> Result<(u64, u32)> {
+        let ctx = self.ctx;
+        let (device, queue) = (&ctx.device, &ctx.queue);
+        let mut upload_bytes = 0u64;
         let fingerprint = scene.static_fingerprint();
         if self.scene.as_ref().map(|s| s.fingerprint) != Some(fingerprint) {
             let (vertices, indices) = scene.static_geometry();
@@ -301,7 +317,7 @@ impl<'c> Renderer<'c> {
             let ib: &[u8] = bytemuck::cast_slice(&indices);
             let mb: &[u8] = bytemuck::cast_slice(&materials);
             // Room for the moving objects too, so the buffers rarely grow later.
-            let (mv, mi) = scene.moving_geometry(&state, vertices.len() as u32);
+            let (mv, mi) = scene.moving_geometry(state, vertices.len() as u32);
             self.vertices.reserve(
                 device,
                 (vb.len() + std::mem::size_of_val(mv.as_slice())) as u64,
@@ -310,7 +326,9 @@ impl<'c> Renderer<'c> {
                 device,
                 (ib.len() + std::mem::size_of_val(mi.as_slice())) as u64,
             );
-            rebind |= self.materials.reserve(device, mb.len() as u64);
+            if self.materials.reserve(device, mb.len() as u64) {
+                self.rebind_scene();
+            }
             self.vertices.write(queue, 0, vb);
             self.indices.write(queue, 0, ib);
             self.materials.write(queue, 0, mb);
@@ -323,9 +341,7 @@ impl<'c> Renderer<'c> {
         }
         let upload = self.scene.as_ref().expect("uploaded above");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
-
-        // Moving geometry: every frame, after the static part.
-        let (vertices, indices) = scene.moving_geometry(&state, static_vertices);
+        let (vertices, indices) = scene.moving_geometry(state, static_vertices);
         let vb: &[u8] = bytemuck::cast_slice(&vertices);
         let ib: &[u8] = bytemuck::cast_slice(&indices);
         let (v_off, i_off) = (
@@ -335,28 +351,27 @@ impl<'c> Renderer<'c> {
         if self.vertices.reserve(device, v_off + vb.len() as u64)
             || self.indices.reserve(device, i_off + ib.len() as u64)
         {
-            // A grown buffer lost the static part: upload it again.
+            // A grown buffer lost the static part: upload everything again.
             self.scene = None;
-            return self.upload(scene, frame);
+            return self.upload_geometry(scene, state);
         }
         self.vertices.write(queue, v_off, vb);
         self.indices.write(queue, i_off, ib);
         upload_bytes += (vb.len() + ib.len()) as u64;
+        Ok((upload_bytes, static_indices + indices.len() as u32))
+    }
 
+    /// The frame's lights and uniforms. Returns the bytes written.
+    fn upload_frame_data(&mut self, state: &FrameState) -> u64 {
+        let ctx = self.ctx;
+        let device = &ctx.device;
         let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
-        rebind |= self.lights.reserve(device, lb.len() as u64);
-        self.lights.write(queue, 0, lb);
-        if rebind {
-            self.scene_bind_group = Self::bind_scene(
-                device,
-                &self.scene_layout,
-                &self.uniforms,
-                &self.lights,
-                &self.materials,
-                self.counters.buffer(),
-            );
+        if self.lights.reserve(device, lb.len() as u64) {
+            self.rebind_scene();
         }
+        self.lights.write(&ctx.queue, 0, lb);
+        let (width, height) = self.size();
         let view = state.camera.view();
         let proj = state.camera.proj(width as f32 / height as f32);
         let view_proj = proj * view;
@@ -371,14 +386,21 @@ impl<'c> Renderer<'c> {
             near: state.camera.near,
             far: state.camera.far,
         };
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-        upload_bytes += (lb.len() + std::mem::size_of::<FrameUniforms>()) as u64;
-        Ok(Uploaded {
-            setup: ViewSetup::new(&state.camera, width, height),
-            index_count: static_indices + indices.len() as u32,
-            state,
-            upload_bytes,
-        })
+        ctx.queue
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        (lb.len() + std::mem::size_of::<FrameUniforms>()) as u64
+    }
+
+    /// Group 0 again, after a buffer it binds was replaced.
+    fn rebind_scene(&mut self) {
+        self.scene_bind_group = Self::bind_scene(
+            &self.ctx.device,
+            &self.scene_layout,
+            &self.uniforms,
+            &self.lights,
+            &self.materials,
+            self.counters.buffer(),
+        );
     }
 
     /// Step 2: record the frame (pipeline, tonemap, `analysis` readback copies when given,

@@ -81,7 +81,8 @@ fn leaves_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let count = min(BVH_WIDTH, frame.light_count - first);
     var lo = vec3<f32>(3.0e38);
     var hi = vec3<f32>(-3.0e38);
-    for (var k = 0u; k < count; k = k + 1u) {
+    var k = 0u;
+    for (; k < count; k = k + 1u) {
         let l = vals[first + k];
         let c = view_centre(l);
         let r = lights[l].range;
@@ -90,6 +91,7 @@ fn leaves_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         lo = min(lo, c - vec3<f32>(e));
         hi = max(hi, c + vec3<f32>(e));
     }
+    check_loop(k, count);
     nodes[level.first + j] = BvhNode(lo, first, hi, count | BVH_LEAF);
 }
 
@@ -103,10 +105,12 @@ fn inner_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let count = min(BVH_WIDTH, level.child_count - j * BVH_WIDTH);
     var lo = vec3<f32>(3.0e38);
     var hi = vec3<f32>(-3.0e38);
-    for (var k = 0u; k < count; k = k + 1u) {
+    var k = 0u;
+    for (; k < count; k = k + 1u) {
         let child = nodes[first + k];
         lo = min(lo, child.lo);
         hi = max(hi, child.hi);
     }
+    check_loop(k, count);
     nodes[level.first + j] = BvhNode(lo, first, hi, count);
 }

@@ -26,10 +26,12 @@ fn include_sample(k: u32, bits: u32) {
 
 @compute @workgroup_size(TILE_THREADS, TILE_THREADS)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    for (var k = li; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
-        atomicStore(&slice_lo[k], W_INFINITY);
-        atomicStore(&slice_hi[k], 0u);
+    var k0 = li;
+    for (; k0 < grid.slices; k0 = k0 + TILE_THREADS * TILE_THREADS) {
+        atomicStore(&slice_lo[k0], W_INFINITY);
+        atomicStore(&slice_hi[k0], 0u);
     }
+    check_loop(k0, grid.slices);
     workgroupBarrier();
     let size = textureDimensions(depth_tex);
     let origin = wg.xy * grid.tile_size;
@@ -58,7 +60,8 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     workgroupBarrier();
     let tile = wg.y * grid.tiles_x + wg.x;
     let tiles = grid.tiles_x * grid.tiles_y;
-    for (var k = li; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
+    var k = li;
+    for (; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
         let lo = atomicLoad(&slice_lo[k]);
         let hi = atomicLoad(&slice_hi[k]);
         bounds_out[k * tiles + tile] = vec2<f32>(bitcast<f32>(lo), bitcast<f32>(hi));
@@ -66,6 +69,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
             occupied_cells[atomicAdd(&occupancy[0], 1u)] = k * tiles + tile;
         }
     }
+    check_loop(k, grid.slices);
 }
 
 // One invocation: the occupied-cell count as (x, y, 1) workgroups, x at most 65535.
