@@ -2,6 +2,7 @@
 //! summaries agree with the per-frame series, the ideal never exceeds any actual count, and a
 //! stopped run keeps what it measured.
 
+#[path = "../../lightgrid/tests/common/mod.rs"]
 mod common;
 
 use lightgrid::passes::GBufferFormat;

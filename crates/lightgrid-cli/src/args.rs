@@ -43,6 +43,14 @@ impl From<AssignArg> for lightgrid::pipelines::Assign {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Size(pub(crate) u32, pub(crate) u32);
 
+impl Size {
+    /// `size`, or the scene's own frame size when none was given.
+    pub(crate) fn or_scene(size: Option<Size>, scene: &lightgrid::scene::Scene) -> (u32, u32) {
+        let Size(w, h) = size.unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+        (w, h)
+    }
+}
+
 pub(crate) fn parse_size(s: &str) -> Result<Size, String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -155,15 +163,21 @@ pub(crate) fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::Atomi
     Ok(stop)
 }
 
-/// A progress bar with an ETA on stderr, redrawn at most every 200 ms.
+/// A progress bar with an ETA on stderr: redrawn in place at most every 200 ms on a terminal,
+/// a plain log line every 10 s when stderr is a file or a pipe (no `\r` in logs).
 pub(crate) fn progress_bar() -> impl FnMut(&lightgrid_bench::Progress) {
+    use std::io::IsTerminal;
+    // On a terminal one line redrawn in place; in a log, a plain line every 10 seconds.
+    let terminal = std::io::stderr().is_terminal();
+    let every = std::time::Duration::from_millis(if terminal { 200 } else { 10_000 });
     let start = std::time::Instant::now();
-    let mut last = std::time::Instant::now() - std::time::Duration::from_secs(1);
+    let mut last: Option<std::time::Instant> = None;
     move |p: &lightgrid_bench::Progress| {
-        if last.elapsed().as_millis() < 200 && p.done < p.total {
+        let due = last.is_none_or(|t| t.elapsed() >= every);
+        if !due && p.done < p.total {
             return;
         }
-        last = std::time::Instant::now();
+        last = Some(std::time::Instant::now());
         let frac = p.done as f64 / p.total.max(1) as f64;
         let elapsed = start.elapsed().as_secs_f64();
         let eta = if p.done > 0 {
@@ -171,16 +185,26 @@ pub(crate) fn progress_bar() -> impl FnMut(&lightgrid_bench::Progress) {
         } else {
             "?".into()
         };
-        let filled = (frac * 30.0) as usize;
-        eprint!(
-            "\r[{}{}] {:>3.0}% {}/{} ETA {:<7} {:<48}",
-            "#".repeat(filled),
-            " ".repeat(30 - filled),
-            frac * 100.0,
-            p.done,
-            p.total,
-            eta,
-            p.label.chars().take(48).collect::<String>()
-        );
+        let label = p.label.chars().take(48).collect::<String>();
+        if terminal {
+            let filled = (frac * 30.0) as usize;
+            eprint!(
+                "\r[{}{}] {:>3.0}% {}/{} ETA {:<7} {:<48}",
+                "#".repeat(filled),
+                " ".repeat(30 - filled),
+                frac * 100.0,
+                p.done,
+                p.total,
+                eta,
+                label
+            );
+        } else {
+            eprintln!(
+                "{:>3.0}% {}/{} ETA {eta} {label}",
+                frac * 100.0,
+                p.done,
+                p.total
+            );
+        }
     }
 }

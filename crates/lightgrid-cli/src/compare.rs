@@ -27,10 +27,7 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
     let scene = build_scene(&a.scene)?;
     let ctx = GpuContext::new(adapter)?;
-    let Size(w, h) = a
-        .scene
-        .size
-        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let (w, h) = Size::or_scene(a.scene.size, &scene);
     let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
     println!(
         "{} frame {} at {w}x{h}, {} lights, on {}",

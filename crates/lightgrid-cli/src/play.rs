@@ -132,9 +132,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     }
     let frames = range.frames(scene.frame_count());
     let ctx = GpuContext::new(adapter)?;
-    let Size(w, h) = a
-        .size
-        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let (w, h) = Size::or_scene(a.size, &scene);
     let settings = RenderSettings {
         tile_size: a.tile,
         gbuffer: a.gbuffer,

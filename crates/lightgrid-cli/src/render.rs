@@ -36,10 +36,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     }
     let scene = build_scene(&a.scene)?;
     let ctx = GpuContext::new(adapter)?;
-    let Size(w, h) = a
-        .scene
-        .size
-        .unwrap_or(Size(scene.default_size.0, scene.default_size.1));
+    let (w, h) = Size::or_scene(a.scene.size, &scene);
     let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
     for _ in 0..a.scene.warmup {
         renderer.render(&scene, a.scene.frame, &a.pipeline)?;

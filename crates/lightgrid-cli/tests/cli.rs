@@ -341,6 +341,9 @@ fn bench_quick_preset_writes_its_report() {
         dir.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // stderr is a pipe here: progress comes as log lines, never a `\r` redraw.
+    let err = stderr(&o);
+    assert!(!err.contains('\r') && err.contains("ETA"), "{err}");
     for f in [
         "results.json",
         "results.csv",

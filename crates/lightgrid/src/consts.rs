@@ -17,8 +17,9 @@ pub const DEFAULT_SLICES: u32 = 32;
 /// Most slices accepted by `--slices`.
 pub const MAX_SLICES: u32 = 256;
 
-/// Tile edges accepted by `--tile`. The single-kernel tiled deferred pipeline keeps
-/// (MAX_TILE_SIZE / TILE_THREADS)^2 accumulators per thread, so this bounds its registers.
+/// Tile edges accepted by `--tile`. The single-kernel tiled deferred pipeline runs
+/// (tile / TILE_THREADS)^2 workgroups per tile, each reducing the tile's depth and culling its
+/// lights again, so large tiles repeat that work (16 times at 64).
 pub const MIN_TILE_SIZE: u32 = 4;
 pub const MAX_TILE_SIZE: u32 = 64;
 

@@ -308,6 +308,27 @@ fn scatter_at_1280x720_matches_cpu_assignment() {
     assert_eq!(scatter.stats.grid_indices, cpu.stats.grid_indices);
 }
 
+/// The same failure at a size `forward` can check: 320x180 with 4-pixel tiles has as many
+/// cells (80 x 45 tiles x 32 slices) as 1280x720 with 16-pixel ones, so a near light's
+/// rectangle x slices loop ran past the guard there too.
+#[test]
+fn scatter_with_4_pixel_tiles_matches_forward() {
+    let ctx = common::gpu();
+    let scene = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let settings = RenderSettings {
+        assign: Assign::Scatter,
+        tile_size: 4,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&ctx, 320, 180, settings).unwrap();
+    let scatter = r.render(&scene, 200, "clustered_deferred").unwrap();
+    let forward = r.render(&scene, 200, "forward").unwrap();
+    let (d, _) = diff(&forward.image, &scatter.image).unwrap();
+    // clustered_deferred's tolerance in pipelines.rs (G-buffer precision, no missing light).
+    assert!(d.mean <= 0.1 && d.p99 <= 2.0, "{d:?}");
+    assert!(scatter.stats.lighting_computations >= Some(scatter.stats.ideal_lighting_computations));
+}
+
 /// `render --scene stress --lights 8000 --size 64x64 --tile 64 --pipeline
 /// tiled_deferred_single` was a black frame (each thread shaded 16 pixels x 8,000 lights, past
 /// llvmpipe's guard); the kernel now shades one sample per invocation.

@@ -55,3 +55,46 @@ fn a_broken_shader_is_rejected() {
     let bad = lightgrid::shader::compose("bad", &["fn f() -> f32 { return undefined_name; }"]);
     assert!(validate(&bad).is_err());
 }
+
+/// A fragment shader that may write the frame counters has a side effect, which would move the
+/// depth test after shading and lose early-Z (tiled forward with pre-Z ran 2-3x slower on
+/// lavapipe): every such entry point forces the early depth test.
+#[test]
+fn fragment_shaders_writing_the_counters_force_the_early_depth_test() {
+    let mut checked = 0;
+    for s in all_shaders() {
+        let module = naga::front::wgsl::parse_str(&s.source).unwrap();
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .unwrap();
+        let Some(counters) = module
+            .global_variables
+            .iter()
+            .find(|(_, g)| g.name.as_deref() == Some("frame_counters"))
+            .map(|(h, _)| h)
+        else {
+            continue;
+        };
+        for (i, ep) in module.entry_points.iter().enumerate() {
+            let writes = info.get_entry_point(i)[counters].contains(naga::valid::GlobalUse::WRITE);
+            if ep.stage == naga::ShaderStage::Fragment && writes {
+                assert_eq!(
+                    ep.early_depth_test,
+                    Some(naga::EarlyDepthTest::Force),
+                    "{}::{} writes the frame counters: it needs {}",
+                    s.name,
+                    ep.name,
+                    lightgrid::shader::EARLY_DEPTH_TEST
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(
+        checked >= 3,
+        "forward, forward_mono and tiled forward: {checked}"
+    );
+}

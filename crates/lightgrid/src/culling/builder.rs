@@ -2,7 +2,7 @@
 //! 1. the cell bounds (`cell_bounds.rs`): from the depth buffer on the GPU, or `[near, far]`
 //!    for a pipeline without a depth pre-pass;
 //! 2. light assignment by the strategy `--assign` names (resolved per frame for `auto`), one
-//!    [`AssignStrategy`] per registry row in `strategy.rs`: `cpu` (`assign_cpu.rs`, reads the
+//!    [`AssignStrategy`] per row of `registry.rs`: `cpu` (`assign_cpu.rs`, reads the
 //!    bounds back: the papers' CPU pipeline), `gather` (`gather.rs`), `scatter` (`scatter.rs`),
 //!    `bvh` (`bvh.rs`), `bvh-gpu` (`bvh_gpu.rs`); the GPU ones record into the frame's one
 //!    submission;

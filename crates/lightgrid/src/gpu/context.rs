@@ -138,6 +138,9 @@ impl GpuContext {
         if count_blend {
             features |= wgpu::Features::FLOAT32_BLENDABLE;
         }
+        // Forced early depth tests keep early-Z for forward fragment shaders that may write
+        // the frame counters (`shader::create_module` drops the attribute without it).
+        features |= adapter.features() & wgpu::Features::SHADER_EARLY_DEPTH_TEST;
         let desc = wgpu::DeviceDescriptor {
             label: Some("lightgrid"),
             required_features: features,

@@ -135,7 +135,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "tiled_deferred_single",
-        description: "G-buffer, then one kernel per tile: depth bounds, cull all lights in workgroup memory, shade",
+        description: "G-buffer, then one kernel: per tile depth bounds, cull all lights in workgroup memory, shade one sample per invocation",
         paper: "tiled-shading §7",
         uses_grid: true,
         assign: false,

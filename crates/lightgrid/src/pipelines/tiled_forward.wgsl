@@ -1,7 +1,11 @@
 // tiled_forward / tiled_forward_prez / clustered_forward: forward shading that loops only the
 // lights listed for the fragment's cell (tiled-shading §3, Listing 3; clusters: §4.8).
 
-@fragment
+// Early depth test forced: the loop check may write the frame counters (a side effect), and
+// a fragment shader with side effects would otherwise be depth-tested after shading, losing
+// early-Z (measured on lavapipe: tiled_forward_prez 2-3x slower). Sound here: the shader
+// neither discards nor writes depth, so early and late tests keep the same fragments.
+@fragment @early_depth_test(force)
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let cell = grid_cell(v.clip.xy, view_distance_from_depth(v.clip.z));

@@ -63,11 +63,26 @@ pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
     Ok(module)
 }
 
-/// Create a wgpu shader module from a composed shader.
+/// The attribute forward fragment shaders carry to keep early-Z although they may write the
+/// frame counters (a side effect that would otherwise move the depth test after shading).
+pub const EARLY_DEPTH_TEST: &str = "@early_depth_test(force)";
+
+/// Create a wgpu shader module from a composed shader. On a device without
+/// `SHADER_EARLY_DEPTH_TEST` (a native-only feature: Vulkan, GLES 3.1+) the forced early depth
+/// test is dropped: the image is the same (no shader discards or writes depth), only early-Z
+/// may be lost.
 pub fn create_module(device: &wgpu::Device, shader: &ComposedShader) -> wgpu::ShaderModule {
+    let source = if device
+        .features()
+        .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST)
+    {
+        std::borrow::Cow::Borrowed(shader.source.as_str())
+    } else {
+        std::borrow::Cow::Owned(shader.source.replace(EARLY_DEPTH_TEST, ""))
+    };
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(&shader.name),
-        source: wgpu::ShaderSource::Wgsl(shader.source.as_str().into()),
+        source: wgpu::ShaderSource::Wgsl(source),
     })
 }
 
