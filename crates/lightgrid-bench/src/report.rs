@@ -345,7 +345,7 @@ fn summary(results: &BenchResults) -> String {
     if results.interrupted {
         s.push_str("- **interrupted**: the run was stopped early; incomplete series are marked\n");
     }
-    s.push_str("\nTimes come from the real-time path (`lightgrid play`: the frames rendered back to back, one queue submission each, no analysis): the sum of each frame's pass durations from timestamp queries where the adapter has them, else the wall time from one frame to the next (column `timing`); *real-time fps* is frames per second of that path. Counts come from an analysis render of each frame (results.json `sources`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
+    s.push_str("\nTimes come from the real-time path (`lightgrid play`: the frames rendered back to back, one queue submission each, no analysis): each frame's GPU time from timestamp queries where the adapter has them (first pass start to last pass end per submission, summed), else the wall time from one frame to the next (column `timing`); *real-time fps* is frames per second of that path. Counts come from an analysis render of each frame (results.json `sources`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
     let (scenes, _) = scenes_and_bits(results);
     for scene in &scenes {
         let _ = writeln!(s, "\n## {scene}\n");

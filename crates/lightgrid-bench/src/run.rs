@@ -108,7 +108,8 @@ impl BenchConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
     pub frame: u32,
-    /// GPU time on the real-time path (sum of pass timestamps; wall frame time without
+    /// GPU time on the real-time path (timestamp span of each submission, summed; wall frame
+    /// time without
     /// timestamps), median over the repeats.
     pub gpu_ms: f64,
     pub gpu_ms_repeats: Vec<f64>,
@@ -270,7 +271,7 @@ pub struct BenchResults {
 
 /// Where the figures of results.json come from.
 pub const SOURCES: &[(&str, &str)] = &[
-    ("gpu_ms", "real-time path (lightgrid play): sum of the frame's pass timestamps, median over --repeat passes over the frames"),
+    ("gpu_ms", "real-time path (lightgrid play): the frame's timestamp span (first pass start to last pass end, per submission, summed), median over --repeat passes over the frames"),
     ("frame_ms", "real-time path: wall time from one frame's start to the next's, median over the passes"),
     ("passes", "real-time path: pass timestamps of the median pass"),
     ("analysis_gpu_ms", "analysis render of the same frame (readbacks recorded in the frame)"),

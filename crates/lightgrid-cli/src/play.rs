@@ -79,7 +79,8 @@ struct PlayJson<'a> {
     fps: f64,
     /// Wall time from one frame's start to the next's: what a game would see.
     frame_ms: Option<Distribution>,
-    /// GPU work per frame: the sum of its pass durations from timestamps resolved without
+    /// GPU time per frame: its submissions' spans of pass timestamps (first pass start to last
+    /// pass end), resolved without
     /// waiting; null where the adapter has no timestamps.
     gpu_ms: Option<Distribution>,
     submits_per_frame: f64,
@@ -239,7 +240,7 @@ fn print_summary(run: &PlayRun) {
     };
     println!("{} frames, {:.2} fps", run.frames.len(), run.fps());
     println!("frame ms (wall, frame to frame): {}", dist(run.frame_ms()));
-    println!("GPU ms (sum of pass timestamps):  {}", dist(run.gpu_ms()));
+    println!("GPU ms (timestamp span):          {}", dist(run.gpu_ms()));
     println!(
         "per frame: {:.2} submissions, {:.0} bytes read back, {:.0} bytes uploaded; {} frames overflowed their lists, {} had truncated loops",
         run.submits_per_frame(),

@@ -147,12 +147,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         None => (a.wall_ms, TimingSource::WallClock),
     };
     let grid_is_pipelines = a.grid.is_some();
-    let assign_gpu_ms = passes
-        .iter()
-        .filter(|p| p.label.starts_with("assign:"))
-        .map(|p| p.ms)
-        .reduce(|x, y| x + y)
-        .filter(|_| grid_is_pipelines);
+    let assign_gpu_ms = a.finished.assign_gpu_ms.filter(|_| grid_is_pipelines);
     let (grid, cell_bounds, assign, assign_cpu_ms) = match a.grid {
         Some(b) => (
             b.grid,
@@ -162,8 +157,9 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         ),
         None => (bounded, None, None, None),
     };
-    // The strategy's whole cost: its GPU passes, its CPU work and the waits it made.
-    let assign_ms = assign_cpu_ms.map(|cpu| cpu + assign_gpu_ms.unwrap_or(0.0) + a.io.cpu_wait_ms);
+    // The strategy's cost: its GPU passes and its CPU work (a wait for the GPU, which `cpu`
+    // with depth bounds makes, is the frame's `cpu_wait_ms`: it also covers the passes before).
+    let assign_ms = assign_cpu_ms.map(|cpu| cpu + assign_gpu_ms.unwrap_or(0.0));
     let occupied = cell_bounds
         .as_ref()
         .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);

@@ -22,7 +22,8 @@ pub struct PlayedFrame {
     /// Wall time from this frame's start to the next one's (the last: to the end of the run):
     /// the frame period a game would see.
     pub frame_ms: f64,
-    /// GPU work of the frame (sum of its pass durations); None without timestamps.
+    /// GPU time of the frame (its submissions' timestamp spans, summed); None without
+    /// timestamps.
     pub gpu_ms: Option<f64>,
     pub passes: Vec<PassTiming>,
     /// CPU time spent waiting for older frames (more than `MAX_FRAMES_IN_FLIGHT` in flight).

@@ -477,12 +477,13 @@ impl<'c> Renderer<'c> {
                 ),
             });
         }
-        let (passes, gpu_ms) = self.timer.timings(&r.tag.pass_labels, &r.ticks);
+        let t = self.timer.timings(&r.tag.pass_labels, &r.ticks);
         Ok(FinishedFrame {
             serial: r.tag.serial,
             pipeline: r.tag.pipeline,
-            gpu_ms,
-            passes,
+            gpu_ms: t.gpu_ms,
+            assign_gpu_ms: t.assign_ms,
+            passes: t.passes,
             truncated_loops: r.values.truncated_loops(),
             overflowed: r.values.overflowed(),
         })

@@ -8,8 +8,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TimingSource {
-    /// Timestamp queries at pass boundaries: the sum of the frame's pass durations (GPU work
-    /// only; CPU waits between submissions are not in it).
+    /// Timestamp queries at pass boundaries: per submission of the frame, its first pass's
+    /// start to its last pass's end, summed (GPU work only; CPU waits between submissions are
+    /// not in it).
     GpuTimestamps,
     /// No timestamp queries: wall time from the first submission until the device is idle
     /// (CPU waits included).
@@ -88,14 +89,15 @@ pub struct FrameStats {
     #[serde(default)]
     pub assign: Option<String>,
     /// GPU time of the assignment passes (cell bounds, and for GPU strategies the
-    /// assignment kernels), from timestamps: the passes labelled `assign: ...`.
+    /// assignment kernels), from timestamps: the span from the first pass labelled
+    /// `assign: ...` to the last, per submission.
     #[serde(default)]
     pub assign_gpu_ms: Option<f64>,
     /// CPU time of the assignment: `assign_cpu` for `cpu`, the hierarchy build for `bvh`.
     #[serde(default)]
     pub assign_cpu_ms: Option<f64>,
-    /// The whole assignment strategy's cost: `assign_gpu_ms` + `assign_cpu_ms` + the CPU
-    /// waits of the frame (the `cpu` strategy's read-back of the cell bounds).
+    /// The assignment strategy's cost: `assign_gpu_ms` + `assign_cpu_ms` (the `cpu`
+    /// strategy's wait for the cell bounds is the frame's `cpu_wait_ms`).
     #[serde(default)]
     pub assign_ms: Option<f64>,
     /// Times the analysis frame was rendered again because a light list, sized from earlier

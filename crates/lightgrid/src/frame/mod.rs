@@ -88,6 +88,7 @@ impl<'a> FrameEncoder<'a> {
         );
         let index = scoped(self.device, stage, || self.queue.submit([done.finish()]))?;
         self.io.submits += 1;
+        self.timer.next_submission();
         Ok(index)
     }
 
@@ -140,8 +141,11 @@ pub struct SubmittedFrame {
 pub struct FinishedFrame {
     pub serial: u64,
     pub pipeline: &'static str,
-    /// Sum of the frame's pass durations (GPU work only); None without timestamps.
+    /// The frame's GPU time: the span of each of its submissions (first pass start to last
+    /// pass end), summed, so CPU waits between them are left out; None without timestamps.
     pub gpu_ms: Option<f64>,
+    /// The span of its light-assignment passes (`assign: ...`, cell bounds included).
+    pub assign_gpu_ms: Option<f64>,
     pub passes: Vec<PassTiming>,
     /// Shader loops that ended before their bound: the frame is wrong when non-zero.
     pub truncated_loops: u32,

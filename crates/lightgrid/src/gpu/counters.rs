@@ -55,7 +55,7 @@ pub struct FrameTag {
     /// The pipeline that rendered it.
     pub pipeline: &'static str,
     /// The passes it recorded, in timestamp order.
-    pub pass_labels: Vec<String>,
+    pub pass_labels: Vec<super::TimedPass>,
 }
 
 /// A finished frame's counters and raw pass timestamps.

@@ -6,7 +6,7 @@ mod timing;
 
 pub use context::{list_adapters, AdapterSummary, GpuContext};
 pub use counters::{CounterValues, FrameCounters, FrameReadback, FrameTag, COUNTER_BYTES};
-pub use timing::{PassTimer, PassTiming};
+pub use timing::{FrameTimings, PassTimer, PassTiming, TimedPass};
 
 use crate::error::{Error, Result};
 
