@@ -32,3 +32,7 @@ pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> lightgri
         reason: reason.into(),
     }
 }
+
+/// Real-time frames played before a series' measured ones, so the measurement starts with
+/// a full queue of frames in flight.
+pub const PLAY_QUEUE_FILL: u32 = lightgrid::MAX_FRAMES_IN_FLIGHT as u32;

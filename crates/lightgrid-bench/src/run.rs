@@ -496,6 +496,9 @@ pub fn run(
                 pipeline: info.id,
                 frames: &frames,
                 passes: config.repeat,
+                // The analysis renders already compiled and sized everything: these only
+                // fill the queue of frames in flight.
+                warmup: crate::PLAY_QUEUE_FILL,
             };
             let base = done;
             let run = play(renderer, &plan, stop, &mut |n, _| {

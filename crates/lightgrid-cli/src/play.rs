@@ -158,26 +158,12 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
         assign.map_or(String::new(), |s| format!(" (assign {s})")),
         ctx.adapter_label()
     );
-    if a.warmup > 0 {
-        let warm: Vec<u32> = frames
-            .iter()
-            .copied()
-            .cycle()
-            .take(a.warmup as usize)
-            .collect();
-        let plan = PlayPlan {
-            scene: &scene,
-            pipeline: info.id,
-            frames: &warm,
-            passes: 1,
-        };
-        play_frames(&mut renderer, &plan, &stop, &mut |_, _| {})?;
-    }
     let plan = PlayPlan {
         scene: &scene,
         pipeline: info.id,
         frames: &frames,
         passes: a.loops,
+        warmup: a.warmup,
     };
     let mut bar = progress_bar();
     let run = play_frames(&mut renderer, &plan, &stop, &mut |done, total| {

@@ -19,8 +19,8 @@ pub struct PlayedFrame {
     pub frame: u32,
     /// Which pass over the frames (0-based).
     pub pass: u32,
-    /// Wall time from this frame's start to the next one's (the last: to the end of the run):
-    /// the frame period a game would see.
+    /// Wall time from this frame's start to the next one's: the frame period a game would see.
+    /// The last frame's is the wait for the frames still in flight divided by their number.
     pub frame_ms: f64,
     /// GPU time of the frame (its submissions' timestamp spans, summed); None without
     /// timestamps.
@@ -86,10 +86,12 @@ impl PlayRun {
         Distribution::of(&v?)
     }
 
-    /// Frames per second over the whole run.
+    /// Frames per second: frames over the sum of their periods (with the queue full when the
+    /// run starts, each frame's GPU work is counted once).
     pub fn fps(&self) -> f64 {
-        if self.wall_ms > 0.0 {
-            self.frames.len() as f64 / (self.wall_ms / 1e3)
+        let total: f64 = self.frames.iter().map(|f| f.frame_ms).sum();
+        if total > 0.0 {
+            self.frames.len() as f64 / (total / 1e3)
         } else {
             0.0
         }
@@ -130,6 +132,9 @@ pub struct PlayPlan<'a> {
     /// Animation frames, in order; played `passes` times.
     pub frames: &'a [u32],
     pub passes: u32,
+    /// Frames played first and not recorded (cycling through `frames`): shader compilation,
+    /// list growth, and a full queue of frames in flight when the measurement starts.
+    pub warmup: u32,
 }
 
 /// Render `plan` back to back on the real-time path. `stop` is polled between frames;
@@ -145,6 +150,16 @@ pub fn play(
     }
     // Frames of an earlier use of the renderer are not this run's.
     renderer.finish()?;
+    for &frame in plan.frames.iter().cycle().take(plan.warmup as usize) {
+        if stop.load(Ordering::Relaxed) {
+            return Ok(PlayRun {
+                interrupted: true,
+                ..Default::default()
+            });
+        }
+        renderer.render_frame(plan.scene, frame, plan.pipeline)?;
+        renderer.poll_finished()?;
+    }
     let total = plan.frames.len() as u64 * u64::from(plan.passes);
     let mut run = PlayRun::default();
     let mut serials = Vec::new();
@@ -182,10 +197,12 @@ pub fn play(
             progress(run.frames.len() as u64, total);
         }
     }
+    // The last frame's period: draining the queue finishes every frame still in flight.
+    let draining = renderer.frames_in_flight().max(1);
     finished.extend(renderer.finish()?);
     let end = Instant::now();
     if let Some(prev) = run.frames.last_mut() {
-        prev.frame_ms = (end - last_start).as_secs_f64() * 1e3;
+        prev.frame_ms = (end - last_start).as_secs_f64() * 1e3 / draining as f64;
     }
     run.wall_ms = (end - start).as_secs_f64() * 1e3;
     for f in finished {

@@ -547,6 +547,12 @@ impl<'c> Renderer<'c> {
         })
     }
 
+    /// Real-time frames submitted whose GPU work may not be done yet (at most
+    /// [`MAX_FRAMES_IN_FLIGHT`]).
+    pub fn frames_in_flight(&self) -> usize {
+        self.in_flight.len()
+    }
+
     /// The real-time frames finished since the last call, oldest first (no waiting).
     pub fn poll_finished(&mut self) -> Result<Vec<FinishedFrame>> {
         self.collect(false)?;
