@@ -98,6 +98,12 @@ impl BenchConfig {
         if self.repeat == 0 {
             return Err(invalid("--repeat", "must be at least 1"));
         }
+        lightgrid::RenderSettings {
+            tile_size: self.tile_size,
+            slices: self.slices,
+            ..Default::default()
+        }
+        .validate()?;
         Ok(())
     }
 }

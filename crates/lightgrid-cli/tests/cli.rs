@@ -575,3 +575,78 @@ fn play_rejects_bad_input() {
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn zero_or_too_many_slices_are_refused_everywhere() {
+    let dir = temp_dir("slices");
+    let d = dir.join("b");
+    for slices in ["0", "257"] {
+        // Not a tiled grid in disguise: the clustered pipelines would silently lose their slices.
+        assert_fails_with(
+            &[
+                "render",
+                "--scene",
+                "robots-few",
+                "--size",
+                "32x16",
+                "--pipeline",
+                "clustered_deferred",
+                "--slices",
+                slices,
+            ],
+            "between 1 and 256",
+        );
+        assert_fails_with(
+            &[
+                "play",
+                "--scene",
+                "robots-few",
+                "--size",
+                "32x16",
+                "--frames",
+                "0",
+                "--slices",
+                slices,
+            ],
+            "between 1 and 256",
+        );
+        assert_fails_with(
+            &[
+                "bench",
+                "--preset",
+                "quick",
+                "--slices",
+                slices,
+                "--out",
+                d.to_str().unwrap(),
+            ],
+            "between 1 and 256",
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_heatmap_of_a_one_pixel_frame_is_written() {
+    let dir = temp_dir("heatmap-1px");
+    let h = dir.join("h.png");
+    let o = lightgrid(&[
+        "render",
+        "--scene",
+        "robots-few",
+        "--size",
+        "1x1",
+        "--pipeline",
+        "tiled_deferred",
+        "--heatmap",
+        h.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&h).unwrap();
+    assert_eq!(
+        (img.width(), img.height()),
+        (96, 15),
+        "frame + legend, legend wide enough"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

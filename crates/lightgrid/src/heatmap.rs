@@ -53,14 +53,21 @@ fn draw_number(img: &mut RgbaImage, mut x: u32, y: u32, n: u32, scale: u32) {
     }
 }
 
-/// The heatmap of `grid` over `frame`; the result is taller than the frame by the legend.
+/// The heatmap of `grid` over `frame`; the result is taller than the frame by the legend, and
+/// at least `LEGEND_MIN_WIDTH` wide (narrow frames get a black margin on the right).
+/// Narrowest legend (pixels at scale 1): bar, "0" and a seven-digit maximum.
+const LEGEND_MIN_WIDTH: u32 = 96;
+
 pub fn heatmap(frame: &RgbaImage, grid: &LightGrid) -> RgbaImage {
     let (w, h) = frame.dimensions();
     let scale = (w / 320).max(1);
     let legend_h = 14 * scale;
     let counts = grid.tile_max_counts();
     let max = counts.iter().copied().max().unwrap_or(0).max(1);
-    let mut out = RgbaImage::from_pixel(w, h + legend_h, Rgba([0, 0, 0, 255]));
+    // The legend needs room for its bar and two numbers: frames narrower than that get a
+    // black margin on the right instead of a legend drawn off the image.
+    let out_w = w.max(LEGEND_MIN_WIDTH * scale);
+    let mut out = RgbaImage::from_pixel(out_w, h + legend_h, Rgba([0, 0, 0, 255]));
     for (x, y, p) in frame.enumerate_pixels() {
         let count = counts[grid.dims.tile_of(x, y)];
         let c = ramp(count as f32 / max as f32);
@@ -76,7 +83,10 @@ pub fn heatmap(frame: &RgbaImage, grid: &LightGrid) -> RgbaImage {
         out.put_pixel(x, y, Rgba([v[0], v[1], v[2], 255]));
     }
     // Legend: the ramp from 0 to max lights per tile, labelled at both ends.
-    let (bar_x0, bar_x1) = (14 * scale, w.saturating_sub(30 * scale).max(14 * scale + 1));
+    let (bar_x0, bar_x1) = (
+        14 * scale,
+        out_w.saturating_sub(30 * scale).max(14 * scale + 1),
+    );
     for x in bar_x0..bar_x1 {
         let c = ramp((x - bar_x0) as f32 / (bar_x1 - bar_x0) as f32);
         for y in h + 2 * scale..h + 8 * scale {

@@ -151,6 +151,7 @@ impl<'c> Renderer<'c> {
         settings: RenderSettings,
     ) -> Result<Self> {
         validate_size(ctx, width, height)?;
+        settings.validate()?;
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
         let on_gl = ctx.info.backend == wgpu::Backend::Gl;

@@ -3,7 +3,7 @@
 //! grid is a clustered grid with one depth slice. Every builder produces a [`LightGrid`];
 //! every grid-reading shader reads it through `culling/light_grid.wgsl`.
 
-use crate::consts::{MAX_SLICES, MAX_TILE_SIZE, MIN_TILE_SIZE};
+use crate::consts::MAX_SLICES;
 use crate::error::{Error, Result};
 use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::gpu_types::GridParams;
@@ -26,12 +26,7 @@ pub struct GridDims {
 impl GridDims {
     /// A tiled grid (one slice).
     pub fn new(width: u32, height: u32, tile_size: u32) -> Result<Self> {
-        if !(MIN_TILE_SIZE..=MAX_TILE_SIZE).contains(&tile_size) {
-            return Err(Error::invalid(
-                "tile size",
-                format!("{tile_size}: must be between {MIN_TILE_SIZE} and {MAX_TILE_SIZE} pixels"),
-            ));
-        }
+        crate::frame::validate_tile_size(tile_size)?;
         Ok(GridDims {
             tile_size,
             width,

@@ -10,7 +10,9 @@
 mod settings;
 pub mod targets;
 
-pub use settings::{Assign, GBufferFormat, RenderSettings, AUTO_GATHER_MAX_LIGHTS};
+pub use settings::{
+    validate_tile_size, Assign, GBufferFormat, RenderSettings, AUTO_GATHER_MAX_LIGHTS,
+};
 pub use targets::Targets;
 
 use crate::error::Result;

@@ -25,6 +25,34 @@ impl Default for RenderSettings {
     }
 }
 
+impl RenderSettings {
+    /// Refuse settings no renderer can use, with the accepted range (`--slices 0` would
+    /// otherwise silently build a tiled grid for the clustered pipelines).
+    pub fn validate(&self) -> crate::error::Result<()> {
+        use crate::consts::MAX_SLICES;
+        validate_tile_size(self.tile_size)?;
+        if !(1..=MAX_SLICES).contains(&self.slices) {
+            return Err(crate::error::Error::invalid(
+                "slices",
+                format!("{}: must be between 1 and {MAX_SLICES}", self.slices),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Refuse a tile edge outside `MIN_TILE_SIZE..=MAX_TILE_SIZE`.
+pub fn validate_tile_size(tile_size: u32) -> crate::error::Result<()> {
+    use crate::consts::{MAX_TILE_SIZE, MIN_TILE_SIZE};
+    if !(MIN_TILE_SIZE..=MAX_TILE_SIZE).contains(&tile_size) {
+        return Err(crate::error::Error::invalid(
+            "tile size",
+            format!("{tile_size}: must be between {MIN_TILE_SIZE} and {MAX_TILE_SIZE} pixels"),
+        ));
+    }
+    Ok(())
+}
+
 /// Bits per G-buffer channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum GBufferFormat {
