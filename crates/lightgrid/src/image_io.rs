@@ -64,12 +64,41 @@ pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
     ))
 }
 
-/// Read a PNG (or any format the image crate decodes) as RGBA8.
+/// Most pixels [`load_image`] decodes: 8192 x 8192 (256 MiB as RGBA8), so comparing two images
+/// stays far below a gigabyte whatever their headers declare.
+pub const MAX_DECODED_PIXELS: u64 = 8192 * 8192;
+
+/// Read a PNG (or any format the image crate decodes) as RGBA8, refusing images larger than
+/// [`MAX_DECODED_PIXELS`] from their header, before anything is allocated.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
-    let img = image::open(path).map_err(|e| Error::Image {
+    let bad = |reason: String| Error::Image {
         path: path.display().to_string(),
-        reason: e.to_string(),
-    })?;
+        reason,
+    };
+    let mut reader = image::ImageReader::open(path)
+        .map_err(|e| bad(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| bad(e.to_string()))?;
+    // A file's header decides how much a decoder allocates: refuse what no comparison here
+    // needs before decoding (MAX_DECODED_PIXELS, RGBA8 plus the decoder's own copy).
+    let edge = crate::consts::MAX_FRAME_EDGE;
+    let (w, h) = reader.into_dimensions().map_err(|e| bad(e.to_string()))?;
+    if w > edge || h > edge || u64::from(w) * u64::from(h) > MAX_DECODED_PIXELS {
+        return Err(bad(format!(
+            "declares {w}x{h} pixels; images of at most {edge} pixels per edge and {} million pixels are read",
+            MAX_DECODED_PIXELS / 1_000_000
+        )));
+    }
+    reader = image::ImageReader::open(path)
+        .map_err(|e| bad(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| bad(e.to_string()))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(edge);
+    limits.max_image_height = Some(edge);
+    limits.max_alloc = Some(2 * 4 * MAX_DECODED_PIXELS);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| bad(e.to_string()))?;
     Ok(img.to_rgba8())
 }
 

@@ -53,3 +53,61 @@ fn png_round_trips_and_unwritable_paths_fail_early() {
     assert_eq!(leftovers.len(), 1, "no temporary files left behind");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A PNG of only a header declaring `w` x `h` (and an empty image stream): what a hostile or
+/// truncated file looks like to the decoder.
+fn png_header_only(w: u32, h: u32) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+        out
+    };
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 6, 0, 0, 0]); // 8-bit RGBA
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+#[test]
+fn images_declaring_absurd_sizes_are_refused_from_their_header() {
+    let dir = std::env::temp_dir().join(format!("lightgrid-decode-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (w, h) in [(30_000, 30_000), (16_000, 16_000), (100_000, 1)] {
+        let path = dir.join(format!("{w}x{h}.png"));
+        std::fs::write(&path, png_header_only(w, h)).unwrap();
+        let err = load_image(&path).unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("{w}x{h}")) && err.contains(path.to_str().unwrap()),
+            "{err}"
+        );
+    }
+    // A header within the limits but without pixel data is a decode error, not a panic.
+    let path = dir.join("empty.png");
+    std::fs::write(&path, png_header_only(64, 64)).unwrap();
+    assert!(load_image(&path).is_err());
+    // A real image of that size loads.
+    let path = dir.join("ok.png");
+    save_png(&RgbaImage::from_pixel(64, 64, Rgba([1, 2, 3, 255])), &path).unwrap();
+    assert_eq!(load_image(&path).unwrap().dimensions(), (64, 64));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
