@@ -460,9 +460,9 @@ fn summary(results: &BenchResults) -> String {
 
 /// Read a results.json written by [`write_report`] (heatmaps are not part of it).
 pub fn read_results(path: &Path) -> Result<BenchResults> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+    let bytes = std::fs::read(path).map_err(|cause| Error::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     })?;
     let v: serde_json::Value = serde_json::from_slice(&bytes)
         .map_err(|e| invalid("results", format!("{}: {e}", path.display())))?;
@@ -483,9 +483,9 @@ pub fn read_results(path: &Path) -> Result<BenchResults> {
 
 /// Write every report file into `dir` (created if missing). Returns the paths written.
 pub fn write_report(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+    std::fs::create_dir_all(dir).map_err(|cause| Error::Io {
         path: dir.display().to_string(),
-        source,
+        cause,
     })?;
     let mut written = Vec::new();
     #[derive(serde::Serialize)]

@@ -424,9 +424,9 @@ struct ScalingRow<'a> {
 
 /// Write scaling.json, scaling.csv, scaling.md and the chart into `dir`.
 pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+    std::fs::create_dir_all(dir).map_err(|cause| Error::Io {
         path: dir.display().to_string(),
-        source,
+        cause,
     })?;
     let json = serde_json::to_vec_pretty(r).map_err(|e| invalid("scaling", e.to_string()))?;
     write_atomic(&dir.join("scaling.json"), &json)?;

@@ -24,13 +24,10 @@ pub enum Error {
     /// A parameter outside what the renderer or adapter accepts.
     #[error("invalid {what}: {reason}")]
     Invalid { what: &'static str, reason: String },
-    /// File I/O, with the path that failed.
-    #[error("{path}: {source}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    /// File I/O, with the path that failed. The cause is part of the message and not a
+    /// `source()`, so a reporter that prints the chain says it once.
+    #[error("{path}: {cause}")]
+    Io { path: String, cause: std::io::Error },
     /// Shader loops of a frame ended before their bound (llvmpipe ends an invocation's loops
     /// after 65,536 iterations without an error): the image is missing work, so it is refused.
     #[error(

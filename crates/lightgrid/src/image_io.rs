@@ -102,18 +102,40 @@ pub fn load_image(path: &Path) -> Result<RgbaImage> {
     Ok(img.to_rgba8())
 }
 
-/// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
-/// the file is either the complete new content or untouched.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |source| Error::Io {
-        path: path.display().to_string(),
-        source,
+/// Where an output named `path` is written: through a symlink to its target, never over a
+/// directory or a file that is not a regular one (a device, FIFO or socket), since outputs
+/// are replaced whole by a rename and that would replace the device itself.
+fn output_target(path: &Path) -> Result<std::path::PathBuf> {
+    let refuse = |what: &str| {
+        Err(Error::invalid(
+            "output path",
+            format!("{} is {what}; name a regular file", path.display()),
+        ))
     };
-    let dir = match path.parent() {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => refuse("a directory"),
+        Ok(m) if !m.is_file() => refuse("not a regular file (a device, FIFO or socket)"),
+        Ok(_) => std::fs::canonicalize(path).map_err(|cause| Error::Io {
+            path: path.display().to_string(),
+            cause,
+        }),
+        Err(_) => Ok(path.to_path_buf()),
+    }
+}
+
+/// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
+/// the file is either the complete new content or untouched (see [`output_target`]).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let target = output_target(path)?;
+    let io = |cause| Error::Io {
+        path: path.display().to_string(),
+        cause,
+    };
+    let dir = match target.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => std::path::PathBuf::from("."),
     };
-    let name = path.file_name().ok_or_else(|| {
+    let name = target.file_name().ok_or_else(|| {
         Error::invalid(
             "output path",
             format!("{} has no file name", path.display()),
@@ -125,7 +147,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         std::process::id()
     ));
     std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
+    std::fs::rename(&tmp, &target).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         io(e)
     })
@@ -146,24 +168,20 @@ pub fn save_png(img: &RgbaImage, path: &Path) -> Result<()> {
 }
 
 /// Fail early (before rendering) when `path` cannot be written: its directory must exist and
-/// accept a new file, and the path must not be a directory.
+/// accept a new file, and the path must not be a directory or another non-regular file.
 pub fn check_writable(path: &Path) -> Result<()> {
-    if path.is_dir() {
-        return Err(Error::invalid(
-            "output path",
-            format!("{} is a directory", path.display()),
-        ));
-    }
-    let probe = path.with_file_name(format!(
+    let target = output_target(path)?;
+    let probe = target.with_file_name(format!(
         ".{}.probe{}",
-        path.file_name()
+        target
+            .file_name()
             .map(|n| n.to_string_lossy())
             .unwrap_or_default(),
         std::process::id()
     ));
-    std::fs::write(&probe, b"").map_err(|source| Error::Io {
+    std::fs::write(&probe, b"").map_err(|cause| Error::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     })?;
     let _ = std::fs::remove_file(&probe);
     Ok(())

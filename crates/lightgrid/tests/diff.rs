@@ -111,3 +111,44 @@ fn images_declaring_absurd_sizes_are_refused_from_their_header() {
     assert_eq!(load_image(&path).unwrap().dimensions(), (64, 64));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Outputs are replaced whole by a rename: that must never replace a FIFO or a device (run as
+/// root, `--stats /dev/null` would have replaced /dev/null), and a symlink is written through.
+#[test]
+fn outputs_refuse_non_regular_files_and_write_through_symlinks() {
+    use lightgrid::image_io::write_atomic;
+    let dir = std::env::temp_dir().join(format!("lightgrid-outputs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("fifo");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    for result in [check_writable(&fifo), write_atomic(&fifo, b"x")] {
+        let err = result.unwrap_err().to_string();
+        assert!(err.contains("not a regular file"), "{err}");
+    }
+    let meta = std::fs::symlink_metadata(&fifo).unwrap();
+    assert!(!meta.is_file(), "the FIFO is still a FIFO");
+    for result in [check_writable(&dir), write_atomic(&dir, b"x")] {
+        assert!(result.unwrap_err().to_string().contains("is a directory"));
+    }
+    let target = dir.join("target.json");
+    std::fs::write(&target, b"old").unwrap();
+    let link = dir.join("link.json");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    check_writable(&link).unwrap();
+    write_atomic(&link, b"new").unwrap();
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    // An I/O error names the path and says its cause once.
+    let missing = dir.join("no/such/dir/out.json");
+    let err = check_writable(&missing).unwrap_err().to_string();
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
