@@ -208,3 +208,12 @@ pub(crate) fn progress_bar() -> impl FnMut(&lightgrid_bench::Progress) {
         }
     }
 }
+
+/// The exit of a long run stopped by Ctrl-C: an error (non-zero status) saying where the
+/// partial results are.
+pub(crate) fn interrupted_run(interrupted: bool, out: &std::path::Path) -> Result<()> {
+    if interrupted {
+        anyhow::bail!("interrupted: partial results written to {}", out.display());
+    }
+    Ok(())
+}

@@ -1,7 +1,8 @@
 //! `lightgrid bench` and `lightgrid report`: the papers' evaluations and their report.
 
 use crate::args::{
-    format_duration, parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size,
+    format_duration, interrupted_run, parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c,
+    AssignArg, Size,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -211,13 +212,7 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         written.len(),
         a.out.display()
     );
-    if results.interrupted {
-        bail!(
-            "interrupted: partial results written to {}",
-            a.out.display()
-        );
-    }
-    Ok(())
+    interrupted_run(results.interrupted, &a.out)
 }
 
 pub(crate) fn report(a: &ReportArgs) -> Result<()> {

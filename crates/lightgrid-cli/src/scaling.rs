@@ -1,7 +1,9 @@
 //! `lightgrid scaling`: light-assignment strategies against the light count.
 
-use crate::args::{format_duration, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size};
-use anyhow::{bail, Context, Result};
+use crate::args::{
+    format_duration, interrupted_run, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size,
+};
+use anyhow::{Context, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::check_writable;
@@ -101,11 +103,5 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
         lightgrid_bench::SCALING_FILES.join(", "),
         a.out.display()
     );
-    if results.interrupted {
-        bail!(
-            "interrupted: partial results written to {}",
-            a.out.display()
-        );
-    }
-    Ok(())
+    interrupted_run(results.interrupted, &a.out)
 }

@@ -43,8 +43,6 @@ pub struct PlayedFrame {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PlayRun {
     pub frames: Vec<PlayedFrame>,
-    /// Wall time from the first frame's start until the GPU finished the last.
-    pub wall_ms: f64,
     /// Stopped (Ctrl-C) before the end.
     pub interrupted: bool,
 }
@@ -162,10 +160,9 @@ pub fn play(
     }
     let total = plan.frames.len() as u64 * u64::from(plan.passes);
     let mut run = PlayRun::default();
-    let mut serials = Vec::new();
+    let mut first_serial = None;
     let mut finished: Vec<FinishedFrame> = Vec::new();
-    let start = Instant::now();
-    let mut last_start = start;
+    let mut last_start = Instant::now();
     'passes: for pass in 0..plan.passes {
         for &frame in plan.frames {
             if stop.load(Ordering::Relaxed) {
@@ -178,7 +175,7 @@ pub fn play(
             }
             last_start = now;
             let s = renderer.render_frame(plan.scene, frame, plan.pipeline)?;
-            serials.push(s.serial);
+            first_serial.get_or_insert(s.serial);
             run.frames.push(PlayedFrame {
                 frame,
                 pass,
@@ -204,10 +201,11 @@ pub fn play(
     if let Some(prev) = run.frames.last_mut() {
         prev.frame_ms = (end - last_start).as_secs_f64() * 1e3 / draining as f64;
     }
-    run.wall_ms = (end - start).as_secs_f64() * 1e3;
+    // The renderer numbers its frames one after another: frame i of the run is serial first + i.
+    let first = first_serial.unwrap_or(0);
     for f in finished {
-        if let Some(i) = serials.iter().position(|&s| s == f.serial) {
-            let p = &mut run.frames[i];
+        let at = f.serial.checked_sub(first);
+        if let Some(p) = at.and_then(|i| run.frames.get_mut(i as usize)) {
             p.gpu_ms = f.gpu_ms;
             p.passes = f.passes;
             p.overflowed = f.overflowed;

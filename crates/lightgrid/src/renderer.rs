@@ -577,8 +577,9 @@ impl<'c> Renderer<'c> {
         // Earlier real-time frames first, so this frame's counters are its own.
         self.finish()?;
         let mut reruns = 0u32;
+        // A rerun records the same uploaded frame again with the grown lists.
+        let up = self.upload(scene, frame)?;
         loop {
-            let up = self.upload(scene, frame)?;
             let start = Instant::now();
             let (serial, io, _) = self.encode_frame(info, &up, true)?;
             let done = self.counters.wait(&self.ctx.device)?;

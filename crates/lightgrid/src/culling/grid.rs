@@ -3,7 +3,6 @@
 //! grid is a clustered grid with one depth slice. Every builder produces a [`LightGrid`];
 //! every grid-reading shader reads it through `culling/light_grid.wgsl`.
 
-use crate::consts::MAX_SLICES;
 use crate::error::{Error, Result};
 use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::gpu_types::GridParams;
@@ -41,12 +40,7 @@ impl GridDims {
 
     /// A clustered grid: `slices` view-depth slices between `near` and `far`.
     pub fn clustered(self, slices: u32, near: f32, far: f32) -> Result<Self> {
-        if !(1..=MAX_SLICES).contains(&slices) {
-            return Err(Error::invalid(
-                "slices",
-                format!("{slices}: must be between 1 and {MAX_SLICES}"),
-            ));
-        }
+        crate::frame::validate_slices(slices)?;
         if !(near > 0.0 && far > near && far.is_finite()) {
             return Err(Error::invalid(
                 "clusters",

@@ -11,7 +11,8 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_tile_size, Assign, GBufferFormat, RenderSettings, AUTO_GATHER_MAX_LIGHTS,
+    validate_slices, validate_tile_size, Assign, GBufferFormat, RenderSettings,
+    AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::Targets;
 

@@ -29,15 +29,8 @@ impl RenderSettings {
     /// Refuse settings no renderer can use, with the accepted range (`--slices 0` would
     /// otherwise silently build a tiled grid for the clustered pipelines).
     pub fn validate(&self) -> crate::error::Result<()> {
-        use crate::consts::MAX_SLICES;
         validate_tile_size(self.tile_size)?;
-        if !(1..=MAX_SLICES).contains(&self.slices) {
-            return Err(crate::error::Error::invalid(
-                "slices",
-                format!("{}: must be between 1 and {MAX_SLICES}", self.slices),
-            ));
-        }
-        Ok(())
+        validate_slices(self.slices)
     }
 }
 
@@ -48,6 +41,18 @@ pub fn validate_tile_size(tile_size: u32) -> crate::error::Result<()> {
         return Err(crate::error::Error::invalid(
             "tile size",
             format!("{tile_size}: must be between {MIN_TILE_SIZE} and {MAX_TILE_SIZE} pixels"),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuse a view-depth slice count outside `1..=MAX_SLICES`.
+pub fn validate_slices(slices: u32) -> crate::error::Result<()> {
+    use crate::consts::MAX_SLICES;
+    if !(1..=MAX_SLICES).contains(&slices) {
+        return Err(crate::error::Error::invalid(
+            "slices",
+            format!("{slices}: must be between 1 and {MAX_SLICES}"),
         ));
     }
     Ok(())
