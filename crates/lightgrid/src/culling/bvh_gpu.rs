@@ -123,10 +123,7 @@ impl GpuBvhBuild {
                    group: &wgpu::BindGroup,
                    label: &str,
                    items: u32| {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: timer.compute_pass(label),
-            });
+            let mut pass = timer.begin_compute(encoder, label);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, f.scene_bind_group, &[]);
             pass.set_bind_group(1, group, &[]);

@@ -159,10 +159,7 @@ impl CellBoundsPass {
             ],
         );
         encoder.clear_buffer(&self.occupancy, 0, None);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("assign: cell bounds"),
-            timestamp_writes: timer.compute_pass("assign: cell bounds"),
-        });
+        let mut pass = timer.begin_compute(encoder, "assign: cell bounds");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, scene, &[]);
         pass.set_bind_group(1, &group, &[]);

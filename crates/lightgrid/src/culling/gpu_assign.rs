@@ -223,10 +223,7 @@ impl CellKernels {
                     timer: &mut PassTimer,
                     label: &str,
                     run: &dyn Fn(&mut wgpu::ComputePass)| {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: timer.compute_pass(label),
-            });
+            let mut pass = timer.begin_compute(encoder, label);
             pass.set_bind_group(0, f.scene_bind_group, &[]);
             pass.set_bind_group(1, &group, &[]);
             for (i, g) in extra.iter().enumerate() {

@@ -136,10 +136,7 @@ impl RadixSort {
                        timer: &mut PassTimer,
                        pipeline: &wgpu::ComputePipeline,
                        label: &str| {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(label),
-                    timestamp_writes: timer.compute_pass(label),
-                });
+                let mut pass = timer.begin_compute(encoder, label);
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &group, &[]);
                 pass.dispatch_workgroups(groups.0, groups.1, 1);

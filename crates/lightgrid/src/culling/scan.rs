@@ -60,10 +60,7 @@ impl ScanPass {
                 range(total.0, total.1, 4),
             ],
         );
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(label),
-            timestamp_writes: timer.compute_pass(label),
-        });
+        let mut pass = timer.begin_compute(encoder, label);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(1, 1, 1);

@@ -109,10 +109,7 @@ fn pass<'e>(
     pipeline: &wgpu::ComputePipeline,
     groups: [&wgpu::BindGroup; 3],
 ) -> wgpu::ComputePass<'e> {
-    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some(label),
-        timestamp_writes: timer.compute_pass(label),
-    });
+    let mut pass = timer.begin_compute(encoder, label);
     pass.set_pipeline(pipeline);
     for (i, g) in groups.iter().enumerate() {
         pass.set_bind_group(i as u32, *g, &[]);

@@ -97,6 +97,18 @@ impl PassTimer {
         &self.labels
     }
 
+    /// Begin a compute pass labelled `label`, timed at its boundaries.
+    pub fn begin_compute<'e>(
+        &mut self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
+    ) -> wgpu::ComputePass<'e> {
+        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: self.compute_pass(label),
+        })
+    }
+
     /// The frame was submitted part-way: later passes go into its next submission.
     pub fn next_submission(&mut self) {
         self.submission += 1;

@@ -201,10 +201,7 @@ impl Technique for TiledDeferred {
             }
         };
         let (encoder, timer) = enc.parts();
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(label),
-            timestamp_writes: timer.compute_pass(label),
-        });
+        let mut pass = timer.begin_compute(encoder, label);
         pass.set_pipeline(&self.shading);
         pass.set_bind_group(0, f.scene_bind_group, &[]);
         pass.set_bind_group(1, group1, &[]);
