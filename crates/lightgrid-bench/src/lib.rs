@@ -9,16 +9,18 @@
 //! writes.
 
 mod claims;
+mod outdir;
 pub mod plot;
 mod report;
 mod run;
 mod scaling;
 
 pub use claims::{evaluate_claims, Claim, Verdict};
+pub use outdir::{check_out_dir, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE, STOPPED_BY_SIGNAL};
 pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
-    run, BenchConfig, BenchResults, FrameRange, FrameRecord, Progress, RunRecord, RunSummary, Stat,
-    TimesFrom, SOURCES,
+    prepare, run, BenchConfig, BenchResults, FrameRange, FrameRecord, PreparedBench, Progress,
+    RunRecord, RunSummary, Stat, TimesFrom, SOURCES,
 };
 pub use scaling::{
     run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,
@@ -36,3 +38,7 @@ pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> lightgri
 /// Real-time frames played before a series' measured ones, so the measurement starts with
 /// a full queue of frames in flight.
 pub const PLAY_QUEUE_FILL: u32 = lightgrid::MAX_FRAMES_IN_FLIGHT as u32;
+
+/// Most `--warmup` renders and `--repeat` / `--runs` measurements a run takes: more is hours
+/// of rendering on a software adapter for no better median.
+pub const MAX_REPEATS: u32 = 1000;

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 pub const REPORT_FILES: &[&str] = &["results.json", "results.csv", "summary.md"];
 
 /// Version of the results.json layout (documented in README).
-pub const SCHEMA_VERSION: u32 = 2;
+pub const SCHEMA_VERSION: u32 = 3;
 
 fn run_name(r: &RunRecord) -> String {
     match r.gbuffer_bits {
@@ -342,8 +342,12 @@ fn summary(results: &BenchResults) -> String {
         "- {w}x{h}, tile {}, frames {}..{} every {}, {} repeat(s) per frame (median kept), {} warm-up render(s) per series",
         c.tile_size, c.frames.start, c.frames.end, c.frames.step, c.repeat, c.warmup
     );
-    if results.interrupted {
-        s.push_str("- **interrupted**: the run was stopped early; incomplete series are marked\n");
+    if !results.outcome.is_complete() {
+        let _ = writeln!(
+            s,
+            "- **{}**; incomplete series are marked",
+            results.outcome.describe()
+        );
     }
     s.push_str("\nTimes come from the real-time path (`lightgrid play`: the frames rendered back to back, one queue submission each, no analysis): each frame's GPU time from timestamp queries where the adapter has them (first pass start to last pass end per submission, summed), else the wall time from one frame to the next (column `timing`); *real-time fps* is frames per second of that path. Counts come from an analysis render of each frame (results.json `sources`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
     let (scenes, _) = scenes_and_bits(results);

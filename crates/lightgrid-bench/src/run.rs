@@ -1,6 +1,7 @@
 //! Running the benchmark: the measurement loop, warm-up, repeats, cancellation.
 
 use crate::invalid;
+use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
 use lightgrid::error::Result;
 use lightgrid::gpu::{GpuContext, PassTiming};
@@ -43,8 +44,17 @@ impl FrameRange {
                 (n, n)
             }
         };
-        if step == 0 || end < start {
-            return Err(bad());
+        if step == 0 {
+            return Err(invalid(
+                "--frames",
+                format!("'{s}': the step must be at least 1"),
+            ));
+        }
+        if end < start {
+            return Err(invalid(
+                "--frames",
+                format!("'{s}': the range ends ({end}) before it starts ({start})"),
+            ));
         }
         Ok(FrameRange { start, end, step })
     }
@@ -95,8 +105,28 @@ impl BenchConfig {
         for s in &self.scenes {
             catalog::find(s)?;
         }
-        if self.repeat == 0 {
-            return Err(invalid("--repeat", "must be at least 1"));
+        // One rule for every command: an option that applies to nothing chosen is refused.
+        // --lights goes to the scenes that take a light count; with none, the first scene's
+        // check says which scenes do.
+        if let Some(n) = self.lights {
+            let taker = self
+                .scenes
+                .iter()
+                .find(|s| catalog::find(s).is_ok_and(|i| i.variable_lights))
+                .unwrap_or(&self.scenes[0]);
+            let params = SceneParams {
+                seed: self.seed,
+                lights: Some(n),
+            };
+            catalog::check_params(taker, &params)?;
+        }
+        for (flag, v, min) in [("--repeat", self.repeat, 1), ("--warmup", self.warmup, 0)] {
+            if !(min..=crate::MAX_REPEATS).contains(&v) {
+                return Err(invalid(
+                    flag,
+                    format!("{v} is out of range {min} to {}", crate::MAX_REPEATS),
+                ));
+            }
         }
         lightgrid::RenderSettings {
             tile_size: self.tile_size,
@@ -264,8 +294,9 @@ pub struct BenchResults {
     pub adapter: String,
     pub software_adapter: bool,
     pub config: BenchConfig,
-    /// Stopped by the user (Ctrl-C) before the end.
-    pub interrupted: bool,
+    /// Complete, interrupted (Ctrl-C, SIGTERM) or failed, with the reason.
+    #[serde(default)]
+    pub outcome: Outcome,
     /// Where each figure comes from (figure, source), [`SOURCES`].
     #[serde(default)]
     pub sources: Vec<(String, String)>,
@@ -301,266 +332,415 @@ fn median(v: &[f64]) -> usize {
     idx[idx.len() / 2]
 }
 
-/// Does the pipeline's memory depend on the G-buffer format (i.e. does it have one)?
-fn uses_gbuffer(p: &pipelines::PipelineInfo) -> bool {
-    let f16 = RenderSettings {
-        gbuffer: GBufferFormat::F16,
-        ..Default::default()
-    };
-    let f32 = RenderSettings {
-        gbuffer: GBufferFormat::F32,
-        ..Default::default()
-    };
-    (p.memory)(&f16) != (p.memory)(&f32)
+/// One series of the plan: a scene, a G-buffer setting and a pipeline over its frames.
+struct Series {
+    scene: usize,
+    gbuffer: GBufferFormat,
+    info: &'static pipelines::PipelineInfo,
+    /// False for pipelines without a G-buffer (measured once, under the first setting).
+    uses_gbuffer: bool,
+    frames: Vec<u32>,
 }
 
-/// Run the benchmark. `stop` is polled after every render; when set, the results so far are
-/// returned with `interrupted = true`.
-pub fn run(
-    ctx: &GpuContext,
-    config: &BenchConfig,
-    stop: &AtomicBool,
-    progress: &mut dyn FnMut(&Progress),
-) -> Result<BenchResults> {
-    config.validate()?;
-    let params = SceneParams {
-        seed: config.seed,
-        lights: config.lights,
-    };
-    let mut scenes = Vec::new();
-    for name in &config.scenes {
-        let params = SceneParams {
-            lights: if catalog::find(name)?.variable_lights {
-                params.lights
-            } else {
-                None
-            },
-            ..params
-        };
-        scenes.push(catalog::build(name, &params)?);
-    }
-    // The plan: (scene index, gbuffer, pipeline) combinations and their frames.
+fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
+    config
+        .scenes
+        .iter()
+        .map(|name| {
+            let variable = catalog::find(name)?.variable_lights;
+            let params = SceneParams {
+                seed: config.seed,
+                lights: config.lights.filter(|_| variable),
+            };
+            catalog::build(name, &params)
+        })
+        .collect()
+}
+
+fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<Series>> {
     let mut plan = Vec::new();
     for (si, scene) in scenes.iter().enumerate() {
         let frames = config.frames.frames(scene.frame_count());
         if frames.is_empty() {
             return Err(invalid(
                 "--frames",
-                format!("no frame of {} is in range", scene.name),
+                format!(
+                    "no frame of {} is in range (it has frames 0..{})",
+                    scene.name,
+                    scene.frame_count().saturating_sub(1)
+                ),
             ));
         }
         for (gi, g) in config.gbuffers.iter().enumerate() {
             for id in &config.pipelines {
                 let info = pipelines::find(id)?;
-                let g_used = uses_gbuffer(info);
+                let g_used = info.uses_gbuffer();
                 if !g_used && gi > 0 {
                     continue;
                 }
-                plan.push((si, *g, info, g_used, frames.clone()));
+                plan.push(Series {
+                    scene: si,
+                    gbuffer: *g,
+                    info,
+                    uses_gbuffer: g_used,
+                    frames: frames.clone(),
+                });
             }
         }
     }
-    // Per frame one analysis render, then `repeat` real-time passes over the frames.
-    let total: u64 = plan
-        .iter()
-        .map(|p| u64::from(config.warmup) + p.4.len() as u64 * u64::from(1 + config.repeat))
-        .sum();
-    let mut done = 0u64;
-    let mut results = BenchResults {
-        command: String::new(),
-        adapter: ctx.adapter_label(),
-        software_adapter: ctx.is_software(),
-        config: config.clone(),
-        interrupted: false,
-        sources: SOURCES
-            .iter()
-            .map(|(a, b)| (a.to_string(), b.to_string()))
-            .collect(),
-        runs: Vec::new(),
-        heatmaps: Vec::new(),
-    };
-    // The heatmap shows a depth-bounded grid when one is measured.
-    let heatmap_pipeline = config
-        .pipelines
-        .iter()
-        .find(|p| p.as_str() == "tiled_deferred")
-        .or_else(|| {
-            config
-                .pipelines
-                .iter()
-                .find(|p| pipelines::find(p).is_ok_and(|i| i.uses_grid))
-        })
-        .cloned();
-    // Renderers by (scene, settings); pipelines without a grid builder ignore `assign`.
-    let mut renderers: Vec<(usize, RenderSettings, Renderer)> = Vec::new();
-    'plan: for (si, g, info, g_used, frames) in plan {
-        let scene = &scenes[si];
-        let (w, h) = config.size.unwrap_or(scene.default_size);
-        let settings = RenderSettings {
-            tile_size: config.tile_size,
-            gbuffer: g,
-            slices: config.slices,
-            assign: if info.assign {
-                config.assign
+    Ok(plan)
+}
+
+/// What the series loop shares: the stop flag, progress and the renderers by settings.
+struct Measuring<'a> {
+    ctx: &'a GpuContext,
+    config: &'a BenchConfig,
+    stop: &'a AtomicBool,
+    progress: &'a mut dyn FnMut(&Progress),
+    done: u64,
+    total: u64,
+    /// The pipeline whose grid the report's heatmap shows (a depth-bounded grid when one is
+    /// measured).
+    heatmap_pipeline: Option<String>,
+    /// Renderers by (scene, settings); pipelines without a grid builder ignore `assign`.
+    renderers: Vec<(usize, RenderSettings, Renderer<'a>)>,
+}
+
+/// How a series ended when it did not fail.
+#[derive(PartialEq)]
+enum SeriesEnd {
+    Complete,
+    Stopped,
+}
+
+impl<'a> Measuring<'a> {
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    fn tick(&mut self, label: String) {
+        (self.progress)(&Progress {
+            done: self.done,
+            total: self.total,
+            label,
+        });
+    }
+
+    fn settings(&self, series: &Series) -> RenderSettings {
+        RenderSettings {
+            tile_size: self.config.tile_size,
+            gbuffer: series.gbuffer,
+            slices: self.config.slices,
+            assign: if series.info.assign {
+                self.config.assign
             } else {
                 lightgrid::pipelines::Assign::default()
             },
-        };
-        if !renderers.iter().any(|r| r.0 == si && r.1 == settings) {
-            renderers.retain(|r| r.0 == si);
-            renderers.push((si, settings, Renderer::new(ctx, w, h, settings)?));
         }
-        let renderer = &mut renderers
+    }
+
+    fn renderer(&mut self, series: &Series, size: (u32, u32)) -> Result<&mut Renderer<'a>> {
+        let settings = self.settings(series);
+        let si = series.scene;
+        if !self.renderers.iter().any(|r| r.0 == si && r.1 == settings) {
+            self.renderers.retain(|r| r.0 == si);
+            let r = Renderer::new(self.ctx, size.0, size.1, settings)?;
+            self.renderers.push((si, settings, r));
+        }
+        Ok(&mut self
+            .renderers
             .iter_mut()
             .find(|r| r.0 == si && r.1 == settings)
             .expect("created above")
-            .2;
-        let label = |f: Option<u32>| {
-            let g = if g_used {
-                format!(" g{}", g.bits())
-            } else {
-                String::new()
-            };
-            match f {
-                Some(f) => format!("{} {}{g} frame {f}", scene.name, info.id),
-                None => format!("{} {}{g} warm-up", scene.name, info.id),
-            }
+            .2)
+    }
+
+    /// Measure one series into `record` (and the render-target bytes per pixel and in all
+    /// into `bytes`): warm-up, one analysis render per frame (counts), then `repeat` real-time
+    /// passes (times). What it measured stays in `record` whatever the outcome.
+    fn series(
+        &mut self,
+        scene: &lightgrid::scene::Scene,
+        series: &Series,
+        record: &mut RunRecord,
+        bytes: &mut (u32, u64),
+        heatmaps: &mut Vec<(String, String, u32, RgbaImage)>,
+    ) -> Result<SeriesEnd> {
+        let info = series.info;
+        let frames = &series.frames;
+        let g = if series.uses_gbuffer {
+            format!(" g{}", series.gbuffer.bits())
+        } else {
+            String::new()
         };
-        for _ in 0..config.warmup {
-            progress(&Progress {
-                done,
-                total,
-                label: label(None),
-            });
-            renderer.render(scene, frames[0], info.id)?;
-            done += 1;
-            if stop.load(Ordering::Relaxed) {
-                results.interrupted = true;
-                break 'plan;
+        let label = |what: &str| format!("{} {}{g} {what}", scene.name, info.id);
+        for _ in 0..self.config.warmup {
+            self.tick(label("warm-up"));
+            self.renderer(series, (record.width, record.height))?
+                .render(scene, frames[0], info.id)?;
+            self.done += 1;
+            if self.stopped() {
+                return Ok(SeriesEnd::Stopped);
             }
         }
-        let mut record = RunRecord {
+        let heatmap_frame = self
+            .config
+            .heatmap_frame
+            .unwrap_or(frames[frames.len() / 2]);
+        let wants_heatmap = self.heatmap_pipeline.as_deref() == Some(info.id);
+        // 1. Counts: one analysis render per frame.
+        for &f in frames {
+            self.tick(label(&format!("frame {f}")));
+            let out = self
+                .renderer(series, (record.width, record.height))?
+                .render(scene, f, info.id)?;
+            self.done += 1;
+            let s = &out.stats;
+            record.timing = s.timing;
+            *bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
+            if f == heatmap_frame && wants_heatmap && !heatmaps.iter().any(|h| h.0 == scene.name) {
+                let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
+                heatmaps.push((scene.name.clone(), info.id.to_string(), f, map));
+            }
+            record.frames.push(FrameRecord::from_analysis(f, s));
+            if self.stopped() {
+                return Ok(SeriesEnd::Stopped);
+            }
+        }
+        // 2. Times: the frames back to back on the real-time path, `repeat` times.
+        let plan = PlayPlan {
+            scene,
+            pipeline: info.id,
+            frames,
+            passes: self.config.repeat,
+            // The analysis renders already compiled and sized everything: these only fill
+            // the queue of frames in flight.
+            warmup: crate::PLAY_QUEUE_FILL,
+        };
+        let (base, total, stop) = (self.done, self.total, self.stop);
+        let settings = self.settings(series);
+        let progress = &mut *self.progress;
+        let renderer = &mut self
+            .renderers
+            .iter_mut()
+            .find(|r| r.0 == series.scene && r.1 == settings)
+            .expect("the analysis renders created it")
+            .2;
+        let run = play(renderer, &plan, stop, &mut |n, _| {
+            progress(&Progress {
+                done: base + n,
+                total,
+                label: label("real-time"),
+            })
+        })?;
+        self.done = base + run.frames.len() as u64;
+        record.take_play_times(&run.frames, frames.len());
+        record.overflow_frames = run.overflow_frames() as u32;
+        Ok(if run.interrupted {
+            SeriesEnd::Stopped
+        } else {
+            SeriesEnd::Complete
+        })
+    }
+}
+
+impl FrameRecord {
+    /// A frame's counts (and, until the real-time pass replaces them, times) from its
+    /// analysis render.
+    fn from_analysis(frame: u32, s: &lightgrid::FrameStats) -> FrameRecord {
+        FrameRecord {
+            frame,
+            gpu_ms: s.gpu_ms,
+            gpu_ms_repeats: Vec::new(),
+            frame_ms: 0.0,
+            analysis_gpu_ms: s.gpu_ms,
+            passes: s.passes.clone(),
+            lighting_computations: s.lighting_computations,
+            ideal_lighting_computations: s.ideal_lighting_computations,
+            lights_per_tile_avg: s.lights_per_tile_avg,
+            lights_per_tile_max: s.lights_per_tile_max,
+            grid_bytes: s.memory.grid_bytes,
+            modelled_write_bytes: s.memory.modelled_write_bytes,
+            modelled_read_bytes: s.memory.modelled_read_bytes,
+            forward_plus_table1: s.memory.forward_plus_table1,
+        }
+    }
+}
+
+impl RunRecord {
+    fn new(scene: &lightgrid::scene::Scene, series: &Series, size: (u32, u32), tile: u32) -> Self {
+        RunRecord {
             scene: scene.name.clone(),
-            pipeline: info.id.to_string(),
-            gbuffer_bits: g_used.then_some(g.bits()),
-            width: w,
-            height: h,
-            tile_size: config.tile_size,
+            pipeline: series.info.id.to_string(),
+            gbuffer_bits: series.uses_gbuffer.then_some(series.gbuffer.bits()),
+            width: size.0,
+            height: size.1,
+            tile_size: tile,
             timing: TimingSource::WallClock,
             complete: false,
             overflow_frames: 0,
             times_from: TimesFrom::Analysis,
             frames: Vec::new(),
             summary: None,
-        };
-        let heatmap_frame = config.heatmap_frame.unwrap_or(frames[frames.len() / 2]);
-        let mut bytes = (0, 0);
-        // 1. Counts: one analysis render per frame.
-        for &f in &frames {
-            progress(&Progress {
-                done,
-                total,
-                label: label(Some(f)),
-            });
-            let out = renderer.render(scene, f, info.id)?;
-            done += 1;
-            let s = &out.stats;
-            record.timing = s.timing;
-            bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
-            let wanted = heatmap_pipeline.as_deref() == Some(info.id);
-            if f == heatmap_frame && wanted && !results.heatmaps.iter().any(|h| h.0 == scene.name) {
-                let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
-                results
-                    .heatmaps
-                    .push((scene.name.clone(), info.id.to_string(), f, map));
-            }
-            record.frames.push(FrameRecord {
-                frame: f,
-                gpu_ms: s.gpu_ms,
-                gpu_ms_repeats: Vec::new(),
-                frame_ms: 0.0,
-                analysis_gpu_ms: s.gpu_ms,
-                passes: s.passes.clone(),
-                lighting_computations: s.lighting_computations,
-                ideal_lighting_computations: s.ideal_lighting_computations,
-                lights_per_tile_avg: s.lights_per_tile_avg,
-                lights_per_tile_max: s.lights_per_tile_max,
-                grid_bytes: s.memory.grid_bytes,
-                modelled_write_bytes: s.memory.modelled_write_bytes,
-                modelled_read_bytes: s.memory.modelled_read_bytes,
-                forward_plus_table1: s.memory.forward_plus_table1,
-            });
-            if stop.load(Ordering::Relaxed) {
-                results.interrupted = true;
-                break;
-            }
-        }
-        // 2. Times: the frames back to back on the real-time path, `repeat` times.
-        if !results.interrupted {
-            let plan = PlayPlan {
-                scene,
-                pipeline: info.id,
-                frames: &frames,
-                passes: config.repeat,
-                // The analysis renders already compiled and sized everything: these only
-                // fill the queue of frames in flight.
-                warmup: crate::PLAY_QUEUE_FILL,
-            };
-            let base = done;
-            let run = play(renderer, &plan, stop, &mut |n, _| {
-                progress(&Progress {
-                    done: base + n,
-                    total,
-                    label: label(None).replace("warm-up", "real-time"),
-                })
-            })?;
-            done = base + run.frames.len() as u64;
-            results.interrupted = run.interrupted;
-            record.overflow_frames = run.overflow_frames() as u32;
-            let timestamps = run.frames.iter().all(|p| p.gpu_ms.is_some());
-            record.timing = if timestamps {
-                TimingSource::GpuTimestamps
-            } else {
-                TimingSource::WallClock
-            };
-            for (i, rec) in record.frames.iter_mut().enumerate() {
-                let played: Vec<&PlayedFrame> =
-                    run.frames.iter().skip(i).step_by(frames.len()).collect();
-                if played.is_empty() {
-                    continue;
-                }
-                let times: Vec<f64> = played
-                    .iter()
-                    .map(|p| p.gpu_ms.unwrap_or(p.frame_ms))
-                    .collect();
-                let m = median(&times);
-                rec.gpu_ms = times[m];
-                rec.gpu_ms_repeats = times.clone();
-                rec.passes = played[m].passes.clone();
-                let periods: Vec<f64> = played.iter().map(|p| p.frame_ms).collect();
-                rec.frame_ms = periods[median(&periods)];
-            }
-            // Frames the interrupted real-time run did not reach carry no real-time figure;
-            // with none measured the run keeps its analysis times (and says so).
-            let measured = run.frames.len().min(frames.len());
-            if measured > 0 {
-                record.frames.truncate(measured);
-                record.times_from = TimesFrom::RealTime;
-            }
-        }
-        record.complete = !results.interrupted;
-        record.summary = RunSummary::from_frames(&record.frames, bytes.0, bytes.1);
-        if !record.frames.is_empty() {
-            results.runs.push(record);
-        }
-        if results.interrupted {
-            break;
         }
     }
-    progress(&Progress {
-        done,
-        total,
-        label: "done".into(),
-    });
-    Ok(results)
+
+    /// Replace the analysis times with the real-time passes' (`played` holds the passes one
+    /// after another, `per_pass` frames each). Frames an interrupted pass did not reach carry
+    /// no real-time figure and are dropped; with none reached the analysis times stay (and
+    /// `times_from` says so).
+    fn take_play_times(&mut self, played: &[PlayedFrame], per_pass: usize) {
+        let timestamps = played.iter().all(|p| p.gpu_ms.is_some());
+        self.timing = if timestamps {
+            TimingSource::GpuTimestamps
+        } else {
+            TimingSource::WallClock
+        };
+        for (i, rec) in self.frames.iter_mut().enumerate() {
+            let of_frame: Vec<&PlayedFrame> = played.iter().skip(i).step_by(per_pass).collect();
+            if of_frame.is_empty() {
+                continue;
+            }
+            let times: Vec<f64> = of_frame
+                .iter()
+                .map(|p| p.gpu_ms.unwrap_or(p.frame_ms))
+                .collect();
+            let m = median(&times);
+            rec.gpu_ms = times[m];
+            rec.gpu_ms_repeats = times.clone();
+            rec.passes = of_frame[m].passes.clone();
+            let periods: Vec<f64> = of_frame.iter().map(|p| p.frame_ms).collect();
+            rec.frame_ms = periods[median(&periods)];
+        }
+        let measured = played.len().min(per_pass);
+        if measured > 0 {
+            self.frames.truncate(measured);
+            self.times_from = TimesFrom::RealTime;
+        }
+    }
+}
+
+/// A benchmark checked and planned: scenes built, every series listed. Everything that can be
+/// refused is refused by [`prepare`], before a directory is created or a frame rendered.
+pub struct PreparedBench {
+    config: BenchConfig,
+    scenes: Vec<lightgrid::scene::Scene>,
+    plan: Vec<Series>,
+}
+
+/// Validate `config`, build its scenes and plan its series.
+pub fn prepare(config: &BenchConfig) -> Result<PreparedBench> {
+    config.validate()?;
+    let scenes = build_scenes(config)?;
+    let plan = plan(config, &scenes)?;
+    Ok(PreparedBench {
+        config: config.clone(),
+        scenes,
+        plan,
+    })
+}
+
+/// Run the benchmark: [`prepare`], then [`PreparedBench::run`].
+pub fn run(
+    ctx: &GpuContext,
+    config: &BenchConfig,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<BenchResults> {
+    prepare(config)?.run(ctx, stop, progress)
+}
+
+impl PreparedBench {
+    /// Run the prepared benchmark. `stop` is polled after every render; when set, the results
+    /// so far are returned with [`Outcome::Interrupted`]. An error part-way is returned the same
+    /// way, as [`Outcome::Failed`] with what was measured before it.
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        stop: &AtomicBool,
+        progress: &mut dyn FnMut(&Progress),
+    ) -> Result<BenchResults> {
+        let (config, scenes, plan) = (&self.config, &self.scenes, &self.plan);
+        // Per frame one analysis render, then `repeat` real-time passes over the frames.
+        let total: u64 = plan
+            .iter()
+            .map(|p| {
+                u64::from(config.warmup) + p.frames.len() as u64 * u64::from(1 + config.repeat)
+            })
+            .sum();
+        let mut results = BenchResults {
+            command: String::new(),
+            adapter: ctx.adapter_label(),
+            software_adapter: ctx.is_software(),
+            config: config.clone(),
+            outcome: Outcome::Complete,
+            sources: SOURCES
+                .iter()
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .collect(),
+            runs: Vec::new(),
+            heatmaps: Vec::new(),
+        };
+        let heatmap_pipeline = config
+            .pipelines
+            .iter()
+            .find(|p| p.as_str() == "tiled_deferred")
+            .or_else(|| {
+                config
+                    .pipelines
+                    .iter()
+                    .find(|p| pipelines::find(p).is_ok_and(|i| i.uses_grid))
+            })
+            .cloned();
+        let mut m = Measuring {
+            ctx,
+            config,
+            stop,
+            progress,
+            done: 0,
+            total,
+            heatmap_pipeline,
+            renderers: Vec::new(),
+        };
+        for series in plan {
+            let scene = &scenes[series.scene];
+            let size = config.size.unwrap_or(scene.default_size);
+            let mut record = RunRecord::new(scene, series, size, config.tile_size);
+            let mut bytes = (0, 0);
+            let end = m.series(
+                scene,
+                series,
+                &mut record,
+                &mut bytes,
+                &mut results.heatmaps,
+            );
+            record.complete = matches!(end, Ok(SeriesEnd::Complete));
+            record.summary = RunSummary::from_frames(&record.frames, bytes.0, bytes.1);
+            if !record.frames.is_empty() {
+                results.runs.push(record);
+            }
+            match end {
+                Ok(SeriesEnd::Complete) => {}
+                Ok(SeriesEnd::Stopped) => {
+                    results.outcome = Outcome::Interrupted(STOPPED_BY_SIGNAL.into());
+                    break;
+                }
+                Err(e) => {
+                    results.outcome = Outcome::Failed(format!(
+                        "{} / {}{}: {e}",
+                        scene.name,
+                        series.info.id,
+                        if series.uses_gbuffer {
+                            format!(" (G-buffer {} bits)", series.gbuffer.bits())
+                        } else {
+                            String::new()
+                        }
+                    ));
+                    break;
+                }
+            }
+        }
+        m.tick("done".into());
+        Ok(results)
+    }
 }

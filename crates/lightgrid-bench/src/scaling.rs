@@ -8,6 +8,7 @@
 
 use super::run::Progress;
 use crate::invalid;
+use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use crate::plot::{LineChart, Series};
 use crate::report::csv_bytes;
 use lightgrid::error::{Error, Result};
@@ -70,8 +71,12 @@ impl Default for ScalingConfig {
 pub struct ScalingPoint {
     pub lights: u32,
     pub assign: String,
-    /// Why the point was not measured (the strategy exceeded the budget at a smaller count).
+    /// Why the point was not measured (the strategy exceeded the budget or failed at a
+    /// smaller count).
     pub skipped: Option<String>,
+    /// The error that stopped this point (the strategy is not run at larger counts).
+    #[serde(default)]
+    pub failed: Option<String>,
     /// Median assignment time (`FrameStats::assign_ms`: GPU timestamp span of the assignment
     /// passes + CPU time of the assignment).
     pub assign_ms: Option<f64>,
@@ -97,7 +102,9 @@ pub struct ScalingResults {
     pub adapter: String,
     pub software_adapter: bool,
     pub config: ScalingConfig,
-    pub interrupted: bool,
+    /// Complete, interrupted (Ctrl-C, SIGTERM) or failed, with the reason.
+    #[serde(default)]
+    pub outcome: Outcome,
     pub points: Vec<ScalingPoint>,
 }
 
@@ -125,11 +132,35 @@ impl ScalingConfig {
                 format!("{} has a fixed light count; use stress", self.scene),
             ));
         }
-        if self.lights.is_empty() || self.strategies.is_empty() || self.runs == 0 {
+        if self.lights.is_empty() || self.strategies.is_empty() {
             return Err(invalid(
                 "scaling",
-                "needs at least one light count, one strategy and one run",
+                "needs at least one light count and one strategy",
             ));
+        }
+        for (flag, v, min) in [("--runs", self.runs, 1), ("--warmup", self.warmup, 0)] {
+            if !(min..=crate::MAX_REPEATS).contains(&v) {
+                return Err(invalid(
+                    flag,
+                    format!("{v} is out of range {min} to {}", crate::MAX_REPEATS),
+                ));
+            }
+        }
+        if !self.budget_ms.is_finite() || self.budget_ms <= 0.0 {
+            return Err(invalid(
+                "--budget",
+                format!(
+                    "{} s: the budget is a positive number of seconds",
+                    self.budget_ms / 1e3
+                ),
+            ));
+        }
+        for &n in &self.lights {
+            let params = SceneParams {
+                seed: self.seed,
+                lights: Some(n),
+            };
+            catalog::check_params(&self.scene, &params)?;
         }
         Ok(())
     }
@@ -141,7 +172,101 @@ fn median(v: &[f64]) -> f64 {
     s[s.len() / 2]
 }
 
-/// Run the scaling benchmark; `stop` is polled after every render.
+impl ScalingPoint {
+    fn new(lights: u32, assign: String) -> Self {
+        ScalingPoint {
+            lights,
+            assign,
+            skipped: None,
+            failed: None,
+            assign_ms: None,
+            assign_ms_runs: Vec::new(),
+            assign_gpu_ms: None,
+            assign_cpu_ms: None,
+            frame_gpu_ms: None,
+            grid_indices: None,
+            grid_bytes: None,
+            grid_cells: None,
+            grid_cells_occupied: None,
+            lights_per_cell_max: None,
+            lighting_computations: None,
+            ideal_lighting_computations: None,
+        }
+    }
+
+    /// Take the figures of the measured renders (the median assignment time, the last
+    /// render's counts).
+    fn take(&mut self, outs: &[lightgrid::FrameOutput]) {
+        let Some(last) = outs.last() else { return };
+        let times: Vec<f64> = outs.iter().filter_map(|o| o.stats.assign_ms).collect();
+        let s = &last.stats;
+        self.assign_ms = (!times.is_empty()).then(|| median(&times));
+        self.assign_ms_runs = times;
+        self.assign_gpu_ms = s.assign_gpu_ms;
+        self.assign_cpu_ms = s.assign_cpu_ms;
+        self.frame_gpu_ms = Some(s.gpu_ms);
+        self.grid_indices = s.grid_indices;
+        self.grid_bytes = s.memory.grid_bytes;
+        self.grid_cells = s.grid_cells;
+        self.grid_cells_occupied = s.grid_cells_occupied;
+        self.lights_per_cell_max = s.lights_per_tile_max;
+        self.lighting_computations = s.lighting_computations;
+        self.ideal_lighting_computations = Some(s.ideal_lighting_computations);
+    }
+}
+
+/// Render one point's warm-up and measured frames; the measured outputs so far and whether
+/// the stop flag ended it early, or the error that did (with the outputs before it).
+#[allow(clippy::too_many_arguments)]
+fn measure_point(
+    ctx: &GpuContext,
+    config: &ScalingConfig,
+    scene: &lightgrid::scene::Scene,
+    assign: Assign,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&Progress),
+    done: &mut u64,
+    total: u64,
+) -> (Vec<lightgrid::FrameOutput>, Result<bool>) {
+    let settings = RenderSettings {
+        tile_size: config.tile_size,
+        slices: config.slices,
+        assign,
+        ..Default::default()
+    };
+    let mut outs = Vec::new();
+    let mut renderer = match Renderer::new(ctx, config.size.0, config.size.1, settings) {
+        Ok(r) => r,
+        Err(e) => return (outs, Err(e)),
+    };
+    for i in 0..config.warmup + config.runs {
+        let warm = i < config.warmup;
+        progress(&Progress {
+            done: *done,
+            total,
+            label: format!(
+                "{} lights, {} ({})",
+                scene.lights.len(),
+                assign.name(),
+                if warm { "warm-up" } else { "measuring" }
+            ),
+        });
+        match renderer.render(scene, 0, &config.pipeline) {
+            Ok(out) if !warm => outs.push(out),
+            Ok(_) => {}
+            Err(e) => return (outs, Err(e)),
+        }
+        *done += 1;
+        if stop.load(Ordering::Relaxed) {
+            return (outs, Ok(true));
+        }
+    }
+    (outs, Ok(false))
+}
+
+/// Run the scaling benchmark; `stop` is polled after every render. A strategy that fails at
+/// a light count has the error recorded in that point and is not run at larger counts; the
+/// run goes on with the others. Results come back on every way out ([`Outcome`]).
 pub fn run_scaling(
     ctx: &GpuContext,
     config: &ScalingConfig,
@@ -152,7 +277,7 @@ pub fn run_scaling(
     let mut lights = config.lights.clone();
     lights.sort_unstable();
     lights.dedup();
-    let per_point = u64::from(config.warmup + config.runs);
+    let per_point = u64::from(config.warmup) + u64::from(config.runs);
     let total = per_point * (lights.len() * config.strategies.len()) as u64;
     let mut done = 0;
     let mut results = ScalingResults {
@@ -160,103 +285,75 @@ pub fn run_scaling(
         adapter: ctx.adapter_label(),
         software_adapter: ctx.is_software(),
         config: config.clone(),
-        interrupted: false,
+        outcome: Outcome::Complete,
         points: Vec::new(),
     };
-    let (w, h) = config.size;
-    let mut over_budget: Vec<Option<(u32, f64)>> = vec![None; config.strategies.len()];
+    // Why a strategy is no longer run: over the budget or failed at a smaller count.
+    let mut dropped: Vec<Option<String>> = vec![None; config.strategies.len()];
     'counts: for &n in &lights {
         let params = SceneParams {
             seed: config.seed,
             lights: Some(n),
         };
-        let scene = catalog::build(&config.scene, &params)?;
+        let scene = match catalog::build(&config.scene, &params) {
+            Ok(s) => s,
+            Err(e) => {
+                results.outcome = Outcome::Failed(format!("{} at {n} lights: {e}", config.scene));
+                break;
+            }
+        };
         for (si, &assign) in config.strategies.iter().enumerate() {
-            let mut point = ScalingPoint {
-                lights: n,
-                assign: assign
-                    .resolve(n as usize, ctx.is_software())
-                    .name()
-                    .to_string(),
-                skipped: None,
-                assign_ms: None,
-                assign_ms_runs: Vec::new(),
-                assign_gpu_ms: None,
-                assign_cpu_ms: None,
-                frame_gpu_ms: None,
-                grid_indices: None,
-                grid_bytes: None,
-                grid_cells: None,
-                grid_cells_occupied: None,
-                lights_per_cell_max: None,
-                lighting_computations: None,
-                ideal_lighting_computations: None,
-            };
-            if let Some((at, ms)) = over_budget[si] {
-                point.skipped = Some(format!(
-                    "took {:.1} s at {at} lights (budget {:.1} s)",
-                    ms / 1e3,
-                    config.budget_ms / 1e3
-                ));
+            let name = assign.resolve(n as usize, ctx.is_software()).name();
+            let mut point = ScalingPoint::new(n, name.to_string());
+            if let Some(why) = &dropped[si] {
+                point.skipped = Some(why.clone());
                 done += per_point;
                 results.points.push(point);
                 continue;
             }
-            let settings = RenderSettings {
-                tile_size: config.tile_size,
-                slices: config.slices,
-                assign,
-                ..Default::default()
-            };
-            let mut renderer = Renderer::new(ctx, w, h, settings)?;
-            let mut outs = Vec::new();
-            for i in 0..per_point {
-                progress(&Progress {
-                    done,
-                    total,
-                    label: format!(
-                        "{n} lights, {} ({})",
-                        assign.name(),
-                        if i < u64::from(config.warmup) {
-                            "warm-up"
-                        } else {
-                            "measuring"
-                        }
-                    ),
-                });
-                let out = renderer.render(&scene, 0, &config.pipeline)?;
-                if i >= u64::from(config.warmup) {
-                    outs.push(out);
+            let before = done;
+            let (outs, end) = measure_point(
+                ctx, config, &scene, assign, stop, progress, &mut done, total,
+            );
+            done = before + per_point;
+            point.take(&outs);
+            match end {
+                Ok(stopped) => {
+                    if let Some(ms) = point.assign_ms.filter(|&ms| ms > config.budget_ms) {
+                        dropped[si] = Some(format!(
+                            "took {:.1} s at {n} lights (budget {:.1} s)",
+                            ms / 1e3,
+                            config.budget_ms / 1e3
+                        ));
+                    }
+                    if !outs.is_empty() {
+                        results.points.push(point);
+                    }
+                    if stopped {
+                        results.outcome = Outcome::Interrupted(STOPPED_BY_SIGNAL.into());
+                        break 'counts;
+                    }
                 }
-                done += 1;
-                if stop.load(Ordering::Relaxed) {
-                    results.interrupted = true;
-                    break;
+                Err(e) => {
+                    dropped[si] = Some(format!("failed at {n} lights"));
+                    point.failed = Some(e.to_string());
+                    results.points.push(point);
                 }
             }
-            if let Some(last) = outs.last() {
-                let times: Vec<f64> = outs.iter().filter_map(|o| o.stats.assign_ms).collect();
-                let s = &last.stats;
-                point.assign_ms = (!times.is_empty()).then(|| median(&times));
-                point.assign_ms_runs = times;
-                point.assign_gpu_ms = s.assign_gpu_ms;
-                point.assign_cpu_ms = s.assign_cpu_ms;
-                point.frame_gpu_ms = Some(s.gpu_ms);
-                point.grid_indices = s.grid_indices;
-                point.grid_bytes = s.memory.grid_bytes;
-                point.grid_cells = s.grid_cells;
-                point.grid_cells_occupied = s.grid_cells_occupied;
-                point.lights_per_cell_max = s.lights_per_tile_max;
-                point.lighting_computations = s.lighting_computations;
-                point.ideal_lighting_computations = Some(s.ideal_lighting_computations);
-                if let Some(ms) = point.assign_ms.filter(|&ms| ms > config.budget_ms) {
-                    over_budget[si] = Some((n, ms));
-                }
-                results.points.push(point);
-            }
-            if results.interrupted {
-                break 'counts;
-            }
+        }
+    }
+    if results.outcome.is_complete() {
+        let failed: Vec<String> = results
+            .points
+            .iter()
+            .filter_map(|p| {
+                p.failed
+                    .as_ref()
+                    .map(|e| format!("{} at {} lights: {e}", p.assign, p.lights))
+            })
+            .collect();
+        if !failed.is_empty() {
+            results.outcome = Outcome::Failed(failed.join("; "));
         }
     }
     progress(&Progress {
@@ -287,10 +384,15 @@ pub fn scaling_table(r: &ScalingResults) -> String {
     );
     out.push_str("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for p in &r.points {
-        if let Some(why) = &p.skipped {
+        let not_measured = match (&p.failed, &p.skipped) {
+            (Some(e), _) => Some(format!("failed: {e}")),
+            (None, Some(why)) => Some(format!("skipped: {why}")),
+            (None, None) => None,
+        };
+        if let Some(why) = not_measured {
             let _ = writeln!(
                 out,
-                "| {} | {} | skipped: {why} | | | | | | | | |",
+                "| {} | {} | {why} | | | | | | | | |",
                 p.lights, p.assign
             );
             continue;
@@ -386,10 +488,11 @@ pub const SCALING_FILES: [&str; 5] = [
 ];
 
 /// The columns of scaling.csv, in order (the header [`ScalingRow`] serializes to).
-const SCALING_CSV_COLUMNS: [&str; 14] = [
+const SCALING_CSV_COLUMNS: [&str; 15] = [
     "lights",
     "assign",
     "skipped",
+    "failed",
     "assign_ms",
     "assign_gpu_ms",
     "assign_cpu_ms",
@@ -409,6 +512,7 @@ struct ScalingRow<'a> {
     lights: u32,
     assign: &'a str,
     skipped: Option<&'a str>,
+    failed: Option<&'a str>,
     assign_ms: Option<f64>,
     assign_gpu_ms: Option<f64>,
     assign_cpu_ms: Option<f64>,
@@ -422,8 +526,9 @@ struct ScalingRow<'a> {
     ideal_lighting_computations: Option<u64>,
 }
 
-/// Write scaling.json, scaling.csv, scaling.md and the chart into `dir`.
-pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
+/// Write scaling.json, scaling.csv, scaling.md and the chart into `dir`; returns the paths
+/// written ([`SCALING_FILES`]).
+pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|cause| Error::Io {
         path: dir.display().to_string(),
         cause,
@@ -434,6 +539,7 @@ pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
         lights: p.lights,
         assign: &p.assign,
         skipped: p.skipped.as_deref(),
+        failed: p.failed.as_deref(),
         assign_ms: p.assign_ms,
         assign_gpu_ms: p.assign_gpu_ms,
         assign_cpu_ms: p.assign_cpu_ms,
@@ -449,8 +555,13 @@ pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
     let csv = csv_bytes("scaling", &SCALING_CSV_COLUMNS, rows)?;
     write_atomic(&dir.join("scaling.csv"), &csv)?;
     let md = format!(
-        "# Light assignment scaling\n\n`{}`\n\n{}\n{}",
+        "# Light assignment scaling\n\n`{}`\n\n{}{}\n{}",
         r.command,
+        if r.outcome.is_complete() {
+            String::new()
+        } else {
+            format!("**{}**\n\n", r.outcome.describe())
+        },
         scaling_table(r),
         scaling_growth(r)
     );
@@ -491,7 +602,7 @@ pub fn write_scaling(r: &ScalingResults, dir: &Path) -> Result<()> {
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| invalid("scaling", e.to_string()))?;
     write_atomic(&dir.join("scaling.png"), &png)?;
-    Ok(())
+    Ok(SCALING_FILES.iter().map(|f| dir.join(f)).collect())
 }
 
 #[cfg(test)]
@@ -525,10 +636,10 @@ mod tests {
         let text =
             String::from_utf8(csv_bytes("scaling", &SCALING_CSV_COLUMNS, rows).unwrap()).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines[1], "1000,cpu,,1.5,,,,12,,,,,,");
+        assert_eq!(lines[1], "1000,cpu,,,1.5,,,,12,,,,,,");
         assert_eq!(
             lines[2],
-            "4000,bvh,\"took 6.0 s at 1000 lights, over budget\",,,,,,,,,,,"
+            "4000,bvh,\"took 6.0 s at 1000 lights, over budget\",,,,,,,,,,,,"
         );
     }
 }

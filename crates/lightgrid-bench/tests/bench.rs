@@ -57,7 +57,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
         assert!(p.done <= p.total);
     })
     .unwrap();
-    assert!(calls > 0 && !results.interrupted);
+    assert!(calls > 0 && results.outcome.is_complete());
     let dir = std::env::temp_dir().join(format!("lightgrid-bench-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let written = write_report(&dir, &results).unwrap();
@@ -104,10 +104,9 @@ fn a_run_writes_every_file_with_consistent_summaries() {
     // results.json: the documented layout.
     let json: Value =
         serde_json::from_slice(&std::fs::read(dir.join("results.json")).unwrap()).unwrap();
-    assert_eq!(json["schema_version"], 2);
-    assert!(
-        json["adapter"].is_string() && json["command"].is_string() && json["interrupted"] == false
-    );
+    assert_eq!(json["schema_version"], 3);
+    assert!(json["adapter"].is_string() && json["command"].is_string());
+    assert_eq!(json["outcome"]["status"], "complete");
     assert_eq!(json["config"]["repeat"], 2);
     // Which figure came from where: times from the real-time path, counts from analysis.
     let sources = json["sources"].as_array().unwrap();
@@ -260,7 +259,10 @@ fn stopped_at(at: u32) -> lightgrid_bench::BenchResults {
         }
     })
     .unwrap();
-    assert!(results.interrupted);
+    assert!(matches!(
+        results.outcome,
+        lightgrid_bench::Outcome::Interrupted(_)
+    ));
     assert!(!results.runs.is_empty() && results.runs.len() < cfg.pipelines.len());
     assert!(results
         .runs
@@ -326,6 +328,7 @@ fn scaling_growth_reports_slopes_and_the_fastest_strategy() {
         lights,
         assign: assign.into(),
         skipped: ms.is_none().then(|| "over budget".into()),
+        failed: None,
         assign_ms: ms,
         assign_ms_runs: ms.into_iter().collect(),
         assign_gpu_ms: None,
@@ -344,7 +347,7 @@ fn scaling_growth_reports_slopes_and_the_fastest_strategy() {
         adapter: "test".into(),
         software_adapter: true,
         config: ScalingConfig::default(),
-        interrupted: false,
+        outcome: lightgrid_bench::Outcome::Complete,
         points: vec![
             point(1000, "linear", Some(10.0)),
             point(1000, "cheap", Some(5.0)),

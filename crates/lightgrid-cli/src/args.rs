@@ -61,10 +61,62 @@ pub(crate) fn parse_size(s: &str) -> Result<Size, String> {
             .map_err(|_| format!("'{v}' in '{s}' is not a positive whole number"))
     };
     let (w, h) = (edge(w)?, edge(h)?);
-    if w == 0 || h == 0 {
-        return Err(format!("{w}x{h}: both edges must be at least 1"));
+    let max = lightgrid::consts::MAX_FRAME_EDGE;
+    if w == 0 || h == 0 || w > max || h > max {
+        return Err(format!("{w}x{h}: both edges must be 1 to {max}"));
     }
     Ok(Size(w, h))
+}
+
+/// Most `--warmup`, `--repeat`, `--runs` and `--loops` a command takes (more would render
+/// for hours on a software adapter without a better figure).
+pub(crate) const MAX_COUNT: i64 = lightgrid_bench::MAX_REPEATS as i64;
+
+/// A finite number at least 0 (thresholds, budgets).
+pub(crate) fn parse_non_negative(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a finite number at least 0")),
+    }
+}
+
+/// Which of the options that only some pipelines read were given on the command line.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Given {
+    pub(crate) slices: bool,
+    pub(crate) gbuffer: bool,
+    pub(crate) assign: bool,
+}
+
+/// One rule for every command: an option given explicitly that applies to none of the chosen
+/// pipelines is refused rather than silently ignored.
+pub(crate) fn check_applies(
+    given: Given,
+    chosen: &[&'static lightgrid::pipelines::PipelineInfo],
+) -> Result<()> {
+    use lightgrid::pipelines::{PipelineInfo, PIPELINES};
+    type Applies = fn(&PipelineInfo) -> bool;
+    let rules: [(&str, bool, Applies); 3] = [
+        ("--slices", given.slices, |p| p.clustered),
+        ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
+        ("--assign", given.assign, |p| p.assign),
+    ];
+    for (flag, given, applies) in rules {
+        if given && !chosen.iter().any(|p| applies(p)) {
+            let takers: Vec<&str> = PIPELINES
+                .iter()
+                .filter(|p| applies(p))
+                .map(|p| p.id)
+                .collect();
+            let chosen: Vec<&str> = chosen.iter().map(|p| p.id).collect();
+            anyhow::bail!(
+                "{flag} does not apply to {}; it applies to: {}",
+                chosen.join(", "),
+                takers.join(", ")
+            );
+        }
+    }
+    Ok(())
 }
 
 #[derive(Args, Clone)]
@@ -73,33 +125,33 @@ pub(crate) struct SceneArgs {
     #[arg(long, default_value = "robots-many")]
     pub(crate) scene: String,
     /// Animation frame to render.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
     pub(crate) frame: u32,
     /// Frame size WIDTHxHEIGHT (default: the scene's own size).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_size)]
     pub(crate) size: Option<Size>,
     /// Light count, for scenes that take one (stress: 1 to 1000000).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) lights: Option<u32>,
     /// Seed of the scene's random placement.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
     /// Screen tile edge in pixels for grid pipelines (4 to 64).
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256).
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
-    pub(crate) slices: u32,
-    /// Who builds the light grid of grid pipelines (tiled_deferred_single culls inside its
-    /// kernel and ignores this).
-    #[arg(long, value_enum, default_value = "auto")]
-    pub(crate) assign: AssignArg,
-    /// G-buffer channel precision in bits for deferred pipelines.
-    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
-    pub(crate) gbuffer: GBufferFormat,
+    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256) [default: 16].
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) slices: Option<u32>,
+    /// Who builds the light grid of grid pipelines (not tiled_deferred_single, which culls
+    /// inside its kernel) [default: auto].
+    #[arg(long, value_enum)]
+    pub(crate) assign: Option<AssignArg>,
+    /// G-buffer channel precision in bits for deferred pipelines [default: 16].
+    #[arg(long, value_parser = parse_gbuffer)]
+    pub(crate) gbuffer: Option<GBufferFormat>,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
-    /// shaders at first use, inside the first frame's GPU time).
-    #[arg(long, default_value_t = 1)]
+    /// shaders at first use, inside the first frame's GPU time); 0 to 1000.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=MAX_COUNT))]
     pub(crate) warmup: u32,
 }
 
@@ -112,12 +164,23 @@ pub(crate) fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
 }
 
 impl SceneArgs {
-    pub(crate) fn settings(&self) -> RenderSettings {
-        RenderSettings {
+    /// The renderer settings, validated (the message gives each option's range).
+    pub(crate) fn settings(&self) -> Result<RenderSettings> {
+        let settings = RenderSettings {
             tile_size: self.tile,
-            gbuffer: self.gbuffer,
-            slices: self.slices,
-            assign: self.assign.into(),
+            gbuffer: self.gbuffer.unwrap_or_default(),
+            slices: self.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
+            assign: self.assign.unwrap_or(AssignArg::Auto).into(),
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    pub(crate) fn given(&self) -> Given {
+        Given {
+            slices: self.slices.is_some(),
+            gbuffer: self.gbuffer.is_some(),
+            assign: self.assign.is_some(),
         }
     }
 }
@@ -148,8 +211,8 @@ pub(crate) fn format_duration(secs: f64) -> String {
     }
 }
 
-/// A flag set by the first Ctrl-C (long runs stop after the current frame and keep their
-/// results); a second Ctrl-C exits at once.
+/// A flag set by the first Ctrl-C or SIGTERM (long runs stop after the current frame and
+/// write what they measured, marked interrupted); a second one exits at once.
 pub(crate) fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let flag = stop.clone();
@@ -157,9 +220,9 @@ pub(crate) fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::Atomi
         if flag.swap(true, std::sync::atomic::Ordering::SeqCst) {
             std::process::exit(130);
         }
-        eprintln!("\nstopping after the current frame (Ctrl-C again to abort without writing)...");
+        eprintln!("\nstopping after the current frame and writing what was measured (again to abort without writing)...");
     })
-    .context("cannot install the Ctrl-C handler")?;
+    .context("cannot install the Ctrl-C / SIGTERM handler")?;
     Ok(stop)
 }
 
@@ -209,11 +272,19 @@ pub(crate) fn progress_bar() -> impl FnMut(&lightgrid_bench::Progress) {
     }
 }
 
-/// The exit of a long run stopped by Ctrl-C: an error (non-zero status) saying where the
-/// partial results are.
-pub(crate) fn interrupted_run(interrupted: bool, out: &std::path::Path) -> Result<()> {
-    if interrupted {
-        anyhow::bail!("interrupted: partial results written to {}", out.display());
+/// The exit of a long run: an error (non-zero status) when it did not complete, saying how
+/// it ended and where the partial results are.
+pub(crate) fn run_outcome(outcome: &lightgrid_bench::Outcome, out: &std::path::Path) -> Result<()> {
+    if !outcome.is_complete() {
+        anyhow::bail!(
+            "{}\nwhat was measured is in {} (marked {})",
+            outcome.describe(),
+            out.display(),
+            match outcome {
+                lightgrid_bench::Outcome::Failed(_) => "failed",
+                _ => "interrupted",
+            }
+        );
     }
     Ok(())
 }

@@ -1,16 +1,15 @@
 //! `lightgrid bench` and `lightgrid report`: the papers' evaluations and their report.
 
 use crate::args::{
-    format_duration, interrupted_run, parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c,
-    AssignArg, Size,
+    check_applies, format_duration, parse_gbuffer, parse_size, progress_bar, run_outcome,
+    stop_on_ctrl_c, AssignArg, Given, Size, MAX_COUNT,
 };
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
-use lightgrid::image_io::check_writable;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::PIPELINES;
-use lightgrid_bench::{BenchConfig, FrameRange};
+use lightgrid_bench::{check_out_dir, BenchConfig, FrameRange, OutDir};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -37,38 +36,39 @@ pub(crate) struct BenchArgs {
     #[arg(long)]
     pub(crate) frames: Option<String>,
     /// Frame size WIDTHxHEIGHT (default: the scene's own size).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_size)]
     pub(crate) size: Option<Size>,
     /// Screen tile edge in pixels.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) tile: Option<u32>,
-    /// View-depth slices of clustered pipelines.
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
-    pub(crate) slices: u32,
-    /// Who builds the light grid of grid pipelines.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub(crate) assign: AssignArg,
+    /// View-depth slices of clustered pipelines (1 to 256) [default: 16].
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) slices: Option<u32>,
+    /// Who builds the light grid of grid pipelines [default: auto].
+    #[arg(long, value_enum)]
+    pub(crate) assign: Option<AssignArg>,
     /// MSAA sample count. Only 1 is supported until MSAA lands.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) msaa: u32,
     /// G-buffer precisions to measure: 16, 32 or 16,32.
     #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
     pub(crate) gbuffer: Vec<GBufferFormat>,
-    /// Measurements per frame; the median is kept and the spread recorded.
-    #[arg(long)]
+    /// Measurements per frame, 1 to 1000; the median is kept and the spread recorded.
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=MAX_COUNT))]
     pub(crate) repeat: Option<u32>,
-    /// Discarded renders before each pipeline's series.
-    #[arg(long)]
+    /// Discarded renders before each pipeline's series, 0 to 1000 [default: 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(0..=MAX_COUNT))]
     pub(crate) warmup: Option<u32>,
-    /// Light count for scenes that take one.
-    #[arg(long)]
+    /// Light count for scenes that take one (refused when no chosen scene does).
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) lights: Option<u32>,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
-    /// Output directory.
+    /// Output directory (created; files an earlier run wrote there and this one does not are
+    /// removed; two runs into one directory at once are refused).
     #[arg(long, default_value = "bench")]
     pub(crate) out: PathBuf,
 }
@@ -155,8 +155,8 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         frames: FrameRange::parse(a.frames.as_deref().unwrap_or(frames))?,
         size: a.size.map(|Size(w, h)| (w, h)).or(size),
         tile_size: a.tile.unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
-        slices: a.slices,
-        assign: a.assign.into(),
+        slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
+        assign: a.assign.unwrap_or(AssignArg::Auto).into(),
         gbuffers: if a.gbuffer.is_empty() {
             gbuffers
         } else {
@@ -169,16 +169,26 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         heatmap_frame: a.heatmap_frame,
     };
     config.validate()?;
+    let chosen: Vec<_> = config
+        .pipelines
+        .iter()
+        .map(|p| lightgrid::pipelines::find(p))
+        .collect::<Result<_, _>>()?;
+    let given = Given {
+        slices: a.slices.is_some(),
+        gbuffer: !a.gbuffer.is_empty(),
+        assign: a.assign.is_some(),
+    };
+    check_applies(given, &chosen)?;
     Ok(config)
 }
 
 pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
-    check_writable(&a.out.join("results.json")).or_else(|_| {
-        std::fs::create_dir_all(&a.out)
-            .with_context(|| format!("cannot create {}", a.out.display()))
-    })?;
+    check_out_dir(&a.out)?;
     let ctx = GpuContext::new(adapter)?;
     let config = bench_config(a, !ctx.is_software())?;
+    let prepared = lightgrid_bench::prepare(&config)?;
+    let dir = OutDir::claim(&a.out)?;
     let stop = stop_on_ctrl_c()?;
     eprintln!(
         "benchmark on {}: {} scene(s), {} pipeline(s), frames {}..{} every {}, writing to {}",
@@ -192,10 +202,11 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     );
     let start = std::time::Instant::now();
     let mut progress = progress_bar();
-    let mut results = lightgrid_bench::run(&ctx, &config, &stop, &mut progress)?;
+    let mut results = prepared.run(&ctx, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
     let written = lightgrid_bench::write_report(&a.out, &results)?;
+    dir.replace_earlier_files(&written)?;
     let claims = lightgrid_bench::evaluate_claims(&results);
     let held = claims
         .iter()
@@ -212,10 +223,11 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         written.len(),
         a.out.display()
     );
-    interrupted_run(results.interrupted, &a.out)
+    run_outcome(&results.outcome, &a.out)
 }
 
 pub(crate) fn report(a: &ReportArgs) -> Result<()> {
+    let _lock = OutDir::claim(&a.dir)?;
     let results = lightgrid_bench::read_results(&a.dir.join("results.json"))?;
     let written = lightgrid_bench::write_report(&a.dir, &results)?;
     println!(

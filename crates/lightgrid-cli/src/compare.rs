@@ -1,13 +1,16 @@
 //! `lightgrid compare` (and the default job): every pipeline on one frame, each image
 //! compared with the `forward` reference.
 
-use crate::args::{build_scene, SceneArgs, Size};
-use anyhow::{bail, Context, Result};
+use crate::args::{build_scene, run_outcome, stop_on_ctrl_c, SceneArgs, Size};
+use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
-use lightgrid::image_io::{diff, save_png, write_atomic};
+use lightgrid::image_io::{diff, encode_png, write_atomic, DiffSummary};
 use lightgrid::pipelines::{PIPELINES, REFERENCE};
 use lightgrid::Renderer;
+use lightgrid_bench::{check_out_dir, OutDir, Outcome, STOPPED_BY_SIGNAL};
+use serde::Serialize;
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -22,13 +25,60 @@ pub(crate) struct CompareArgs {
 /// Frame of `robots-many` the default job renders: street level, looking down the street.
 pub(crate) const DEFAULT_JOB_FRAME: u32 = 200;
 
+/// One row of the table and of compare.json.
+#[derive(Serialize)]
+struct Row {
+    pipeline: &'static str,
+    /// Why the pipeline produced no image.
+    failed: Option<String>,
+    gpu_ms: Option<f64>,
+    /// Difference from `forward`; null when there is none to compare with (`diff_note`).
+    diff: Option<DiffSummary>,
+    diff_note: Option<String>,
+    lighting_computations: Option<u64>,
+    ideal_lighting_computations: Option<u64>,
+}
+
+/// compare.json: the table, and how the run ended.
+#[derive(Serialize)]
+struct CompareJson<'a> {
+    command: String,
+    adapter: String,
+    scene: &'a str,
+    frame: u32,
+    width: u32,
+    height: u32,
+    outcome: &'a Outcome,
+    rows: &'a [Row],
+    notes: &'a [String],
+}
+
+/// What the difference column says for a pipeline whose image exists.
+fn diff_cell(
+    id: &str,
+    image: &image::RgbaImage,
+    references: &HashMap<&str, image::RgbaImage>,
+    reference_failed: bool,
+) -> Result<(Option<DiffSummary>, Option<String>)> {
+    if id == REFERENCE {
+        return Ok((None, Some("reference".into())));
+    }
+    match references.get(REFERENCE) {
+        Some(r) => Ok((Some(diff(r, image)?.0), None)),
+        None if reference_failed => Ok((None, Some(format!("not computed: {REFERENCE} failed")))),
+        None => Ok((None, Some(format!("not computed: no {REFERENCE} image")))),
+    }
+}
+
 pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
-    std::fs::create_dir_all(&a.out_dir)
-        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+    let settings = a.scene.settings()?;
+    check_out_dir(&a.out_dir)?;
     let scene = build_scene(&a.scene)?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);
-    let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
+    let mut renderer = Renderer::new(&ctx, w, h, settings)?;
+    let dir = OutDir::claim(&a.out_dir)?;
+    let stop = stop_on_ctrl_c()?;
     println!(
         "{} frame {} at {w}x{h}, {} lights, on {}",
         scene.name,
@@ -41,31 +91,48 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         "pipeline", "time ms", "diff mean", "p99", "max", "lighting comp", "x ideal", "lights/tile"
     );
     // Reference images by id; `forward` is rendered first (registry order).
-    let mut references: std::collections::HashMap<&str, image::RgbaImage> = Default::default();
+    let mut references: HashMap<&str, image::RgbaImage> = Default::default();
     let mut notes = Vec::new();
     let mut assigned_by: Option<String> = None;
-    let mut failed = Vec::new();
+    let mut rows: Vec<Row> = Vec::new();
+    let mut written = Vec::new();
+    let mut outcome = Outcome::Complete;
     for p in PIPELINES {
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            outcome = Outcome::Interrupted(STOPPED_BY_SIGNAL.into());
+            break;
+        }
         let warm = (0..a.scene.warmup)
             .try_for_each(|_| renderer.render(&scene, a.scene.frame, p.id).map(drop));
         let out = match warm.and_then(|_| renderer.render(&scene, a.scene.frame, p.id)) {
             Ok(o) => o,
             Err(e) => {
                 println!("{:<24} failed: {e}", p.id);
-                failed.push(p.id);
+                rows.push(Row {
+                    pipeline: p.id,
+                    failed: Some(e.to_string()),
+                    gpu_ms: None,
+                    diff: None,
+                    diff_note: None,
+                    lighting_computations: None,
+                    ideal_lighting_computations: None,
+                });
                 continue;
             }
         };
         let png = a.out_dir.join(format!("{}.png", p.id));
-        save_png(&out.image, &png)?;
-        write_atomic(
-            &a.out_dir.join(format!("{}.json", p.id)),
-            &serde_json::to_vec_pretty(&out.stats)?,
-        )?;
-        let d = match references.get(REFERENCE) {
-            None => None,
-            Some(r) => Some(diff(r, &out.image)?.0),
-        };
+        let stats = a.out_dir.join(format!("{}.json", p.id));
+        for (path, bytes) in [
+            (png.clone(), encode_png(&out.image, &png)?),
+            (stats, serde_json::to_vec_pretty(&out.stats)?),
+        ] {
+            write_atomic(&path, &bytes)?;
+            written.push(path);
+        }
+        let reference_failed = rows
+            .iter()
+            .any(|r| r.pipeline == REFERENCE && r.failed.is_some());
+        let (d, note) = diff_cell(p.id, &out.image, &references, reference_failed)?;
         if p.reference != REFERENCE && p.reference != p.id {
             if let Some(r) = references.get(p.reference) {
                 let own = diff(r, &out.image)?.0;
@@ -85,13 +152,13 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             }
         );
         let s = &out.stats;
-        let (mean, p99, max) = match d {
-            None => ("reference".to_string(), String::new(), String::new()),
-            Some(d) => (
+        let (mean, p99, max) = match (&d, &note) {
+            (Some(d), _) => (
                 format!("{:.3}", d.mean),
                 d.p99.to_string(),
                 d.max.to_string(),
             ),
+            (None, n) => (n.clone().unwrap_or_default(), String::new(), String::new()),
         };
         let comps = s
             .lighting_computations
@@ -113,6 +180,15 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
             p.id, time, mean, p99, max, comps, ratio, per_tile
         );
+        rows.push(Row {
+            pipeline: p.id,
+            failed: None,
+            gpu_ms: Some(s.gpu_ms),
+            diff: d,
+            diff_note: note,
+            lighting_computations: s.lighting_computations,
+            ideal_lighting_computations: Some(s.ideal_lighting_computations),
+        });
         if p.reference == p.id {
             references.insert(p.id, out.image);
         }
@@ -128,9 +204,40 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         a.scene.tile,
         assigned_by.as_deref().unwrap_or("-")
     );
-    println!("images and stats in {}", a.out_dir.display());
-    if !failed.is_empty() {
-        bail!("pipelines failed: {}", failed.join(", "));
+    let failed: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.failed.is_some())
+        .map(|r| r.pipeline)
+        .collect();
+    if outcome.is_complete() && !failed.is_empty() {
+        outcome = Outcome::Failed(format!("pipelines failed: {}", failed.join(", ")));
     }
-    Ok(())
+    let summary = CompareJson {
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        adapter: ctx.adapter_label(),
+        scene: &scene.name,
+        frame: a.scene.frame,
+        width: w,
+        height: h,
+        outcome: &outcome,
+        rows: &rows,
+        notes: &notes,
+    };
+    let path = a.out_dir.join(COMPARE_JSON);
+    write_atomic(&path, &serde_json::to_vec_pretty(&summary)?)?;
+    written.push(path);
+    // Images of pipelines that failed this time must not stay from an earlier run.
+    dir.replace_earlier_files(&written)?;
+    println!(
+        "images and stats in {} ({COMPARE_JSON}: the table)",
+        a.out_dir.display()
+    );
+    match outcome {
+        Outcome::Complete => Ok(()),
+        Outcome::Failed(reason) => bail!("{reason}"),
+        o => run_outcome(&o, &a.out_dir),
+    }
 }
+
+/// The table's file in the output directory.
+pub(crate) const COMPARE_JSON: &str = "compare.json";

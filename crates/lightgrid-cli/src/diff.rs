@@ -1,5 +1,7 @@
 //! `lightgrid diff`: the per-pixel difference of two images.
 
+use crate::args::parse_non_negative;
+use crate::files::{Files, Kind};
 use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::image_io::{diff, load_image, save_png};
@@ -12,18 +14,22 @@ pub(crate) struct DiffArgs {
     /// Print a JSON object {"mean", "p99", "max"} instead of text.
     #[arg(long)]
     pub(crate) json: bool,
-    /// Exit with status 1 when the mean difference is above this.
-    #[arg(long)]
+    /// Exit with status 1 when the mean difference is above this (a number at least 0).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_non_negative)]
     pub(crate) max_mean: Option<f64>,
-    /// Exit with status 1 when the 99th-percentile difference is above this.
-    #[arg(long)]
+    /// Exit with status 1 when the 99th-percentile difference is above this (at least 0).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_non_negative)]
     pub(crate) max_p99: Option<f64>,
-    /// Write a visual diff image (PNG) here.
+    /// Write a visual diff image here (a *.png file; not one of the inputs).
     #[arg(long)]
     pub(crate) diff_image: Option<PathBuf>,
 }
 
 pub(crate) fn diff_cmd(a: &DiffArgs) -> Result<()> {
+    let mut files = Files::default();
+    files.input("A", &a.a)?;
+    files.input("B", &a.b)?;
+    files.output("--diff-image", a.diff_image.as_deref(), Kind::Png)?;
     let img_a = load_image(&a.a)?;
     let img_b = load_image(&a.b)?;
     let (d, vis) = diff(&img_a, &img_b)?;

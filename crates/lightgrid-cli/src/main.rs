@@ -7,15 +7,15 @@ mod args;
 mod bench;
 mod compare;
 mod diff;
+mod files;
 mod list;
 mod memory;
 mod play;
 mod render;
 mod scaling;
 
-use args::{AssignArg, SceneArgs, Size};
+use args::{SceneArgs, Size};
 use clap::{Parser, Subcommand};
-use lightgrid::passes::GBufferFormat;
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -71,9 +71,9 @@ fn main() {
                     lights: None,
                     seed: 1,
                     tile: lightgrid::consts::DEFAULT_TILE_SIZE,
-                    slices: lightgrid::consts::DEFAULT_SLICES,
-                    assign: AssignArg::Auto,
-                    gbuffer: GBufferFormat::F16,
+                    slices: None,
+                    assign: None,
+                    gbuffer: None,
                     warmup: 1,
                 },
                 out_dir: PathBuf::from("out"),

@@ -10,7 +10,7 @@ use lightgrid::RenderSettings;
 #[derive(Args)]
 pub(crate) struct MemoryArgs {
     /// Frame size WIDTHxHEIGHT.
-    #[arg(long, value_parser = parse_size, default_value = "1920x1080")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_size, default_value = "1920x1080")]
     pub(crate) size: Size,
     /// G-buffer channel precision in bits for deferred pipelines.
     #[arg(long, default_value = "16", value_parser = parse_gbuffer)]

@@ -2,11 +2,15 @@
 //! queue submission per frame, frames in flight, no analysis), with frames per second and
 //! the frame-time distribution (`lightgrid::realtime`).
 
-use crate::args::{parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size};
-use anyhow::{bail, Context, Result};
+use crate::args::{
+    check_applies, parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Given, Size,
+    MAX_COUNT,
+};
+use crate::files::{Files, Kind};
+use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
-use lightgrid::image_io::{check_writable, write_atomic};
+use lightgrid::image_io::write_atomic;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{self, REFERENCE};
 use lightgrid::realtime::{play as play_frames, Distribution, PlayPlan, PlayRun};
@@ -24,39 +28,39 @@ pub(crate) struct PlayArgs {
     /// Pipeline id (see `lightgrid list`).
     #[arg(long, default_value = REFERENCE)]
     pub(crate) pipeline: String,
-    /// Who builds the light grid of grid pipelines.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub(crate) assign: AssignArg,
+    /// Who builds the light grid of grid pipelines [default: auto].
+    #[arg(long, value_enum)]
+    pub(crate) assign: Option<AssignArg>,
     /// Animation frames A..B (inclusive; A..B:STEP or N also work). Default: the whole
     /// animation.
     #[arg(long)]
     pub(crate) frames: Option<String>,
     /// Frame size WIDTHxHEIGHT (default: the scene's own size).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_size)]
     pub(crate) size: Option<Size>,
-    /// Passes over the frames.
-    #[arg(long, default_value_t = 1)]
+    /// Passes over the frames, 1 to 1000.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_COUNT))]
     pub(crate) loops: u32,
-    /// Frames rendered first and not measured (shader compilation, list growth).
-    #[arg(long, default_value_t = 3)]
+    /// Frames rendered first and not measured (shader compilation, list growth), 0 to 1000.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=MAX_COUNT))]
     pub(crate) warmup: u32,
     /// Write the results as JSON here.
     #[arg(long)]
     pub(crate) json: Option<PathBuf>,
     /// Screen tile edge in pixels for grid pipelines (4 to 64).
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (1 to 256).
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
-    pub(crate) slices: u32,
-    /// G-buffer channel precision in bits for deferred pipelines.
-    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
-    pub(crate) gbuffer: GBufferFormat,
+    /// View-depth slices of clustered pipelines (1 to 256) [default: 16].
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) slices: Option<u32>,
+    /// G-buffer channel precision in bits for deferred pipelines [default: 16].
+    #[arg(long, value_parser = parse_gbuffer)]
+    pub(crate) gbuffer: Option<GBufferFormat>,
     /// Light count, for scenes that take one (stress: 1 to 1000000).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub(crate) lights: Option<u32>,
     /// Seed of the scene's random placement.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
 }
 
@@ -97,23 +101,27 @@ struct PlayJson<'a> {
 
 pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
-    if let Some(path) = &a.json {
-        check_writable(path).context("--json is not writable")?;
-    }
-    if a.loops == 0 {
-        bail!("--loops must be at least 1");
-    }
-    let variable = catalog::find(&a.scene)?.variable_lights;
+    let given = Given {
+        slices: a.slices.is_some(),
+        gbuffer: a.gbuffer.is_some(),
+        assign: a.assign.is_some(),
+    };
+    check_applies(given, &[info])?;
+    let settings = RenderSettings {
+        tile_size: a.tile,
+        gbuffer: a.gbuffer.unwrap_or_default(),
+        slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
+        assign: a.assign.unwrap_or(AssignArg::Auto).into(),
+    };
+    settings.validate()?;
+    Files::default().output("--json", a.json.as_deref(), Kind::Data)?;
     let scene = catalog::build(
         &a.scene,
         &SceneParams {
             seed: a.seed,
-            lights: if variable { a.lights } else { None },
+            lights: a.lights,
         },
     )?;
-    if a.lights.is_some() && !variable {
-        bail!("--lights: {} has a fixed light count", a.scene);
-    }
     let range = match &a.frames {
         Some(s) => FrameRange::parse(s)?,
         None => FrameRange {
@@ -134,12 +142,6 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     let frames = range.frames(scene.frame_count());
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.size, &scene);
-    let settings = RenderSettings {
-        tile_size: a.tile,
-        gbuffer: a.gbuffer,
-        slices: a.slices,
-        assign: a.assign.into(),
-    };
     let mut renderer = Renderer::new(&ctx, w, h, settings)?;
     let assign = info.assign.then(|| {
         settings

@@ -1,11 +1,12 @@
 //! `lightgrid render`: one frame of a scene with one pipeline (an analysis run: image,
 //! statistics, heatmap).
 
-use crate::args::{build_scene, timing_label, SceneArgs, Size};
-use anyhow::{Context, Result};
+use crate::args::{build_scene, check_applies, timing_label, SceneArgs, Size};
+use crate::files::{Files, Kind};
+use anyhow::Result;
 use clap::Args;
 use lightgrid::gpu::GpuContext;
-use lightgrid::image_io::{check_writable, save_png, write_atomic};
+use lightgrid::image_io::{encode_png, write_atomic};
 use lightgrid::pipelines::{self, REFERENCE};
 use lightgrid::Renderer;
 use std::path::PathBuf;
@@ -17,40 +18,48 @@ pub(crate) struct RenderArgs {
     /// Pipeline id (see `lightgrid list`).
     #[arg(long, default_value = REFERENCE)]
     pub(crate) pipeline: String,
-    /// Image to write (PNG).
+    /// Image to write (a *.png file).
     #[arg(long)]
     pub(crate) out: Option<PathBuf>,
     /// Statistics to write (JSON).
     #[arg(long)]
     pub(crate) stats: Option<PathBuf>,
-    /// Lights-per-tile heatmap to write (PNG): the pipeline's own grid, or for pipelines
+    /// Lights-per-tile heatmap to write (a *.png file): the pipeline's own grid, or for pipelines
     /// without a CPU grid the depth-bounded grid used for the ideal count.
     #[arg(long)]
     pub(crate) heatmap: Option<PathBuf>,
 }
 
 pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
-    pipelines::find(&a.pipeline)?;
-    for path in a.out.iter().chain(a.stats.iter()).chain(a.heatmap.iter()) {
-        check_writable(path).context("output is not writable")?;
-    }
+    let info = pipelines::find(&a.pipeline)?;
+    check_applies(a.scene.given(), &[info])?;
+    let settings = a.scene.settings()?;
+    let mut files = Files::default();
+    files.output("--out", a.out.as_deref(), Kind::Png)?;
+    files.output("--stats", a.stats.as_deref(), Kind::Data)?;
+    files.output("--heatmap", a.heatmap.as_deref(), Kind::Png)?;
     let scene = build_scene(&a.scene)?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);
-    let mut renderer = Renderer::new(&ctx, w, h, a.scene.settings())?;
+    let mut renderer = Renderer::new(&ctx, w, h, settings)?;
     for _ in 0..a.scene.warmup {
         renderer.render(&scene, a.scene.frame, &a.pipeline)?;
     }
     let out = renderer.render(&scene, a.scene.frame, &a.pipeline)?;
+    // Every output is made before any is written, so a failure leaves all of them untouched.
+    let mut writes: Vec<(&PathBuf, Vec<u8>)> = Vec::new();
     if let Some(path) = &a.out {
-        save_png(&out.image, path)?;
+        writes.push((path, encode_png(&out.image, path)?));
     }
     if let Some(path) = &a.heatmap {
-        save_png(&lightgrid::heatmap::heatmap(&out.image, &out.grid), path)?;
+        let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
+        writes.push((path, encode_png(&map, path)?));
     }
     if let Some(path) = &a.stats {
-        let json = serde_json::to_vec_pretty(&out.stats)?;
-        write_atomic(path, &json)?;
+        writes.push((path, serde_json::to_vec_pretty(&out.stats)?));
+    }
+    for (path, bytes) in writes {
+        write_atomic(path, &bytes)?;
     }
     let s = &out.stats;
     println!(

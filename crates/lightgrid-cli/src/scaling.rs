@@ -1,12 +1,13 @@
 //! `lightgrid scaling`: light-assignment strategies against the light count.
 
 use crate::args::{
-    format_duration, interrupted_run, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Size,
+    check_applies, format_duration, parse_non_negative, parse_size, progress_bar, run_outcome,
+    stop_on_ctrl_c, AssignArg, Given, Size, MAX_COUNT,
 };
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use lightgrid::gpu::GpuContext;
-use lightgrid::image_io::check_writable;
+use lightgrid_bench::{check_out_dir, OutDir};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -33,35 +34,40 @@ pub(crate) struct ScalingArgs {
     #[arg(long, default_value = "stress")]
     pub(crate) scene: String,
     /// Frame size WIDTHxHEIGHT.
-    #[arg(long, default_value = "640x360", value_parser = parse_size)]
+    #[arg(long, allow_hyphen_values = true, default_value = "640x360", value_parser = parse_size)]
     pub(crate) size: Size,
     /// Screen tile edge in pixels.
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines.
-    #[arg(long, default_value_t = lightgrid::consts::DEFAULT_SLICES)]
-    pub(crate) slices: u32,
-    #[arg(long, default_value_t = 1)]
+    /// View-depth slices of clustered pipelines (1 to 256) [default: 16].
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) slices: Option<u32>,
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
-    /// Measured renders per point (the median assignment time is kept).
-    #[arg(long, default_value_t = 1)]
+    /// Measured renders per point, 1 to 1000 (the median assignment time is kept).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_COUNT))]
     pub(crate) runs: u32,
-    /// Discarded renders before each point (shader compilation, buffer growth).
-    #[arg(long, default_value_t = 1)]
+    /// Discarded renders before each point (shader compilation, buffer growth), 0 to 1000.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=MAX_COUNT))]
     pub(crate) warmup: u32,
-    /// A strategy whose assignment takes longer than this many seconds is not run at larger
-    /// light counts.
-    #[arg(long = "budget", default_value_t = 5.0)]
+    /// A strategy whose assignment takes longer than this many seconds (more than 0) is not
+    /// run at larger light counts.
+    #[arg(long = "budget", allow_hyphen_values = true, default_value_t = 5.0, value_parser = parse_non_negative)]
     pub(crate) budget_s: f64,
-    /// Output directory.
+    /// Output directory (created; files an earlier run wrote there and this one does not are
+    /// removed; two runs into one directory at once are refused).
     #[arg(long, default_value = "scaling")]
     pub(crate) out: PathBuf,
 }
 
 pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
-    std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("cannot create {}", a.out.display()))?;
-    check_writable(&a.out.join("scaling.json"))?;
+    check_out_dir(&a.out)?;
+    let info = lightgrid::pipelines::find(&a.pipeline)?;
+    let given = Given {
+        slices: a.slices.is_some(),
+        ..Given::default()
+    };
+    check_applies(given, &[info])?;
     let config = lightgrid_bench::ScalingConfig {
         scene: a.scene.clone(),
         pipeline: a.pipeline.clone(),
@@ -69,7 +75,7 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
         strategies: a.assign.iter().map(|&s| s.into()).collect(),
         size: (a.size.0, a.size.1),
         tile_size: a.tile,
-        slices: a.slices,
+        slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
         seed: a.seed,
         runs: a.runs,
         warmup: a.warmup,
@@ -77,6 +83,7 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     };
     config.validate()?;
     let ctx = GpuContext::new(adapter)?;
+    let dir = OutDir::claim(&a.out)?;
     let stop = stop_on_ctrl_c()?;
     eprintln!(
         "light assignment scaling on {}: {} at {}x{}, {} light counts x {} strategies, writing to {}",
@@ -93,7 +100,8 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     let mut results = lightgrid_bench::run_scaling(&ctx, &config, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
-    lightgrid_bench::write_scaling(&results, &a.out)?;
+    let written = lightgrid_bench::write_scaling(&results, &a.out)?;
+    dir.replace_earlier_files(&written)?;
     println!("{}", lightgrid_bench::scaling_table(&results));
     println!("{}", lightgrid_bench::scaling_growth(&results));
     println!(
@@ -103,5 +111,5 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
         lightgrid_bench::SCALING_FILES.join(", "),
         a.out.display()
     );
-    interrupted_run(results.interrupted, &a.out)
+    run_outcome(&results.outcome, &a.out)
 }

@@ -135,17 +135,13 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => std::path::PathBuf::from("."),
     };
-    let name = target.file_name().ok_or_else(|| {
-        Error::invalid(
+    if target.file_name().is_none() {
+        return Err(Error::invalid(
             "output path",
             format!("{} has no file name", path.display()),
-        )
-    })?;
-    let tmp = dir.join(format!(
-        ".{}.tmp{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+        ));
+    }
+    let tmp = dir.join(sibling_name("tmp"));
     std::fs::write(&tmp, bytes).map_err(io)?;
     std::fs::rename(&tmp, &target).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
@@ -153,8 +149,37 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     })
 }
 
-/// Encode as PNG and write atomically.
-pub fn save_png(img: &RgbaImage, path: &Path) -> Result<()> {
+/// A temporary file name beside an output, short whatever the output's name (a name of 255
+/// bytes is valid, and `.NAME.tmp` beside it would not be) and unique within this process.
+fn sibling_name(kind: &str) -> String {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    format!(".lightgrid-{}-{n}.{kind}", std::process::id())
+}
+
+/// Refuse an image output whose name does not end in `.png` (any case): PNG bytes under a
+/// `.jpg` name would be read as something they are not.
+pub fn check_png_name(path: &Path) -> Result<()> {
+    let png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if png {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "output path",
+            format!(
+                "{}: images are written as PNG; name the file *.png",
+                path.display()
+            ),
+        ))
+    }
+}
+
+/// The PNG bytes of `img`, to be written to `path` (whose name must end in `.png`,
+/// [`check_png_name`]).
+pub fn encode_png(img: &RgbaImage, path: &Path) -> Result<Vec<u8>> {
+    check_png_name(path)?;
     let mut bytes = Vec::new();
     img.write_to(
         &mut std::io::Cursor::new(&mut bytes),
@@ -164,25 +189,40 @@ pub fn save_png(img: &RgbaImage, path: &Path) -> Result<()> {
         path: path.display().to_string(),
         reason: e.to_string(),
     })?;
-    write_atomic(path, &bytes)
+    Ok(bytes)
+}
+
+/// Encode as PNG and write atomically ([`encode_png`], [`write_atomic`]).
+pub fn save_png(img: &RgbaImage, path: &Path) -> Result<()> {
+    write_atomic(path, &encode_png(img, path)?)
 }
 
 /// Fail early (before rendering) when `path` cannot be written: its directory must exist and
 /// accept a new file, and the path must not be a directory or another non-regular file.
 pub fn check_writable(path: &Path) -> Result<()> {
     let target = output_target(path)?;
-    let probe = target.with_file_name(format!(
-        ".{}.probe{}",
-        target
-            .file_name()
-            .map(|n| n.to_string_lossy())
-            .unwrap_or_default(),
-        std::process::id()
-    ));
+    let probe = target.with_file_name(sibling_name("probe"));
     std::fs::write(&probe, b"").map_err(|cause| Error::Io {
         path: path.display().to_string(),
         cause,
     })?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
+}
+
+/// What a path names, for telling whether two arguments name the same file: the canonical path
+/// of an existing file (symlinks followed), else its canonical directory joined with its name.
+/// Paths whose directory does not exist are returned as given (they fail the writability check).
+pub fn file_identity(path: &Path) -> std::path::PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match (std::fs::canonicalize(dir), path.file_name()) {
+        (Ok(d), Some(name)) => d.join(name),
+        _ => path.to_path_buf(),
+    }
 }

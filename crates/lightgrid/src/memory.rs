@@ -50,7 +50,9 @@ impl MemoryModel {
     }
 
     pub fn target_bytes(&self, width: u32, height: u32) -> u64 {
-        u64::from(self.bytes_per_pixel()) * u64::from(width) * u64::from(height)
+        u64::from(self.bytes_per_pixel())
+            .saturating_mul(u64::from(width))
+            .saturating_mul(u64::from(height))
     }
 }
 

@@ -154,7 +154,6 @@ impl<'c> Renderer<'c> {
         settings.validate()?;
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
-        let on_gl = ctx.info.backend == wgpu::Backend::Gl;
         let created = scoped(device, "creating render targets", || {
             let targets = Targets::new(device, width, height);
             let scene_layout = scene_layout(device);
@@ -202,11 +201,11 @@ impl<'c> Renderer<'c> {
             }
         });
         created.map_err(|e| match e {
-            Error::Gpu { stage, message } if on_gl => Error::Gpu {
+            Error::Gpu { stage, message } if message.contains("out of memory") => Error::Gpu {
                 stage,
                 message: format!(
-                    "{message}\nThe GL backend (llvmpipe GL) lacks features lightgrid's render targets need; \
-                     use a Vulkan adapter (`sudo apt-get install -y mesa-vulkan-drivers libvulkan1`, then --adapter vulkan)"
+                    "out of memory: the shared render targets of {width}x{height} alone need {} MiB",
+                    (Targets::bytes_per_pixel() * u64::from(width) * u64::from(height)) >> 20
                 ),
             },
             e => e,

@@ -79,6 +79,15 @@ pub struct Targets {
 }
 
 impl Targets {
+    /// Bytes per pixel of the shared targets (HDR colour, depth, lighting counts, LDR); a
+    /// pipeline's own (G-buffers) come on top.
+    pub fn bytes_per_pixel() -> u64 {
+        [HDR_FORMAT, DEPTH_FORMAT, COUNT_FORMAT, LDR_FORMAT]
+            .iter()
+            .map(|f| u64::from(f.block_copy_size(None).unwrap_or(4)))
+            .sum()
+    }
+
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let make =
             |label, format, usage| render_texture(device, label, format, (width, height), usage);

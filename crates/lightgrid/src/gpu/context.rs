@@ -1,8 +1,12 @@
 //! Headless adapter and device selection.
 //!
-//! Order of preference: discrete GPU, integrated, virtual, then software adapters with
-//! Vulkan (Mesa lavapipe) before GL (llvmpipe), which cannot run every pipeline correctly
-//! (see ECOSYSTEM.md). `--adapter` overrides the choice by index, name or backend.
+//! Order of preference: discrete GPU, integrated, virtual, then software adapters (Mesa
+//! lavapipe). `--adapter` overrides the choice by index, name or backend.
+//!
+//! GL adapters are not offered: the lighting-count target needs R32Float blending, which GL
+//! (llvmpipe GL, and WebGL-class drivers) only has as a downlevel exception wgpu does not
+//! enable, and forward shaders write storage buffers from fragment shaders; every GL render
+//! failed at target creation. Vulkan, Metal and DX12 are used ([`BACKENDS`]).
 
 use crate::error::{Error, Result};
 
@@ -28,8 +32,13 @@ pub struct AdapterSummary {
     pub driver: String,
 }
 
-const NO_ADAPTER_HELP: &str = "no GPU adapter found. lightgrid needs a Vulkan, Metal, DX12 or GL \
-adapter; on a machine without a GPU install Mesa's software Vulkan driver: \
+/// The backends lightgrid renders with (not GL: see the module docs).
+pub const BACKENDS: wgpu::Backends = wgpu::Backends::VULKAN
+    .union(wgpu::Backends::METAL)
+    .union(wgpu::Backends::DX12);
+
+const NO_ADAPTER_HELP: &str = "no GPU adapter found. lightgrid needs a Vulkan, Metal or DX12 \
+adapter (GL cannot run its render targets); on a machine without a GPU install Mesa's software Vulkan driver: \
 `sudo apt-get install -y mesa-vulkan-drivers libvulkan1` (Debian/Ubuntu)";
 
 fn instance() -> wgpu::Instance {
@@ -37,22 +46,17 @@ fn instance() -> wgpu::Instance {
 }
 
 fn rank(info: &wgpu::AdapterInfo) -> u32 {
-    let ty = match info.device_type {
+    match info.device_type {
         wgpu::DeviceType::DiscreteGpu => 0,
         wgpu::DeviceType::IntegratedGpu => 1,
         wgpu::DeviceType::VirtualGpu => 2,
         wgpu::DeviceType::Cpu => 3,
         wgpu::DeviceType::Other => 4,
-    };
-    let backend = match info.backend {
-        wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
-        _ => 1,
-    };
-    ty * 2 + backend
+    }
 }
 
 fn sorted_adapters(instance: &wgpu::Instance) -> Vec<wgpu::Adapter> {
-    let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    let mut adapters = pollster::block_on(instance.enumerate_adapters(BACKENDS));
     adapters.sort_by_key(|a| rank(&a.get_info()));
     adapters
 }
@@ -98,6 +102,16 @@ impl GpuContext {
         }
         let adapter = match wanted {
             None => adapters.into_iter().next(),
+            Some(w) if w.trim().is_empty() => {
+                return Err(Error::NoAdapter(
+                    "--adapter is empty; give an index from `lightgrid list`, a backend (vulkan) or part of an adapter's name".into(),
+                ))
+            }
+            Some(w) if w.trim().eq_ignore_ascii_case("gl") || w.trim().eq_ignore_ascii_case("opengl") => {
+                return Err(Error::NoAdapter(
+                    "GL adapters are not supported: lightgrid's lighting-count target needs R32Float blending and forward shaders write storage buffers, which the GL backend lacks; use Vulkan (on a machine without a GPU: `sudo apt-get install -y mesa-vulkan-drivers libvulkan1`)".into(),
+                ))
+            }
             Some(w) => {
                 let names: Vec<String> = adapters
                     .iter()

@@ -18,12 +18,17 @@ pub fn scoped<T>(device: &wgpu::Device, stage: &str, f: impl FnOnce() -> T) -> R
     let value = f();
     let v = pollster::block_on(validation.pop());
     let o = pollster::block_on(oom.pop());
-    match v.or(o) {
-        Some(e) => Err(Error::Gpu {
+    // An allocation that fails can also fail validation after it; the cause is memory.
+    match (o, v) {
+        (Some(_), _) => Err(Error::Gpu {
+            stage: stage.to_string(),
+            message: "out of memory".into(),
+        }),
+        (None, Some(e)) => Err(Error::Gpu {
             stage: stage.to_string(),
             message: e.to_string(),
         }),
-        None => Ok(value),
+        (None, None) => Ok(value),
     }
 }
 

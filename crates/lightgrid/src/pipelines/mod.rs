@@ -14,6 +14,7 @@ use crate::memory::MemoryModel;
 use crate::shader::ComposedShader;
 
 pub use crate::culling::Assign;
+use crate::frame::GBufferFormat;
 pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings};
 
 /// What a pipeline needs to create its GPU objects.
@@ -66,6 +67,8 @@ pub struct PipelineInfo {
     pub uses_grid: bool,
     /// Builds its grid with the strategy `--assign` names (a `GridBuilder`).
     pub assign: bool,
+    /// Its grid is clustered: `--slices` view-depth slices per tile.
+    pub clustered: bool,
     /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
     /// same approximations (e.g. `forward_mono`).
     pub reference: &'static str,
@@ -76,6 +79,19 @@ pub struct PipelineInfo {
     pub memory: fn(&RenderSettings) -> MemoryModel,
 }
 
+impl PipelineInfo {
+    /// Whether the pipeline has a G-buffer (its memory depends on `--gbuffer`).
+    pub fn uses_gbuffer(&self) -> bool {
+        let with = |gbuffer| {
+            (self.memory)(&RenderSettings {
+                gbuffer,
+                ..Default::default()
+            })
+        };
+        with(GBufferFormat::F16) != with(GBufferFormat::F32)
+    }
+}
+
 /// The registry, reference first.
 pub const PIPELINES: &[PipelineInfo] = &[
     PipelineInfo {
@@ -84,6 +100,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "all (brute force)",
         uses_grid: false,
         assign: false,
+        clustered: false,
         reference: "forward",
         shaders: forward::shaders,
         create: forward::create,
@@ -95,6 +112,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
         assign: false,
+        clustered: false,
         reference: "forward_mono",
         shaders: forward::shaders,
         create: forward::create_mono,
@@ -106,6 +124,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §3",
         uses_grid: true,
         assign: true,
+        clustered: false,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
@@ -117,6 +136,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
         assign: true,
+        clustered: false,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
@@ -128,6 +148,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
         assign: true,
+        clustered: false,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
@@ -139,6 +160,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §7",
         uses_grid: true,
         assign: false,
+        clustered: false,
         reference: "forward",
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
@@ -150,6 +172,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
         assign: true,
+        clustered: true,
         reference: "forward",
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_clustered,
@@ -161,6 +184,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
         assign: true,
+        clustered: true,
         reference: "forward",
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_clustered,
@@ -172,6 +196,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §1.1, §8 (Deferred)",
         uses_grid: false,
         assign: false,
+        clustered: false,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_plain,
@@ -183,6 +208,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §8 (Deferred-Stencil)",
         uses_grid: false,
         assign: false,
+        clustered: false,
         reference: "forward",
         shaders: deferred::shaders,
         create: deferred::create_stencil,
@@ -194,6 +220,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting",
         uses_grid: false,
         assign: false,
+        clustered: false,
         reference: "forward",
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
@@ -205,6 +232,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
         assign: false,
+        clustered: false,
         reference: "forward_mono",
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,

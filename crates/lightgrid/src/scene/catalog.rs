@@ -116,33 +116,34 @@ pub fn find(name: &str) -> Result<&'static SceneInfo> {
         })
 }
 
-/// Build a catalog scene by name.
-pub fn build(name: &str, params: &SceneParams) -> Result<Scene> {
+/// Check a scene's parameters without building it: `--lights` only for scenes that take a
+/// light count, and within 1 to [`STRESS_MAX_LIGHTS`].
+pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneInfo> {
     let info = find(name)?;
     match params.lights {
-        Some(_) if !info.variable_lights => {
-            return Err(Error::invalid(
-                "--lights",
-                format!(
-                    "scene {name} has a fixed light count; --lights applies to: {}",
-                    SCENES
-                        .iter()
-                        .filter(|s| s.variable_lights)
-                        .map(|s| s.name)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            ))
-        }
-        Some(0) => return Err(Error::invalid("--lights", "must be at least 1")),
-        Some(n) if n > STRESS_MAX_LIGHTS => {
-            return Err(Error::invalid(
-                "--lights",
-                format!("{n} is above the maximum of {STRESS_MAX_LIGHTS}"),
-            ))
-        }
-        _ => {}
+        Some(_) if !info.variable_lights => Err(Error::invalid(
+            "--lights",
+            format!(
+                "scene {name} has a fixed light count; --lights applies to: {}",
+                SCENES
+                    .iter()
+                    .filter(|s| s.variable_lights)
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+        Some(n) if n == 0 || n > STRESS_MAX_LIGHTS => Err(Error::invalid(
+            "--lights",
+            format!("{n} is out of range 1 to {STRESS_MAX_LIGHTS}"),
+        )),
+        _ => Ok(info),
     }
+}
+
+/// Build a catalog scene by name.
+pub fn build(name: &str, params: &SceneParams) -> Result<Scene> {
+    let info = check_params(name, params)?;
     let scene = (info.build)(params);
     scene.validate()?;
     Ok(scene)

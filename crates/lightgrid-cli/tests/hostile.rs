@@ -1,0 +1,643 @@
+//! Hostile and careless input, one test per class (README "What bad input gets"): outputs
+//! that would destroy something, long runs that end badly, options out of range or beside
+//! the point. Each test checks what happens to the files as well as the exit status.
+
+mod support;
+
+use std::path::Path;
+use support::{assert_fails_with, lightgrid, stderr, temp_dir};
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())))
+        .unwrap()
+}
+
+/// A tiny, fast render command (robots-few at 16x8).
+fn render(extra: &[&str]) -> Vec<String> {
+    let mut v: Vec<String> = [
+        "render",
+        "--scene",
+        "robots-few",
+        "--size",
+        "16x8",
+        "--warmup",
+        "0",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    v.extend(extra.iter().map(|s| s.to_string()));
+    v
+}
+
+fn run(args: &[String]) -> std::process::Output {
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    lightgrid(&refs)
+}
+
+fn fails_with(args: &[String], needle: &str) {
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_fails_with(&refs, needle);
+}
+
+#[test]
+fn two_outputs_naming_one_file_are_refused_and_nothing_is_written() {
+    let dir = temp_dir("same-file");
+    let a = dir.join("a.png");
+    std::fs::write(&a, b"earlier").unwrap();
+    fails_with(&render(&["--out", s(&a), "--stats", s(&a)]), "both name");
+    // The same file under another spelling, and through a symlink.
+    let other = format!("{}/./a.png", s(&dir));
+    fails_with(&render(&["--out", s(&a), "--heatmap", &other]), "both name");
+    let link = dir.join("link.png");
+    std::os::unix::fs::symlink(&a, &link).unwrap();
+    fails_with(
+        &render(&["--out", s(&a), "--heatmap", s(&link)]),
+        "both name",
+    );
+    assert_eq!(std::fs::read(&a).unwrap(), b"earlier");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn diff_never_writes_over_its_inputs() {
+    let dir = temp_dir("diff-input");
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([9, 9, 9, 255]))
+        .save(&a)
+        .unwrap();
+    std::fs::copy(&a, &b).unwrap();
+    let before = std::fs::read(&a).unwrap();
+    for target in [&a, &b] {
+        assert_fails_with(
+            &["diff", s(&a), s(&b), "--diff-image", s(target)],
+            "an output cannot replace an input",
+        );
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), before);
+    // Comparing a file with itself is fine.
+    let o = lightgrid(&["diff", s(&a), s(&a), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn image_outputs_must_be_named_png() {
+    let dir = temp_dir("ext");
+    for flag in ["--out", "--heatmap"] {
+        for name in ["x.jpg", "x", "x.png.tmp"] {
+            let p = dir.join(name);
+            fails_with(
+                &render(&["--pipeline", "tiled_deferred", flag, s(&p)]),
+                "name the file *.png",
+            );
+            assert!(!p.exists(), "{name} was written");
+        }
+    }
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    image::RgbaImage::new(2, 2).save(&a).unwrap();
+    std::fs::copy(&a, &b).unwrap();
+    assert_fails_with(
+        &["diff", s(&a), s(&b), "--diff-image", s(&dir.join("d.jpg"))],
+        "*.png",
+    );
+    // Upper-case extensions are PNG too, and diff reads what render writes.
+    let up = dir.join("UP.PNG");
+    let o = run(&render(&["--out", s(&up)]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = lightgrid(&["diff", s(&up), s(&up)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 3, "a, b, UP");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_long_valid_file_name_is_written() {
+    let dir = temp_dir("long-name");
+    // 255 bytes: the longest name the file system takes; probes and temporary files beside
+    // it must not be longer.
+    let name = format!("{}.png", "n".repeat(251));
+    assert_eq!(name.len(), 255);
+    let p = dir.join(&name);
+    let o = run(&render(&["--out", s(&p)]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(image::open(&p).unwrap().width(), 16);
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, vec![name], "no probe or temporary file left");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn outputs_that_are_not_regular_files_are_refused_from_the_cli() {
+    let dir = temp_dir("fifo");
+    let fifo = dir.join("f.json");
+    let ok = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "mkfifo");
+    // Without the check this would block forever opening the FIFO, or replace it.
+    fails_with(&render(&["--stats", s(&fifo)]), "not a regular file");
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    fails_with(&render(&["--stats", s(&dir)]), "is a directory");
+    fails_with(&render(&["--stats", "/dev/null"]), "not a regular file");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+use std::os::unix::fs::FileTypeExt;
+use std::process::Command;
+
+#[test]
+fn io_errors_name_the_path_and_say_the_cause_once() {
+    let o = run(&render(&["--out", "/nonexistent/dir/x.png"]));
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(err.contains("/nonexistent/dir/x.png"), "{err}");
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+}
+
+#[test]
+fn a_failing_command_creates_no_directory_and_changes_no_file() {
+    let dir = temp_dir("no-trace");
+    let out = dir.join("out");
+    // Refused after parsing, before anything is created: a bad pipeline, a bad frame range,
+    // an option that applies to nothing chosen, a scene that takes no light count.
+    let cases: Vec<Vec<String>> = vec![
+        vec!["bench".into(), "--pipelines".into(), "nope".into()],
+        vec!["bench".into(), "--frames".into(), "9..3".into()],
+        vec!["bench".into(), "--lights".into(), "5".into()],
+        vec!["scaling".into(), "--pipeline".into(), "deferred".into()],
+        vec!["scaling".into(), "--lights".into(), "0".into()],
+        vec!["compare".into(), "--scene".into(), "nope".into()],
+        vec!["compare".into(), "--tile".into(), "3".into()],
+    ];
+    for mut case in cases {
+        case.push(
+            if case[0] == "compare" {
+                "--out-dir"
+            } else {
+                "--out"
+            }
+            .into(),
+        );
+        case.push(s(&out).into());
+        let o = run(&case);
+        assert!(!o.status.success(), "{case:?}");
+        assert!(!out.exists(), "{case:?} created {}", out.display());
+    }
+    // A render whose heatmap name is refused leaves the image it would also have written.
+    let png = dir.join("x.png");
+    std::fs::write(&png, b"earlier").unwrap();
+    fails_with(
+        &render(&["--out", s(&png), "--heatmap", s(&dir.join("h.jpg"))]),
+        "*.png",
+    );
+    assert_eq!(std::fs::read(&png).unwrap(), b"earlier");
+    // An output directory that is a file is refused, and the file is left alone.
+    let file = dir.join("file");
+    std::fs::write(&file, b"mine").unwrap();
+    assert_fails_with(&["bench", "--out", s(&file)], "is a file, not a directory");
+    assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_bench_failing_part_way_keeps_what_it_measured() {
+    let dir = temp_dir("bench-fail");
+    // forward loops over all 70,000 lights per fragment: lavapipe cuts such loops short,
+    // which lightgrid refuses, after tiled_deferred was measured.
+    let o = lightgrid(&[
+        "bench",
+        "--scene",
+        "stress",
+        "--lights",
+        "70000",
+        "--pipelines",
+        "tiled_deferred,forward",
+        "--size",
+        "32x18",
+        "--frames",
+        "0",
+        "--out",
+        s(&dir),
+    ]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("failed: stress / forward") && !err.contains("panicked"),
+        "{err}"
+    );
+    let v = json(&dir.join("results.json"));
+    assert_eq!(v["outcome"]["status"], "failed", "{}", v["outcome"]);
+    assert!(v["outcome"]["reason"].as_str().unwrap().contains("forward"));
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 1);
+    assert_eq!(runs[0]["pipeline"], "tiled_deferred");
+    assert_eq!(runs[0]["complete"], true);
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert!(summary.contains("**failed: stress / forward"), "{summary}");
+    assert!(
+        !dir.join(lightgrid_bench::LOCK_FILE).exists(),
+        "lock released"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scaling_records_a_failing_point_and_goes_on() {
+    let dir = temp_dir("scaling-fail");
+    // One 64-px tile at 300,000 lights: a cluster's list is longer than lavapipe's loops go.
+    let o = lightgrid(&[
+        "scaling",
+        "--lights",
+        "1000,300000",
+        "--assign",
+        "cpu",
+        "--size",
+        "64x64",
+        "--tile",
+        "64",
+        "--warmup",
+        "0",
+        "--out",
+        s(&dir),
+    ]);
+    assert!(!o.status.success());
+    let v = json(&dir.join("scaling.json"));
+    assert_eq!(v["outcome"]["status"], "failed");
+    let points = v["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2);
+    assert!(
+        points[0]["assign_ms"].as_f64().unwrap() > 0.0,
+        "1000 lights measured"
+    );
+    assert!(points[0]["failed"].is_null());
+    assert!(
+        points[1]["failed"]
+            .as_str()
+            .unwrap()
+            .contains("shader loops"),
+        "{}",
+        points[1]
+    );
+    let csv = std::fs::read_to_string(dir.join("scaling.csv")).unwrap();
+    assert!(
+        csv.lines().nth(2).unwrap().contains("shader loops"),
+        "{csv}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_says_when_the_reference_failed() {
+    let dir = temp_dir("compare-ref");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Files of an earlier run: forward.png from it must not stay beside the new table.
+    std::fs::write(dir.join("forward.png"), b"earlier").unwrap();
+    std::fs::write(dir.join("mine.txt"), b"not lightgrid's").unwrap();
+    std::fs::write(
+        dir.join(lightgrid_bench::MANIFEST_FILE),
+        "forward.png\nforward.json\n",
+    )
+    .unwrap();
+    let o = lightgrid(&[
+        "compare",
+        "--scene",
+        "stress",
+        "--lights",
+        "66000",
+        "--size",
+        "8x8",
+        "--warmup",
+        "0",
+        "--out-dir",
+        s(&dir),
+    ]);
+    assert!(!o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        !out.lines()
+            .any(|l| l.starts_with("tiled_deferred ") && l.contains("reference")),
+        "{out}"
+    );
+    let v = json(&dir.join("compare.json"));
+    assert_eq!(v["outcome"]["status"], "failed");
+    for row in v["rows"].as_array().unwrap() {
+        let id = row["pipeline"].as_str().unwrap();
+        if id.starts_with("forward") {
+            assert!(row["failed"].is_string(), "{row}");
+        } else {
+            assert!(row["diff"].is_null(), "{row}");
+            assert_eq!(row["diff_note"], "not computed: forward failed", "{row}");
+        }
+    }
+    assert!(
+        !dir.join("forward.png").exists(),
+        "stale reference image removed"
+    );
+    assert!(
+        dir.join("mine.txt").exists(),
+        "files lightgrid did not write stay"
+    );
+    assert!(dir.join("tiled_deferred.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn two_runs_into_one_directory_do_not_mix() {
+    let dir = temp_dir("lock");
+    let lock = dir.join(lightgrid_bench::LOCK_FILE);
+    // A live holder (pid 1 always exists): refused, and the holder's lock is kept.
+    std::fs::write(&lock, "1\n").unwrap();
+    for args in [
+        vec![
+            "bench",
+            "--preset",
+            "quick",
+            "--pipelines",
+            "forward",
+            "--out",
+            s(&dir),
+        ],
+        vec![
+            "scaling",
+            "--lights",
+            "100",
+            "--assign",
+            "cpu",
+            "--out",
+            s(&dir),
+        ],
+        vec!["compare", "--size", "8x8", "--out-dir", s(&dir)],
+        vec!["report", s(&dir)],
+    ] {
+        assert_fails_with(&args, "another lightgrid run (pid 1)");
+    }
+    assert_eq!(std::fs::read_to_string(&lock).unwrap(), "1\n");
+    // A lock left by a process that is gone is taken over.
+    std::fs::write(&lock, "999999999\n").unwrap();
+    let o = lightgrid(&[
+        "scaling",
+        "--lights",
+        "100",
+        "--assign",
+        "cpu",
+        "--size",
+        "32x16",
+        "--warmup",
+        "0",
+        "--out",
+        s(&dir),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!lock.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sigterm_stops_a_bench_and_keeps_its_results() {
+    use std::io::{BufRead, BufReader};
+    let dir = temp_dir("sigterm");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .args([
+            "bench",
+            "--scene",
+            "robots-few",
+            "--pipelines",
+            "forward,deferred",
+            "--size",
+            "32x18",
+            "--frames",
+            "0..259:1",
+            "--warmup",
+            "0",
+            "--out",
+            s(&dir),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until it measures (the first progress line), then SIGTERM.
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
+        line.clear();
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let mut rest = String::new();
+    let _ = std::io::Read::read_to_string(&mut err, &mut rest);
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "an interrupted run exits non-zero");
+    assert!(rest.contains("interrupted"), "{rest}");
+    let v = json(&dir.join("results.json"));
+    assert_eq!(v["outcome"]["status"], "interrupted");
+    let runs = v["runs"].as_array().unwrap();
+    assert!(!runs.is_empty() && runs[0]["complete"] == false, "{runs:?}");
+    assert!(!runs[0]["frames"].as_array().unwrap().is_empty());
+    assert!(dir.join("summary.md").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn counts_and_thresholds_are_bounded_where_parsed() {
+    let dir = temp_dir("bounds");
+    let d = s(&dir);
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "--warmup", "1000000"], "not in 0..=1000"),
+        (
+            &["compare", "--warmup", "1001", "--out-dir", d],
+            "not in 0..=1000",
+        ),
+        (&["bench", "--repeat", "0", "--out", d], "not in 1..=1000"),
+        (
+            &["bench", "--warmup", "5000", "--out", d],
+            "not in 0..=1000",
+        ),
+        (&["scaling", "--runs", "0", "--out", d], "not in 1..=1000"),
+        (
+            &[
+                "scaling",
+                "--warmup",
+                "4294967295",
+                "--runs",
+                "1",
+                "--out",
+                d,
+            ],
+            "not in 0..=1000",
+        ),
+        (
+            &["scaling", "--budget", "NaN", "--out", d],
+            "not a finite number",
+        ),
+        (
+            &["scaling", "--budget", "-1", "--out", d],
+            "not a finite number",
+        ),
+        (
+            &["scaling", "--budget", "0", "--out", d],
+            "positive number of seconds",
+        ),
+        (
+            &["scaling", "--lights", "0", "--out", d],
+            "out of range 1 to 1000000",
+        ),
+        (
+            &["scaling", "--lights", "1000,2000000", "--out", d],
+            "out of range 1 to 1000000",
+        ),
+        (
+            &["diff", "a.png", "b.png", "--max-mean", "NaN"],
+            "not a finite number",
+        ),
+        (
+            &["diff", "a.png", "b.png", "--max-p99", "-1"],
+            "not a finite number",
+        ),
+        (
+            &["diff", "a.png", "b.png", "--max-p99", "inf"],
+            "not a finite number",
+        ),
+        (
+            &["bench", "--frames", "9..3", "--out", d],
+            "ends (3) before it starts (9)",
+        ),
+        (
+            &["bench", "--frames", "0..9:0", "--out", d],
+            "the step must be at least 1",
+        ),
+        (
+            &["bench", "--frames", "300..400", "--out", d],
+            "no frame of robots-many is in range",
+        ),
+        (
+            &["play", "--frames", "5..1"],
+            "ends (1) before it starts (5)",
+        ),
+        (&["--adapter", "", "render"], "--adapter is empty"),
+        (
+            &["--adapter", "gl", "render"],
+            "GL adapters are not supported",
+        ),
+        (
+            &["--adapter", "nope", "render"],
+            "no adapter matches 'nope'",
+        ),
+    ];
+    for (args, needle) in cases {
+        assert_fails_with(args, needle);
+    }
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "nothing created"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_option_that_applies_to_nothing_chosen_is_refused_in_every_command() {
+    let dir = temp_dir("applies");
+    let d = s(&dir);
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["render", "--pipeline", "forward", "--slices", "4"],
+            "--slices does not apply to forward",
+        ),
+        (
+            &["render", "--pipeline", "tiled_forward", "--gbuffer", "32"],
+            "--gbuffer does not apply",
+        ),
+        (
+            &["render", "--pipeline", "deferred", "--assign", "gather"],
+            "--assign does not apply",
+        ),
+        (
+            &["render", "--scene", "robots-many", "--lights", "5"],
+            "fixed light count",
+        ),
+        (
+            &["play", "--pipeline", "forward", "--slices", "4"],
+            "--slices does not apply",
+        ),
+        (
+            &["play", "--scene", "robots-few", "--lights", "5"],
+            "fixed light count",
+        ),
+        (&["bench", "--lights", "5", "--out", d], "fixed light count"),
+        (
+            &[
+                "bench",
+                "--pipelines",
+                "forward",
+                "--gbuffer",
+                "32",
+                "--out",
+                d,
+            ],
+            "--gbuffer does not apply",
+        ),
+        (
+            &[
+                "bench",
+                "--pipelines",
+                "forward,deferred",
+                "--slices",
+                "8",
+                "--out",
+                d,
+            ],
+            "--slices does not apply",
+        ),
+        (
+            &[
+                "scaling",
+                "--pipeline",
+                "tiled_deferred",
+                "--slices",
+                "8",
+                "--out",
+                d,
+            ],
+            "--slices does not apply",
+        ),
+        (
+            &[
+                "compare",
+                "--scene",
+                "robots-few",
+                "--lights",
+                "5",
+                "--out-dir",
+                d,
+            ],
+            "fixed light count",
+        ),
+    ];
+    for (args, needle) in cases {
+        assert_fails_with(args, needle);
+    }
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "nothing created"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
