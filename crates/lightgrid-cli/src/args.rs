@@ -139,7 +139,7 @@ pub(crate) struct SceneArgs {
     /// Screen tile edge in pixels for grid pipelines (4 to 64).
     #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256) [default: 16].
+    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256) [default: 32].
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) slices: Option<u32>,
     /// Who builds the light grid of grid pipelines (not tiled_deferred_single, which culls

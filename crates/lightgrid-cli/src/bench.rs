@@ -41,7 +41,7 @@ pub(crate) struct BenchArgs {
     /// Screen tile edge in pixels.
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) tile: Option<u32>,
-    /// View-depth slices of clustered pipelines (1 to 256) [default: 16].
+    /// View-depth slices of clustered pipelines (1 to 256) [default: 32].
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) slices: Option<u32>,
     /// Who builds the light grid of grid pipelines [default: auto].

@@ -50,7 +50,7 @@ pub(crate) struct PlayArgs {
     /// Screen tile edge in pixels for grid pipelines (4 to 64).
     #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (1 to 256) [default: 16].
+    /// View-depth slices of clustered pipelines (1 to 256) [default: 32].
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) slices: Option<u32>,
     /// G-buffer channel precision in bits for deferred pipelines [default: 16].

@@ -39,7 +39,7 @@ pub(crate) struct ScalingArgs {
     /// Screen tile edge in pixels.
     #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (1 to 256) [default: 16].
+    /// View-depth slices of clustered pipelines (1 to 256) [default: 32].
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) slices: Option<u32>,
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
