@@ -23,9 +23,10 @@ fn bad_numbers_are_rejected() {
         &["render", "--scene", "robots-few", "--size", "0x0"],
         "both edges must be 1 to 16384",
     );
+    // Reaches the project's own size check (not clap's "unexpected argument").
     assert_fails_with(
         &["render", "--scene", "robots-few", "--size", "-5x10"],
-        "-5",
+        "'-5' in '-5x10' is not a positive whole number",
     );
     assert_fails_with(
         &["render", "--scene", "robots-few", "--size", "abc"],
@@ -213,13 +214,51 @@ fn compare_renders_every_pipeline_with_its_difference() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
-    for p in lightgrid::pipelines::PIPELINES {
+    let table: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("compare.json")).unwrap()).unwrap();
+    assert_eq!(table["outcome"]["status"], "complete");
+    let rows = table["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), lightgrid::pipelines::PIPELINES.len());
+    for (p, row) in lightgrid::pipelines::PIPELINES.iter().zip(rows) {
         assert!(
             dir.join(format!("{}.png", p.id)).exists(),
             "{} image missing",
             p.id
         );
         assert!(out.contains(p.id), "table lacks {}", p.id);
+        assert_eq!(row["pipeline"], p.id);
+        if p.id == "forward" {
+            assert_eq!(row["diff_note"], "reference");
+            continue;
+        }
+        // The difference column holds a real difference, and a small one; the printed
+        // table shows the same mean.
+        let d = &row["diff"];
+        let mean = d["mean"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{}: {row}", p.id));
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(&format!("{} ", p.id)))
+            .unwrap();
+        assert!(line.contains(&format!("{mean:.3}")), "{line} vs {row}");
+        // light_prepass_mono differs from forward by its monochrome specular (compared with
+        // forward_mono in the notes); everything else matches forward closely.
+        let (max_mean, max_p99) = if p.reference == "forward" {
+            (0.5, 4.0)
+        } else {
+            (8.0, 64.0)
+        };
+        assert!(
+            mean <= max_mean && d["p99"].as_f64().unwrap() <= max_p99,
+            "{}: {d}",
+            p.id
+        );
+        let comps = row["lighting_computations"].as_u64().unwrap();
+        assert!(
+            comps >= row["ideal_lighting_computations"].as_u64().unwrap(),
+            "{row}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -367,6 +406,7 @@ fn bench_quick_preset_writes_its_report() {
 #[test]
 fn render_with_each_assignment_strategy_reports_it() {
     let dir = temp_dir("assign");
+    let mut grids = Vec::new();
     for assign in ["cpu", "gather", "scatter", "bvh", "bvh-gpu"] {
         let json = dir.join(format!("{assign}.json"));
         let o = lightgrid(&[
@@ -396,7 +436,45 @@ fn render_with_each_assignment_strategy_reports_it() {
         assert!(stats["assign_ms"].as_f64().unwrap() > 0.0);
         assert!(stats["grid_indices"].as_u64().unwrap() > 0);
         assert!(stats["grid_cells_occupied"].as_u64().unwrap() > 0);
+        grids.push((assign, stats));
     }
+    // The grids themselves: every strategy lists at least the lights that reach the samples
+    // (lighting computations ≥ ideal), cells hold the same samples whoever assigns, and the
+    // strategies that share a test list the same entries (cpu = scatter: the same sphere
+    // projection; gather = bvh = bvh-gpu: the same plane test).
+    let field = |i: usize, k: &str| grids[i].1[k].as_u64().unwrap();
+    for (i, (assign, stats)) in grids.iter().enumerate() {
+        assert!(
+            field(i, "lighting_computations") >= field(i, "ideal_lighting_computations"),
+            "{assign}: {stats}"
+        );
+        assert_eq!(
+            field(i, "grid_cells_occupied"),
+            field(0, "grid_cells_occupied"),
+            "{assign}"
+        );
+        assert_eq!(
+            field(i, "ideal_lighting_computations"),
+            field(0, "ideal_lighting_computations")
+        );
+    }
+    assert_eq!(
+        field(0, "grid_indices"),
+        field(2, "grid_indices"),
+        "cpu vs scatter"
+    );
+    assert_eq!(
+        field(1, "grid_indices"),
+        field(3, "grid_indices"),
+        "gather vs bvh"
+    );
+    assert_eq!(
+        field(1, "grid_indices"),
+        field(4, "grid_indices"),
+        "gather vs bvh-gpu"
+    );
+    // Plane tests are looser than sphere projection, never tighter by much.
+    assert!(field(1, "grid_indices") * 10 >= field(0, "grid_indices") * 9);
     assert_fails_with(&["render", "--assign", "magic"], "possible values");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -638,4 +716,33 @@ fn a_heatmap_of_a_one_pixel_frame_is_written() {
         "frame + legend, legend wide enough"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn help_states_the_defaults_the_code_uses() {
+    // The help text of one option: from its flag to the next option's.
+    fn section(help: &str, flag: &str) -> String {
+        let start = help
+            .find(&format!("{flag} <"))
+            .unwrap_or_else(|| panic!("{flag}: {help}"));
+        let rest = &help[start + flag.len()..];
+        let end = rest.find("\n  -").unwrap_or(rest.len());
+        rest[..end].replace('\n', " ")
+    }
+    let slices = format!("[default: {}]", lightgrid::consts::DEFAULT_SLICES);
+    let bits = format!(
+        "[default: {}]",
+        lightgrid::passes::GBufferFormat::default().bits()
+    );
+    for cmd in ["render", "play", "bench", "scaling"] {
+        let o = lightgrid(&[cmd, "--help"]);
+        let help = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(
+            section(&help, "--slices").contains(&slices),
+            "{cmd}: {help}"
+        );
+        if cmd == "render" || cmd == "play" {
+            assert!(section(&help, "--gbuffer").contains(&bits), "{cmd}: {help}");
+        }
+    }
 }
