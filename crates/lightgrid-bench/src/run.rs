@@ -358,6 +358,20 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
 }
 
 fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<Series>> {
+    if let Some(f) = config.heatmap_frame {
+        let measured = scenes
+            .iter()
+            .any(|s| config.frames.frames(s.frame_count()).contains(&f));
+        if !measured {
+            return Err(invalid(
+                "--heatmap-frame",
+                format!(
+                    "frame {f} is not one of the measured frames ({}..{} every {})",
+                    config.frames.start, config.frames.end, config.frames.step
+                ),
+            ));
+        }
+    }
     let mut plan = Vec::new();
     for (si, scene) in scenes.iter().enumerate() {
         let frames = config.frames.frames(scene.frame_count());

@@ -227,8 +227,8 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
 }
 
 pub(crate) fn report(a: &ReportArgs) -> Result<()> {
-    let _lock = OutDir::claim(&a.dir)?;
     let results = lightgrid_bench::read_results(&a.dir.join("results.json"))?;
+    let _lock = OutDir::claim(&a.dir)?;
     let written = lightgrid_bench::write_report(&a.dir, &results)?;
     println!(
         "{} files rewritten in {} (heatmaps are kept from the run)",

@@ -58,7 +58,18 @@ enum Command {
     List,
 }
 
+/// Let a closed stdout end the process quietly, as other command-line tools do
+/// (`lightgrid list | head`): Rust ignores SIGPIPE, so `println!` would panic instead.
+fn default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() {
+    default_sigpipe();
     let cli = Cli::parse();
     let result = match cli.command {
         None => compare::compare(

@@ -380,7 +380,6 @@ fn two_runs_into_one_directory_do_not_mix() {
             s(&dir),
         ],
         vec!["compare", "--size", "8x8", "--out-dir", s(&dir)],
-        vec!["report", s(&dir)],
     ] {
         assert_fails_with(&args, "another lightgrid run (pid 1)");
     }
@@ -640,4 +639,43 @@ fn an_option_that_applies_to_nothing_chosen_is_refused_in_every_command() {
         "nothing created"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn gl_adapters_are_not_offered() {
+    // README says why: the count target needs R32Float blending, which GL lacks.
+    let o = lightgrid(&["list"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success());
+    assert!(out.contains("[vulkan, "), "{out}");
+    assert!(!out.contains("[gl, "), "GL listed:\n{out}");
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    use std::io::Read;
+    // `lightgrid list | head -1`: the reader goes away after one line.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .arg("list")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 8];
+    child
+        .stdout
+        .as_mut()
+        .unwrap()
+        .read_exact(&mut first)
+        .unwrap();
+    drop(child.stdout.take());
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    child.wait().unwrap();
+    assert!(!err.contains("panicked"), "{err}");
 }
