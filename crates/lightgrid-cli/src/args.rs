@@ -119,6 +119,47 @@ pub(crate) fn check_applies(
     Ok(())
 }
 
+/// The renderer's settings as options (`render`, `compare`, `play`).
+#[derive(Args, Clone)]
+pub(crate) struct RendererArgs {
+    /// Screen tile edge in pixels for grid pipelines (4 to 64).
+    #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
+    pub(crate) tile: u32,
+    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256) [default: 32].
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) slices: Option<u32>,
+    /// Who builds the light grid of grid pipelines (not tiled_deferred_single, which culls
+    /// inside its kernel) [default: auto].
+    #[arg(long, value_enum)]
+    pub(crate) assign: Option<AssignArg>,
+    /// G-buffer channel precision in bits for deferred pipelines [default: 16].
+    #[arg(long, value_parser = parse_gbuffer)]
+    pub(crate) gbuffer: Option<GBufferFormat>,
+}
+
+impl RendererArgs {
+    /// The renderer settings, validated (the message gives each option's range).
+    pub(crate) fn settings(&self) -> Result<RenderSettings> {
+        let settings = RenderSettings {
+            tile_size: self.tile,
+            gbuffer: self.gbuffer.unwrap_or_default(),
+            slices: self.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
+            assign: self.assign.unwrap_or(AssignArg::Auto).into(),
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    /// Which options were given, for [`check_applies`].
+    pub(crate) fn given(&self) -> Given {
+        Given {
+            slices: self.slices.is_some(),
+            gbuffer: self.gbuffer.is_some(),
+            assign: self.assign.is_some(),
+        }
+    }
+}
+
 #[derive(Args, Clone)]
 pub(crate) struct SceneArgs {
     /// Scene from the catalog (see `lightgrid list`).
@@ -136,19 +177,8 @@ pub(crate) struct SceneArgs {
     /// Seed of the scene's random placement.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
-    /// Screen tile edge in pixels for grid pipelines (4 to 64).
-    #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
-    pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256) [default: 32].
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) slices: Option<u32>,
-    /// Who builds the light grid of grid pipelines (not tiled_deferred_single, which culls
-    /// inside its kernel) [default: auto].
-    #[arg(long, value_enum)]
-    pub(crate) assign: Option<AssignArg>,
-    /// G-buffer channel precision in bits for deferred pipelines [default: 16].
-    #[arg(long, value_parser = parse_gbuffer)]
-    pub(crate) gbuffer: Option<GBufferFormat>,
+    #[command(flatten)]
+    pub(crate) renderer: RendererArgs,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
     /// shaders at first use, inside the first frame's GPU time); 0 to 1000.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=MAX_COUNT))]
@@ -160,28 +190,6 @@ pub(crate) fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
         "16" => Ok(GBufferFormat::F16),
         "32" => Ok(GBufferFormat::F32),
         _ => Err(format!("'{s}': the G-buffer is 16 or 32 bits per channel")),
-    }
-}
-
-impl SceneArgs {
-    /// The renderer settings, validated (the message gives each option's range).
-    pub(crate) fn settings(&self) -> Result<RenderSettings> {
-        let settings = RenderSettings {
-            tile_size: self.tile,
-            gbuffer: self.gbuffer.unwrap_or_default(),
-            slices: self.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
-            assign: self.assign.unwrap_or(AssignArg::Auto).into(),
-        };
-        settings.validate()?;
-        Ok(settings)
-    }
-
-    pub(crate) fn given(&self) -> Given {
-        Given {
-            slices: self.slices.is_some(),
-            gbuffer: self.gbuffer.is_some(),
-            assign: self.assign.is_some(),
-        }
     }
 }
 

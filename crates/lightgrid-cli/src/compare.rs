@@ -71,7 +71,7 @@ fn diff_cell(
 }
 
 pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
-    let settings = a.scene.settings()?;
+    let settings = a.scene.renderer.settings()?;
     check_out_dir(&a.out_dir)?;
     let scene = build_scene(&a.scene)?;
     let ctx = GpuContext::new(adapter)?;
@@ -201,7 +201,7 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     }
     println!(
         "diff in 8-bit sRGB levels vs {REFERENCE}; 'x ideal' = lighting computations / ideal (one per light reaching a visible sample); lights/tile = avg/max per cell of the pipeline's grid ({}px tiles; clusters for clustered_*), built by --assign {}",
-        a.scene.tile,
+        a.scene.renderer.tile,
         assigned_by.as_deref().unwrap_or("-")
     );
     let failed: Vec<&str> = rows

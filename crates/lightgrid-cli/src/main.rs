@@ -14,7 +14,7 @@ mod play;
 mod render;
 mod scaling;
 
-use args::{SceneArgs, Size};
+use args::{RendererArgs, SceneArgs, Size};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -81,10 +81,12 @@ fn main() {
                     size: Some(Size(640, 360)),
                     lights: None,
                     seed: 1,
-                    tile: lightgrid::consts::DEFAULT_TILE_SIZE,
-                    slices: None,
-                    assign: None,
-                    gbuffer: None,
+                    renderer: RendererArgs {
+                        tile: lightgrid::consts::DEFAULT_TILE_SIZE,
+                        slices: None,
+                        assign: None,
+                        gbuffer: None,
+                    },
                     warmup: 1,
                 },
                 out_dir: PathBuf::from("out"),

@@ -3,19 +3,17 @@
 //! the frame-time distribution (`lightgrid::realtime`).
 
 use crate::args::{
-    check_applies, parse_gbuffer, parse_size, progress_bar, stop_on_ctrl_c, AssignArg, Given, Size,
-    MAX_COUNT,
+    check_applies, parse_size, progress_bar, stop_on_ctrl_c, RendererArgs, Size, MAX_COUNT,
 };
 use crate::files::{Files, Kind};
 use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::write_atomic;
-use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{self, REFERENCE};
 use lightgrid::realtime::{play as play_frames, Distribution, PlayPlan, PlayRun};
 use lightgrid::scene::catalog::{self, SceneParams};
-use lightgrid::{RenderSettings, Renderer};
+use lightgrid::Renderer;
 use lightgrid_bench::{FrameRange, Progress};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -28,9 +26,6 @@ pub(crate) struct PlayArgs {
     /// Pipeline id (see `lightgrid list`).
     #[arg(long, default_value = REFERENCE)]
     pub(crate) pipeline: String,
-    /// Who builds the light grid of grid pipelines [default: auto].
-    #[arg(long, value_enum)]
-    pub(crate) assign: Option<AssignArg>,
     /// Animation frames A..B (inclusive; A..B:STEP or N also work). Default: the whole
     /// animation.
     #[arg(long)]
@@ -47,15 +42,8 @@ pub(crate) struct PlayArgs {
     /// Write the results as JSON here.
     #[arg(long)]
     pub(crate) json: Option<PathBuf>,
-    /// Screen tile edge in pixels for grid pipelines (4 to 64).
-    #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
-    pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (1 to 256) [default: 32].
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) slices: Option<u32>,
-    /// G-buffer channel precision in bits for deferred pipelines [default: 16].
-    #[arg(long, value_parser = parse_gbuffer)]
-    pub(crate) gbuffer: Option<GBufferFormat>,
+    #[command(flatten)]
+    pub(crate) renderer: RendererArgs,
     /// Light count, for scenes that take one (stress: 1 to 1000000).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) lights: Option<u32>,
@@ -101,19 +89,8 @@ struct PlayJson<'a> {
 
 pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
-    let given = Given {
-        slices: a.slices.is_some(),
-        gbuffer: a.gbuffer.is_some(),
-        assign: a.assign.is_some(),
-    };
-    check_applies(given, &[info])?;
-    let settings = RenderSettings {
-        tile_size: a.tile,
-        gbuffer: a.gbuffer.unwrap_or_default(),
-        slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
-        assign: a.assign.unwrap_or(AssignArg::Auto).into(),
-    };
-    settings.validate()?;
+    check_applies(a.renderer.given(), &[info])?;
+    let settings = a.renderer.settings()?;
     Files::default().output("--json", a.json.as_deref(), Kind::Data)?;
     let scene = catalog::build(
         &a.scene,

@@ -44,6 +44,19 @@ fn fails_with(args: &[String], needle: &str) {
     assert_fails_with(&refs, needle);
 }
 
+/// Every case fails with its message, and `dir` (named by the cases' outputs) stays empty.
+fn all_refused_leaving_nothing(dir: &Path, cases: &[(&[&str], &str)]) {
+    for (args, needle) in cases {
+        assert_fails_with(args, needle);
+    }
+    assert_eq!(
+        std::fs::read_dir(dir).unwrap().count(),
+        0,
+        "nothing created"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn two_outputs_naming_one_file_are_refused_and_nothing_is_written() {
     let dir = temp_dir("same-file");
@@ -539,16 +552,21 @@ fn counts_and_thresholds_are_bounded_where_parsed() {
             &["--adapter", "nope", "render"],
             "no adapter matches 'nope'",
         ),
+        (
+            &[
+                "bench",
+                "--frames",
+                "0..10:5",
+                "--heatmap-frame",
+                "3",
+                "--out",
+                d,
+            ],
+            "not one of the measured frames",
+        ),
+        (&["report", d], "results.json: No such file"),
     ];
-    for (args, needle) in cases {
-        assert_fails_with(args, needle);
-    }
-    assert_eq!(
-        std::fs::read_dir(&dir).unwrap().count(),
-        0,
-        "nothing created"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
+    all_refused_leaving_nothing(&dir, cases);
 }
 
 #[test]
@@ -630,15 +648,7 @@ fn an_option_that_applies_to_nothing_chosen_is_refused_in_every_command() {
             "fixed light count",
         ),
     ];
-    for (args, needle) in cases {
-        assert_fails_with(args, needle);
-    }
-    assert_eq!(
-        std::fs::read_dir(&dir).unwrap().count(),
-        0,
-        "nothing created"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
+    all_refused_leaving_nothing(&dir, cases);
 }
 
 #[test]
