@@ -689,3 +689,28 @@ fn a_closed_stdout_ends_quietly() {
     child.wait().unwrap();
     assert!(!err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn out_of_memory_at_target_creation_says_so_with_the_size() {
+    // A 6 GB address-space limit: the 16384x16384 targets (5 GiB shared, more with the
+    // G-buffer) cannot be allocated, as on a GPU with too little memory.
+    let o = Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -v 6000000 && exec \"$0\" render --scene robots-few --size 16384x16384 \
+             --pipeline tiled_deferred --warmup 0",
+            env!("CARGO_BIN_EXE_lightgrid"),
+        ])
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("out of memory") && err.contains("16384x16384") && err.contains("MiB"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("Validation Error") && !err.contains("panicked"),
+        "{err}"
+    );
+}
