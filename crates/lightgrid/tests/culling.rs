@@ -1,7 +1,9 @@
-//! CPU light assignment never misses a light: thousands of randomized cases against the
-//! brute-force oracle, including lights behind the camera, crossing the near plane,
+//! CPU light assignment never misses a light: 10,000 randomized cases against the
+//! brute-force oracle, on tiles and clusters, including lights behind the camera, crossing the near plane,
 //! containing the camera and at the screen edges, tile sizes from 4 to 64 and resolutions
 //! that are not multiples of the tile size. CPU only.
+
+mod common;
 
 use glam::Vec3;
 use lightgrid::culling::{
@@ -132,28 +134,25 @@ fn random_depth(rng: &mut Rng, case: &Case) -> Vec<f32> {
         .collect()
 }
 
+/// Cases per randomized test: 10,000 in all across tiles and clusters (about 8 s in release on
+/// two cores).
+const TILE_CASES: usize = 4000;
+const CLUSTER_CASES: usize = 3000;
+const TWIN_CASES: usize = 3000;
+
 #[test]
 fn cpu_assignment_contains_the_oracle_in_randomized_cases() {
     let mut rng = Rng::new(2024);
-    let mut oracle_pairs = 0usize;
+    let mut coverage = common::Coverage::default();
     let mut assigned_pairs = 0usize;
     let mut all_pairs = 0usize;
-    for case_index in 0..1500 {
+    for case_index in 0..TILE_CASES {
         let case = random_case(&mut rng);
         let depth = random_depth(&mut rng, &case);
         let s = &case.setup;
         let tile = TILES[case_index % TILES.len()];
         let dims = GridDims::new(s.width, s.height, tile).unwrap();
-        let view_distance: Vec<f32> = depth
-            .iter()
-            .map(|&d| {
-                if d < 1.0 {
-                    s.view_distance(d)
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
+        let view_distance = common::view_distances(s, &depth);
         let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
         let bounds = cell_bounds_cpu(s, &dims, &depth);
         let bounded = assign_cpu(s, &dims, &case.lights, DepthRange::Cells(&bounds));
@@ -176,16 +175,26 @@ fn cpu_assignment_contains_the_oracle_in_randomized_cases() {
                     "case {case_index}: depth bounds added light {l}"
                 );
             }
-            oracle_pairs += must.len();
         }
+        coverage.add(s, &dims, &case.lights, &oracle);
         assigned_pairs += bounded.indices.len();
         all_pairs += dims.tile_count() * case.lights.len();
     }
-    // The cases must really exercise hits, and the assignment must really cull.
-    assert!(
-        oracle_pairs > 10_000,
-        "only {oracle_pairs} light-tile hits: cases too sparse"
-    );
+    // The cases must really exercise hits of every kind: at least half of what they measured
+    // (oracle (tile, light) pairs; the edge-case kinds are disjoint, and most hits come from
+    // lights containing the camera, which reach every tile with samples).
+    let measured = common::Coverage {
+        cases: 4000,
+        odd_cases: 3927,
+        hits: 1_448_857,
+        containing: 1_326_983,
+        behind: 3254,
+        crossing_near: 73_454,
+        off_screen: 24_888,
+        partial_tiles: 237_161,
+    };
+    coverage.at_least(&measured.halved(), "tiles");
+    // The assignment must really cull (measured: 1,714,946 of 4,826,448 pairs listed).
     assert!(
         assigned_pairs < all_pairs / 2,
         "assignment barely culls: {assigned_pairs} of {all_pairs}"
@@ -195,10 +204,10 @@ fn cpu_assignment_contains_the_oracle_in_randomized_cases() {
 #[test]
 fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
     let mut rng = Rng::new(99);
-    let mut oracle_pairs = 0usize;
+    let mut coverage = common::Coverage::default();
     let mut cluster_pairs = 0usize;
     let mut tile_pairs = 0usize;
-    for case_index in 0..800 {
+    for case_index in 0..CLUSTER_CASES {
         let case = random_case(&mut rng);
         let depth = random_depth(&mut rng, &case);
         let s = &case.setup;
@@ -206,16 +215,7 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
         let slices = [1, 4, 16, 32, 64][case_index % 5];
         let tiles = GridDims::new(s.width, s.height, tile).unwrap();
         let dims = tiles.clustered(slices, s.near, s.far).unwrap();
-        let view_distance: Vec<f32> = depth
-            .iter()
-            .map(|&d| {
-                if d < 1.0 {
-                    s.view_distance(d)
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
+        let view_distance = common::view_distances(s, &depth);
         let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
         let bounds = cell_bounds_cpu(s, &dims, &depth);
         let grid = assign_cpu(s, &dims, &case.lights, DepthRange::Cells(&bounds));
@@ -230,8 +230,8 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
                     case.camera
                 );
             }
-            oracle_pairs += must.len();
         }
+        coverage.add(s, &dims, &case.lights, &oracle);
         // Per sample, a cluster never lists more lights than its depth-bounded tile.
         let tile_bounds = cell_bounds_cpu(s, &tiles, &depth);
         let tiled = assign_cpu(s, &tiles, &case.lights, DepthRange::Cells(&tile_bounds));
@@ -245,8 +245,23 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
         cluster_pairs += grid.indices.len();
         tile_pairs += tiled.indices.len();
     }
-    assert!(oracle_pairs > 5_000, "only {oracle_pairs} hits");
-    assert!(cluster_pairs > 0 && tile_pairs > 0);
+    // At least half of what the cases measured (oracle (cluster, light) pairs).
+    let measured = common::Coverage {
+        cases: 3000,
+        odd_cases: 2950,
+        hits: 1_648_805,
+        containing: 1_484_458,
+        behind: 3311,
+        crossing_near: 105_415,
+        off_screen: 29_482,
+        partial_tiles: 282_541,
+    };
+    coverage.at_least(&measured.halved(), "clusters");
+    // Measured: 2,163,744 (cluster, light) pairs listed, 1,260,430 (tile, light) pairs.
+    assert!(
+        cluster_pairs >= 2_163_744 / 2 && tile_pairs >= 1_260_430 / 2,
+        "lists emptied: {cluster_pairs} cluster pairs, {tile_pairs} tile pairs"
+    );
 }
 
 /// The CPU twins of GPU gather and of the BVH traversal contain the oracle, on tiles and
@@ -254,8 +269,9 @@ fn clustered_assignment_contains_the_oracle_in_randomized_cases() {
 #[test]
 fn gather_and_bvh_twins_contain_the_oracle_in_randomized_cases() {
     let mut rng = Rng::new(4242);
-    let mut hits = 0usize;
-    for case_index in 0..800 {
+    let mut coverage = common::Coverage::default();
+    let mut inner_nodes = 0usize;
+    for case_index in 0..TWIN_CASES {
         let mut case = random_case(&mut rng);
         // Enough lights for a hierarchy with inner nodes now and then.
         if case_index % 4 == 0 {
@@ -279,16 +295,7 @@ fn gather_and_bvh_twins_contain_the_oracle_in_randomized_cases() {
         let dims = tiles
             .clustered([1, 8, 32][case_index % 3], s.near, s.far)
             .unwrap();
-        let view_distance: Vec<f32> = depth
-            .iter()
-            .map(|&d| {
-                if d < 1.0 {
-                    s.view_distance(d)
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
+        let view_distance = common::view_distances(s, &depth);
         let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
         let bounds = cell_bounds_cpu(s, &dims, &depth);
         let gather = assign_gather_cpu(s, &dims, &case.lights, &bounds);
@@ -301,13 +308,99 @@ fn gather_and_bvh_twins_contain_the_oracle_in_randomized_cases() {
                     case.camera
                 );
             }
-            hits += must.len();
         }
+        coverage.add(s, &dims, &case.lights, &oracle);
         let bvh = build_bvh(s, &case.lights);
+        inner_nodes += bvh.nodes.iter().filter(|n| !n.is_leaf()).count();
         let walked = traverse_bvh_cpu(s, &dims, &case.lights, &bounds, &bvh);
         assert_eq!(walked, gather, "case {case_index}: the BVH pruned a light");
     }
-    assert!(hits > 5_000, "only {hits} hits");
+    // At least half of what the cases measured (oracle (cell, light) pairs).
+    let measured = common::Coverage {
+        cases: 3000,
+        odd_cases: 2955,
+        hits: 3_433_556,
+        containing: 2_604_196,
+        behind: 20_636,
+        crossing_near: 349_579,
+        off_screen: 155_192,
+        partial_tiles: 652_110,
+    };
+    coverage.at_least(&measured.halved(), "gather and BVH twins");
+    // Measured: 2250 inner nodes over the 750 hierarchies of 1224 lights.
+    assert!(
+        inner_nodes >= 2250 / 2,
+        "only {inner_nodes} inner BVH nodes: the hierarchies are flat"
+    );
+}
+
+/// The grid checks the GPU tests rely on (`common::FrameOracle::check` and
+/// `common::check_grid_against_twin`) pass on an intact grid and fail when one light the oracle
+/// needs is taken out of one cell.
+#[test]
+fn grid_checks_catch_one_missing_light() {
+    use lightgrid::culling::{Assign, LightGrid};
+    use std::panic::{catch_unwind, AssertUnwindSafe};
+    let mut rng = Rng::new(5);
+    let mut damaged_cases = 0;
+    for case_index in 0..60 {
+        let case = random_case(&mut rng);
+        let depth = random_depth(&mut rng, &case);
+        let s = &case.setup;
+        let dims = GridDims::new(s.width, s.height, TILES[case_index % TILES.len()])
+            .unwrap()
+            .clustered([1, 8, 32][case_index % 3], s.near, s.far)
+            .unwrap();
+        let bounds = cell_bounds_cpu(s, &dims, &depth);
+        let grid = assign_gather_cpu(s, &dims, &case.lights, &bounds);
+        let oracle = common::FrameOracle::new(s, &dims, &case.lights, &depth);
+        let twin_check = |what: &str, g: &LightGrid| {
+            common::check_grid_against_twin(
+                what,
+                Assign::Gather,
+                s,
+                g,
+                &case.lights,
+                &bounds,
+                false,
+                4,
+            )
+        };
+        assert_eq!(oracle.check("intact", s, &grid).at_slice_boundary, 0);
+        assert_eq!(twin_check("intact", &grid), 0);
+        let pairs: Vec<(usize, u32)> = oracle
+            .cells
+            .iter()
+            .enumerate()
+            .flat_map(|(c, must)| must.iter().map(move |&l| (c, l)))
+            .collect();
+        if pairs.is_empty() {
+            continue;
+        }
+        let (c, l) = pairs[rng.below(pairs.len() as u32) as usize];
+        let lists: Vec<Vec<u32>> = (0..grid.cells.len())
+            .map(|i| {
+                let list = grid.cell(i).iter().copied();
+                list.filter(|&x| i != c || x != l).collect()
+            })
+            .collect();
+        let damaged = LightGrid::from_lists(dims, &lists);
+        assert_eq!(damaged.indices.len() + 1, grid.indices.len());
+        let oracle_caught =
+            catch_unwind(AssertUnwindSafe(|| oracle.check("damaged", s, &damaged))).is_err();
+        let twin_caught =
+            catch_unwind(AssertUnwindSafe(|| twin_check("damaged", &damaged))).is_err();
+        assert!(
+            oracle_caught && twin_caught,
+            "case {case_index}: light {l} taken out of cell {c} went unnoticed (oracle check \
+             caught it: {oracle_caught}, twin check: {twin_caught})"
+        );
+        damaged_cases += 1;
+    }
+    assert!(
+        damaged_cases >= 50,
+        "only {damaged_cases} cases had a hit to remove"
+    );
 }
 
 /// The hierarchy's structure: root first, every light in exactly one leaf, at most 32

@@ -1,74 +1,152 @@
 //! GPU: every registry pipeline's image equals the `forward` reference within its stated
-//! tolerance, on two catalog scenes, two tile sizes and a resolution that is not a multiple
+//! tolerance (mean, p99 and how many pixels may be off by more than a few levels, so one
+//! missing light cannot hide), on two catalog scenes, two tile sizes and a resolution that is not a multiple
 //! of the tile size; lighting-computation counts are never below the ideal; every light
 //! assignment strategy (CPU, GPU gather, scatter, BVH) builds, on every grid pipeline, the grid
-//! its CPU twin builds from the same cell bounds, and the GPU cell bounds equal their twin's.
+//! its CPU twin builds from the same cell bounds and contains every light the brute-force
+//! oracle finds, and the GPU cell bounds equal their twin's. Many randomized scenes per
+//! strategy are in `gpu_culling.rs`.
 
 mod common;
 
-use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu, cell_bounds_cpu, DepthRange, LightGrid, ViewSetup,
-};
+use lightgrid::culling::{LightGrid, ViewSetup};
 use lightgrid::image_io::{diff, save_png};
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::Assign;
 use lightgrid::pipelines::{PipelineInfo, PIPELINES, REFERENCE};
 use lightgrid::scene::catalog::{self, SceneParams};
-use lightgrid::scene::{PointLight, Scene};
+use lightgrid::scene::Scene;
 use lightgrid::{RenderSettings, Renderer};
 
-/// Per-pipeline tolerance against `forward`, in 8-bit sRGB levels: (id, max mean, max p99,
-/// why). Every registry row must have one.
-const TOLERANCES: &[(&str, f64, f64, &str)] = &[
-    (
-        "tiled_forward",
-        0.01,
-        1.0,
-        "same fragments and light order as forward; unlisted lights contribute exactly zero, so \
-         lavapipe is bit-identical; one level allows other drivers' reassociation",
-    ),
-    (
-        "tiled_forward_prez",
-        0.01,
-        1.0,
-        "as tiled_forward (the pre-pass uses the same invariant vertex stage), except single \
-         pixels on an edge shared by two faces at exactly equal depth, where LessEqual keeps the \
-         face drawn last and forward's Less the one drawn first (affects max, not p99)",
-    ),
-    (
-        "tiled_deferred",
-        0.1,
-        2.0,
-        "16-bit G-buffer normals and colours, and positions rebuilt from depth instead of interpolated",
-    ),
-    ("tiled_deferred_single", 0.1, 2.0, "as tiled_deferred"),
-    ("clustered_forward", 0.01, 1.0, "as tiled_forward_prez: same fragments, each cluster list holds every light reaching its samples"),
-    ("clustered_deferred", 0.1, 2.0, "as tiled_deferred"),
-    (
-        "deferred",
-        0.5,
-        2.0,
-        "16-bit G-buffer, positions rebuilt from depth, and per-light additive blending into the \
-         16-bit HDR target (forward sums in 32-bit registers): where many lights overlap the \
-         rounding of each blend shifts many pixels by one level (measured: mean 0.36, max 1)",
-    ),
-    ("deferred_stencil", 0.5, 2.0, "as deferred"),
-    (
-        "light_prepass",
-        0.5,
-        2.0,
-        "positions rebuilt from depth, and diffuse and specular irradiance summed by 16-bit \
-         blending before the material multiplies them",
-    ),
-    ("light_prepass_mono", 0.5, 2.0, "as light_prepass, against forward_mono (the same monochrome-specular model)"),
+/// Per-pipeline tolerance against `forward`, in 8-bit sRGB levels (a pixel's difference is its
+/// largest channel difference). Every registry row must have one.
+struct Tolerance {
+    id: &'static str,
+    max_mean: f64,
+    max_p99: f64,
+    /// At most `max_over` pixels may differ by more than `level`. One missing light darkens a
+    /// region: a 200-pixel disc darkened by 50 levels is under 1% of a 192x108 frame (below
+    /// the p99) and its mean shrinks with the frame, so only a count bounds it whatever the
+    /// size. Measured on lavapipe over every image comparison in this file (180 of them, 97x61
+    /// to 170x100, every strategy): no pipeline has a single pixel more than 1 level from its
+    /// reference, so `level` 4 leaves four times the measured maximum for other drivers'
+    /// round-off, and `max_over` is what the reason allows beyond it.
+    level: u8,
+    max_over: u64,
+    why: &'static str,
+}
+
+/// The G-buffer pipelines' count allowance: measured 0 pixels over 1 level; 10 (a twentieth of
+/// the 200-pixel disc) for silhouette pixels whose position another driver rebuilds from depth
+/// differently.
+const GBUFFER_OVER: u64 = 10;
+
+const TOLERANCES: &[Tolerance] = &[
+    Tolerance {
+        id: "tiled_forward",
+        max_mean: 0.01,
+        max_p99: 1.0,
+        level: 4,
+        max_over: 0,
+        why: "same fragments and light order as forward; unlisted lights contribute exactly zero, so \
+              lavapipe is bit-identical; one level allows other drivers' reassociation, which \
+              never reaches 4 levels",
+    },
+    Tolerance {
+        id: "tiled_forward_prez",
+        max_mean: 0.01,
+        max_p99: 1.0,
+        level: 4,
+        max_over: 10,
+        why: "as tiled_forward (the pre-pass uses the same invariant vertex stage), except single \
+              pixels on an edge shared by two faces at exactly equal depth, where LessEqual keeps \
+              the face drawn last and forward's Less the one drawn first (affects max, not p99; \
+              measured 0 such pixels on lavapipe, 10 allowed)",
+    },
+    Tolerance {
+        id: "tiled_deferred",
+        max_mean: 0.1,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "16-bit G-buffer normals and colours, and positions rebuilt from depth instead of \
+              interpolated",
+    },
+    Tolerance {
+        id: "tiled_deferred_single",
+        max_mean: 0.1,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "as tiled_deferred",
+    },
+    Tolerance {
+        id: "clustered_forward",
+        max_mean: 0.01,
+        max_p99: 1.0,
+        level: 4,
+        max_over: 10,
+        why: "as tiled_forward_prez: same fragments, each cluster list holds every light reaching \
+              its samples",
+    },
+    Tolerance {
+        id: "clustered_deferred",
+        max_mean: 0.1,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "as tiled_deferred",
+    },
+    Tolerance {
+        id: "deferred",
+        max_mean: 0.5,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "16-bit G-buffer, positions rebuilt from depth, and per-light additive blending into \
+              the 16-bit HDR target (forward sums in 32-bit registers): where many lights overlap \
+              the rounding of each blend shifts many pixels by one level (measured: mean 0.36, \
+              max 1)",
+    },
+    Tolerance {
+        id: "deferred_stencil",
+        max_mean: 0.5,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "as deferred",
+    },
+    Tolerance {
+        id: "light_prepass",
+        max_mean: 0.5,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "positions rebuilt from depth, and diffuse and specular irradiance summed by 16-bit \
+              blending before the material multiplies them",
+    },
+    Tolerance {
+        id: "light_prepass_mono",
+        max_mean: 0.5,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "as light_prepass, against forward_mono (the same monochrome-specular model)",
+    },
 ];
 
-fn tolerance(id: &str) -> (f64, f64) {
+fn tolerance(id: &str) -> common::ImageTolerance {
     let row = TOLERANCES
         .iter()
-        .find(|t| t.0 == id)
+        .find(|t| t.id == id)
         .unwrap_or_else(|| panic!("pipeline {id} has no row in TOLERANCES"));
-    (row.1, row.2)
+    assert!(!row.why.is_empty(), "{id}: a tolerance says why");
+    common::ImageTolerance {
+        max_mean: row.max_mean,
+        max_p99: row.max_p99,
+        level: row.level,
+        max_over: row.max_over,
+    }
 }
 
 /// A pipeline that is its own reference (`forward`, `forward_mono`).
@@ -103,19 +181,15 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
     let mut counts = std::collections::HashMap::new();
     for p in PIPELINES.iter().filter(|p| !is_reference(p)) {
         let out = r.render(s, frame, p.id).unwrap();
-        let (max_mean, max_p99) = tolerance(p.id);
         let expected = &references[p.reference];
-        let (d, vis) = diff(&expected.image, &out.image).unwrap();
+        let cmp = common::compare_images(&expected.image, &out.image, tolerance(p.id));
         let name = format!("{scene}-f{frame}-{w}x{h}-t{}-{}", settings.tile_size, p.id);
-        if d.mean > max_mean || d.p99 > max_p99 {
+        if !cmp.passes() {
             let dir = common::output_dir();
             save_png(&out.image, &dir.join(format!("actual-{name}.png"))).unwrap();
             save_png(&expected.image, &dir.join(format!("reference-{name}.png"))).unwrap();
-            save_png(&vis, &dir.join(format!("diff-{name}.png"))).unwrap();
-            panic!(
-                "{name}: mean {:.4} p99 {} max {} vs {} (allowed {max_mean}/{max_p99})",
-                d.mean, d.p99, d.max, p.reference
-            );
+            save_png(&cmp.visual, &dir.join(format!("diff-{name}.png"))).unwrap();
+            panic!("{name} vs {}: {}", p.reference, cmp.describe());
         }
         let st = &out.stats;
         assert_eq!(
@@ -161,6 +235,41 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
     // Deferred lighting runs the light function on the same volume fragments as deferred.
     assert_eq!(counts["light_prepass"], counts["deferred"]);
     assert_eq!(counts["light_prepass_mono"], counts["deferred"]);
+}
+
+/// One missing light darkens the samples only it reached: a 200-pixel disc darkened by 50
+/// levels in a pipeline's image must fail that pipeline's tolerance by the count of pixels over
+/// its level (whatever the mean and p99 say), while the undamaged image passes.
+#[test]
+fn a_darkened_disc_fails_every_tolerance() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h) = (192, 108);
+    let mut r = Renderer::new(&ctx, w, h, settings(16)).unwrap();
+    let mut references = std::collections::HashMap::new();
+    for p in PIPELINES.iter().filter(|p| is_reference(p)) {
+        references.insert(p.id, r.render(&s, 200, p.id).unwrap().image);
+    }
+    for p in PIPELINES.iter().filter(|p| !is_reference(p)) {
+        let expected = &references[p.reference];
+        let image = r.render(&s, 200, p.id).unwrap().image;
+        let tol = tolerance(p.id);
+        let intact = common::compare_images(expected, &image, tol);
+        assert!(intact.passes(), "{}: {}", p.id, intact.describe());
+        let (damaged, full) = common::darken_disc(&image, 200, 50);
+        assert_eq!(
+            full, 200,
+            "{}: the disc must lie where 50 levels can be taken",
+            p.id
+        );
+        let cmp = common::compare_images(expected, &damaged, tol);
+        assert!(
+            cmp.over > tol.max_over && cmp.violations().iter().any(|v| v.contains("pixels")),
+            "{}: a darkened 200-pixel disc passes the count bound: {}",
+            p.id,
+            cmp.describe()
+        );
+    }
 }
 
 fn settings(tile_size: u32) -> RenderSettings {
@@ -241,45 +350,13 @@ fn random_fps_tile_16_with_32_bit_gbuffer() {
     );
 }
 
-/// The grid a strategy's CPU twin builds from the given cell bounds.
-fn twin(
-    assign: Assign,
-    setup: &ViewSetup,
-    grid: &LightGrid,
-    lights: &[PointLight],
-    bounds: &[[f32; 2]],
-    near_far: bool,
-) -> LightGrid {
-    let dims = &grid.dims;
-    match assign {
-        Assign::Cpu | Assign::Scatter if near_far => {
-            assign_cpu(setup, dims, lights, DepthRange::NearFar)
-        }
-        Assign::Cpu | Assign::Scatter => assign_cpu(setup, dims, lights, DepthRange::Cells(bounds)),
-        Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
-            assign_gather_cpu(setup, dims, lights, bounds)
-        }
-        Assign::Auto => unreachable!("resolved by the renderer"),
-    }
-}
-
-fn with_ranges_scaled(lights: &[PointLight], f: f32) -> Vec<PointLight> {
-    lights
-        .iter()
-        .map(|l| PointLight {
-            range: l.range * f,
-            ..*l
-        })
-        .collect()
-}
-
 /// Render `id` with `settings` and check its grid against the CPU twin of the strategy that
-/// built it, fed with the pipeline's own cell bounds: equal for the CPU strategy; for GPU
-/// strategies every cell's set lies between the twin's with all light ranges 0.1% smaller and
-/// 0.1% larger (f32 round-off of the view transform and frustum planes differs between the GPU
-/// and the CPU), and differs from the exact twin in at most a handful of (cell, light) pairs.
-/// Also: the GPU cell bounds equal `cell_bounds_cpu` of the frame's depth, the grid is well
-/// formed, the image matches the reference and the count is never below the ideal.
+/// built it, fed with the pipeline's own cell bounds (`common::check_grid_against_twin`: equal
+/// for the CPU strategy, within 0.1% of the light ranges and a handful of (cell, light) pairs
+/// for GPU strategies), and against the brute-force oracle on the frame's depth (no light
+/// reaching a cell's samples is missing). Also: the GPU cell bounds equal `cell_bounds_cpu` of
+/// the frame's depth, the grid is well formed, the image matches the reference and the count
+/// is never below the ideal.
 fn check_assign(
     r: &mut Renderer,
     s: &Scene,
@@ -304,89 +381,23 @@ fn check_assign(
         .clone()
         .expect("a grid pipeline reports its cell bounds");
     let grid = &out.grid;
-    let dims = grid.dims;
     let near_far = id == "tiled_forward";
-    // Cell bounds: the GPU kernel against its twin on the same depth buffer.
     if !near_far {
-        let cpu = cell_bounds_cpu(&setup, &dims, &out.depth);
-        let mut emptiness = 0;
-        for (c, (g, b)) in bounds.iter().zip(&cpu).enumerate() {
-            match (g[0] <= g[1], b[0] <= b[1]) {
-                (true, true) => assert!(
-                    (g[0] - b[0]).abs() <= 1e-5 * b[0] && (g[1] - b[1]).abs() <= 1e-5 * b[1],
-                    "{what}: cell {c} bounds {g:?} vs twin {b:?}"
-                ),
-                (false, false) => {}
-                _ => emptiness += 1, // a sample within round-off of a slice boundary
-            }
-        }
-        assert!(
-            emptiness <= 2,
-            "{what}: {emptiness} cells differ in occupancy"
-        );
-        assert!(
-            bounds.iter().any(|b| b[0] <= b[1]),
-            "{what}: no cell holds samples"
-        );
-        if dims.slices > 1 {
-            assert!(
-                bounds.iter().any(|b| b[0] > b[1]),
-                "{what}: every cluster occupied"
-            );
-        }
+        common::check_cell_bounds(&what, &setup, &grid.dims, &bounds, &out.depth, 2);
     }
-    // Well formed: counts add up, lists inside the index array, no light twice in a cell.
-    let total: u64 = grid.cells.iter().map(|c| u64::from(c[1])).sum();
-    assert_eq!(total, grid.indices.len() as u64, "{what}");
-    let mut sets = Vec::with_capacity(grid.cells.len());
-    for c in 0..grid.cells.len() {
-        let mut list = grid.cell(c).to_vec();
-        list.sort_unstable();
-        let n = list.len();
-        list.dedup();
-        assert_eq!(n, list.len(), "{what}: cell {c} lists a light twice");
-        sets.push(list);
-    }
-    let exact = twin(assign, &setup, grid, &state.lights, &bounds, near_far);
-    if assign == Assign::Cpu {
-        assert_eq!(grid, &exact, "{what}");
-    } else {
-        let lo = twin(
-            assign,
-            &setup,
-            grid,
-            &with_ranges_scaled(&state.lights, 0.999),
-            &bounds,
-            near_far,
-        );
-        let hi = twin(
-            assign,
-            &setup,
-            grid,
-            &with_ranges_scaled(&state.lights, 1.001),
-            &bounds,
-            near_far,
-        );
-        let mut differing = 0;
-        for (c, set) in sets.iter().enumerate() {
-            assert!(
-                lo.cell(c).iter().all(|l| set.binary_search(l).is_ok()),
-                "{what}: cell {c} misses a light"
-            );
-            assert!(
-                set.iter().all(|l| hi.cell(c).contains(l)),
-                "{what}: cell {c} lists a light out of reach"
-            );
-            differing += set.len().abs_diff(exact.cell(c).len());
-        }
-        assert!(
-            differing <= 4,
-            "{what}: {differing} round-off disagreements with the twin"
-        );
-    }
-    let (d, _) = diff(reference, &out.image).unwrap();
-    let (max_mean, max_p99) = tolerance(id);
-    assert!(d.mean <= max_mean && d.p99 <= max_p99, "{what}: {d:?}");
+    common::check_grid_against_twin(
+        &what,
+        assign,
+        &setup,
+        grid,
+        &state.lights,
+        &bounds,
+        near_far,
+        4,
+    );
+    common::check_grid_contains_oracle(&what, &setup, grid, &state.lights, &out.depth);
+    let cmp = common::compare_images(reference, &out.image, tolerance(id));
+    assert!(cmp.passes(), "{what}: {}", cmp.describe());
     let n = out.stats.lighting_computations.unwrap();
     assert!(n >= out.stats.ideal_lighting_computations, "{what}");
     out.grid
@@ -545,7 +556,6 @@ fn index_lists_beyond_the_device_limit_are_refused() {
 /// tile size; every strategy on every grid pipeline against its CPU twin.
 #[test]
 fn strategies_on_randomized_edge_case_lights() {
-    use glam::Vec3;
     use lightgrid::scene::{LightAnchor, Rng, SceneLight};
     let mut rng = Rng::new(77);
     let cases = [
@@ -558,52 +568,13 @@ fn strategies_on_randomized_edge_case_lights() {
         let frame = rng.below(scene.frame_count());
         let camera = scene.frame(frame).camera;
         let setup = ViewSetup::new(&camera, w, h);
-        let world = setup.view.inverse();
-        let mut lights = Vec::new();
-        for k in 0..240 {
-            let r = rng.range(0.3, 10.0);
-            let v = match k % 6 {
-                0 => Vec3::new(rng.range(-r, r), rng.range(-r, r), rng.range(-r, r)) * 0.5,
-                1 => Vec3::new(
-                    rng.range(-r, r),
-                    rng.range(-r, r),
-                    -camera.near + rng.range(-r, r),
-                ),
-                2 => Vec3::new(
-                    rng.range(-3.0, 3.0),
-                    rng.range(-3.0, 3.0),
-                    rng.range(0.0, r),
-                ),
-                3 => {
-                    let depth = rng.range(1.0, 60.0);
-                    let edge = if rng.unit() < 0.5 { -1.0 } else { 1.0 } * rng.range(0.95, 1.15);
-                    let other = rng.range(-1.1, 1.1);
-                    let (sx, sy) = if k % 12 < 6 {
-                        (edge, other)
-                    } else {
-                        (other, edge)
-                    };
-                    Vec3::new(sx / setup.p00 * depth, sy / setup.p11 * depth, -depth)
-                }
-                _ => {
-                    let depth = rng.range(0.5, 80.0);
-                    Vec3::new(
-                        rng.range(-1.0, 1.0) / setup.p00 * depth,
-                        rng.range(-1.0, 1.0) / setup.p11 * depth,
-                        -depth,
-                    )
-                }
-            };
-            lights.push(SceneLight {
-                light: PointLight {
-                    position: world.transform_point3(v),
-                    color: Vec3::new(rng.unit(), rng.unit(), rng.unit()),
-                    intensity: rng.range(0.5, 3.0),
-                    range: r,
-                },
+        let lights = common::edge_case_lights(&mut rng, &camera, &setup, 240)
+            .into_iter()
+            .map(|light| SceneLight {
+                light,
                 anchor: LightAnchor::World,
-            });
-        }
+            })
+            .collect();
         scene.lights = lights;
         scene.validate().unwrap();
         check_strategies(&scene, frame, (w, h), tile, slices, &GRID_PIPELINES);

@@ -1,7 +1,15 @@
-//! Helpers shared by the GPU tests.
+//! Helpers shared by the integration tests: the GPU context, image comparison with its
+//! tolerances, and the light-grid checks (CPU twin, brute-force oracle, edge-case coverage).
 #![allow(dead_code)]
 
+use glam::Vec3;
+use lightgrid::culling::{
+    assign_cpu, assign_gather_cpu, cell_bounds_cpu, oracle_tile_lights, DepthRange, GridDims,
+    LightGrid, ViewSetup,
+};
 use lightgrid::gpu::GpuContext;
+use lightgrid::pipelines::Assign;
+use lightgrid::scene::{Camera, PointLight, Rng};
 use std::path::PathBuf;
 
 /// A GPU context, or a failing test. A missing adapter is never a pass: install
@@ -42,4 +50,629 @@ pub fn golden_dir() -> PathBuf {
 
 pub fn blessing() -> bool {
     std::env::var("LIGHTGRID_BLESS").is_ok_and(|v| v == "1")
+}
+
+/// An image comparison's bounds, in 8-bit sRGB levels; a pixel's difference is its largest
+/// channel difference (as in `image_io::diff`). The mean and p99 bound round-off spread over
+/// the frame; `max_over` bounds how many pixels may differ by more than `level`, so a region
+/// that one missing light darkens cannot hide below the mean and the 99th percentile.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageTolerance {
+    pub max_mean: f64,
+    pub max_p99: f64,
+    pub level: u8,
+    pub max_over: u64,
+}
+
+/// What [`compare_images`] measured.
+pub struct ImageComparison {
+    pub summary: lightgrid::image_io::DiffSummary,
+    /// Pixels whose difference exceeds the tolerance's `level`.
+    pub over: u64,
+    /// The visual diff image (`image_io::diff`).
+    pub visual: image::RgbaImage,
+    pub tolerance: ImageTolerance,
+}
+
+impl ImageComparison {
+    /// The bounds this comparison breaks, as text (empty: within tolerance).
+    pub fn violations(&self) -> Vec<String> {
+        let (d, t) = (&self.summary, &self.tolerance);
+        let mut v = Vec::new();
+        if d.mean > t.max_mean {
+            v.push(format!("mean {:.4} > {}", d.mean, t.max_mean));
+        }
+        if d.p99 > t.max_p99 {
+            v.push(format!("p99 {} > {}", d.p99, t.max_p99));
+        }
+        if self.over > t.max_over {
+            v.push(format!(
+                "{} pixels differ by more than {} levels (at most {} allowed)",
+                self.over, t.level, t.max_over
+            ));
+        }
+        v
+    }
+
+    pub fn passes(&self) -> bool {
+        self.violations().is_empty()
+    }
+
+    /// One line for a failure message: every measure and every bound.
+    pub fn describe(&self) -> String {
+        let (d, t) = (&self.summary, &self.tolerance);
+        format!(
+            "mean {:.4} p99 {} max {}, {} pixels over {} levels (allowed mean {} p99 {}, {} over {}){}",
+            d.mean,
+            d.p99,
+            d.max,
+            self.over,
+            t.level,
+            t.max_mean,
+            t.max_p99,
+            t.max_over,
+            t.level,
+            match self.violations() {
+                v if v.is_empty() => String::new(),
+                v => format!(": {}", v.join("; ")),
+            }
+        )
+    }
+}
+
+/// Per-pixel differences (largest absolute channel difference, alpha ignored) of two images of
+/// the same size, as a histogram over the 256 levels.
+pub fn difference_histogram(a: &image::RgbaImage, b: &image::RgbaImage) -> [u64; 256] {
+    assert_eq!(a.dimensions(), b.dimensions(), "image sizes differ");
+    let mut histogram = [0u64; 256];
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        let d = (0..3).map(|c| pa[c].abs_diff(pb[c])).max().unwrap_or(0);
+        histogram[d as usize] += 1;
+    }
+    histogram
+}
+
+/// How many pixels differ by more than `level`.
+pub fn pixels_over(a: &image::RgbaImage, b: &image::RgbaImage, level: u8) -> u64 {
+    difference_histogram(a, b)[usize::from(level) + 1..]
+        .iter()
+        .sum()
+}
+
+/// `image_io::diff` plus the count of pixels over the tolerance's level.
+pub fn compare_images(
+    expected: &image::RgbaImage,
+    actual: &image::RgbaImage,
+    tolerance: ImageTolerance,
+) -> ImageComparison {
+    let (summary, visual) = lightgrid::image_io::diff(expected, actual).unwrap();
+    ImageComparison {
+        summary,
+        over: pixels_over(expected, actual, tolerance.level),
+        visual,
+        tolerance,
+    }
+}
+
+/// `image` with a disc of `pixels` pixels darkened by `levels` in every channel: what
+/// one missing light does to the samples it alone reached. The disc goes where the image is
+/// brightest (its centre on the pixel whose disc has the largest sum of channel maxima), so
+/// that darkening really changes it; returns the damaged image and how many pixels of it now
+/// differ by the full `levels`.
+pub fn darken_disc(image: &image::RgbaImage, pixels: u32, levels: u8) -> (image::RgbaImage, u32) {
+    let (w, h) = image.dimensions();
+    // The `pixels` offsets nearest the centre: a disc of exactly that many pixels.
+    let r = (f64::from(pixels) / std::f64::consts::PI).sqrt().ceil() as i64 + 1;
+    let mut offsets: Vec<(i64, i64)> = (-r..=r)
+        .flat_map(|dy| (-r..=r).map(move |dx| (dx, dy)))
+        .collect();
+    offsets.sort_by_key(|&(dx, dy)| (dx * dx + dy * dy, dy, dx));
+    offsets.truncate(pixels as usize);
+    let value = |x: i64, y: i64| -> u64 {
+        if x < 0 || y < 0 || x >= i64::from(w) || y >= i64::from(h) {
+            return 0;
+        }
+        let p = image.get_pixel(x as u32, y as u32);
+        u64::from(p[0].max(p[1]).max(p[2]).min(levels))
+    };
+    let mut best = (0u64, 0i64, 0i64);
+    for cy in 0..i64::from(h) {
+        for cx in 0..i64::from(w) {
+            let sum: u64 = offsets
+                .iter()
+                .map(|&(dx, dy)| value(cx + dx, cy + dy))
+                .sum();
+            if sum > best.0 {
+                best = (sum, cx, cy);
+            }
+        }
+    }
+    let (_, cx, cy) = best;
+    let mut out = image.clone();
+    let mut full = 0;
+    for &(dx, dy) in &offsets {
+        let (x, y) = (cx + dx, cy + dy);
+        if x < 0 || y < 0 || x >= i64::from(w) || y >= i64::from(h) {
+            continue;
+        }
+        let p = out.get_pixel_mut(x as u32, y as u32);
+        let before = p[0].max(p[1]).max(p[2]);
+        for c in 0..3 {
+            p[c] = p[c].saturating_sub(levels);
+        }
+        if before >= levels {
+            full += 1;
+        }
+    }
+    (out, full)
+}
+
+/// Each sample's view distance from a [0, 1] depth buffer; infinite where there is no geometry
+/// (what `oracle_tile_lights` reads).
+pub fn view_distances(setup: &ViewSetup, depth: &[f32]) -> Vec<f32> {
+    depth
+        .iter()
+        .map(|&d| {
+            if d < 1.0 {
+                setup.view_distance(d)
+            } else {
+                f32::INFINITY
+            }
+        })
+        .collect()
+}
+
+/// `n` lights placed relative to `camera` where light assignment goes wrong: containing the
+/// camera, crossing the near plane, behind the camera reaching forward, centred just outside a
+/// screen edge, and scattered through the frustum (one of each in turn, the last twice).
+pub fn edge_case_lights(
+    rng: &mut Rng,
+    camera: &Camera,
+    setup: &ViewSetup,
+    n: usize,
+) -> Vec<PointLight> {
+    let world = setup.view.inverse();
+    let mut lights = Vec::with_capacity(n);
+    for k in 0..n {
+        let r = rng.range(0.3, 10.0);
+        let v = match k % 6 {
+            0 => Vec3::new(rng.range(-r, r), rng.range(-r, r), rng.range(-r, r)) * 0.5,
+            1 => Vec3::new(
+                rng.range(-r, r),
+                rng.range(-r, r),
+                -camera.near + rng.range(-r, r),
+            ),
+            2 => Vec3::new(
+                rng.range(-3.0, 3.0),
+                rng.range(-3.0, 3.0),
+                rng.range(0.0, r),
+            ),
+            3 => {
+                let depth = rng.range(1.0, 60.0);
+                let edge = if rng.unit() < 0.5 { -1.0 } else { 1.0 } * rng.range(0.95, 1.15);
+                let other = rng.range(-1.1, 1.1);
+                let (sx, sy) = if k % 12 < 6 {
+                    (edge, other)
+                } else {
+                    (other, edge)
+                };
+                Vec3::new(sx / setup.p00 * depth, sy / setup.p11 * depth, -depth)
+            }
+            _ => {
+                let depth = rng.range(0.5, 80.0);
+                Vec3::new(
+                    rng.range(-1.0, 1.0) / setup.p00 * depth,
+                    rng.range(-1.0, 1.0) / setup.p11 * depth,
+                    -depth,
+                )
+            }
+        };
+        lights.push(PointLight {
+            position: world.transform_point3(v),
+            color: Vec3::new(rng.unit(), rng.unit(), rng.unit()),
+            intensity: rng.range(0.5, 3.0),
+            range: r,
+        });
+    }
+    lights
+}
+
+/// The grid a strategy's CPU twin builds from the given cell bounds.
+pub fn twin(
+    assign: Assign,
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[PointLight],
+    bounds: &[[f32; 2]],
+    near_far: bool,
+) -> LightGrid {
+    let dims = &grid.dims;
+    match assign {
+        Assign::Cpu | Assign::Scatter if near_far => {
+            assign_cpu(setup, dims, lights, DepthRange::NearFar)
+        }
+        Assign::Cpu | Assign::Scatter => assign_cpu(setup, dims, lights, DepthRange::Cells(bounds)),
+        Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
+            assign_gather_cpu(setup, dims, lights, bounds)
+        }
+        Assign::Auto => unreachable!("resolved by the renderer"),
+    }
+}
+
+pub fn with_ranges_scaled(lights: &[PointLight], f: f32) -> Vec<PointLight> {
+    lights
+        .iter()
+        .map(|l| PointLight {
+            range: l.range * f,
+            ..*l
+        })
+        .collect()
+}
+
+/// The GPU cell bounds against `cell_bounds_cpu` of the same depth buffer: equal within f32
+/// round-off, occupied in the same cells except at most `max_occupancy_differences` (a sample
+/// within round-off of a slice boundary), some cell occupied and, for clusters, some empty.
+pub fn check_cell_bounds(
+    what: &str,
+    setup: &ViewSetup,
+    dims: &GridDims,
+    bounds: &[[f32; 2]],
+    depth: &[f32],
+    max_occupancy_differences: usize,
+) {
+    let cpu = cell_bounds_cpu(setup, dims, depth);
+    assert_eq!(bounds.len(), cpu.len(), "{what}: cell count");
+    let mut emptiness = 0;
+    for (c, (g, b)) in bounds.iter().zip(&cpu).enumerate() {
+        match (g[0] <= g[1], b[0] <= b[1]) {
+            (true, true) => assert!(
+                (g[0] - b[0]).abs() <= 1e-5 * b[0] && (g[1] - b[1]).abs() <= 1e-5 * b[1],
+                "{what}: cell {c} bounds {g:?} vs twin {b:?}"
+            ),
+            (false, false) => {}
+            _ => emptiness += 1, // a sample within round-off of a slice boundary
+        }
+    }
+    assert!(
+        emptiness <= max_occupancy_differences,
+        "{what}: {emptiness} cells differ in occupancy"
+    );
+    assert!(
+        bounds.iter().any(|b| b[0] <= b[1]),
+        "{what}: no cell holds samples"
+    );
+    if dims.slices > 1 {
+        assert!(
+            bounds.iter().any(|b| b[0] > b[1]),
+            "{what}: every cluster occupied"
+        );
+    }
+}
+
+/// A GPU strategy's grid against its CPU twin fed with the same cell bounds: well formed
+/// (counts add up, no light twice in a cell); equal to the twin for `cpu`; for GPU strategies
+/// every cell's set lies between the twin's with all light ranges 0.1% smaller and 0.1% larger
+/// (f32 round-off of the view transform and frustum planes differs between the GPU and the
+/// CPU), and differs from the exact twin in at most `max_disagreements` (cell, light) pairs.
+/// Returns the number of disagreements with the exact twin.
+#[allow(clippy::too_many_arguments)]
+pub fn check_grid_against_twin(
+    what: &str,
+    assign: Assign,
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[PointLight],
+    bounds: &[[f32; 2]],
+    near_far: bool,
+    max_disagreements: usize,
+) -> usize {
+    let total: u64 = grid.cells.iter().map(|c| u64::from(c[1])).sum();
+    assert_eq!(total, grid.indices.len() as u64, "{what}");
+    let sets = sorted_cells(what, grid);
+    let exact = twin(assign, setup, grid, lights, bounds, near_far);
+    if assign == Assign::Cpu {
+        assert_eq!(grid, &exact, "{what}");
+        return 0;
+    }
+    let lo = twin(
+        assign,
+        setup,
+        grid,
+        &with_ranges_scaled(lights, 0.999),
+        bounds,
+        near_far,
+    );
+    let hi = twin(
+        assign,
+        setup,
+        grid,
+        &with_ranges_scaled(lights, 1.001),
+        bounds,
+        near_far,
+    );
+    let mut differing = 0;
+    for (c, set) in sets.iter().enumerate() {
+        assert!(
+            lo.cell(c).iter().all(|l| set.binary_search(l).is_ok()),
+            "{what}: cell {c} misses a light"
+        );
+        let reach = hi.cell(c);
+        assert!(
+            set.iter().all(|l| reach.contains(l)),
+            "{what}: cell {c} lists a light out of reach"
+        );
+        differing += set.len().abs_diff(exact.cell(c).len());
+    }
+    assert!(
+        differing <= max_disagreements,
+        "{what}: {differing} round-off disagreements with the twin"
+    );
+    differing
+}
+
+/// Every cell's list, sorted, asserting that no cell lists a light twice.
+pub fn sorted_cells(what: &str, grid: &LightGrid) -> Vec<Vec<u32>> {
+    (0..grid.cells.len())
+        .map(|c| {
+            let mut list = grid.cell(c).to_vec();
+            list.sort_unstable();
+            let n = list.len();
+            list.dedup();
+            assert_eq!(n, list.len(), "{what}: cell {c} lists a light twice");
+            list
+        })
+        .collect()
+}
+
+/// What [`check_grid_contains_oracle`] found.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OracleCheck {
+    /// (cell, light) pairs the oracle found, all listed by the grid.
+    pub hits: u64,
+    /// Of those, pairs found in the neighbouring slice instead: every sample of the cell that
+    /// the light reaches lies within f32 round-off of the slice boundary, where the GPU may
+    /// have put it into the other slice.
+    pub at_slice_boundary: u64,
+}
+
+/// The brute-force oracle of one frame: for every cell, the lights reaching one of its samples
+/// on the frame's own depth buffer. Lights are 0.1% smaller for the oracle, so a sample within
+/// f32 round-off of a sphere's surface decides nothing.
+pub struct FrameOracle {
+    pub dims: GridDims,
+    pub cells: Vec<Vec<u32>>,
+    view_distance: Vec<f32>,
+    shrunk: Vec<PointLight>,
+}
+
+impl FrameOracle {
+    pub fn new(setup: &ViewSetup, dims: &GridDims, lights: &[PointLight], depth: &[f32]) -> Self {
+        let view_distance = view_distances(setup, depth);
+        let shrunk = with_ranges_scaled(lights, 0.999);
+        let cells = oracle_tile_lights(setup, dims, &shrunk, &view_distance);
+        FrameOracle {
+            dims: *dims,
+            cells,
+            view_distance,
+            shrunk,
+        }
+    }
+
+    /// No missing light: every light the oracle finds for a cell is listed for that cell;
+    /// only a cluster sample within round-off of a slice boundary may count for the
+    /// neighbouring slice, which must then list the light.
+    pub fn check(&self, what: &str, setup: &ViewSetup, grid: &LightGrid) -> OracleCheck {
+        let dims = self.dims;
+        assert_eq!(grid.dims, dims, "{what}: the oracle is for other cells");
+        let sets = sorted_cells(what, grid);
+        let mut check = OracleCheck::default();
+        for (c, must) in self.cells.iter().enumerate() {
+            for &l in must {
+                check.hits += 1;
+                if sets[c].binary_search(&l).is_ok() {
+                    continue;
+                }
+                let light = &self.shrunk[l as usize];
+                assert!(
+                    dims.slices > 1
+                        && listed_across_the_slice_boundary(
+                            setup,
+                            &dims,
+                            &sets,
+                            light,
+                            l,
+                            c,
+                            &self.view_distance
+                        ),
+                    "{what}: cell {c} (tile {} slice {}) misses light {l} {light:?} that reaches \
+                     its samples",
+                    c % dims.tile_count(),
+                    c / dims.tile_count(),
+                );
+                check.at_slice_boundary += 1;
+            }
+        }
+        check
+    }
+}
+
+/// [`FrameOracle::check`] of a frame's grid on its depth buffer.
+pub fn check_grid_contains_oracle(
+    what: &str,
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[PointLight],
+    depth: &[f32],
+) -> OracleCheck {
+    FrameOracle::new(setup, &grid.dims, lights, depth).check(what, setup, grid)
+}
+
+/// Whether every sample of cell `c` that `light` reaches is within round-off of its slice's
+/// boundary and the neighbouring slice's cell lists the light.
+fn listed_across_the_slice_boundary(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    sets: &[Vec<u32>],
+    light: &PointLight,
+    l: u32,
+    c: usize,
+    w: &[f32],
+) -> bool {
+    let v = setup.to_view(light);
+    let (t, k) = (c % dims.tile_count(), (c / dims.tile_count()) as u32);
+    let (x0, y0, x1, y1) = dims.tile_rect(t);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let d = w[(y * dims.width + x) as usize];
+            if !d.is_finite() || dims.slice_of(d) != k {
+                continue;
+            }
+            if setup.sample_position(x, y, d).distance_squared(v.center) >= v.radius * v.radius {
+                continue;
+            }
+            let other = [d * (1.0 - 1e-5), d * (1.0 + 1e-5)]
+                .map(|e| dims.slice_of(e))
+                .into_iter()
+                .find(|&s| s != k);
+            match other {
+                Some(s) => {
+                    let neighbour = s as usize * dims.tile_count() + t;
+                    if sets[neighbour].binary_search(&l).is_err() {
+                        return false;
+                    }
+                }
+                None => return false,
+            }
+        }
+    }
+    true
+}
+
+/// Oracle hits sorted by what made them, so a randomized test can show it exercises the cases
+/// light assignment gets wrong (each counts (cell, light) pairs the oracle finds).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Coverage {
+    pub cases: u64,
+    /// Cases whose frame is not a multiple of the tile size in x or y.
+    pub odd_cases: u64,
+    pub hits: u64,
+    /// Hits of lights that contain the camera.
+    pub containing: u64,
+    /// Hits of lights centred behind the camera (not containing it) that reach forward.
+    pub behind: u64,
+    /// Hits of lights centred in front of the camera that cross the near plane (not
+    /// containing the camera).
+    pub crossing_near: u64,
+    /// Hits of lights centred beyond the near plane but outside the frame (not crossing the
+    /// near plane).
+    pub off_screen: u64,
+    /// Hits in tiles cut short by the frame's right or bottom edge.
+    pub partial_tiles: u64,
+}
+
+impl Coverage {
+    pub fn add(
+        &mut self,
+        setup: &ViewSetup,
+        dims: &GridDims,
+        lights: &[PointLight],
+        oracle: &[Vec<u32>],
+    ) {
+        self.cases += 1;
+        if dims.width % dims.tile_size != 0 || dims.height % dims.tile_size != 0 {
+            self.odd_cases += 1;
+        }
+        // 0 containing, 1 behind, 2 crossing the near plane, 3 off screen, 4 none of these.
+        let kinds: Vec<usize> = lights
+            .iter()
+            .map(|l| {
+                let v = setup.to_view(l);
+                let w = -v.center.z;
+                if v.center.length() < v.radius {
+                    0
+                } else if w < 0.0 {
+                    1
+                } else if (w - setup.near).abs() < v.radius {
+                    2
+                } else if w > setup.near
+                    && ((setup.p00 * v.center.x / w).abs() > 1.0
+                        || (setup.p11 * v.center.y / w).abs() > 1.0)
+                {
+                    3
+                } else {
+                    4
+                }
+            })
+            .collect();
+        for (c, must) in oracle.iter().enumerate() {
+            let (x0, y0, x1, y1) = dims.tile_rect(c % dims.tile_count());
+            let partial = x1 - x0 < dims.tile_size || y1 - y0 < dims.tile_size;
+            for &l in must {
+                self.hits += 1;
+                match kinds[l as usize] {
+                    0 => self.containing += 1,
+                    1 => self.behind += 1,
+                    2 => self.crossing_near += 1,
+                    3 => self.off_screen += 1,
+                    _ => {}
+                }
+                self.partial_tiles += u64::from(partial);
+            }
+        }
+    }
+
+    /// Every count halved: the bound a randomized test keeps against what it measured, so it
+    /// fails when most hits of a kind vanish, not when a seed or a tolerance moves a few.
+    pub fn halved(&self) -> Coverage {
+        Coverage {
+            cases: self.cases / 2,
+            odd_cases: self.odd_cases / 2,
+            hits: self.hits / 2,
+            containing: self.containing / 2,
+            behind: self.behind / 2,
+            crossing_near: self.crossing_near / 2,
+            off_screen: self.off_screen / 2,
+            partial_tiles: self.partial_tiles / 2,
+        }
+    }
+
+    /// Assert every count reaches `min`'s.
+    pub fn at_least(&self, min: &Coverage, what: &str) {
+        let pairs = [
+            ("cases", self.cases, min.cases),
+            (
+                "cases not a multiple of the tile",
+                self.odd_cases,
+                min.odd_cases,
+            ),
+            ("oracle hits", self.hits, min.hits),
+            ("hits of lights behind the camera", self.behind, min.behind),
+            (
+                "hits of lights containing the camera",
+                self.containing,
+                min.containing,
+            ),
+            (
+                "hits of lights crossing the near plane",
+                self.crossing_near,
+                min.crossing_near,
+            ),
+            (
+                "hits of lights centred off screen",
+                self.off_screen,
+                min.off_screen,
+            ),
+            (
+                "hits in partial tiles",
+                self.partial_tiles,
+                min.partial_tiles,
+            ),
+        ];
+        for (name, got, want) in pairs {
+            assert!(
+                got >= want,
+                "{what}: {got} {name}, fewer than {want}: the cases no longer exercise it ({self:?})"
+            );
+        }
+    }
 }
