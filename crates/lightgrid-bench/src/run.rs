@@ -89,6 +89,12 @@ pub struct BenchConfig {
     pub lights: Option<u32>,
     /// Frame whose lights-per-tile heatmap goes into the report (None: the middle one).
     pub heatmap_frame: Option<u32>,
+    /// Fraction of each scene's lights made spots (`--spot-fraction`).
+    #[serde(default)]
+    pub spot_fraction: f32,
+    /// What grid pipelines cull spots by (`--spot-cull`).
+    #[serde(default)]
+    pub spot_cull: lightgrid::pipelines::SpotCull,
 }
 
 impl BenchConfig {
@@ -117,6 +123,7 @@ impl BenchConfig {
             let params = SceneParams {
                 seed: self.seed,
                 lights: Some(n),
+                ..Default::default()
             };
             catalog::check_params(taker, &params)?;
         }
@@ -134,6 +141,11 @@ impl BenchConfig {
             ..Default::default()
         }
         .validate()?;
+        let params = SceneParams {
+            spot_fraction: self.spot_fraction,
+            ..Default::default()
+        };
+        catalog::check_params(&self.scenes[0], &params)?;
         Ok(())
     }
 }
@@ -351,6 +363,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             let params = SceneParams {
                 seed: config.seed,
                 lights: config.lights.filter(|_| variable),
+                spot_fraction: config.spot_fraction,
             };
             catalog::build(name, &params)
         })
@@ -450,6 +463,7 @@ impl<'a> Measuring<'a> {
             } else {
                 lightgrid::pipelines::Assign::default()
             },
+            spot_cull: self.config.spot_cull,
         }
     }
 

@@ -159,6 +159,7 @@ impl ScalingConfig {
             let params = SceneParams {
                 seed: self.seed,
                 lights: Some(n),
+                ..Default::default()
             };
             catalog::check_params(&self.scene, &params)?;
         }
@@ -294,6 +295,7 @@ pub fn run_scaling(
         let params = SceneParams {
             seed: config.seed,
             lights: Some(n),
+            ..Default::default()
         };
         let scene = match catalog::build(&config.scene, &params) {
             Ok(s) => s,

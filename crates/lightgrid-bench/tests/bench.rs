@@ -37,6 +37,8 @@ fn config() -> BenchConfig {
         seed: 1,
         lights: None,
         heatmap_frame: None,
+        spot_fraction: 0.0,
+        spot_cull: Default::default(),
     }
 }
 

@@ -72,6 +72,33 @@ pub(crate) fn parse_size(s: &str) -> Result<Size, String> {
 /// for hours on a software adapter without a better figure).
 pub(crate) const MAX_COUNT: i64 = lightgrid_bench::MAX_REPEATS as i64;
 
+/// A fraction: a finite number from 0 to 1.
+pub(crate) fn parse_fraction(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if (0.0..=1.0).contains(&v) => Ok(v),
+        _ => Err(format!("'{s}' is not a number from 0 to 1")),
+    }
+}
+
+/// `--spot-cull` values.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub(crate) enum SpotCullArg {
+    /// The tightest sphere around each spot's cone.
+    Sphere,
+    /// The sphere, then the cone against each cell's bounding sphere (never misses a lit
+    /// sample, and tighter).
+    Cone,
+}
+
+impl From<SpotCullArg> for lightgrid::pipelines::SpotCull {
+    fn from(a: SpotCullArg) -> Self {
+        match a {
+            SpotCullArg::Sphere => Self::Sphere,
+            SpotCullArg::Cone => Self::Cone,
+        }
+    }
+}
+
 /// A finite number at least 0 (thresholds, budgets).
 pub(crate) fn parse_non_negative(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -86,6 +113,7 @@ pub(crate) struct Given {
     pub(crate) slices: bool,
     pub(crate) gbuffer: bool,
     pub(crate) assign: bool,
+    pub(crate) spot_cull: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -96,10 +124,11 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 3] = [
+    let rules: [(&str, bool, Applies); 4] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
+        ("--spot-cull", given.spot_cull, |p| p.uses_grid),
     ];
     for (flag, given, applies) in rules {
         if given && !chosen.iter().any(|p| applies(p)) {
@@ -135,6 +164,9 @@ pub(crate) struct RendererArgs {
     /// G-buffer channel precision in bits for deferred pipelines [default: 16].
     #[arg(long, value_parser = parse_gbuffer)]
     pub(crate) gbuffer: Option<GBufferFormat>,
+    /// What grid pipelines cull spot lights by [default: cone].
+    #[arg(long, value_enum)]
+    pub(crate) spot_cull: Option<SpotCullArg>,
 }
 
 impl RendererArgs {
@@ -145,6 +177,7 @@ impl RendererArgs {
             gbuffer: self.gbuffer.unwrap_or_default(),
             slices: self.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
             assign: self.assign.unwrap_or(AssignArg::Auto).into(),
+            spot_cull: self.spot_cull.map(Into::into).unwrap_or_default(),
         };
         settings.validate()?;
         Ok(settings)
@@ -156,6 +189,7 @@ impl RendererArgs {
             slices: self.slices.is_some(),
             gbuffer: self.gbuffer.is_some(),
             assign: self.assign.is_some(),
+            spot_cull: self.spot_cull.is_some(),
         }
     }
 }
@@ -177,6 +211,10 @@ pub(crate) struct SceneArgs {
     /// Seed of the scene's random placement.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// Fraction of the scene's lights (0 to 1) turned into spot lights with seeded random
+    /// directions and cones.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = parse_fraction)]
+    pub(crate) spot_fraction: f64,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
@@ -197,6 +235,7 @@ pub(crate) fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
     let params = SceneParams {
         seed: a.seed,
         lights: a.lights,
+        spot_fraction: a.spot_fraction as f32,
     };
     Ok(catalog::build(&a.scene, &params)?)
 }

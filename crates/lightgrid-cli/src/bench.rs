@@ -1,8 +1,8 @@
 //! `lightgrid bench` and `lightgrid report`: the papers' evaluations and their report.
 
 use crate::args::{
-    check_applies, format_duration, parse_gbuffer, parse_size, progress_bar, run_outcome,
-    stop_on_ctrl_c, AssignArg, Given, Size, MAX_COUNT,
+    check_applies, format_duration, parse_fraction, parse_gbuffer, parse_size, progress_bar,
+    run_outcome, stop_on_ctrl_c, AssignArg, Given, Size, SpotCullArg, MAX_COUNT,
 };
 use anyhow::{bail, Result};
 use clap::Args;
@@ -64,6 +64,12 @@ pub(crate) struct BenchArgs {
     pub(crate) lights: Option<u32>,
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// Fraction of each scene's lights (0 to 1) turned into spot lights.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_fraction)]
+    pub(crate) spot_fraction: Option<f64>,
+    /// What grid pipelines cull spot lights by [default: cone].
+    #[arg(long, value_enum)]
+    pub(crate) spot_cull: Option<SpotCullArg>,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
@@ -167,6 +173,8 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         seed: a.seed,
         lights: a.lights,
         heatmap_frame: a.heatmap_frame,
+        spot_fraction: a.spot_fraction.unwrap_or(0.0) as f32,
+        spot_cull: a.spot_cull.map(Into::into).unwrap_or_default(),
     };
     config.validate()?;
     let chosen: Vec<_> = config
@@ -178,6 +186,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         slices: a.slices.is_some(),
         gbuffer: !a.gbuffer.is_empty(),
         assign: a.assign.is_some(),
+        spot_cull: a.spot_cull.is_some(),
     };
     check_applies(given, &chosen)?;
     Ok(config)

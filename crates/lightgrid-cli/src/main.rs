@@ -81,11 +81,13 @@ fn main() {
                     size: Some(Size(640, 360)),
                     lights: None,
                     seed: 1,
+                    spot_fraction: 0.0,
                     renderer: RendererArgs {
                         tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                         slices: None,
                         assign: None,
                         gbuffer: None,
+                        spot_cull: None,
                     },
                     warmup: 1,
                 },

@@ -3,7 +3,8 @@
 //! the frame-time distribution (`lightgrid::realtime`).
 
 use crate::args::{
-    check_applies, parse_size, progress_bar, stop_on_ctrl_c, RendererArgs, Size, MAX_COUNT,
+    check_applies, parse_fraction, parse_size, progress_bar, stop_on_ctrl_c, RendererArgs, Size,
+    MAX_COUNT,
 };
 use crate::files::{Files, Kind};
 use anyhow::{bail, Result};
@@ -50,6 +51,9 @@ pub(crate) struct PlayArgs {
     /// Seed of the scene's random placement.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// Fraction of the scene's lights (0 to 1) turned into spot lights.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = parse_fraction)]
+    pub(crate) spot_fraction: f64,
 }
 
 /// The `--json` file.
@@ -97,6 +101,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
         &SceneParams {
             seed: a.seed,
             lights: a.lights,
+            spot_fraction: a.spot_fraction as f32,
         },
     )?;
     let range = match &a.frames {

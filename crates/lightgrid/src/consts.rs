@@ -36,6 +36,13 @@ pub const TILE_LIGHT_BATCH: u32 = 1024;
 /// round-off can never drop a light that reaches a sample.
 pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 
+/// Relative and absolute widening of a cell's bounding sphere in the spot-cone test (CPU and
+/// GPU), so f32 round-off can never drop a spot that reaches a sample.
+pub const CONE_SLACK: f32 = 1e-3;
+
+/// `GpuLight::cos_outer` of a point light (no cone: below every cosine).
+pub const POINT_LIGHT_COS: f32 = -2.0;
+
 /// Invocations per workgroup of the one-thread-per-item assignment kernels (scatter per light,
 /// radix sort blocks, prefix sums).
 pub const ASSIGN_THREADS: u32 = 256;
@@ -119,6 +126,8 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
+    ("CONE_SLACK", WgslConst::F32(CONE_SLACK)),
+    ("POINT_LIGHT_COS", WgslConst::F32(POINT_LIGHT_COS)),
     ("ASSIGN_THREADS", WgslConst::U32(ASSIGN_THREADS)),
     ("CELL_LIST_CAPACITY", WgslConst::U32(CELL_LIST_CAPACITY)),
     ("MAX_SLICES", WgslConst::U32(MAX_SLICES)),

@@ -3,8 +3,12 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// A point light with a finite range (tiled-shading §1.1). `color` is linear RGB, scaled by
-/// `intensity`; the light contributes nothing at or beyond `range`.
+/// A light with a finite range (tiled-shading §1.1): a point light, or a spot light whose
+/// cone (`direction`, `cos_outer` < `cos_inner`) limits it further. `color` is linear RGB,
+/// scaled by `intensity`; the light contributes nothing at or beyond `range`, nor outside the
+/// outer cone. `cos_outer` = `consts::POINT_LIGHT_COS` marks a point light. `bound_center` and
+/// `bound_radius` are the smallest sphere around everything the light reaches (for a point
+/// light, its range sphere): what light assignment culls by (`Light::bounding_sphere`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
@@ -12,7 +16,17 @@ pub struct GpuLight {
     pub range: f32,
     pub color: [f32; 3],
     pub intensity: f32,
+    pub direction: [f32; 3],
+    pub cos_outer: f32,
+    pub bound_center: [f32; 3],
+    pub bound_radius: f32,
+    pub cos_inner: f32,
+    pub _pad0: f32,
+    pub _pad1: f32,
+    pub _pad2: f32,
 }
+
+pub use crate::consts::POINT_LIGHT_COS;
 
 /// A Blinn-Phong material. `flags` holds `MATERIAL_FLAG_*` bits.
 #[repr(C)]
@@ -51,6 +65,12 @@ pub struct FrameUniforms {
     pub viewport: [f32; 2],
     pub near: f32,
     pub far: f32,
+    /// 1: spot lights are culled by their cone as well as their bounding sphere
+    /// (`SpotCull::Cone`); 0: by the sphere only.
+    pub spot_cull: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// The light grid's shape (`culling/light_grid.wgsl`). A tiled grid has one slice.
@@ -69,10 +89,10 @@ pub struct GridParams {
 }
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 32);
-const _: () = assert!(std::mem::size_of::<GpuLight>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuLight>() == 80);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 288);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
 
 /// One node of the light BVH: 32 bytes (`BvhNode` in `shading/types.wgsl`).
 #[repr(C)]

@@ -25,7 +25,7 @@ use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, Pas
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique};
-use crate::scene::{FrameState, Scene};
+use crate::scene::{FrameState, Scene, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::time::Instant;
 
@@ -266,8 +266,10 @@ impl<'c> Renderer<'c> {
         let (mut upload_bytes, index_count) = self.upload_geometry(scene, &state)?;
         upload_bytes += self.upload_frame_data(&state);
         let (width, height) = self.size();
+        let mut setup = ViewSetup::new(&state.camera, width, height);
+        setup.spot_cull = self.settings.spot_cull;
         Ok(Uploaded {
-            setup: ViewSetup::new(&state.camera, width, height),
+            setup,
             index_count,
             state,
             upload_bytes,
@@ -385,6 +387,10 @@ impl<'c> Renderer<'c> {
             viewport: [width as f32, height as f32],
             near: state.camera.near,
             far: state.camera.far,
+            spot_cull: u32::from(self.settings.spot_cull == SpotCull::Cone),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         };
         ctx.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));

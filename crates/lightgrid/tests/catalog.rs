@@ -1,10 +1,10 @@
 //! The catalog's scenes: exact light counts and ranges, determinism, and bad input.
 
 use lightgrid::scene::catalog::{self, SceneParams, SCENES};
-use lightgrid::scene::PointLight;
+use lightgrid::scene::Light;
 use lightgrid::Error;
 
-fn lights_of(name: &str) -> Vec<PointLight> {
+fn lights_of(name: &str) -> Vec<Light> {
     let scene = catalog::build(name, &SceneParams::default()).expect(name);
     scene.frame(0).lights
 }
@@ -26,6 +26,7 @@ fn light_counts_and_ranges_are_the_papers() {
             &SceneParams {
                 seed: 1,
                 lights: Some(n),
+                ..Default::default()
             },
         )
         .unwrap();
@@ -70,6 +71,7 @@ fn scenes_are_deterministic_from_the_seed() {
         &SceneParams {
             seed: 2,
             lights: None,
+            ..Default::default()
         },
     )
     .unwrap()
@@ -105,6 +107,7 @@ fn bad_input_is_a_typed_error() {
         &SceneParams {
             seed: 1,
             lights: Some(0),
+            ..Default::default()
         },
     );
     assert!(matches!(zero, Err(Error::Invalid { .. })));
@@ -113,6 +116,7 @@ fn bad_input_is_a_typed_error() {
         &SceneParams {
             seed: 1,
             lights: Some(1_000_001),
+            ..Default::default()
         },
     );
     assert!(matches!(too_many, Err(Error::Invalid { .. })));
@@ -121,6 +125,7 @@ fn bad_input_is_a_typed_error() {
         &SceneParams {
             seed: 1,
             lights: Some(5),
+            ..Default::default()
         },
     );
     assert!(matches!(fixed, Err(Error::Invalid { .. })));

@@ -46,7 +46,20 @@ fn gpu_structs_match_wgsl() {
         &module,
         "Light",
         GpuLight,
-        [position, range, color, intensity]
+        [
+            position,
+            range,
+            color,
+            intensity,
+            direction,
+            cos_outer,
+            bound_center,
+            bound_radius,
+            cos_inner,
+            _pad0,
+            _pad1,
+            _pad2
+        ]
     );
     check_layout!(
         &module,
@@ -90,7 +103,11 @@ fn gpu_structs_match_wgsl() {
             light_count,
             viewport,
             near,
-            far
+            far,
+            spot_cull,
+            _pad0,
+            _pad1,
+            _pad2
         ]
     );
 }

@@ -335,6 +335,89 @@ fn robots_few_tile_32_odd_resolution_camera_inside_light_volumes() {
     check_scene("robots-few", 200, (170, 100), settings(32));
 }
 
+/// Spot lights in every pipeline: `robots-many` with half its lights made spots, and `stress`
+/// with every light a spot, both culled by their cones (the default) and, on `stress`, by
+/// their bounding spheres; every pipeline must still equal `forward`.
+#[test]
+fn spot_lights_render_the_same_in_every_pipeline() {
+    let params = |lights, spot_fraction| SceneParams {
+        lights,
+        spot_fraction,
+        ..Default::default()
+    };
+    let street = catalog::build("robots-many", &params(None, 0.5)).unwrap();
+    assert!(
+        street
+            .lights
+            .iter()
+            .filter(|l| l.light.spot.is_some())
+            .count()
+            > 300
+    );
+    check(&street, 200, (149, 83), settings(8));
+    let stress = catalog::build("stress", &params(Some(3000), 1.0)).unwrap();
+    check(&stress, 3, (131, 77), settings(16));
+    let spheres = RenderSettings {
+        spot_cull: lightgrid::pipelines::SpotCull::Sphere,
+        ..settings(16)
+    };
+    check(&stress, 3, (131, 77), spheres);
+}
+
+/// Culling by the cone lists fewer lights than by the bounding sphere, which lists fewer than
+/// the range sphere would, and all three shade the same image.
+#[test]
+fn cone_culling_is_tighter_than_sphere_culling() {
+    let ctx = common::gpu();
+    let points = catalog::build(
+        "stress",
+        &SceneParams {
+            lights: Some(3000),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut spots = points.clone();
+    let with_cones = catalog::build(
+        "stress",
+        &SceneParams {
+            lights: Some(3000),
+            spot_fraction: 1.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for (a, b) in spots.lights.iter_mut().zip(&with_cones.lights) {
+        a.light.spot = b.light.spot;
+    }
+    let count = |scene: &lightgrid::scene::Scene, spot_cull| {
+        let settings = RenderSettings {
+            spot_cull,
+            ..settings(16)
+        };
+        let mut r = Renderer::new(&ctx, 160, 90, settings).unwrap();
+        let out = r.render(scene, 3, "clustered_deferred").unwrap();
+        (
+            out.stats.lighting_computations.unwrap(),
+            out.stats.ideal_lighting_computations,
+            out.image,
+        )
+    };
+    use lightgrid::pipelines::SpotCull;
+    let (range, _, _) = count(&points, SpotCull::Cone);
+    let (sphere, ideal_s, img_s) = count(&spots, SpotCull::Sphere);
+    let (cone, ideal_c, img_c) = count(&spots, SpotCull::Cone);
+    assert_eq!(ideal_s, ideal_c, "the ideal does not depend on the culling");
+    assert!(ideal_c > 0);
+    assert!(cone >= ideal_c, "cone {cone} below the ideal {ideal_c}");
+    assert!(
+        cone < sphere && sphere < range,
+        "range {range}, sphere {sphere}, cone {cone}"
+    );
+    let d = lightgrid::image_io::diff(&img_s, &img_c).unwrap().0;
+    assert!(d.max <= 1.0, "{d:?}");
+}
+
 #[test]
 fn random_fps_tile_16_with_32_bit_gbuffer() {
     check_scene(
@@ -345,7 +428,7 @@ fn random_fps_tile_16_with_32_bit_gbuffer() {
             tile_size: 16,
             gbuffer: GBufferFormat::F32,
             slices: 24,
-            assign: Default::default(),
+            ..Default::default()
         },
     );
 }

@@ -18,7 +18,8 @@ use super::{GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
-use crate::scene::PointLight;
+use crate::scene::Light;
+use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -112,11 +113,52 @@ pub fn project_sphere(setup: &ViewSetup, light: &ViewLight) -> Option<PixelRect>
     })
 }
 
+/// Per cell, the bounding sphere of its frustum piece (`ViewSetup::cell_sphere`) over the
+/// depth range its samples span (near..far without bounds; nothing for an empty cell); None
+/// when no light is culled by a cone (no spots, or `SpotCull::Sphere`).
+pub fn cell_spheres(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    depth: &DepthRange,
+    lights: &[Light],
+) -> Option<Vec<(Vec3, f32)>> {
+    let cones = setup.spot_cull == crate::scene::SpotCull::Cone;
+    if !cones || lights.iter().all(|l| l.spot.is_none()) {
+        return None;
+    }
+    let tiles = dims.tile_count();
+    let spheres = match depth {
+        // The GPU strategies' bounds are [near, far] here, widened by the slack as below.
+        DepthRange::NearFar => (0..tiles)
+            .map(|t| {
+                let (lo, hi) = (
+                    setup.near * (1.0 - DEPTH_SLACK),
+                    setup.far * (1.0 + DEPTH_SLACK),
+                );
+                setup.cell_sphere(dims.tile_rect(t), lo, hi)
+            })
+            .collect(),
+        DepthRange::Cells(bounds) => bounds
+            .iter()
+            .enumerate()
+            .map(|(cell, &[lo, hi])| {
+                if lo > hi {
+                    return (Vec3::ZERO, 0.0);
+                }
+                let lo = lo * (1.0 - DEPTH_SLACK);
+                let hi = hi * (1.0 + DEPTH_SLACK);
+                setup.cell_sphere(dims.tile_rect(cell % tiles), lo, hi)
+            })
+            .collect(),
+    };
+    Some(spheres)
+}
+
 /// Build the tile grid on the CPU.
 pub fn assign_cpu(
     setup: &ViewSetup,
     dims: &GridDims,
-    lights: &[PointLight],
+    lights: &[Light],
     depth: DepthRange,
 ) -> LightGrid {
     struct Placed {
@@ -126,6 +168,7 @@ pub fn assign_cpu(
         ty1: u32,
         w_min: f32,
         w_max: f32,
+        view: ViewLight,
     }
     let placed: Vec<Option<Placed>> = lights
         .par_iter()
@@ -140,6 +183,7 @@ pub fn assign_cpu(
                 ty1: rect.y1 / t,
                 w_min: -v.center.z - v.radius,
                 w_max: -v.center.z + v.radius,
+                view: v,
             })
         })
         .collect();
@@ -155,6 +199,13 @@ pub fn assign_cpu(
     let overlaps = |p: &Placed, lo: f32, hi: f32| {
         lo <= hi && p.w_max >= lo * (1.0 - DEPTH_SLACK) && p.w_min <= hi * (1.0 + DEPTH_SLACK)
     };
+    // Spots culled by their cone test it against each cell's bounding sphere.
+    let spheres = cell_spheres(setup, dims, &depth, lights);
+    let cone_reaches = |p: &Placed, cell: usize| {
+        spheres
+            .as_ref()
+            .is_none_or(|s| p.view.may_reach_sphere(s[cell].0, s[cell].1))
+    };
     // (cell, light) pairs per row; a cell belongs to one row and lights are visited in index
     // order, so each cell's list comes out sorted.
     let pairs: Vec<Vec<(u32, u32)>> = rows
@@ -169,14 +220,18 @@ pub fn assign_cpu(
                 for tx in p.tx0..=p.tx1 {
                     let tile = ty * dims.tiles_x as usize + tx as usize;
                     match depth {
-                        DepthRange::NearFar => out.push((tile as u32, l)),
+                        DepthRange::NearFar => {
+                            if cone_reaches(p, tile) {
+                                out.push((tile as u32, l));
+                            }
+                        }
                         DepthRange::Cells(bounds) => {
                             let k0 = dims.slice_of(p.w_min * (1.0 - DEPTH_SLACK));
                             let k1 = dims.slice_of(p.w_max * (1.0 + DEPTH_SLACK));
                             for k in k0..=k1 {
                                 let cell = k as usize * tiles + tile;
                                 let [lo, hi] = bounds[cell];
-                                if overlaps(p, lo, hi) {
+                                if overlaps(p, lo, hi) && cone_reaches(p, cell) {
                                     out.push((cell as u32, l));
                                 }
                             }

@@ -9,7 +9,7 @@
 //! spheres, padded for round-off), so the traversal never prunes a light the gather test
 //! would keep, and the lists it builds equal gather's.
 
-use super::gather::{cpu_frustum, margin, CpuFrustum};
+use super::gather::{cpu_frustum, light_margin, CpuFrustum};
 use super::gpu_assign::{bvh_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use super::{GridDims, LightGrid, ViewSetup};
@@ -18,7 +18,7 @@ use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
 use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, STORAGE_READ};
-use crate::scene::PointLight;
+use crate::scene::Light;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -97,14 +97,19 @@ pub fn bvh_levels(lights: usize) -> Vec<(u32, u32)> {
 }
 
 /// Build the hierarchy over `lights` as seen by `setup`'s camera.
-pub fn build_bvh(setup: &ViewSetup, lights: &[PointLight]) -> LightBvh {
+pub fn build_bvh(setup: &ViewSetup, lights: &[Light]) -> LightBvh {
     if lights.is_empty() {
         return LightBvh::default();
     }
-    let centers: Vec<Vec3> = lights
+    // Each light as its bounding sphere (a spot's cone sector, `Light::bounding_sphere`).
+    let spheres: Vec<(Vec3, f32)> = lights
         .par_iter()
-        .map(|l| setup.view.transform_point3(l.position))
+        .map(|l| {
+            let (c, r) = l.bounding_sphere();
+            (setup.view.transform_point3(c), r)
+        })
         .collect();
+    let centers: Vec<Vec3> = spheres.iter().map(|s| s.0).collect();
     let (lo, hi) = centers.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), &c| (lo.min(c), hi.max(c)),
@@ -125,8 +130,7 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[PointLight]) -> LightBvh {
             let mut lo = Vec3::splat(f32::INFINITY);
             let mut hi = Vec3::splat(f32::NEG_INFINITY);
             for &l in chunk {
-                let c = centers[l as usize];
-                let r = lights[l as usize].range;
+                let (c, r) = spheres[l as usize];
                 let e = Vec3::splat(r + pad(c, r));
                 lo = lo.min(c - e);
                 hi = hi.max(c + e);
@@ -195,7 +199,7 @@ fn box_in_cell(f: &CpuFrustum, n: &BvhNode) -> bool {
 pub fn traverse_bvh_cpu(
     setup: &ViewSetup,
     dims: &GridDims,
-    lights: &[PointLight],
+    lights: &[Light],
     cell_bounds: &[[f32; 2]],
     bvh: &LightBvh,
 ) -> LightGrid {
@@ -213,9 +217,7 @@ pub fn traverse_bvh_cpu(
                 for child in node.children() {
                     if node.is_leaf() {
                         let l = bvh.order[child as usize];
-                        let light = &lights[l as usize];
-                        let center = setup.view.transform_point3(light.position);
-                        if margin(&f, center, light.range) >= 0.0 {
+                        if light_margin(&f, &setup.to_view(&lights[l as usize])) >= 0.0 {
                             out.push(l);
                         }
                     } else if box_in_cell(&f, &bvh.nodes[child as usize]) {

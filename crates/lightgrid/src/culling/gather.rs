@@ -1,16 +1,17 @@
 //! CPU twin of the GPU gather and BVH traversal (`gather.wgsl`, `bvh.wgsl`, driven by
-//! `gpu_assign.rs`): per cell, the lights whose sphere reaches into the cell's frustum (its
-//! tile's four side planes and its samples' view-distance bounds), computed exactly as
-//! `tile_frustum` / `sphere_in_tile` in `tile_frustum.wgsl`, in the same f32 arithmetic.
+//! `gpu_assign.rs`): per cell, the lights whose bounding sphere reaches into the cell's
+//! frustum (its tile's four side planes and its samples' view-distance bounds) and, for spots,
+//! whose cone may reach the frustum's bounding sphere, computed as `tile_frustum` /
+//! `light_in_tile` in `tile_frustum.wgsl`, in the same f32 arithmetic.
 
 use super::gpu_assign::{gather_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{GridDims, LightGrid, ViewSetup};
+use super::{GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
-use crate::scene::PointLight;
+use crate::scene::Light;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -19,6 +20,9 @@ pub(super) struct CpuFrustum {
     pub planes: [Vec3; 4],
     pub w_min: f32,
     pub w_max: f32,
+    /// Bounding sphere of the frustum piece (`ViewSetup::cell_sphere` over the slack-widened
+    /// bounds), for spot cones.
+    pub sphere: (Vec3, f32),
 }
 
 pub(super) fn cpu_frustum(
@@ -43,6 +47,11 @@ pub(super) fn cpu_frustum(
         ],
         w_min: w_bounds[0],
         w_max: w_bounds[1],
+        sphere: setup.cell_sphere(
+            dims.tile_rect(t),
+            w_bounds[0] * (1.0 - ASSIGN_DEPTH_SLACK),
+            w_bounds[1] * (1.0 + ASSIGN_DEPTH_SLACK),
+        ),
     }
 }
 
@@ -61,23 +70,30 @@ pub(super) fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
     m
 }
 
+/// `light_in_tile` in WGSL: the light's bounding sphere against the frustum, and a spot's
+/// cone against the frustum's bounding sphere; the smaller margin.
+pub(super) fn light_margin(f: &CpuFrustum, v: &ViewLight) -> f32 {
+    let m = margin(f, v.center, v.radius);
+    if m < 0.0 || v.cone.is_none() {
+        return m;
+    }
+    m.min(v.cone_margin(f.sphere.0, f.sphere.1))
+}
+
 /// Per cell and light, the gather test's margin (cells in grid order, lights in order).
 /// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`).
 pub fn gather_margins(
     setup: &ViewSetup,
     dims: &GridDims,
-    lights: &[PointLight],
+    lights: &[Light],
     cell_bounds: &[[f32; 2]],
 ) -> Vec<Vec<f32>> {
-    let centers: Vec<(Vec3, f32)> = lights
-        .iter()
-        .map(|l| (setup.view.transform_point3(l.position), l.range))
-        .collect();
+    let view: Vec<ViewLight> = lights.iter().map(|l| setup.to_view(l)).collect();
     (0..dims.cell_count())
         .into_par_iter()
         .map(|c| {
             let f = cpu_frustum(setup, dims, c % dims.tile_count(), cell_bounds[c]);
-            centers.iter().map(|(p, r)| margin(&f, *p, *r)).collect()
+            view.iter().map(|v| light_margin(&f, v)).collect()
         })
         .collect()
 }
@@ -87,7 +103,7 @@ pub fn gather_margins(
 pub fn assign_gather_cpu(
     setup: &ViewSetup,
     dims: &GridDims,
-    lights: &[PointLight],
+    lights: &[Light],
     cell_bounds: &[[f32; 2]],
 ) -> LightGrid {
     let lists: Vec<Vec<u32>> = gather_margins(setup, dims, lights, cell_bounds)

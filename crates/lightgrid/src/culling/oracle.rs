@@ -3,16 +3,16 @@
 //! count: for every visible sample, the lights whose range reaches it.
 
 use super::{GridDims, LightGrid, ViewSetup};
-use crate::scene::PointLight;
+use crate::scene::Light;
 use rayon::prelude::*;
 
-/// For every cell (tile, or tile × slice), the lights whose sphere contains at least one of the
-/// cell's samples. `view_distance[y * width + x]` is the sample's view distance; non-finite
+/// For every cell (tile, or tile × slice), the lights that reach at least one of the cell's
+/// samples (inside the range and, for a spot, the outer cone). `view_distance[y * width + x]` is the sample's view distance; non-finite
 /// means no sample.
 pub fn oracle_tile_lights(
     setup: &ViewSetup,
     dims: &GridDims,
-    lights: &[PointLight],
+    lights: &[Light],
     view_distance: &[f32],
 ) -> Vec<Vec<u32>> {
     let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
@@ -35,10 +35,7 @@ pub fn oracle_tile_lights(
                     view_lights
                         .iter()
                         .enumerate()
-                        .filter(|(_, l)| {
-                            s.iter()
-                                .any(|p| p.distance_squared(l.center) < l.radius * l.radius)
-                        })
+                        .filter(|(_, l)| s.iter().any(|&p| l.reaches(p)))
                         .map(|(i, _)| i as u32)
                         .collect()
                 })
@@ -55,13 +52,13 @@ pub fn oracle_tile_lights(
     cells
 }
 
-/// The ideal count: for every sample with a finite view distance, the number of lights whose
-/// range reaches it. `grid` must contain every such light for the sample's tile (the CPU
+/// The ideal count: for every sample with a finite view distance, the number of lights that
+/// reach it (range and cone). `grid` must contain every such light for the sample's tile (the CPU
 /// assignment does; the culling tests prove it), so only its lists are searched.
 pub fn ideal_lighting_computations(
     setup: &ViewSetup,
     grid: &LightGrid,
-    lights: &[PointLight],
+    lights: &[Light],
     view_distance: &[f32],
 ) -> u64 {
     let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
@@ -77,8 +74,7 @@ pub fn ideal_lighting_computations(
                 }
                 let p = setup.sample_position(x, y, w);
                 for &l in grid.cell(dims.cell_of(x, y, w)) {
-                    let v = &view_lights[l as usize];
-                    if p.distance_squared(v.center) < v.radius * v.radius {
+                    if view_lights[l as usize].reaches(p) {
                         n += 1;
                     }
                 }

@@ -108,8 +108,8 @@ fn rect_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         return;
     }
     let light = lights[l];
-    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
-    let rect = light_tiles(c, light.range);
+    let c = (frame.view * vec4<f32>(light.bound_center, 1.0)).xyz;
+    let rect = light_tiles(c, light.bound_radius);
     light_rects[l] = rect;
     var n = 0u;
     if (rect.x <= rect.z && rect.y <= rect.w) {
@@ -160,9 +160,12 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let tile = u32(rect.y + i32(k / width)) * grid.tiles_x + u32(rect.x + i32(k % width));
 
     let light = lights[l];
-    let c = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
-    let w_min = -c.z - light.range;
-    let w_max = -c.z + light.range;
+    let c = (frame.view * vec4<f32>(light.bound_center, 1.0)).xyz;
+    let w_min = -c.z - light.bound_radius;
+    let w_max = -c.z + light.bound_radius;
+    // Spots culled by their cone test it against each cell's sphere, as assign_cpu does.
+    let by_cone = frame.spot_cull != 0u && light.cos_outer > POINT_LIGHT_COS;
+    let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);
     let k0 = grid_slice(w_min * (1.0 - ASSIGN_DEPTH_SLACK));
     let k1 = grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
     let tiles = grid.tiles_x * grid.tiles_y;
@@ -171,7 +174,8 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     for (; s <= k1; s = s + 1u) {
         let cell = s * tiles + tile;
         let b = cell_bounds[cell];
-        if (b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK)) {
+        let in_depth = b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
+        if (in_depth && (!by_cone || cone_margin(light, tile_frustum(xy, grid.tile_size, b).sphere) >= 0.0)) {
             let slot = atomicAdd(&frame_counters[COUNTER_PAIRS_NEEDED], 1u);
             if (slot < capacity) {
                 pair_keys[slot] = cell;

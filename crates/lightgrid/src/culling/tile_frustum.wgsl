@@ -6,6 +6,9 @@ struct TileFrustum {
     planes: array<vec3<f32>, 4>,  // inward unit normals of the side planes
     w_min: f32,
     w_max: f32,
+    // Bounding sphere (centre, radius) of the frustum piece between the slack-widened depth
+    // bounds: what spot cones are tested against (`ViewSetup::cell_sphere`).
+    sphere: vec4<f32>,
 }
 
 // `tile`: tile coordinates; `w_range`: the view-distance [min, max] of the samples the frustum
@@ -25,7 +28,29 @@ fn tile_frustum(tile: vec2<u32>, tile_size: u32, w_range: vec2<f32>) -> TileFrus
     f.planes[3] = normalize(vec3<f32>(0.0, -1.0, -ndc_lo.y / p11));
     f.w_min = w_range.x;
     f.w_max = w_range.y;
+    f.sphere = frustum_sphere(ndc_lo, ndc_hi, w_range.x * (1.0 - ASSIGN_DEPTH_SLACK), w_range.y * (1.0 + ASSIGN_DEPTH_SLACK));
     return f;
+}
+
+// The centre of the eight corners of the frustum piece over NDC rectangle [lo, hi] between
+// view distances w0 and w1, and its farthest corner.
+fn frustum_sphere(ndc_lo: vec2<f32>, ndc_hi: vec2<f32>, w0: f32, w1: f32) -> vec4<f32> {
+    var corners: array<vec3<f32>, 8>;
+    var i = 0u;
+    var centre = vec3<f32>(0.0);
+    for (var k = 0u; k < 8u; k = k + 1u) {
+        let w = select(w0, w1, (k & 4u) != 0u);
+        let nx = select(ndc_lo.x, ndc_hi.x, (k & 2u) != 0u);
+        let ny = select(ndc_lo.y, ndc_hi.y, (k & 1u) != 0u);
+        corners[k] = vec3<f32>(nx / frame.proj[0][0] * w, ny / frame.proj[1][1] * w, -w);
+        centre = centre + corners[k];
+    }
+    centre = centre / 8.0;
+    var radius = 0.0;
+    for (var k = 0u; k < 8u; k = k + 1u) {
+        radius = max(radius, distance(corners[k], centre));
+    }
+    return vec4<f32>(centre, radius);
 }
 
 // View-distance range of a tile's [min, max] depth-buffer values (an empty tile stays empty:
@@ -48,6 +73,31 @@ fn sphere_in_tile(f: TileFrustum, c: vec3<f32>, r: f32) -> bool {
     return true;
 }
 
+// How far a spot's cone reaches into the view-space sphere `cell` (>= 0: it may reach it);
+// 1 for point lights and when spots are culled by their sphere only (`spot_cull` 0). The
+// argument for why this never rejects a sphere the cone reaches is at its CPU twin,
+// `ViewLight::cone_margin`.
+fn cone_margin(light: Light, cell: vec4<f32>) -> f32 {
+    if (frame.spot_cull == 0u || light.cos_outer <= POINT_LIGHT_COS) {
+        return 1.0;
+    }
+    let r = cell.w * (1.0 + CONE_SLACK) + CONE_SLACK;
+    let apex = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
+    let axis = normalize((frame.view * vec4<f32>(light.direction, 0.0)).xyz);
+    let v = cell.xyz - apex;
+    let m = light.range + r - length(v);
+    if (light.cos_outer <= 0.0) {
+        return m;
+    }
+    let along = dot(v, axis);
+    let across = sqrt(max(dot(v, v) - along * along, 0.0));
+    let sin_outer = sqrt(max(1.0 - light.cos_outer * light.cos_outer, 0.0));
+    return min(m, min(along + r, r - (light.cos_outer * across - along * sin_outer)));
+}
+
+// A light reaches into the frustum when its bounding sphere does and, for a spot, its cone
+// may reach the frustum's bounding sphere.
 fn light_in_tile(f: TileFrustum, light: Light) -> bool {
-    return sphere_in_tile(f, (frame.view * vec4<f32>(light.position, 1.0)).xyz, light.range);
+    let c = (frame.view * vec4<f32>(light.bound_center, 1.0)).xyz;
+    return sphere_in_tile(f, c, light.bound_radius) && cone_margin(light, f.sphere) >= 0.0;
 }

@@ -11,14 +11,14 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_slices, validate_tile_size, Assign, GBufferFormat, RenderSettings,
+    validate_slices, validate_tile_size, Assign, GBufferFormat, RenderSettings, SpotCull,
     AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::Targets;
 
 use crate::error::Result;
 use crate::gpu::{read_buffer, scoped, PassTimer, PassTiming};
-use crate::scene::{PointLight, ViewSetup};
+use crate::scene::{Light, ViewSetup};
 use std::time::Instant;
 
 /// What a pipeline reads to render one frame.
@@ -36,7 +36,7 @@ pub struct FrameInputs<'a> {
     /// Camera and frame size, for CPU light assignment.
     pub setup: ViewSetup,
     /// The frame's lights (world space), as uploaded to group 0.
-    pub lights: &'a [PointLight],
+    pub lights: &'a [Light],
     /// The count target is blended into (see `PipelineContext::count_blend`).
     pub count_blend: bool,
 }

@@ -12,7 +12,11 @@ pub struct RenderSettings {
     pub slices: u32,
     /// Who builds the grid (`--assign`).
     pub assign: Assign,
+    /// What spot lights are culled by (`--spot-cull`), in every strategy.
+    pub spot_cull: SpotCull,
 }
+
+pub use crate::scene::SpotCull;
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -21,6 +25,7 @@ impl Default for RenderSettings {
             gbuffer: GBufferFormat::F16,
             slices: crate::consts::DEFAULT_SLICES,
             assign: Assign::default(),
+            spot_cull: SpotCull::default(),
         }
     }
 }

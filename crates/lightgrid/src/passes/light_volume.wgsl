@@ -17,7 +17,7 @@ struct VolumeOut {
 fn vs_volume(v: VolumeIn) -> VolumeOut {
     let l = lights[v.light];
     var out: VolumeOut;
-    out.clip = frame.view_proj * vec4<f32>(l.position + v.position * l.range, 1.0);
+    out.clip = frame.view_proj * vec4<f32>(l.bound_center + v.position * l.bound_radius, 1.0);
     out.light = v.light;
     return out;
 }

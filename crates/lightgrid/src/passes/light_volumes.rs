@@ -19,7 +19,7 @@
 //! positions, and a texture cannot be a written stencil attachment and sampled in one pass.
 
 use crate::scene::ViewSetup;
-use crate::scene::{Mesh, PointLight};
+use crate::scene::{Light, Mesh};
 use std::ops::Range;
 
 pub const VOLUME_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
@@ -47,7 +47,7 @@ pub struct VolumeClasses {
 
 /// Sort the lights into draw classes (see the module docs). Lights that cannot reach any
 /// sample (entirely behind the near plane or beyond the far plane) are left out.
-pub fn classify_lights(setup: &ViewSetup, lights: &[PointLight], stencil: bool) -> VolumeClasses {
+pub fn classify_lights(setup: &ViewSetup, lights: &[Light], stencil: bool) -> VolumeClasses {
     let mut c = VolumeClasses::default();
     for (i, l) in lights.iter().enumerate() {
         let v = setup.to_view(l);

@@ -15,7 +15,7 @@ use crate::shader::ComposedShader;
 
 pub use crate::culling::Assign;
 use crate::frame::GBufferFormat;
-pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings};
+pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings, SpotCull};
 
 /// What a pipeline needs to create its GPU objects.
 pub struct PipelineContext<'a> {

@@ -6,8 +6,8 @@
 //! lights, top-down and first-person); `stress` takes any light count for scaling runs.
 
 use super::{
-    CameraPath, LightAnchor, Material, Mesh, Motion, Object, Path, PointLight, Rng, Scene,
-    SceneLight,
+    CameraPath, Light, LightAnchor, Material, Mesh, Motion, Object, Path, Rng, Scene, SceneLight,
+    Spot,
 };
 use crate::error::{Error, Result};
 use glam::{Mat4, Vec3};
@@ -36,6 +36,9 @@ pub struct SceneParams {
     pub seed: u64,
     /// Light count; only scenes with `variable_lights` accept it.
     pub lights: Option<u32>,
+    /// Fraction of the lights (0 to 1) turned into spot lights with seeded random directions
+    /// and cones (`--spot-fraction`).
+    pub spot_fraction: f32,
 }
 
 impl Default for SceneParams {
@@ -43,7 +46,38 @@ impl Default for SceneParams {
         SceneParams {
             seed: 1,
             lights: None,
+            spot_fraction: 0.0,
         }
+    }
+}
+
+/// Outer half-angles of the spots `--spot-fraction` makes, in degrees (street lamps to wide
+/// floods); the inner cone is 50% to 90% of the outer.
+pub const SPOT_OUTER_DEGREES: (f32, f32) = (15.0, 75.0);
+
+/// Turn `fraction` of the scene's lights into spots: each light is chosen with that
+/// probability from its own seeded stream, so the choice and the cones do not depend on the
+/// light count. Directions are uniform on the sphere.
+fn make_spots(scene: &mut Scene, seed: u64, fraction: f32) {
+    if fraction <= 0.0 {
+        return;
+    }
+    let mut rng = Rng::new(seed ^ 0x5907_11a4_c0de_0001);
+    for l in &mut scene.lights {
+        let (pick, z, phi, outer, inner) = (
+            rng.unit(),
+            rng.range(-1.0, 1.0),
+            rng.range(0.0, std::f32::consts::TAU),
+            rng.range(SPOT_OUTER_DEGREES.0, SPOT_OUTER_DEGREES.1),
+            rng.range(0.5, 0.9),
+        );
+        if pick >= fraction {
+            continue;
+        }
+        let xy = (1.0 - z * z).max(0.0).sqrt();
+        let direction = Vec3::new(xy * phi.cos(), z, xy * phi.sin());
+        let outer = outer.to_radians();
+        l.light.spot = Some(Spot::new(direction, outer * inner, outer));
     }
 }
 
@@ -137,6 +171,10 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
             "--lights",
             format!("{n} is out of range 1 to {STRESS_MAX_LIGHTS}"),
         )),
+        _ if !(0.0..=1.0).contains(&params.spot_fraction) => Err(Error::invalid(
+            "--spot-fraction",
+            format!("{} is out of range 0 to 1", params.spot_fraction),
+        )),
         _ => Ok(info),
     }
 }
@@ -144,7 +182,8 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
 /// Build a catalog scene by name.
 pub fn build(name: &str, params: &SceneParams) -> Result<Scene> {
     let info = check_params(name, params)?;
-    let scene = (info.build)(params);
+    let mut scene = (info.build)(params);
+    make_spots(&mut scene, params.seed, params.spot_fraction);
     scene.validate()?;
     Ok(scene)
 }
@@ -188,7 +227,7 @@ impl Builder {
         self.scene.objects.len() - 1
     }
 
-    fn light(&mut self, light: PointLight, anchor: LightAnchor) {
+    fn light(&mut self, light: Light, anchor: LightAnchor) {
         self.scene.lights.push(SceneLight { light, anchor });
     }
 
@@ -439,11 +478,12 @@ fn robots_many(p: &SceneParams) -> Scene {
         for k in 0..per_path {
             let (pos, dir) = b.scene.paths[path].sample((k as f32 + 0.5) * len / per_path as f32);
             let sideways = dir.cross(Vec3::Y) * b.rng.range(-5.0, 5.0);
-            let light = PointLight {
+            let light = Light {
                 position: pos + sideways + Vec3::Y * b.rng.range(1.0, 6.0),
                 color: b.light_color(),
                 intensity: 0.35,
                 range: ROBOTS_MANY_RANGE,
+                spot: None,
             };
             b.light(light, LightAnchor::World);
         }
@@ -454,11 +494,12 @@ fn robots_many(p: &SceneParams) -> Scene {
 fn robots_few(p: &SceneParams) -> Scene {
     let (mut b, robots) = robots_street("robots-few", p.seed);
     for body in robots {
-        let light = PointLight {
+        let light = Light {
             position: Vec3::new(0.0, 14.0, 0.0),
             color: b.light_color(),
             intensity: 1.2,
             range: ROBOTS_FEW_RANGE,
+            spot: None,
         };
         b.light(light, LightAnchor::Object(body));
     }
@@ -530,7 +571,7 @@ fn scattered(p: &SceneParams) -> Scene {
     }
     b.object(blocks, shiny, Motion::Static);
     for _ in 0..SCATTERED_LIGHTS {
-        let light = PointLight {
+        let light = Light {
             position: Vec3::new(
                 b.rng.range(-100.0, 100.0),
                 b.rng.range(0.5, 35.0),
@@ -539,6 +580,7 @@ fn scattered(p: &SceneParams) -> Scene {
             color: b.light_color(),
             intensity: 0.6,
             range: 10.0,
+            spot: None,
         };
         b.light(light, LightAnchor::World);
     }
@@ -559,7 +601,7 @@ fn random_field(name: &str, seed: u64, camera: CameraPath) -> Scene {
     let field = b.block_field(80.0, 12, 2.5, (1.0, 9.0));
     b.object(field, block, Motion::Static);
     for _ in 0..RANDOM_LIGHTS {
-        let light = PointLight {
+        let light = Light {
             position: Vec3::new(
                 b.rng.range(-80.0, 80.0),
                 b.rng.range(0.5, 6.0),
@@ -568,6 +610,7 @@ fn random_field(name: &str, seed: u64, camera: CameraPath) -> Scene {
             color: b.light_color(),
             intensity: 0.9,
             range: 9.0,
+            spot: None,
         };
         b.light(light, LightAnchor::World);
     }
@@ -633,7 +676,7 @@ fn stress(p: &SceneParams) -> Scene {
     let range = (25.0 * (1000.0 / n as f32).sqrt()).clamp(0.4, 40.0);
     let intensity = 0.35;
     for _ in 0..n {
-        let light = PointLight {
+        let light = Light {
             position: Vec3::new(
                 b.rng.range(-half, half),
                 b.rng.range(0.2, 0.2 + range.min(12.0)),
@@ -642,6 +685,7 @@ fn stress(p: &SceneParams) -> Scene {
             color: b.light_color(),
             intensity,
             range,
+            spot: None,
         };
         b.light(light, LightAnchor::World);
     }

@@ -12,11 +12,11 @@ pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use mesh::Mesh;
 pub use rng::Rng;
-pub use view::{ViewLight, ViewSetup};
+pub use view::{SpotCull, ViewLight, ViewSetup};
 
 use crate::consts::{MATERIAL_FLAG_TRANSPARENT, MAX_LIGHTS};
 use crate::error::{Error, Result};
-use crate::gpu_types::{GpuLight, GpuMaterial, GpuVertex};
+use crate::gpu_types::{GpuLight, GpuMaterial, GpuVertex, POINT_LIGHT_COS};
 use glam::{Mat4, Quat, Vec3};
 
 /// Blinn-Phong material. `alpha` and `transparent` are carried for transparency support.
@@ -63,26 +63,115 @@ impl Material {
     }
 }
 
-/// A point light with a finite range: it contributes nothing at or beyond `range`.
+/// A light with a finite range: it contributes nothing at or beyond `range`. A point light
+/// shines in every direction; a spot light (`spot`) only inside its outer cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PointLight {
+pub struct Light {
     pub position: Vec3,
     pub color: Vec3,
     pub intensity: f32,
     pub range: f32,
+    pub spot: Option<Spot>,
 }
 
-impl PointLight {
+/// A spot light's cone: full intensity within `cos_inner` of `direction`, a smooth falloff to
+/// zero at `cos_outer` (tiled-deferred-tricks, Trick 2's spot lights), nothing outside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// Unit axis of the cone, from the light outwards.
+    pub direction: Vec3,
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+}
+
+/// Narrowest gap between a spot's inner and outer cosines (the falloff must have a width).
+pub const SPOT_MIN_FALLOFF: f32 = 1e-4;
+
+impl Spot {
+    /// A cone around `direction` (need not be unit length) with half-angles `inner` < `outer`
+    /// in radians, `outer` at most π.
+    pub fn new(direction: Vec3, inner: f32, outer: f32) -> Spot {
+        let cos_outer = outer.cos();
+        Spot {
+            direction: direction.normalize_or(Vec3::NEG_Y),
+            cos_inner: inner.cos().max(cos_outer + SPOT_MIN_FALLOFF),
+            cos_outer,
+        }
+    }
+}
+
+impl Light {
+    /// A point light.
+    pub fn point(position: Vec3, color: Vec3, intensity: f32, range: f32) -> Light {
+        Light {
+            position,
+            color,
+            intensity,
+            range,
+            spot: None,
+        }
+    }
+
+    /// The smallest sphere around everything the light reaches: its range sphere, or for a
+    /// spot the tightest sphere around the cone's spherical sector. With half-angle θ ≤ 45°
+    /// the sphere through the apex and the rim of the cap (centre r/(2 cos θ) along the axis,
+    /// radius the same); up to 90°, the sphere around the rim's disc (centre r cos θ along the
+    /// axis, radius r sin θ), which holds the apex and the cap's tip too; wider cones reach
+    /// behind the apex and keep the range sphere.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        let Some(spot) = self.spot else {
+            return (self.position, self.range);
+        };
+        let (c, r) = (spot.cos_outer, self.range);
+        if c >= std::f32::consts::FRAC_1_SQRT_2 {
+            let t = r / (2.0 * c);
+            (self.position + spot.direction * t, t)
+        } else if c > 0.0 {
+            let sin = (1.0 - c * c).max(0.0).sqrt();
+            (self.position + spot.direction * (r * c), r * sin)
+        } else {
+            (self.position, r)
+        }
+    }
+
+    /// Does the light reach world point `p`: inside its range and, for a spot, inside its
+    /// outer cone (the light function's angular factor is positive exactly there)?
+    pub fn reaches(&self, p: Vec3) -> bool {
+        let d = p - self.position;
+        let dist_sq = d.length_squared();
+        if dist_sq >= self.range * self.range {
+            return false;
+        }
+        match self.spot {
+            None => true,
+            Some(s) => d.dot(s.direction) > s.cos_outer * dist_sq.sqrt(),
+        }
+    }
+
     pub fn to_gpu(&self) -> GpuLight {
+        let (center, radius) = self.bounding_sphere();
+        let (direction, cos_outer, cos_inner) = match self.spot {
+            None => (Vec3::ZERO, POINT_LIGHT_COS, POINT_LIGHT_COS),
+            Some(s) => (s.direction, s.cos_outer, s.cos_inner),
+        };
         GpuLight {
             position: self.position.to_array(),
             range: self.range,
             color: self.color.to_array(),
             intensity: self.intensity,
+            direction: direction.to_array(),
+            cos_outer,
+            bound_center: center.to_array(),
+            bound_radius: radius,
+            cos_inner,
+            _pad0: 0.0,
+            _pad1: 0.0,
+            _pad2: 0.0,
         }
     }
 
-    /// Finite position, colour and intensity, and a positive finite range.
+    /// Finite position, colour and intensity, a positive finite range, and for a spot a unit
+    /// direction and cosines with -1 ≤ outer < inner ≤ 1.
     pub fn validate(&self, index: usize) -> Result<()> {
         let finite = self.position.is_finite()
             && self.color.is_finite()
@@ -99,6 +188,20 @@ impl PointLight {
                 "light",
                 format!("light {index} needs range > 0 and non-negative colour and intensity"),
             ));
+        }
+        if let Some(s) = self.spot {
+            let unit = s.direction.is_finite() && (s.direction.length() - 1.0).abs() < 1e-3;
+            let cones = s.cos_outer >= -1.0
+                && s.cos_inner <= 1.0
+                && s.cos_inner - s.cos_outer >= SPOT_MIN_FALLOFF * 0.5;
+            if !unit || !cones {
+                return Err(Error::invalid(
+                    "light",
+                    format!(
+                        "spot light {index} needs a unit direction and an inner cone narrower than its outer cone (at most 180°)"
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -178,7 +281,7 @@ pub enum LightAnchor {
 #[derive(Clone, Copy, Debug)]
 pub struct SceneLight {
     /// For `LightAnchor::Object`, `light.position` is relative to the object.
-    pub light: PointLight,
+    pub light: Light,
     pub anchor: LightAnchor,
 }
 
@@ -201,7 +304,7 @@ pub struct Scene {
 pub struct FrameState {
     pub frame: u32,
     pub camera: Camera,
-    pub lights: Vec<PointLight>,
+    pub lights: Vec<Light>,
     /// World transform of each object.
     pub transforms: Vec<Mat4>,
 }
@@ -241,8 +344,14 @@ impl Scene {
             .iter()
             .map(|l| match l.anchor {
                 LightAnchor::World => l.light,
-                LightAnchor::Object(o) => PointLight {
+                LightAnchor::Object(o) => Light {
                     position: motion[o].transform_point3(l.light.position),
+                    spot: l.light.spot.map(|s| Spot {
+                        direction: motion[o]
+                            .transform_vector3(s.direction)
+                            .normalize_or(s.direction),
+                        ..s
+                    }),
                     ..l.light
                 },
             })

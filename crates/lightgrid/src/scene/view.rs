@@ -3,8 +3,21 @@
 //!
 //! View space is right-handed with the camera looking down -z; "view distance" `w = -z`.
 
-use super::{Camera, PointLight};
+use super::{Camera, Light};
+use crate::consts::CONE_SLACK;
 use glam::{Mat4, Vec3};
+
+/// What spot lights are culled by (`--spot-cull`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpotCull {
+    /// The tightest sphere around the cone's sector (the baseline, test (a) of the issue).
+    Sphere,
+    /// The sphere, then the cone itself against each cell's bounding sphere: conservative by
+    /// construction (`ViewLight::may_reach_sphere`).
+    #[default]
+    Cone,
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct ViewSetup {
@@ -16,13 +29,72 @@ pub struct ViewSetup {
     pub far: f32,
     pub width: u32,
     pub height: u32,
+    /// What spot lights are culled by; `to_view` hands it to each light.
+    pub spot_cull: SpotCull,
 }
 
-/// A light in view space.
+/// A light in view space: the sphere culling starts from (the light's bounding sphere), and
+/// what it exactly reaches.
 #[derive(Clone, Copy, Debug)]
 pub struct ViewLight {
+    /// Bounding sphere: everything the light reaches is inside it.
     pub center: Vec3,
     pub radius: f32,
+    pub apex: Vec3,
+    pub range: f32,
+    /// A spot's unit axis and outer cosine.
+    pub cone: Option<(Vec3, f32)>,
+    /// Cull by the cone as well as the sphere (`SpotCull::Cone`).
+    pub cull_by_cone: bool,
+}
+
+impl ViewLight {
+    /// Does the light reach view-space point `p` (the light function's factors are positive
+    /// exactly there: inside the range and the outer cone)?
+    pub fn reaches(&self, p: Vec3) -> bool {
+        let d = p - self.apex;
+        let dist_sq = d.length_squared();
+        if dist_sq >= self.range * self.range {
+            return false;
+        }
+        match self.cone {
+            None => true,
+            Some((axis, cos_outer)) => d.dot(axis) > cos_outer * dist_sq.sqrt(),
+        }
+    }
+
+    /// May the light reach anything inside the view-space sphere (c, r)? The bounding sphere
+    /// is tested by the caller (against a frustum, a rectangle, a box); this adds the cone,
+    /// when culling by it. Never false for a sphere the light reaches into: for a cone of
+    /// half-angle θ ≤ 90°, `cos θ · |v⊥| - v∥ · sin θ` (v = c - apex, split along and across
+    /// the axis) is |v| sin(α - θ), α the angle between v and the axis: the distance from c to
+    /// the cone's boundary line when α - θ ≤ 90°, and less than the distance to the cone (the
+    /// apex, |v|) beyond; inside the cone it is negative. So "more than r" means the sphere
+    /// misses the cone. Points the cone lights also lie in front of the apex (v∥ ≥ 0) and
+    /// within the range. Wider cones are left to the sphere.
+    pub fn may_reach_sphere(&self, c: Vec3, r: f32) -> bool {
+        self.cone_margin(c, r) >= 0.0
+    }
+
+    /// How far the cone reaches into the sphere (c, r), as [`Self::may_reach_sphere`]
+    /// decides (≥ 0: it may reach it; infinite when not culling by a cone). `cone_margin` in
+    /// `tile_frustum.wgsl` is its GPU twin.
+    pub fn cone_margin(&self, c: Vec3, r: f32) -> f32 {
+        let Some((axis, cos)) = self.cone.filter(|_| self.cull_by_cone) else {
+            return f32::INFINITY;
+        };
+        // Round-off slack for the cell sphere (the GPU twin uses the same).
+        let r = r * (1.0 + CONE_SLACK) + CONE_SLACK;
+        let v = c - self.apex;
+        let m = self.range + r - v.length();
+        if cos <= 0.0 {
+            return m;
+        }
+        let along = v.dot(axis);
+        let across = (v.length_squared() - along * along).max(0.0).sqrt();
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        m.min(along + r).min(r - (cos * across - along * sin))
+    }
 }
 
 impl ViewSetup {
@@ -36,14 +108,55 @@ impl ViewSetup {
             far: camera.far,
             width,
             height,
+            spot_cull: SpotCull::default(),
         }
     }
 
-    pub fn to_view(&self, l: &PointLight) -> ViewLight {
+    pub fn to_view(&self, l: &Light) -> ViewLight {
+        let (center, radius) = l.bounding_sphere();
         ViewLight {
-            center: self.view.transform_point3(l.position),
-            radius: l.range,
+            center: self.view.transform_point3(center),
+            radius,
+            apex: self.view.transform_point3(l.position),
+            range: l.range,
+            cone: l.spot.map(|s| {
+                let axis = self
+                    .view
+                    .transform_vector3(s.direction)
+                    .normalize_or(s.direction);
+                (axis, s.cos_outer)
+            }),
+            cull_by_cone: self.spot_cull == SpotCull::Cone,
         }
+    }
+
+    /// The bounding sphere (view space) of the frustum piece over pixel rectangle
+    /// `[x0, x1) x [y0, y1)` between view distances `w_min` and `w_max`: the centre of its
+    /// eight corners and the farthest corner. `tile_frustum.wgsl` computes the same.
+    pub fn cell_sphere(
+        &self,
+        (x0, y0, x1, y1): (u32, u32, u32, u32),
+        w_min: f32,
+        w_max: f32,
+    ) -> (Vec3, f32) {
+        let ndc_x = |x: u32| x as f32 / self.width as f32 * 2.0 - 1.0;
+        let ndc_y = |y: u32| 1.0 - y as f32 / self.height as f32 * 2.0;
+        let mut corners = [Vec3::ZERO; 8];
+        let mut i = 0;
+        for w in [w_min, w_max] {
+            for nx in [ndc_x(x0), ndc_x(x1)] {
+                for ny in [ndc_y(y0), ndc_y(y1)] {
+                    corners[i] = Vec3::new(nx / self.p00 * w, ny / self.p11 * w, -w);
+                    i += 1;
+                }
+            }
+        }
+        let center = corners.iter().copied().sum::<Vec3>() / 8.0;
+        let radius = corners
+            .iter()
+            .map(|p| p.distance(center))
+            .fold(0.0f32, f32::max);
+        (center, radius)
     }
 
     /// View distance of a [0, 1] depth-buffer value (inverse of the projection's depth).

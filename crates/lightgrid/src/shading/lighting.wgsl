@@ -22,14 +22,24 @@ struct LightTerms {
 }
 
 // Smooth window that is 1 at the light and reaches exactly 0 at `range`, with zero slope there:
-// (1 - (d/r)^2)^2. Lights are bounded spheres (tiled-shading §1.1), so culling by range is exact.
+// (1 - (d/r)^2)^2. Lights are bounded (tiled-shading §1.1): nothing beyond the range, nor
+// outside a spot's outer cone, so culling by those bounds is exact.
 fn range_falloff(dist_sq: f32, range: f32) -> f32 {
     let t = saturate(1.0 - dist_sq / (range * range));
     return t * t;
 }
 
-// Blinn-Phong from a point light with a finite range. `view_dir` points from the surface to
-// the eye.
+// A spot's angular window: 1 inside the inner cone, a smoothstep to exactly 0 at the outer
+// cone, 0 outside; 1 for a point light. `l` is the unit vector from the surface to the light.
+fn spot_falloff(light: Light, l: vec3<f32>) -> f32 {
+    if (light.cos_outer <= POINT_LIGHT_COS) {
+        return 1.0;
+    }
+    return smoothstep(light.cos_outer, light.cos_inner, dot(-l, light.direction));
+}
+
+// Blinn-Phong from a point or spot light with a finite range. `view_dir` points from the
+// surface to the eye.
 fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     var out: LightTerms;
     out.diffuse = vec3<f32>(0.0);
@@ -41,10 +51,11 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     }
     let l = to_light * inverseSqrt(max(dist_sq, 1e-12));
     let n_dot_l = dot(s.normal, l);
-    if (n_dot_l <= 0.0) {
+    let cone = spot_falloff(light, l);
+    if (n_dot_l <= 0.0 || cone <= 0.0) {
         return out;
     }
-    let radiance = light.color * (light.intensity * range_falloff(dist_sq, light.range));
+    let radiance = light.color * (light.intensity * range_falloff(dist_sq, light.range) * cone);
     let h = normalize(l + view_dir);
     let n_dot_h = max(dot(s.normal, h), 0.0);
     out.diffuse = radiance * n_dot_l;

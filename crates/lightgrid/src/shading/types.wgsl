@@ -1,11 +1,21 @@
 // Structs shared by every shader. Their Rust twins are in gpu_types.rs; the layout test
 // compares the two field by field.
 
+// A point light, or a spot (cos_outer > POINT_LIGHT_COS) whose cone limits it further;
+// culling uses the bounding sphere (bound_center, bound_radius).
 struct Light {
     position: vec3<f32>,
     range: f32,
     color: vec3<f32>,
     intensity: f32,
+    direction: vec3<f32>,
+    cos_outer: f32,
+    bound_center: vec3<f32>,
+    bound_radius: f32,
+    cos_inner: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 struct Material {
@@ -29,6 +39,10 @@ struct FrameUniforms {
     viewport: vec2<f32>,
     near: f32,
     far: f32,
+    spot_cull: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct GridParams {
