@@ -18,8 +18,24 @@ pub const SCHEMA_VERSION: u32 = 3;
 
 fn run_name(r: &RunRecord) -> String {
     match r.gbuffer_bits {
-        Some(b) => format!("{} (g{b})", r.pipeline),
+        Some(b) => format!("{} (g{b})", pipeline_label(r)),
+        None => pipeline_label(r),
+    }
+}
+
+/// The pipeline, with the spot culling when the run measured more than one.
+fn pipeline_label(r: &RunRecord) -> String {
+    match r.spot_cull {
+        Some(c) => format!("{} [{}]", r.pipeline, spot_cull_name(c)),
         None => r.pipeline.clone(),
+    }
+}
+
+/// `--spot-cull` value names, as in results.json.
+fn spot_cull_name(c: lightgrid::pipelines::SpotCull) -> &'static str {
+    match c {
+        lightgrid::pipelines::SpotCull::Sphere => "sphere",
+        lightgrid::pipelines::SpotCull::Cone => "cone",
     }
 }
 
@@ -41,10 +57,11 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 21] = [
+const RESULTS_CSV_COLUMNS: [&str; 22] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
+    "spot_cull",
     "width",
     "height",
     "tile_size",
@@ -72,6 +89,7 @@ struct ResultsRow<'a> {
     scene: &'a str,
     pipeline: &'a str,
     gbuffer_bits: Option<u32>,
+    spot_cull: Option<&'static str>,
     width: u32,
     height: u32,
     tile_size: u32,
@@ -135,6 +153,7 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 scene: &r.scene,
                 pipeline: &r.pipeline,
                 gbuffer_bits: r.gbuffer_bits,
+                spot_cull: r.spot_cull.map(spot_cull_name),
                 width: r.width,
                 height: r.height,
                 tile_size: r.tile_size,
@@ -221,7 +240,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 series: runs
                     .iter()
                     .map(|r| Series {
-                        name: r.pipeline.clone(),
+                        name: pipeline_label(r),
                         points: r
                             .frames
                             .iter()
@@ -249,7 +268,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                     .filter_map(|r| {
                         let s = r.summary.as_ref()?;
                         Some((
-                            r.pipeline.clone(),
+                            pipeline_label(r),
                             s.passes.iter().map(|p| (p.label.clone(), p.ms)).collect(),
                         ))
                     })
@@ -274,7 +293,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
             .iter()
             .filter(|r| r.frames.iter().all(|f| f.lighting_computations.is_some()))
             .map(|r| Series {
-                name: r.pipeline.clone(),
+                name: pipeline_label(r),
                 points: r
                     .frames
                     .iter()
@@ -342,6 +361,16 @@ fn summary(results: &BenchResults) -> String {
         "- {w}x{h}, tile {}, frames {}..{} every {}, {} repeat(s) per frame (median kept), {} warm-up render(s) per series",
         c.tile_size, c.frames.start, c.frames.end, c.frames.step, c.repeat, c.warmup
     );
+    if c.spot_fraction > 0.0 {
+        let culls: Vec<&str> = c.spot_culls.iter().map(|&x| spot_cull_name(x)).collect();
+        let _ = writeln!(
+            s,
+            "- spot lights: {:.0}% of each scene's lights (`--spot-fraction {}`); grid pipelines cull them by {} (`[sphere]`: the cone's bounding sphere; `[cone]`: the sphere, then the cone against each cell's bounding sphere)",
+            c.spot_fraction * 100.0,
+            c.spot_fraction,
+            culls.join(" and by ")
+        );
+    }
     if !results.outcome.is_complete() {
         let _ = writeln!(
             s,
@@ -372,7 +401,7 @@ fn summary(results: &BenchResults) -> String {
             let _ = writeln!(
                 s,
                 "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} | {} |",
-                r.pipeline,
+                pipeline_label(r),
                 match (r.complete, r.times_from) {
                     (true, _) => "",
                     (false, super::run::TimesFrom::RealTime) => " (incomplete)",
@@ -544,7 +573,7 @@ mod tests {
         let row = text.lines().nth(1).unwrap();
         assert_eq!(
             row,
-            ",,16,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,1.500,,,,,gbuffer=0.1000;shade=0.2000"
+            ",,16,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,1.500,,,,,gbuffer=0.1000;shade=0.2000"
         );
         let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
         assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);

@@ -7,7 +7,7 @@ use lightgrid::error::Result;
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
-use lightgrid::pipelines::{self, RenderSettings};
+use lightgrid::pipelines::{self, RenderSettings, SpotCull};
 use lightgrid::realtime::{play, PlayPlan, PlayedFrame};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::stats::TimingSource;
@@ -92,17 +92,26 @@ pub struct BenchConfig {
     /// Fraction of each scene's lights made spots (`--spot-fraction`).
     #[serde(default)]
     pub spot_fraction: f32,
-    /// What grid pipelines cull spots by (`--spot-cull`).
-    #[serde(default)]
-    pub spot_cull: lightgrid::pipelines::SpotCull,
+    /// What grid pipelines cull spots by (`--spot-cull`): every grid pipeline is measured
+    /// once per entry (pipelines without a grid once).
+    #[serde(default = "default_spot_culls")]
+    pub spot_culls: Vec<SpotCull>,
+}
+
+fn default_spot_culls() -> Vec<SpotCull> {
+    vec![SpotCull::default()]
 }
 
 impl BenchConfig {
     pub fn validate(&self) -> Result<()> {
-        if self.scenes.is_empty() || self.pipelines.is_empty() || self.gbuffers.is_empty() {
+        if self.scenes.is_empty()
+            || self.pipelines.is_empty()
+            || self.gbuffers.is_empty()
+            || self.spot_culls.is_empty()
+        {
             return Err(invalid(
                 "bench",
-                "needs at least one scene, pipeline and G-buffer setting",
+                "needs at least one scene, pipeline, G-buffer setting and spot culling",
             ));
         }
         for p in &self.pipelines {
@@ -281,6 +290,9 @@ pub struct RunRecord {
     pub pipeline: String,
     /// None for pipelines without a G-buffer (measured once).
     pub gbuffer_bits: Option<u32>,
+    /// What spots were culled by, when the run measured more than one way (grid pipelines).
+    #[serde(default)]
+    pub spot_cull: Option<SpotCull>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -351,6 +363,8 @@ struct Series {
     info: &'static pipelines::PipelineInfo,
     /// False for pipelines without a G-buffer (measured once, under the first setting).
     uses_gbuffer: bool,
+    /// What spots are culled by; recorded when more than one is measured.
+    spot_cull: SpotCull,
     frames: Vec<u32>,
 }
 
@@ -405,13 +419,22 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                 if !g_used && gi > 0 {
                     continue;
                 }
-                plan.push(Series {
-                    scene: si,
-                    gbuffer: *g,
-                    info,
-                    uses_gbuffer: g_used,
-                    frames: frames.clone(),
-                });
+                // Pipelines without a grid cull nothing: measured under the first setting.
+                let culls = if info.uses_grid {
+                    &config.spot_culls[..]
+                } else {
+                    &config.spot_culls[..1]
+                };
+                for &spot_cull in culls {
+                    plan.push(Series {
+                        scene: si,
+                        gbuffer: *g,
+                        info,
+                        uses_gbuffer: g_used,
+                        spot_cull,
+                        frames: frames.clone(),
+                    });
+                }
             }
         }
     }
@@ -463,7 +486,7 @@ impl<'a> Measuring<'a> {
             } else {
                 lightgrid::pipelines::Assign::default()
             },
-            spot_cull: self.config.spot_cull,
+            spot_cull: series.spot_cull,
         }
     }
 
@@ -501,7 +524,12 @@ impl<'a> Measuring<'a> {
         } else {
             String::new()
         };
-        let label = |what: &str| format!("{} {}{g} {what}", scene.name, info.id);
+        let cull = if self.config.spot_culls.len() > 1 && info.uses_grid {
+            format!(" {:?}", series.spot_cull).to_lowercase()
+        } else {
+            String::new()
+        };
+        let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
             self.tick(label("warm-up"));
             self.renderer(series, (record.width, record.height))?
@@ -601,6 +629,7 @@ impl RunRecord {
             scene: scene.name.clone(),
             pipeline: series.info.id.to_string(),
             gbuffer_bits: series.uses_gbuffer.then_some(series.gbuffer.bits()),
+            spot_cull: None,
             width: size.0,
             height: size.1,
             tile_size: tile,
@@ -734,6 +763,9 @@ impl PreparedBench {
             let scene = &scenes[series.scene];
             let size = config.size.unwrap_or(scene.default_size);
             let mut record = RunRecord::new(scene, series, size, config.tile_size);
+            if config.spot_culls.len() > 1 && series.info.uses_grid {
+                record.spot_cull = Some(series.spot_cull);
+            }
             let mut bytes = (0, 0);
             let end = m.series(
                 scene,

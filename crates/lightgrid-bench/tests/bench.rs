@@ -38,7 +38,7 @@ fn config() -> BenchConfig {
         lights: None,
         heatmap_frame: None,
         spot_fraction: 0.0,
-        spot_cull: Default::default(),
+        spot_culls: vec![Default::default()],
     }
 }
 
@@ -376,4 +376,63 @@ fn scaling_growth_reports_slopes_and_the_fastest_strategy() {
         "{t}"
     );
     assert!(t.contains("| 1000 | linear | 10.0 |"), "{t}");
+}
+
+/// With spots, each grid pipeline is measured once per spot culling and the report keeps them
+/// apart: cone culling never lists more than sphere culling, the ideal is the same, and the
+/// pipelines without a grid run once.
+#[test]
+fn spot_culls_are_measured_side_by_side() {
+    use lightgrid::pipelines::SpotCull;
+    let ctx = common::gpu();
+    let cfg = BenchConfig {
+        pipelines: vec!["forward".into(), "clustered_deferred".into()],
+        frames: FrameRange::parse("0..259:200").unwrap(),
+        gbuffers: vec![GBufferFormat::F16],
+        repeat: 1,
+        spot_fraction: 1.0,
+        spot_culls: vec![SpotCull::Sphere, SpotCull::Cone],
+        ..config()
+    };
+    let results = run(&ctx, &cfg, &AtomicBool::new(false), &mut |_| {}).unwrap();
+    let runs: Vec<(&str, Option<SpotCull>)> = results
+        .runs
+        .iter()
+        .map(|r| (r.pipeline.as_str(), r.spot_cull))
+        .collect();
+    assert_eq!(
+        runs,
+        vec![
+            ("forward", None),
+            ("clustered_deferred", Some(SpotCull::Sphere)),
+            ("clustered_deferred", Some(SpotCull::Cone)),
+        ]
+    );
+    let (sphere, cone) = (&results.runs[1], &results.runs[2]);
+    for (a, b) in sphere.frames.iter().zip(&cone.frames) {
+        assert_eq!(a.ideal_lighting_computations, b.ideal_lighting_computations);
+        let (a, b) = (
+            a.lighting_computations.unwrap(),
+            b.lighting_computations.unwrap(),
+        );
+        assert!(b < a, "cone {b} not below sphere {a}");
+    }
+    let dir = std::env::temp_dir().join(format!("lightgrid-bench-spots-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    write_report(&dir, &results).unwrap();
+    let summary = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert!(
+        summary.contains("clustered_deferred [sphere]")
+            && summary.contains("clustered_deferred [cone]")
+    );
+    assert!(summary.contains("spot lights: 100%"), "{summary}");
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().contains("spot_cull"));
+    assert_eq!(
+        csv.lines().filter(|l| l.contains(",sphere,")).count(),
+        sphere.frames.len()
+    );
+    let back = lightgrid_bench::read_results(&dir.join("results.json")).unwrap();
+    assert_eq!(back.runs, results.runs);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

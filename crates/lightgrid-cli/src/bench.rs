@@ -19,6 +19,10 @@ pub(crate) enum Preset {
     /// The papers' configurations: robots-many and robots-few, frames 0..259 every 5, 16- and
     /// 32-bit G-buffers, at 1920x1080 on a hardware GPU or 640x360 on a software one.
     Paper,
+    /// A scene dominated by spot lights (tiled-deferred-tricks' case): robots-many with every
+    /// light a spot, frames 0..259 every 20, grid pipelines culling by sphere and by cone,
+    /// with forward and deferred beside them.
+    Spots,
 }
 
 #[derive(Args)]
@@ -67,9 +71,10 @@ pub(crate) struct BenchArgs {
     /// Fraction of each scene's lights (0 to 1) turned into spot lights.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_fraction)]
     pub(crate) spot_fraction: Option<f64>,
-    /// What grid pipelines cull spot lights by [default: cone].
-    #[arg(long, value_enum)]
-    pub(crate) spot_cull: Option<SpotCullArg>,
+    /// What grid pipelines cull spot lights by: sphere, cone, or sphere,cone to measure both
+    /// [default: cone].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) spot_cull: Vec<SpotCullArg>,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
@@ -93,6 +98,8 @@ pub(crate) struct BenchDefaults {
     pub(crate) gbuffers: Vec<GBufferFormat>,
     pub(crate) repeat: u32,
     pub(crate) pipelines: Vec<String>,
+    pub(crate) spot_fraction: f32,
+    pub(crate) spot_culls: Vec<lightgrid::pipelines::SpotCull>,
 }
 
 pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
@@ -111,6 +118,8 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             gbuffers: vec![GBufferFormat::F16],
             repeat: 1,
             pipelines: all.clone(),
+            spot_fraction: 0.0,
+            spot_culls: vec![Default::default()],
         },
         Some(Preset::Quick) => BenchDefaults {
             scenes: vec!["robots-many"],
@@ -119,6 +128,25 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             gbuffers: vec![GBufferFormat::F16],
             repeat: 1,
             pipelines: all.clone(),
+            spot_fraction: 0.0,
+            spot_culls: vec![Default::default()],
+        },
+        Some(Preset::Spots) => BenchDefaults {
+            scenes: vec!["robots-many"],
+            frames: "0..259:20",
+            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+            gbuffers: vec![GBufferFormat::F16],
+            repeat: if hardware { 3 } else { 1 },
+            pipelines: PIPELINES
+                .iter()
+                .filter(|p| p.uses_grid || p.id == "forward" || p.id == "deferred")
+                .map(|p| p.id.to_string())
+                .collect(),
+            spot_fraction: 1.0,
+            spot_culls: vec![
+                lightgrid::pipelines::SpotCull::Sphere,
+                lightgrid::pipelines::SpotCull::Cone,
+            ],
         },
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
@@ -132,6 +160,8 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
                 .filter(|p| *p != "forward_mono")
                 .cloned()
                 .collect(),
+            spot_fraction: 0.0,
+            spot_culls: vec![Default::default()],
         },
     };
     let (scenes, frames, size, gbuffers, repeat, pipelines) = (
@@ -173,8 +203,12 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         seed: a.seed,
         lights: a.lights,
         heatmap_frame: a.heatmap_frame,
-        spot_fraction: a.spot_fraction.unwrap_or(0.0) as f32,
-        spot_cull: a.spot_cull.map(Into::into).unwrap_or_default(),
+        spot_fraction: a.spot_fraction.map_or(d.spot_fraction, |f| f as f32),
+        spot_culls: if a.spot_cull.is_empty() {
+            d.spot_culls.clone()
+        } else {
+            a.spot_cull.iter().map(|&c| c.into()).collect()
+        },
     };
     config.validate()?;
     let chosen: Vec<_> = config
@@ -186,7 +220,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         slices: a.slices.is_some(),
         gbuffer: !a.gbuffer.is_empty(),
         assign: a.assign.is_some(),
-        spot_cull: a.spot_cull.is_some(),
+        spot_cull: !a.spot_cull.is_empty(),
     };
     check_applies(given, &chosen)?;
     Ok(config)
