@@ -476,6 +476,22 @@ fn counts_and_thresholds_are_bounded_where_parsed() {
     let dir = temp_dir("bounds");
     let d = s(&dir);
     let cases: &[(&[&str], &str)] = &[
+        (
+            &["render", "--spot-fraction", "NaN"],
+            "not a number from 0 to 1",
+        ),
+        (
+            &["render", "--spot-fraction", "-0.5"],
+            "not a number from 0 to 1",
+        ),
+        (
+            &["play", "--spot-fraction", "1.5"],
+            "not a number from 0 to 1",
+        ),
+        (
+            &["bench", "--spot-fraction", "inf", "--out", d],
+            "not a number from 0 to 1",
+        ),
         (&["render", "--warmup", "1000000"], "not in 0..=1000"),
         (
             &["compare", "--warmup", "1001", "--out-dir", d],
@@ -578,6 +594,22 @@ fn an_option_that_applies_to_nothing_chosen_is_refused_in_every_command() {
     let dir = temp_dir("applies");
     let d = s(&dir);
     let cases: &[(&[&str], &str)] = &[
+        (
+            &["render", "--pipeline", "deferred", "--spot-cull", "sphere"],
+            "--spot-cull does not apply to deferred",
+        ),
+        (
+            &[
+                "bench",
+                "--pipelines",
+                "forward",
+                "--spot-cull",
+                "cone",
+                "--out",
+                d,
+            ],
+            "--spot-cull does not apply",
+        ),
         (
             &["render", "--pipeline", "forward", "--slices", "4"],
             "--slices does not apply to forward",

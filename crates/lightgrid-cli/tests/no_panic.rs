@@ -75,6 +75,10 @@ const NAMES: &[&str] = &[
     "gl",
     "0",
     "9",
+    "sphere",
+    "cone",
+    "sphere,cone",
+    "0.5",
 ];
 
 /// Options per command, with the safe values that keep a valid run short (tiny frames, one
@@ -91,6 +95,8 @@ const CMDS: &[Cmd] = &[
     Cmd {
         name: "render",
         flags: &[
+            "--spot-fraction",
+            "--spot-cull",
             "--scene",
             "--frame",
             "--size",
@@ -113,6 +119,8 @@ const CMDS: &[Cmd] = &[
     Cmd {
         name: "play",
         flags: &[
+            "--spot-fraction",
+            "--spot-cull",
             "--scene",
             "--pipeline",
             "--assign",
@@ -137,7 +145,14 @@ const CMDS: &[Cmd] = &[
     Cmd {
         name: "compare",
         flags: &[
-            "--scene", "--frame", "--size", "--lights", "--tile", "--slices", "--warmup",
+            "--spot-fraction",
+            "--scene",
+            "--frame",
+            "--size",
+            "--lights",
+            "--tile",
+            "--slices",
+            "--warmup",
         ],
         paths: &["--out-dir"],
         safe: &[
@@ -150,6 +165,8 @@ const CMDS: &[Cmd] = &[
     Cmd {
         name: "bench",
         flags: &[
+            "--spot-fraction",
+            "--spot-cull",
             "--scene",
             "--pipelines",
             "--frames",
