@@ -4,26 +4,21 @@
 use bytemuck::{Pod, Zeroable};
 
 /// A light with a finite range (tiled-shading §1.1): a point light, or a spot light whose
-/// cone (`direction`, `cos_outer` < `cos_inner`) limits it further. `color` is linear RGB,
-/// scaled by `intensity`; the light contributes nothing at or beyond `range`, nor outside the
-/// outer cone. `cos_outer` = `consts::POINT_LIGHT_COS` marks a point light. `bound_center` and
-/// `bound_radius` are the smallest sphere around everything the light reaches (for a point
-/// light, its range sphere): what light assignment culls by (`Light::bounding_sphere`).
+/// cone (`direction`, `cos_outer` < `cos_inner`) limits it further. `radiance` is linear RGB
+/// (the colour times the intensity); the light contributes nothing at or beyond `range`, nor
+/// outside the outer cone. `cos_outer` = `consts::POINT_LIGHT_COS` marks a point light. 48
+/// bytes, what shading reads per light; culling also reads the light's bounding sphere, kept
+/// in a buffer of its own (group 0 binding 4, `[centre, radius]` per light,
+/// `Light::bounding_sphere`) so shading does not load it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
     pub position: [f32; 3],
     pub range: f32,
-    pub color: [f32; 3],
-    pub intensity: f32,
+    pub radiance: [f32; 3],
+    pub cos_inner: f32,
     pub direction: [f32; 3],
     pub cos_outer: f32,
-    pub bound_center: [f32; 3],
-    pub bound_radius: f32,
-    pub cos_inner: f32,
-    pub _pad0: f32,
-    pub _pad1: f32,
-    pub _pad2: f32,
 }
 
 pub use crate::consts::POINT_LIGHT_COS;
@@ -89,7 +84,7 @@ pub struct GridParams {
 }
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 32);
-const _: () = assert!(std::mem::size_of::<GpuLight>() == 80);
+const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);

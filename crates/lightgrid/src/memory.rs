@@ -60,8 +60,8 @@ impl MemoryModel {
 pub const HDR_BYTES: u32 = 8;
 /// Bytes of the scene depth (32-bit float).
 pub const DEPTH_BYTES: u32 = 4;
-/// Bytes of one light in the global light list (`GpuLight`: the paper's L = 8 floats of a
-/// point light, plus the spot cone and the culling sphere).
+/// Bytes of one light in the global light list as shading reads it (`GpuLight`: the paper's
+/// L = 8 floats of a point light, plus the spot cone; culling's bounding spheres are apart).
 pub const LIGHT_BYTES: u32 = std::mem::size_of::<crate::gpu_types::GpuLight>() as u32;
 /// Bytes of one light index in a grid list.
 pub const INDEX_BYTES: u32 = 4;

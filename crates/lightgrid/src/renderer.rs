@@ -108,6 +108,7 @@ pub struct Renderer<'c> {
     scene_layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     lights: GrowBuffer,
+    light_bounds: GrowBuffer,
     materials: GrowBuffer,
     vertices: GrowBuffer,
     indices: GrowBuffer,
@@ -165,6 +166,7 @@ impl<'c> Renderer<'c> {
             });
             use wgpu::BufferUsages as U;
             let lights = GrowBuffer::new(device, "lights", U::STORAGE, 1 << 16);
+            let light_bounds = GrowBuffer::new(device, "light bounds", U::STORAGE, 1 << 14);
             let materials = GrowBuffer::new(device, "materials", U::STORAGE, 1 << 12);
             let vertices = GrowBuffer::new(device, "vertices", U::VERTEX, 1 << 20);
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
@@ -173,8 +175,7 @@ impl<'c> Renderer<'c> {
                 device,
                 &scene_layout,
                 &uniforms,
-                &lights,
-                &materials,
+                [&lights, &light_bounds, &materials],
                 counters.buffer(),
             );
             Renderer {
@@ -186,6 +187,7 @@ impl<'c> Renderer<'c> {
                 scene_layout,
                 uniforms,
                 lights,
+                light_bounds,
                 materials,
                 vertices,
                 indices,
@@ -216,8 +218,7 @@ impl<'c> Renderer<'c> {
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
         uniforms: &wgpu::Buffer,
-        lights: &GrowBuffer,
-        materials: &GrowBuffer,
+        [lights, light_bounds, materials]: [&GrowBuffer; 3],
         counters: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
         crate::gpu::bind_resources(
@@ -229,6 +230,7 @@ impl<'c> Renderer<'c> {
                 lights.buffer.as_entire_binding(),
                 materials.buffer.as_entire_binding(),
                 counters.as_entire_binding(),
+                light_bounds.buffer.as_entire_binding(),
             ],
         )
     }
@@ -368,11 +370,15 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         let device = &ctx.device;
         let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
+        let bounds: Vec<[f32; 4]> = state.lights.iter().map(|l| l.bounds_gpu()).collect();
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
-        if self.lights.reserve(device, lb.len() as u64) {
+        let bb: &[u8] = bytemuck::cast_slice(&bounds);
+        let grew_lights = self.lights.reserve(device, lb.len() as u64);
+        if self.light_bounds.reserve(device, bb.len() as u64) || grew_lights {
             self.rebind_scene();
         }
         self.lights.write(&ctx.queue, 0, lb);
+        self.light_bounds.write(&ctx.queue, 0, bb);
         let (width, height) = self.size();
         let view = state.camera.view();
         let proj = state.camera.proj(width as f32 / height as f32);
@@ -394,7 +400,7 @@ impl<'c> Renderer<'c> {
         };
         ctx.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-        (lb.len() + std::mem::size_of::<FrameUniforms>()) as u64
+        (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64
     }
 
     /// Group 0 again, after a buffer it binds was replaced.
@@ -403,8 +409,7 @@ impl<'c> Renderer<'c> {
             &self.ctx.device,
             &self.scene_layout,
             &self.uniforms,
-            &self.lights,
-            &self.materials,
+            [&self.lights, &self.light_bounds, &self.materials],
             self.counters.buffer(),
         );
     }

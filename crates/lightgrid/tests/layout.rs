@@ -46,20 +46,7 @@ fn gpu_structs_match_wgsl() {
         &module,
         "Light",
         GpuLight,
-        [
-            position,
-            range,
-            color,
-            intensity,
-            direction,
-            cos_outer,
-            bound_center,
-            bound_radius,
-            cos_inner,
-            _pad0,
-            _pad1,
-            _pad2
-        ]
+        [position, range, radiance, cos_inner, direction, cos_outer]
     );
     check_layout!(
         &module,

@@ -52,7 +52,7 @@ fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, spill: bool) {
         if (li < (node.count & ~BVH_LEAF)) {
             if ((node.count & BVH_LEAF) != 0u) {
                 let l = bvh_order[node.first + li];
-                if (light_in_tile(f, lights[l])) {
+                if (light_in_tile(f, l)) {
                     record_hit(c, l, spill);
                 }
             } else {

@@ -12,7 +12,7 @@ fn gather_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, spill: bool) {
     if (f.w_min <= f.w_max) {
         var l = li;
         for (; l < frame.light_count; l = l + WORKGROUP_SIZE) {
-            if (light_in_tile(f, lights[l])) {
+            if (light_in_tile(f, l)) {
                 record_hit(c, l, spill);
             }
         }

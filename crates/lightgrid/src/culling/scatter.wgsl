@@ -107,9 +107,9 @@ fn rect_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (l >= frame.light_count) {
         return;
     }
-    let light = lights[l];
-    let c = (frame.view * vec4<f32>(light.bound_center, 1.0)).xyz;
-    let rect = light_tiles(c, light.bound_radius);
+    let b = light_bounds[l];
+    let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
+    let rect = light_tiles(c, b.w);
     light_rects[l] = rect;
     var n = 0u;
     if (rect.x <= rect.z && rect.y <= rect.w) {
@@ -160,9 +160,10 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let tile = u32(rect.y + i32(k / width)) * grid.tiles_x + u32(rect.x + i32(k % width));
 
     let light = lights[l];
-    let c = (frame.view * vec4<f32>(light.bound_center, 1.0)).xyz;
-    let w_min = -c.z - light.bound_radius;
-    let w_max = -c.z + light.bound_radius;
+    let b = light_bounds[l];
+    let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
+    let w_min = -c.z - b.w;
+    let w_max = -c.z + b.w;
     // Spots culled by their cone test it against each cell's sphere, as assign_cpu does.
     let by_cone = frame.spot_cull != 0u && light.cos_outer > POINT_LIGHT_COS;
     let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);

@@ -95,9 +95,10 @@ fn cone_margin(light: Light, cell: vec4<f32>) -> f32 {
     return min(m, min(along + r, r - (light.cos_outer * across - along * sin_outer)));
 }
 
-// A light reaches into the frustum when its bounding sphere does and, for a spot, its cone
+// Light `l` reaches into the frustum when its bounding sphere does and, for a spot, its cone
 // may reach the frustum's bounding sphere.
-fn light_in_tile(f: TileFrustum, light: Light) -> bool {
-    let c = (frame.view * vec4<f32>(light.bound_center, 1.0)).xyz;
-    return sphere_in_tile(f, c, light.bound_radius) && cone_margin(light, f.sphere) >= 0.0;
+fn light_in_tile(f: TileFrustum, l: u32) -> bool {
+    let b = light_bounds[l];
+    let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
+    return sphere_in_tile(f, c, b.w) && cone_margin(lights[l], f.sphere) >= 0.0;
 }

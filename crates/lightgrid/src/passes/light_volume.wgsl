@@ -15,9 +15,9 @@ struct VolumeOut {
 
 @vertex
 fn vs_volume(v: VolumeIn) -> VolumeOut {
-    let l = lights[v.light];
+    let b = light_bounds[v.light];
     var out: VolumeOut;
-    out.clip = frame.view_proj * vec4<f32>(l.bound_center + v.position * l.bound_radius, 1.0);
+    out.clip = frame.view_proj * vec4<f32>(b.xyz + v.position * b.w, 1.0);
     out.light = v.light;
     return out;
 }

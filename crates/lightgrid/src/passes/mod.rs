@@ -129,6 +129,8 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             },
             storage(1, std::mem::size_of::<GpuLight>()),
             storage(2, std::mem::size_of::<GpuMaterial>()),
+            // Per light its bounding sphere [centre, radius], for culling and light volumes.
+            storage(4, 16),
             // The frame counters (`gpu/counters.rs`): written by fragment and compute stages
             // (a vertex stage may not write storage).
             wgpu::BindGroupLayoutEntry {

@@ -57,7 +57,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         var i = li;
         for (; i < TILE_LIGHT_BATCH; i = i + TILE_THREADS * TILE_THREADS) {
             let l = first + i;
-            if (l < frame.light_count && light_in_tile(f, lights[l])) {
+            if (l < frame.light_count && light_in_tile(f, l)) {
                 batch[atomicAdd(&batch_count, 1u)] = l;
             }
         }

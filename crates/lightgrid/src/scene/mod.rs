@@ -149,7 +149,6 @@ impl Light {
     }
 
     pub fn to_gpu(&self) -> GpuLight {
-        let (center, radius) = self.bounding_sphere();
         let (direction, cos_outer, cos_inner) = match self.spot {
             None => (Vec3::ZERO, POINT_LIGHT_COS, POINT_LIGHT_COS),
             Some(s) => (s.direction, s.cos_outer, s.cos_inner),
@@ -157,17 +156,17 @@ impl Light {
         GpuLight {
             position: self.position.to_array(),
             range: self.range,
-            color: self.color.to_array(),
-            intensity: self.intensity,
+            radiance: (self.color * self.intensity).to_array(),
+            cos_inner,
             direction: direction.to_array(),
             cos_outer,
-            bound_center: center.to_array(),
-            bound_radius: radius,
-            cos_inner,
-            _pad0: 0.0,
-            _pad1: 0.0,
-            _pad2: 0.0,
         }
+    }
+
+    /// The bounding sphere as the GPU's `light_bounds` entry: centre and radius.
+    pub fn bounds_gpu(&self) -> [f32; 4] {
+        let (c, r) = self.bounding_sphere();
+        [c.x, c.y, c.z, r]
     }
 
     /// Finite position, colour and intensity, a positive finite range, and for a spot a unit

@@ -55,7 +55,7 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     if (n_dot_l <= 0.0 || cone <= 0.0) {
         return out;
     }
-    let radiance = light.color * (light.intensity * range_falloff(dist_sq, light.range) * cone);
+    let radiance = light.radiance * (range_falloff(dist_sq, light.range) * cone);
     let h = normalize(l + view_dir);
     let n_dot_h = max(dot(s.normal, h), 0.0);
     out.diffuse = radiance * n_dot_l;

@@ -4,6 +4,8 @@
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var<storage, read> materials: array<Material>;
+// Per light, the sphere around everything it reaches (centre, radius): what culling tests.
+@group(0) @binding(4) var<storage, read> light_bounds: array<vec4<f32>>;
 // The frame counters (slots COUNTER_* from consts.rs), cleared at the start of every frame and
 // read back after it: truncated loops, index-list and pair sizes, indirect dispatch arguments.
 @group(0) @binding(3) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;

@@ -2,20 +2,14 @@
 // compares the two field by field.
 
 // A point light, or a spot (cos_outer > POINT_LIGHT_COS) whose cone limits it further;
-// culling uses the bounding sphere (bound_center, bound_radius).
+// culling uses its bounding sphere, `light_bounds[i]` (scene_bindings.wgsl).
 struct Light {
     position: vec3<f32>,
     range: f32,
-    color: vec3<f32>,
-    intensity: f32,
+    radiance: vec3<f32>,
+    cos_inner: f32,
     direction: vec3<f32>,
     cos_outer: f32,
-    bound_center: vec3<f32>,
-    bound_radius: f32,
-    cos_inner: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
 }
 
 struct Material {
