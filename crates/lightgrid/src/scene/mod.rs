@@ -137,15 +137,8 @@ impl Light {
     /// Does the light reach world point `p`: inside its range and, for a spot, inside its
     /// outer cone (the light function's angular factor is positive exactly there)?
     pub fn reaches(&self, p: Vec3) -> bool {
-        let d = p - self.position;
-        let dist_sq = d.length_squared();
-        if dist_sq >= self.range * self.range {
-            return false;
-        }
-        match self.spot {
-            None => true,
-            Some(s) => d.dot(s.direction) > s.cos_outer * dist_sq.sqrt(),
-        }
+        let cone = self.spot.map(|s| (s.direction, s.cos_outer));
+        view::reaches(p - self.position, self.range, cone)
     }
 
     pub fn to_gpu(&self) -> GpuLight {

@@ -48,19 +48,24 @@ pub struct ViewLight {
     pub cull_by_cone: bool,
 }
 
+/// Is the offset `d` from a light inside its `range` and, for a spot, its outer cone
+/// (unit axis, outer cosine)? The light function's factors are positive exactly there.
+pub(super) fn reaches(d: Vec3, range: f32, cone: Option<(Vec3, f32)>) -> bool {
+    let dist_sq = d.length_squared();
+    if dist_sq >= range * range {
+        return false;
+    }
+    match cone {
+        None => true,
+        Some((axis, cos_outer)) => d.dot(axis) > cos_outer * dist_sq.sqrt(),
+    }
+}
+
 impl ViewLight {
     /// Does the light reach view-space point `p` (the light function's factors are positive
     /// exactly there: inside the range and the outer cone)?
     pub fn reaches(&self, p: Vec3) -> bool {
-        let d = p - self.apex;
-        let dist_sq = d.length_squared();
-        if dist_sq >= self.range * self.range {
-            return false;
-        }
-        match self.cone {
-            None => true,
-            Some((axis, cos_outer)) => d.dot(axis) > cos_outer * dist_sq.sqrt(),
-        }
+        reaches(p - self.apex, self.range, self.cone)
     }
 
     /// May the light reach anything inside the view-space sphere (c, r)? The bounding sphere
