@@ -53,16 +53,20 @@ struct CompareJson<'a> {
     notes: &'a [String],
 }
 
-/// What the difference column says for a pipeline whose image exists.
+/// What the difference column says for a pipeline whose image exists, given the rows so far
+/// (the reference's among them, failed or not).
 fn diff_cell(
     id: &str,
     image: &image::RgbaImage,
     references: &HashMap<&str, image::RgbaImage>,
-    reference_failed: bool,
+    rows: &[Row],
 ) -> Result<(Option<DiffSummary>, Option<String>)> {
     if id == REFERENCE {
         return Ok((None, Some("reference".into())));
     }
+    let reference_failed = rows
+        .iter()
+        .any(|r| r.pipeline == REFERENCE && r.failed.is_some());
     match references.get(REFERENCE) {
         Some(r) => Ok((Some(diff(r, image)?.0), None)),
         None if reference_failed => Ok((None, Some(format!("not computed: {REFERENCE} failed")))),
@@ -129,10 +133,7 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             write_atomic(&path, &bytes)?;
             written.push(path);
         }
-        let reference_failed = rows
-            .iter()
-            .any(|r| r.pipeline == REFERENCE && r.failed.is_some());
-        let (d, note) = diff_cell(p.id, &out.image, &references, reference_failed)?;
+        let (d, note) = diff_cell(p.id, &out.image, &references, &rows)?;
         if p.reference != REFERENCE && p.reference != p.id {
             if let Some(r) = references.get(p.reference) {
                 let own = diff(r, &out.image)?.0;
