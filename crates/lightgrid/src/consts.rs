@@ -40,6 +40,12 @@ pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 /// GPU), so f32 round-off can never drop a spot that reaches a sample.
 pub const CONE_SLACK: f32 = 1e-3;
 
+/// Spots with an outer cosine at least this (half-angle up to 45°) are drawn as cone light
+/// volumes by the classic deferred family; wider ones as their bounding sphere.
+pub const CONE_VOLUME_MIN_COS: f32 = std::f32::consts::FRAC_1_SQRT_2;
+/// Segments of the cone light volume's rings.
+pub const CONE_VOLUME_SEGMENTS: u32 = 16;
+
 /// `GpuLight::cos_outer` of a point light (no cone: below every cosine).
 pub const POINT_LIGHT_COS: f32 = -2.0;
 
@@ -127,6 +133,8 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
     ("CONE_SLACK", WgslConst::F32(CONE_SLACK)),
+    ("CONE_VOLUME_MIN_COS", WgslConst::F32(CONE_VOLUME_MIN_COS)),
+    ("CONE_VOLUME_SEGMENTS", WgslConst::U32(CONE_VOLUME_SEGMENTS)),
     ("POINT_LIGHT_COS", WgslConst::F32(POINT_LIGHT_COS)),
     ("ASSIGN_THREADS", WgslConst::U32(ASSIGN_THREADS)),
     ("CELL_LIST_CAPACITY", WgslConst::U32(CELL_LIST_CAPACITY)),

@@ -1,7 +1,10 @@
 //! Light volumes for the classic deferred family (`deferred`, `deferred_stencil`,
 //! `light_prepass*`).
 //!
-//! Each light's range sphere is drawn as an instanced low-poly sphere scaled to enclose it.
+//! Each light's bounding sphere is drawn as an instanced low-poly sphere scaled to enclose it;
+//! a spot of half-angle up to 45° as a closed cone instead (apex, a ring at the cap's rim, a
+//! cylinder to the range: the convex hull of the cone's sector, [`cone_volume`]), which the
+//! vertex shader builds from a unit cone mesh and the light.
 //! Per frame the CPU sorts the lights into draw classes by where the sphere sits against the
 //! near and far planes, so the image is right when the camera is inside a volume or a volume
 //! crosses a clip plane:
@@ -18,9 +21,34 @@
 //! a full-screen pass at the start, because they also sample the scene depth to rebuild
 //! positions, and a texture cannot be a written stencil attachment and sampled in one pass.
 
+use crate::consts::{CONE_VOLUME_MIN_COS, CONE_VOLUME_SEGMENTS};
 use crate::scene::ViewSetup;
 use crate::scene::{Light, Mesh};
+use glam::Vec3;
 use std::ops::Range;
+
+/// Is the light drawn as a cone volume (a spot no wider than 45°)? `vs_volume` decides the
+/// same way.
+pub fn cone_volume(l: &Light) -> bool {
+    l.spot.is_some_and(|s| s.cos_outer >= CONE_VOLUME_MIN_COS)
+}
+
+/// The cone volume's extreme points in world space (apex pulled back, the tip ring), as
+/// `vs_volume` places them: for the classification's extent.
+fn cone_volume_extent(l: &Light, center: Vec3) -> f32 {
+    let s = l.spot.expect("cone volumes are spots");
+    let (c, r) = (s.cos_outer, l.range);
+    let sin = (1.0 - c * c).max(0.0).sqrt();
+    let rho = r * sin / (std::f32::consts::PI / CONE_VOLUME_SEGMENTS as f32).cos() * 1.01;
+    let apex = l.position - s.direction * (0.01 * r);
+    let tip = l.position + s.direction * (1.01 * r);
+    let along = (tip - center).dot(s.direction);
+    let across = ((tip - center).length_squared() - along * along)
+        .max(0.0)
+        .sqrt();
+    let ring = (along * along + (across + rho) * (across + rho)).sqrt();
+    apex.distance(center).max(ring) * 1.01
+}
 
 pub const VOLUME_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
 /// Bytes per pixel of [`VOLUME_DEPTH_FORMAT`] (24-bit depth + 8-bit stencil).
@@ -43,6 +71,8 @@ pub struct VolumeClasses {
     pub back: Vec<u32>,
     pub full: Vec<u32>,
     pub stencil: Vec<u32>,
+    /// Per class (front, back, full, stencil), where its cone volumes start.
+    pub cones_from: [u32; 4],
 }
 
 /// Sort the lights into draw classes (see the module docs). Lights that cannot reach any
@@ -52,7 +82,11 @@ pub fn classify_lights(setup: &ViewSetup, lights: &[Light], stencil: bool) -> Vo
     for (i, l) in lights.iter().enumerate() {
         let v = setup.to_view(l);
         let w = -v.center.z;
-        let r = v.radius * ENCLOSING_SCALE;
+        let r = if cone_volume(l) {
+            cone_volume_extent(l, l.bounding_sphere().0)
+        } else {
+            v.radius * ENCLOSING_SCALE
+        };
         if w + v.radius < setup.near || w - v.radius > setup.far {
             continue;
         }
@@ -66,7 +100,51 @@ pub fn classify_lights(setup: &ViewSetup, lights: &[Light], stencil: bool) -> Vo
             (true, true) => c.full.push(i),
         }
     }
+    // Sphere volumes first, then cone volumes, in each class (drawn with their own mesh).
+    for list in [&mut c.front, &mut c.back, &mut c.full, &mut c.stencil] {
+        list.sort_by_key(|&i| cone_volume(&lights[i as usize]));
+    }
+    c.cones_from = [&c.front, &c.back, &c.full, &c.stencil]
+        .map(|list| list.partition_point(|&i| !cone_volume(&lights[i as usize])) as u32);
     c
+}
+
+/// The unit cone mesh `vs_volume` shapes per spot: xy on the unit circle (scaled to enclose
+/// it), z the part: 0 the apex, 1 the ring at the cap's rim, 2 the ring at the range (and its
+/// centre). Triangles wound like the sphere's (front faces outward).
+fn unit_cone(outward_ccw: bool) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let n = CONE_VOLUME_SEGMENTS;
+    let mut v = vec![[0.0, 0.0, 0.0]];
+    for z in [1.0, 2.0] {
+        for k in 0..n {
+            let a = k as f32 / n as f32 * std::f32::consts::TAU;
+            v.push([a.cos(), a.sin(), z]);
+        }
+    }
+    v.push([0.0, 0.0, 2.0]);
+    let ring = |z: u32, k: u32| 1 + (z - 1) * n + k % n;
+    let tip = 1 + 2 * n;
+    let mut tris = Vec::new();
+    for k in 0..n {
+        tris.push([0, ring(1, k), ring(1, k + 1)]);
+        tris.push([ring(1, k), ring(2, k), ring(2, k + 1)]);
+        tris.push([ring(1, k), ring(2, k + 1), ring(1, k + 1)]);
+        tris.push([tip, ring(2, k + 1), ring(2, k)]);
+    }
+    // Orient every triangle against an interior point of the (convex) code-space shape.
+    let p = |i: u32| Vec3::from(v[i as usize]);
+    let inside = Vec3::new(0.0, 0.0, 1.2);
+    let mut indices = Vec::new();
+    for [a, b, c] in tris {
+        let normal = (p(b) - p(a)).cross(p(c) - p(a));
+        let out = normal.dot((p(a) + p(b) + p(c)) / 3.0 - inside) > 0.0;
+        if out == outward_ccw {
+            indices.extend_from_slice(&[a, b, c]);
+        } else {
+            indices.extend_from_slice(&[a, c, b]);
+        }
+    }
+    (v, indices)
 }
 
 /// Which light volumes a draw covers, and how they are rasterized.
@@ -112,9 +190,13 @@ pub fn additive(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
 pub struct LightVolumes {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
-    index_count: u32,
+    /// The sphere's and the unit cone's index ranges in `indices`, and the cone's first vertex.
+    sphere: Range<u32>,
+    cone: Range<u32>,
+    cone_base: i32,
     instances: wgpu::Buffer,
     ranges: [Range<u32>; 4],
+    cones_from: [u32; 4],
     pub depth: wgpu::TextureView,
     copy_layout: wgpu::BindGroupLayout,
 }
@@ -132,17 +214,31 @@ impl LightVolumes {
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         use wgpu::util::DeviceExt;
         let sphere = Mesh::sphere(ENCLOSING_SCALE, RINGS, SEGMENTS);
-        let positions: Vec<[f32; 3]> = sphere.positions.iter().map(|p| p.to_array()).collect();
+        let mut positions: Vec<[f32; 3]> = sphere.positions.iter().map(|p| p.to_array()).collect();
+        // The cone is wound like the sphere: look at a triangle away from the poles.
+        let t = (RINGS / 2 * SEGMENTS * 6) as usize;
+        let tri = &sphere.indices[t..t + 3];
+        let p = |i: u32| sphere.positions[i as usize];
+        let outward_ccw = (p(tri[1]) - p(tri[0]))
+            .cross(p(tri[2]) - p(tri[0]))
+            .dot(p(tri[0]))
+            > 0.0;
+        let (cone_positions, cone_indices) = unit_cone(outward_ccw);
+        let cone_base = positions.len() as i32;
+        positions.extend_from_slice(&cone_positions);
+        let mut all_indices = sphere.indices.clone();
+        all_indices.extend_from_slice(&cone_indices);
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("light volume sphere"),
+            label: Some("light volume meshes"),
             contents: bytemuck::cast_slice(&positions),
             usage: wgpu::BufferUsages::VERTEX,
         });
         let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("light volume sphere indices"),
-            contents: bytemuck::cast_slice(&sphere.indices),
+            label: Some("light volume mesh indices"),
+            contents: bytemuck::cast_slice(&all_indices),
             usage: wgpu::BufferUsages::INDEX,
         });
+        let sphere_count = sphere.indices.len() as u32;
         let depth = super::render_texture(
             device,
             "light volume depth-stencil",
@@ -167,9 +263,12 @@ impl LightVolumes {
         LightVolumes {
             vertices,
             indices,
-            index_count: sphere.indices.len() as u32,
+            sphere: 0..sphere_count,
+            cone: sphere_count..all_indices.len() as u32,
+            cone_base,
             instances: instance_buffer(device, 1 << 14),
             ranges: Default::default(),
+            cones_from: [0; 4],
             depth,
             copy_layout,
         }
@@ -188,6 +287,7 @@ impl LightVolumes {
             self.ranges[slot] = start..start + list.len() as u32;
             start += list.len() as u32;
         }
+        self.cones_from = c.cones_from;
         let bytes: &[u8] = bytemuck::cast_slice(&all);
         if bytes.len() as u64 > self.instances.size() {
             self.instances = instance_buffer(device, (bytes.len() as u64).next_power_of_two());
@@ -411,12 +511,24 @@ impl LightVolumes {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
     }
 
+    /// Draw the instances `i` of class `slot`: its sphere volumes with the sphere mesh, its cone
+    /// volumes with the cone mesh.
+    fn draw_instances(&self, pass: &mut wgpu::RenderPass, slot: usize, i: Range<u32>) {
+        let split = (self.ranges[slot].start + self.cones_from[slot]).clamp(i.start, i.end);
+        if i.start < split {
+            pass.draw_indexed(self.sphere.clone(), 0, i.start..split);
+        }
+        if split < i.end {
+            pass.draw_indexed(self.cone.clone(), self.cone_base, split..i.end);
+        }
+    }
+
     /// Draw every light of class `Front`, `Back` or `Full` with the bound pipeline.
     pub fn draw(&self, pass: &mut wgpu::RenderPass, draw: VolumeDraw) {
         self.bind(pass);
         match draw {
-            VolumeDraw::Front => pass.draw_indexed(0..self.index_count, 0, self.ranges[0].clone()),
-            VolumeDraw::Back => pass.draw_indexed(0..self.index_count, 0, self.ranges[1].clone()),
+            VolumeDraw::Front => self.draw_instances(pass, 0, self.ranges[0].clone()),
+            VolumeDraw::Back => self.draw_instances(pass, 1, self.ranges[1].clone()),
             VolumeDraw::Full => pass.draw(0..3, self.ranges[2].clone()),
             _ => panic!("stencil lights are drawn one at a time with draw_stencil_light"),
         }
@@ -426,6 +538,6 @@ impl LightVolumes {
     pub fn draw_stencil_light(&self, pass: &mut wgpu::RenderPass, k: u32) {
         self.bind(pass);
         let i = self.ranges[3].start + k;
-        pass.draw_indexed(0..self.index_count, 0, i..i + 1);
+        self.draw_instances(pass, 3, i..i + 1);
     }
 }
