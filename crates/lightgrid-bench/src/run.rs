@@ -92,6 +92,9 @@ pub struct BenchConfig {
     /// Fraction of each scene's lights made spots (`--spot-fraction`).
     #[serde(default)]
     pub spot_fraction: f32,
+    /// Headlights on the robots of the scenes that have them (`--headlights`).
+    #[serde(default)]
+    pub headlights: bool,
     /// What grid pipelines cull spots by (`--spot-cull`): every grid pipeline is measured
     /// once per entry (pipelines without a grid once).
     #[serde(default = "default_spot_culls")]
@@ -155,6 +158,19 @@ impl BenchConfig {
             ..Default::default()
         };
         catalog::check_params(&self.scenes[0], &params)?;
+        if self.headlights {
+            // As --lights: refused only when no chosen scene has robots.
+            let taker = self
+                .scenes
+                .iter()
+                .find(|s| catalog::find(s).is_ok_and(|i| i.robots))
+                .unwrap_or(&self.scenes[0]);
+            let params = SceneParams {
+                headlights: true,
+                ..Default::default()
+            };
+            catalog::check_params(taker, &params)?;
+        }
         Ok(())
     }
 }
@@ -373,11 +389,12 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
         .scenes
         .iter()
         .map(|name| {
-            let variable = catalog::find(name)?.variable_lights;
+            let info = catalog::find(name)?;
             let params = SceneParams {
                 seed: config.seed,
-                lights: config.lights.filter(|_| variable),
+                lights: config.lights.filter(|_| info.variable_lights),
                 spot_fraction: config.spot_fraction,
+                headlights: config.headlights && info.robots,
             };
             catalog::build(name, &params)
         })

@@ -215,6 +215,9 @@ pub(crate) struct SceneArgs {
     /// directions and cones.
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = parse_fraction)]
     pub(crate) spot_fraction: f64,
+    /// Give every robot two headlights (spot lights that turn with it); robots scenes only.
+    #[arg(long)]
+    pub(crate) headlights: bool,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
@@ -236,6 +239,7 @@ pub(crate) fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
         seed: a.seed,
         lights: a.lights,
         spot_fraction: a.spot_fraction as f32,
+        headlights: a.headlights,
     };
     Ok(catalog::build(&a.scene, &params)?)
 }

@@ -71,6 +71,9 @@ pub(crate) struct BenchArgs {
     /// Fraction of each scene's lights (0 to 1) turned into spot lights.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_fraction)]
     pub(crate) spot_fraction: Option<f64>,
+    /// Give every robot two headlights (spot lights), in the scenes that have robots.
+    #[arg(long)]
+    pub(crate) headlights: bool,
     /// What grid pipelines cull spot lights by: sphere, cone, or sphere,cone to measure both
     /// [default: cone].
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -204,6 +207,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         lights: a.lights,
         heatmap_frame: a.heatmap_frame,
         spot_fraction: a.spot_fraction.map_or(d.spot_fraction, |f| f as f32),
+        headlights: a.headlights,
         spot_culls: if a.spot_cull.is_empty() {
             d.spot_culls.clone()
         } else {

@@ -82,6 +82,7 @@ fn main() {
                     lights: None,
                     seed: 1,
                     spot_fraction: 0.0,
+                    headlights: false,
                     renderer: RendererArgs {
                         tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                         slices: None,

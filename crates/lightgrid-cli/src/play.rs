@@ -54,6 +54,9 @@ pub(crate) struct PlayArgs {
     /// Fraction of the scene's lights (0 to 1) turned into spot lights.
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = parse_fraction)]
     pub(crate) spot_fraction: f64,
+    /// Give every robot two headlights (spot lights that turn with it); robots scenes only.
+    #[arg(long)]
+    pub(crate) headlights: bool,
 }
 
 /// The `--json` file.
@@ -102,6 +105,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
             seed: a.seed,
             lights: a.lights,
             spot_fraction: a.spot_fraction as f32,
+            headlights: a.headlights,
         },
     )?;
     let range = match &a.frames {

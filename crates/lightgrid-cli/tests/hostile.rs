@@ -595,6 +595,14 @@ fn an_option_that_applies_to_nothing_chosen_is_refused_in_every_command() {
     let d = s(&dir);
     let cases: &[(&[&str], &str)] = &[
         (
+            &["render", "--scene", "stress", "--headlights"],
+            "has no robots",
+        ),
+        (
+            &["bench", "--scene", "stress", "--headlights", "--out", d],
+            "has no robots",
+        ),
+        (
             &["render", "--pipeline", "deferred", "--spot-cull", "sphere"],
             "--spot-cull does not apply to deferred",
         ),

@@ -140,3 +140,47 @@ fn nan_or_non_positive_lights_are_rejected() {
     s.lights[0].light.range = 0.0;
     assert!(s.validate().is_err());
 }
+
+/// `--headlights`: two spots per robot that turn with it (object-anchored directions follow the
+/// robot's motion), refused on scenes without robots.
+#[test]
+fn headlights_turn_with_their_robots() {
+    use lightgrid::scene::LightAnchor;
+    let params = SceneParams {
+        headlights: true,
+        ..Default::default()
+    };
+    let scene = catalog::build("robots-few", &params).unwrap();
+    let heads: Vec<_> = scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.light.spot.is_some())
+        .collect();
+    assert_eq!(heads.len(), 22, "two per robot");
+    let mut turned = 0;
+    let first = scene.frame(0);
+    for f in [0, 60, 130, 259] {
+        let state = scene.frame(f);
+        for (i, l) in &heads {
+            let LightAnchor::Object(o) = l.anchor else {
+                panic!("headlights ride on their robots")
+            };
+            let t = state.transforms[o];
+            let forward = t.transform_vector3(glam::Vec3::Z).normalize();
+            let dir = state.lights[*i].spot.unwrap().direction;
+            assert!(
+                dir.dot(forward) > 0.9,
+                "frame {f}: headlight {i} does not look ahead"
+            );
+            assert!(dir.y < 0.0, "headlights look a little down");
+            let before = first.lights[*i].spot.unwrap().direction;
+            turned += usize::from(before.dot(dir) < 0.99);
+        }
+    }
+    assert!(
+        turned > 0,
+        "no robot turned its headlights over the animation"
+    );
+    assert!(catalog::build("stress", &params).is_err());
+}

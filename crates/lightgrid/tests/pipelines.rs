@@ -335,7 +335,8 @@ fn robots_few_tile_32_odd_resolution_camera_inside_light_volumes() {
     check_scene("robots-few", 200, (170, 100), settings(32));
 }
 
-/// Spot lights in every pipeline: `robots-many` with half its lights made spots, and `stress`
+/// Spot lights in every pipeline: `robots-many` with half its lights made spots, `robots-few`
+/// with headlights, and `stress`
 /// with every light a spot, both culled by their cones (the default) and, on `stress`, by
 /// their bounding spheres; every pipeline must still equal `forward`.
 #[test]
@@ -355,6 +356,12 @@ fn spot_lights_render_the_same_in_every_pipeline() {
             > 300
     );
     check(&street, 200, (149, 83), settings(8));
+    let headlights = SceneParams {
+        headlights: true,
+        ..Default::default()
+    };
+    let robots = catalog::build("robots-few", &headlights).unwrap();
+    check(&robots, 130, (121, 69), settings(16));
     let stress = catalog::build("stress", &params(Some(3000), 1.0)).unwrap();
     check(&stress, 3, (131, 77), settings(16));
     let spheres = RenderSettings {

@@ -39,6 +39,8 @@ pub struct SceneParams {
     /// Fraction of the lights (0 to 1) turned into spot lights with seeded random directions
     /// and cones (`--spot-fraction`).
     pub spot_fraction: f32,
+    /// Two headlights (spots) on every robot (`--headlights`, robots scenes only).
+    pub headlights: bool,
 }
 
 impl Default for SceneParams {
@@ -47,6 +49,7 @@ impl Default for SceneParams {
             seed: 1,
             lights: None,
             spot_fraction: 0.0,
+            headlights: false,
         }
     }
 }
@@ -71,7 +74,8 @@ fn make_spots(scene: &mut Scene, seed: u64, fraction: f32) {
             rng.range(SPOT_OUTER_DEGREES.0, SPOT_OUTER_DEGREES.1),
             rng.range(0.5, 0.9),
         );
-        if pick >= fraction {
+        // Lights that are spots already (headlights) keep their cones.
+        if pick >= fraction || l.light.spot.is_some() {
             continue;
         }
         let xy = (1.0 - z * z).max(0.0).sqrt();
@@ -87,6 +91,8 @@ pub struct SceneInfo {
     pub description: &'static str,
     /// Accepts `--lights N`.
     pub variable_lights: bool,
+    /// Has walking robots, which `--headlights` gives two spot lights each.
+    pub robots: bool,
     build: fn(&SceneParams) -> Scene,
 }
 
@@ -97,12 +103,14 @@ pub const SCENES: &[SceneInfo] = &[
         description:
             "city street, 11 walking robots, 924 static lights (range 12.5) along their paths",
         variable_lights: false,
+        robots: true,
         build: robots_many,
     },
     SceneInfo {
         name: "robots-few",
         description: "the same street with one light (range 40) carried by each of the 11 robots",
         variable_lights: false,
+        robots: true,
         build: robots_few,
     },
     SceneInfo {
@@ -110,18 +118,21 @@ pub const SCENES: &[SceneInfo] = &[
         description:
             "3072 lights scattered through a volume of pillars and blocks (Forward+ demo), 1280x720",
         variable_lights: false,
+        robots: false,
         build: scattered,
     },
     SceneInfo {
         name: "random-top",
         description: "1024 randomly placed lights over a block field, seen top-down",
         variable_lights: false,
+        robots: false,
         build: random_top,
     },
     SceneInfo {
         name: "random-fps",
         description: "the same 1024 lights and field, seen first-person",
         variable_lights: false,
+        robots: false,
         build: random_fps,
     },
     SceneInfo {
@@ -129,6 +140,7 @@ pub const SCENES: &[SceneInfo] = &[
         description:
             "any light count (--lights N, up to 1,000,000; default 10,000) over a large block field",
         variable_lights: true,
+        robots: false,
         build: stress,
     },
 ];
@@ -170,6 +182,18 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
         Some(n) if n == 0 || n > STRESS_MAX_LIGHTS => Err(Error::invalid(
             "--lights",
             format!("{n} is out of range 1 to {STRESS_MAX_LIGHTS}"),
+        )),
+        _ if params.headlights && !info.robots => Err(Error::invalid(
+            "--headlights",
+            format!(
+                "scene {name} has no robots; --headlights applies to: {}",
+                SCENES
+                    .iter()
+                    .filter(|s| s.robots)
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         )),
         _ if !(0.0..=1.0).contains(&params.spot_fraction) => Err(Error::invalid(
             "--spot-fraction",
@@ -470,8 +494,35 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
     (b, robots)
 }
 
+/// Headlights: two spots on each robot's head, beside its eyes, looking ahead and a little
+/// down (robots face +z in object space); they turn with the robot.
+fn headlights(b: &mut Builder, robots: &[usize]) {
+    for &body in robots {
+        for x in [-0.6f32, 0.6] {
+            let light = Light {
+                position: Vec3::new(x, 10.6, 1.3),
+                color: Vec3::new(1.0, 0.92, 0.75),
+                intensity: 2.0,
+                range: HEADLIGHT_RANGE,
+                spot: Some(Spot::new(
+                    Vec3::new(0.0, -0.3, 1.0),
+                    12f32.to_radians(),
+                    22f32.to_radians(),
+                )),
+            };
+            b.light(light, LightAnchor::Object(body));
+        }
+    }
+}
+
+/// Reach of a robot's headlight.
+pub const HEADLIGHT_RANGE: f32 = 35.0;
+
 fn robots_many(p: &SceneParams) -> Scene {
-    let (mut b, _) = robots_street("robots-many", p.seed);
+    let (mut b, robots) = robots_street("robots-many", p.seed);
+    if p.headlights {
+        headlights(&mut b, &robots);
+    }
     let per_path = ROBOTS_MANY_LIGHTS / ROBOT_COUNT;
     for path in 0..ROBOT_COUNT {
         let len = b.scene.paths[path].length();
@@ -493,6 +544,9 @@ fn robots_many(p: &SceneParams) -> Scene {
 
 fn robots_few(p: &SceneParams) -> Scene {
     let (mut b, robots) = robots_street("robots-few", p.seed);
+    if p.headlights {
+        headlights(&mut b, &robots);
+    }
     for body in robots {
         let light = Light {
             position: Vec3::new(0.0, 14.0, 0.0),
