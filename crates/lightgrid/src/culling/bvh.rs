@@ -9,11 +9,11 @@
 //! spheres, padded for round-off), so the traversal never prunes a light the gather test
 //! would keep, and the lists it builds equal gather's.
 
-use super::gather::{cpu_frustum, light_margin, CpuFrustum};
+use super::gather::{box_margin, cpu_frustum, light_margin, CpuFrustum};
 use super::gpu_assign::{bvh_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use super::{GridDims, LightGrid, ViewSetup};
-use crate::consts::{ASSIGN_DEPTH_SLACK, BVH_LEAF, BVH_WIDTH};
+use crate::consts::{BVH_LEAF, BVH_WIDTH};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
@@ -130,10 +130,16 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[Light]) -> LightBvh {
             let mut lo = Vec3::splat(f32::INFINITY);
             let mut hi = Vec3::splat(f32::NEG_INFINITY);
             for &l in chunk {
+                // The light's sphere box, or a spot's sector box (`ViewLight::reach_box`),
+                // padded.
                 let (c, r) = spheres[l as usize];
-                let e = Vec3::splat(r + pad(c, r));
-                lo = lo.min(c - e);
-                hi = hi.max(c + e);
+                let (box_lo, box_hi) = setup
+                    .to_view(&lights[l as usize])
+                    .reach_box()
+                    .unwrap_or((c - Vec3::splat(r), c + Vec3::splat(r)));
+                let e = Vec3::splat(r * 1e-4 + pad(c, r));
+                lo = lo.min(box_lo - e);
+                hi = hi.max(box_hi + e);
             }
             BvhNode {
                 lo: lo.to_array(),
@@ -177,19 +183,9 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[Light]) -> LightBvh {
     LightBvh { nodes, order }
 }
 
-/// `box_in_cell` of bvh.wgsl: does the view-space box reach into the frustum?
+/// `box_in_cell` of tile_frustum.wgsl: does the node's view-space box reach into the frustum?
 fn box_in_cell(f: &CpuFrustum, n: &BvhNode) -> bool {
-    let (lo, hi) = (Vec3::from(n.lo), Vec3::from(n.hi));
-    let (w_lo, w_hi) = (-hi.z, -lo.z);
-    if f.w_min > f.w_max
-        || w_hi < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK)
-        || w_lo > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)
-    {
-        return false;
-    }
-    f.planes
-        .iter()
-        .all(|p| p.dot(Vec3::select(p.cmpgt(Vec3::ZERO), hi, lo)) >= 0.0)
+    box_margin(f, Vec3::from(n.lo), Vec3::from(n.hi)) >= 0.0
 }
 
 /// CPU twin of the GPU traversal (`bvh.wgsl`): per cell, walk `bvh` pruning boxes outside the

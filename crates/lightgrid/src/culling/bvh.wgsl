@@ -14,23 +14,6 @@ var<workgroup> bvh_stack: array<u32, BVH_STACK>;
 var<workgroup> bvh_top: u32;
 var<workgroup> bvh_pushed: atomic<u32>;
 
-// Does the view-space box reach into the frustum? (Conservative: the box's farthest corner
-// along each plane's normal.)
-fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
-    let w_lo = -hi.z;
-    let w_hi = -lo.z;
-    if (f.w_min > f.w_max || w_hi < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK) || w_lo > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)) {
-        return false;
-    }
-    for (var i = 0u; i < 4u; i = i + 1u) {
-        let n = f.planes[i];
-        if (dot(n, select(lo, hi, n > vec3<f32>(0.0))) < 0.0) {
-            return false;
-        }
-    }
-    return true;
-}
-
 fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, spill: bool) {
     let c = cell_of_group(wg, nwg, spill);
     let f = cell_frustum(c);

@@ -87,9 +87,10 @@ fn leaves_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         let c = view_centre(l);
         let r = light_bounds[l].w;
         // The padding of `pad` in bvh.rs: GPU and CPU view positions differ by a few ulps.
-        let e = r + r * 1e-4 + max(max(abs(c.x), abs(c.y)), abs(c.z)) * 1e-5 + 1e-5;
-        lo = min(lo, c - vec3<f32>(e));
-        hi = max(hi, c + vec3<f32>(e));
+        let e = r * 2e-4 + max(max(abs(c.x), abs(c.y)), abs(c.z)) * 1e-5 + 1e-5;
+        let b = reach_box(l, c, r);
+        lo = min(lo, b[0] - vec3<f32>(e));
+        hi = max(hi, b[1] + vec3<f32>(e));
     }
     check_loop(k, count);
     nodes[level.first + j] = BvhNode(lo, first, hi, count | BVH_LEAF);

@@ -25,6 +25,7 @@ pub(crate) fn shader() -> ComposedShader {
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
+            super::TILE_FRUSTUM_WGSL,
             include_str!("bvh_build.wgsl"),
         ],
     )

@@ -77,7 +77,26 @@ pub(super) fn light_margin(f: &CpuFrustum, v: &ViewLight) -> f32 {
     if m < 0.0 || v.cone.is_none() {
         return m;
     }
-    m.min(v.cone_margin(f.sphere.0, f.sphere.1))
+    let m = m.min(v.cone_margin(f.sphere.0, f.sphere.1));
+    match v.reach_box() {
+        Some((lo, hi)) if m >= 0.0 => m.min(box_margin(f, lo, hi)),
+        _ => m,
+    }
+}
+
+/// `box_in_cell` of tile_frustum.wgsl as a margin: how far the view-space box reaches into
+/// the frustum (≥ 0: it does).
+pub(super) fn box_margin(f: &CpuFrustum, lo: Vec3, hi: Vec3) -> f32 {
+    if f.w_min > f.w_max {
+        return f32::NEG_INFINITY;
+    }
+    let (w_lo, w_hi) = (-hi.z, -lo.z);
+    let mut m = (w_hi - f.w_min * (1.0 - ASSIGN_DEPTH_SLACK))
+        .min(f.w_max * (1.0 + ASSIGN_DEPTH_SLACK) - w_lo);
+    for p in &f.planes {
+        m = m.min(p.dot(Vec3::select(p.cmpgt(Vec3::ZERO), hi, lo)));
+    }
+    m
 }
 
 /// Per cell and light, the gather test's margin (cells in grid order, lights in order).

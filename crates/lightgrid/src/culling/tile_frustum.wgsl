@@ -95,10 +95,60 @@ fn cone_margin(light: Light, cell: vec4<f32>) -> f32 {
     return min(m, min(along + r, r - (light.cos_outer * across - along * sin_outer)));
 }
 
-// Light `l` reaches into the frustum when its bounding sphere does and, for a spot, its cone
-// may reach the frustum's bounding sphere.
+// Does the view-space box [lo, hi] reach into the frustum (the BVH's node test; spots' boxes)?
+fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let w_lo = -hi.z;
+    let w_hi = -lo.z;
+    if (f.w_min > f.w_max || w_hi < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK) || w_lo > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)) {
+        return false;
+    }
+    for (var i = 0u; i < 4u; i = i + 1u) {
+        let n = f.planes[i];
+        if (dot(n, select(lo, hi, n > vec3<f32>(0.0))) < 0.0) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// A spot's box in view space: the cone sector's box within its bounding sphere's (CPU twin
+// and argument: `ViewLight::reach_box`); the sphere's box for point lights, wider cones and
+// sphere culling.
+fn reach_box(l: u32, c: vec3<f32>, radius: f32) -> array<vec3<f32>, 2> {
+    var lo = c - vec3<f32>(radius);
+    var hi = c + vec3<f32>(radius);
+    let light = lights[l];
+    if (frame.spot_cull == 0u || light.cos_outer <= 0.0) {
+        return array<vec3<f32>, 2>(lo, hi);
+    }
+    let apex = (frame.view * vec4<f32>(light.position, 1.0)).xyz;
+    let axis = normalize((frame.view * vec4<f32>(light.direction, 0.0)).xyz);
+    let cos_o = light.cos_outer;
+    let sin_o = sqrt(max(1.0 - cos_o * cos_o, 0.0));
+    let r = light.range;
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        let a = axis[i];
+        let spread = sin_o * sqrt(max(1.0 - a * a, 0.0));
+        let top = select(r * (cos_o * a + spread), r, a >= cos_o);
+        let bottom = select(r * (cos_o * a - spread), -r, -a >= cos_o);
+        hi[i] = min(hi[i], apex[i] + max(top, 0.0));
+        lo[i] = max(lo[i], apex[i] + min(bottom, 0.0));
+    }
+    return array<vec3<f32>, 2>(lo, hi);
+}
+
+// Light `l` reaches into the frustum when its bounding sphere does and, for a spot culled by
+// its cone, the cone may reach the frustum's bounding sphere and the sector's box reaches
+// into the frustum.
 fn light_in_tile(f: TileFrustum, l: u32) -> bool {
     let b = light_bounds[l];
     let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
-    return sphere_in_tile(f, c, b.w) && cone_margin(lights[l], f.sphere) >= 0.0;
+    if (!sphere_in_tile(f, c, b.w) || cone_margin(lights[l], f.sphere) < 0.0) {
+        return false;
+    }
+    if (frame.spot_cull == 0u || lights[l].cos_outer <= 0.0) {
+        return true;
+    }
+    let sector = reach_box(l, c, b.w);
+    return box_in_cell(f, sector[0], sector[1]);
 }

@@ -81,6 +81,37 @@ impl ViewLight {
         self.cone_margin(c, r) >= 0.0
     }
 
+    /// The box (view space) a spot culled by its cone is bounded by: the cone sector's box,
+    /// within its bounding sphere's. Along each axis e the sector reaches from the apex to
+    /// the cap's rim circle (centre r cos θ along the axis, radius r sin θ: the extent
+    /// r (a cos θ ± sin θ √(1 - a²)) for a = axis · e), and to the full range r where e lies
+    /// inside the cone (±a ≥ cos θ). None for point lights, wider cones and sphere culling.
+    /// `reach_box` in `tile_frustum.wgsl` is its GPU twin.
+    pub fn reach_box(&self) -> Option<(Vec3, Vec3)> {
+        let (axis, cos) = self
+            .cone
+            .filter(|&(_, cos)| self.cull_by_cone && cos > 0.0)?;
+        let (mut lo, mut hi) = (
+            self.center - Vec3::splat(self.radius),
+            self.center + Vec3::splat(self.radius),
+        );
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let r = self.range;
+        for i in 0..3 {
+            let a = axis[i];
+            let spread = sin * (1.0 - a * a).max(0.0).sqrt();
+            let top = if a >= cos { r } else { r * (cos * a + spread) };
+            let bottom = if -a >= cos {
+                -r
+            } else {
+                r * (cos * a - spread)
+            };
+            hi[i] = hi[i].min(self.apex[i] + top.max(0.0));
+            lo[i] = lo[i].max(self.apex[i] + bottom.min(0.0));
+        }
+        Some((lo, hi))
+    }
+
     /// How far the cone reaches into the sphere (c, r), as [`Self::may_reach_sphere`]
     /// decides (≥ 0: it may reach it; infinite when not culling by a cone). `cone_margin` in
     /// `tile_frustum.wgsl` is its GPU twin.
