@@ -20,7 +20,7 @@ pub use outdir::{check_out_dir, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE, STOPP
 pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     prepare, run, BenchConfig, BenchResults, FrameRange, FrameRecord, PreparedBench, Progress,
-    RunRecord, RunSummary, Stat, TimesFrom, SOURCES,
+    RunRecord, RunSummary, SpotRayTest, Stat, TimesFrom, SOURCES,
 };
 pub use scaling::{
     run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,

@@ -31,6 +31,29 @@ fn pipeline_label(r: &RunRecord) -> String {
     }
 }
 
+/// Test (b) of the spot culling over the scene's frames, when it was measured.
+fn spot_ray_section(s: &mut String, results: &BenchResults, scene: &str) {
+    let tests: Vec<_> = results
+        .spot_ray_tests
+        .iter()
+        .filter(|t| t.scene == scene)
+        .collect();
+    if tests.is_empty() {
+        return;
+    }
+    let sum = |f: &dyn Fn(&crate::SpotRayTest) -> u64| tests.iter().map(|t| f(t)).sum::<u64>();
+    let listed = sum(&|t| t.count.lighting_computations);
+    let ideal = sum(&|t| t.ideal_lighting_computations).max(1);
+    let (lit, missed) = (sum(&|t| t.count.lit_pairs), sum(&|t| t.count.missed_pairs));
+    let _ = writeln!(
+        s,
+        "\n### Spot test (b): the post's ray against a thickened cone (measured, not shipped)\n\nOn the depth-bounded {}-px tile grid of the same frames (tiled-deferred-tricks, Trick 2, with its constants): {:.2} × ideal, and it misses {missed} of {lit} lit (tile, spot) pairs ({:.1}%): light that tiled shading would lose, which is why `[cone]` ships instead.",
+        tests[0].tile_size,
+        listed as f64 / ideal as f64,
+        100.0 * missed as f64 / lit.max(1) as f64
+    );
+}
+
 /// `--spot-cull` value names, as in results.json.
 fn spot_cull_name(c: lightgrid::pipelines::SpotCull) -> &'static str {
     match c {
@@ -429,6 +452,7 @@ fn summary(results: &BenchResults) -> String {
         if let Some(i) = ideal {
             let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
         }
+        spot_ray_section(&mut s, results, scene);
         s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };

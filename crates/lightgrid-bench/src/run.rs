@@ -341,9 +341,25 @@ pub struct BenchResults {
     #[serde(default)]
     pub sources: Vec<(String, String)>,
     pub runs: Vec<RunRecord>,
+    /// With spots: per (scene, frame), what test (b), the post's ray against a thickened cone,
+    /// would list on the depth-bounded tile grid and how many lit (tile, spot) pairs it
+    /// would miss (`culling::ray_test_count`; measured, not shipped).
+    #[serde(default)]
+    pub spot_ray_tests: Vec<SpotRayTest>,
     /// Lights-per-tile heatmaps: (scene, pipeline, frame, image).
     #[serde(skip)]
     pub heatmaps: Vec<(String, String, u32, RgbaImage)>,
+}
+
+/// Test (b) on one frame (see [`BenchResults::spot_ray_tests`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpotRayTest {
+    pub scene: String,
+    pub frame: u32,
+    pub tile_size: u32,
+    pub ideal_lighting_computations: u64,
+    #[serde(flatten)]
+    pub count: lightgrid::culling::RayTestCount,
 }
 
 /// Where the figures of results.json come from.
@@ -532,7 +548,7 @@ impl<'a> Measuring<'a> {
         series: &Series,
         record: &mut RunRecord,
         bytes: &mut (u32, u64),
-        heatmaps: &mut Vec<(String, String, u32, RgbaImage)>,
+        results: &mut BenchResults,
     ) -> Result<SeriesEnd> {
         let info = series.info;
         let frames = &series.frames;
@@ -571,9 +587,29 @@ impl<'a> Measuring<'a> {
             let s = &out.stats;
             record.timing = s.timing;
             *bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
+            let heatmaps = &mut results.heatmaps;
             if f == heatmap_frame && wants_heatmap && !heatmaps.iter().any(|h| h.0 == scene.name) {
                 let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
                 heatmaps.push((scene.name.clone(), info.id.to_string(), f, map));
+            }
+            let tested = |t: &SpotRayTest| t.scene == scene.name && t.frame == f;
+            if self.config.spot_fraction > 0.0 && !results.spot_ray_tests.iter().any(tested) {
+                let state = scene.frame(f);
+                let setup =
+                    lightgrid::scene::ViewSetup::new(&state.camera, record.width, record.height);
+                let count = lightgrid::culling::ray_test_count(
+                    &setup,
+                    self.config.tile_size,
+                    &state.lights,
+                    &out.depth,
+                )?;
+                results.spot_ray_tests.push(SpotRayTest {
+                    scene: scene.name.clone(),
+                    frame: f,
+                    tile_size: self.config.tile_size,
+                    ideal_lighting_computations: s.ideal_lighting_computations,
+                    count,
+                });
             }
             record.frames.push(FrameRecord::from_analysis(f, s));
             if self.stopped() {
@@ -753,6 +789,7 @@ impl PreparedBench {
                 .map(|(a, b)| (a.to_string(), b.to_string()))
                 .collect(),
             runs: Vec::new(),
+            spot_ray_tests: Vec::new(),
             heatmaps: Vec::new(),
         };
         let heatmap_pipeline = config
@@ -784,13 +821,7 @@ impl PreparedBench {
                 record.spot_cull = Some(series.spot_cull);
             }
             let mut bytes = (0, 0);
-            let end = m.series(
-                scene,
-                series,
-                &mut record,
-                &mut bytes,
-                &mut results.heatmaps,
-            );
+            let end = m.series(scene, series, &mut record, &mut bytes, &mut results);
             record.complete = matches!(end, Ok(SeriesEnd::Complete));
             record.summary = RunSummary::from_frames(&record.frames, bytes.0, bytes.1);
             if !record.frames.is_empty() {

@@ -427,6 +427,16 @@ fn spot_culls_are_measured_side_by_side() {
             && summary.contains("clustered_deferred [cone]")
     );
     assert!(summary.contains("spot lights: 100%"), "{summary}");
+    // Test (b) measured once per frame, never listing fewer than the ideal for what it keeps.
+    assert_eq!(results.spot_ray_tests.len(), sphere.frames.len());
+    for t in &results.spot_ray_tests {
+        assert!(
+            t.count.lit_pairs > 0 && t.count.missed_pairs <= t.count.lit_pairs,
+            "{t:?}"
+        );
+        assert!(t.count.lighting_computations > 0);
+    }
+    assert!(summary.contains("Spot test (b)"), "{summary}");
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     assert!(csv.lines().next().unwrap().contains("spot_cull"));
     assert_eq!(

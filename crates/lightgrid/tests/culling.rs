@@ -859,116 +859,25 @@ fn spot_bounds_and_cone_test_never_lose_a_lit_point() {
     assert!(rejected > 68_000, "the cone test must cull: {rejected}");
 }
 
-/// Test (b) of the spot-light issue, measured and not shipped: the post's ray through each
-/// tile's centre against a cone thickened on the CPU (tiled-deferred-tricks, Trick 2, with its
-/// constants: the apex moved back and the cone lengthened and widened by
-/// `0.2 * sqrt(|light centre - eye| + max scale / 2)`). Over randomized cases it misses tiles
+/// Test (b) of the spot-light issue, measured and not shipped (`culling::ray_test_count`: the
+/// post's ray through each tile's centre against a cone thickened on the CPU,
+/// tiled-deferred-tricks Trick 2, with its constants). Over randomized cases it misses tiles
 /// the oracle says a spot lights, which is why `--spot-cull cone` tests against each cell's
 /// bounding sphere instead. The counts are printed (`--nocapture`) for README.
 #[test]
 fn the_posts_ray_against_a_thickened_cone_misses_lit_tiles() {
-    /// Does the segment `o + t d`, t in [t0, t1], meet the solid finite cone (apex `a`, unit
-    /// axis `axis`, length `len`, base radius `base`)? The cone is convex: an end inside, or
-    /// a crossing of the lateral surface or of the base disc.
-    fn segment_meets_cone(
-        o: Vec3,
-        d: Vec3,
-        t: (f32, f32),
-        a: Vec3,
-        axis: Vec3,
-        len: f32,
-        base: f32,
-    ) -> bool {
-        let k = base / len;
-        let inside = |p: Vec3| {
-            let h = (p - a).dot(axis);
-            let perp = ((p - a).length_squared() - h * h).max(0.0).sqrt();
-            (0.0..=len).contains(&h) && perp <= k * h
-        };
-        if inside(o + d * t.0) || inside(o + d * t.1) {
-            return true;
-        }
-        let v0 = o - a;
-        let (h0, hd) = (v0.dot(axis), d.dot(axis));
-        // |v|² - (1 + k²) h² = 0 along the segment.
-        let qa = d.length_squared() - (1.0 + k * k) * hd * hd;
-        let qb = 2.0 * (v0.dot(d) - (1.0 + k * k) * h0 * hd);
-        let qc = v0.length_squared() - (1.0 + k * k) * h0 * h0;
-        let mut roots = Vec::new();
-        if qa.abs() < 1e-12 {
-            if qb.abs() > 1e-12 {
-                roots.push(-qc / qb);
-            }
-        } else {
-            let disc = qb * qb - 4.0 * qa * qc;
-            if disc >= 0.0 {
-                roots.push((-qb - disc.sqrt()) / (2.0 * qa));
-                roots.push((-qb + disc.sqrt()) / (2.0 * qa));
-            }
-        }
-        let lateral = roots
-            .iter()
-            .any(|&r| (t.0..=t.1).contains(&r) && (0.0..=len).contains(&(h0 + r * hd)));
-        let cap = hd.abs() > 1e-12 && {
-            let r = (len - h0) / hd;
-            let p = v0 + d * r;
-            (t.0..=t.1).contains(&r) && (p.length_squared() - len * len).max(0.0).sqrt() <= base
-        };
-        lateral || cap
-    }
+    use lightgrid::culling::ray_test_count;
     let mut rng = Rng::new(2024);
-    let (mut lit_pairs, mut missed, mut ray_pairs, mut cone_pairs) = (0u64, 0u64, 0u64, 0u64);
+    let (mut lit_pairs, mut missed) = (0u64, 0u64);
     for _ in 0..1000 {
         let case = random_case(&mut rng);
         let depth = random_depth(&mut rng, &case);
-        let s = &case.setup;
-        let dims = GridDims::new(s.width, s.height, 8).unwrap();
-        let view_distance = common::view_distances(s, &depth);
-        let oracle = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
-        let bounds = cell_bounds_cpu(s, &dims, &depth);
-        let cone = assign_cpu(s, &dims, &case.lights, DepthRange::Cells(&bounds));
-        for t in 0..dims.tile_count() {
-            let [w0, w1] = bounds[t];
-            if w0 > w1 {
-                continue;
-            }
-            let (x0, y0, x1, y1) = dims.tile_rect(t);
-            let cx = (x0 + x1) as f32 * 0.5 / s.width as f32 * 2.0 - 1.0;
-            let cy = 1.0 - (y0 + y1) as f32 * 0.5 / s.height as f32 * 2.0;
-            let d = Vec3::new(cx / s.p00, cy / s.p11, -1.0);
-            for (l, light) in case.lights.iter().enumerate() {
-                // The post's cone mesh holds cones narrower than a half-space only.
-                let Some(spot) = light.spot.filter(|s| s.cos_outer > 0.02) else {
-                    continue;
-                };
-                let v = s.to_view(light);
-                let axis = s.view.transform_vector3(spot.direction);
-                let half = spot.cos_outer.acos();
-                let base = light.range * half.sin();
-                let max_scale = (base * std::f32::consts::PI).max(light.range);
-                let centre = v.apex + axis * (light.range * 0.5);
-                let off = 0.2 * (centre.length() + max_scale * 0.5).sqrt();
-                let hit = segment_meets_cone(
-                    Vec3::ZERO,
-                    d,
-                    (w0, w1),
-                    v.apex - axis * off,
-                    axis,
-                    light.range + 2.0 * off,
-                    base * std::f32::consts::PI + off,
-                );
-                let lit = oracle[t].contains(&(l as u32));
-                lit_pairs += u64::from(lit);
-                missed += u64::from(lit && !hit);
-                ray_pairs += u64::from(hit);
-                cone_pairs += u64::from(cone.cell(t).contains(&(l as u32)));
-            }
-        }
+        let count = ray_test_count(&case.setup, 8, &case.lights, &depth).unwrap();
+        assert!(count.missed_pairs <= count.lit_pairs);
+        lit_pairs += count.lit_pairs;
+        missed += count.missed_pairs;
     }
-    eprintln!(
-        "ray vs thickened cone: {missed} of {lit_pairs} lit (tile, spot) pairs missed; \
-         {ray_pairs} pairs listed against {cone_pairs} by the cone test"
-    );
+    eprintln!("ray vs thickened cone: {missed} of {lit_pairs} lit (tile, spot) pairs missed");
     assert!(
         lit_pairs > 10_000,
         "{lit_pairs} lit pairs: the cases must light tiles"
