@@ -127,16 +127,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     // The ideal: for each visible sample, the lights reaching it. The depth-bounded CPU
     // grid narrows the search (it provably contains every such light).
     let setup = a.setup;
-    let view_distance: Vec<f32> = depth
-        .iter()
-        .map(|&d| {
-            if d < 1.0 {
-                setup.view_distance(d)
-            } else {
-                f32::INFINITY
-            }
-        })
-        .collect();
+    let view_distance = setup.view_distances(&depth);
     let bounds = cell_bounds_cpu(&setup, &dims, &depth);
     let bounded = assign_cpu(&setup, &dims, lights, DepthRange::Cells(&bounds));
     let ideal = ideal_lighting_computations(&setup, &bounded, lights, &view_distance);

@@ -105,16 +105,7 @@ pub fn ray_test_count(
     depth: &[f32],
 ) -> Result<RayTestCount> {
     let dims = GridDims::new(setup.width, setup.height, tile_size)?;
-    let view_distance: Vec<f32> = depth
-        .iter()
-        .map(|&d| {
-            if d < 1.0 {
-                setup.view_distance(d)
-            } else {
-                f32::INFINITY
-            }
-        })
-        .collect();
+    let view_distance = setup.view_distances(depth);
     let bounds = cell_bounds_cpu(setup, &dims, depth);
     let oracle = oracle_tile_lights(setup, &dims, lights, &view_distance);
     let grid = assign_cpu(setup, &dims, lights, DepthRange::Cells(&bounds));

@@ -195,6 +195,20 @@ impl ViewSetup {
         (center, radius)
     }
 
+    /// The view distance of every sample of a depth buffer ([0, 1], 1 = no geometry: infinite).
+    pub fn view_distances(&self, depth: &[f32]) -> Vec<f32> {
+        depth
+            .iter()
+            .map(|&d| {
+                if d < 1.0 {
+                    self.view_distance(d)
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect()
+    }
+
     /// View distance of a [0, 1] depth-buffer value (inverse of the projection's depth).
     pub fn view_distance(&self, ndc_depth: f32) -> f32 {
         let r = self.far / (self.near - self.far);

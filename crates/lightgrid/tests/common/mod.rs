@@ -210,16 +210,7 @@ pub fn darken_disc(image: &image::RgbaImage, pixels: u32, levels: u8) -> (image:
 /// Each sample's view distance from a [0, 1] depth buffer; infinite where there is no geometry
 /// (what `oracle_tile_lights` reads).
 pub fn view_distances(setup: &ViewSetup, depth: &[f32]) -> Vec<f32> {
-    depth
-        .iter()
-        .map(|&d| {
-            if d < 1.0 {
-                setup.view_distance(d)
-            } else {
-                f32::INFINITY
-            }
-        })
-        .collect()
+    setup.view_distances(depth)
 }
 
 /// With probability 0.4, a spot cone for a light at `position`: pointing at the camera at
