@@ -12,7 +12,7 @@
 use super::gather::{box_margin, cpu_frustum, light_margin, CpuFrustum};
 use super::gpu_assign::{bvh_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{GridDims, LightGrid, ViewSetup};
+use super::{GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::{BVH_LEAF, BVH_WIDTH};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -101,15 +101,9 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[Light]) -> LightBvh {
     if lights.is_empty() {
         return LightBvh::default();
     }
-    // Each light as its bounding sphere (a spot's cone sector, `Light::bounding_sphere`).
-    let spheres: Vec<(Vec3, f32)> = lights
-        .par_iter()
-        .map(|l| {
-            let (c, r) = l.bounding_sphere();
-            (setup.view.transform_point3(c), r)
-        })
-        .collect();
-    let centers: Vec<Vec3> = spheres.iter().map(|s| s.0).collect();
+    // Each light in view space: its bounding sphere (a spot's cone sector) and reach box.
+    let views: Vec<ViewLight> = lights.par_iter().map(|l| setup.to_view(l)).collect();
+    let centers: Vec<Vec3> = views.iter().map(|v| v.center).collect();
     let (lo, hi) = centers.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), &c| (lo.min(c), hi.max(c)),
@@ -132,9 +126,9 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[Light]) -> LightBvh {
             for &l in chunk {
                 // The light's sphere box, or a spot's sector box (`ViewLight::reach_box`),
                 // padded.
-                let (c, r) = spheres[l as usize];
-                let (box_lo, box_hi) = setup
-                    .to_view(&lights[l as usize])
+                let v = &views[l as usize];
+                let (c, r) = (v.center, v.radius);
+                let (box_lo, box_hi) = v
                     .reach_box()
                     .unwrap_or((c - Vec3::splat(r), c + Vec3::splat(r)));
                 let e = Vec3::splat(r * 1e-4 + pad(c, r));
@@ -199,6 +193,7 @@ pub fn traverse_bvh_cpu(
     cell_bounds: &[[f32; 2]],
     bvh: &LightBvh,
 ) -> LightGrid {
+    let views: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
     let lists: Vec<Vec<u32>> = (0..dims.cell_count())
         .into_par_iter()
         .map(|c| {
@@ -213,7 +208,7 @@ pub fn traverse_bvh_cpu(
                 for child in node.children() {
                     if node.is_leaf() {
                         let l = bvh.order[child as usize];
-                        if light_margin(&f, &setup.to_view(&lights[l as usize])) >= 0.0 {
+                        if light_margin(&f, &views[l as usize]) >= 0.0 {
                             out.push(l);
                         }
                     } else if box_in_cell(&f, &bvh.nodes[child as usize]) {

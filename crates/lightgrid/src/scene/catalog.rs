@@ -147,7 +147,7 @@ pub const SCENES: &[SceneInfo] = &[
 
 /// Comma-separated scene names, for error messages and help.
 pub fn scene_names() -> String {
-    SCENES.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+    scenes_where(|_| true)
 }
 
 /// Look up a scene by name.
@@ -162,6 +162,16 @@ pub fn find(name: &str) -> Result<&'static SceneInfo> {
         })
 }
 
+/// Comma-separated names of the scenes an option applies to.
+fn scenes_where(applies: fn(&SceneInfo) -> bool) -> String {
+    SCENES
+        .iter()
+        .filter(|s| applies(s))
+        .map(|s| s.name)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Check a scene's parameters without building it: `--lights` only for scenes that take a
 /// light count, and within 1 to [`STRESS_MAX_LIGHTS`].
 pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneInfo> {
@@ -171,12 +181,7 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
             "--lights",
             format!(
                 "scene {name} has a fixed light count; --lights applies to: {}",
-                SCENES
-                    .iter()
-                    .filter(|s| s.variable_lights)
-                    .map(|s| s.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                scenes_where(|s| s.variable_lights)
             ),
         )),
         Some(n) if n == 0 || n > STRESS_MAX_LIGHTS => Err(Error::invalid(
@@ -187,12 +192,7 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
             "--headlights",
             format!(
                 "scene {name} has no robots; --headlights applies to: {}",
-                SCENES
-                    .iter()
-                    .filter(|s| s.robots)
-                    .map(|s| s.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                scenes_where(|s| s.robots)
             ),
         )),
         _ if !(0.0..=1.0).contains(&params.spot_fraction) => Err(Error::invalid(
