@@ -30,7 +30,7 @@ pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, LightGrid};
 pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
 pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
-pub use spot_ray::{ray_accepts, ray_test_count, RayTestCount};
+pub use spot_ray::{ray_test_count, RayTestCount};
 pub use strategy::AssignStrategy;
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).

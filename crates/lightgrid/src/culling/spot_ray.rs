@@ -72,27 +72,39 @@ fn segment_meets_cone(
     lateral || cap
 }
 
-/// Does the post's test keep `light` (a spot narrower than a half-space) for the tile whose
-/// centre ray (view space, through NDC `(cx, cy)`) spans view distances `w`?
-pub fn ray_accepts(setup: &ViewSetup, light: &Light, (cx, cy): (f32, f32), w: (f32, f32)) -> bool {
-    let Some(spot) = light.spot else { return true };
-    let v = setup.to_view(light);
-    let axis = setup.view.transform_vector3(spot.direction);
-    let half = spot.cos_outer.clamp(-1.0, 1.0).acos();
-    let base = light.range * half.sin();
-    let max_scale = (base * std::f32::consts::PI).max(light.range);
-    let centre = v.apex + axis * (light.range * 0.5);
-    let off = 0.2 * (centre.length() + max_scale * 0.5).sqrt();
-    let d = Vec3::new(cx / setup.p00, cy / setup.p11, -1.0);
-    segment_meets_cone(
-        Vec3::ZERO,
-        d,
-        w,
-        v.apex - axis * off,
-        axis,
-        light.range + 2.0 * off,
-        base * std::f32::consts::PI + off,
-    )
+/// A spot's cone thickened as the post does (view space): apex, unit axis, length, base
+/// radius.
+struct ThickCone {
+    apex: Vec3,
+    axis: Vec3,
+    len: f32,
+    base: f32,
+}
+
+impl ThickCone {
+    /// The post's cone for a spot narrower than a half-space; None for other lights (they
+    /// are culled as `assign_cpu` culls them).
+    fn of(setup: &ViewSetup, light: &Light) -> Option<ThickCone> {
+        let spot = light.spot.filter(|s| s.cos_outer > 0.02)?;
+        let v = setup.to_view(light);
+        let axis = setup.view.transform_vector3(spot.direction);
+        let half = spot.cos_outer.clamp(-1.0, 1.0).acos();
+        let base = light.range * half.sin();
+        let max_scale = (base * std::f32::consts::PI).max(light.range);
+        let centre = v.apex + axis * (light.range * 0.5);
+        let off = 0.2 * (centre.length() + max_scale * 0.5).sqrt();
+        Some(ThickCone {
+            apex: v.apex - axis * off,
+            axis,
+            len: light.range + 2.0 * off,
+            base: base * std::f32::consts::PI + off,
+        })
+    }
+
+    /// Does the ray `d` from the eye, over view distances `w`, meet it?
+    fn hit_by(&self, d: Vec3, w: (f32, f32)) -> bool {
+        segment_meets_cone(Vec3::ZERO, d, w, self.apex, self.axis, self.len, self.base)
+    }
 }
 
 /// Test (b) on one frame: a depth-bounded tile grid (`tile_size`) from `depth` ([0, 1],
@@ -109,6 +121,7 @@ pub fn ray_test_count(
     let bounds = cell_bounds_cpu(setup, &dims, depth);
     let oracle = oracle_tile_lights(setup, &dims, lights, &view_distance);
     let grid = assign_cpu(setup, &dims, lights, DepthRange::Cells(&bounds));
+    let cones: Vec<Option<ThickCone>> = lights.iter().map(|l| ThickCone::of(setup, l)).collect();
     let mut count = RayTestCount::default();
     for t in 0..dims.tile_count() {
         let [w0, w1] = bounds[t];
@@ -122,20 +135,24 @@ pub fn ray_test_count(
             .count() as u64;
         let cx = (x0 + x1) as f32 * 0.5 / setup.width as f32 * 2.0 - 1.0;
         let cy = 1.0 - (y0 + y1) as f32 * 0.5 / setup.height as f32 * 2.0;
-        for (l, light) in lights.iter().enumerate() {
-            let l = l as u32;
-            let by_ray = light.spot.is_some_and(|s| s.cos_outer > 0.02);
-            let kept = if by_ray {
-                ray_accepts(setup, light, (cx, cy), (w0, w1))
-            } else {
-                grid.cell(t).contains(&l)
-            };
-            count.lighting_computations += samples * u64::from(kept);
-            if by_ray && oracle[t].contains(&l) {
+        let ray = Vec3::new(cx / setup.p00, cy / setup.p11, -1.0);
+        // Lights without a thickened cone: as the CPU grid lists them.
+        let others = grid
+            .cell(t)
+            .iter()
+            .filter(|&&l| cones[l as usize].is_none());
+        let mut kept = others.count() as u64;
+        let lit = &oracle[t];
+        for (l, cone) in cones.iter().enumerate() {
+            let Some(cone) = cone else { continue };
+            let hit = cone.hit_by(ray, (w0, w1));
+            kept += u64::from(hit);
+            if lit.contains(&(l as u32)) {
                 count.lit_pairs += 1;
-                count.missed_pairs += u64::from(!kept);
+                count.missed_pairs += u64::from(!hit);
             }
         }
+        count.lighting_computations += samples * kept;
     }
     Ok(count)
 }
