@@ -45,6 +45,9 @@ pub const CONE_SLACK: f32 = 1e-3;
 pub const CONE_VOLUME_MIN_COS: f32 = std::f32::consts::FRAC_1_SQRT_2;
 /// Segments of the cone light volume's rings.
 pub const CONE_VOLUME_SEGMENTS: u32 = 16;
+/// How far a cone light volume reaches past its cone, as a fraction of the range: the apex is
+/// pulled back by it, the rings widened and the far ring pushed out by it.
+pub const CONE_VOLUME_MARGIN: f32 = 0.01;
 
 /// `GpuLight::cos_outer` of a point light (no cone: below every cosine).
 pub const POINT_LIGHT_COS: f32 = -2.0;
@@ -135,6 +138,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("CONE_SLACK", WgslConst::F32(CONE_SLACK)),
     ("CONE_VOLUME_MIN_COS", WgslConst::F32(CONE_VOLUME_MIN_COS)),
     ("CONE_VOLUME_SEGMENTS", WgslConst::U32(CONE_VOLUME_SEGMENTS)),
+    ("CONE_VOLUME_MARGIN", WgslConst::F32(CONE_VOLUME_MARGIN)),
     ("POINT_LIGHT_COS", WgslConst::F32(POINT_LIGHT_COS)),
     ("ASSIGN_THREADS", WgslConst::U32(ASSIGN_THREADS)),
     ("CELL_LIST_CAPACITY", WgslConst::U32(CELL_LIST_CAPACITY)),

@@ -16,8 +16,9 @@ struct VolumeOut {
 // World position of a volume vertex: a unit-sphere vertex scaled to the light's bounding
 // sphere, or for a spot up to 45° (light_volumes.rs `cone_volume`) a unit-cone vertex (xy on
 // the circle, z the part: 0 apex, 1 the cap's rim, 2 the range) placed around its cone: the
-// apex pulled back 1% of the range, a ring at the rim's depth r cos θ and one at 1.01 r, both
-// of radius 1.01 r sin θ / cos(π / segments), so the polygon holds the circle.
+// apex pulled back CONE_VOLUME_MARGIN of the range, a ring at the rim's depth r cos θ and one
+// past the range by that margin, both widened by it over r sin θ / cos(π / segments), so the
+// polygon holds the circle.
 fn volume_position(p: vec3<f32>, l: u32) -> vec3<f32> {
     let light = lights[l];
     if (light.cos_outer < CONE_VOLUME_MIN_COS) {
@@ -30,11 +31,12 @@ fn volume_position(p: vec3<f32>, l: u32) -> vec3<f32> {
     let w = cross(axis, u);
     let r = light.range;
     let sin_outer = sqrt(max(1.0 - light.cos_outer * light.cos_outer, 0.0));
-    let rho = r * sin_outer / cos(3.14159265 / f32(CONE_VOLUME_SEGMENTS)) * 1.01;
+    let grow = 1.0 + CONE_VOLUME_MARGIN;
+    let rho = r * sin_outer / cos(3.14159265 / f32(CONE_VOLUME_SEGMENTS)) * grow;
     if (p.z < 0.5) {
-        return light.position - axis * (0.01 * r);
+        return light.position - axis * (CONE_VOLUME_MARGIN * r);
     }
-    let h = select(r * 1.01, r * light.cos_outer, p.z < 1.5);
+    let h = select(r * grow, r * light.cos_outer, p.z < 1.5);
     return light.position + axis * h + (u * p.x + w * p.y) * rho;
 }
 

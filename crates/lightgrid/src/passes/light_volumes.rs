@@ -21,7 +21,7 @@
 //! a full-screen pass at the start, because they also sample the scene depth to rebuild
 //! positions, and a texture cannot be a written stencil attachment and sampled in one pass.
 
-use crate::consts::{CONE_VOLUME_MIN_COS, CONE_VOLUME_SEGMENTS};
+use crate::consts::{CONE_VOLUME_MARGIN, CONE_VOLUME_MIN_COS, CONE_VOLUME_SEGMENTS};
 use crate::scene::ViewSetup;
 use crate::scene::{Light, Mesh};
 use glam::Vec3;
@@ -39,9 +39,10 @@ fn cone_volume_extent(l: &Light, center: Vec3) -> f32 {
     let s = l.spot.expect("cone volumes are spots");
     let (c, r) = (s.cos_outer, l.range);
     let sin = (1.0 - c * c).max(0.0).sqrt();
-    let rho = r * sin / (std::f32::consts::PI / CONE_VOLUME_SEGMENTS as f32).cos() * 1.01;
-    let apex = l.position - s.direction * (0.01 * r);
-    let tip = l.position + s.direction * (1.01 * r);
+    let grow = 1.0 + CONE_VOLUME_MARGIN;
+    let rho = r * sin / (std::f32::consts::PI / CONE_VOLUME_SEGMENTS as f32).cos() * grow;
+    let apex = l.position - s.direction * (CONE_VOLUME_MARGIN * r);
+    let tip = l.position + s.direction * (grow * r);
     let along = (tip - center).dot(s.direction);
     let across = ((tip - center).length_squared() - along * along)
         .max(0.0)
