@@ -23,12 +23,17 @@ fn run_name(r: &RunRecord) -> String {
     }
 }
 
-/// The pipeline, with the spot culling when the run measured more than one.
+/// The pipeline, with the spot culling and the transparent lists when the run measured more
+/// than one.
 fn pipeline_label(r: &RunRecord) -> String {
-    match r.spot_cull {
-        Some(c) => format!("{} [{}]", r.pipeline, spot_cull_name(c)),
-        None => r.pipeline.clone(),
+    let mut label = r.pipeline.clone();
+    if let Some(c) = r.spot_cull {
+        label += &format!(" [{}]", spot_cull_name(c));
     }
+    if let Some(l) = r.lists {
+        label += &format!(" [{} lists]", l.name());
+    }
+    label
 }
 
 /// Test (b) of the spot culling over the scene's frames, when it was measured.
@@ -80,11 +85,12 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 22] = [
+const RESULTS_CSV_COLUMNS: [&str; 25] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
     "spot_cull",
+    "lists",
     "width",
     "height",
     "tile_size",
@@ -97,6 +103,8 @@ const RESULTS_CSV_COLUMNS: [&str; 22] = [
     "analysis_gpu_ms",
     "lighting_computations",
     "ideal_lighting_computations",
+    "transparent_fragments",
+    "ideal_transparent_computations",
     "lights_per_tile_avg",
     "lights_per_tile_max",
     "grid_bytes",
@@ -113,6 +121,7 @@ struct ResultsRow<'a> {
     pipeline: &'a str,
     gbuffer_bits: Option<u32>,
     spot_cull: Option<&'static str>,
+    lists: Option<&'static str>,
     width: u32,
     height: u32,
     tile_size: u32,
@@ -130,6 +139,8 @@ struct ResultsRow<'a> {
     analysis_gpu_ms: f64,
     lighting_computations: Option<u64>,
     ideal_lighting_computations: u64,
+    transparent_fragments: u64,
+    ideal_transparent_computations: u64,
     #[serde(serialize_with = "fixed3_opt")]
     lights_per_tile_avg: Option<f64>,
     lights_per_tile_max: Option<u32>,
@@ -177,6 +188,7 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 pipeline: &r.pipeline,
                 gbuffer_bits: r.gbuffer_bits,
                 spot_cull: r.spot_cull.map(spot_cull_name),
+                lists: r.lists.map(|l| l.name()),
                 width: r.width,
                 height: r.height,
                 tile_size: r.tile_size,
@@ -189,6 +201,8 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 analysis_gpu_ms: f.analysis_gpu_ms,
                 lighting_computations: f.lighting_computations,
                 ideal_lighting_computations: f.ideal_lighting_computations,
+                transparent_fragments: f.transparent_fragments,
+                ideal_transparent_computations: f.ideal_transparent_computations,
                 lights_per_tile_avg: f.lights_per_tile_avg,
                 lights_per_tile_max: f.lights_per_tile_max,
                 grid_bytes: f.grid_bytes,

@@ -3,6 +3,7 @@
 use crate::invalid;
 use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
+use lightgrid::culling::GridLists;
 use lightgrid::error::Result;
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
@@ -99,10 +100,25 @@ pub struct BenchConfig {
     /// once per entry (pipelines without a grid once).
     #[serde(default = "default_spot_culls")]
     pub spot_culls: Vec<SpotCull>,
+    /// The scenes' transparent objects (`--transparency on|off`).
+    #[serde(default = "default_transparency")]
+    pub transparency: bool,
+    /// The lists grid pipelines build for frames with transparent geometry (`--lists`):
+    /// every pipeline with an `--assign` grid is measured once per entry.
+    #[serde(default = "default_lists")]
+    pub lists: Vec<GridLists>,
 }
 
 fn default_spot_culls() -> Vec<SpotCull> {
     vec![SpotCull::default()]
+}
+
+fn default_transparency() -> bool {
+    true
+}
+
+fn default_lists() -> Vec<GridLists> {
+    vec![RenderSettings::default().lists]
 }
 
 impl BenchConfig {
@@ -111,10 +127,11 @@ impl BenchConfig {
             || self.pipelines.is_empty()
             || self.gbuffers.is_empty()
             || self.spot_culls.is_empty()
+            || self.lists.is_empty()
         {
             return Err(invalid(
                 "bench",
-                "needs at least one scene, pipeline, G-buffer setting and spot culling",
+                "needs at least one scene, pipeline, G-buffer setting, spot culling and list setting",
             ));
         }
         for p in &self.pipelines {
@@ -196,6 +213,12 @@ pub struct FrameRecord {
     pub passes: Vec<PassTiming>,
     pub lighting_computations: Option<u64>,
     pub ideal_lighting_computations: u64,
+    /// Transparent fragments in front of the opaque depth (the transparent overdraw), and
+    /// their part of the ideal count.
+    #[serde(default)]
+    pub transparent_fragments: u64,
+    #[serde(default)]
+    pub ideal_transparent_computations: u64,
     pub lights_per_tile_avg: Option<f64>,
     pub lights_per_tile_max: Option<u32>,
     pub grid_bytes: Option<u64>,
@@ -309,6 +332,9 @@ pub struct RunRecord {
     /// What spots were culled by, when the run measured more than one way (grid pipelines).
     #[serde(default)]
     pub spot_cull: Option<SpotCull>,
+    /// The transparent lists, when the run measured more than one setting (`--lists`).
+    #[serde(default)]
+    pub lists: Option<GridLists>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -397,6 +423,8 @@ struct Series {
     uses_gbuffer: bool,
     /// What spots are culled by; recorded when more than one is measured.
     spot_cull: SpotCull,
+    /// The transparent lists; recorded when more than one is measured.
+    lists: GridLists,
     frames: Vec<u32>,
 }
 
@@ -411,6 +439,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 lights: config.lights.filter(|_| info.variable_lights),
                 spot_fraction: config.spot_fraction,
                 headlights: config.headlights && info.robots,
+                transparency: config.transparency || !info.transparency(),
             };
             catalog::build(name, &params)
         })
@@ -458,15 +487,24 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                 } else {
                     &config.spot_culls[..1]
                 };
+                // Only pipelines with an `--assign` grid build transparent lists.
+                let lists = if info.assign {
+                    &config.lists[..]
+                } else {
+                    &config.lists[..1]
+                };
                 for &spot_cull in culls {
-                    plan.push(Series {
-                        scene: si,
-                        gbuffer: *g,
-                        info,
-                        uses_gbuffer: g_used,
-                        spot_cull,
-                        frames: frames.clone(),
-                    });
+                    for &lists in lists {
+                        plan.push(Series {
+                            scene: si,
+                            gbuffer: *g,
+                            info,
+                            uses_gbuffer: g_used,
+                            spot_cull,
+                            lists,
+                            frames: frames.clone(),
+                        });
+                    }
                 }
             }
         }
@@ -520,6 +558,7 @@ impl<'a> Measuring<'a> {
                 lightgrid::pipelines::Assign::default()
             },
             spot_cull: series.spot_cull,
+            lists: series.lists,
         }
     }
 
@@ -557,11 +596,14 @@ impl<'a> Measuring<'a> {
         } else {
             String::new()
         };
-        let cull = if self.config.spot_culls.len() > 1 && info.uses_grid {
+        let mut cull = if self.config.spot_culls.len() > 1 && info.uses_grid {
             format!(" {:?}", series.spot_cull).to_lowercase()
         } else {
             String::new()
         };
+        if self.config.lists.len() > 1 && info.assign {
+            cull += &format!(" {} lists", series.lists.name());
+        }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
             self.tick(label("warm-up"));
@@ -666,6 +708,8 @@ impl FrameRecord {
             passes: s.passes.clone(),
             lighting_computations: s.lighting_computations,
             ideal_lighting_computations: s.ideal_lighting_computations,
+            transparent_fragments: s.transparent_fragments,
+            ideal_transparent_computations: s.ideal_transparent_computations,
             lights_per_tile_avg: s.lights_per_tile_avg,
             lights_per_tile_max: s.lights_per_tile_max,
             grid_bytes: s.memory.grid_bytes,
@@ -683,6 +727,7 @@ impl RunRecord {
             pipeline: series.info.id.to_string(),
             gbuffer_bits: series.uses_gbuffer.then_some(series.gbuffer.bits()),
             spot_cull: None,
+            lists: None,
             width: size.0,
             height: size.1,
             tile_size: tile,
@@ -819,6 +864,9 @@ impl PreparedBench {
             let mut record = RunRecord::new(scene, series, size, config.tile_size);
             if config.spot_culls.len() > 1 && series.info.uses_grid {
                 record.spot_cull = Some(series.spot_cull);
+            }
+            if config.lists.len() > 1 && series.info.assign {
+                record.lists = Some(series.lists);
             }
             let mut bytes = (0, 0);
             let end = m.series(scene, series, &mut record, &mut bytes, &mut results);

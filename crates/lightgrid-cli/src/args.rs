@@ -99,6 +99,38 @@ impl From<SpotCullArg> for lightgrid::pipelines::SpotCull {
     }
 }
 
+/// `--lists`: the light lists of frames with transparent geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum ListsArg {
+    /// An opaque list pruned by the tile's depth bounds and a transparent list over
+    /// near..opaque max (tiled-forward-shading §4.5).
+    Separate,
+    /// One list over near..opaque max for both.
+    Shared,
+}
+
+impl From<ListsArg> for lightgrid::culling::GridLists {
+    fn from(a: ListsArg) -> Self {
+        match a {
+            ListsArg::Separate => Self::Separate,
+            ListsArg::Shared => Self::Shared,
+        }
+    }
+}
+
+/// `--transparency on|off`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum OnOff {
+    On,
+    Off,
+}
+
+impl OnOff {
+    pub(crate) fn on(self) -> bool {
+        self == OnOff::On
+    }
+}
+
 /// A finite number at least 0 (thresholds, budgets).
 pub(crate) fn parse_non_negative(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -114,6 +146,7 @@ pub(crate) struct Given {
     pub(crate) gbuffer: bool,
     pub(crate) assign: bool,
     pub(crate) spot_cull: bool,
+    pub(crate) lists: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -124,11 +157,12 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 4] = [
+    let rules: [(&str, bool, Applies); 5] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
         ("--spot-cull", given.spot_cull, |p| p.uses_grid),
+        ("--lists", given.lists, |p| p.assign),
     ];
     for (flag, given, applies) in rules {
         if given && !chosen.iter().any(|p| applies(p)) {
@@ -167,6 +201,10 @@ pub(crate) struct RendererArgs {
     /// What grid pipelines cull spot lights by [default: cone].
     #[arg(long, value_enum)]
     pub(crate) spot_cull: Option<SpotCullArg>,
+    /// The light lists of grid pipelines with an --assign grid, for frames with transparent
+    /// objects [default: separate].
+    #[arg(long, value_enum)]
+    pub(crate) lists: Option<ListsArg>,
 }
 
 impl RendererArgs {
@@ -178,6 +216,9 @@ impl RendererArgs {
             slices: self.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
             assign: self.assign.unwrap_or(AssignArg::Auto).into(),
             spot_cull: self.spot_cull.map(Into::into).unwrap_or_default(),
+            lists: self
+                .lists
+                .map_or(RenderSettings::default().lists, Into::into),
         };
         settings.validate()?;
         Ok(settings)
@@ -190,6 +231,7 @@ impl RendererArgs {
             gbuffer: self.gbuffer.is_some(),
             assign: self.assign.is_some(),
             spot_cull: self.spot_cull.is_some(),
+            lists: self.lists.is_some(),
         }
     }
 }
@@ -218,6 +260,10 @@ pub(crate) struct SceneArgs {
     /// Give every robot two headlights (spot lights that turn with it); robots scenes only.
     #[arg(long)]
     pub(crate) headlights: bool,
+    /// The scene's transparent objects (glass panes and bubbles, translucent blocks), drawn
+    /// blended after the opaque geometry; robots and random scenes.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub(crate) transparency: OnOff,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
@@ -240,6 +286,7 @@ pub(crate) fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
         lights: a.lights,
         spot_fraction: a.spot_fraction as f32,
         headlights: a.headlights,
+        transparency: a.transparency.on(),
     };
     Ok(catalog::build(&a.scene, &params)?)
 }

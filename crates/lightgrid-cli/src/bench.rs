@@ -2,7 +2,7 @@
 
 use crate::args::{
     check_applies, format_duration, parse_fraction, parse_gbuffer, parse_size, progress_bar,
-    run_outcome, stop_on_ctrl_c, AssignArg, Given, Size, SpotCullArg, MAX_COUNT,
+    run_outcome, stop_on_ctrl_c, AssignArg, Given, ListsArg, OnOff, Size, SpotCullArg, MAX_COUNT,
 };
 use anyhow::{bail, Result};
 use clap::Args;
@@ -23,6 +23,10 @@ pub(crate) enum Preset {
     /// light a spot, frames 0..259 every 20, grid pipelines culling by sphere and by cone,
     /// with forward and deferred beside them.
     Spots,
+    /// Transparency (tiled-forward-shading §4.5): robots-many with its glass, frames 0..259
+    /// every 20, grid pipelines with separate and with shared opaque/transparent lists, with
+    /// forward and deferred beside them.
+    Transparency,
 }
 
 #[derive(Args)]
@@ -78,6 +82,13 @@ pub(crate) struct BenchArgs {
     /// [default: cone].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(crate) spot_cull: Vec<SpotCullArg>,
+    /// The scenes' transparent objects (robots and random scenes).
+    #[arg(long, value_enum)]
+    pub(crate) transparency: Option<OnOff>,
+    /// The light lists of grid pipelines for frames with transparent objects: separate,
+    /// shared, or separate,shared to measure both [default: separate].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) lists: Vec<ListsArg>,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
@@ -103,6 +114,11 @@ pub(crate) struct BenchDefaults {
     pub(crate) pipelines: Vec<String>,
     pub(crate) spot_fraction: f32,
     pub(crate) spot_culls: Vec<lightgrid::pipelines::SpotCull>,
+    pub(crate) lists: Vec<lightgrid::culling::GridLists>,
+}
+
+fn default_lists() -> Vec<lightgrid::culling::GridLists> {
+    vec![lightgrid::pipelines::RenderSettings::default().lists]
 }
 
 pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
@@ -123,6 +139,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             pipelines: all.clone(),
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],
+            lists: default_lists(),
         },
         Some(Preset::Quick) => BenchDefaults {
             scenes: vec!["robots-many"],
@@ -133,6 +150,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             pipelines: all.clone(),
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],
+            lists: default_lists(),
         },
         Some(Preset::Spots) => BenchDefaults {
             scenes: vec!["robots-many"],
@@ -150,6 +168,25 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
                 lightgrid::pipelines::SpotCull::Sphere,
                 lightgrid::pipelines::SpotCull::Cone,
             ],
+            lists: default_lists(),
+        },
+        Some(Preset::Transparency) => BenchDefaults {
+            scenes: vec!["robots-many"],
+            frames: "0..259:20",
+            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+            gbuffers: vec![GBufferFormat::F16],
+            repeat: if hardware { 3 } else { 1 },
+            pipelines: PIPELINES
+                .iter()
+                .filter(|p| p.assign || p.id == "forward" || p.id == "deferred")
+                .map(|p| p.id.to_string())
+                .collect(),
+            spot_fraction: 0.0,
+            spot_culls: vec![Default::default()],
+            lists: vec![
+                lightgrid::culling::GridLists::Separate,
+                lightgrid::culling::GridLists::Shared,
+            ],
         },
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
@@ -165,6 +202,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
                 .collect(),
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],
+            lists: default_lists(),
         },
     };
     let (scenes, frames, size, gbuffers, repeat, pipelines) = (
@@ -213,6 +251,12 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         } else {
             a.spot_cull.iter().map(|&c| c.into()).collect()
         },
+        transparency: a.transparency.is_none_or(OnOff::on),
+        lists: if a.lists.is_empty() {
+            d.lists.clone()
+        } else {
+            a.lists.iter().map(|&l| l.into()).collect()
+        },
     };
     config.validate()?;
     let chosen: Vec<_> = config
@@ -225,6 +269,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         gbuffer: !a.gbuffer.is_empty(),
         assign: a.assign.is_some(),
         spot_cull: !a.spot_cull.is_empty(),
+        lists: !a.lists.is_empty(),
     };
     check_applies(given, &chosen)?;
     Ok(config)

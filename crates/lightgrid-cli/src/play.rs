@@ -3,8 +3,8 @@
 //! the frame-time distribution (`lightgrid::realtime`).
 
 use crate::args::{
-    check_applies, parse_fraction, parse_size, progress_bar, stop_on_ctrl_c, RendererArgs, Size,
-    MAX_COUNT,
+    check_applies, parse_fraction, parse_size, progress_bar, stop_on_ctrl_c, OnOff, RendererArgs,
+    Size, MAX_COUNT,
 };
 use crate::files::{Files, Kind};
 use anyhow::{bail, Result};
@@ -57,6 +57,9 @@ pub(crate) struct PlayArgs {
     /// Give every robot two headlights (spot lights that turn with it); robots scenes only.
     #[arg(long)]
     pub(crate) headlights: bool,
+    /// The scene's transparent objects (robots and random scenes).
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub(crate) transparency: OnOff,
 }
 
 /// The `--json` file.
@@ -106,6 +109,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
             lights: a.lights,
             spot_fraction: a.spot_fraction as f32,
             headlights: a.headlights,
+            transparency: a.transparency.on(),
         },
     )?;
     let range = match &a.frames {

@@ -5,8 +5,8 @@
 //! (`GridBuilder::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
-    assign_cpu, cell_bounds_cpu, ideal_lighting_computations, BuiltGrid, DepthRange, GridDims,
-    LightGrid, ViewSetup,
+    assign_cpu, cell_bounds_cpu, ideal_fragment_computations, ideal_lighting_computations,
+    BuiltGrid, DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
 };
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
@@ -14,8 +14,9 @@ use crate::gpu::GpuContext;
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
 use crate::passes::{Readback, Targets};
 use crate::pipelines::PipelineInfo;
-use crate::scene::{FrameState, Scene};
+use crate::scene::{rasterize, FrameState, Scene};
 use crate::stats::{FrameStats, TimingSource};
+use glam::Vec3;
 use image::RgbaImage;
 
 /// An image, its statistics, and what the analysis saw.
@@ -98,6 +99,8 @@ pub(crate) struct AnalysisInput<'r> {
     pub scene: &'r Scene,
     pub info: &'static PipelineInfo,
     pub up_state: &'r FrameState,
+    /// The frame's transparent triangles (world space), drawn after the opaque image.
+    pub transparent: Vec<[Vec3; 3]>,
     pub setup: ViewSetup,
     pub triangles: u32,
     pub finished: FinishedFrame,
@@ -124,13 +127,22 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         None
     };
 
-    // The ideal: for each visible sample, the lights reaching it. The depth-bounded CPU
-    // grid narrows the search (it provably contains every such light).
+    // The ideal: for each visible sample and each transparent fragment in front of it, the
+    // lights reaching it. The depth-bounded CPU grid (with transparent lists when there are
+    // transparent fragments) narrows the search: it provably contains every such light.
     let setup = a.setup;
     let view_distance = setup.view_distances(&depth);
-    let bounds = cell_bounds_cpu(&setup, &dims, &depth);
-    let bounded = assign_cpu(&setup, &dims, lights, DepthRange::Cells(&bounds));
-    let ideal = ideal_lighting_computations(&setup, &bounded, lights, &view_distance);
+    let fragments = rasterize(&setup, &a.transparent, &view_distance);
+    let ideal_dims = if fragments.is_empty() {
+        dims
+    } else {
+        dims.with_lists(GridLists::Separate)
+    };
+    let bounds = cell_bounds_cpu(&setup, &ideal_dims, &depth);
+    let bounded = assign_cpu(&setup, &ideal_dims, lights, DepthRange::Cells(&bounds));
+    let ideal_transparent = ideal_fragment_computations(&setup, &bounded, lights, &fragments);
+    let ideal =
+        ideal_lighting_computations(&setup, &bounded, lights, &view_distance) + ideal_transparent;
 
     let passes = a.finished.passes;
     let (gpu_ms, timing) = match a.finished.gpu_ms {
@@ -183,6 +195,8 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             gbuffer_bits: settings.gbuffer.bits(),
             lighting_computations,
             ideal_lighting_computations: ideal,
+            transparent_fragments: fragments.len() as u64,
+            ideal_transparent_computations: ideal_transparent,
             efficiency: lighting_computations
                 .filter(|&n| n > 0)
                 .map(|n| ideal as f64 / n as f64),

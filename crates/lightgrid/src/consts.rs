@@ -115,6 +115,12 @@ pub const EXPOSURE: f32 = 1.0;
 /// Workgroup edge of the full-screen compute passes (8×8 = 64 invocations).
 pub const SCREEN_WORKGROUP: u32 = 8;
 
+/// `GridParams::lists` values (`frame::GridLists`): lists over opaque samples only, one list
+/// shared by opaque and transparent fragments, or separate lists (a second layer of cells).
+pub const GRID_LISTS_OPAQUE: u32 = 0;
+pub const GRID_LISTS_SHARED: u32 = 1;
+pub const GRID_LISTS_SEPARATE: u32 = 2;
+
 /// Material flag bit: the material is transparent (blended, drawn after opaque geometry).
 pub const MATERIAL_FLAG_TRANSPARENT: u32 = 1;
 
@@ -168,6 +174,9 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("COUNTER_SPILL_ARGS", WgslConst::U32(COUNTER_SPILL_ARGS)),
     ("COUNTER_ITEM_ARGS", WgslConst::U32(COUNTER_ITEM_ARGS)),
     ("COUNTER_SLOTS", WgslConst::U32(COUNTER_SLOTS)),
+    ("GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
+    ("GRID_LISTS_SHARED", WgslConst::U32(GRID_LISTS_SHARED)),
+    ("GRID_LISTS_SEPARATE", WgslConst::U32(GRID_LISTS_SEPARATE)),
     (
         "MATERIAL_FLAG_TRANSPARENT",
         WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),

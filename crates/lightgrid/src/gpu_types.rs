@@ -79,8 +79,10 @@ pub struct GridParams {
     /// slice = floor(ln(view distance) * slice_scale + slice_bias), clamped (clusters only).
     pub slice_scale: f32,
     pub slice_bias: f32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// `GridLists::gpu`: 0 opaque, 1 shared, 2 separate (a second layer of cells).
+    pub lists: u32,
+    /// Cells of one layer (tiles × slices).
+    pub layer_cells: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 32);

@@ -24,8 +24,8 @@ use crate::frame::{
 use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::{scene_layout, Targets, Tonemap};
-use crate::pipelines::{self, PipelineContext, Technique};
-use crate::scene::{FrameState, Scene, SpotCull};
+use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
+use crate::scene::{FrameState, Geometry, Scene, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::time::Instant;
 
@@ -97,6 +97,11 @@ struct Uploaded {
     state: FrameState,
     setup: ViewSetup,
     index_count: u32,
+    opaque_indices: u32,
+    /// What this frame wrote after the static geometry (its transparent triangles are
+    /// rasterized for the ideal count), and the vertex it starts at.
+    frame_geometry: Geometry,
+    static_vertices: u32,
     /// Bytes written to the GPU for this frame.
     upload_bytes: u64,
 }
@@ -118,6 +123,8 @@ pub struct Renderer<'c> {
     timer: PassTimer,
     counters: FrameCounters,
     techniques: HashMap<&'static str, Box<dyn Technique>>,
+    /// The transparent objects' pass after every technique (created with the first one).
+    transparent: Option<TransparentPass>,
     settings: RenderSettings,
     dims: GridDims,
     readbacks: AnalysisReadbacks,
@@ -194,6 +201,7 @@ impl<'c> Renderer<'c> {
                 scene_bind_group,
                 scene: None,
                 techniques: HashMap::new(),
+                transparent: None,
                 settings,
                 dims,
                 readbacks: AnalysisReadbacks::new(device, width, height),
@@ -258,6 +266,12 @@ impl<'c> Renderer<'c> {
                 (info.create)(&ctx)
             })?;
             self.techniques.insert(info.id, t);
+            if self.transparent.is_none() {
+                let pass = scoped(device, "creating the transparent pass", || {
+                    TransparentPass::new(&ctx)
+                })?;
+                self.transparent = Some(pass);
+            }
         }
         Ok(())
     }
@@ -265,14 +279,19 @@ impl<'c> Renderer<'c> {
     /// Step 1: validate `frame` of `scene` and upload what the frame needs.
     fn upload(&mut self, scene: &Scene, frame: u32) -> Result<Uploaded> {
         let state = Self::validated_frame(scene, frame)?;
-        let (mut upload_bytes, index_count) = self.upload_geometry(scene, &state)?;
+        let (mut upload_bytes, frame_geometry) = self.upload_geometry(scene, &state)?;
         upload_bytes += self.upload_frame_data(&state);
+        let upload = self.scene.as_ref().expect("geometry uploaded");
+        let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
         let (width, height) = self.size();
         let mut setup = ViewSetup::new(&state.camera, width, height);
         setup.spot_cull = self.settings.spot_cull;
         Ok(Uploaded {
             setup,
-            index_count,
+            index_count: static_indices + frame_geometry.indices.len() as u32,
+            opaque_indices: static_indices + frame_geometry.opaque_indices as u32,
+            frame_geometry,
+            static_vertices,
             state,
             upload_bytes,
         })
@@ -308,8 +327,9 @@ impl<'c> Renderer<'c> {
     }
 
     /// The static geometry and materials once per scene (by fingerprint), the moving objects
-    /// every frame after them. Returns the bytes written and the frame's index count.
-    fn upload_geometry(&mut self, scene: &Scene, state: &FrameState) -> Result<(u64, u32)> {
+    /// every frame after them. Returns the bytes written and what was written after the
+    /// static geometry.
+    fn upload_geometry(&mut self, scene: &Scene, state: &FrameState) -> Result<(u64, Geometry)> {
         let ctx = self.ctx;
         let (device, queue) = (&ctx.device, &ctx.queue);
         let mut upload_bytes = 0u64;
@@ -321,14 +341,14 @@ impl<'c> Renderer<'c> {
             let ib: &[u8] = bytemuck::cast_slice(&indices);
             let mb: &[u8] = bytemuck::cast_slice(&materials);
             // Room for the moving objects too, so the buffers rarely grow later.
-            let (mv, mi) = scene.moving_geometry(state, vertices.len() as u32);
+            let moving = scene.frame_geometry(state, vertices.len() as u32);
             self.vertices.reserve(
                 device,
-                (vb.len() + std::mem::size_of_val(mv.as_slice())) as u64,
+                (vb.len() + std::mem::size_of_val(moving.vertices.as_slice())) as u64,
             );
             self.indices.reserve(
                 device,
-                (ib.len() + std::mem::size_of_val(mi.as_slice())) as u64,
+                (ib.len() + std::mem::size_of_val(moving.indices.as_slice())) as u64,
             );
             if self.materials.reserve(device, mb.len() as u64) {
                 self.rebind_scene();
@@ -345,9 +365,9 @@ impl<'c> Renderer<'c> {
         }
         let upload = self.scene.as_ref().expect("uploaded above");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
-        let (vertices, indices) = scene.moving_geometry(state, static_vertices);
-        let vb: &[u8] = bytemuck::cast_slice(&vertices);
-        let ib: &[u8] = bytemuck::cast_slice(&indices);
+        let moving = scene.frame_geometry(state, static_vertices);
+        let vb: &[u8] = bytemuck::cast_slice(&moving.vertices);
+        let ib: &[u8] = bytemuck::cast_slice(&moving.indices);
         let (v_off, i_off) = (
             u64::from(static_vertices) * std::mem::size_of::<crate::gpu_types::GpuVertex>() as u64,
             u64::from(static_indices) * 4,
@@ -362,7 +382,7 @@ impl<'c> Renderer<'c> {
         self.vertices.write(queue, v_off, vb);
         self.indices.write(queue, i_off, ib);
         upload_bytes += (vb.len() + ib.len()) as u64;
-        Ok((upload_bytes, static_indices + indices.len() as u32))
+        Ok((upload_bytes, moving))
     }
 
     /// The frame's lights and uniforms. Returns the bytes written.
@@ -433,6 +453,7 @@ impl<'c> Renderer<'c> {
             counters: self.counters.buffer(),
             vertices: &self.vertices.buffer,
             indices: &self.indices.buffer,
+            opaque_indices: up.opaque_indices,
             index_count: up.index_count,
             targets: &self.targets,
             setup: up.setup,
@@ -442,6 +463,10 @@ impl<'c> Renderer<'c> {
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
         self.counters.clear(enc.parts().0);
         technique.encode(&inputs, &mut enc)?;
+        self.transparent
+            .as_mut()
+            .expect("created with the technique")
+            .encode(&inputs, &mut enc, technique.transparent_lights())?;
         let (encoder, timer) = enc.parts();
         self.tonemap
             .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
@@ -478,6 +503,9 @@ impl<'c> Renderer<'c> {
             .and_then(|t| t.grid_builder())
         {
             builder.observe(&self.ctx.device, &r.values)?;
+        }
+        if let Some(t) = &mut self.transparent {
+            t.observe(&self.ctx.device, &r.values)?;
         }
         let write_overflow = r.values.write_overflow();
         if write_overflow > 0 {
@@ -635,6 +663,7 @@ impl<'c> Renderer<'c> {
                 scene,
                 info,
                 up_state: &up.state,
+                transparent: up.frame_geometry.transparent_triangles(up.static_vertices),
                 setup: up.setup,
                 triangles: up.index_count / 3,
                 finished,

@@ -69,9 +69,16 @@ pub struct FrameStats {
     /// times their tile's list length. None where the adapter cannot count (no R32Float
     /// blending).
     pub lighting_computations: Option<u64>,
-    /// For every visible sample, the lights whose range reaches it: the floor no technique
-    /// can go below.
+    /// For every visible sample and every transparent fragment in front of the opaque
+    /// depth, the lights that reach it: the floor no technique can go below.
     pub ideal_lighting_computations: u64,
+    /// Transparent fragments shaded (CPU rasterization of the transparent objects in front
+    /// of the opaque depth): the transparent overdraw.
+    #[serde(default)]
+    pub transparent_fragments: u64,
+    /// The part of the ideal count that is the transparent fragments'.
+    #[serde(default)]
+    pub ideal_transparent_computations: u64,
     /// ideal / actual (1.0 is perfect culling).
     pub efficiency: Option<f64>,
     /// Lights per cell (tile, or cluster) of the grid this pipeline shaded with (None: it

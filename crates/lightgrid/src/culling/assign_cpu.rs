@@ -228,11 +228,14 @@ pub fn assign_cpu(
                         DepthRange::Cells(bounds) => {
                             let k0 = dims.slice_of(p.w_min * (1.0 - DEPTH_SLACK));
                             let k1 = dims.slice_of(p.w_max * (1.0 + DEPTH_SLACK));
-                            for k in k0..=k1 {
-                                let cell = k as usize * tiles + tile;
-                                let [lo, hi] = bounds[cell];
-                                if overlaps(p, lo, hi) && cone_reaches(p, cell) {
-                                    out.push((cell as u32, l));
+                            for layer in 0..dims.lists.layers() as usize {
+                                for k in k0..=k1 {
+                                    let cell =
+                                        layer * dims.layer_cells() + k as usize * tiles + tile;
+                                    let [lo, hi] = bounds[cell];
+                                    if overlaps(p, lo, hi) && cone_reaches(p, cell) {
+                                        out.push((cell as u32, l));
+                                    }
                                 }
                             }
                         }

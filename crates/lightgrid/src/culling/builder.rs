@@ -14,7 +14,7 @@ use super::gpu_assign::read_grid;
 use super::registry::find_strategy;
 pub use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext};
-use super::{GridBuffers, GridDims, LightGrid};
+use super::{GridBuffers, GridDims, GridLists, LightGrid};
 use crate::error::{Error, Result};
 use crate::frame::{Assign, FrameEncoder, FrameInputs};
 use crate::gpu::CounterValues;
@@ -30,6 +30,9 @@ pub struct GridSetup<'a> {
     pub assign: Assign,
     /// A CPU-emulated adapter (`auto` picks `cpu` there).
     pub software_adapter: bool,
+    /// The lists of a frame with transparent geometry (`--lists`); a frame without any
+    /// builds opaque lists only.
+    pub lists: GridLists,
 }
 
 /// A built grid and what went into it (analysis).
@@ -59,6 +62,7 @@ pub struct GridBuilder {
     slices: u32,
     source: CellSource,
     assign: Assign,
+    lists: GridLists,
     software_adapter: bool,
     scene_layout: wgpu::BindGroupLayout,
     bounds: CellBoundsPass,
@@ -78,6 +82,7 @@ impl GridBuilder {
             slices,
             source,
             assign: ctx.assign,
+            lists: ctx.lists,
             software_adapter: ctx.software_adapter,
             scene_layout: scene_layout.clone(),
             bounds: CellBoundsPass::new(device, scene_layout),
@@ -135,6 +140,11 @@ impl GridBuilder {
         } else {
             self.tiles
         };
+        // Cells spanning near..far already cover every transparent fragment.
+        let dims = dims.with_lists(match self.source {
+            CellSource::Depth if f.has_transparency() => self.lists,
+            _ => GridLists::Opaque,
+        });
         match self.source {
             CellSource::Depth => self.bounds.encode(f, enc, &dims),
             CellSource::NearFar => {

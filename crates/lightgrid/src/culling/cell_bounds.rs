@@ -9,7 +9,7 @@
 //! GPU kernel: `cell_bounds.wgsl`, one workgroup per tile. CPU twin: [`cell_bounds_cpu`].
 //! Without a depth pre-pass (`tiled_forward`) every cell gets `[near, far]` instead.
 
-use super::{GridDims, ViewSetup};
+use super::{GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::{FrameEncoder, FrameInputs};
@@ -35,6 +35,7 @@ pub const EMPTY_CELL: [f32; 2] = [f32::INFINITY, 0.0];
 /// row-major) and the same output.
 pub fn cell_bounds_cpu(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec<[f32; 2]> {
     let mut bounds = vec![EMPTY_CELL; dims.cell_count()];
+    let mut tile_max = vec![0.0f32; dims.tile_count()];
     let mut include = |cell: usize, w: f32| {
         let b = &mut bounds[cell];
         b[0] = b[0].min(w);
@@ -43,11 +44,13 @@ pub fn cell_bounds_cpu(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec
     for y in 0..dims.height {
         for x in 0..dims.width {
             let d = depth[(y * dims.width + x) as usize];
+            let tile = dims.tile_of(x, y);
             if d >= 1.0 {
+                tile_max[tile] = tile_max[tile].max(setup.far);
                 continue;
             }
             let w = setup.view_distance(d);
-            let tile = dims.tile_of(x, y);
+            tile_max[tile] = tile_max[tile].max(w);
             let k0 = dims.slice_of(w * (1.0 - ASSIGN_DEPTH_SLACK));
             let k1 = dims.slice_of(w * (1.0 + ASSIGN_DEPTH_SLACK));
             include(k0 as usize * dims.tile_count() + tile, w);
@@ -56,7 +59,42 @@ pub fn cell_bounds_cpu(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec
             }
         }
     }
+    if dims.lists != GridLists::Opaque {
+        let layer = dims.layer_cells();
+        for cell in 0..layer {
+            let tile = cell % dims.tile_count();
+            let t = transparent_bounds(setup, dims, dims.slice_of_cell(cell), tile_max[tile]);
+            match dims.lists {
+                GridLists::Shared => bounds[cell] = bounds_union(bounds[cell], t),
+                _ => bounds[layer + cell] = t,
+            }
+        }
+    }
     bounds
+}
+
+/// Where transparent fragments of slice `k` can lie in a tile whose opaque maximum is
+/// `tile_max` (an empty pixel counts as the far plane): in front of it, behind the near
+/// plane, inside the slice's range widened by twice the slack (tiled-forward-shading §4.5:
+/// the transparent list spans near..max). Twin of `transparent_bounds` in the kernel.
+fn transparent_bounds(setup: &ViewSetup, dims: &GridDims, k: u32, tile_max: f32) -> [f32; 2] {
+    let [slice_lo, slice_hi] = dims.slice_range(k);
+    let lo = setup.near.max(slice_lo * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
+    let hi = tile_max.min(slice_hi * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
+    if lo > hi {
+        EMPTY_CELL
+    } else {
+        [lo, hi]
+    }
+}
+
+/// The smallest range holding both (either may be empty: min > max).
+fn bounds_union(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
+    match (a[0] <= a[1], b[0] <= b[1]) {
+        (false, _) => b,
+        (_, false) => a,
+        _ => [a[0].min(b[0]), a[1].max(b[1])],
+    }
 }
 
 /// The GPU kernel and the bounds buffer it fills.

@@ -17,6 +17,8 @@
 const W_INFINITY: u32 = 0x7f800000u;
 
 var<workgroup> slice_lo: array<atomic<u32>, MAX_SLICES>;
+// The tile's opaque maximum, an empty pixel counting as the far plane (transparent lists).
+var<workgroup> tile_hi: atomic<u32>;
 var<workgroup> slice_hi: array<atomic<u32>, MAX_SLICES>;
 
 fn include_sample(k: u32, bits: u32) {
@@ -32,6 +34,9 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         atomicStore(&slice_hi[k0], 0u);
     }
     check_loop(k0, grid.slices);
+    if (li == 0u) {
+        atomicStore(&tile_hi, 0u);
+    }
     workgroupBarrier();
     let size = textureDimensions(depth_tex);
     let origin = wg.xy * grid.tile_size;
@@ -42,6 +47,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
             let p = origin + vec2<u32>(x, y);
             if (p.x < size.x && p.y < size.y) {
                 let d = textureLoad(depth_tex, p, 0);
+                atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), d < 1.0)));
                 if (d < 1.0) {
                     let w = view_distance_from_depth(d);
                     let bits = bitcast<u32>(w);
@@ -62,14 +68,57 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     let tiles = grid.tiles_x * grid.tiles_y;
     var k = li;
     for (; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
-        let lo = atomicLoad(&slice_lo[k]);
-        let hi = atomicLoad(&slice_hi[k]);
-        bounds_out[k * tiles + tile] = vec2<f32>(bitcast<f32>(lo), bitcast<f32>(hi));
-        if (lo <= hi) {
-            occupied_cells[atomicAdd(&occupancy[0], 1u)] = k * tiles + tile;
+        var b = vec2<f32>(bitcast<f32>(atomicLoad(&slice_lo[k])), bitcast<f32>(atomicLoad(&slice_hi[k])));
+        let cell = k * tiles + tile;
+        if (grid.lists != GRID_LISTS_OPAQUE) {
+            let t = transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi)));
+            if (grid.lists == GRID_LISTS_SHARED) {
+                b = bounds_union(b, t);
+            } else {
+                write_bounds(grid.layer_cells + cell, t);
+            }
         }
+        write_bounds(cell, b);
     }
     check_loop(k, grid.slices);
+}
+
+fn write_bounds(cell: u32, b: vec2<f32>) {
+    bounds_out[cell] = b;
+    if (b.x <= b.y) {
+        occupied_cells[atomicAdd(&occupancy[0], 1u)] = cell;
+    }
+}
+
+// Where transparent fragments of slice k can lie in a tile whose opaque maximum is
+// `tile_max`: in front of it, behind the near plane, inside the slice's range widened by
+// twice the slack (the fragment's slice is computed in f32). Twin: `transparent_bounds`.
+fn transparent_bounds(k: u32, tile_max: f32) -> vec2<f32> {
+    var lo = frame.near;
+    var hi = tile_max;
+    if (grid.slices > 1u) {
+        if (k > 0u) {
+            lo = max(lo, exp((f32(k) - grid.slice_bias) / grid.slice_scale) * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
+        }
+        if (k + 1u < grid.slices) {
+            hi = min(hi, exp((f32(k + 1u) - grid.slice_bias) / grid.slice_scale) * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
+        }
+    }
+    if (lo > hi) {
+        return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+    }
+    return vec2<f32>(lo, hi);
+}
+
+// The smallest range holding both (either may be empty: min > max).
+fn bounds_union(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    if (a.x > a.y) {
+        return b;
+    }
+    if (b.x > b.y) {
+        return a;
+    }
+    return vec2<f32>(min(a.x, b.x), max(a.y, b.y));
 }
 
 // One invocation: the occupied-cell count as (x, y, 1) workgroups, x at most 65535.

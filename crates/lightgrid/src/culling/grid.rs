@@ -4,6 +4,7 @@
 //! every grid-reading shader reads it through `culling/light_grid.wgsl`.
 
 use crate::error::{Error, Result};
+pub use crate::frame::GridLists;
 use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::gpu_types::GridParams;
 
@@ -20,6 +21,8 @@ pub struct GridDims {
     pub slices: u32,
     pub near: f32,
     pub far: f32,
+    /// Which samples the lists cover: opaque samples only, or transparent fragments too.
+    pub lists: GridLists,
 }
 
 impl GridDims {
@@ -35,6 +38,7 @@ impl GridDims {
             slices: 1,
             near: 0.0,
             far: 0.0,
+            lists: GridLists::Opaque,
         })
     }
 
@@ -60,9 +64,29 @@ impl GridDims {
         (self.tiles_x * self.tiles_y) as usize
     }
 
-    /// All cells: tiles × slices.
-    pub fn cell_count(&self) -> usize {
+    /// The same grid with lists covering `lists`.
+    pub fn with_lists(self, lists: GridLists) -> Self {
+        GridDims { lists, ..self }
+    }
+
+    /// Cells of one layer: tiles × slices.
+    pub fn layer_cells(&self) -> usize {
         self.tile_count() * self.slices as usize
+    }
+
+    /// All cells: tiles × slices × layers.
+    pub fn cell_count(&self) -> usize {
+        self.layer_cells() * self.lists.layers() as usize
+    }
+
+    /// Depth slice of cell `c` (any layer).
+    pub fn slice_of_cell(&self, c: usize) -> u32 {
+        ((c % self.layer_cells()) / self.tile_count()) as u32
+    }
+
+    /// Layer of cell `c` (0: opaque samples; 1: transparent fragments, separate lists).
+    pub fn layer_of_cell(&self, c: usize) -> u32 {
+        (c / self.layer_cells()) as u32
     }
 
     pub fn tile_of(&self, x: u32, y: u32) -> usize {
@@ -106,9 +130,15 @@ impl GridDims {
         ]
     }
 
-    /// Cell of the sample at pixel (x, y) with view distance `w`.
+    /// Cell of the opaque sample at pixel (x, y) with view distance `w`.
     pub fn cell_of(&self, x: u32, y: u32, w: f32) -> usize {
         self.slice_of(w) as usize * self.tile_count() + self.tile_of(x, y)
+    }
+
+    /// Cell of a transparent fragment at pixel (x, y) with view distance `w`
+    /// (`grid_cell_transparent` in grid_cell.wgsl).
+    pub fn transparent_cell_of(&self, x: u32, y: u32, w: f32) -> usize {
+        self.lists.transparent_layer() as usize * self.layer_cells() + self.cell_of(x, y, w)
     }
 
     /// Pixel rectangle [x0, x1) × [y0, y1) of tile `t`, clipped to the frame.
@@ -132,8 +162,8 @@ impl GridDims {
             slices: self.slices,
             slice_scale,
             slice_bias,
-            _pad0: 0,
-            _pad1: 0,
+            lists: self.lists.gpu(),
+            layer_cells: self.layer_cells() as u32,
         }
     }
 }

@@ -1,6 +1,7 @@
 // Cell addressing of the light grid, shared by the shading accessor (light_grid.wgsl) and the
 // cell-bounds kernel. Needs a `grid: GridParams` binding from the including shader.
-// Cell index = (slice * tiles_y + tile_y) * tiles_x + tile_x; a tiled grid has one slice.
+// Cell index = (layer * slices + slice) * tiles_y + tile_y) * tiles_x + tile_x; a tiled grid
+// has one slice; a grid with separate transparent lists (GRID_LISTS_SEPARATE) has a second layer.
 
 // Depth slice of a sample at view distance `w`: exponential spacing between near and far
 // (tiled-forward-shading §4.8). A tiled grid has one slice.
@@ -18,3 +19,13 @@ fn grid_cell(pixel: vec2<f32>, w: f32) -> u32 {
     return (grid_slice(w) * grid.tiles_y + t.y) * grid.tiles_x + t.x;
 }
 
+
+// Cell of a transparent fragment: the second layer's cell with separate lists, else the same.
+fn grid_cell_transparent(pixel: vec2<f32>, w: f32) -> u32 {
+    return grid_cell(pixel, w) + select(0u, grid.layer_cells, grid.lists == GRID_LISTS_SEPARATE);
+}
+
+// All cells of the grid (every layer).
+fn grid_cell_total() -> u32 {
+    return grid.layer_cells * select(1u, 2u, grid.lists == GRID_LISTS_SEPARATE);
+}

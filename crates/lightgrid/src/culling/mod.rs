@@ -27,8 +27,11 @@ pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, Lig
 pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
-pub use grid::{GridBuffers, GridDims, LightGrid};
-pub use oracle::{ideal_lighting_computations, oracle_tile_lights};
+pub use grid::{GridBuffers, GridDims, GridLists, LightGrid};
+pub use oracle::{
+    ideal_fragment_computations, ideal_lighting_computations, oracle_fragment_lights,
+    oracle_tile_lights,
+};
 pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
 pub use spot_ray::{ray_test_count, RayTestCount};
 pub use strategy::AssignStrategy;

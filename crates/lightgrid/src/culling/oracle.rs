@@ -3,7 +3,8 @@
 //! count: for every visible sample, the lights whose range reaches it.
 
 use super::{GridDims, LightGrid, ViewSetup};
-use crate::scene::Light;
+use crate::scene::{Fragment, Light};
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// For every cell (tile, or tile × slice), the lights that reach at least one of the cell's
@@ -80,6 +81,60 @@ pub fn ideal_lighting_computations(
                 }
             }
             n
+        })
+        .sum()
+}
+
+/// For every cell, the lights reaching at least one of the transparent fragments that read it
+/// (`GridDims::transparent_cell_of`); cells no fragment reads stay empty. Brute force over
+/// every light (tests only).
+pub fn oracle_fragment_lights(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    lights: &[Light],
+    fragments: &[Fragment],
+) -> Vec<Vec<u32>> {
+    let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
+    let mut per_cell: Vec<Vec<Vec3>> = vec![Vec::new(); dims.cell_count()];
+    for f in fragments {
+        per_cell[dims.transparent_cell_of(f.x, f.y, f.w)]
+            .push(setup.sample_position(f.x, f.y, f.w));
+    }
+    per_cell
+        .par_iter()
+        .map(|samples| {
+            if samples.is_empty() {
+                return Vec::new();
+            }
+            view_lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| samples.iter().any(|&p| l.reaches(p)))
+                .map(|(i, _)| i as u32)
+                .collect()
+        })
+        .collect()
+}
+
+/// The ideal count of transparent fragments: for each, the lights that reach it. `grid` must
+/// list every such light in the fragment's transparent cell (the CPU assignment with
+/// transparent lists does).
+pub fn ideal_fragment_computations(
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[Light],
+    fragments: &[Fragment],
+) -> u64 {
+    let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
+    let dims = grid.dims;
+    fragments
+        .par_iter()
+        .map(|f| {
+            let p = setup.sample_position(f.x, f.y, f.w);
+            grid.cell(dims.transparent_cell_of(f.x, f.y, f.w))
+                .iter()
+                .filter(|&&l| view_lights[l as usize].reaches(p))
+                .count() as u64
         })
         .sum()
 }

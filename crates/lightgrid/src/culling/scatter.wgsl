@@ -171,9 +171,13 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let k1 = grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
     let tiles = grid.tiles_x * grid.tiles_y;
     let capacity = arrayLength(&pair_keys);
-    var s = k0;
-    for (; s <= k1; s = s + 1u) {
-        let cell = s * tiles + tile;
+    // With separate transparent lists the second layer's cells are walked after the first:
+    // item s of the loop is slice k0 + s % n of layer s / n.
+    let n = k1 - k0 + 1u;
+    let steps = n * select(1u, 2u, grid.lists == GRID_LISTS_SEPARATE);
+    var s = 0u;
+    for (; s < steps; s = s + 1u) {
+        let cell = (s / n) * grid.layer_cells + (k0 + s % n) * tiles + tile;
         let b = cell_bounds[cell];
         let in_depth = b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
         if (in_depth && (!by_cone || cone_margin(light, tile_frustum(xy, grid.tile_size, b).sphere) >= 0.0)) {
@@ -186,7 +190,7 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
             }
         }
     }
-    check_loop(s, k1 + 1u);
+    check_loop(s, steps);
 }
 
 // The pairs emitted and kept: the cursor, clamped to the buffer.
@@ -224,7 +228,7 @@ fn bounds_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 @compute @workgroup_size(ASSIGN_THREADS)
 fn counts_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let c = flat_index(gid, nwg);
-    if (c < grid.tiles_x * grid.tiles_y * grid.slices) {
+    if (c < grid_cell_total()) {
         cells[c].y = cells[c].y - cells[c].x;
     }
 }

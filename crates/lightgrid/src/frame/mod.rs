@@ -11,8 +11,8 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_slices, validate_tile_size, Assign, GBufferFormat, RenderSettings, SpotCull,
-    AUTO_GATHER_MAX_LIGHTS,
+    validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists, RenderSettings,
+    SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::Targets;
 
@@ -31,6 +31,9 @@ pub struct FrameInputs<'a> {
     pub counters: &'a wgpu::Buffer,
     pub vertices: &'a wgpu::Buffer,
     pub indices: &'a wgpu::Buffer,
+    /// Indices `0..opaque_indices` are the opaque geometry, the rest up to `index_count` the
+    /// transparent objects, back to front.
+    pub opaque_indices: u32,
     pub index_count: u32,
     pub targets: &'a Targets,
     /// Camera and frame size, for CPU light assignment.
@@ -39,6 +42,13 @@ pub struct FrameInputs<'a> {
     pub lights: &'a [Light],
     /// The count target is blended into (see `PipelineContext::count_blend`).
     pub count_blend: bool,
+}
+
+impl FrameInputs<'_> {
+    /// Does the frame draw transparent geometry?
+    pub fn has_transparency(&self) -> bool {
+        self.index_count > self.opaque_indices
+    }
 }
 
 /// What a frame cost the CPU side: queue submissions, bytes it waited to read back, and the

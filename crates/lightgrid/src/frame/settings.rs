@@ -14,6 +14,9 @@ pub struct RenderSettings {
     pub assign: Assign,
     /// What spot lights are culled by (`--spot-cull`), in every strategy.
     pub spot_cull: SpotCull,
+    /// Lists for frames with transparent geometry (`--lists`): separate opaque and
+    /// transparent lists, or one shared list.
+    pub lists: GridLists,
 }
 
 pub use crate::scene::SpotCull;
@@ -26,6 +29,7 @@ impl Default for RenderSettings {
             slices: crate::consts::DEFAULT_SLICES,
             assign: Assign::default(),
             spot_cull: SpotCull::default(),
+            lists: GridLists::Separate,
         }
     }
 }
@@ -161,6 +165,56 @@ impl Assign {
             Assign::Auto if lights <= AUTO_GATHER_MAX_LIGHTS => Assign::Gather,
             Assign::Auto => Assign::BvhGpu,
             other => other,
+        }
+    }
+}
+
+/// Which samples a grid's lists cover (tiled-forward-shading §4.5, Listing 4.2). A
+/// transparent fragment lies in front of the opaque depth at its pixel, so anywhere between
+/// the near plane and the tile's opaque *maximum*; an opaque sample lies inside the tile's
+/// `[min, max]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum GridLists {
+    /// One list per cell over its opaque samples (no transparent geometry in the frame).
+    #[default]
+    Opaque,
+    /// One list per cell covering near..opaque max: opaque and transparent fragments share it.
+    Shared,
+    /// Two layers of cells: layer 0 over the opaque samples (pruned by the minimum too),
+    /// layer 1 over near..opaque max for transparent fragments.
+    Separate,
+}
+
+impl GridLists {
+    pub fn name(self) -> &'static str {
+        match self {
+            GridLists::Opaque => "opaque",
+            GridLists::Shared => "shared",
+            GridLists::Separate => "separate",
+        }
+    }
+
+    /// Layers of cells: 2 for separate lists.
+    pub fn layers(self) -> u32 {
+        if self == GridLists::Separate {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// The layer transparent fragments read.
+    pub fn transparent_layer(self) -> u32 {
+        self.layers() - 1
+    }
+
+    /// The value of `GridParams::lists` (`culling/grid_cell.wgsl`).
+    pub fn gpu(self) -> u32 {
+        use crate::consts::{GRID_LISTS_OPAQUE, GRID_LISTS_SEPARATE, GRID_LISTS_SHARED};
+        match self {
+            GridLists::Opaque => GRID_LISTS_OPAQUE,
+            GridLists::Shared => GRID_LISTS_SHARED,
+            GridLists::Separate => GRID_LISTS_SEPARATE,
         }
     }
 }

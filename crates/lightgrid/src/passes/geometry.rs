@@ -56,15 +56,34 @@ pub(crate) fn geometry_pipeline(
     })
 }
 
-/// Bind group 0 (+ `extra` from group 1 on), the scene's buffers, and draw everything.
+/// Bind group 0 (+ `extra` from group 1 on), the scene's buffers, and draw the opaque
+/// geometry.
 pub(crate) fn draw_scene(pass: &mut wgpu::RenderPass, f: &FrameInputs, extra: &[&wgpu::BindGroup]) {
+    draw_range(pass, f, extra, 0..f.opaque_indices);
+}
+
+/// As [`draw_scene`], the transparent objects (in the frame's back-to-front order).
+pub(crate) fn draw_transparent(
+    pass: &mut wgpu::RenderPass,
+    f: &FrameInputs,
+    extra: &[&wgpu::BindGroup],
+) {
+    draw_range(pass, f, extra, f.opaque_indices..f.index_count);
+}
+
+fn draw_range(
+    pass: &mut wgpu::RenderPass,
+    f: &FrameInputs,
+    extra: &[&wgpu::BindGroup],
+    indices: std::ops::Range<u32>,
+) {
     pass.set_bind_group(0, f.scene_bind_group, &[]);
     for (i, g) in extra.iter().enumerate() {
         pass.set_bind_group(1 + i as u32, *g, &[]);
     }
     pass.set_vertex_buffer(0, f.vertices.slice(..));
     pass.set_index_buffer(f.indices.slice(..), wgpu::IndexFormat::Uint32);
-    pass.draw_indexed(0..f.index_count, 0, 0..1);
+    pass.draw_indexed(indices, 0, 0..1);
 }
 
 /// A forward lighting pass into HDR + counts. `depth_cleared`: clear and write depth (no

@@ -11,3 +11,10 @@ fn lit(color: vec3<f32>, count: u32) -> LitOut {
     out.count = f32(count);
     return out;
 }
+
+// A transparent fragment's output: blended over the image with coverage `alpha`.
+fn lit_blended(color: vec3<f32>, alpha: f32, count: u32) -> LitOut {
+    var out = lit(color, count);
+    out.color.a = alpha;
+    return out;
+}

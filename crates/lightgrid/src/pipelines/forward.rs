@@ -2,11 +2,11 @@
 //! Inputs: group 0 only. Outputs: HDR colour, depth, counts. Never reads a light grid: it is
 //! the independent reference every other pipeline is compared with.
 
-use super::RenderSettings;
 use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
+use super::{RenderSettings, TransparentLights};
 use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
@@ -54,6 +54,10 @@ impl Technique for Forward {
         pass.set_pipeline(&self.pipeline);
         draw_scene(&mut pass, f, &[]);
         Ok(())
+    }
+
+    fn transparent_lights(&self) -> TransparentLights<'_> {
+        TransparentLights::All
     }
 }
 

@@ -6,6 +6,7 @@ mod forward;
 mod light_prepass;
 mod tiled_deferred;
 mod tiled_forward;
+mod transparent;
 
 use crate::culling::{GridBuilder, GridDims, GridSetup};
 use crate::error::Error;
@@ -16,6 +17,7 @@ use crate::shader::ComposedShader;
 pub use crate::culling::Assign;
 use crate::frame::GBufferFormat;
 pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings, SpotCull};
+pub use transparent::{TransparentLights, TransparentPass};
 
 /// What a pipeline needs to create its GPU objects.
 pub struct PipelineContext<'a> {
@@ -39,6 +41,7 @@ impl PipelineContext<'_> {
             tiles: self.dims,
             assign: self.settings.assign,
             software_adapter: self.software_adapter,
+            lists: self.settings.lists,
         }
     }
 }
@@ -53,6 +56,11 @@ pub trait Technique {
     /// its grid, and the frame counters size its lists.
     fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
         None
+    }
+    /// Where the frame's transparent fragments find their lights (after `encode`): a grid
+    /// pipeline's own grid, or by default a grid the transparent pass builds.
+    fn transparent_lights(&self) -> TransparentLights<'_> {
+        TransparentLights::Own
     }
 }
 
@@ -245,6 +253,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
 pub fn all_shaders() -> Vec<ComposedShader> {
     let mut out = crate::passes::shaders();
     out.extend(crate::culling::shaders());
+    out.push(transparent::shader());
     for p in PIPELINES {
         out.extend((p.shaders)());
     }

@@ -14,7 +14,7 @@
 //! hold samples; the shading kernel is the same, the accessor finds each sample's cluster.
 
 use super::RenderSettings;
-use super::{FrameEncoder, FrameInputs, PipelineContext, Technique};
+use super::{FrameEncoder, FrameInputs, PipelineContext, Technique, TransparentLights};
 use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
 use crate::culling::{CellSource, GridBuilder, GridDims};
@@ -216,6 +216,15 @@ impl Technique for TiledDeferred {
         match &mut self.variant {
             Variant::Multi { builder, .. } => Some(builder),
             Variant::Single { .. } => None,
+        }
+    }
+
+    /// The frame's grid for the transparent pass (tiled-shading §4); the single kernel has
+    /// none, so the pass builds one.
+    fn transparent_lights(&self) -> TransparentLights<'_> {
+        match &self.variant {
+            Variant::Multi { builder, .. } => TransparentLights::Grid(builder),
+            Variant::Single { .. } => TransparentLights::Own,
         }
     }
 }

@@ -13,7 +13,7 @@
 use super::{
     begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
 };
-use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique};
+use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, TransparentLights};
 use crate::culling::{CellSource, GridBuilder};
 use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
@@ -138,6 +138,10 @@ impl Technique for TiledForward {
 
     fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
         Some(&mut self.builder)
+    }
+
+    fn transparent_lights(&self) -> TransparentLights<'_> {
+        TransparentLights::Grid(&self.builder)
     }
 }
 

@@ -41,6 +41,8 @@ pub struct SceneParams {
     pub spot_fraction: f32,
     /// Two headlights (spots) on every robot (`--headlights`, robots scenes only).
     pub headlights: bool,
+    /// The scene's transparent objects (`--transparency on|off`), where it has any.
+    pub transparency: bool,
 }
 
 impl Default for SceneParams {
@@ -50,6 +52,7 @@ impl Default for SceneParams {
             lights: None,
             spot_fraction: 0.0,
             headlights: false,
+            transparency: true,
         }
     }
 }
@@ -94,6 +97,16 @@ pub struct SceneInfo {
     /// Has walking robots, which `--headlights` gives two spot lights each.
     pub robots: bool,
     build: fn(&SceneParams) -> Scene,
+    /// Adds the scene's transparent objects (`--transparency on`), from their own seeded
+    /// stream so the rest of the scene does not change.
+    glass: Option<fn(&mut Scene, u64)>,
+}
+
+impl SceneInfo {
+    /// Has transparent objects (`--transparency` applies).
+    pub fn transparency(&self) -> bool {
+        self.glass.is_some()
+    }
 }
 
 /// Every scene, in the order `lightgrid list` prints them.
@@ -105,6 +118,7 @@ pub const SCENES: &[SceneInfo] = &[
         variable_lights: false,
         robots: true,
         build: robots_many,
+        glass: Some(street_glass),
     },
     SceneInfo {
         name: "robots-few",
@@ -112,6 +126,7 @@ pub const SCENES: &[SceneInfo] = &[
         variable_lights: false,
         robots: true,
         build: robots_few,
+        glass: Some(street_glass),
     },
     SceneInfo {
         name: "scattered",
@@ -120,6 +135,7 @@ pub const SCENES: &[SceneInfo] = &[
         variable_lights: false,
         robots: false,
         build: scattered,
+        glass: None,
     },
     SceneInfo {
         name: "random-top",
@@ -127,6 +143,7 @@ pub const SCENES: &[SceneInfo] = &[
         variable_lights: false,
         robots: false,
         build: random_top,
+        glass: Some(field_glass),
     },
     SceneInfo {
         name: "random-fps",
@@ -134,6 +151,7 @@ pub const SCENES: &[SceneInfo] = &[
         variable_lights: false,
         robots: false,
         build: random_fps,
+        glass: Some(field_glass),
     },
     SceneInfo {
         name: "stress",
@@ -142,6 +160,7 @@ pub const SCENES: &[SceneInfo] = &[
         variable_lights: true,
         robots: false,
         build: stress,
+        glass: None,
     },
 ];
 
@@ -195,6 +214,13 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
                 scenes_where(|s| s.robots)
             ),
         )),
+        _ if !params.transparency && !info.transparency() => Err(Error::invalid(
+            "--transparency",
+            format!(
+                "scene {name} has no transparent objects; --transparency applies to: {}",
+                scenes_where(SceneInfo::transparency)
+            ),
+        )),
         _ if !(0.0..=1.0).contains(&params.spot_fraction) => Err(Error::invalid(
             "--spot-fraction",
             format!("{} is out of range 0 to 1", params.spot_fraction),
@@ -207,6 +233,9 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
 pub fn build(name: &str, params: &SceneParams) -> Result<Scene> {
     let info = check_params(name, params)?;
     let mut scene = (info.build)(params);
+    if let (true, Some(glass)) = (params.transparency, info.glass) {
+        glass(&mut scene, params.seed);
+    }
     make_spots(&mut scene, params.seed, params.spot_fraction);
     scene.validate()?;
     Ok(scene)
@@ -512,6 +541,108 @@ fn headlights(b: &mut Builder, robots: &[usize]) {
             };
             b.light(light, LightAnchor::Object(body));
         }
+    }
+}
+
+/// Add a static transparent object.
+fn add_glass(scene: &mut Scene, mesh: Mesh, material: usize) {
+    scene.meshes.push(mesh);
+    scene.objects.push(Object {
+        mesh: scene.meshes.len() - 1,
+        material,
+        local: Mat4::IDENTITY,
+        motion: Motion::Static,
+    });
+}
+
+fn add_material(scene: &mut Scene, m: Material) -> usize {
+    scene.materials.push(m);
+    scene.materials.len() - 1
+}
+
+/// The street's glass (tiled-shading §4's transparent objects among many lights): panes
+/// standing on both sidewalks, some along the street and some across it, and bubbles
+/// floating over the street, one of them around the camera's key at frame 150, so the
+/// animation flies through a transparent object.
+fn street_glass(scene: &mut Scene, seed: u64) {
+    let mut rng = Rng::new(seed ^ 0x61a5_55e5_0000_0001);
+    let pane = add_material(scene, Material::glass(Vec3::new(0.55, 0.78, 0.85), 0.35));
+    let bubble = add_material(scene, Material::glass(Vec3::new(0.85, 0.7, 0.95), 0.25));
+    let m = MAIN_STREET_WIDTH * 0.5;
+    let clear_of_crossings = |z: f32| {
+        CROSS_STREETS_Z
+            .iter()
+            .all(|c| (z - c).abs() > CROSS_STREET_WIDTH * 0.5 + 6.0)
+    };
+    for side in [-1.0f32, 1.0] {
+        let x = side * (m + SIDEWALK * 0.5);
+        let mut z = -STREET_HALF_LENGTH + 12.0;
+        let mut across = side > 0.0;
+        while z < STREET_HALF_LENGTH - 12.0 {
+            if clear_of_crossings(z) {
+                let (lo, hi) = if across {
+                    (
+                        Vec3::new(x - SIDEWALK * 0.45, 0.2, z - 0.08),
+                        Vec3::new(x + SIDEWALK * 0.45, 3.0, z + 0.08),
+                    )
+                } else {
+                    (
+                        Vec3::new(x - 0.08, 0.2, z - 3.5),
+                        Vec3::new(x + 0.08, 3.0, z + 3.5),
+                    )
+                };
+                add_glass(scene, Mesh::cuboid(lo, hi), pane);
+                across = !across;
+            }
+            z += rng.range(18.0, 30.0);
+        }
+    }
+    let sphere = |scene: &mut Scene, centre: Vec3, r: f32| {
+        let mut mesh = Mesh::default();
+        mesh.append(&Mesh::sphere(r, 12, 24), Mat4::from_translation(centre));
+        add_glass(scene, mesh, bubble);
+    };
+    let mut z = -STREET_HALF_LENGTH + 8.0;
+    while z < STREET_HALF_LENGTH - 8.0 {
+        let centre = Vec3::new(rng.range(-m + 3.0, m - 3.0), rng.range(4.0, 12.0), z);
+        let r = rng.range(1.2, 3.0);
+        sphere(scene, centre, r);
+        z += rng.range(9.0, 16.0);
+    }
+    // Around the camera at frame 150 ((4, 6, -10) in `robots_street`).
+    sphere(scene, Vec3::new(4.5, 6.5, -9.0), 3.5);
+}
+
+/// Translucent blocks and spheres among the random lights (tiled-forward-shading Fig. 4.6's
+/// field, with transparent geometry as in §4.5).
+fn field_glass(scene: &mut Scene, seed: u64) {
+    let mut rng = Rng::new(seed ^ 0x61a5_55e5_0000_0002);
+    let tints = [
+        Vec3::new(0.6, 0.85, 0.7),
+        Vec3::new(0.85, 0.75, 0.55),
+        Vec3::new(0.6, 0.7, 0.95),
+    ];
+    let materials: Vec<usize> = tints
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| add_material(scene, Material::glass(t, 0.3 + 0.1 * i as f32)))
+        .collect();
+    for i in 0..48 {
+        let centre = Vec3::new(
+            rng.range(-75.0, 75.0),
+            rng.range(2.0, 8.0),
+            rng.range(-75.0, 75.0),
+        );
+        let size = rng.range(1.5, 3.5);
+        let material = materials[i % materials.len()];
+        let mesh = if i % 2 == 0 {
+            Mesh::cuboid(centre - Vec3::splat(size), centre + Vec3::splat(size))
+        } else {
+            let mut m = Mesh::default();
+            m.append(&Mesh::sphere(size, 10, 20), Mat4::from_translation(centre));
+            m
+        };
+        add_glass(scene, mesh, material);
     }
 }
 

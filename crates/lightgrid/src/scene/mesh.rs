@@ -20,6 +20,20 @@ impl Mesh {
         self.indices.len() / 3
     }
 
+    /// Centre of the axis-aligned bounds (the origin for an empty mesh).
+    pub fn centre(&self) -> Vec3 {
+        let lo = self.positions.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
+        let hi = self
+            .positions
+            .iter()
+            .fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
+        if self.positions.is_empty() {
+            Vec3::ZERO
+        } else {
+            (lo + hi) * 0.5
+        }
+    }
+
     /// Append `other` transformed by `m`.
     pub fn append(&mut self, other: &Mesh, m: Mat4) {
         let base = self.positions.len() as u32;

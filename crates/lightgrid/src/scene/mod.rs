@@ -5,12 +5,14 @@
 mod camera;
 pub mod catalog;
 mod mesh;
+mod raster;
 mod rng;
 mod view;
 
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use mesh::Mesh;
+pub use raster::{rasterize, Fragment};
 pub use rng::Rng;
 pub use view::{SpotCull, ViewLight, ViewSetup};
 
@@ -19,7 +21,8 @@ use crate::error::{Error, Result};
 use crate::gpu_types::{GpuLight, GpuMaterial, GpuVertex, POINT_LIGHT_COS};
 use glam::{Mat4, Quat, Vec3};
 
-/// Blinn-Phong material. `alpha` and `transparent` are carried for transparency support.
+/// Blinn-Phong material. A `transparent` material is drawn after the opaque geometry,
+/// back to front, blended with `alpha` (its fragments' coverage).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
     pub diffuse: Vec3,
@@ -42,6 +45,17 @@ impl Material {
             ambient: diffuse,
             alpha: 1.0,
             transparent: false,
+        }
+    }
+
+    /// A transparent material (glass, bubbles): tinted diffuse, a sharp white highlight,
+    /// `alpha` coverage.
+    pub fn glass(tint: Vec3, alpha: f32) -> Self {
+        Material {
+            ambient: tint * 0.5,
+            alpha,
+            transparent: true,
+            ..Material::plain(tint, 0.8, 96.0)
         }
     }
 
@@ -291,6 +305,28 @@ pub struct Scene {
     pub default_size: (u32, u32),
 }
 
+/// The frame's geometry in world space: opaque triangles first, then the transparent
+/// objects' triangles, object by object from the farthest to the nearest.
+#[derive(Clone, Debug, Default)]
+pub struct Geometry {
+    pub vertices: Vec<GpuVertex>,
+    pub indices: Vec<u32>,
+    /// `indices[..opaque_indices]` are opaque, the rest transparent, back to front.
+    pub opaque_indices: usize,
+}
+
+impl Geometry {
+    /// The transparent triangles in world space (the analysis rasterizes them).
+    pub fn transparent_triangles(&self, base: u32) -> Vec<[Vec3; 3]> {
+        self.indices[self.opaque_indices..]
+            .chunks_exact(3)
+            .map(|t| {
+                [t[0], t[1], t[2]].map(|i| Vec3::from(self.vertices[(i - base) as usize].position))
+            })
+            .collect()
+    }
+}
+
 /// The scene evaluated at one frame.
 #[derive(Clone, Debug)]
 pub struct FrameState {
@@ -356,36 +392,77 @@ impl Scene {
         }
     }
 
-    /// All objects of the frame in world space, as one vertex and index list: the static
-    /// objects first ([`Scene::static_geometry`]), then the moving ones.
-    pub fn geometry(&self, state: &FrameState) -> (Vec<GpuVertex>, Vec<u32>) {
-        let (mut vertices, mut indices) = self.static_geometry();
-        let (v, i) = self.moving_geometry(state, vertices.len() as u32);
-        vertices.extend(v);
-        indices.extend(i);
-        (vertices, indices)
+    /// Is the object drawn blended, after the opaque geometry?
+    pub fn is_transparent(&self, o: &Object) -> bool {
+        self.materials[o.material].transparent
     }
 
-    /// The objects that never move, in world space: the same every frame, so a renderer
-    /// uploads them once.
+    /// Does the scene have transparent objects?
+    pub fn has_transparency(&self) -> bool {
+        self.objects.iter().any(|o| self.is_transparent(o))
+    }
+
+    /// All objects of the frame in world space: the static opaque objects first
+    /// ([`Scene::static_geometry`]), then [`Scene::frame_geometry`]'s.
+    pub fn geometry(&self, state: &FrameState) -> Geometry {
+        let (mut vertices, mut indices) = self.static_geometry();
+        let moving = self.frame_geometry(state, vertices.len() as u32);
+        let opaque_indices = indices.len() + moving.opaque_indices;
+        vertices.extend(moving.vertices);
+        indices.extend(moving.indices);
+        Geometry {
+            vertices,
+            indices,
+            opaque_indices,
+        }
+    }
+
+    /// The opaque objects that never move, in world space: the same every frame, so a
+    /// renderer uploads them once.
     pub fn static_geometry(&self) -> (Vec<GpuVertex>, Vec<u32>) {
         let mut out = (Vec::new(), Vec::new());
-        for o in self.objects.iter().filter(|o| o.is_static()) {
+        for o in self
+            .objects
+            .iter()
+            .filter(|o| o.is_static() && !self.is_transparent(o))
+        {
             self.bake(o, o.local, 0, &mut out);
         }
         out
     }
 
-    /// The moving objects at `state`'s frame, in world space, with indices starting at
-    /// vertex `base` (where they follow the static geometry).
-    pub fn moving_geometry(&self, state: &FrameState, base: u32) -> (Vec<GpuVertex>, Vec<u32>) {
+    /// What changes per frame, with indices starting at vertex `base` (where it follows the
+    /// static geometry): the moving opaque objects, then every transparent object, sorted
+    /// back to front by the distance from the camera to its bounds' centre (tiled-shading
+    /// §4: blending needs the order; objects that intersect can still sort wrong).
+    pub fn frame_geometry(&self, state: &FrameState, base: u32) -> Geometry {
         let mut out = (Vec::new(), Vec::new());
         for (o, m) in self.objects.iter().zip(&state.transforms) {
-            if !o.is_static() {
+            if !o.is_static() && !self.is_transparent(o) {
                 self.bake(o, *m, base, &mut out);
             }
         }
-        out
+        let opaque_indices = out.1.len();
+        let eye = state.camera.eye;
+        let mut order: Vec<(f32, usize)> = self
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| self.is_transparent(o))
+            .map(|(i, o)| {
+                let centre = state.transforms[i].transform_point3(self.meshes[o.mesh].centre());
+                (-centre.distance_squared(eye), i)
+            })
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for (_, i) in order {
+            self.bake(&self.objects[i], state.transforms[i], base, &mut out);
+        }
+        Geometry {
+            vertices: out.0,
+            indices: out.1,
+            opaque_indices,
+        }
     }
 
     /// A fingerprint of everything [`Scene::static_geometry`] depends on (objects, meshes,
@@ -397,7 +474,11 @@ impl Scene {
             bytemuck::cast_slice::<f32, u32>(v).hash(h)
         };
         self.meshes.len().hash(&mut h);
-        for o in self.objects.iter().filter(|o| o.is_static()) {
+        for o in self
+            .objects
+            .iter()
+            .filter(|o| o.is_static() && !self.is_transparent(o))
+        {
             (o.mesh, o.material).hash(&mut h);
             words(&mut h, &o.local.to_cols_array());
             let mesh = &self.meshes[o.mesh];

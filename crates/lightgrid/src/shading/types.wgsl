@@ -46,8 +46,8 @@ struct GridParams {
     slices: u32,
     slice_scale: f32,
     slice_bias: f32,
-    _pad0: u32,
-    _pad1: u32,
+    lists: u32,
+    layer_cells: u32,
 }
 
 // The light BVH (culling/bvh.rs): built by bvh_build.wgsl, walked by bvh.wgsl.

@@ -1,0 +1,177 @@
+//! The transparent pass every pipeline ends with (tiled-shading §4, tiled-forward-shading
+//! §4.5): the transparent objects, sorted back to front per frame (`Scene::frame_geometry`),
+//! forward-shaded and alpha-blended over the opaque HDR image, depth-tested against the opaque
+//! depth without writing it. Their lighting computations add to the count target.
+//!
+//! Where the lights come from ([`TransparentLights`]): `forward` loops every light (the
+//! reference); a grid pipeline reads its own frame's grid, whose transparent lists cover
+//! near..opaque max (`GridLists`); deferred, deferred_stencil, the light pre-passes and the
+//! single-kernel tiled deferred have no grid of their own (the papers note classic deferred
+//! has no answer for transparency), so this pass builds one with the default strategy over
+//! the opaque depth.
+
+use super::{FrameEncoder, FrameInputs, GeometryPipelineDesc, PipelineContext};
+use crate::culling::{CellSource, GridBuffers, GridBuilder, GridLists};
+use crate::error::Result;
+use crate::frame::Assign;
+use crate::gpu::CounterValues;
+use crate::passes::geometry::{draw_transparent, geometry_pipeline};
+use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
+
+pub(super) fn shader() -> ComposedShader {
+    let mut parts = SCENE_PARTS.to_vec();
+    parts.push(crate::shader::src::LIGHT_GRID);
+    parts.push(include_str!("transparent.wgsl"));
+    compose("transparent", &parts)
+}
+
+/// Where a technique's transparent fragments find their lights.
+pub enum TransparentLights<'a> {
+    /// Every light (`forward`).
+    All,
+    /// The technique's own grid, built this frame with transparent lists.
+    Grid(&'a GridBuilder),
+    /// No grid of its own: the pass builds one.
+    Own,
+}
+
+/// The pass's two pipelines and the grid it builds for techniques without one.
+pub struct TransparentPass {
+    all_lights: wgpu::RenderPipeline,
+    grid: wgpu::RenderPipeline,
+    own_grid: GridBuilder,
+}
+
+/// Colour blending over the opaque image (alpha kept), counts added.
+fn blended_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
+    [
+        Some(wgpu::ColorTargetState {
+            format: crate::passes::HDR_FORMAT,
+            blend: Some(wgpu::BlendState {
+                color: wgpu::BlendComponent {
+                    src_factor: wgpu::BlendFactor::SrcAlpha,
+                    dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+                    operation: wgpu::BlendOperation::Add,
+                },
+                alpha: wgpu::BlendComponent {
+                    src_factor: wgpu::BlendFactor::Zero,
+                    dst_factor: wgpu::BlendFactor::One,
+                    operation: wgpu::BlendOperation::Add,
+                },
+            }),
+            write_mask: wgpu::ColorWrites::ALL,
+        }),
+        crate::passes::count_target(count_blend),
+    ]
+}
+
+impl TransparentPass {
+    pub fn new(ctx: &PipelineContext) -> Self {
+        let module = create_module(ctx.device, &shader());
+        // The default strategy, over the opaque depth; one list per tile covering near..max.
+        let own_grid = GridBuilder::new(
+            &crate::culling::GridSetup {
+                assign: Assign::Auto,
+                lists: GridLists::Shared,
+                ..ctx.grid_setup()
+            },
+            1,
+            CellSource::Depth,
+        );
+        let grid_layout = GridBuffers::layout(ctx.device);
+        let targets = blended_targets(ctx.count_blend);
+        let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
+            geometry_pipeline(
+                ctx.device,
+                &GeometryPipelineDesc {
+                    label,
+                    module: &module,
+                    fragment_entry: Some(entry),
+                    layouts,
+                    color_targets: &targets,
+                    depth_write: false,
+                    depth_compare: wgpu::CompareFunction::Less,
+                },
+            )
+        };
+        TransparentPass {
+            all_lights: pipeline(
+                "transparent (all lights)",
+                "fs_all_lights",
+                &[Some(ctx.scene_layout)],
+            ),
+            grid: pipeline(
+                "transparent (grid)",
+                "fs_grid",
+                &[Some(ctx.scene_layout), Some(&grid_layout)],
+            ),
+            own_grid,
+        }
+    }
+
+    /// Record the pass after a technique's opaque passes (nothing when the frame has no
+    /// transparent geometry).
+    pub fn encode(
+        &mut self,
+        f: &FrameInputs,
+        enc: &mut FrameEncoder,
+        lights: TransparentLights,
+    ) -> Result<()> {
+        if !f.has_transparency() {
+            return Ok(());
+        }
+        let grid = match lights {
+            TransparentLights::All => None,
+            TransparentLights::Grid(b) => Some(b.bind_group()),
+            TransparentLights::Own => {
+                self.own_grid.build(f, enc)?;
+                Some(self.own_grid.bind_group())
+            }
+        };
+        let (encoder, timer) = enc.parts();
+        let label = "transparent";
+        let load = |view| wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            },
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[
+                Some(load(&f.targets.hdr)),
+                f.count_blend.then(|| load(&f.targets.counts)),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &f.targets.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.render_pass(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        match grid {
+            None => {
+                pass.set_pipeline(&self.all_lights);
+                draw_transparent(&mut pass, f, &[]);
+            }
+            Some(g) => {
+                pass.set_pipeline(&self.grid);
+                draw_transparent(&mut pass, f, &[g]);
+            }
+        }
+        Ok(())
+    }
+
+    /// A finished frame's counters (the own grid's strategy sizes its lists from them).
+    pub fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
+        self.own_grid.observe(device, values)
+    }
+}

@@ -1,0 +1,28 @@
+// The transparent objects, after any pipeline's opaque image: forward shading blended over
+// it, depth-tested against the opaque depth without writing depth (tiled-shading §4). Each
+// fragment is lit by the one light function and counted like an opaque sample.
+
+// Early depth test forced, as in the opaque forward passes (no discard, no depth write).
+// `forward`: every light (the reference, for transparent geometry too).
+@fragment @early_depth_test(force)
+fn fs_all_lights(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
+    let s = surface_from_vertex(v, front);
+    let view_dir = view_dir_to(s.position);
+    var color = surface_base(s);
+    var i = 0u;
+    for (; i < frame.light_count; i = i + 1u) {
+        color += shade_light(s, view_dir, lights[i]);
+    }
+    check_loop(i, frame.light_count);
+    return lit_blended(color, s.alpha, frame.light_count);
+}
+
+// Every other pipeline: the lights of the fragment's transparent list (tiled-forward-shading
+// §4.5: its cell spans near..opaque max, so it holds every light reaching the fragment).
+@fragment @early_depth_test(force)
+fn fs_grid(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
+    let s = surface_from_vertex(v, front);
+    let cell = grid_cell_transparent(v.clip.xy, view_distance_from_depth(v.clip.z));
+    let color = surface_base(s) + grid_shade(s, view_dir_to(s.position), cell);
+    return lit_blended(color, s.alpha, grid_cell_count(cell));
+}
