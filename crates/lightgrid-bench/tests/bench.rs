@@ -40,6 +40,8 @@ fn config() -> BenchConfig {
         spot_fraction: 0.0,
         headlights: false,
         spot_culls: vec![Default::default()],
+        transparency: true,
+        lists: vec![lightgrid::culling::GridLists::Separate],
     }
 }
 

@@ -85,8 +85,15 @@ fn every_scene_builds_valid_geometry() {
     for info in SCENES {
         let s = catalog::build(info.name, &SceneParams::default()).unwrap();
         let state = s.frame(0);
-        let (v, i) = s.geometry(&state);
+        let g = s.geometry(&state);
+        let (v, i) = (&g.vertices, &g.indices);
         assert!(!v.is_empty() && i.len() % 3 == 0, "{}", info.name);
+        assert_eq!(
+            g.opaque_indices < i.len(),
+            info.transparency(),
+            "{}: transparent triangles follow the opaque ones exactly when the scene has glass",
+            info.name
+        );
         assert!(i.iter().all(|&x| (x as usize) < v.len()), "{}", info.name);
         assert!(v.iter().all(|v| v.position.iter().all(|c| c.is_finite())));
         assert!(state.camera.view().is_finite(), "{}", info.name);
@@ -183,4 +190,59 @@ fn headlights_turn_with_their_robots() {
         "no robot turned its headlights over the animation"
     );
     assert!(catalog::build("stress", &params).is_err());
+}
+
+/// The transparent objects come after the opaque geometry, farthest first, every frame; and
+/// `--transparency off` leaves the rest of the scene as it was.
+#[test]
+fn transparent_objects_are_sorted_back_to_front_and_optional() {
+    for name in ["robots-many", "random-fps"] {
+        let on = catalog::build(name, &SceneParams::default()).unwrap();
+        let off = catalog::build(
+            name,
+            &SceneParams {
+                transparency: false,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(on.has_transparency() && !off.has_transparency(), "{name}");
+        assert_eq!(on.lights.len(), off.lights.len(), "{name}");
+        assert_eq!(
+            on.static_geometry(),
+            off.static_geometry(),
+            "{name}: the opaque static geometry does not depend on the glass"
+        );
+        for frame in [0, 60, 150] {
+            let state = on.frame(frame);
+            let g = on.geometry(&state);
+            let eye = state.camera.eye;
+            let order = on.transparent_order(&state);
+            let transparent = on.objects.iter().filter(|o| on.is_transparent(o)).count();
+            assert_eq!(order.len(), transparent, "{name}");
+            let distance = |i: usize| {
+                let o = &on.objects[i];
+                state.transforms[i]
+                    .transform_point3(on.meshes[o.mesh].centre())
+                    .distance(eye)
+            };
+            assert!(
+                order.windows(2).all(|w| distance(w[0]) >= distance(w[1])),
+                "{name} frame {frame}: not farthest first"
+            );
+            // The frame's index list holds exactly those objects' triangles after the opaque.
+            let triangles: usize = order
+                .iter()
+                .map(|&i| on.meshes[on.objects[i].mesh].triangle_count())
+                .sum();
+            assert_eq!(g.transparent_triangles(0).len(), triangles, "{name}");
+            // The first transparent triangle is the farthest object's.
+            let first = &on.meshes[on.objects[order[0]].mesh];
+            let t0 = g.transparent_triangles(0)[0][0];
+            assert!(
+                first.positions.iter().any(|p| p.distance(t0) < 1e-3),
+                "{name} frame {frame}: the farthest object is drawn first"
+            );
+        }
+    }
 }

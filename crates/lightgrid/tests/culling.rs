@@ -7,10 +7,11 @@ mod common;
 
 use glam::Vec3;
 use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu, build_bvh, cell_bounds_cpu, oracle_tile_lights, project_sphere,
-    traverse_bvh_cpu, DepthRange, GridDims, ViewSetup, EMPTY_CELL,
+    assign_cpu, assign_gather_cpu, build_bvh, cell_bounds_cpu, oracle_fragment_lights,
+    oracle_tile_lights, project_sphere, traverse_bvh_cpu, DepthRange, GridDims, GridLists,
+    ViewSetup, EMPTY_CELL,
 };
-use lightgrid::scene::{Camera, Light, Rng};
+use lightgrid::scene::{Camera, Fragment, Light, Rng};
 
 const TILES: [u32; 9] = [4, 5, 7, 8, 13, 16, 31, 32, 64];
 
@@ -885,5 +886,104 @@ fn the_posts_ray_against_a_thickened_cone_misses_lit_tiles() {
     assert!(
         missed > 0,
         "the post's test missed nothing here: measure again before shipping it"
+    );
+}
+
+/// Transparent fragments in front of the opaque samples (or anywhere up to the far plane
+/// where a pixel has none): a few per pixel on a random subset of pixels, some just in front
+/// of the opaque depth, some at the near plane, some at slice boundaries' scale.
+fn random_fragments(rng: &mut Rng, s: &ViewSetup, view_distance: &[f32]) -> Vec<Fragment> {
+    let mut out = Vec::new();
+    for y in 0..s.height {
+        for x in 0..s.width {
+            if rng.unit() > 0.3 {
+                continue;
+            }
+            let opaque = view_distance[(y * s.width + x) as usize].min(s.far);
+            for k in 0..1 + rng.below(3) {
+                let t = match k {
+                    0 => rng.unit(),
+                    1 => 0.999,
+                    _ => 0.0,
+                };
+                let w = s.near * (opaque / s.near).powf(t);
+                if w >= s.near && w < opaque {
+                    out.push(Fragment { x, y, w });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// tiled-forward-shading §4.5's two lists: every transparent fragment's list (separate or
+/// shared) holds every light reaching it, on tiles and clusters, for the CPU assignment and
+/// the gather/BVH twin; the opaque lists of separate grids still hold the oracle's lights and
+/// never more than the shared list.
+#[test]
+fn transparent_lists_contain_the_oracle_in_randomized_cases() {
+    let mut rng = Rng::new(4242);
+    let (mut fragments_checked, mut lit_pairs) = (0usize, 0usize);
+    let (mut separate_entries, mut shared_entries) = (0usize, 0usize);
+    for case_index in 0..600 {
+        let case = random_case(&mut rng);
+        let depth = random_depth(&mut rng, &case);
+        let s = &case.setup;
+        let tile = TILES[case_index % TILES.len()];
+        let slices = [1, 1, 8, 32][case_index % 4];
+        let tiles = GridDims::new(s.width, s.height, tile).unwrap();
+        let base = if slices > 1 {
+            tiles.clustered(slices, s.near, s.far).unwrap()
+        } else {
+            tiles
+        };
+        let view_distance = common::view_distances(s, &depth);
+        let fragments = random_fragments(&mut rng, s, &view_distance);
+        fragments_checked += fragments.len();
+        for lists in [GridLists::Separate, GridLists::Shared] {
+            let dims = base.with_lists(lists);
+            let bounds = cell_bounds_cpu(s, &dims, &depth);
+            assert_eq!(bounds.len(), dims.cell_count());
+            let must = oracle_fragment_lights(s, &dims, &case.lights, &fragments);
+            let opaque = oracle_tile_lights(s, &dims, &case.lights, &view_distance);
+            let grids = [
+                (
+                    "cpu",
+                    assign_cpu(s, &dims, &case.lights, DepthRange::Cells(&bounds)),
+                ),
+                ("gather", assign_gather_cpu(s, &dims, &case.lights, &bounds)),
+            ];
+            for (name, grid) in &grids {
+                for (c, list) in must.iter().enumerate().chain(opaque.iter().enumerate()) {
+                    for l in list {
+                        assert!(
+                            grid.cell(c).contains(l),
+                            "case {case_index} {name} {} lists: cell {c} (layer {}, slice {} of {slices}, tile {tile}) misses light {l}: {:?}, camera {:?}",
+                            lists.name(),
+                            dims.layer_of_cell(c),
+                            dims.slice_of_cell(c),
+                            case.lights[*l as usize],
+                            case.camera
+                        );
+                    }
+                }
+            }
+            if lists == GridLists::Separate {
+                lit_pairs += must.iter().map(Vec::len).sum::<usize>();
+                // The opaque layer, pruned by the tiles' minimum too.
+                separate_entries += (0..dims.layer_cells())
+                    .map(|c| grids[0].1.cell(c).len())
+                    .sum::<usize>();
+            } else {
+                shared_entries += grids[0].1.indices.len();
+            }
+        }
+    }
+    assert!(fragments_checked > 100_000, "{fragments_checked} fragments");
+    assert!(lit_pairs > 10_000, "{lit_pairs} lit (cell, light) pairs");
+    // Separate lists make the opaque samples' lists shorter than the shared ones.
+    assert!(
+        separate_entries < shared_entries,
+        "opaque lists {separate_entries} vs shared {shared_entries}"
     );
 }

@@ -59,8 +59,8 @@ fn gpu_structs_match_wgsl() {
             slices,
             slice_scale,
             slice_bias,
-            _pad0,
-            _pad1
+            lists,
+            layer_cells
         ]
     );
     check_layout!(

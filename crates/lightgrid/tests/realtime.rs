@@ -58,7 +58,9 @@ fn play(
 fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     let ctx = common::gpu();
     let scene = catalog::build("robots-many", &SceneParams::default()).unwrap();
-    let frames = [190, 195, 200, 205];
+    // The last frame repeated: its lists were sized by the counters of the frame before (the
+    // glass makes the transparent lists grow by more than the 5/4 headroom between frames).
+    let frames = [190, 195, 200, 205, 205];
     let mut checked = 0;
     for assign in GPU_STRATEGIES {
         let settings = RenderSettings {

@@ -39,6 +39,12 @@ impl RenderSettings {
     /// otherwise silently build a tiled grid for the clustered pipelines).
     pub fn validate(&self) -> crate::error::Result<()> {
         validate_tile_size(self.tile_size)?;
+        if self.lists == GridLists::Opaque {
+            return Err(crate::error::Error::invalid(
+                "lists",
+                "frames with transparent objects need transparent lists: separate or shared",
+            ));
+        }
         validate_slices(self.slices)
     }
 }

@@ -7,8 +7,8 @@
 //! reference); a grid pipeline reads its own frame's grid, whose transparent lists cover
 //! near..opaque max (`GridLists`); deferred, deferred_stencil, the light pre-passes and the
 //! single-kernel tiled deferred have no grid of their own (the papers note classic deferred
-//! has no answer for transparency), so this pass builds one with the default strategy over
-//! the opaque depth.
+//! has no answer for transparency), so this pass builds one with `gather` over the opaque
+//! depth (a GPU strategy: the frame stays one submission without readback).
 
 use super::{FrameEncoder, FrameInputs, GeometryPipelineDesc, PipelineContext};
 use crate::culling::{CellSource, GridBuffers, GridBuilder, GridLists};
@@ -68,10 +68,11 @@ fn blended_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
 impl TransparentPass {
     pub fn new(ctx: &PipelineContext) -> Self {
         let module = create_module(ctx.device, &shader());
-        // The default strategy, over the opaque depth; one list per tile covering near..max.
+        // A GPU strategy (gather), so the frame still makes one submission and no readback,
+        // over the opaque depth; one list per tile covering near..max.
         let own_grid = GridBuilder::new(
             &crate::culling::GridSetup {
-                assign: Assign::Auto,
+                assign: Assign::Gather,
                 lists: GridLists::Shared,
                 ..ctx.grid_setup()
             },

@@ -443,6 +443,19 @@ impl Scene {
             }
         }
         let opaque_indices = out.1.len();
+        for i in self.transparent_order(state) {
+            self.bake(&self.objects[i], state.transforms[i], base, &mut out);
+        }
+        Geometry {
+            vertices: out.0,
+            indices: out.1,
+            opaque_indices,
+        }
+    }
+
+    /// The transparent objects, farthest first: by the distance from the camera to the
+    /// centre of each object's bounds (ties by index).
+    pub fn transparent_order(&self, state: &FrameState) -> Vec<usize> {
         let eye = state.camera.eye;
         let mut order: Vec<(f32, usize)> = self
             .objects
@@ -455,14 +468,7 @@ impl Scene {
             })
             .collect();
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for (_, i) in order {
-            self.bake(&self.objects[i], state.transforms[i], base, &mut out);
-        }
-        Geometry {
-            vertices: out.0,
-            indices: out.1,
-            opaque_indices,
-        }
+        order.into_iter().map(|(_, i)| i).collect()
     }
 
     /// A fingerprint of everything [`Scene::static_geometry`] depends on (objects, meshes,

@@ -354,7 +354,7 @@ pub fn check_cell_bounds(
                 }
                 // A sample within round-off of a slice boundary counted on the other side:
                 // the bound that differs lies on the boundary.
-                let [lo, hi] = dims.slice_range((c / dims.tile_count()) as u32);
+                let [lo, hi] = dims.slice_range(dims.slice_of_cell(c));
                 let on_boundary = (near(g[0], b[0], 1e-5) || near(g[0].min(b[0]), lo, 3e-4))
                     && (near(g[1], b[1], 1e-5) || near(g[1].max(b[1]), hi, 3e-4));
                 assert!(
@@ -539,6 +539,33 @@ pub fn check_grid_contains_oracle(
     depth: &[f32],
 ) -> OracleCheck {
     FrameOracle::new(setup, &grid.dims, lights, depth).check(what, setup, grid)
+}
+
+/// Every transparent fragment of the frame (its transparent objects rasterized on the CPU in
+/// front of the opaque depth) finds every light that reaches it in its cell's list
+/// (tiled-forward-shading §4.5). Returns the number of fragments checked.
+pub fn check_grid_covers_transparent_fragments(
+    what: &str,
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[Light],
+    depth: &[f32],
+    triangles: &[[Vec3; 3]],
+) -> usize {
+    let fragments = lightgrid::scene::rasterize(setup, triangles, &setup.view_distances(depth));
+    let must = lightgrid::culling::oracle_fragment_lights(setup, &grid.dims, lights, &fragments);
+    for (c, list) in must.iter().enumerate() {
+        for l in list {
+            assert!(
+                grid.cell(c).contains(l),
+                "{what}: transparent cell {c} (layer {}, slice {}) misses light {l} ({:?})",
+                grid.dims.layer_of_cell(c),
+                grid.dims.slice_of_cell(c),
+                lights[*l as usize]
+            );
+        }
+    }
+    fragments.len()
 }
 
 /// Whether every sample of cell `c` that `light` reaches is within round-off of its slice's
