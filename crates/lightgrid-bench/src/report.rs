@@ -33,6 +33,9 @@ fn pipeline_label(r: &RunRecord) -> String {
     if let Some(l) = r.lists {
         label += &format!(" [{} lists]", l.name());
     }
+    if let Some(d) = r.material_draws {
+        label += &format!(" [{} draws]", d.name());
+    }
     label
 }
 
@@ -85,12 +88,13 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 25] = [
+const RESULTS_CSV_COLUMNS: [&str; 26] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
     "spot_cull",
     "lists",
+    "material_draws",
     "width",
     "height",
     "tile_size",
@@ -122,6 +126,7 @@ struct ResultsRow<'a> {
     gbuffer_bits: Option<u32>,
     spot_cull: Option<&'static str>,
     lists: Option<&'static str>,
+    material_draws: Option<&'static str>,
     width: u32,
     height: u32,
     tile_size: u32,
@@ -189,6 +194,7 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 gbuffer_bits: r.gbuffer_bits,
                 spot_cull: r.spot_cull.map(spot_cull_name),
                 lists: r.lists.map(|l| l.name()),
+                material_draws: r.material_draws.map(|d| d.name()),
                 width: r.width,
                 height: r.height,
                 tile_size: r.tile_size,
@@ -611,7 +617,7 @@ mod tests {
         let row = text.lines().nth(1).unwrap();
         assert_eq!(
             row,
-            ",,16,,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,gbuffer=0.1000;shade=0.2000"
+            ",,16,,,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,gbuffer=0.1000;shade=0.2000"
         );
         let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
         assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);

@@ -5,6 +5,7 @@ use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
 use lightgrid::culling::GridLists;
 use lightgrid::error::Result;
+use lightgrid::frame::MaterialDraws;
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
@@ -107,6 +108,14 @@ pub struct BenchConfig {
     /// every pipeline with an `--assign` grid is measured once per entry.
     #[serde(default = "default_lists")]
     pub lists: Vec<GridLists>,
+    /// How forward-shading pipelines draw the material shaders (`--material-draws`): each of
+    /// them is measured once per entry.
+    #[serde(default = "default_material_draws")]
+    pub material_draws: Vec<MaterialDraws>,
+}
+
+fn default_material_draws() -> Vec<MaterialDraws> {
+    vec![MaterialDraws::default()]
 }
 
 fn default_spot_culls() -> Vec<SpotCull> {
@@ -128,6 +137,7 @@ impl BenchConfig {
             || self.gbuffers.is_empty()
             || self.spot_culls.is_empty()
             || self.lists.is_empty()
+            || self.material_draws.is_empty()
         {
             return Err(invalid(
                 "bench",
@@ -335,6 +345,9 @@ pub struct RunRecord {
     /// The transparent lists, when the run measured more than one setting (`--lists`).
     #[serde(default)]
     pub lists: Option<GridLists>,
+    /// How material shaders were drawn, when the run measured more than one way.
+    #[serde(default)]
+    pub material_draws: Option<MaterialDraws>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -425,6 +438,8 @@ struct Series {
     spot_cull: SpotCull,
     /// The transparent lists; recorded when more than one is measured.
     lists: GridLists,
+    /// How material shaders are drawn; recorded when more than one is measured.
+    material_draws: MaterialDraws,
     frames: Vec<u32>,
 }
 
@@ -493,17 +508,25 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                 } else {
                     &config.lists[..1]
                 };
+                let draws = if info.forward_shading {
+                    &config.material_draws[..]
+                } else {
+                    &config.material_draws[..1]
+                };
                 for &spot_cull in culls {
                     for &lists in lists {
-                        plan.push(Series {
-                            scene: si,
-                            gbuffer: *g,
-                            info,
-                            uses_gbuffer: g_used,
-                            spot_cull,
-                            lists,
-                            frames: frames.clone(),
-                        });
+                        for &material_draws in draws {
+                            plan.push(Series {
+                                scene: si,
+                                gbuffer: *g,
+                                info,
+                                uses_gbuffer: g_used,
+                                spot_cull,
+                                lists,
+                                material_draws,
+                                frames: frames.clone(),
+                            });
+                        }
                     }
                 }
             }
@@ -559,6 +582,7 @@ impl<'a> Measuring<'a> {
             },
             spot_cull: series.spot_cull,
             lists: series.lists,
+            material_draws: series.material_draws,
         }
     }
 
@@ -603,6 +627,9 @@ impl<'a> Measuring<'a> {
         };
         if self.config.lists.len() > 1 && info.assign {
             cull += &format!(" {} lists", series.lists.name());
+        }
+        if self.config.material_draws.len() > 1 && info.forward_shading {
+            cull += &format!(" {} draws", series.material_draws.name());
         }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
@@ -728,6 +755,7 @@ impl RunRecord {
             gbuffer_bits: series.uses_gbuffer.then_some(series.gbuffer.bits()),
             spot_cull: None,
             lists: None,
+            material_draws: None,
             width: size.0,
             height: size.1,
             tile_size: tile,
@@ -867,6 +895,9 @@ impl PreparedBench {
             }
             if config.lists.len() > 1 && series.info.assign {
                 record.lists = Some(series.lists);
+            }
+            if config.material_draws.len() > 1 && series.info.forward_shading {
+                record.material_draws = Some(series.material_draws);
             }
             let mut bytes = (0, 0);
             let end = m.series(scene, series, &mut record, &mut bytes, &mut results);

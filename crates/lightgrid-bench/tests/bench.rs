@@ -42,6 +42,7 @@ fn config() -> BenchConfig {
         spot_culls: vec![Default::default()],
         transparency: true,
         lists: vec![lightgrid::culling::GridLists::Separate],
+        material_draws: vec![Default::default()],
     }
 }
 

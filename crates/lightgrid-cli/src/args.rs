@@ -118,6 +118,24 @@ impl From<ListsArg> for lightgrid::culling::GridLists {
     }
 }
 
+/// `--material-draws`: how forward pipelines draw the material shaders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum MaterialDrawsArg {
+    /// A pipeline per material shader, switched between runs of geometry.
+    PerMaterial,
+    /// One pipeline branching on the material, as deferred shading does.
+    Uber,
+}
+
+impl From<MaterialDrawsArg> for lightgrid::frame::MaterialDraws {
+    fn from(a: MaterialDrawsArg) -> Self {
+        match a {
+            MaterialDrawsArg::PerMaterial => Self::PerMaterial,
+            MaterialDrawsArg::Uber => Self::Uber,
+        }
+    }
+}
+
 /// `--transparency on|off`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum OnOff {
@@ -147,6 +165,7 @@ pub(crate) struct Given {
     pub(crate) assign: bool,
     pub(crate) spot_cull: bool,
     pub(crate) lists: bool,
+    pub(crate) material_draws: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -157,12 +176,15 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 5] = [
+    let rules: [(&str, bool, Applies); 6] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
         ("--spot-cull", given.spot_cull, |p| p.uses_grid),
         ("--lists", given.lists, |p| p.assign),
+        ("--material-draws", given.material_draws, |p| {
+            p.forward_shading
+        }),
     ];
     for (flag, given, applies) in rules {
         if given && !chosen.iter().any(|p| applies(p)) {
@@ -205,6 +227,10 @@ pub(crate) struct RendererArgs {
     /// objects [default: separate].
     #[arg(long, value_enum)]
     pub(crate) lists: Option<ListsArg>,
+    /// How forward-shading pipelines draw the material shaders: a pipeline per shader, or
+    /// one branching übershader [default: per-material].
+    #[arg(long, value_enum)]
+    pub(crate) material_draws: Option<MaterialDrawsArg>,
 }
 
 impl RendererArgs {
@@ -219,6 +245,7 @@ impl RendererArgs {
             lists: self
                 .lists
                 .map_or(RenderSettings::default().lists, Into::into),
+            material_draws: self.material_draws.map(Into::into).unwrap_or_default(),
         };
         settings.validate()?;
         Ok(settings)
@@ -232,6 +259,7 @@ impl RendererArgs {
             assign: self.assign.is_some(),
             spot_cull: self.spot_cull.is_some(),
             lists: self.lists.is_some(),
+            material_draws: self.material_draws.is_some(),
         }
     }
 }

@@ -2,7 +2,8 @@
 
 use crate::args::{
     check_applies, format_duration, parse_fraction, parse_gbuffer, parse_size, progress_bar,
-    run_outcome, stop_on_ctrl_c, AssignArg, Given, ListsArg, OnOff, Size, SpotCullArg, MAX_COUNT,
+    run_outcome, stop_on_ctrl_c, AssignArg, Given, ListsArg, MaterialDrawsArg, OnOff, Size,
+    SpotCullArg, MAX_COUNT,
 };
 use anyhow::{bail, Result};
 use clap::Args;
@@ -89,6 +90,10 @@ pub(crate) struct BenchArgs {
     /// shared, or separate,shared to measure both [default: separate].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(crate) lists: Vec<ListsArg>,
+    /// How forward-shading pipelines draw the material shaders: per-material, uber, or
+    /// per-material,uber to measure both [default: per-material].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) material_draws: Vec<MaterialDrawsArg>,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
@@ -257,6 +262,11 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         } else {
             a.lists.iter().map(|&l| l.into()).collect()
         },
+        material_draws: if a.material_draws.is_empty() {
+            vec![Default::default()]
+        } else {
+            a.material_draws.iter().map(|&m| m.into()).collect()
+        },
     };
     config.validate()?;
     let chosen: Vec<_> = config
@@ -270,6 +280,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         assign: a.assign.is_some(),
         spot_cull: !a.spot_cull.is_empty(),
         lists: !a.lists.is_empty(),
+        material_draws: !a.material_draws.is_empty(),
     };
     check_applies(given, &chosen)?;
     Ok(config)

@@ -91,6 +91,7 @@ fn main() {
                         gbuffer: None,
                         spot_cull: None,
                         lists: None,
+                        material_draws: None,
                     },
                     warmup: 1,
                 },

@@ -121,6 +121,19 @@ pub const GRID_LISTS_OPAQUE: u32 = 0;
 pub const GRID_LISTS_SHARED: u32 = 1;
 pub const GRID_LISTS_SEPARATE: u32 = 2;
 
+/// Material shaders (`scene::MaterialShader`, tiled-forward-shading §4.7): the id each
+/// material carries, and the value of the WGSL override `MATERIAL_SHADER` that makes a
+/// pipeline branch on the material instead of being specialised to one shader.
+pub const MATERIAL_SHADER_STANDARD: u32 = 0;
+pub const MATERIAL_SHADER_CAR_PAINT: u32 = 1;
+pub const MATERIAL_SHADER_RIM: u32 = 2;
+/// Number of material shaders (forward pipelines create one pipeline each).
+pub const MATERIAL_SHADERS: u32 = 3;
+pub const MATERIAL_SHADER_ANY: u32 = 0xffff_ffff;
+/// Most materials a scene may have (the G-buffer stores the index in a 16-bit float, exact
+/// up to 2048).
+pub const MAX_MATERIALS: usize = 2048;
+
 /// Material flag bit: the material is transparent (blended, drawn after opaque geometry).
 pub const MATERIAL_FLAG_TRANSPARENT: u32 = 1;
 
@@ -175,6 +188,16 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("COUNTER_ITEM_ARGS", WgslConst::U32(COUNTER_ITEM_ARGS)),
     ("COUNTER_SLOTS", WgslConst::U32(COUNTER_SLOTS)),
     ("GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
+    (
+        "MATERIAL_SHADER_STANDARD",
+        WgslConst::U32(MATERIAL_SHADER_STANDARD),
+    ),
+    (
+        "MATERIAL_SHADER_CAR_PAINT",
+        WgslConst::U32(MATERIAL_SHADER_CAR_PAINT),
+    ),
+    ("MATERIAL_SHADER_RIM", WgslConst::U32(MATERIAL_SHADER_RIM)),
+    ("MATERIAL_SHADER_ANY", WgslConst::U32(MATERIAL_SHADER_ANY)),
     ("GRID_LISTS_SHARED", WgslConst::U32(GRID_LISTS_SHARED)),
     ("GRID_LISTS_SEPARATE", WgslConst::U32(GRID_LISTS_SEPARATE)),
     (

@@ -34,7 +34,12 @@ pub struct GpuMaterial {
     pub emissive: [f32; 3],
     pub flags: u32,
     pub ambient: [f32; 3],
-    pub _pad: f32,
+    /// Exponent of the material shader's view-angle blend (car paint, rim).
+    pub paint_power: f32,
+    /// The material shader's second colour: car paint's flip colour, the rim colour.
+    pub paint: [f32; 3],
+    /// `consts::MATERIAL_SHADER_*`.
+    pub shader: u32,
 }
 
 /// One vertex in world space (the CPU bakes object transforms each frame).
@@ -87,7 +92,7 @@ pub struct GridParams {
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
-const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 80);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
 

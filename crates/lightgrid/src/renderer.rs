@@ -25,7 +25,7 @@ use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, Pas
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
-use crate::scene::{FrameState, Geometry, Scene, SpotCull};
+use crate::scene::{Draw, FrameState, Geometry, Scene, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::time::Instant;
 
@@ -90,6 +90,8 @@ struct SceneUpload {
     fingerprint: u64,
     static_vertices: u32,
     static_indices: u32,
+    /// The static geometry's runs of one material shader each.
+    static_draws: Vec<Draw>,
 }
 
 /// What one frame uploaded.
@@ -97,7 +99,9 @@ struct Uploaded {
     state: FrameState,
     setup: ViewSetup,
     index_count: u32,
-    opaque_indices: u32,
+    /// Runs of one material shader: the opaque geometry's, the transparent objects'.
+    opaque: Vec<Draw>,
+    transparent: Vec<Draw>,
     /// What this frame wrote after the static geometry (its transparent triangles are
     /// rasterized for the ideal count), and the vertex it starts at.
     frame_geometry: Geometry,
@@ -283,13 +287,21 @@ impl<'c> Renderer<'c> {
         upload_bytes += self.upload_frame_data(&state);
         let upload = self.scene.as_ref().expect("geometry uploaded");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
+        let (moving_opaque, moving_transparent) = frame_geometry.split_draws();
+        let mut opaque = upload.static_draws.clone();
+        opaque.extend(moving_opaque.iter().map(|d| d.offset(static_indices)));
+        let transparent = moving_transparent
+            .iter()
+            .map(|d| d.offset(static_indices))
+            .collect();
         let (width, height) = self.size();
         let mut setup = ViewSetup::new(&state.camera, width, height);
         setup.spot_cull = self.settings.spot_cull;
         Ok(Uploaded {
             setup,
             index_count: static_indices + frame_geometry.indices.len() as u32,
-            opaque_indices: static_indices + frame_geometry.opaque_indices as u32,
+            opaque,
+            transparent,
             frame_geometry,
             static_vertices,
             state,
@@ -335,13 +347,13 @@ impl<'c> Renderer<'c> {
         let mut upload_bytes = 0u64;
         let fingerprint = scene.static_fingerprint();
         if self.scene.as_ref().map(|s| s.fingerprint) != Some(fingerprint) {
-            let (vertices, indices) = scene.static_geometry();
+            let geometry = scene.static_geometry();
             let materials = scene.materials_gpu();
-            let vb: &[u8] = bytemuck::cast_slice(&vertices);
-            let ib: &[u8] = bytemuck::cast_slice(&indices);
+            let vb: &[u8] = bytemuck::cast_slice(&geometry.vertices);
+            let ib: &[u8] = bytemuck::cast_slice(&geometry.indices);
             let mb: &[u8] = bytemuck::cast_slice(&materials);
             // Room for the moving objects too, so the buffers rarely grow later.
-            let moving = scene.frame_geometry(state, vertices.len() as u32);
+            let moving = scene.frame_geometry(state, geometry.vertices.len() as u32);
             self.vertices.reserve(
                 device,
                 (vb.len() + std::mem::size_of_val(moving.vertices.as_slice())) as u64,
@@ -359,8 +371,9 @@ impl<'c> Renderer<'c> {
             upload_bytes += (vb.len() + ib.len() + mb.len()) as u64;
             self.scene = Some(SceneUpload {
                 fingerprint,
-                static_vertices: vertices.len() as u32,
-                static_indices: indices.len() as u32,
+                static_vertices: geometry.vertices.len() as u32,
+                static_indices: geometry.indices.len() as u32,
+                static_draws: geometry.draws,
             });
         }
         let upload = self.scene.as_ref().expect("uploaded above");
@@ -453,8 +466,8 @@ impl<'c> Renderer<'c> {
             counters: self.counters.buffer(),
             vertices: &self.vertices.buffer,
             indices: &self.indices.buffer,
-            opaque_indices: up.opaque_indices,
-            index_count: up.index_count,
+            opaque: &up.opaque,
+            transparent: &up.transparent,
             targets: &self.targets,
             setup: up.setup,
             lights: &up.state.lights,

@@ -246,3 +246,35 @@ fn transparent_objects_are_sorted_back_to_front_and_optional() {
         }
     }
 }
+
+/// Per-material draws: every run of the frame's geometry holds only triangles of materials
+/// with the run's shader, the opaque runs come first grouped by shader, and the robots'
+/// scene has runs of more than one shader.
+#[test]
+fn geometry_runs_are_grouped_by_material_shader() {
+    for name in ["robots-many", "scattered"] {
+        let s = catalog::build(name, &SceneParams::default()).unwrap();
+        let g = s.geometry(&s.frame(10));
+        let mut covered = 0;
+        for d in &g.draws {
+            assert_eq!(d.first as usize, covered, "{name}: runs are contiguous");
+            covered += d.count as usize;
+            for &i in &g.indices[d.first as usize..(d.first + d.count) as usize] {
+                let m = g.vertices[i as usize].material as usize;
+                assert_eq!(s.materials[m].shader.gpu().0, d.shader, "{name}");
+            }
+        }
+        assert_eq!(covered, g.indices.len(), "{name}: every index is drawn");
+        let (opaque, transparent) = g.split_draws();
+        let opaque_end = opaque.last().map_or(0, |d| (d.first + d.count) as usize);
+        assert_eq!(opaque_end, g.opaque_indices, "{name}");
+        assert_eq!(transparent.is_empty(), !s.has_transparency(), "{name}");
+        let shaders: std::collections::HashSet<u32> = opaque.iter().map(|d| d.shader).collect();
+        assert!(shaders.len() > 1, "{name}: more than one shader");
+        // The static part and the moving part are each grouped: at most two runs per shader.
+        for k in &shaders {
+            let runs = opaque.iter().filter(|d| d.shader == *k).count();
+            assert!(runs <= 2, "{name}: shader {k} in {runs} opaque runs");
+        }
+    }
+}

@@ -67,7 +67,18 @@ fn gpu_structs_match_wgsl() {
         &module,
         "Material",
         GpuMaterial,
-        [diffuse, alpha, specular, shininess, emissive, flags, ambient, _pad]
+        [
+            diffuse,
+            alpha,
+            specular,
+            shininess,
+            emissive,
+            flags,
+            ambient,
+            paint_power,
+            paint,
+            shader
+        ]
     );
     check_layout!(&module, "BvhNode", BvhNode, [lo, first, hi, count]);
     check_layout!(&module, "SortParams", SortParams, [n, shift, blocks, _pad]);

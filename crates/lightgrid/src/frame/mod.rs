@@ -11,14 +11,14 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists, RenderSettings,
-    SpotCull, AUTO_GATHER_MAX_LIGHTS,
+    validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists, MaterialDraws,
+    RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::Targets;
 
 use crate::error::Result;
 use crate::gpu::{read_buffer, scoped, PassTimer, PassTiming};
-use crate::scene::{Light, ViewSetup};
+use crate::scene::{Draw, Light, ViewSetup};
 use std::time::Instant;
 
 /// What a pipeline reads to render one frame.
@@ -31,10 +31,10 @@ pub struct FrameInputs<'a> {
     pub counters: &'a wgpu::Buffer,
     pub vertices: &'a wgpu::Buffer,
     pub indices: &'a wgpu::Buffer,
-    /// Indices `0..opaque_indices` are the opaque geometry, the rest up to `index_count` the
-    /// transparent objects, back to front.
-    pub opaque_indices: u32,
-    pub index_count: u32,
+    /// Runs of the opaque geometry's indices, one material shader each.
+    pub opaque: &'a [Draw],
+    /// Runs of the transparent objects' indices, back to front.
+    pub transparent: &'a [Draw],
     pub targets: &'a Targets,
     /// Camera and frame size, for CPU light assignment.
     pub setup: ViewSetup,
@@ -47,7 +47,7 @@ pub struct FrameInputs<'a> {
 impl FrameInputs<'_> {
     /// Does the frame draw transparent geometry?
     pub fn has_transparency(&self) -> bool {
-        self.index_count > self.opaque_indices
+        !self.transparent.is_empty()
     }
 }
 

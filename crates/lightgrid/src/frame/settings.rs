@@ -17,6 +17,28 @@ pub struct RenderSettings {
     /// Lists for frames with transparent geometry (`--lists`): separate opaque and
     /// transparent lists, or one shared list.
     pub lists: GridLists,
+    /// How forward pipelines draw the material shaders (`--material-draws`).
+    pub material_draws: MaterialDraws,
+}
+
+/// How forward pipelines draw materials with different shaders (tiled-forward-shading §4.7).
+/// Deferred pipelines always branch on the material stored in the G-buffer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum MaterialDraws {
+    /// A pipeline per material shader, switched between the runs of geometry.
+    #[default]
+    PerMaterial,
+    /// One pipeline for all, branching on the material (as deferred shading does).
+    Uber,
+}
+
+impl MaterialDraws {
+    pub fn name(self) -> &'static str {
+        match self {
+            MaterialDraws::PerMaterial => "per-material",
+            MaterialDraws::Uber => "uber",
+        }
+    }
 }
 
 pub use crate::scene::SpotCull;
@@ -30,6 +52,7 @@ impl Default for RenderSettings {
             assign: Assign::default(),
             spot_cull: SpotCull::default(),
             lists: GridLists::Separate,
+            material_draws: MaterialDraws::PerMaterial,
         }
     }
 }

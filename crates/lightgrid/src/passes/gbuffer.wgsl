@@ -1,4 +1,4 @@
-// G-buffer pass (tiled-shading §8): normal, diffuse colour, specular colour + shininess,
+// G-buffer pass (tiled-shading §8): normal + material index, diffuse colour, specular colour + shininess,
 // and the light-independent term (emissive + ambient). Depth goes to the shared depth target.
 
 struct GBufferOut {
@@ -10,9 +10,11 @@ struct GBufferOut {
 
 @fragment
 fn fs_gbuffer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
-    let s = surface_from_vertex(v, front);
+    let s = raw_surface_from_vertex(v, front);
     var out: GBufferOut;
-    out.normal = vec4<f32>(s.normal, 0.0);
+    // The material index rides in the normal's fourth channel (exact in 16-bit floats up to
+    // MAX_MATERIALS): the shading pass branches on its shader.
+    out.normal = vec4<f32>(s.normal, f32(s.material));
     out.diffuse = vec4<f32>(s.diffuse, s.alpha);
     out.specular = vec4<f32>(s.specular, s.shininess);
     out.base = vec4<f32>(surface_base(s), 1.0);

@@ -6,7 +6,8 @@
 @group(2) @binding(3) var gb_base: texture_2d<f32>;
 @group(2) @binding(4) var gb_depth: texture_depth_2d;
 
-// The surface stored at pixel `p`; the light-independent term travels as `emissive`.
+// The surface stored at pixel `p`, its material's shader applied (the branch of deferred
+// shading on the stored material); the light-independent term travels as `emissive`.
 fn surface_from_gbuffer(p: vec2<u32>, depth: f32) -> Surface {
     let n = textureLoad(gb_normal, p, 0);
     let d = textureLoad(gb_diffuse, p, 0);
@@ -21,5 +22,6 @@ fn surface_from_gbuffer(p: vec2<u32>, depth: f32) -> Surface {
     s.shininess = sp.a;
     s.emissive = b.rgb;
     s.ambient = vec3<f32>(0.0);
-    return s;
+    s.material = u32(n.w + 0.5);
+    return apply_material(s);
 }

@@ -17,9 +17,57 @@ pub(crate) struct GeometryPipelineDesc<'a> {
     pub depth_compare: wgpu::CompareFunction,
 }
 
+/// One pipeline per material shader (tiled-forward-shading §4.7: forward shading draws each
+/// material's geometry with its own shader), each specialised through the WGSL override
+/// `MATERIAL_SHADER`; or, for `MaterialDraws::Uber`, one pipeline branching on the material.
+pub(crate) struct MaterialPipelines(Vec<wgpu::RenderPipeline>);
+
+impl MaterialPipelines {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        d: &GeometryPipelineDesc,
+        draws: crate::frame::MaterialDraws,
+    ) -> Self {
+        use crate::consts::{MATERIAL_SHADERS, MATERIAL_SHADER_ANY};
+        match draws {
+            crate::frame::MaterialDraws::PerMaterial => MaterialPipelines(
+                (0..MATERIAL_SHADERS)
+                    .map(|k| specialised_pipeline(device, d, k))
+                    .collect(),
+            ),
+            crate::frame::MaterialDraws::Uber => {
+                MaterialPipelines(vec![specialised_pipeline(device, d, MATERIAL_SHADER_ANY)])
+            }
+        }
+    }
+
+    /// The pipeline for draws of material shader `shader`.
+    fn get(&self, shader: u32) -> &wgpu::RenderPipeline {
+        &self.0[(shader as usize).min(self.0.len() - 1)]
+    }
+}
+
+/// A pipeline drawing with the shaders' default `MATERIAL_SHADER` (every material through
+/// the branch, or no lighting at all: depth, G-buffer and attribute passes).
 pub(crate) fn geometry_pipeline(
     device: &wgpu::Device,
     d: &GeometryPipelineDesc,
+) -> wgpu::RenderPipeline {
+    pipeline_with_constants(device, d, &[])
+}
+
+fn specialised_pipeline(
+    device: &wgpu::Device,
+    d: &GeometryPipelineDesc,
+    shader: u32,
+) -> wgpu::RenderPipeline {
+    pipeline_with_constants(device, d, &[("MATERIAL_SHADER", f64::from(shader))])
+}
+
+fn pipeline_with_constants(
+    device: &wgpu::Device,
+    d: &GeometryPipelineDesc,
+    constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(d.label),
@@ -48,7 +96,10 @@ pub(crate) fn geometry_pipeline(
         fragment: d.fragment_entry.map(|entry| wgpu::FragmentState {
             module: d.module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             targets: d.color_targets,
         }),
         multiview_mask: None,
@@ -57,33 +108,56 @@ pub(crate) fn geometry_pipeline(
 }
 
 /// Bind group 0 (+ `extra` from group 1 on), the scene's buffers, and draw the opaque
-/// geometry.
+/// geometry with the pipeline already set (depth, G-buffer and attribute passes).
 pub(crate) fn draw_scene(pass: &mut wgpu::RenderPass, f: &FrameInputs, extra: &[&wgpu::BindGroup]) {
-    draw_range(pass, f, extra, 0..f.opaque_indices);
+    bind(pass, f, extra);
+    for d in f.opaque {
+        pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
+    }
 }
 
-/// As [`draw_scene`], the transparent objects (in the frame's back-to-front order).
+/// The opaque geometry, each run of one material shader with its own pipeline.
+pub(crate) fn draw_scene_materials(
+    pass: &mut wgpu::RenderPass,
+    f: &FrameInputs,
+    extra: &[&wgpu::BindGroup],
+    pipelines: &MaterialPipelines,
+) {
+    draw_runs(pass, f, extra, pipelines, f.opaque);
+}
+
+/// The transparent objects in the frame's back-to-front order, each run with its shader's
+/// pipeline.
 pub(crate) fn draw_transparent(
     pass: &mut wgpu::RenderPass,
     f: &FrameInputs,
     extra: &[&wgpu::BindGroup],
+    pipelines: &MaterialPipelines,
 ) {
-    draw_range(pass, f, extra, f.opaque_indices..f.index_count);
+    draw_runs(pass, f, extra, pipelines, f.transparent);
 }
 
-fn draw_range(
+fn draw_runs(
     pass: &mut wgpu::RenderPass,
     f: &FrameInputs,
     extra: &[&wgpu::BindGroup],
-    indices: std::ops::Range<u32>,
+    pipelines: &MaterialPipelines,
+    runs: &[crate::scene::Draw],
 ) {
+    bind(pass, f, extra);
+    for d in runs {
+        pass.set_pipeline(pipelines.get(d.shader));
+        pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
+    }
+}
+
+fn bind(pass: &mut wgpu::RenderPass, f: &FrameInputs, extra: &[&wgpu::BindGroup]) {
     pass.set_bind_group(0, f.scene_bind_group, &[]);
     for (i, g) in extra.iter().enumerate() {
         pass.set_bind_group(1 + i as u32, *g, &[]);
     }
     pass.set_vertex_buffer(0, f.vertices.slice(..));
     pass.set_index_buffer(f.indices.slice(..), wgpu::IndexFormat::Uint32);
-    pass.draw_indexed(indices, 0, 0..1);
 }
 
 /// A forward lighting pass into HDR + counts. `depth_cleared`: clear and write depth (no

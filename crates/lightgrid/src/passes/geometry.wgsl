@@ -27,7 +27,13 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
+// The surface a lighting pass shades: the material's colours with its shader applied.
 fn surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
+    return apply_material(raw_surface_from_vertex(v, front_facing));
+}
+
+// The material's own colours (what the G-buffer stores; the shading pass applies the shader).
+fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     let m = materials[v.material];
     var s: Surface;
     s.position = v.world;
@@ -39,5 +45,6 @@ fn surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     s.shininess = m.shininess;
     s.emissive = m.emissive;
     s.ambient = m.ambient;
+    s.material = v.material;
     return s;
 }

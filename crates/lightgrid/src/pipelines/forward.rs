@@ -3,7 +3,8 @@
 //! the independent reference every other pipeline is compared with.
 
 use super::{
-    begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
+    begin_lighting_pass, draw_scene_materials, lighting_targets, FrameEncoder, FrameInputs,
+    MaterialPipelines,
 };
 use super::{GeometryPipelineDesc, PipelineContext, Technique};
 use super::{RenderSettings, TransparentLights};
@@ -18,7 +19,7 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 }
 
 struct Forward {
-    pipeline: wgpu::RenderPipeline,
+    pipelines: MaterialPipelines,
 }
 
 pub(super) fn create(ctx: &PipelineContext) -> Box<dyn Technique> {
@@ -32,7 +33,7 @@ pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
 
 fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
-    let pipeline = geometry_pipeline(
+    let pipelines = MaterialPipelines::new(
         ctx.device,
         &GeometryPipelineDesc {
             label: "forward",
@@ -43,16 +44,16 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
             depth_write: true,
             depth_compare: wgpu::CompareFunction::Less,
         },
+        ctx.settings.material_draws,
     );
-    Box::new(Forward { pipeline })
+    Box::new(Forward { pipelines })
 }
 
 impl Technique for Forward {
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let (encoder, timer) = enc.parts();
         let mut pass = begin_lighting_pass(encoder, timer, f, "forward shading", true);
-        pass.set_pipeline(&self.pipeline);
-        draw_scene(&mut pass, f, &[]);
+        draw_scene_materials(&mut pass, f, &[], &self.pipelines);
         Ok(())
     }
 

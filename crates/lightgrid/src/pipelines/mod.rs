@@ -77,6 +77,9 @@ pub struct PipelineInfo {
     pub assign: bool,
     /// Its grid is clustered: `--slices` view-depth slices per tile.
     pub clustered: bool,
+    /// Shades the opaque geometry in a forward pass, a pipeline per material shader
+    /// (`--material-draws`; every pipeline's transparent pass does too).
+    pub forward_shading: bool,
     /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
     /// same approximations (e.g. `forward_mono`).
     pub reference: &'static str,
@@ -108,6 +111,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "all (brute force)",
         uses_grid: false,
         assign: false,
+        forward_shading: true,
         clustered: false,
         reference: "forward",
         shaders: forward::shaders,
@@ -120,6 +124,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
         assign: false,
+        forward_shading: true,
         clustered: false,
         reference: "forward_mono",
         shaders: forward::shaders,
@@ -132,6 +137,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §3",
         uses_grid: true,
         assign: true,
+        forward_shading: true,
         clustered: false,
         reference: "forward",
         shaders: tiled_forward::shaders,
@@ -144,6 +150,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
         assign: true,
+        forward_shading: true,
         clustered: false,
         reference: "forward",
         shaders: tiled_forward::shaders,
@@ -156,6 +163,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
         assign: true,
+        forward_shading: false,
         clustered: false,
         reference: "forward",
         shaders: tiled_deferred::shaders,
@@ -168,6 +176,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §7",
         uses_grid: true,
         assign: false,
+        forward_shading: false,
         clustered: false,
         reference: "forward",
         shaders: tiled_deferred::shaders_single,
@@ -180,6 +189,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
         assign: true,
+        forward_shading: true,
         clustered: true,
         reference: "forward",
         shaders: tiled_forward::shaders,
@@ -192,6 +202,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
         assign: true,
+        forward_shading: false,
         clustered: true,
         reference: "forward",
         shaders: tiled_deferred::shaders,
@@ -204,6 +215,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §1.1, §8 (Deferred)",
         uses_grid: false,
         assign: false,
+        forward_shading: false,
         clustered: false,
         reference: "forward",
         shaders: deferred::shaders,
@@ -216,6 +228,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "tiled-shading §8 (Deferred-Stencil)",
         uses_grid: false,
         assign: false,
+        forward_shading: false,
         clustered: false,
         reference: "forward",
         shaders: deferred::shaders,
@@ -228,6 +241,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting",
         uses_grid: false,
         assign: false,
+        forward_shading: false,
         clustered: false,
         reference: "forward",
         shaders: light_prepass::shaders,
@@ -240,6 +254,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
         assign: false,
+        forward_shading: false,
         clustered: false,
         reference: "forward_mono",
         shaders: light_prepass::shaders,
@@ -283,6 +298,6 @@ pub fn find(id: &str) -> Result<&'static PipelineInfo> {
 }
 
 pub(crate) use crate::passes::geometry::{
-    begin_lighting_pass, draw_scene, geometry_pipeline, lighting_attachments, lighting_targets,
-    GeometryPipelineDesc,
+    begin_lighting_pass, draw_scene, draw_scene_materials, geometry_pipeline, lighting_attachments,
+    lighting_targets, GeometryPipelineDesc, MaterialPipelines,
 };

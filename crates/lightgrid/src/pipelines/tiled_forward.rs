@@ -11,7 +11,8 @@
 //! cluster's list.
 
 use super::{
-    begin_lighting_pass, draw_scene, geometry_pipeline, lighting_targets, FrameEncoder, FrameInputs,
+    begin_lighting_pass, draw_scene, draw_scene_materials, geometry_pipeline, lighting_targets,
+    FrameEncoder, FrameInputs, MaterialPipelines,
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, TransparentLights};
 use crate::culling::{CellSource, GridBuilder};
@@ -30,7 +31,7 @@ struct TiledForward {
     builder: GridBuilder,
     /// The depth pre-pass (pre-Z and clustered).
     depth_only: Option<wgpu::RenderPipeline>,
-    shading: wgpu::RenderPipeline,
+    shading: MaterialPipelines,
     label: &'static str,
 }
 
@@ -57,7 +58,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             CellSource::NearFar
         },
     );
-    let shading = geometry_pipeline(
+    let shading = MaterialPipelines::new(
         ctx.device,
         &GeometryPipelineDesc {
             label: "tiled forward shading",
@@ -72,6 +73,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
                 wgpu::CompareFunction::Less
             },
         },
+        ctx.settings.material_draws,
     );
     let depth_only = prepass.then(|| {
         geometry_pipeline(
@@ -130,8 +132,7 @@ impl Technique for TiledForward {
         let (encoder, timer) = enc.parts();
         let mut pass =
             begin_lighting_pass(encoder, timer, f, self.label, self.depth_only.is_none());
-        pass.set_pipeline(&self.shading);
-        draw_scene(&mut pass, f, &[self.builder.bind_group()]);
+        draw_scene_materials(&mut pass, f, &[self.builder.bind_group()], &self.shading);
         drop(pass);
         Ok(())
     }

@@ -15,7 +15,7 @@ use crate::culling::{CellSource, GridBuffers, GridBuilder, GridLists};
 use crate::error::Result;
 use crate::frame::Assign;
 use crate::gpu::CounterValues;
-use crate::passes::geometry::{draw_transparent, geometry_pipeline};
+use crate::passes::geometry::{draw_transparent, MaterialPipelines};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 
 pub(super) fn shader() -> ComposedShader {
@@ -37,8 +37,8 @@ pub enum TransparentLights<'a> {
 
 /// The pass's two pipelines and the grid it builds for techniques without one.
 pub struct TransparentPass {
-    all_lights: wgpu::RenderPipeline,
-    grid: wgpu::RenderPipeline,
+    all_lights: MaterialPipelines,
+    grid: MaterialPipelines,
     own_grid: GridBuilder,
 }
 
@@ -82,7 +82,7 @@ impl TransparentPass {
         let grid_layout = GridBuffers::layout(ctx.device);
         let targets = blended_targets(ctx.count_blend);
         let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
-            geometry_pipeline(
+            MaterialPipelines::new(
                 ctx.device,
                 &GeometryPipelineDesc {
                     label,
@@ -93,6 +93,7 @@ impl TransparentPass {
                     depth_write: false,
                     depth_compare: wgpu::CompareFunction::Less,
                 },
+                ctx.settings.material_draws,
             )
         };
         TransparentPass {
@@ -159,14 +160,8 @@ impl TransparentPass {
             multiview_mask: None,
         });
         match grid {
-            None => {
-                pass.set_pipeline(&self.all_lights);
-                draw_transparent(&mut pass, f, &[]);
-            }
-            Some(g) => {
-                pass.set_pipeline(&self.grid);
-                draw_transparent(&mut pass, f, &[g]);
-            }
+            None => draw_transparent(&mut pass, f, &[], &self.all_lights),
+            Some(g) => draw_transparent(&mut pass, f, &[g], &self.grid),
         }
         Ok(())
     }

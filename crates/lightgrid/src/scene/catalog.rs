@@ -6,8 +6,8 @@
 //! lights, top-down and first-person); `stress` takes any light count for scaling runs.
 
 use super::{
-    CameraPath, Light, LightAnchor, Material, Mesh, Motion, Object, Path, Rng, Scene, SceneLight,
-    Spot,
+    CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object, Path, Rng,
+    Scene, SceneLight, Spot,
 };
 use crate::error::{Error, Result};
 use glam::{Mat4, Vec3};
@@ -411,7 +411,15 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
     .into_iter()
     .map(|c| b.material(Material::plain(c, 0.25, 24.0)))
     .collect();
-    let metal = b.material(Material::plain(Vec3::new(0.45, 0.50, 0.58), 0.9, 64.0));
+    // The robots wear two-colour car paint (tiled-forward-shading §4.7's per-material
+    // shaders): steel blue turning plum at grazing angles.
+    let metal = b.material(Material {
+        shader: MaterialShader::CarPaint {
+            flip: Vec3::new(0.55, 0.12, 0.40),
+            power: 2.0,
+        },
+        ..Material::plain(Vec3::new(0.45, 0.50, 0.58), 0.9, 64.0)
+    });
     let eyes = b.material(Material {
         emissive: Vec3::new(1.5, 0.2, 0.1),
         ..Material::plain(Vec3::new(0.2, 0.05, 0.05), 0.5, 32.0)
@@ -715,7 +723,14 @@ fn scattered(p: &SceneParams) -> Scene {
     };
     let mut b = Builder::new("scattered", p.seed, camera, (1280, 720));
     let floor = b.material(Material::plain(Vec3::splat(0.55), 0.2, 16.0));
-    let stone = b.material(Material::plain(Vec3::new(0.66, 0.62, 0.56), 0.4, 32.0));
+    // The pillars are rim-lit (tiled-forward-shading §4.7's per-material shaders).
+    let rim = b.material(Material {
+        shader: MaterialShader::Rim {
+            color: Vec3::new(0.35, 0.55, 1.0),
+            power: 3.0,
+        },
+        ..Material::plain(Vec3::new(0.66, 0.62, 0.56), 0.4, 32.0)
+    });
     let shiny = b.material(Material::plain(Vec3::new(0.35, 0.40, 0.50), 0.9, 96.0));
     b.object(
         Mesh::ground(-100.0, -100.0, 100.0, 100.0, 0.0),
@@ -729,7 +744,7 @@ fn scattered(p: &SceneParams) -> Scene {
             pillars.append(&Mesh::cylinder(2.0, 30.0, 24), Mat4::from_translation(pos));
         }
     }
-    b.object(pillars, stone, Motion::Static);
+    b.object(pillars, rim, Motion::Static);
     let mut blocks = Mesh::default();
     for _ in 0..60 {
         let c = Vec3::new(b.rng.range(-90.0, 90.0), 0.0, b.rng.range(-90.0, 90.0));

@@ -32,6 +32,37 @@ pub struct Material {
     pub ambient: Vec3,
     pub alpha: f32,
     pub transparent: bool,
+    /// How the material responds to the view (its shader).
+    pub shader: MaterialShader,
+}
+
+/// A material's shader (tiled-forward-shading §4.7). Each changes only the colour the one
+/// light function's diffuse term is multiplied by, as a function of the view angle (see
+/// `apply_material` in `shading/lighting.wgsl`), so every pipeline shades it the same.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum MaterialShader {
+    /// Blinn-Phong with the material's own colours.
+    #[default]
+    Standard,
+    /// Two-colour car paint: the diffuse colour turns toward `flip` at grazing angles,
+    /// `(1 - n·v)^power`.
+    CarPaint { flip: Vec3, power: f32 },
+    /// A rim: `color × (1 - n·v)^power` added to the diffuse colour, lit by the lights.
+    Rim { color: Vec3, power: f32 },
+}
+
+impl MaterialShader {
+    /// `consts::MATERIAL_SHADER_*`, the second colour and the exponent.
+    pub fn gpu(self) -> (u32, Vec3, f32) {
+        use crate::consts::{
+            MATERIAL_SHADER_CAR_PAINT, MATERIAL_SHADER_RIM, MATERIAL_SHADER_STANDARD,
+        };
+        match self {
+            MaterialShader::Standard => (MATERIAL_SHADER_STANDARD, Vec3::ZERO, 1.0),
+            MaterialShader::CarPaint { flip, power } => (MATERIAL_SHADER_CAR_PAINT, flip, power),
+            MaterialShader::Rim { color, power } => (MATERIAL_SHADER_RIM, color, power),
+        }
+    }
 }
 
 impl Material {
@@ -45,6 +76,7 @@ impl Material {
             ambient: diffuse,
             alpha: 1.0,
             transparent: false,
+            shader: MaterialShader::Standard,
         }
     }
 
@@ -60,6 +92,7 @@ impl Material {
     }
 
     pub fn to_gpu(&self) -> GpuMaterial {
+        let (shader, paint, paint_power) = self.shader.gpu();
         GpuMaterial {
             diffuse: self.diffuse.to_array(),
             alpha: self.alpha,
@@ -72,7 +105,9 @@ impl Material {
                 0
             },
             ambient: self.ambient.to_array(),
-            _pad: 0.0,
+            paint_power,
+            paint: paint.to_array(),
+            shader,
         }
     }
 }
@@ -305,18 +340,42 @@ pub struct Scene {
     pub default_size: (u32, u32),
 }
 
-/// The frame's geometry in world space: opaque triangles first, then the transparent
-/// objects' triangles, object by object from the farthest to the nearest.
-#[derive(Clone, Debug, Default)]
+/// The frame's geometry in world space: opaque triangles first (grouped by material shader),
+/// then the transparent objects' triangles, object by object from the farthest to the
+/// nearest.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Geometry {
     pub vertices: Vec<GpuVertex>,
     pub indices: Vec<u32>,
     /// `indices[..opaque_indices]` are opaque, the rest transparent, back to front.
     pub opaque_indices: usize,
+    /// Runs of indices drawn with one material shader, in drawing order (the opaque runs
+    /// first): forward pipelines switch pipelines between runs (per-material draws).
+    pub draws: Vec<Draw>,
+}
+
+/// A run of indices whose triangles all use one material shader.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Draw {
+    /// `consts::MATERIAL_SHADER_*`.
+    pub shader: u32,
+    pub first: u32,
+    pub count: u32,
+}
+
+impl Draw {
+    /// The same run, its indices `offset` further on.
+    pub fn offset(self, offset: u32) -> Draw {
+        Draw {
+            first: self.first + offset,
+            ..self
+        }
+    }
 }
 
 impl Geometry {
-    /// The transparent triangles in world space (the analysis rasterizes them).
+    /// The transparent triangles in world space (the analysis rasterizes them); `base` is
+    /// the vertex the geometry's indices start at.
     pub fn transparent_triangles(&self, base: u32) -> Vec<[Vec3; 3]> {
         self.indices[self.opaque_indices..]
             .chunks_exact(3)
@@ -324,6 +383,16 @@ impl Geometry {
                 [t[0], t[1], t[2]].map(|i| Vec3::from(self.vertices[(i - base) as usize].position))
             })
             .collect()
+    }
+
+    /// The runs of opaque indices, and of transparent ones.
+    pub fn split_draws(&self) -> (&[Draw], &[Draw]) {
+        let n = self
+            .draws
+            .iter()
+            .take_while(|d| (d.first as usize) < self.opaque_indices)
+            .count();
+        self.draws.split_at(n)
     }
 }
 
@@ -405,51 +474,84 @@ impl Scene {
     /// All objects of the frame in world space: the static opaque objects first
     /// ([`Scene::static_geometry`]), then [`Scene::frame_geometry`]'s.
     pub fn geometry(&self, state: &FrameState) -> Geometry {
-        let (mut vertices, mut indices) = self.static_geometry();
-        let moving = self.frame_geometry(state, vertices.len() as u32);
-        let opaque_indices = indices.len() + moving.opaque_indices;
-        vertices.extend(moving.vertices);
-        indices.extend(moving.indices);
-        Geometry {
-            vertices,
-            indices,
-            opaque_indices,
-        }
+        let mut g = self.static_geometry();
+        let moving = self.frame_geometry(state, g.vertices.len() as u32);
+        let offset = g.indices.len() as u32;
+        g.opaque_indices += moving.opaque_indices;
+        g.draws
+            .extend(moving.draws.iter().map(|d| d.offset(offset)));
+        g.vertices.extend(moving.vertices);
+        g.indices.extend(moving.indices);
+        g
     }
 
-    /// The opaque objects that never move, in world space: the same every frame, so a
-    /// renderer uploads them once.
-    pub fn static_geometry(&self) -> (Vec<GpuVertex>, Vec<u32>) {
-        let mut out = (Vec::new(), Vec::new());
-        for o in self
+    /// The opaque objects that never move, in world space, grouped by material shader: the
+    /// same every frame, so a renderer uploads them once.
+    pub fn static_geometry(&self) -> Geometry {
+        let mut items: Vec<(usize, Mat4)> = self
             .objects
             .iter()
-            .filter(|o| o.is_static() && !self.is_transparent(o))
-        {
-            self.bake(o, o.local, 0, &mut out);
-        }
+            .enumerate()
+            .filter(|(_, o)| o.is_static() && !self.is_transparent(o))
+            .map(|(i, o)| (i, o.local))
+            .collect();
+        items.sort_by_key(|&(i, _)| self.shader_of(i));
+        let mut out = Geometry::default();
+        self.bake_runs(&items, 0, &mut out);
+        out.opaque_indices = out.indices.len();
         out
     }
 
     /// What changes per frame, with indices starting at vertex `base` (where it follows the
-    /// static geometry): the moving opaque objects, then every transparent object, sorted
-    /// back to front by the distance from the camera to its bounds' centre (tiled-shading
+    /// static geometry): the moving opaque objects (grouped by material shader), then every
+    /// transparent object, sorted back to front ([`Scene::transparent_order`]; tiled-shading
     /// §4: blending needs the order; objects that intersect can still sort wrong).
     pub fn frame_geometry(&self, state: &FrameState, base: u32) -> Geometry {
-        let mut out = (Vec::new(), Vec::new());
-        for (o, m) in self.objects.iter().zip(&state.transforms) {
-            if !o.is_static() && !self.is_transparent(o) {
-                self.bake(o, *m, base, &mut out);
+        let mut moving: Vec<(usize, Mat4)> = self
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| !o.is_static() && !self.is_transparent(o))
+            .map(|(i, _)| (i, state.transforms[i]))
+            .collect();
+        moving.sort_by_key(|&(i, _)| self.shader_of(i));
+        let mut out = Geometry::default();
+        self.bake_runs(&moving, base, &mut out);
+        out.opaque_indices = out.indices.len();
+        let transparent: Vec<(usize, Mat4)> = self
+            .transparent_order(state)
+            .into_iter()
+            .map(|i| (i, state.transforms[i]))
+            .collect();
+        self.bake_runs(&transparent, base, &mut out);
+        out
+    }
+
+    /// The material shader id of object `i`.
+    fn shader_of(&self, i: usize) -> u32 {
+        self.materials[self.objects[i].material].shader.gpu().0
+    }
+
+    /// Bake objects in order, merging consecutive ones with one shader into one draw (never
+    /// into a draw from before this call: opaque and transparent runs stay apart).
+    fn bake_runs(&self, items: &[(usize, Mat4)], base: u32, out: &mut Geometry) {
+        let earlier = out.draws.len();
+        for &(i, m) in items {
+            let first = out.indices.len() as u32;
+            self.bake(&self.objects[i], m, base, out);
+            let count = out.indices.len() as u32 - first;
+            let shader = self.shader_of(i);
+            let mergeable = out.draws.len() > earlier;
+            match out.draws.last_mut() {
+                Some(d) if mergeable && d.shader == shader && d.first + d.count == first => {
+                    d.count += count
+                }
+                _ => out.draws.push(Draw {
+                    shader,
+                    first,
+                    count,
+                }),
             }
-        }
-        let opaque_indices = out.1.len();
-        for i in self.transparent_order(state) {
-            self.bake(&self.objects[i], state.transforms[i], base, &mut out);
-        }
-        Geometry {
-            vertices: out.0,
-            indices: out.1,
-            opaque_indices,
         }
     }
 
@@ -499,8 +601,8 @@ impl Scene {
         h.finish()
     }
 
-    fn bake(&self, o: &Object, m: Mat4, base: u32, out: &mut (Vec<GpuVertex>, Vec<u32>)) {
-        let (vertices, indices) = out;
+    fn bake(&self, o: &Object, m: Mat4, base: u32, out: &mut Geometry) {
+        let (vertices, indices) = (&mut out.vertices, &mut out.indices);
         let mesh = &self.meshes[o.mesh];
         let first = base + vertices.len() as u32;
         let nm = glam::Mat3::from_mat4(m).inverse().transpose();
@@ -535,6 +637,16 @@ impl Scene {
         }
         for (i, l) in self.lights.iter().enumerate() {
             l.light.validate(i)?;
+        }
+        if self.materials.len() > crate::consts::MAX_MATERIALS {
+            return Err(Error::invalid(
+                "scene",
+                format!(
+                    "{} materials exceed the maximum of {}",
+                    self.materials.len(),
+                    crate::consts::MAX_MATERIALS
+                ),
+            ));
         }
         for (i, o) in self.objects.iter().enumerate() {
             let mesh = self.meshes.get(o.mesh).ok_or_else(|| {

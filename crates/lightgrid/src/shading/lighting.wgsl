@@ -12,6 +12,7 @@ struct Surface {
     shininess: f32,
     emissive: vec3<f32>,
     ambient: vec3<f32>,
+    material: u32,         // index into `materials` (its shader and paint)
 }
 
 // Diffuse and specular irradiance from one light, before the material colours multiply them.
@@ -66,6 +67,34 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
 fn shade_light(s: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
     let t = light_terms(s, view_dir, light);
     return t.diffuse * s.diffuse + t.specular * s.specular;
+}
+
+// Per-material shaders (tiled-forward-shading §4.7: each draw may have its own lighting
+// model). A material shader only changes the colour the one light function's diffuse term is
+// multiplied by, from the view: car paint blends its diffuse colour toward a flip colour at
+// grazing angles, a rim material adds a rim colour there (lit by the lights reaching it). So
+// the result is linear in each light's terms, and forward (one pipeline per shader), deferred
+// (a branch on the G-buffer's material) and the light pre-pass (applied once to the summed
+// irradiance) give the same image.
+// Forward pipelines set MATERIAL_SHADER per pipeline and draw each shader's geometry with its
+// own; MATERIAL_SHADER_ANY (the default) branches on the material's own id.
+override MATERIAL_SHADER: u32 = MATERIAL_SHADER_ANY;
+
+fn apply_material(s: Surface) -> Surface {
+    let m = materials[s.material];
+    let kind = select(MATERIAL_SHADER, m.shader, MATERIAL_SHADER == MATERIAL_SHADER_ANY);
+    let grazing = pow(1.0 - saturate(dot(s.normal, view_dir_to(s.position))), m.paint_power);
+    var out = s;
+    switch kind {
+        case MATERIAL_SHADER_CAR_PAINT: {
+            out.diffuse = mix(s.diffuse, m.paint, grazing);
+        }
+        case MATERIAL_SHADER_RIM: {
+            out.diffuse = s.diffuse + m.paint * grazing;
+        }
+        default: {}
+    }
+    return out;
 }
 
 // The part of a sample's colour that does not depend on any light.

@@ -20,7 +20,9 @@ struct Material {
     emissive: vec3<f32>,
     flags: u32,
     ambient: vec3<f32>,
-    _pad: f32,
+    paint_power: f32,
+    paint: vec3<f32>,
+    shader: u32,
 }
 
 struct FrameUniforms {
