@@ -414,6 +414,19 @@ fn summary(results: &BenchResults) -> String {
             culls.join(" and by ")
         );
     }
+    if c.lists.len() > 1 {
+        let _ = writeln!(
+            s,
+            "- transparent objects {}; grid pipelines measured with `[separate lists]` (an opaque list pruned by each tile's depth bounds and a transparent list over near..opaque max, tiled-forward-shading §4.5) and `[shared lists]` (one list over near..max for both)",
+            if c.transparency { "on" } else { "off" }
+        );
+    }
+    if c.material_draws.len() > 1 {
+        let _ = writeln!(
+            s,
+            "- forward-shading pipelines measured with `[per-material draws]` (a pipeline per material shader) and `[uber draws]` (one pipeline branching on the material)"
+        );
+    }
     if !results.outcome.is_complete() {
         let _ = writeln!(
             s,
@@ -471,6 +484,35 @@ fn summary(results: &BenchResults) -> String {
             .map(|m| m.ideal_lighting_computations.avg);
         if let Some(i) = ideal {
             let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
+        }
+        // The transparent overdraw: the same for every run of the scene (the analysis
+        // rasterizes the frame's transparent objects).
+        if let Some(r) = results
+            .runs
+            .iter()
+            .find(|r| &r.scene == scene && !r.frames.is_empty())
+        {
+            let n = r.frames.len() as f64;
+            let fragments: f64 = r
+                .frames
+                .iter()
+                .map(|f| f.transparent_fragments as f64)
+                .sum();
+            let ideal: f64 = r
+                .frames
+                .iter()
+                .map(|f| f.ideal_transparent_computations as f64)
+                .sum();
+            if fragments > 0.0 {
+                let pixels = f64::from(r.width) * f64::from(r.height);
+                let _ = writeln!(
+                    s,
+                    "Transparent fragments per frame (avg): {:.0} ({:.3} per pixel), lit {:.0} times in the ideal (included above).",
+                    fragments / n,
+                    fragments / n / pixels,
+                    ideal / n
+                );
+            }
         }
         spot_ray_section(&mut s, results, scene);
         s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");

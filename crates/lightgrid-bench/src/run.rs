@@ -658,7 +658,8 @@ impl<'a> Measuring<'a> {
             *bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
             let heatmaps = &mut results.heatmaps;
             if f == heatmap_frame && wants_heatmap && !heatmaps.iter().any(|h| h.0 == scene.name) {
-                let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
+                let view_distance = out.view_distances();
+                let map = lightgrid::heatmap::heatmap(&out.image, &out.grid, Some(&view_distance));
                 heatmaps.push((scene.name.clone(), info.id.to_string(), f, map));
             }
             let tested = |t: &SpotRayTest| t.scene == scene.name && t.frame == f;

@@ -55,5 +55,22 @@ pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
         lightgrid::memory::LIGHT_BYTES,
         lightgrid::memory::INDEX_BYTES
     );
+    // The grid's cell array (offset + count per cell); frames with transparent objects and
+    // separate lists (the default) keep a second layer of cells for the transparent lists.
+    let (tile, slices) = (settings.tile_size, settings.slices);
+    let tiles = lightgrid::culling::GridDims::new(w, h, tile)?;
+    let clusters = tiles.clustered(slices, 1.0, 2.0)?;
+    let kib = |d: &lightgrid::culling::GridDims| (d.cell_count() * 8) as f64 / 1024.0;
+    let separate = lightgrid::culling::GridLists::Separate;
+    println!(
+        "light grid cells (8 B each) at tile {tile}: tiled {} cells = {:.1} KiB, clustered ({slices} slices) {} cells = {:.1} KiB; \
+         with transparent objects and --lists separate a second layer: {:.1} and {:.1} KiB (the index lists depend on the frame: --stats memory.grid_bytes)",
+        tiles.cell_count(),
+        kib(&tiles),
+        clusters.cell_count(),
+        kib(&clusters),
+        kib(&tiles.with_lists(separate)),
+        kib(&clusters.with_lists(separate)),
+    );
     Ok(())
 }

@@ -52,7 +52,8 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         writes.push((path, encode_png(&out.image, path)?));
     }
     if let Some(path) = &a.heatmap {
-        let map = lightgrid::heatmap::heatmap(&out.image, &out.grid);
+        let view_distance = out.view_distances();
+        let map = lightgrid::heatmap::heatmap(&out.image, &out.grid, Some(&view_distance));
         writes.push((path, encode_png(&map, path)?));
     }
     if let Some(path) = &a.stats {

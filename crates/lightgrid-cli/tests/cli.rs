@@ -608,8 +608,8 @@ fn play_reports_one_submission_and_no_readback_per_frame() {
     assert_eq!(v["submits_per_frame"], 2.0);
     assert_eq!(
         v["readback_bytes_per_frame"],
-        4.0 * 2.0 * 8.0,
-        "4x2 tiles of [min, max]"
+        4.0 * 2.0 * 2.0 * 8.0,
+        "4x2 tiles of [min, max], opaque and transparent lists (the street's glass)"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -607,6 +607,24 @@ fn an_option_that_applies_to_nothing_chosen_is_refused_in_every_command() {
             "--spot-cull does not apply to deferred",
         ),
         (
+            &["render", "--pipeline", "deferred", "--lists", "shared"],
+            "--lists does not apply to deferred",
+        ),
+        (
+            &[
+                "render",
+                "--pipeline",
+                "tiled_deferred",
+                "--material-draws",
+                "uber",
+            ],
+            "--material-draws does not apply to tiled_deferred",
+        ),
+        (
+            &["render", "--scene", "stress", "--transparency", "off"],
+            "scene stress has no transparent objects",
+        ),
+        (
             &[
                 "bench",
                 "--pipelines",

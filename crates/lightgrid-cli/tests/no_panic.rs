@@ -79,6 +79,13 @@ const NAMES: &[&str] = &[
     "cone",
     "sphere,cone",
     "0.5",
+    "on",
+    "off",
+    "separate",
+    "shared",
+    "separate,shared",
+    "per-material",
+    "uber",
 ];
 
 /// Options per command, with the safe values that keep a valid run short (tiny frames, one
@@ -97,6 +104,9 @@ const CMDS: &[Cmd] = &[
         flags: &[
             "--spot-fraction",
             "--spot-cull",
+            "--transparency",
+            "--lists",
+            "--material-draws",
             "--scene",
             "--frame",
             "--size",
@@ -121,6 +131,9 @@ const CMDS: &[Cmd] = &[
         flags: &[
             "--spot-fraction",
             "--spot-cull",
+            "--transparency",
+            "--lists",
+            "--material-draws",
             "--scene",
             "--pipeline",
             "--assign",
@@ -146,6 +159,7 @@ const CMDS: &[Cmd] = &[
         name: "compare",
         flags: &[
             "--spot-fraction",
+            "--transparency",
             "--scene",
             "--frame",
             "--size",
@@ -167,6 +181,9 @@ const CMDS: &[Cmd] = &[
         flags: &[
             "--spot-fraction",
             "--spot-cull",
+            "--transparency",
+            "--lists",
+            "--material-draws",
             "--scene",
             "--pipelines",
             "--frames",

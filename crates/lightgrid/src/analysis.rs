@@ -32,6 +32,8 @@ pub struct FrameOutput {
     pub cell_bounds: Option<Vec<[f32; 2]>>,
     /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry).
     pub depth: Vec<f32>,
+    /// The frame's camera and size.
+    pub setup: ViewSetup,
 }
 
 /// The staging buffers an analysis frame copies its image, counts and depth into.
@@ -86,6 +88,13 @@ fn frame_memory(
             .map(|g| ForwardPlusTable1::new(pixels, g.average_lights_per_cell(), g.dims.tile_size)),
         targets: model.targets,
         traffic: t,
+    }
+}
+
+impl FrameOutput {
+    /// The view distance of every pixel's visible sample (infinite for none).
+    pub fn view_distances(&self) -> Vec<f32> {
+        self.setup.view_distances(&self.depth)
     }
 }
 
@@ -216,5 +225,6 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         grid_is_pipelines,
         cell_bounds,
         depth,
+        setup,
     })
 }

@@ -1,7 +1,9 @@
 //! The lights-per-tile view (forward-plus Fig. 2b style): each tile tinted by its light count
-//! (for a clustered grid, its fullest cluster)
 //! over a dimmed copy of the frame, with a colour legend (blue 0, green half, red the maximum)
-//! and its end values drawn underneath.
+//! and its end values drawn underneath. For a clustered grid each pixel shows the list of the
+//! cluster its visible sample reads (its fullest cluster where it has none, the sky), so what
+//! culls by depth and by cone (spot pools on the ground) shows per sample, not as the far
+//! field's density.
 
 use crate::culling::LightGrid;
 use image::{Rgba, RgbaImage};
@@ -58,18 +60,37 @@ fn draw_number(img: &mut RgbaImage, mut x: u32, y: u32, n: u32, scale: u32) {
 /// Narrowest legend (pixels at scale 1): bar, "0" and a seven-digit maximum.
 const LEGEND_MIN_WIDTH: u32 = 96;
 
-pub fn heatmap(frame: &RgbaImage, grid: &LightGrid) -> RgbaImage {
+/// `view_distance`: the frame's per-pixel view distance (infinite for no sample), which a
+/// clustered grid's view needs to find each pixel's cluster.
+pub fn heatmap(frame: &RgbaImage, grid: &LightGrid, view_distance: Option<&[f32]>) -> RgbaImage {
     let (w, h) = frame.dimensions();
     let scale = (w / 320).max(1);
     let legend_h = 14 * scale;
-    let counts = grid.tile_max_counts();
-    let max = counts.iter().copied().max().unwrap_or(0).max(1);
+    let tile_max = grid.tile_max_counts();
+    let dims = grid.dims;
+    let count_at = |x: u32, y: u32| match view_distance {
+        Some(vd) if dims.slices > 1 => {
+            let d = vd[(y * w + x) as usize];
+            if d.is_finite() {
+                grid.cells[dims.cell_of(x, y, d)][1]
+            } else {
+                tile_max[dims.tile_of(x, y)]
+            }
+        }
+        _ => tile_max[dims.tile_of(x, y)],
+    };
+    let max = frame
+        .enumerate_pixels()
+        .map(|(x, y, _)| count_at(x, y))
+        .max()
+        .unwrap_or(0)
+        .max(1);
     // The legend needs room for its bar and two numbers: frames narrower than that get a
     // black margin on the right instead of a legend drawn off the image.
     let out_w = w.max(LEGEND_MIN_WIDTH * scale);
     let mut out = RgbaImage::from_pixel(out_w, h + legend_h, Rgba([0, 0, 0, 255]));
     for (x, y, p) in frame.enumerate_pixels() {
-        let count = counts[grid.dims.tile_of(x, y)];
+        let count = count_at(x, y);
         let c = ramp(count as f32 / max as f32);
         let luma = (0.2 * p[0] as f32 + 0.6 * p[1] as f32 + 0.2 * p[2] as f32) / 255.0;
         let px = |i: usize| ((0.55 * c[i] + 0.45 * luma) * 255.0) as u8;

@@ -73,23 +73,24 @@ impl Totals {
     }
 }
 
-/// Catalog scenes whose geometry and camera paths the random lights are placed in (their
-/// opaque geometry: transparent lists are checked on the catalog's own lights in
-/// `tests/pipelines.rs`; against these edge-case spots, cells spanning near..far disagree
-/// with the twin beyond the test's 0.1% range slack at f32 precision, an open point).
-fn backdrops() -> Vec<Scene> {
-    let opaque = SceneParams {
-        transparency: false,
-        ..Default::default()
-    };
+/// Catalog scenes whose geometry and camera paths the random lights are placed in, built
+/// with `params`: with the glass, their grids have transparent lists too, whose cells span
+/// near..opaque max (the 1280x720 run keeps them opaque: two layers of 921,600 cells there
+/// more than double its time).
+fn backdrops(params: &SceneParams) -> Vec<Scene> {
     ["random-fps", "robots-many", "random-top", "robots-few"]
         .iter()
-        .map(|n| catalog::build(n, &opaque).unwrap())
+        .map(|n| catalog::build(n, params).unwrap())
         .collect()
 }
 
-fn run(ctx: &lightgrid::gpu::GpuContext, configs: &[Config], seed: u64, totals: &mut Totals) {
-    let backdrops = backdrops();
+fn run(
+    ctx: &lightgrid::gpu::GpuContext,
+    configs: &[Config],
+    (seed, params): (u64, &SceneParams),
+    totals: &mut Totals,
+) {
+    let backdrops = backdrops(params);
     let mut rng = Rng::new(seed);
     for (ci, config) in configs.iter().enumerate() {
         let start = Instant::now();
@@ -196,7 +197,7 @@ fn gpu_strategies_contain_the_oracle_in_small_randomized_scenes() {
         })
         .collect();
     let mut totals = Totals::default();
-    run(&ctx, &configs, 808, &mut totals);
+    run(&ctx, &configs, (808, &SceneParams::default()), &mut totals);
     eprintln!(
         "small: scenes per strategy {:?}, {} oracle hits checked ({} across a slice boundary), \
          {} twin disagreements, {:?}",
@@ -261,7 +262,11 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
         },
     ];
     let mut totals = Totals::default();
-    run(&ctx, &configs, 1280, &mut totals);
+    let opaque = SceneParams {
+        transparency: false,
+        ..Default::default()
+    };
+    run(&ctx, &configs, (1280, &opaque), &mut totals);
     eprintln!(
         "1280x720: {} oracle hits checked ({} across a slice boundary), {} twin \
          disagreements, {:?}",

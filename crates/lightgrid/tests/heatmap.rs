@@ -22,7 +22,7 @@ fn heatmaps_of_tiny_and_odd_frames_keep_the_frame_and_fit_the_legend() {
         let lists: Vec<Vec<u32>> = (0..dims.cell_count())
             .map(|c| if c == 0 { vec![0] } else { Vec::new() })
             .collect();
-        let map = heatmap(&frame, &LightGrid::from_lists(dims, &lists));
+        let map = heatmap(&frame, &LightGrid::from_lists(dims, &lists), None);
         let scale = (w / 320).max(1);
         assert_eq!(
             map.dimensions(),

@@ -720,12 +720,7 @@ fn strategies_on_randomized_edge_case_lights() {
         ("random-top", (151, 83), 31, 8),
     ];
     for (name, (w, h), tile, slices) in cases {
-        // Opaque geometry only, as in gpu_culling.rs's randomized scenes.
-        let opaque = SceneParams {
-            transparency: false,
-            ..Default::default()
-        };
-        let mut scene = catalog::build(name, &opaque).unwrap();
+        let mut scene = catalog::build(name, &SceneParams::default()).unwrap();
         let frame = rng.below(scene.frame_count());
         let camera = scene.frame(frame).camera;
         let setup = ViewSetup::new(&camera, w, h);

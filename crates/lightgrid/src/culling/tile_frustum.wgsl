@@ -90,7 +90,9 @@ fn cone_margin(light: Light, cell: vec4<f32>) -> f32 {
         return m;
     }
     let along = dot(v, axis);
-    let across = sqrt(max(dot(v, v) - along * along, 0.0));
+    // The perpendicular part's length, not sqrt(|v|² - along²), which cancels for far cells
+    // (CPU twin: `ViewLight::cone_margin`).
+    let across = length(v - axis * along);
     let sin_outer = sqrt(max(1.0 - light.cos_outer * light.cos_outer, 0.0));
     return min(m, min(along + r, r - (light.cos_outer * across - along * sin_outer)));
 }
