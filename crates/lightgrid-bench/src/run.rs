@@ -102,8 +102,11 @@ pub struct BenchConfig {
     #[serde(default = "default_spot_culls")]
     pub spot_culls: Vec<SpotCull>,
     /// The scenes' transparent objects (`--transparency on|off`).
-    #[serde(default = "default_transparency")]
+    #[serde(default = "default_on")]
     pub transparency: bool,
+    /// The materials' own shaders (`--material-shaders on|off`).
+    #[serde(default = "default_on")]
+    pub material_shaders: bool,
     /// The lists grid pipelines build for frames with transparent geometry (`--lists`):
     /// every pipeline with an `--assign` grid is measured once per entry.
     #[serde(default = "default_lists")]
@@ -122,7 +125,7 @@ fn default_spot_culls() -> Vec<SpotCull> {
     vec![SpotCull::default()]
 }
 
-fn default_transparency() -> bool {
+fn default_on() -> bool {
     true
 }
 
@@ -455,6 +458,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 spot_fraction: config.spot_fraction,
                 headlights: config.headlights && info.robots,
                 transparency: config.transparency || !info.transparency(),
+                material_shaders: config.material_shaders,
             };
             catalog::build(name, &params)
         })

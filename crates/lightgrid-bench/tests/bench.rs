@@ -41,6 +41,7 @@ fn config() -> BenchConfig {
         headlights: false,
         spot_culls: vec![Default::default()],
         transparency: true,
+        material_shaders: true,
         lists: vec![lightgrid::culling::GridLists::Separate],
         material_draws: vec![Default::default()],
     }

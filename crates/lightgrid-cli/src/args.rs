@@ -292,6 +292,9 @@ pub(crate) struct SceneArgs {
     /// blended after the opaque geometry; robots and random scenes.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub(crate) transparency: OnOff,
+    /// The materials' own shaders (car paint, rim); off renders every material standard.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub(crate) material_shaders: OnOff,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
@@ -315,6 +318,7 @@ pub(crate) fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
         spot_fraction: a.spot_fraction as f32,
         headlights: a.headlights,
         transparency: a.transparency.on(),
+        material_shaders: a.material_shaders.on(),
     };
     Ok(catalog::build(&a.scene, &params)?)
 }

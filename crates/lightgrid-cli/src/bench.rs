@@ -86,6 +86,9 @@ pub(crate) struct BenchArgs {
     /// The scenes' transparent objects (robots and random scenes).
     #[arg(long, value_enum)]
     pub(crate) transparency: Option<OnOff>,
+    /// The materials' own shaders (car paint, rim); off renders every material standard.
+    #[arg(long, value_enum)]
+    pub(crate) material_shaders: Option<OnOff>,
     /// The light lists of grid pipelines for frames with transparent objects: separate,
     /// shared, or separate,shared to measure both [default: separate].
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -257,6 +260,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             a.spot_cull.iter().map(|&c| c.into()).collect()
         },
         transparency: a.transparency.is_none_or(OnOff::on),
+        material_shaders: a.material_shaders.is_none_or(OnOff::on),
         lists: if a.lists.is_empty() {
             d.lists.clone()
         } else {

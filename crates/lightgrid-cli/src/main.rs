@@ -84,6 +84,7 @@ fn main() {
                     spot_fraction: 0.0,
                     headlights: false,
                     transparency: args::OnOff::On,
+                    material_shaders: args::OnOff::On,
                     renderer: RendererArgs {
                         tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                         slices: None,

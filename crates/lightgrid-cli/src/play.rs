@@ -60,6 +60,9 @@ pub(crate) struct PlayArgs {
     /// The scene's transparent objects (robots and random scenes).
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub(crate) transparency: OnOff,
+    /// The materials' own shaders (car paint, rim); off renders every material standard.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub(crate) material_shaders: OnOff,
 }
 
 /// The `--json` file.
@@ -110,6 +113,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
             spot_fraction: a.spot_fraction as f32,
             headlights: a.headlights,
             transparency: a.transparency.on(),
+            material_shaders: a.material_shaders.on(),
         },
     )?;
     let range = match &a.frames {

@@ -43,6 +43,9 @@ pub struct SceneParams {
     pub headlights: bool,
     /// The scene's transparent objects (`--transparency on|off`), where it has any.
     pub transparency: bool,
+    /// The materials' own shaders (`--material-shaders on|off`); off makes every material
+    /// standard Blinn-Phong (tiled-forward-shading §4.7 measures the difference).
+    pub material_shaders: bool,
 }
 
 impl Default for SceneParams {
@@ -53,6 +56,7 @@ impl Default for SceneParams {
             spot_fraction: 0.0,
             headlights: false,
             transparency: true,
+            material_shaders: true,
         }
     }
 }
@@ -237,6 +241,11 @@ pub fn build(name: &str, params: &SceneParams) -> Result<Scene> {
         glass(&mut scene, params.seed);
     }
     make_spots(&mut scene, params.seed, params.spot_fraction);
+    if !params.material_shaders {
+        for m in &mut scene.materials {
+            m.shader = MaterialShader::Standard;
+        }
+    }
     scene.validate()?;
     Ok(scene)
 }
