@@ -507,11 +507,27 @@ fn summary(results: &BenchResults) -> String {
                 let pixels = f64::from(r.width) * f64::from(r.height);
                 let _ = writeln!(
                     s,
-                    "Transparent fragments per frame (avg): {:.0} ({:.3} per pixel), lit {:.0} times in the ideal (included above).",
+                    "Transparent fragments per frame (avg): {:.0} ({:.3} per pixel), lit {:.0} times in the ideal (included above). The transparent pass's lighting computations per frame (avg, × that ideal):\n",
                     fragments / n,
                     fragments / n / pixels,
                     ideal / n
                 );
+                for r in results.runs.iter().filter(|r| &r.scene == scene) {
+                    let counts: Option<Vec<u64>> = r
+                        .frames
+                        .iter()
+                        .map(|f| f.transparent_lighting_computations)
+                        .collect();
+                    if let Some(c) = counts.filter(|c| !c.is_empty()) {
+                        let avg = c.iter().sum::<u64>() as f64 / c.len() as f64;
+                        let _ = writeln!(
+                            s,
+                            "- {}: {avg:.0} ({:.2}×)",
+                            run_name(r),
+                            avg / (ideal / n).max(1.0)
+                        );
+                    }
+                }
             }
         }
         spot_ray_section(&mut s, results, scene);

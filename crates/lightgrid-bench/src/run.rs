@@ -232,6 +232,9 @@ pub struct FrameRecord {
     pub transparent_fragments: u64,
     #[serde(default)]
     pub ideal_transparent_computations: u64,
+    /// The transparent pass's lighting computations.
+    #[serde(default)]
+    pub transparent_lighting_computations: Option<u64>,
     pub lights_per_tile_avg: Option<f64>,
     pub lights_per_tile_max: Option<u32>,
     pub grid_bytes: Option<u64>,
@@ -742,6 +745,7 @@ impl FrameRecord {
             ideal_lighting_computations: s.ideal_lighting_computations,
             transparent_fragments: s.transparent_fragments,
             ideal_transparent_computations: s.ideal_transparent_computations,
+            transparent_lighting_computations: s.transparent_lighting_computations,
             lights_per_tile_avg: s.lights_per_tile_avg,
             lights_per_tile_max: s.lights_per_tile_max,
             grid_bytes: s.memory.grid_bytes,

@@ -40,6 +40,8 @@ pub struct FrameOutput {
 pub struct AnalysisReadbacks {
     image: Readback,
     counts: Readback,
+    /// The counts before the transparent pass (frames with transparent objects).
+    opaque_counts: Readback,
     depth: Readback,
 }
 
@@ -48,8 +50,16 @@ impl AnalysisReadbacks {
         AnalysisReadbacks {
             image: Readback::new(device, "image readback", width, height),
             counts: Readback::new(device, "counts readback", width, height),
+            opaque_counts: Readback::new(device, "opaque counts readback", width, height),
             depth: Readback::new(device, "depth readback", width, height),
         }
+    }
+
+    /// Record the copy of the counts the opaque passes made (before the transparent pass),
+    /// so the transparent pass's share of the lighting computations is known.
+    pub fn encode_opaque_counts(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
+        self.opaque_counts
+            .encode(encoder, &targets.counts_texture, wgpu::TextureAspect::All);
     }
 
     /// Record the copies (after the tonemap).
@@ -129,11 +139,19 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let image =
         RgbaImage::from_raw(width, height, a.readbacks.image.read(device)?).expect("size matches");
     let depth: Vec<f32> = a.readbacks.depth.read_f32(device)?;
+    let sum = |counts: Vec<f32>| counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64;
     let lighting_computations = if ctx.count_blend {
-        let counts: Vec<f32> = a.readbacks.counts.read_f32(device)?;
-        Some(counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64)
+        Some(sum(a.readbacks.counts.read_f32(device)?))
     } else {
         None
+    };
+    // The transparent pass's share: the counts after it minus those before it.
+    let transparent_lighting_computations = match lighting_computations {
+        Some(all) if !a.transparent.is_empty() => {
+            Some(all.saturating_sub(sum(a.readbacks.opaque_counts.read_f32(device)?)))
+        }
+        Some(_) => Some(0),
+        None => None,
     };
 
     // The ideal: for each visible sample and each transparent fragment in front of it, the
@@ -205,6 +223,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             lighting_computations,
             ideal_lighting_computations: ideal,
             transparent_fragments: fragments.len() as u64,
+            transparent_lighting_computations,
             ideal_transparent_computations: ideal_transparent,
             efficiency: lighting_computations
                 .filter(|&n| n > 0)

@@ -476,6 +476,9 @@ impl<'c> Renderer<'c> {
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
         self.counters.clear(enc.parts().0);
         technique.encode(&inputs, &mut enc)?;
+        if analysis && inputs.has_transparency() {
+            self.readbacks.encode_opaque_counts(enc.parts().0, &self.targets);
+        }
         self.transparent
             .as_mut()
             .expect("created with the technique")

@@ -79,6 +79,9 @@ pub struct FrameStats {
     /// The part of the ideal count that is the transparent fragments'.
     #[serde(default)]
     pub ideal_transparent_computations: u64,
+    /// The transparent pass's lighting computations (the count target before and after it).
+    #[serde(default)]
+    pub transparent_lighting_computations: Option<u64>,
     /// ideal / actual (1.0 is perfect culling).
     pub efficiency: Option<f64>,
     /// Lights per cell (tile, or cluster) of the grid this pipeline shaded with (None: it
