@@ -125,6 +125,30 @@ pub(crate) struct BenchDefaults {
     pub(crate) lists: Vec<lightgrid::culling::GridLists>,
 }
 
+/// A study of one dimension over robots-many's animation (frames every 20, the papers' size
+/// on a hardware GPU): the pipelines `studied` picks, with `forward` and `deferred` beside
+/// them.
+fn study(
+    hardware: bool,
+    studied: fn(&lightgrid::pipelines::PipelineInfo) -> bool,
+) -> BenchDefaults {
+    BenchDefaults {
+        scenes: vec!["robots-many"],
+        frames: "0..259:20",
+        size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+        gbuffers: vec![GBufferFormat::F16],
+        repeat: if hardware { 3 } else { 1 },
+        pipelines: PIPELINES
+            .iter()
+            .filter(|p| studied(p) || p.id == "forward" || p.id == "deferred")
+            .map(|p| p.id.to_string())
+            .collect(),
+        spot_fraction: 0.0,
+        spot_culls: vec![Default::default()],
+        lists: default_lists(),
+    }
+}
+
 fn default_lists() -> Vec<lightgrid::culling::GridLists> {
     vec![lightgrid::pipelines::RenderSettings::default().lists]
 }
@@ -161,40 +185,19 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             lists: default_lists(),
         },
         Some(Preset::Spots) => BenchDefaults {
-            scenes: vec!["robots-many"],
-            frames: "0..259:20",
-            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
-            gbuffers: vec![GBufferFormat::F16],
-            repeat: if hardware { 3 } else { 1 },
-            pipelines: PIPELINES
-                .iter()
-                .filter(|p| p.uses_grid || p.id == "forward" || p.id == "deferred")
-                .map(|p| p.id.to_string())
-                .collect(),
             spot_fraction: 1.0,
             spot_culls: vec![
                 lightgrid::pipelines::SpotCull::Sphere,
                 lightgrid::pipelines::SpotCull::Cone,
             ],
-            lists: default_lists(),
+            ..study(hardware, |p| p.uses_grid)
         },
         Some(Preset::Transparency) => BenchDefaults {
-            scenes: vec!["robots-many"],
-            frames: "0..259:20",
-            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
-            gbuffers: vec![GBufferFormat::F16],
-            repeat: if hardware { 3 } else { 1 },
-            pipelines: PIPELINES
-                .iter()
-                .filter(|p| p.assign || p.id == "forward" || p.id == "deferred")
-                .map(|p| p.id.to_string())
-                .collect(),
-            spot_fraction: 0.0,
-            spot_culls: vec![Default::default()],
             lists: vec![
                 lightgrid::culling::GridLists::Separate,
                 lightgrid::culling::GridLists::Shared,
             ],
+            ..study(hardware, |p| p.assign)
         },
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],

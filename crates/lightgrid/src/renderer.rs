@@ -477,7 +477,8 @@ impl<'c> Renderer<'c> {
         self.counters.clear(enc.parts().0);
         technique.encode(&inputs, &mut enc)?;
         if analysis && inputs.has_transparency() {
-            self.readbacks.encode_opaque_counts(enc.parts().0, &self.targets);
+            self.readbacks
+                .encode_opaque_counts(enc.parts().0, &self.targets);
         }
         self.transparent
             .as_mut()

@@ -65,6 +65,31 @@ pub fn cleared_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAt
     }
 }
 
+/// A colour attachment that keeps what the target holds (a pass drawing over an image).
+pub fn loaded(view: &wgpu::TextureView) -> wgpu::RenderPassColorAttachment<'_> {
+    wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        },
+    }
+}
+
+/// The depth target as an earlier pass left it (tested against, not cleared).
+pub fn loaded_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
 /// The frame's render targets.
 pub struct Targets {
     pub width: u32,

@@ -172,17 +172,10 @@ pub(crate) fn begin_lighting_pass<'e>(
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &lighting_attachments(f),
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &f.targets.depth,
-            depth_ops: Some(wgpu::Operations {
-                load: if depth_cleared {
-                    wgpu::LoadOp::Clear(1.0)
-                } else {
-                    wgpu::LoadOp::Load
-                },
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
+        depth_stencil_attachment: Some(if depth_cleared {
+            crate::passes::cleared_depth(&f.targets.depth)
+        } else {
+            crate::passes::loaded_depth(&f.targets.depth)
         }),
         timestamp_writes: timer.render_pass(label),
         occlusion_query_set: None,

@@ -8,8 +8,8 @@ mod readback;
 mod tonemap;
 
 pub use crate::frame::targets::{
-    cleared, cleared_depth, render_texture, Targets, COUNT_FORMAT, DEPTH_FORMAT, HDR_FORMAT,
-    LDR_FORMAT,
+    cleared, cleared_depth, loaded, loaded_depth, render_texture, Targets, COUNT_FORMAT,
+    DEPTH_FORMAT, HDR_FORMAT, LDR_FORMAT,
 };
 pub use gbuffer::{GBuffer, GBufferFormat, GBUFFER_READ_WGSL};
 pub use light_volumes::{

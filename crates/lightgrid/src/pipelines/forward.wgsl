@@ -7,13 +7,7 @@
 @fragment @early_depth_test(force)
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
-    let view_dir = view_dir_to(s.position);
-    var color = surface_base(s);
-    var i = 0u;
-    for (; i < frame.light_count; i = i + 1u) {
-        color += shade_light(s, view_dir, lights[i]);
-    }
-    check_loop(i, frame.light_count);
+    let color = surface_base(s) + shade_all_lights(s, view_dir_to(s.position));
     return lit(color, frame.light_count);
 }
 

@@ -243,14 +243,7 @@ impl Technique for LightPrepass {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light pre-pass shading"),
             color_attachments: &[Some(color(&f.targets.hdr, wgpu::Color::BLACK))],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &f.targets.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
             timestamp_writes: timer.render_pass("light pre-pass shading"),
             occlusion_query_set: None,
             multiview_mask: None,

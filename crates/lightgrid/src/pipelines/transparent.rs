@@ -132,29 +132,14 @@ impl TransparentPass {
         };
         let (encoder, timer) = enc.parts();
         let label = "transparent";
-        let load = |view| wgpu::RenderPassColorAttachment {
-            view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Load,
-                store: wgpu::StoreOp::Store,
-            },
-        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[
-                Some(load(&f.targets.hdr)),
-                f.count_blend.then(|| load(&f.targets.counts)),
+                Some(crate::passes::loaded(&f.targets.hdr)),
+                f.count_blend
+                    .then(|| crate::passes::loaded(&f.targets.counts)),
             ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &f.targets.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
             timestamp_writes: timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,

@@ -584,7 +584,7 @@ fn add_material(scene: &mut Scene, m: Material) -> usize {
 fn street_glass(scene: &mut Scene, seed: u64) {
     let mut rng = Rng::new(seed ^ 0x61a5_55e5_0000_0001);
     let pane = add_material(scene, Material::glass(Vec3::new(0.55, 0.78, 0.85), 0.35));
-    let bubble = add_material(scene, Material::glass(Vec3::new(0.85, 0.7, 0.95), 0.25));
+    let bubble = add_material(scene, Material::glass(Vec3::new(0.85, 0.7, 0.95), 0.3));
     let m = MAIN_STREET_WIDTH * 0.5;
     let clear_of_crossings = |z: f32| {
         CROSS_STREETS_Z
@@ -621,8 +621,9 @@ fn street_glass(scene: &mut Scene, seed: u64) {
     };
     let mut z = -STREET_HALF_LENGTH + 8.0;
     while z < STREET_HALF_LENGTH - 8.0 {
-        let centre = Vec3::new(rng.range(-m + 3.0, m - 3.0), rng.range(4.0, 12.0), z);
-        let r = rng.range(1.2, 3.0);
+        // Among the lights (1 to 6 units up), so they are lit from around them.
+        let r = rng.range(1.0, 2.4);
+        let centre = Vec3::new(rng.range(-m + 3.0, m - 3.0), r + rng.range(0.3, 3.5), z);
         sphere(scene, centre, r);
         z += rng.range(9.0, 16.0);
     }

@@ -97,6 +97,18 @@ fn apply_material(s: Surface) -> Surface {
     return out;
 }
 
+// Every light of the frame on the surface: brute force (`forward`, and the transparent pass
+// of `forward`), with the loop checked.
+fn shade_all_lights(s: Surface, view_dir: vec3<f32>) -> vec3<f32> {
+    var acc = vec3<f32>(0.0);
+    var i = 0u;
+    for (; i < frame.light_count; i = i + 1u) {
+        acc += shade_light(s, view_dir, lights[i]);
+    }
+    check_loop(i, frame.light_count);
+    return acc;
+}
+
 // The part of a sample's colour that does not depend on any light.
 fn surface_base(s: Surface) -> vec3<f32> {
     return s.emissive + s.ambient * SCENE_AMBIENT;
