@@ -118,7 +118,7 @@ pub const SCENES: &[SceneInfo] = &[
     SceneInfo {
         name: "robots-many",
         description:
-            "city street, 11 walking robots, 924 static lights (range 12.5) along their paths",
+            "city street, 11 car-painted walking robots, 924 static lights (range 12.5) along their paths; glass panes and bubbles",
         variable_lights: false,
         robots: true,
         build: robots_many,
@@ -126,7 +126,7 @@ pub const SCENES: &[SceneInfo] = &[
     },
     SceneInfo {
         name: "robots-few",
-        description: "the same street with one light (range 40) carried by each of the 11 robots",
+        description: "the same street (and glass) with one light (range 40) carried by each of the 11 robots",
         variable_lights: false,
         robots: true,
         build: robots_few,
@@ -135,7 +135,7 @@ pub const SCENES: &[SceneInfo] = &[
     SceneInfo {
         name: "scattered",
         description:
-            "3072 lights scattered through a volume of pillars and blocks (Forward+ demo), 1280x720",
+            "3072 lights scattered through a volume of rim-lit pillars and blocks (Forward+ demo), 1280x720",
         variable_lights: false,
         robots: false,
         build: scattered,
@@ -143,7 +143,7 @@ pub const SCENES: &[SceneInfo] = &[
     },
     SceneInfo {
         name: "random-top",
-        description: "1024 randomly placed lights over a block field, seen top-down",
+        description: "1024 randomly placed lights over a block field with translucent blocks, seen top-down",
         variable_lights: false,
         robots: false,
         build: random_top,
