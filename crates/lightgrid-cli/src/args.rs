@@ -264,17 +264,12 @@ impl RendererArgs {
     }
 }
 
+/// The options that build a catalog scene (`render`, `compare`, `play`).
 #[derive(Args, Clone)]
-pub(crate) struct SceneArgs {
+pub(crate) struct SceneOptions {
     /// Scene from the catalog (see `lightgrid list`).
     #[arg(long, default_value = "robots-many")]
     pub(crate) scene: String,
-    /// Animation frame to render.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
-    pub(crate) frame: u32,
-    /// Frame size WIDTHxHEIGHT (default: the scene's own size).
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_size)]
-    pub(crate) size: Option<Size>,
     /// Light count, for scenes that take one (stress: 1 to 1000000).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) lights: Option<u32>,
@@ -295,6 +290,33 @@ pub(crate) struct SceneArgs {
     /// The materials' own shaders (car paint, rim); off renders every material standard.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub(crate) material_shaders: OnOff,
+}
+
+impl SceneOptions {
+    /// The catalog scene these options name, built (and its parameters checked).
+    pub(crate) fn build(&self) -> Result<lightgrid::scene::Scene> {
+        let params = SceneParams {
+            seed: self.seed,
+            lights: self.lights,
+            spot_fraction: self.spot_fraction as f32,
+            headlights: self.headlights,
+            transparency: self.transparency.on(),
+            material_shaders: self.material_shaders.on(),
+        };
+        Ok(catalog::build(&self.scene, &params)?)
+    }
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct SceneArgs {
+    #[command(flatten)]
+    pub(crate) options: SceneOptions,
+    /// Animation frame to render.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
+    pub(crate) frame: u32,
+    /// Frame size WIDTHxHEIGHT (default: the scene's own size).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_size)]
+    pub(crate) size: Option<Size>,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
     /// Frames rendered and discarded before the measured one (drivers such as lavapipe compile
@@ -309,18 +331,6 @@ pub(crate) fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
         "32" => Ok(GBufferFormat::F32),
         _ => Err(format!("'{s}': the G-buffer is 16 or 32 bits per channel")),
     }
-}
-
-pub(crate) fn build_scene(a: &SceneArgs) -> Result<lightgrid::scene::Scene> {
-    let params = SceneParams {
-        seed: a.seed,
-        lights: a.lights,
-        spot_fraction: a.spot_fraction as f32,
-        headlights: a.headlights,
-        transparency: a.transparency.on(),
-        material_shaders: a.material_shaders.on(),
-    };
-    Ok(catalog::build(&a.scene, &params)?)
 }
 
 pub(crate) fn timing_label(t: lightgrid::TimingSource) -> &'static str {

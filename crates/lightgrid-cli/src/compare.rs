@@ -1,7 +1,7 @@
 //! `lightgrid compare` (and the default job): every pipeline on one frame, each image
 //! compared with the `forward` reference.
 
-use crate::args::{build_scene, run_outcome, stop_on_ctrl_c, SceneArgs, Size};
+use crate::args::{run_outcome, stop_on_ctrl_c, SceneArgs, Size};
 use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
@@ -77,7 +77,7 @@ fn diff_cell(
 pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let settings = a.scene.renderer.settings()?;
     check_out_dir(&a.out_dir)?;
-    let scene = build_scene(&a.scene)?;
+    let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);
     let mut renderer = Renderer::new(&ctx, w, h, settings)?;

@@ -76,15 +76,17 @@ fn main() {
             cli.adapter.as_deref(),
             &compare::CompareArgs {
                 scene: SceneArgs {
-                    scene: "robots-many".into(),
+                    options: args::SceneOptions {
+                        scene: "robots-many".into(),
+                        lights: None,
+                        seed: 1,
+                        spot_fraction: 0.0,
+                        headlights: false,
+                        transparency: args::OnOff::On,
+                        material_shaders: args::OnOff::On,
+                    },
                     frame: compare::DEFAULT_JOB_FRAME,
                     size: Some(Size(640, 360)),
-                    lights: None,
-                    seed: 1,
-                    spot_fraction: 0.0,
-                    headlights: false,
-                    transparency: args::OnOff::On,
-                    material_shaders: args::OnOff::On,
                     renderer: RendererArgs {
                         tile: lightgrid::consts::DEFAULT_TILE_SIZE,
                         slices: None,

@@ -3,8 +3,8 @@
 //! the frame-time distribution (`lightgrid::realtime`).
 
 use crate::args::{
-    check_applies, parse_fraction, parse_size, progress_bar, stop_on_ctrl_c, OnOff, RendererArgs,
-    Size, MAX_COUNT,
+    check_applies, parse_size, progress_bar, stop_on_ctrl_c, RendererArgs, SceneOptions, Size,
+    MAX_COUNT,
 };
 use crate::files::{Files, Kind};
 use anyhow::{bail, Result};
@@ -13,7 +13,6 @@ use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::write_atomic;
 use lightgrid::pipelines::{self, REFERENCE};
 use lightgrid::realtime::{play as play_frames, Distribution, PlayPlan, PlayRun};
-use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::Renderer;
 use lightgrid_bench::{FrameRange, Progress};
 use serde::Serialize;
@@ -21,9 +20,8 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 pub(crate) struct PlayArgs {
-    /// Scene from the catalog (see `lightgrid list`).
-    #[arg(long, default_value = "robots-many")]
-    pub(crate) scene: String,
+    #[command(flatten)]
+    pub(crate) scene: SceneOptions,
     /// Pipeline id (see `lightgrid list`).
     #[arg(long, default_value = REFERENCE)]
     pub(crate) pipeline: String,
@@ -45,24 +43,6 @@ pub(crate) struct PlayArgs {
     pub(crate) json: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
-    /// Light count, for scenes that take one (stress: 1 to 1000000).
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) lights: Option<u32>,
-    /// Seed of the scene's random placement.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
-    pub(crate) seed: u64,
-    /// Fraction of the scene's lights (0 to 1) turned into spot lights.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0, value_parser = parse_fraction)]
-    pub(crate) spot_fraction: f64,
-    /// Give every robot two headlights (spot lights that turn with it); robots scenes only.
-    #[arg(long)]
-    pub(crate) headlights: bool,
-    /// The scene's transparent objects (robots and random scenes).
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
-    pub(crate) transparency: OnOff,
-    /// The materials' own shaders (car paint, rim); off renders every material standard.
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
-    pub(crate) material_shaders: OnOff,
 }
 
 /// The `--json` file.
@@ -105,17 +85,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     check_applies(a.renderer.given(), &[info])?;
     let settings = a.renderer.settings()?;
     Files::default().output("--json", a.json.as_deref(), Kind::Data)?;
-    let scene = catalog::build(
-        &a.scene,
-        &SceneParams {
-            seed: a.seed,
-            lights: a.lights,
-            spot_fraction: a.spot_fraction as f32,
-            headlights: a.headlights,
-            transparency: a.transparency.on(),
-            material_shaders: a.material_shaders.on(),
-        },
-    )?;
+    let scene = a.scene.build()?;
     let range = match &a.frames {
         Some(s) => FrameRange::parse(s)?,
         None => FrameRange {

@@ -1,7 +1,7 @@
 //! `lightgrid render`: one frame of a scene with one pipeline (an analysis run: image,
 //! statistics, heatmap).
 
-use crate::args::{build_scene, check_applies, timing_label, SceneArgs, Size};
+use crate::args::{check_applies, timing_label, SceneArgs, Size};
 use crate::files::{Files, Kind};
 use anyhow::Result;
 use clap::Args;
@@ -38,7 +38,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     files.output("--out", a.out.as_deref(), Kind::Png)?;
     files.output("--stats", a.stats.as_deref(), Kind::Data)?;
     files.output("--heatmap", a.heatmap.as_deref(), Kind::Png)?;
-    let scene = build_scene(&a.scene)?;
+    let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);
     let mut renderer = Renderer::new(&ctx, w, h, settings)?;

@@ -79,18 +79,17 @@ pub fn heatmap(frame: &RgbaImage, grid: &LightGrid, view_distance: Option<&[f32]
         }
         _ => tile_max[dims.tile_of(x, y)],
     };
-    let max = frame
+    let counts: Vec<u32> = frame
         .enumerate_pixels()
         .map(|(x, y, _)| count_at(x, y))
-        .max()
-        .unwrap_or(0)
-        .max(1);
+        .collect();
+    let max = counts.iter().copied().max().unwrap_or(0).max(1);
     // The legend needs room for its bar and two numbers: frames narrower than that get a
     // black margin on the right instead of a legend drawn off the image.
     let out_w = w.max(LEGEND_MIN_WIDTH * scale);
     let mut out = RgbaImage::from_pixel(out_w, h + legend_h, Rgba([0, 0, 0, 255]));
     for (x, y, p) in frame.enumerate_pixels() {
-        let count = count_at(x, y);
+        let count = counts[(y * w + x) as usize];
         let c = ramp(count as f32 / max as f32);
         let luma = (0.2 * p[0] as f32 + 0.6 * p[1] as f32 + 0.2 * p[2] as f32) / 255.0;
         let px = |i: usize| ((0.55 * c[i] + 0.45 * luma) * 255.0) as u8;

@@ -346,6 +346,8 @@ impl<'c> Renderer<'c> {
         let (device, queue) = (&ctx.device, &ctx.queue);
         let mut upload_bytes = 0u64;
         let fingerprint = scene.static_fingerprint();
+        // The per-frame geometry, when the static upload below has already baked it.
+        let mut baked = None;
         if self.scene.as_ref().map(|s| s.fingerprint) != Some(fingerprint) {
             let geometry = scene.static_geometry();
             let materials = scene.materials_gpu();
@@ -375,10 +377,11 @@ impl<'c> Renderer<'c> {
                 static_indices: geometry.indices.len() as u32,
                 static_draws: geometry.draws,
             });
+            baked = Some(moving);
         }
         let upload = self.scene.as_ref().expect("uploaded above");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
-        let moving = scene.frame_geometry(state, static_vertices);
+        let moving = baked.unwrap_or_else(|| scene.frame_geometry(state, static_vertices));
         let vb: &[u8] = bytemuck::cast_slice(&moving.vertices);
         let ib: &[u8] = bytemuck::cast_slice(&moving.indices);
         let (v_off, i_off) = (

@@ -2,10 +2,23 @@
 //! grids must contain every light the oracle finds) and for the ideal lighting-computation
 //! count: for every visible sample, the lights whose range reaches it.
 
-use super::{GridDims, LightGrid, ViewSetup};
+use super::{GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::scene::{Fragment, Light};
 use glam::Vec3;
 use rayon::prelude::*;
+
+/// The lights (indices, in order) reaching at least one of `samples` (view space).
+fn lights_reaching_any(view_lights: &[ViewLight], samples: &[Vec3]) -> Vec<u32> {
+    if samples.is_empty() {
+        return Vec::new();
+    }
+    view_lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| samples.iter().any(|&p| l.reaches(p)))
+        .map(|(i, _)| i as u32)
+        .collect()
+}
 
 /// For every cell (tile, or tile × slice), the lights that reach at least one of the cell's
 /// samples (inside the range and, for a spot, the outer cone). `view_distance[y * width + x]` is the sample's view distance; non-finite
@@ -32,14 +45,7 @@ pub fn oracle_tile_lights(
             }
             samples
                 .iter()
-                .map(|s| {
-                    view_lights
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, l)| s.iter().any(|&p| l.reaches(p)))
-                        .map(|(i, _)| i as u32)
-                        .collect()
-                })
+                .map(|s| lights_reaching_any(&view_lights, s))
                 .collect()
         })
         .collect();
@@ -102,17 +108,7 @@ pub fn oracle_fragment_lights(
     }
     per_cell
         .par_iter()
-        .map(|samples| {
-            if samples.is_empty() {
-                return Vec::new();
-            }
-            view_lights
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| samples.iter().any(|&p| l.reaches(p)))
-                .map(|(i, _)| i as u32)
-                .collect()
-        })
+        .map(|samples| lights_reaching_any(&view_lights, samples))
         .collect()
 }
 

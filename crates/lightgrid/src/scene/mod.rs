@@ -461,6 +461,11 @@ impl Scene {
         }
     }
 
+    /// Is the object opaque and fixed: part of the geometry uploaded once?
+    fn is_static_opaque(&self, o: &Object) -> bool {
+        o.is_static() && !self.is_transparent(o)
+    }
+
     /// Is the object drawn blended, after the opaque geometry?
     pub fn is_transparent(&self, o: &Object) -> bool {
         self.materials[o.material].transparent
@@ -492,7 +497,7 @@ impl Scene {
             .objects
             .iter()
             .enumerate()
-            .filter(|(_, o)| o.is_static() && !self.is_transparent(o))
+            .filter(|(_, o)| self.is_static_opaque(o))
             .map(|(i, o)| (i, o.local))
             .collect();
         items.sort_by_key(|&(i, _)| self.shader_of(i));
@@ -582,11 +587,7 @@ impl Scene {
             bytemuck::cast_slice::<f32, u32>(v).hash(h)
         };
         self.meshes.len().hash(&mut h);
-        for o in self
-            .objects
-            .iter()
-            .filter(|o| o.is_static() && !self.is_transparent(o))
-        {
+        for o in self.objects.iter().filter(|o| self.is_static_opaque(o)) {
             (o.mesh, o.material).hash(&mut h);
             words(&mut h, &o.local.to_cols_array());
             let mesh = &self.meshes[o.mesh];
