@@ -115,6 +115,18 @@ pub struct BenchConfig {
     /// them is measured once per entry.
     #[serde(default = "default_material_draws")]
     pub material_draws: Vec<MaterialDraws>,
+    /// MSAA sample counts (`--msaa`): every pipeline that renders with MSAA is measured once
+    /// per entry (the others only at 1).
+    #[serde(default = "default_msaa")]
+    pub msaa: Vec<u32>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+fn default_msaa() -> Vec<u32> {
+    vec![1]
 }
 
 fn default_material_draws() -> Vec<MaterialDraws> {
@@ -141,11 +153,15 @@ impl BenchConfig {
             || self.spot_culls.is_empty()
             || self.lists.is_empty()
             || self.material_draws.is_empty()
+            || self.msaa.is_empty()
         {
             return Err(invalid(
                 "bench",
-                "needs at least one scene, pipeline, G-buffer setting, spot culling and list setting",
+                "needs at least one scene, pipeline, G-buffer setting, spot culling, list setting and sample count",
             ));
+        }
+        for &n in &self.msaa {
+            lightgrid::frame::validate_msaa(n)?;
         }
         for p in &self.pipelines {
             pipelines::find(p)?;
@@ -354,6 +370,9 @@ pub struct RunRecord {
     /// How material shaders were drawn, when the run measured more than one way.
     #[serde(default)]
     pub material_draws: Option<MaterialDraws>,
+    /// MSAA samples per pixel.
+    #[serde(default = "one")]
+    pub msaa: u32,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -446,7 +465,50 @@ struct Series {
     lists: GridLists,
     /// How material shaders are drawn; recorded when more than one is measured.
     material_draws: MaterialDraws,
+    /// MSAA samples per pixel.
+    msaa: u32,
     frames: Vec<u32>,
+}
+
+/// The settings one pipeline is measured under: every combination of the entries that
+/// apply to it (a setting that changes nothing for it is measured once, at its first entry).
+#[derive(Clone, Copy)]
+struct Variant {
+    spot_cull: SpotCull,
+    lists: GridLists,
+    material_draws: MaterialDraws,
+    msaa: u32,
+}
+
+fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
+    fn used<T: Copy>(all: &[T], applies: bool) -> &[T] {
+        if applies {
+            all
+        } else {
+            &all[..1]
+        }
+    }
+    let mut out = Vec::new();
+    for &spot_cull in used(&config.spot_culls, info.uses_grid) {
+        // Only pipelines with an `--assign` grid build transparent lists.
+        for &lists in used(&config.lists, info.assign) {
+            for &material_draws in used(&config.material_draws, info.forward_shading) {
+                for &msaa in &config.msaa {
+                    // A pipeline refusing MSAA is measured without it only.
+                    if msaa > 1 && info.msaa != pipelines::Msaa::Supported {
+                        continue;
+                    }
+                    out.push(Variant {
+                        spot_cull,
+                        lists,
+                        material_draws,
+                        msaa,
+                    });
+                }
+            }
+        }
+    }
+    out
 }
 
 fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
@@ -503,38 +565,18 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                 if !g_used && gi > 0 {
                     continue;
                 }
-                // Pipelines without a grid cull nothing: measured under the first setting.
-                let culls = if info.uses_grid {
-                    &config.spot_culls[..]
-                } else {
-                    &config.spot_culls[..1]
-                };
-                // Only pipelines with an `--assign` grid build transparent lists.
-                let lists = if info.assign {
-                    &config.lists[..]
-                } else {
-                    &config.lists[..1]
-                };
-                let draws = if info.forward_shading {
-                    &config.material_draws[..]
-                } else {
-                    &config.material_draws[..1]
-                };
-                for &spot_cull in culls {
-                    for &lists in lists {
-                        for &material_draws in draws {
-                            plan.push(Series {
-                                scene: si,
-                                gbuffer: *g,
-                                info,
-                                uses_gbuffer: g_used,
-                                spot_cull,
-                                lists,
-                                material_draws,
-                                frames: frames.clone(),
-                            });
-                        }
-                    }
+                for v in variants(config, info) {
+                    plan.push(Series {
+                        scene: si,
+                        gbuffer: *g,
+                        info,
+                        uses_gbuffer: g_used,
+                        spot_cull: v.spot_cull,
+                        lists: v.lists,
+                        material_draws: v.material_draws,
+                        msaa: v.msaa,
+                        frames: frames.clone(),
+                    });
                 }
             }
         }
@@ -590,6 +632,7 @@ impl<'a> Measuring<'a> {
             spot_cull: series.spot_cull,
             lists: series.lists,
             material_draws: series.material_draws,
+            msaa: series.msaa,
         }
     }
 
@@ -637,6 +680,9 @@ impl<'a> Measuring<'a> {
         }
         if self.config.material_draws.len() > 1 && info.forward_shading {
             cull += &format!(" {} draws", series.material_draws.name());
+        }
+        if series.msaa > 1 {
+            cull += &format!(" {}x msaa", series.msaa);
         }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
@@ -765,6 +811,7 @@ impl RunRecord {
             spot_cull: None,
             lists: None,
             material_draws: None,
+            msaa: series.msaa,
             width: size.0,
             height: size.1,
             tile_size: tile,

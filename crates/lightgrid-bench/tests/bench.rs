@@ -38,6 +38,7 @@ fn config() -> BenchConfig {
         lights: None,
         heatmap_frame: None,
         spot_fraction: 0.0,
+        msaa: vec![1],
         headlights: false,
         spot_culls: vec![Default::default()],
         transparency: true,

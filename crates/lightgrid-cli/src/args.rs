@@ -166,6 +166,8 @@ pub(crate) struct Given {
     pub(crate) spot_cull: bool,
     pub(crate) lists: bool,
     pub(crate) material_draws: bool,
+    /// `--msaa` above 1.
+    pub(crate) msaa: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -176,7 +178,7 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 6] = [
+    let rules: [(&str, bool, Applies); 7] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
@@ -184,6 +186,9 @@ pub(crate) fn check_applies(
         ("--lists", given.lists, |p| p.assign),
         ("--material-draws", given.material_draws, |p| {
             p.forward_shading
+        }),
+        ("--msaa", given.msaa, |p| {
+            p.msaa == lightgrid::pipelines::Msaa::Supported
         }),
     ];
     for (flag, given, applies) in rules {
@@ -231,6 +236,11 @@ pub(crate) struct RendererArgs {
     /// one branching übershader [default: per-material].
     #[arg(long, value_enum)]
     pub(crate) material_draws: Option<MaterialDrawsArg>,
+    /// MSAA samples per pixel: 1 (off) or a count the adapter supports for every target
+    /// (lavapipe: 4; real GPUs also 2 and 8). Light-volume pipelines and
+    /// tiled_deferred_single refuse MSAA.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
+    pub(crate) msaa: u32,
 }
 
 impl RendererArgs {
@@ -246,6 +256,7 @@ impl RendererArgs {
                 .lists
                 .map_or(RenderSettings::default().lists, Into::into),
             material_draws: self.material_draws.map(Into::into).unwrap_or_default(),
+            msaa: self.msaa,
         };
         settings.validate()?;
         Ok(settings)
@@ -260,6 +271,7 @@ impl RendererArgs {
             spot_cull: self.spot_cull.is_some(),
             lists: self.lists.is_some(),
             material_draws: self.material_draws.is_some(),
+            msaa: self.msaa > 1,
         }
     }
 }

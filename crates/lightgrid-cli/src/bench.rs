@@ -5,7 +5,7 @@ use crate::args::{
     run_outcome, stop_on_ctrl_c, AssignArg, Given, ListsArg, MaterialDrawsArg, OnOff, Size,
     SpotCullArg, MAX_COUNT,
 };
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
@@ -56,9 +56,11 @@ pub(crate) struct BenchArgs {
     /// Who builds the light grid of grid pipelines [default: auto].
     #[arg(long, value_enum)]
     pub(crate) assign: Option<AssignArg>,
-    /// MSAA sample count. Only 1 is supported until MSAA lands.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
-    pub(crate) msaa: u32,
+    /// MSAA sample counts to measure: 1, 4 or a list (1,4); the adapter's supported counts
+    /// only (lavapipe: 1 and 4). Pipelines that refuse MSAA are measured at 1 only
+    /// [default: 1].
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
+    pub(crate) msaa: Vec<u32>,
     /// G-buffer precisions to measure: 16, 32 or 16,32.
     #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
     pub(crate) gbuffer: Vec<GBufferFormat>,
@@ -123,6 +125,7 @@ pub(crate) struct BenchDefaults {
     pub(crate) spot_fraction: f32,
     pub(crate) spot_culls: Vec<lightgrid::pipelines::SpotCull>,
     pub(crate) lists: Vec<lightgrid::culling::GridLists>,
+    pub(crate) msaa: Vec<u32>,
 }
 
 /// A study of one dimension over robots-many's animation (frames every 20, the papers' size
@@ -146,6 +149,7 @@ fn study(
         spot_fraction: 0.0,
         spot_culls: vec![Default::default()],
         lists: default_lists(),
+        msaa: vec![1],
     }
 }
 
@@ -154,12 +158,6 @@ fn default_lists() -> Vec<lightgrid::culling::GridLists> {
 }
 
 pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
-    if a.msaa != 1 {
-        bail!(
-            "--msaa {}: MSAA is not implemented yet; only --msaa 1 can be measured",
-            a.msaa
-        );
-    }
     let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
     let d = match a.preset {
         None => BenchDefaults {
@@ -172,6 +170,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],
             lists: default_lists(),
+            msaa: vec![1],
         },
         Some(Preset::Quick) => BenchDefaults {
             scenes: vec!["robots-many"],
@@ -183,6 +182,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],
             lists: default_lists(),
+            msaa: vec![1],
         },
         Some(Preset::Spots) => BenchDefaults {
             spot_fraction: 1.0,
@@ -214,6 +214,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],
             lists: default_lists(),
+            msaa: vec![1],
         },
     };
     let (scenes, frames, size, gbuffers, repeat, pipelines) = (
@@ -274,6 +275,11 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         } else {
             a.material_draws.iter().map(|&m| m.into()).collect()
         },
+        msaa: if a.msaa.is_empty() {
+            d.msaa.clone()
+        } else {
+            a.msaa.clone()
+        },
     };
     config.validate()?;
     let chosen: Vec<_> = config
@@ -288,6 +294,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         spot_cull: !a.spot_cull.is_empty(),
         lists: !a.lists.is_empty(),
         material_draws: !a.material_draws.is_empty(),
+        msaa: a.msaa.iter().any(|&n| n > 1),
     };
     check_applies(given, &chosen)?;
     Ok(config)
@@ -297,6 +304,11 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     check_out_dir(&a.out)?;
     let ctx = GpuContext::new(adapter)?;
     let config = bench_config(a, !ctx.is_software())?;
+    for &n in &config.msaa {
+        for &g in &config.gbuffers {
+            ctx.check_sample_count(n, g)?;
+        }
+    }
     let prepared = lightgrid_bench::prepare(&config)?;
     let dir = OutDir::claim(&a.out)?;
     let stop = stop_on_ctrl_c()?;

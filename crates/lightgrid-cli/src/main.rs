@@ -95,6 +95,7 @@ fn main() {
                         spot_cull: None,
                         lists: None,
                         material_draws: None,
+                        msaa: 1,
                     },
                     warmup: 1,
                 },

@@ -29,7 +29,7 @@ pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
         "pipeline", "B/px", "total MiB", "wr B/px", "rd B/px", "wr B/lit", "rd B/lit"
     );
     for p in PIPELINES {
-        let m = (p.memory)(&settings);
+        let m = p.memory_model(&settings);
         let t = m.traffic;
         let targets: Vec<String> = m
             .targets

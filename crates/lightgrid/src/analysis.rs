@@ -5,14 +5,14 @@
 //! (`GridBuilder::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
-    assign_cpu, cell_bounds_cpu, ideal_fragment_computations, ideal_lighting_computations,
+    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_computations, ideal_lighting_computations,
     BuiltGrid, DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
 };
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
 use crate::gpu::GpuContext;
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
-use crate::passes::{Readback, Targets};
+use crate::passes::{BufferReadback, DepthSamples, Readback, Targets};
 use crate::pipelines::PipelineInfo;
 use crate::scene::{rasterize, FrameState, Scene};
 use crate::stats::{FrameStats, TimingSource};
@@ -30,48 +30,117 @@ pub struct FrameOutput {
     /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
     /// their CPU twin); None for pipelines without a grid.
     pub cell_bounds: Option<Vec<[f32; 2]>>,
-    /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry).
+    /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry); with MSAA its sample 0.
     pub depth: Vec<f32>,
+    /// Every sample of the depth buffer, one plane per sample (one plane without MSAA).
+    pub depth_samples: Vec<Vec<f32>>,
+    /// Per pixel, the lighting computations of every pass (None where not countable).
+    pub counts: Option<Vec<u32>>,
     /// The frame's camera and size.
     pub setup: ViewSetup,
+}
+
+/// Where a frame's per-pixel lighting counts are read from: the count target, or with MSAA
+/// the `pixel_counts` buffer (`frame/targets.rs`).
+enum CountsReadback {
+    Target(Readback),
+    Pixels(BufferReadback),
+}
+
+impl CountsReadback {
+    fn new(device: &wgpu::Device, label: &str, (width, height): (u32, u32), samples: u32) -> Self {
+        if samples > 1 {
+            CountsReadback::Pixels(BufferReadback::new(
+                device,
+                label,
+                u64::from(width) * u64::from(height) * 4,
+            ))
+        } else {
+            CountsReadback::Target(Readback::new(device, label, width, height))
+        }
+    }
+
+    fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
+        match self {
+            CountsReadback::Target(r) => {
+                r.encode(encoder, &targets.counts_texture, wgpu::TextureAspect::All)
+            }
+            CountsReadback::Pixels(r) => r.encode(encoder, &targets.pixel_counts),
+        }
+    }
+
+    /// Per pixel, the lighting computations (waits for the GPU).
+    fn read(&self, device: &wgpu::Device) -> Result<Vec<u32>> {
+        Ok(match self {
+            CountsReadback::Target(r) => r.read_f32(device)?.iter().map(|&c| c as u32).collect(),
+            CountsReadback::Pixels(r) => r.read(device)?,
+        })
+    }
+}
+
+/// Where the depth of every sample is read from: the depth target, or with MSAA a copy of
+/// every sample.
+enum DepthReadback {
+    Target(Readback),
+    Samples(DepthSamples),
 }
 
 /// The staging buffers an analysis frame copies its image, counts and depth into.
 pub struct AnalysisReadbacks {
     image: Readback,
-    counts: Readback,
+    counts: CountsReadback,
     /// The counts before the transparent pass (frames with transparent objects).
-    opaque_counts: Readback,
-    depth: Readback,
+    opaque_counts: CountsReadback,
+    depth: DepthReadback,
 }
 
 impl AnalysisReadbacks {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
+        let size = (width, height);
         AnalysisReadbacks {
             image: Readback::new(device, "image readback", width, height),
-            counts: Readback::new(device, "counts readback", width, height),
-            opaque_counts: Readback::new(device, "opaque counts readback", width, height),
-            depth: Readback::new(device, "depth readback", width, height),
+            counts: CountsReadback::new(device, "counts readback", size, samples),
+            opaque_counts: CountsReadback::new(device, "opaque counts readback", size, samples),
+            depth: if samples > 1 {
+                DepthReadback::Samples(DepthSamples::new(device, size, samples))
+            } else {
+                DepthReadback::Target(Readback::new(device, "depth readback", width, height))
+            },
         }
     }
 
     /// Record the copy of the counts the opaque passes made (before the transparent pass),
     /// so the transparent pass's share of the lighting computations is known.
     pub fn encode_opaque_counts(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
-        self.opaque_counts
-            .encode(encoder, &targets.counts_texture, wgpu::TextureAspect::All);
+        self.opaque_counts.encode(encoder, targets);
     }
 
     /// Record the copies (after the tonemap).
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+    ) {
         let all = wgpu::TextureAspect::All;
         self.image.encode(encoder, &targets.ldr_texture, all);
-        self.counts.encode(encoder, &targets.counts_texture, all);
-        self.depth.encode(
-            encoder,
-            &targets.depth_texture,
-            wgpu::TextureAspect::DepthOnly,
-        );
+        self.counts.encode(encoder, targets);
+        match &self.depth {
+            DepthReadback::Target(r) => r.encode(
+                encoder,
+                &targets.depth_texture,
+                wgpu::TextureAspect::DepthOnly,
+            ),
+            DepthReadback::Samples(d) => d.encode(device, encoder, &targets.depth),
+        }
+    }
+
+    /// One plane of depth-buffer values per sample (waits for the GPU).
+    fn read_depth(&self, device: &wgpu::Device) -> Result<Vec<Vec<f32>>> {
+        match &self.depth {
+            DepthReadback::Target(r) => Ok(vec![r.read_f32(device)?]),
+            DepthReadback::Samples(d) => d.read(device),
+        }
     }
 }
 
@@ -138,17 +207,22 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let lights = &a.up_state.lights;
     let image =
         RgbaImage::from_raw(width, height, a.readbacks.image.read(device)?).expect("size matches");
-    let depth: Vec<f32> = a.readbacks.depth.read_f32(device)?;
-    let sum = |counts: Vec<f32>| counts.iter().map(|&c| c as f64).sum::<f64>().round() as u64;
-    let lighting_computations = if ctx.count_blend {
-        Some(sum(a.readbacks.counts.read_f32(device)?))
+    let depth_samples = a.readbacks.read_depth(device)?;
+    let depth = depth_samples[0].clone();
+    let samples = depth_samples.len() as u64;
+    let sum = |counts: &[u32]| counts.iter().map(|&c| u64::from(c)).sum::<u64>();
+    // Counted by the count target where it can blend, always with MSAA (`pixel_counts`).
+    let countable = ctx.count_blend || samples > 1;
+    let counts = if countable {
+        Some(a.readbacks.counts.read(device)?)
     } else {
         None
     };
+    let lighting_computations = counts.as_deref().map(sum);
     // The transparent pass's share: the counts after it minus those before it.
     let transparent_lighting_computations = match lighting_computations {
         Some(all) if !a.transparent.is_empty() => {
-            Some(all.saturating_sub(sum(a.readbacks.opaque_counts.read_f32(device)?)))
+            Some(all.saturating_sub(sum(&a.readbacks.opaque_counts.read(device)?)))
         }
         Some(_) => Some(0),
         None => None,
@@ -157,6 +231,9 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     // The ideal: for each visible sample and each transparent fragment in front of it, the
     // lights reaching it. The depth-bounded CPU grid (with transparent lists when there are
     // transparent fragments) narrows the search: it provably contains every such light.
+    // With MSAA the ideal is still one computation per light per pixel (MSAA shades once per
+    // pixel and surface): the average over the pixel's samples of the lights reaching each
+    // (at the pixel's centre ray, the sample's depth).
     let setup = a.setup;
     let view_distance = setup.view_distances(&depth);
     let fragments = rasterize(&setup, &a.transparent, &view_distance);
@@ -165,11 +242,17 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     } else {
         dims.with_lists(GridLists::Separate)
     };
-    let bounds = cell_bounds_cpu(&setup, &ideal_dims, &depth);
+    let planes: Vec<&[f32]> = depth_samples.iter().map(Vec::as_slice).collect();
+    let bounds = cell_bounds_cpu_samples(&setup, &ideal_dims, &planes);
     let bounded = assign_cpu(&setup, &ideal_dims, lights, DepthRange::Cells(&bounds));
     let ideal_transparent = ideal_fragment_computations(&setup, &bounded, lights, &fragments);
-    let ideal =
-        ideal_lighting_computations(&setup, &bounded, lights, &view_distance) + ideal_transparent;
+    let ideal_opaque: u64 = depth_samples
+        .iter()
+        .map(|plane| {
+            ideal_lighting_computations(&setup, &bounded, lights, &setup.view_distances(plane))
+        })
+        .sum::<u64>();
+    let ideal = (ideal_opaque + samples / 2) / samples + ideal_transparent;
 
     let passes = a.finished.passes;
     let (gpu_ms, timing) = match a.finished.gpu_ms {
@@ -194,7 +277,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         .as_ref()
         .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
     let memory = frame_memory(
-        (a.info.memory)(&settings),
+        a.info.memory_model(&settings),
         (width, height),
         lighting_computations,
         grid_is_pipelines.then_some(&grid),
@@ -220,6 +303,8 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             passes,
             tile_size: settings.tile_size,
             gbuffer_bits: settings.gbuffer.bits(),
+            msaa: settings.msaa,
+            msaa_shading: a.finished.msaa_shading,
             lighting_computations,
             ideal_lighting_computations: ideal,
             transparent_fragments: fragments.len() as u64,
@@ -244,6 +329,8 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         grid_is_pipelines,
         cell_bounds,
         depth,
+        depth_samples,
+        counts,
         setup,
     })
 }

@@ -85,8 +85,70 @@ pub const COUNTER_PAIRS_OUT_OF_ROOM: u32 = 6;
 pub const COUNTER_SPILL_ARGS: u32 = 8;
 /// Three slots: the scatter emit pass's indirect dispatch arguments (x, y, z).
 pub const COUNTER_ITEM_ARGS: u32 = 12;
+/// Pixels the edge-aware MSAA shading kernels shaded per sample (samples differing in depth,
+/// normal or material: `EDGE_*`).
+pub const COUNTER_EDGE_PIXELS: u32 = 16;
+/// Samples the MSAA shading kernels shaded: one per pixel with geometry, plus every other
+/// covered sample of an edge pixel.
+pub const COUNTER_SHADED_SAMPLES: u32 = 17;
+/// Samples with geometry the MSAA shading kernels saw (what per-sample shading would shade).
+pub const COUNTER_GEOMETRY_SAMPLES: u32 = 18;
 /// Number of slots.
-pub const COUNTER_SLOTS: u32 = 16;
+pub const COUNTER_SLOTS: u32 = 20;
+
+/// MSAA sample counts lightgrid knows (`--msaa`); the adapter decides which it offers
+/// (`GpuContext::sample_counts`).
+pub const MSAA_COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
+/// The standard sample positions (Vulkan `standardSampleLocations`, D3D's standard
+/// patterns) within a pixel, for `samples` samples: where a per-sample shading kernel
+/// reconstructs a sample's position from its depth.
+pub fn msaa_sample_positions(samples: u32) -> &'static [[f32; 2]] {
+    match samples {
+        2 => &[[0.75, 0.75], [0.25, 0.25]],
+        4 => &[
+            [0.375, 0.125],
+            [0.875, 0.375],
+            [0.125, 0.625],
+            [0.625, 0.875],
+        ],
+        8 => &[
+            [0.5625, 0.3125],
+            [0.4375, 0.6875],
+            [0.8125, 0.5625],
+            [0.3125, 0.1875],
+            [0.1875, 0.8125],
+            [0.0625, 0.4375],
+            [0.6875, 0.9375],
+            [0.9375, 0.0625],
+        ],
+        16 => &[
+            [0.5625, 0.5625],
+            [0.4375, 0.3125],
+            [0.3125, 0.625],
+            [0.75, 0.4375],
+            [0.1875, 0.375],
+            [0.625, 0.8125],
+            [0.8125, 0.6875],
+            [0.6875, 0.1875],
+            [0.375, 0.875],
+            [0.5, 0.0625],
+            [0.25, 0.125],
+            [0.125, 0.75],
+            [0.0, 0.5],
+            [0.9375, 0.25],
+            [0.875, 0.9375],
+            [0.0625, 0.0],
+        ],
+        _ => &[[0.5, 0.5]],
+    }
+}
+
+/// Edge detection of the MSAA deferred kernels (tiled-deferred-tricks, edge detection): two
+/// samples of a pixel belong to different surfaces when their materials differ, their
+/// normals differ by more than about 8 degrees (cosine below this), or their view distances
+/// differ by more than this fraction.
+pub const EDGE_NORMAL_COS: f32 = 0.99;
+pub const EDGE_DEPTH_RATIO: f32 = 0.01;
 
 /// Light indices one per-cell assignment workgroup (gather, BVH walk) collects in workgroup
 /// memory before flushing them to the global index list. A cell with more lights "spills": a
@@ -187,6 +249,17 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("COUNTER_SPILL_ARGS", WgslConst::U32(COUNTER_SPILL_ARGS)),
     ("COUNTER_ITEM_ARGS", WgslConst::U32(COUNTER_ITEM_ARGS)),
     ("COUNTER_SLOTS", WgslConst::U32(COUNTER_SLOTS)),
+    ("COUNTER_EDGE_PIXELS", WgslConst::U32(COUNTER_EDGE_PIXELS)),
+    (
+        "COUNTER_SHADED_SAMPLES",
+        WgslConst::U32(COUNTER_SHADED_SAMPLES),
+    ),
+    (
+        "COUNTER_GEOMETRY_SAMPLES",
+        WgslConst::U32(COUNTER_GEOMETRY_SAMPLES),
+    ),
+    ("EDGE_NORMAL_COS", WgslConst::F32(EDGE_NORMAL_COS)),
+    ("EDGE_DEPTH_RATIO", WgslConst::F32(EDGE_DEPTH_RATIO)),
     ("GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
     (
         "MATERIAL_SHADER_STANDARD",

@@ -45,6 +45,17 @@ impl MemoryModel {
         }
     }
 
+    /// The model with every target holding `samples` samples per pixel (tiled-forward-shading
+    /// Fig. 4.4: MSAA multiplies the targets and the per-pixel traffic).
+    pub fn multisampled(mut self, samples: u32) -> Self {
+        for t in &mut self.targets {
+            t.bytes_per_pixel *= samples;
+        }
+        self.traffic.write_per_pixel *= samples;
+        self.traffic.read_per_pixel *= samples;
+        self
+    }
+
     pub fn bytes_per_pixel(&self) -> u32 {
         self.targets.iter().map(|t| t.bytes_per_pixel).sum()
     }

@@ -164,10 +164,11 @@ impl<'c> Renderer<'c> {
     ) -> Result<Self> {
         validate_size(ctx, width, height)?;
         settings.validate()?;
+        ctx.check_sample_count(settings.msaa, settings.gbuffer)?;
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {
-            let targets = Targets::new(device, width, height);
+            let targets = Targets::new(device, width, height, settings.msaa);
             let scene_layout = scene_layout(device);
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
@@ -187,12 +188,12 @@ impl<'c> Renderer<'c> {
                 &scene_layout,
                 &uniforms,
                 [&lights, &light_bounds, &materials],
-                counters.buffer(),
+                [counters.buffer(), &targets.pixel_counts],
             );
             Renderer {
                 ctx,
                 targets,
-                tonemap: Tonemap::new(device),
+                tonemap: Tonemap::new(device, settings.msaa),
                 timer: PassTimer::new(ctx, MAX_PASSES),
                 counters,
                 scene_layout,
@@ -208,7 +209,7 @@ impl<'c> Renderer<'c> {
                 transparent: None,
                 settings,
                 dims,
-                readbacks: AnalysisReadbacks::new(device, width, height),
+                readbacks: AnalysisReadbacks::new(device, width, height, settings.msaa),
                 serial: 0,
                 in_flight: VecDeque::new(),
                 finished: Vec::new(),
@@ -219,7 +220,7 @@ impl<'c> Renderer<'c> {
                 stage,
                 message: format!(
                     "out of memory: the shared render targets of {width}x{height} alone need {} MiB",
-                    (Targets::bytes_per_pixel() * u64::from(width) * u64::from(height)) >> 20
+                    (Targets::bytes_per_pixel(settings.msaa) * u64::from(width) * u64::from(height)) >> 20
                 ),
             },
             e => e,
@@ -231,7 +232,7 @@ impl<'c> Renderer<'c> {
         layout: &wgpu::BindGroupLayout,
         uniforms: &wgpu::Buffer,
         [lights, light_bounds, materials]: [&GrowBuffer; 3],
-        counters: &wgpu::Buffer,
+        [counters, pixel_counts]: [&wgpu::Buffer; 2],
     ) -> wgpu::BindGroup {
         crate::gpu::bind_resources(
             device,
@@ -243,6 +244,7 @@ impl<'c> Renderer<'c> {
                 materials.buffer.as_entire_binding(),
                 counters.as_entire_binding(),
                 light_bounds.buffer.as_entire_binding(),
+                pixel_counts.as_entire_binding(),
             ],
         )
     }
@@ -256,6 +258,15 @@ impl<'c> Renderer<'c> {
     }
 
     fn prepare_technique(&mut self, info: &'static pipelines::PipelineInfo) -> Result<()> {
+        if let (true, pipelines::Msaa::Refused(reason)) = (self.settings.msaa > 1, info.msaa) {
+            return Err(Error::invalid(
+                "msaa",
+                format!(
+                    "{} does not render with MSAA ({}x asked): {reason}",
+                    info.id, self.settings.msaa
+                ),
+            ));
+        }
         if !self.techniques.contains_key(info.id) {
             let device = &self.ctx.device;
             let ctx = PipelineContext {
@@ -446,7 +457,7 @@ impl<'c> Renderer<'c> {
             &self.scene_layout,
             &self.uniforms,
             [&self.lights, &self.light_bounds, &self.materials],
-            self.counters.buffer(),
+            [self.counters.buffer(), &self.targets.pixel_counts],
         );
     }
 
@@ -478,6 +489,11 @@ impl<'c> Renderer<'c> {
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
         self.counters.clear(enc.parts().0);
+        if self.targets.samples > 1 {
+            enc.parts()
+                .0
+                .clear_buffer(&self.targets.pixel_counts, 0, None);
+        }
         technique.encode(&inputs, &mut enc)?;
         if analysis && inputs.has_transparency() {
             self.readbacks
@@ -491,7 +507,7 @@ impl<'c> Renderer<'c> {
         self.tonemap
             .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
         if analysis {
-            self.readbacks.encode(encoder, &self.targets);
+            self.readbacks.encode(device, encoder, &self.targets);
         }
         self.serial += 1;
         let tag = FrameTag {
@@ -545,6 +561,11 @@ impl<'c> Renderer<'c> {
             passes: t.passes,
             truncated_loops: r.values.truncated_loops(),
             overflowed: r.values.overflowed(),
+            msaa_shading: (r.values.geometry_samples() > 0).then(|| crate::frame::MsaaShading {
+                edge_pixels: r.values.edge_pixels().into(),
+                shaded_samples: r.values.shaded_samples().into(),
+                geometry_samples: r.values.geometry_samples().into(),
+            }),
         })
     }
 

@@ -64,6 +64,13 @@ pub struct FrameStats {
     pub tile_size: u32,
     /// G-buffer channel bits (16 or 32); meaningful for deferred pipelines.
     pub gbuffer_bits: u32,
+    /// MSAA samples per pixel (`--msaa`).
+    #[serde(default = "one")]
+    pub msaa: u32,
+    /// The edge-aware MSAA deferred kernels: pixels shaded per sample, samples shaded, and
+    /// samples with geometry (what shading every sample would shade). None for other frames.
+    #[serde(default)]
+    pub msaa_shading: Option<crate::frame::MsaaShading>,
     /// Times the light function ran this frame (tiled-shading §8): for forward pipelines the
     /// fragments shaded times the lights each looped over, for deferred ones the samples
     /// times their tile's list length. None where the adapter cannot count (no R32Float
@@ -116,4 +123,8 @@ pub struct FrameStats {
     pub assign_reruns: Option<u32>,
     /// Render targets, grid size and the traffic models (`memory.rs`).
     pub memory: FrameMemory,
+}
+
+fn one() -> u32 {
+    1
 }

@@ -209,7 +209,7 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
             assert_eq!(out.grid.dims.tile_size, settings.tile_size);
             assert_eq!(st.lights_per_tile_max, Some(out.grid.max_lights_per_cell()));
         }
-        let m = (p.memory)(&settings);
+        let m = p.memory_model(&settings);
         assert_eq!(st.memory.bytes_per_pixel, m.bytes_per_pixel());
         assert_eq!(
             st.memory.target_bytes,

@@ -33,6 +33,8 @@ pub struct GridSetup<'a> {
     /// The lists of a frame with transparent geometry (`--lists`); a frame without any
     /// builds opaque lists only.
     pub lists: GridLists,
+    /// Samples per pixel of the depth target the cell bounds read (`--msaa`).
+    pub samples: u32,
 }
 
 /// A built grid and what went into it (analysis).
@@ -85,7 +87,7 @@ impl GridBuilder {
             lists: ctx.lists,
             software_adapter: ctx.software_adapter,
             scene_layout: scene_layout.clone(),
-            bounds: CellBoundsPass::new(device, scene_layout),
+            bounds: CellBoundsPass::new(device, scene_layout, ctx.samples),
             buffers: GridBuffers::new(device),
             strategies: Vec::new(),
             last: None,

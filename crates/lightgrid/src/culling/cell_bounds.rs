@@ -16,13 +16,14 @@ use crate::frame::{FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
-pub(crate) fn shader() -> ComposedShader {
+pub(crate) fn shader(samples: u32) -> ComposedShader {
     compose(
         "cell_bounds",
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
             src::GRID_CELL,
+            &crate::shader::msaa_wgsl(samples),
             include_str!("cell_bounds.wgsl"),
         ],
     )
@@ -34,6 +35,16 @@ pub const EMPTY_CELL: [f32; 2] = [f32::INFINITY, 0.0];
 /// CPU twin of the kernel: the same inputs (depth-buffer values in [0, 1], 1 = no sample,
 /// row-major) and the same output.
 pub fn cell_bounds_cpu(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec<[f32; 2]> {
+    cell_bounds_cpu_samples(setup, dims, &[depth])
+}
+
+/// As [`cell_bounds_cpu`] over every sample of an MSAA depth buffer: `planes[s]` holds
+/// sample `s` of every pixel (row-major).
+pub fn cell_bounds_cpu_samples(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    planes: &[&[f32]],
+) -> Vec<[f32; 2]> {
     let mut bounds = vec![EMPTY_CELL; dims.cell_count()];
     let mut tile_max = vec![0.0f32; dims.tile_count()];
     let mut include = |cell: usize, w: f32| {
@@ -41,8 +52,11 @@ pub fn cell_bounds_cpu(setup: &ViewSetup, dims: &GridDims, depth: &[f32]) -> Vec
         b[0] = b[0].min(w);
         b[1] = b[1].max(w);
     };
-    for y in 0..dims.height {
-        for x in 0..dims.width {
+    for (y, x, depth) in (0..dims.height)
+        .flat_map(|y| (0..dims.width).map(move |x| (y, x)))
+        .flat_map(|(y, x)| planes.iter().map(move |p| (y, x, p)))
+    {
+        {
             let d = depth[(y * dims.width + x) as usize];
             let tile = dims.tile_of(x, y);
             if d >= 1.0 {
@@ -110,7 +124,8 @@ pub struct CellBoundsPass {
 }
 
 impl CellBoundsPass {
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+    /// The kernel over a depth target of `samples` samples per pixel.
+    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout, samples: u32) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cell bounds (group 1)"),
             entries: &[
@@ -120,7 +135,7 @@ impl CellBoundsPass {
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Depth,
                         view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
+                        multisampled: samples > 1,
                     },
                     count: None,
                 },
@@ -130,7 +145,7 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(4, crate::gpu::STORAGE_RW),
             ],
         });
-        let s = shader();
+        let s = shader(samples);
         let layouts = [Some(scene_layout), Some(&layout)];
         let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);

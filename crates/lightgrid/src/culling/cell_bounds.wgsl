@@ -7,7 +7,9 @@
 // args_main turns their number into indirect dispatch arguments, so the per-cell assignment
 // kernels run one workgroup per occupied cell instead of one per cell.
 
-@group(1) @binding(0) var depth_tex: texture_depth_2d;
+// With MSAA every sample of every pixel (tiled-forward-shading §4.6: the bounds cover every
+// sample a fragment may shade).
+@group(1) @binding(0) var depth_tex: DepthTexture;
 @group(1) @binding(1) var<uniform> grid: GridParams;
 @group(1) @binding(2) var<storage, read_write> bounds_out: array<vec2<f32>>;
 @group(1) @binding(3) var<storage, read_write> occupied_cells: array<u32>;
@@ -20,6 +22,21 @@ var<workgroup> slice_lo: array<atomic<u32>, MAX_SLICES>;
 // The tile's opaque maximum, an empty pixel counting as the far plane (transparent lists).
 var<workgroup> tile_hi: atomic<u32>;
 var<workgroup> slice_hi: array<atomic<u32>, MAX_SLICES>;
+
+// A depth-buffer value: the tile maximum, and the slices its view distance lies in.
+fn include_depth(d: f32) {
+    atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), d < 1.0)));
+    if (d < 1.0) {
+        let w = view_distance_from_depth(d);
+        let bits = bitcast<u32>(w);
+        let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+        let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+        include_sample(k0, bits);
+        if (k1 != k0) {
+            include_sample(k1, bits);
+        }
+    }
+}
 
 fn include_sample(k: u32, bits: u32) {
     atomicMin(&slice_lo[k], bits);
@@ -46,17 +63,8 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         for (; x < grid.tile_size; x = x + TILE_THREADS) {
             let p = origin + vec2<u32>(x, y);
             if (p.x < size.x && p.y < size.y) {
-                let d = textureLoad(depth_tex, p, 0);
-                atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), d < 1.0)));
-                if (d < 1.0) {
-                    let w = view_distance_from_depth(d);
-                    let bits = bitcast<u32>(w);
-                    let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
-                    let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
-                    include_sample(k0, bits);
-                    if (k1 != k0) {
-                        include_sample(k1, bits);
-                    }
+                for (var s = 0u; s < SAMPLES; s = s + 1u) {
+                    include_depth(textureLoad(depth_tex, p, s));
                 }
             }
         }

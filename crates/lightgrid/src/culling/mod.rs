@@ -24,7 +24,7 @@ pub use crate::scene::{ViewLight, ViewSetup};
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
 pub use builder::{BuiltGrid, CellSource, GridBuilder, GridSetup};
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
-pub use cell_bounds::{cell_bounds_cpu, CellBoundsPass, EMPTY_CELL};
+pub use cell_bounds::{cell_bounds_cpu, cell_bounds_cpu_samples, CellBoundsPass, EMPTY_CELL};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, GridLists, LightGrid};
@@ -44,7 +44,8 @@ pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
 /// Every assignment shader, for the validation test.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
     vec![
-        cell_bounds::shader(),
+        cell_bounds::shader(1),
+        cell_bounds::shader(4),
         scan::shader(),
         radix_sort::shader(),
         gpu_assign::gather_shader(),

@@ -11,8 +11,8 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists, MaterialDraws,
-    RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
+    validate_msaa, validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists,
+    MaterialDraws, RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::Targets;
 
@@ -149,6 +149,18 @@ pub struct SubmittedFrame {
     pub upload_bytes: u64,
 }
 
+/// What the edge-aware MSAA deferred kernels did in a frame (tiled-deferred-tricks).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct MsaaShading {
+    /// Pixels whose samples differ (shaded per sample).
+    pub edge_pixels: u64,
+    /// Samples shaded: one per pixel with geometry plus the other covered samples of edge
+    /// pixels.
+    pub shaded_samples: u64,
+    /// Samples with geometry: what shading every sample would shade.
+    pub geometry_samples: u64,
+}
+
 /// What the GPU reported about a finished real-time frame (read back without waiting).
 #[derive(Clone, Debug)]
 pub struct FinishedFrame {
@@ -165,4 +177,6 @@ pub struct FinishedFrame {
     /// Some light list did not fit its buffer (sized from earlier frames): the frame is
     /// missing lights; the buffers have grown for the next one.
     pub overflowed: bool,
+    /// The MSAA deferred kernels' edge counts (None where none ran).
+    pub msaa_shading: Option<MsaaShading>,
 }

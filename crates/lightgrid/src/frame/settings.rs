@@ -19,6 +19,9 @@ pub struct RenderSettings {
     pub lists: GridLists,
     /// How forward pipelines draw the material shaders (`--material-draws`).
     pub material_draws: MaterialDraws,
+    /// MSAA samples per pixel of every target (`--msaa`): 1 (none) or a count the adapter
+    /// offers for every format (`GpuContext::sample_counts`).
+    pub msaa: u32,
 }
 
 /// How forward pipelines draw materials with different shaders (tiled-forward-shading §4.7).
@@ -53,6 +56,7 @@ impl Default for RenderSettings {
             spot_cull: SpotCull::default(),
             lists: GridLists::Separate,
             material_draws: MaterialDraws::PerMaterial,
+            msaa: 1,
         }
     }
 }
@@ -68,8 +72,22 @@ impl RenderSettings {
                 "frames with transparent objects need transparent lists: separate or shared",
             ));
         }
+        validate_msaa(self.msaa)?;
         validate_slices(self.slices)
     }
+}
+
+/// Refuse a sample count no adapter offers (the adapter's own list is checked by the renderer).
+pub fn validate_msaa(samples: u32) -> crate::error::Result<()> {
+    use crate::consts::MSAA_COUNTS;
+    if !MSAA_COUNTS.contains(&samples) {
+        let list: Vec<String> = MSAA_COUNTS.iter().map(u32::to_string).collect();
+        return Err(crate::error::Error::invalid(
+            "msaa",
+            format!("{samples}: must be one of {}", list.join(", ")),
+        ));
+    }
+    Ok(())
 }
 
 /// Refuse a tile edge outside `MIN_TILE_SIZE..=MAX_TILE_SIZE`.

@@ -18,7 +18,19 @@ pub fn render_texture(
     device: &wgpu::Device,
     label: &str,
     format: wgpu::TextureFormat,
+    size: (u32, u32),
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    multisampled_texture(device, label, format, size, 1, usage)
+}
+
+/// A 2D texture of the frame's size with `samples` samples per pixel.
+pub fn multisampled_texture(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
     (width, height): (u32, u32),
+    samples: u32,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
@@ -29,7 +41,7 @@ pub fn render_texture(
             depth_or_array_layers: 1,
         },
         mip_level_count: 1,
-        sample_count: 1,
+        sample_count: samples,
         dimension: wgpu::TextureDimension::D2,
         format,
         usage,
@@ -90,10 +102,15 @@ pub fn loaded_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAtt
     }
 }
 
-/// The frame's render targets.
+/// The frame's render targets. With MSAA (`samples` > 1) HDR colour and depth hold every
+/// sample; the tonemap pass resolves them into the single-sample display target, and the
+/// lighting counts are added per pixel into `pixel_counts` (a count target per sample would
+/// count a fragment once per covered sample, or, blended, lose the samples failing the depth
+/// test: a fragment shader runs once per pixel and primitive).
 pub struct Targets {
     pub width: u32,
     pub height: u32,
+    pub samples: u32,
     pub hdr: wgpu::TextureView,
     pub depth_texture: wgpu::Texture,
     pub depth: wgpu::TextureView,
@@ -101,31 +118,43 @@ pub struct Targets {
     pub counts: wgpu::TextureView,
     pub ldr_texture: wgpu::Texture,
     pub ldr: wgpu::TextureView,
+    /// Per pixel, the lighting computations of every pass (`array<atomic<u32>>`, group 0
+    /// binding 5), cleared every frame; used instead of `counts` when `samples` > 1.
+    pub pixel_counts: wgpu::Buffer,
 }
 
 impl Targets {
-    /// Bytes per pixel of the shared targets (HDR colour, depth, lighting counts, LDR); a
-    /// pipeline's own (G-buffers) come on top.
-    pub fn bytes_per_pixel() -> u64 {
-        [HDR_FORMAT, DEPTH_FORMAT, COUNT_FORMAT, LDR_FORMAT]
-            .iter()
-            .map(|f| u64::from(f.block_copy_size(None).unwrap_or(4)))
-            .sum()
+    /// Bytes per pixel of the shared targets (HDR colour and depth per sample, lighting
+    /// counts, LDR); a pipeline's own (G-buffers) come on top.
+    pub fn bytes_per_pixel(samples: u32) -> u64 {
+        let bytes = |f: wgpu::TextureFormat| u64::from(f.block_copy_size(None).unwrap_or(4));
+        u64::from(samples) * (bytes(HDR_FORMAT) + bytes(DEPTH_FORMAT))
+            + bytes(COUNT_FORMAT)
+            + bytes(LDR_FORMAT)
     }
 
-    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
         let make =
             |label, format, usage| render_texture(device, label, format, (width, height), usage);
+        let make_ms = |label, format, usage| {
+            multisampled_texture(device, label, format, (width, height), samples, usage)
+        };
         use wgpu::TextureUsages as U;
-        let hdr = make(
+        // A multisampled texture can be neither a storage texture nor copied.
+        let (hdr_usage, depth_usage) = if samples > 1 {
+            (U::empty(), U::empty())
+        } else {
+            (U::STORAGE_BINDING, U::COPY_SRC)
+        };
+        let hdr = make_ms(
             "hdr",
             HDR_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | hdr_usage,
         );
-        let depth_texture = make(
+        let depth_texture = make_ms(
             "depth",
             DEPTH_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | depth_usage,
         );
         let counts_texture = make(
             "lighting counts",
@@ -133,9 +162,23 @@ impl Targets {
             U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::COPY_SRC,
         );
         let ldr_texture = make("ldr", LDR_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+        let pixel_counts = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pixel lighting counts"),
+            size: if samples > 1 {
+                u64::from(width) * u64::from(height) * 4
+            } else {
+                16
+            },
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         Targets {
             width,
             height,
+            samples,
+            pixel_counts,
             hdr: hdr.create_view(&Default::default()),
             depth: depth_texture.create_view(&Default::default()),
             depth_texture,

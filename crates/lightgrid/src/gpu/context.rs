@@ -155,6 +155,9 @@ impl GpuContext {
         // Forced early depth tests keep early-Z for forward fragment shaders that may write
         // the frame counters (`shader::create_module` drops the attribute without it).
         features |= adapter.features() & wgpu::Features::SHADER_EARLY_DEPTH_TEST;
+        // Sample counts beyond WebGPU's 1 and 4 (and MSAA of 32-bit float G-buffers) are
+        // adapter-specific format features (`--msaa`, [`GpuContext::sample_counts`]).
+        features |= adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
         let desc = wgpu::DeviceDescriptor {
             label: Some("lightgrid"),
             required_features: features,
@@ -207,6 +210,57 @@ impl GpuContext {
             .name
             .contains("llvmpipe")
             .then_some(crate::consts::SOFTWARE_LOOP_BUDGET)
+    }
+
+    /// The MSAA sample counts every format of a frame rendered with `gbuffer` supports as a
+    /// multisampled render target (HDR colour, depth, the G-buffer), ascending; always has 1.
+    pub fn sample_counts(&self, gbuffer: crate::frame::GBufferFormat) -> Vec<u32> {
+        use crate::frame::targets::{DEPTH_FORMAT, HDR_FORMAT};
+        let specific = self
+            .device
+            .features()
+            .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+        let formats = [HDR_FORMAT, DEPTH_FORMAT, gbuffer.texture_format()];
+        crate::consts::MSAA_COUNTS
+            .iter()
+            .copied()
+            .filter(|&n| {
+                n == 1
+                    || formats.iter().all(|&f| {
+                        let features = if specific {
+                            self.adapter.get_texture_format_features(f)
+                        } else {
+                            f.guaranteed_format_features(self.device.features())
+                        };
+                        features.flags.sample_count_supported(n)
+                            && features
+                                .allowed_usages
+                                .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+                    })
+            })
+            .collect()
+    }
+
+    /// Refuse a sample count the adapter cannot render every target of a frame with.
+    pub fn check_sample_count(
+        &self,
+        samples: u32,
+        gbuffer: crate::frame::GBufferFormat,
+    ) -> Result<()> {
+        let counts = self.sample_counts(gbuffer);
+        if counts.contains(&samples) {
+            return Ok(());
+        }
+        let list: Vec<String> = counts.iter().map(u32::to_string).collect();
+        Err(Error::invalid(
+            "msaa",
+            format!(
+                "{samples} samples: this adapter ({}) supports {} for every target (with the {}-bit G-buffer)",
+                self.info.name,
+                list.join(", "),
+                gbuffer.bits()
+            ),
+        ))
     }
 
     /// Largest 2D texture edge the device accepts.

@@ -7,8 +7,9 @@
 
 use super::{wait_idle, PassTimer};
 use crate::consts::{
-    COUNTER_INDEX_NEEDED, COUNTER_INDEX_OUT_OF_ROOM, COUNTER_PAIRS_NEEDED,
-    COUNTER_PAIRS_OUT_OF_ROOM, COUNTER_SLOTS, COUNTER_TRUNCATED_LOOPS, COUNTER_WRITE_OVERFLOW,
+    COUNTER_EDGE_PIXELS, COUNTER_GEOMETRY_SAMPLES, COUNTER_INDEX_NEEDED, COUNTER_INDEX_OUT_OF_ROOM,
+    COUNTER_PAIRS_NEEDED, COUNTER_PAIRS_OUT_OF_ROOM, COUNTER_SHADED_SAMPLES, COUNTER_SLOTS,
+    COUNTER_TRUNCATED_LOOPS, COUNTER_WRITE_OVERFLOW,
 };
 use crate::error::{Error, Result};
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -40,6 +41,18 @@ impl CounterValues {
     /// Some list did not fit its buffer: the frame's grid is missing lights.
     pub fn overflowed(&self) -> bool {
         self.get(COUNTER_INDEX_OUT_OF_ROOM) > 0 || self.get(COUNTER_PAIRS_OUT_OF_ROOM) > 0
+    }
+    /// Edge pixels the MSAA deferred kernels shaded per sample.
+    pub fn edge_pixels(&self) -> u32 {
+        self.get(COUNTER_EDGE_PIXELS)
+    }
+    /// Samples the MSAA deferred kernels shaded.
+    pub fn shaded_samples(&self) -> u32 {
+        self.get(COUNTER_SHADED_SAMPLES)
+    }
+    /// Samples with geometry the MSAA deferred kernels saw.
+    pub fn geometry_samples(&self) -> u32 {
+        self.get(COUNTER_GEOMETRY_SAMPLES)
     }
     /// Count and write passes disagreed (a bug, never silent).
     pub fn write_overflow(&self) -> u32 {

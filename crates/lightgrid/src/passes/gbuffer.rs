@@ -38,18 +38,19 @@ impl GBuffer {
         device: &wgpu::Device,
         scene_layout: &wgpu::BindGroupLayout,
         format: GBufferFormat,
-        width: u32,
-        height: u32,
+        size: (u32, u32),
+        samples: u32,
     ) -> Self {
         let tf = format.texture_format();
         let views = TARGET_NAMES
             .iter()
             .map(|name| {
-                super::render_texture(
+                super::multisampled_texture(
                     device,
                     name,
                     tf,
-                    (width, height),
+                    size,
+                    samples,
                     wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
                 )
                 .create_view(&Default::default())
@@ -68,18 +69,20 @@ impl GBuffer {
                 color_targets: &targets,
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Less,
+                samples,
             },
         );
         GBuffer {
             format,
             views,
             pipeline,
-            read_layout: Self::read_layout(device),
+            read_layout: Self::read_layout(device, samples),
         }
     }
 
-    fn read_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let tex = super::texture_entry;
+    fn read_layout(device: &wgpu::Device, samples: u32) -> wgpu::BindGroupLayout {
+        let tex =
+            |binding, sample_type| super::sampled_texture_entry(binding, sample_type, samples);
         let float = wgpu::TextureSampleType::Float { filterable: false };
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer read (group 2)"),

@@ -15,6 +15,9 @@ pub(crate) struct GeometryPipelineDesc<'a> {
     pub color_targets: &'a [Option<wgpu::ColorTargetState>],
     pub depth_write: bool,
     pub depth_compare: wgpu::CompareFunction,
+    /// Samples per pixel of the targets (`RenderSettings::msaa`). Above one, a lighting
+    /// shader counts into `pixel_counts` (`lit_out.wgsl`'s `PIXEL_COUNTS`).
+    pub samples: u32,
 }
 
 /// One pipeline per material shader (tiled-forward-shading §4.7: forward shading draws each
@@ -69,6 +72,10 @@ fn pipeline_with_constants(
     d: &GeometryPipelineDesc,
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
+    let mut constants = constants.to_vec();
+    if d.samples > 1 {
+        constants.push(("PIXEL_COUNTS", 1.0));
+    }
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(d.label),
         bind_group_layouts: d.layouts,
@@ -92,12 +99,15 @@ fn pipeline_with_constants(
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: Default::default(),
+        multisample: wgpu::MultisampleState {
+            count: d.samples,
+            ..Default::default()
+        },
         fragment: d.fragment_entry.map(|entry| wgpu::FragmentState {
             module: d.module,
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions {
-                constants,
+                constants: &constants,
                 ..Default::default()
             },
             targets: d.color_targets,
@@ -183,21 +193,26 @@ pub(crate) fn begin_lighting_pass<'e>(
     })
 }
 
-/// HDR (cleared to black) and, when countable, the count target (cleared to zero).
+/// HDR (cleared to black) and, when countable, the count target (cleared to zero); with
+/// MSAA the counts go to `pixel_counts` instead.
 pub(crate) fn lighting_attachments<'a>(
     f: &'a FrameInputs,
 ) -> [Option<wgpu::RenderPassColorAttachment<'a>>; 2] {
     [
         Some(crate::passes::cleared(&f.targets.hdr, wgpu::Color::BLACK)),
-        f.count_blend
+        (f.count_blend && f.targets.samples == 1)
             .then(|| crate::passes::cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
     ]
 }
 
-/// Colour targets of a forward lighting pipeline: HDR and (when countable) the count target.
-pub(crate) fn lighting_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
+/// Colour targets of a forward lighting pipeline: HDR and (when countable, without MSAA) the
+/// count target.
+pub(crate) fn lighting_targets(
+    count_blend: bool,
+    samples: u32,
+) -> [Option<wgpu::ColorTargetState>; 2] {
     [
         Some(crate::passes::HDR_FORMAT.into()),
-        crate::passes::count_target(count_blend),
+        crate::passes::count_target(count_blend && samples == 1),
     ]
 }

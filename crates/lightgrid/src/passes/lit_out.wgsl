@@ -5,7 +5,15 @@ struct LitOut {
     @location(1) count: f32,
 }
 
-fn lit(color: vec3<f32>, count: u32) -> LitOut {
+// Set for pipelines drawing into multisampled targets: the count goes to the pixel's entry
+// of `pixel_counts` instead of the count target (which such a pipeline does not have).
+override PIXEL_COUNTS: bool = false;
+
+// `clip`: the fragment's position (`@builtin(position)`).
+fn lit(clip: vec4<f32>, color: vec3<f32>, count: u32) -> LitOut {
+    if (PIXEL_COUNTS) {
+        count_pixel(vec2<u32>(clip.xy), count);
+    }
     var out: LitOut;
     out.color = vec4<f32>(color, 1.0);
     out.count = f32(count);
@@ -13,8 +21,8 @@ fn lit(color: vec3<f32>, count: u32) -> LitOut {
 }
 
 // A transparent fragment's output: blended over the image with coverage `alpha`.
-fn lit_blended(color: vec3<f32>, alpha: f32, count: u32) -> LitOut {
-    var out = lit(color, count);
+fn lit_blended(clip: vec4<f32>, color: vec3<f32>, alpha: f32, count: u32) -> LitOut {
+    var out = lit(clip, color, count);
     out.color.a = alpha;
     return out;
 }

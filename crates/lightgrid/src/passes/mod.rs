@@ -8,15 +8,15 @@ mod readback;
 mod tonemap;
 
 pub use crate::frame::targets::{
-    cleared, cleared_depth, loaded, loaded_depth, render_texture, Targets, COUNT_FORMAT,
-    DEPTH_FORMAT, HDR_FORMAT, LDR_FORMAT,
+    cleared, cleared_depth, loaded, loaded_depth, multisampled_texture, render_texture, Targets,
+    COUNT_FORMAT, DEPTH_FORMAT, HDR_FORMAT, LDR_FORMAT,
 };
 pub use gbuffer::{GBuffer, GBufferFormat, GBUFFER_READ_WGSL};
 pub use light_volumes::{
     additive, classify_lights, LightVolumes, VolumeClasses, VolumeDraw, VolumePipelineDesc,
     VOLUME_DEPTH_BYTES, VOLUME_DEPTH_FORMAT, VOLUME_WGSL,
 };
-pub use readback::Readback;
+pub use readback::{BufferReadback, DepthSamples, Readback};
 pub use tonemap::Tonemap;
 
 use crate::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GpuVertex};
@@ -25,7 +25,7 @@ use std::num::NonZeroU64;
 
 /// Every shader of the shared passes, for validation.
 pub fn shaders() -> Vec<ComposedShader> {
-    vec![tonemap::shader(), gbuffer::shader()]
+    vec![tonemap::shader(1), tonemap::shader(4), gbuffer::shader()]
 }
 
 /// `fullscreen_position(vertex_index)`: a screen-covering triangle.
@@ -143,6 +143,17 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 },
                 count: None,
             },
+            // Per-pixel lighting counts with MSAA (`Targets::pixel_counts`).
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(4),
+                },
+                count: None,
+            },
         ],
     })
 }
@@ -152,13 +163,22 @@ pub fn texture_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
 ) -> wgpu::BindGroupLayoutEntry {
+    sampled_texture_entry(binding, sample_type, 1)
+}
+
+/// As [`texture_entry`], multisampled when `samples` > 1 (`shader::msaa_wgsl`'s types).
+pub fn sampled_texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+    samples: u32,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Texture {
             sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
+            multisampled: samples > 1,
         },
         count: None,
     }

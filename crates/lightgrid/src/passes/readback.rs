@@ -74,3 +74,125 @@ impl Readback {
         Ok(bytemuck::pod_collect_to_vec(&self.read(device)?))
     }
 }
+
+/// A MAP_READ buffer for copies of a storage buffer's first `bytes`.
+pub struct BufferReadback {
+    staging: wgpu::Buffer,
+    bytes: u64,
+}
+
+impl BufferReadback {
+    pub fn new(device: &wgpu::Device, label: &str, bytes: u64) -> Self {
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        BufferReadback { staging, bytes }
+    }
+
+    /// Record the copy of `source`'s first bytes.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, source: &wgpu::Buffer) {
+        encoder.copy_buffer_to_buffer(source, 0, &self.staging, 0, self.bytes);
+    }
+
+    /// The copied words (waits for the GPU).
+    pub fn read<T: bytemuck::Pod>(&self, device: &wgpu::Device) -> Result<Vec<T>> {
+        Ok(bytemuck::pod_collect_to_vec(&read_buffer(
+            device,
+            &self.staging,
+        )?))
+    }
+}
+
+/// Analysis of an MSAA frame: every sample of the depth target, one plane per sample
+/// (`depth_samples.wgsl`), read back.
+pub struct DepthSamples {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    planes: wgpu::Buffer,
+    readback: BufferReadback,
+    size: (u32, u32),
+    samples: u32,
+}
+
+impl DepthSamples {
+    pub fn new(device: &wgpu::Device, (width, height): (u32, u32), samples: u32) -> Self {
+        let shader = crate::shader::compose(
+            "depth_samples",
+            &[
+                &crate::shader::msaa_wgsl(samples),
+                include_str!("depth_samples.wgsl"),
+            ],
+        );
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth samples"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: samples > 1,
+                    },
+                    count: None,
+                },
+                crate::gpu::buffer_entry(1, crate::gpu::STORAGE_RW),
+            ],
+        });
+        let pipeline = crate::shader::compute_pipeline(
+            device,
+            "depth samples",
+            &shader,
+            "main",
+            &[Some(&layout)],
+        );
+        let bytes = u64::from(width) * u64::from(height) * u64::from(samples) * 4;
+        DepthSamples {
+            pipeline,
+            layout,
+            planes: crate::gpu::storage_buffer(device, "depth samples", bytes),
+            readback: BufferReadback::new(device, "depth samples readback", bytes),
+            size: (width, height),
+            samples,
+        }
+    }
+
+    /// Record the copy of `depth` (a view of the frame's depth target).
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+    ) {
+        let group = crate::gpu::bind_resources(
+            device,
+            "depth samples",
+            &self.layout,
+            &[
+                wgpu::BindingResource::TextureView(depth),
+                self.planes.as_entire_binding(),
+            ],
+        );
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(self.size.0.div_ceil(8), self.size.1.div_ceil(8), 1);
+        }
+        self.readback.encode(encoder, &self.planes);
+    }
+
+    /// One plane of depth-buffer values per sample (waits for the GPU).
+    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<Vec<f32>>> {
+        let all: Vec<f32> = self.readback.read(device)?;
+        let plane = (self.size.0 * self.size.1) as usize;
+        Ok(all
+            .chunks_exact(plane)
+            .take(self.samples as usize)
+            .map(<[f32]>::to_vec)
+            .collect())
+    }
+}

@@ -1,14 +1,18 @@
-//! Tonemap: reads the HDR target, writes the sRGB display target.
+//! Tonemap: reads the HDR target, writes the sRGB display target (and resolves MSAA).
 //! Bindings: group 0 binding 0 = HDR texture (textureLoad, no sampler).
 
 use super::LDR_FORMAT;
 use crate::gpu::PassTimer;
 use crate::shader::{compose, create_module, ComposedShader};
 
-pub(crate) fn shader() -> ComposedShader {
+pub(crate) fn shader(samples: u32) -> ComposedShader {
     compose(
         "tonemap",
-        &[super::FULLSCREEN_WGSL, include_str!("tonemap.wgsl")],
+        &[
+            super::FULLSCREEN_WGSL,
+            &crate::shader::msaa_wgsl(samples),
+            include_str!("tonemap.wgsl"),
+        ],
     )
 }
 
@@ -18,8 +22,9 @@ pub struct Tonemap {
 }
 
 impl Tonemap {
-    pub fn new(device: &wgpu::Device) -> Self {
-        let module = create_module(device, &shader());
+    /// The tonemap of a frame with `samples` samples per pixel (above one, it resolves).
+    pub fn new(device: &wgpu::Device, samples: u32) -> Self {
+        let module = create_module(device, &shader(samples));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -28,7 +33,7 @@ impl Tonemap {
                 ty: wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Float { filterable: false },
                     view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
+                    multisampled: samples > 1,
                 },
                 count: None,
             }],

@@ -25,6 +25,8 @@ use crate::passes::{GBuffer, COUNT_FORMAT, FULLSCREEN_WGSL, GBUFFER_READ_WGSL, H
 use crate::shader::{compose, create_module, src, ComposedShader};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
+    // Light volumes shade single-sample G-buffers only (`PipelineInfo::msaa`).
+    let single_sample = crate::shader::msaa_wgsl(1);
     vec![compose(
         "deferred",
         &[
@@ -34,6 +36,7 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
             src::LIT_OUT,
             FULLSCREEN_WGSL,
             VOLUME_WGSL,
+            &single_sample,
             GBUFFER_READ_WGSL,
             include_str!("deferred.wgsl"),
         ],
@@ -63,7 +66,7 @@ pub(super) fn volume_targets(count_blend: bool) -> [Option<wgpu::ColorTargetStat
 fn create(ctx: &PipelineContext, stencil: bool) -> Box<dyn Technique> {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let gbuffer = GBuffer::new(device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let gbuffer = GBuffer::new(device, ctx.scene_layout, ctx.settings.gbuffer, (w, h), 1);
     let volumes = LightVolumes::new(device, w, h);
     let module = create_module(device, &shaders()[0]);
     let targets = volume_targets(ctx.count_blend);

@@ -10,7 +10,7 @@ fn fs_light(v: VolumeOut) -> LitOut {
         discard;
     }
     let s = surface_from_gbuffer(p, depth);
-    return lit(shade_light(s, view_dir_to(s.position), lights[v.light]), 1u);
+    return lit(v.clip, shade_light(s, view_dir_to(s.position), lights[v.light]), 1u);
 }
 
 // The light-independent term of every sample, written before the lights add up.
@@ -22,7 +22,7 @@ fn fs_base(@builtin(position) pos: vec4<f32>) -> LitOut {
     if (depth < 1.0) {
         color = textureLoad(gb_base, p, 0).rgb;
     }
-    return lit(color, 0u);
+    return lit(pos, color, 0u);
 }
 
 @vertex

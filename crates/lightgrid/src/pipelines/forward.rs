@@ -40,9 +40,10 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
             module: &module,
             fragment_entry: Some(fragment_entry),
             layouts: &[Some(ctx.scene_layout)],
-            color_targets: &lighting_targets(ctx.count_blend),
+            color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
             depth_write: true,
             depth_compare: wgpu::CompareFunction::Less,
+            samples: ctx.settings.msaa,
         },
         ctx.settings.material_draws,
     );

@@ -8,7 +8,7 @@
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let color = surface_base(s) + shade_all_lights(s, view_dir_to(s.position));
-    return lit(color, frame.light_count);
+    return lit(v.clip, color, frame.light_count);
 }
 
 // forward_mono: the reference for light_prepass_mono: every light for every fragment, with
@@ -28,5 +28,5 @@ fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     }
     check_loop(i, frame.light_count);
     let color = surface_base(s) + diffuse * s.diffuse + mono_specular(diffuse, specular) * s.specular;
-    return lit(color, frame.light_count);
+    return lit(v.clip, color, frame.light_count);
 }

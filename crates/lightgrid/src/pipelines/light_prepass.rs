@@ -85,6 +85,7 @@ fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
             color_targets: &[Some(TARGET_FORMAT.into())],
             depth_write: true,
             depth_compare: wgpu::CompareFunction::Less,
+            samples: 1,
         },
     );
     let volumes = LightVolumes::new(device, w, h);
@@ -132,6 +133,7 @@ fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
             color_targets: &[Some(HDR_FORMAT.into())],
             depth_write: false,
             depth_compare: wgpu::CompareFunction::LessEqual,
+            samples: 1,
         },
     );
     Box::new(LightPrepass {

@@ -42,6 +42,7 @@ impl PipelineContext<'_> {
             assign: self.settings.assign,
             software_adapter: self.software_adapter,
             lists: self.settings.lists,
+            samples: self.settings.msaa,
         }
     }
 }
@@ -64,6 +65,17 @@ pub trait Technique {
     }
 }
 
+/// How a pipeline renders with MSAA (`--msaa` above 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Msaa {
+    /// Every target multisampled, resolved by the tonemap.
+    Supported,
+    /// Refused with the reason (README, "MSAA").
+    Refused(&'static str),
+}
+
+const LIGHT_VOLUMES_MSAA: &str = "light volumes shade per pixel; per-sample shading of the stencil-marked edge pixels is not implemented";
+
 /// One registry row.
 pub struct PipelineInfo {
     /// The id used on the command line and in stats.
@@ -83,6 +95,8 @@ pub struct PipelineInfo {
     /// The pipeline whose image this one must reproduce: `forward`, or a reference with the
     /// same approximations (e.g. `forward_mono`).
     pub reference: &'static str,
+    /// With MSAA: supported, or refused and why.
+    pub msaa: Msaa,
     /// Every composed shader the pipeline creates (validated by the tests without a GPU).
     pub shaders: fn() -> Vec<ComposedShader>,
     pub create: fn(&PipelineContext) -> Box<dyn Technique>,
@@ -91,10 +105,15 @@ pub struct PipelineInfo {
 }
 
 impl PipelineInfo {
+    /// The render targets and traffic model with `settings` (per sample with MSAA).
+    pub fn memory_model(&self, settings: &RenderSettings) -> MemoryModel {
+        (self.memory)(settings).multisampled(settings.msaa)
+    }
+
     /// Whether the pipeline has a G-buffer (its memory depends on `--gbuffer`).
     pub fn uses_gbuffer(&self) -> bool {
         let with = |gbuffer| {
-            (self.memory)(&RenderSettings {
+            self.memory_model(&RenderSettings {
                 gbuffer,
                 ..Default::default()
             })
@@ -114,6 +133,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Supported,
         shaders: forward::shaders,
         create: forward::create,
         memory: forward::memory,
@@ -127,6 +147,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         reference: "forward_mono",
+        msaa: Msaa::Supported,
         shaders: forward::shaders,
         create: forward::create_mono,
         memory: forward::memory,
@@ -140,6 +161,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Supported,
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
         memory: tiled_forward::memory_plain,
@@ -153,6 +175,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Supported,
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
         memory: tiled_forward::memory_prez,
@@ -166,6 +189,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Supported,
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
         memory: tiled_deferred::memory_multi,
@@ -179,6 +203,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Refused("its one kernel shades one sample per invocation; edge-aware per-sample shading is implemented in tiled_deferred and clustered_deferred"),
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
         memory: tiled_deferred::memory_single,
@@ -192,6 +217,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: true,
         reference: "forward",
+        msaa: Msaa::Supported,
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_clustered,
         memory: tiled_forward::memory_clustered,
@@ -205,6 +231,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: true,
         reference: "forward",
+        msaa: Msaa::Supported,
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_clustered,
         memory: tiled_deferred::memory_clustered,
@@ -218,6 +245,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: deferred::shaders,
         create: deferred::create_plain,
         memory: deferred::memory,
@@ -231,6 +259,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: deferred::shaders,
         create: deferred::create_stencil,
         memory: deferred::memory,
@@ -244,6 +273,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         reference: "forward",
+        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
         memory: light_prepass::memory_full,
@@ -257,6 +287,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         reference: "forward_mono",
+        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,
         memory: light_prepass::memory_mono,

@@ -25,26 +25,61 @@ use crate::passes::{
 };
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
-/// Shared modules of a deferred compute shader (no vertex stage).
-fn deferred_parts() -> Vec<&'static str> {
+/// Shared modules of a single-sample deferred compute shader (no vertex stage).
+fn deferred_parts(single_sample: &str) -> Vec<&str> {
     vec![
         src::TYPES,
         src::SCENE_BINDINGS,
         src::LIGHTING,
+        single_sample,
         GBUFFER_READ_WGSL,
         COMPUTE_OUTPUTS_WGSL,
     ]
 }
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    let mut parts = deferred_parts();
-    parts.push(src::LIGHT_GRID);
-    parts.push(include_str!("tiled_deferred.wgsl"));
-    vec![compose("tiled_deferred", &parts)]
+    vec![kernel_shader(1), kernel_shader(4), expand_shader(4)]
+}
+
+/// The grid pipelines' shading kernel for `samples` samples per pixel: one sample per
+/// invocation, or above one the edge-aware kernel (`tiled_deferred_msaa.wgsl`).
+fn kernel_shader(samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    if samples == 1 {
+        let mut parts = deferred_parts(&msaa);
+        parts.push(src::LIGHT_GRID);
+        parts.push(include_str!("tiled_deferred.wgsl"));
+        return compose("tiled_deferred", &parts);
+    }
+    compose(
+        "tiled_deferred_msaa",
+        &[
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            src::LIGHTING,
+            &msaa,
+            GBUFFER_READ_WGSL,
+            src::LIGHT_GRID,
+            include_str!("tiled_deferred_msaa.wgsl"),
+        ],
+    )
+}
+
+/// The pass writing the MSAA kernel's per-sample colours into the multisampled HDR target.
+fn expand_shader(samples: u32) -> ComposedShader {
+    compose(
+        "sample_expand",
+        &[
+            crate::passes::FULLSCREEN_WGSL,
+            &crate::shader::msaa_wgsl(samples),
+            include_str!("sample_expand.wgsl"),
+        ],
+    )
 }
 
 pub(super) fn shaders_single() -> Vec<ComposedShader> {
-    let mut parts = deferred_parts();
+    let single_sample = crate::shader::msaa_wgsl(1);
+    let mut parts = deferred_parts(&single_sample);
     parts.push(TILE_DEPTH_WGSL);
     parts.push(crate::culling::TILE_FRUSTUM_WGSL);
     parts.push(include_str!("tiled_deferred_single.wgsl"));
@@ -64,9 +99,127 @@ enum Variant {
     },
 }
 
+/// Where the shading kernel writes.
+enum Outputs {
+    /// The HDR and count targets as storage textures (group 3, `compute_outputs.wgsl`).
+    Targets(wgpu::BindGroupLayout),
+    /// MSAA: the per-sample colour buffer (group 3 of the kernel), and the pass that writes
+    /// it into the multisampled HDR target.
+    Samples(SampleOutputs),
+}
+
+struct SampleOutputs {
+    kernel_group: wgpu::BindGroup,
+    expand: wgpu::RenderPipeline,
+    expand_group: wgpu::BindGroup,
+}
+
+impl SampleOutputs {
+    /// The kernel's group-3 layout and the outputs of a `w` x `h` frame of `samples` samples.
+    fn new(
+        device: &wgpu::Device,
+        (w, h): (u32, u32),
+        samples: u32,
+    ) -> (wgpu::BindGroupLayout, Self) {
+        use crate::gpu::{bind_resources, buffer_layout, STORAGE_RW};
+        let buffer = crate::gpu::storage_buffer(
+            device,
+            "msaa sample colours",
+            u64::from(w) * u64::from(h) * u64::from(samples) * 8,
+        );
+        let kernel_layout = buffer_layout(device, "msaa kernel outputs (group 3)", &[STORAGE_RW]);
+        let kernel_group = bind_resources(
+            device,
+            "msaa kernel outputs",
+            &kernel_layout,
+            &[buffer.as_entire_binding()],
+        );
+        let expand_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sample expand"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let expand_group = bind_resources(
+            device,
+            "sample expand",
+            &expand_layout,
+            &[buffer.as_entire_binding()],
+        );
+        let module = crate::shader::create_module(device, &expand_shader(samples));
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("sample expand"),
+            bind_group_layouts: &[Some(&expand_layout)],
+            immediate_size: 0,
+        });
+        let expand = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("sample expand"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState {
+                count: samples,
+                ..Default::default()
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_expand"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &[("WIDTH", f64::from(w))],
+                    ..Default::default()
+                },
+                targets: &[Some(crate::passes::HDR_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        (
+            kernel_layout,
+            SampleOutputs {
+                kernel_group,
+                expand,
+                expand_group,
+            },
+        )
+    }
+
+    /// The per-sample colours into the multisampled HDR target.
+    fn encode_expand(&self, f: &FrameInputs, enc: &mut FrameEncoder) {
+        let (encoder, timer) = enc.parts();
+        let label = "msaa sample expand";
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[Some(crate::passes::cleared(
+                &f.targets.hdr,
+                wgpu::Color::BLACK,
+            ))],
+            depth_stencil_attachment: None,
+            timestamp_writes: timer.render_pass(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.expand);
+        pass.set_bind_group(0, &self.expand_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
 struct TiledDeferred {
     gbuffer: GBuffer,
-    outputs_layout: wgpu::BindGroupLayout,
+    outputs: Outputs,
     shading: wgpu::ComputePipeline,
     variant: Variant,
     dims: GridDims,
@@ -82,13 +235,26 @@ pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
 
 fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let samples = ctx.settings.msaa;
+    let gbuffer = GBuffer::new(
+        ctx.device,
+        ctx.scene_layout,
+        ctx.settings.gbuffer,
+        (w, h),
+        samples,
+    );
     let builder = GridBuilder::new(&ctx.grid_setup(), slices, CellSource::Depth);
-    let outputs_layout = compute_outputs_layout(ctx.device);
+    let (outputs_layout, outputs) = if samples > 1 {
+        let (layout, outputs) = SampleOutputs::new(ctx.device, (w, h), samples);
+        (layout, Outputs::Samples(outputs))
+    } else {
+        let layout = compute_outputs_layout(ctx.device);
+        (layout.clone(), Outputs::Targets(layout))
+    };
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred shading",
-        &shaders()[0],
+        &kernel_shader(samples),
         "main",
         &[
             Some(ctx.scene_layout),
@@ -99,7 +265,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
     );
     Box::new(TiledDeferred {
         gbuffer,
-        outputs_layout,
+        outputs,
         shading,
         variant: Variant::Multi {
             builder: Box::new(builder),
@@ -111,7 +277,13 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
 
 pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let gbuffer = GBuffer::new(ctx.device, ctx.scene_layout, ctx.settings.gbuffer, w, h);
+    let gbuffer = GBuffer::new(
+        ctx.device,
+        ctx.scene_layout,
+        ctx.settings.gbuffer,
+        (w, h),
+        1,
+    );
     let outputs_layout = compute_outputs_layout(ctx.device);
     let params_layout = ctx
         .device
@@ -156,7 +328,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
     );
     Box::new(TiledDeferred {
         gbuffer,
-        outputs_layout,
+        outputs: Outputs::Targets(outputs_layout),
         shading,
         variant: Variant::Single {
             params,
@@ -174,7 +346,10 @@ impl Technique for TiledDeferred {
             self.gbuffer.encode(f, encoder, timer);
         }
         let read_group = self.gbuffer.read_bind_group(f.device, f.targets);
-        let outputs = compute_outputs(f.device, &self.outputs_layout, f.targets);
+        let outputs = match &self.outputs {
+            Outputs::Targets(layout) => compute_outputs(f.device, layout, f.targets),
+            Outputs::Samples(s) => s.kernel_group.clone(),
+        };
         let (group1, label, groups) = match &mut self.variant {
             Variant::Multi { builder, label } => {
                 builder.build(f, enc)?;
@@ -209,6 +384,9 @@ impl Technique for TiledDeferred {
         pass.set_bind_group(3, &outputs, &[]);
         pass.dispatch_workgroups(groups.0, groups.1, 1);
         drop(pass);
+        if let Outputs::Samples(s) = &self.outputs {
+            s.encode_expand(f, enc);
+        }
         Ok(())
     }
 
@@ -232,14 +410,20 @@ impl Technique for TiledDeferred {
 /// Depth + four G-buffer targets + HDR; the shading kernel reads depth and the G-buffer once
 /// per sample, the cell-bounds kernel depth once more; each lighting computation reads an
 /// index and a light.
+/// With MSAA the kernel's per-sample colours come on top (a per-sample buffer the size of
+/// the HDR target).
 pub(super) fn memory_multi(settings: &RenderSettings) -> MemoryModel {
     let g = settings.gbuffer.bytes_per_target();
+    let mut targets = vec![
+        ("depth", DEPTH_BYTES),
+        ("gbuffer (4 targets)", 4 * g),
+        ("hdr", HDR_BYTES),
+    ];
+    if settings.msaa > 1 {
+        targets.push(("msaa sample colours", HDR_BYTES));
+    }
     MemoryModel::new(
-        &[
-            ("depth", DEPTH_BYTES),
-            ("gbuffer (4 targets)", 4 * g),
-            ("hdr", HDR_BYTES),
-        ],
+        &targets,
         Traffic {
             write_per_pixel: DEPTH_BYTES + 4 * g + HDR_BYTES,
             read_per_pixel: 2 * DEPTH_BYTES + 4 * g,

@@ -65,13 +65,14 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             module: &module,
             fragment_entry: Some("fs_main"),
             layouts: &[Some(ctx.scene_layout), Some(builder.layout())],
-            color_targets: &lighting_targets(ctx.count_blend),
+            color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
             depth_write: !prepass,
             depth_compare: if prepass {
                 wgpu::CompareFunction::LessEqual
             } else {
                 wgpu::CompareFunction::Less
             },
+            samples: ctx.settings.msaa,
         },
         ctx.settings.material_draws,
     );
@@ -86,6 +87,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
                 color_targets: &[],
                 depth_write: true,
                 depth_compare: wgpu::CompareFunction::Less,
+                samples: ctx.settings.msaa,
             },
         )
     });

@@ -10,6 +10,6 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let cell = grid_cell(v.clip.xy, view_distance_from_depth(v.clip.z));
     let color = surface_base(s) + grid_shade(s, view_dir_to(s.position), cell);
-    return lit(color, grid_cell_count(cell));
+    return lit(v.clip, color, grid_cell_count(cell));
 }
 

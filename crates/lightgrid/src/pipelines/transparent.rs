@@ -80,7 +80,7 @@ impl TransparentPass {
             CellSource::Depth,
         );
         let grid_layout = GridBuffers::layout(ctx.device);
-        let targets = blended_targets(ctx.count_blend);
+        let targets = blended_targets(ctx.count_blend && ctx.settings.msaa == 1);
         let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
             MaterialPipelines::new(
                 ctx.device,
@@ -92,6 +92,7 @@ impl TransparentPass {
                     color_targets: &targets,
                     depth_write: false,
                     depth_compare: wgpu::CompareFunction::Less,
+                    samples: ctx.settings.msaa,
                 },
                 ctx.settings.material_draws,
             )
@@ -136,7 +137,7 @@ impl TransparentPass {
             label: Some(label),
             color_attachments: &[
                 Some(crate::passes::loaded(&f.targets.hdr)),
-                f.count_blend
+                (f.count_blend && f.targets.samples == 1)
                     .then(|| crate::passes::loaded(&f.targets.counts)),
             ],
             depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),

@@ -8,7 +8,7 @@
 fn fs_all_lights(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let color = surface_base(s) + shade_all_lights(s, view_dir_to(s.position));
-    return lit_blended(color, s.alpha, frame.light_count);
+    return lit_blended(v.clip, color, s.alpha, frame.light_count);
 }
 
 // Every other pipeline: the lights of the fragment's transparent list (tiled-forward-shading
@@ -18,5 +18,5 @@ fn fs_grid(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let cell = grid_cell_transparent(v.clip.xy, view_distance_from_depth(v.clip.z));
     let color = surface_base(s) + grid_shade(s, view_dir_to(s.position), cell);
-    return lit_blended(color, s.alpha, grid_cell_count(cell));
+    return lit_blended(v.clip, color, s.alpha, grid_cell_count(cell));
 }

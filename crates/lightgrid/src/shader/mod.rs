@@ -63,6 +63,39 @@ pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
     Ok(module)
 }
 
+/// WGSL of a frame's sample count, for shaders that read its multisampled targets: `SAMPLES`,
+/// the texture types (`DepthTexture`, `SampleTexture`: multisampled above one sample, so
+/// `textureLoad(t, p, s)` reads sample `s`, or level 0 of a plain texture at one sample) and
+/// `sample_position(s)`, the standard position of sample `s` in its pixel
+/// (`consts::msaa_sample_positions`).
+pub fn msaa_wgsl(samples: u32) -> String {
+    let ms = samples > 1;
+    let positions: Vec<String> = crate::consts::msaa_sample_positions(samples)
+        .iter()
+        .map(|[x, y]| format!("vec2<f32>({x:?}, {y:?})"))
+        .collect();
+    format!(
+        "const SAMPLES: u32 = {samples}u;\n\
+         alias DepthTexture = {};\n\
+         alias SampleTexture = {};\n\
+         fn sample_position(s: u32) -> vec2<f32> {{\n\
+         \x20   var positions = array<vec2<f32>, {samples}>({});\n\
+         \x20   return positions[s];\n\
+         }}\n",
+        if ms {
+            "texture_depth_multisampled_2d"
+        } else {
+            "texture_depth_2d"
+        },
+        if ms {
+            "texture_multisampled_2d<f32>"
+        } else {
+            "texture_2d<f32>"
+        },
+        positions.join(", ")
+    )
+}
+
 /// The attribute forward fragment shaders carry to keep early-Z although they may write the
 /// frame counters (a side effect that would otherwise move the depth test after shading).
 pub const EARLY_DEPTH_TEST: &str = "@early_depth_test(force)";

@@ -9,6 +9,17 @@
 // The frame counters (slots COUNTER_* from consts.rs), cleared at the start of every frame and
 // read back after it: truncated loops, index-list and pair sizes, indirect dispatch arguments.
 @group(0) @binding(3) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;
+// With MSAA, per pixel the lighting computations of every pass (row-major), cleared every
+// frame: a fragment shader runs once per pixel and primitive, so a per-sample count target
+// cannot count it (`frame/targets.rs`).
+@group(0) @binding(5) var<storage, read_write> pixel_counts: array<atomic<u32>>;
+
+// Add `count` lighting computations to pixel `p`'s count (MSAA frames).
+fn count_pixel(p: vec2<u32>, count: u32) {
+    if (count > 0u) {
+        atomicAdd(&pixel_counts[p.y * u32(frame.viewport.x) + p.x], count);
+    }
+}
 
 // No loop ends silently (llvmpipe ends an invocation's loops after 65,536 iterations without a
 // word): call after every data-dependent loop with the index it stopped at and its bound; a
@@ -26,7 +37,13 @@ fn view_dir_to(world: vec3<f32>) -> vec3<f32> {
 
 // World position of the sample at the centre of pixel `p` with depth-buffer value `depth`.
 fn world_from_depth(p: vec2<u32>, depth: f32) -> vec3<f32> {
-    let uv = (vec2<f32>(p) + vec2<f32>(0.5)) / frame.viewport;
+    return world_from_screen(vec2<f32>(p) + vec2<f32>(0.5), depth);
+}
+
+// World position of the sample at framebuffer position `xy` (pixels, y down) with
+// depth-buffer value `depth`.
+fn world_from_screen(xy: vec2<f32>, depth: f32) -> vec3<f32> {
+    let uv = xy / frame.viewport;
     let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
     let h = frame.inv_view_proj * ndc;
     return h.xyz / h.w;

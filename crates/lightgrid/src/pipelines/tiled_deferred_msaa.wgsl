@@ -1,0 +1,123 @@
+// tiled_deferred / clustered_deferred with MSAA: edge-aware shading over a per-sample
+// G-buffer (tiled-shading §2.1, tiled-deferred-tricks: edge detection, and Lauritzen's
+// redistribution of the edge samples over the workgroup).
+//
+// Each invocation owns a pixel. It compares the pixel's samples (edge: a sample with or
+// without geometry where sample 0 differs, another material, a normal more than ~8 degrees
+// off (EDGE_NORMAL_COS), or a view distance more than EDGE_DEPTH_RATIO off) and shades
+// sample 0. A pixel that is no edge is done: its one colour goes to every sample. An edge
+// pixel queues its other covered samples in workgroup memory; after a barrier every
+// invocation of the workgroup takes queued samples in turn, so a workgroup with few edges
+// does not leave most invocations idle while a few loop over their samples. Each sample is
+// shaded at its own position (its depth at its standard place in the pixel) and stored in
+// `sample_colors`; a fragment pass writes them into the multisampled HDR target
+// (`sample_expand.wgsl`), where the transparent pass blends and the tonemap resolves.
+// Counts go to `pixel_counts` (lighting computations) and the frame counters (edge pixels,
+// samples shaded, samples with geometry).
+
+// Per sample (pixel * SAMPLES + sample): HDR colour as two pack2x16float words.
+@group(3) @binding(0) var<storage, read_write> sample_colors: array<vec2<u32>>;
+
+const GROUP_PIXELS: u32 = SCREEN_WORKGROUP * SCREEN_WORKGROUP;
+
+// The queued edge samples: (local pixel index << 8) | sample.
+var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
+var<workgroup> queued: atomic<u32>;
+var<workgroup> group_edges: atomic<u32>;
+var<workgroup> group_first: atomic<u32>;
+var<workgroup> group_geometry: atomic<u32>;
+
+fn store_sample(pixel: u32, s: u32, color: vec3<f32>) {
+    sample_colors[pixel * SAMPLES + s] = vec2<u32>(pack2x16float(color.rg), pack2x16float(vec2<f32>(color.b, 1.0)));
+}
+
+// Sample `s` of pixel `p`, at depth-buffer value `depth`: shaded from its cell's lights,
+// counted into the pixel.
+fn shade_sample(p: vec2<u32>, s: u32, depth: f32) -> vec3<f32> {
+    let position = world_from_screen(vec2<f32>(p) + sample_position(s), depth);
+    let surface = apply_material(raw_surface_from_gbuffer(p, s, position));
+    let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
+    count_pixel(p, grid_cell_count(cell));
+    return surface_base(surface) + grid_shade(surface, view_dir_to(surface.position), cell);
+}
+
+// Do samples 0 and `s` of pixel `p` show different surfaces?
+fn differs(p: vec2<u32>, s: u32, d0: f32, n0: vec4<f32>) -> bool {
+    let d = textureLoad(gb_depth, p, s);
+    if ((d < 1.0) != (d0 < 1.0)) {
+        return true;
+    }
+    if (d0 >= 1.0) {
+        return false;
+    }
+    let n = textureLoad(gb_normal, p, s);
+    let w0 = view_distance_from_depth(d0);
+    let w = view_distance_from_depth(d);
+    return u32(n.w + 0.5) != u32(n0.w + 0.5)
+        || dot(normalize(n.xyz), normalize(n0.xyz)) < EDGE_NORMAL_COS
+        || abs(w - w0) > EDGE_DEPTH_RATIO * min(w, w0);
+}
+
+@compute @workgroup_size(SCREEN_WORKGROUP, SCREEN_WORKGROUP)
+fn main(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    if (li == 0u) {
+        atomicStore(&queued, 0u);
+        atomicStore(&group_edges, 0u);
+        atomicStore(&group_first, 0u);
+        atomicStore(&group_geometry, 0u);
+    }
+    workgroupBarrier();
+    let size = vec2<u32>(frame.viewport);
+    let p = gid.xy;
+    if (p.x < size.x && p.y < size.y) {
+        let pixel = p.y * size.x + p.x;
+        let d0 = textureLoad(gb_depth, p, 0);
+        let n0 = textureLoad(gb_normal, p, 0);
+        var edge = false;
+        var geometry = 0u;
+        for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            geometry += select(0u, 1u, textureLoad(gb_depth, p, s) < 1.0);
+            edge = edge || (s > 0u && differs(p, s, d0, n0));
+        }
+        var c0 = vec3<f32>(0.0);
+        if (d0 < 1.0) {
+            c0 = shade_sample(p, 0u, d0);
+            atomicAdd(&group_first, 1u);
+        }
+        store_sample(pixel, 0u, c0);
+        for (var s = 1u; s < SAMPLES; s = s + 1u) {
+            if (!edge) {
+                store_sample(pixel, s, c0);
+            } else if (textureLoad(gb_depth, p, s) < 1.0) {
+                queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
+            } else {
+                store_sample(pixel, s, vec3<f32>(0.0));
+            }
+        }
+        if (edge) {
+            atomicAdd(&group_edges, 1u);
+        }
+        atomicAdd(&group_geometry, geometry);
+    }
+    // Every invocation takes queued edge samples in turn.
+    let n = workgroupUniformLoad(&queued);
+    let origin = wg.xy * SCREEN_WORKGROUP;
+    var i = li;
+    for (; i < n; i = i + GROUP_PIXELS) {
+        let item = queue[i];
+        let local = item >> 8u;
+        let s = item & 0xffu;
+        let q = origin + vec2<u32>(local % SCREEN_WORKGROUP, local / SCREEN_WORKGROUP);
+        store_sample(q.y * size.x + q.x, s, shade_sample(q, s, textureLoad(gb_depth, q, s)));
+    }
+    check_loop(i, n);
+    if (li == 0u) {
+        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
+        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n);
+        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], atomicLoad(&group_geometry));
+    }
+}
