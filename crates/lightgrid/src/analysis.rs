@@ -305,6 +305,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             gbuffer_bits: settings.gbuffer.bits(),
             msaa: settings.msaa,
             msaa_shading: a.finished.msaa_shading,
+            msaa_fallback_fragments: a.finished.msaa_fallback_fragments,
             lighting_computations,
             ideal_lighting_computations: ideal,
             transparent_fragments: fragments.len() as u64,

@@ -566,6 +566,7 @@ impl<'c> Renderer<'c> {
                 shaded_samples: r.values.shaded_samples().into(),
                 geometry_samples: r.values.geometry_samples().into(),
             }),
+            msaa_fallback_fragments: r.values.msaa_fallbacks().into(),
         })
     }
 

@@ -71,6 +71,10 @@ pub struct FrameStats {
     /// samples with geometry (what shading every sample would shade). None for other frames.
     #[serde(default)]
     pub msaa_shading: Option<crate::frame::MsaaShading>,
+    /// MSAA grid-forward fragments whose pixel centre (extrapolated off their triangle) lay
+    /// outside their cell's bounds, so they looped over every light (`grid_shade_fragment`).
+    #[serde(default)]
+    pub msaa_fallback_fragments: u64,
     /// Times the light function ran this frame (tiled-shading §8): for forward pipelines the
     /// fragments shaded times the lights each looped over, for deferred ones the samples
     /// times their tile's list length. None where the adapter cannot count (no R32Float

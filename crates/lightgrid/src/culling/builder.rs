@@ -174,6 +174,12 @@ impl GridBuilder {
             },
             enc,
         )?;
+        self.buffers.encode_bounds(
+            f.device,
+            enc.parts().0,
+            self.bounds.buffer(),
+            dims.cell_count(),
+        );
         self.last = Some(LastFrame {
             dims,
             assign,

@@ -228,6 +228,8 @@ pub struct GridBuffers {
     params: wgpu::Buffer,
     cells: wgpu::Buffer,
     indices: wgpu::Buffer,
+    /// The cell bounds the lists were built for (`light_grid.wgsl`'s `grid_bounds`).
+    bounds: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
 }
 
@@ -253,6 +255,7 @@ impl GridBuffers {
                 entry(0, wgpu::BufferBindingType::Uniform),
                 entry(1, storage),
                 entry(2, storage),
+                entry(3, storage),
             ],
         })
     }
@@ -271,12 +274,14 @@ impl GridBuffers {
             "grid indices",
             u64::from(Self::INITIAL_INDEX_CAPACITY) * 4,
         );
-        let bind_group = Self::bind(device, &layout, &params, &cells, &indices);
+        let bounds = storage_buffer(device, "grid cell bounds", 1 << 14);
+        let bind_group = Self::bind(device, &layout, [&params, &cells, &indices, &bounds]);
         GridBuffers {
             layout,
             params,
             cells,
             indices,
+            bounds,
             bind_group,
         }
     }
@@ -284,19 +289,13 @@ impl GridBuffers {
     fn bind(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
-        params: &wgpu::Buffer,
-        cells: &wgpu::Buffer,
-        indices: &wgpu::Buffer,
+        buffers: [&wgpu::Buffer; 4],
     ) -> wgpu::BindGroup {
         bind_resources(
             device,
             "light grid",
             layout,
-            &[
-                params.as_entire_binding(),
-                cells.as_entire_binding(),
-                indices.as_entire_binding(),
-            ],
+            &buffers.map(|b| b.as_entire_binding()),
         )
     }
 
@@ -335,16 +334,37 @@ impl GridBuffers {
         let (cb, ib) = ((cells * 8) as u64, (indices.max(1) * 4) as u64);
         let grown_cells = grow_storage(device, &mut self.cells, "grid cells", cb);
         let grown_indices = grow_storage(device, &mut self.indices, "grid indices", ib);
-        if grown_cells || grown_indices {
+        let grown_bounds = grow_storage(device, &mut self.bounds, "grid cell bounds", cb);
+        if grown_cells || grown_indices || grown_bounds {
             self.bind_group = Self::bind(
                 device,
                 &self.layout,
-                &self.params,
-                &self.cells,
-                &self.indices,
+                [&self.params, &self.cells, &self.indices, &self.bounds],
             );
         }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
+    }
+
+    /// Record the copy of the frame's cell bounds (`cells` of them) next to the lists, for
+    /// the shading passes' check that a fragment lies in its cell (`grid_cell_holds`).
+    pub fn encode_bounds(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        bounds: &wgpu::Buffer,
+        cells: usize,
+    ) {
+        let bytes = (cells * 8) as u64;
+        if grow_storage(device, &mut self.bounds, "grid cell bounds", bytes) {
+            self.bind_group = Self::bind(
+                device,
+                &self.layout,
+                [&self.params, &self.cells, &self.indices, &self.bounds],
+            );
+        }
+        if bytes > 0 {
+            encoder.copy_buffer_to_buffer(bounds, 0, &self.bounds, 0, bytes);
+        }
     }
 
     pub fn params_buffer(&self) -> &wgpu::Buffer {

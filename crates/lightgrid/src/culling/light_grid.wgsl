@@ -5,6 +5,15 @@
 @group(1) @binding(0) var<uniform> grid: GridParams;
 @group(1) @binding(1) var<storage, read> grid_cells: array<vec2<u32>>;  // (offset, count)
 @group(1) @binding(2) var<storage, read> grid_indices: array<u32>;
+// The view-distance bounds each cell's list was built for ([min, max], min > max: empty).
+@group(1) @binding(3) var<storage, read> grid_bounds: array<vec2<f32>>;
+
+// Does cell `cell`'s volume hold a point at view distance `w` (its screen position inside
+// the cell's tile)? Then its list holds every light reaching the point.
+fn grid_cell_holds(cell: u32, w: f32) -> bool {
+    let b = grid_bounds[cell];
+    return w >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
+}
 
 fn grid_cell_count(cell: u32) -> u32 {
     return grid_cells[cell].y;
@@ -13,6 +22,30 @@ fn grid_cell_count(cell: u32) -> u32 {
 // The light at position `i` of the cell's list.
 fn grid_light(cell: u32, i: u32) -> Light {
     return lights[grid_indices[grid_cells[cell].x + i]];
+}
+
+// A forward fragment: its surface lit by the lights of `cell` (found at the fragment's pixel
+// and view distance `w`), and how many it looped. With MSAA a fragment covering part of a
+// pixel is shaded at the pixel centre, which may lie outside its triangle: its extrapolated
+// depth can leave the bounds of every sample of the cell (measured: clustered_forward 75
+// levels off at such edges). Such a fragment loops over every light instead (counted in
+// COUNTER_MSAA_FALLBACKS), so no light reaching it is ever missing.
+struct FragmentLight {
+    color: vec3<f32>,
+    count: u32,
+}
+
+fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> FragmentLight {
+    var out: FragmentLight;
+    if (MULTISAMPLED && !grid_cell_holds(cell, w)) {
+        atomicAdd(&frame_counters[COUNTER_MSAA_FALLBACKS], 1u);
+        out.color = shade_all_lights(s, view_dir);
+        out.count = frame.light_count;
+    } else {
+        out.color = grid_shade(s, view_dir, cell);
+        out.count = grid_cell_count(cell);
+    }
+    return out;
 }
 
 // Sum of the cell's lights on the surface (Listing 1's computeLight).

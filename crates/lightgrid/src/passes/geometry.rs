@@ -16,7 +16,7 @@ pub(crate) struct GeometryPipelineDesc<'a> {
     pub depth_write: bool,
     pub depth_compare: wgpu::CompareFunction,
     /// Samples per pixel of the targets (`RenderSettings::msaa`). Above one, a lighting
-    /// shader counts into `pixel_counts` (`lit_out.wgsl`'s `PIXEL_COUNTS`).
+    /// shader counts into `pixel_counts` (`lit_out.wgsl`'s `MULTISAMPLED`).
     pub samples: u32,
 }
 
@@ -74,7 +74,7 @@ fn pipeline_with_constants(
 ) -> wgpu::RenderPipeline {
     let mut constants = constants.to_vec();
     if d.samples > 1 {
-        constants.push(("PIXEL_COUNTS", 1.0));
+        constants.push(("MULTISAMPLED", 1.0));
     }
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(d.label),

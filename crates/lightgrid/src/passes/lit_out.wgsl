@@ -5,13 +5,9 @@ struct LitOut {
     @location(1) count: f32,
 }
 
-// Set for pipelines drawing into multisampled targets: the count goes to the pixel's entry
-// of `pixel_counts` instead of the count target (which such a pipeline does not have).
-override PIXEL_COUNTS: bool = false;
-
 // `clip`: the fragment's position (`@builtin(position)`).
 fn lit(clip: vec4<f32>, color: vec3<f32>, count: u32) -> LitOut {
-    if (PIXEL_COUNTS) {
+    if (MULTISAMPLED) {
         count_pixel(vec2<u32>(clip.xy), count);
     }
     var out: LitOut;

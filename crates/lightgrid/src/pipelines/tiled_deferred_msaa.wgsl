@@ -8,8 +8,9 @@
 // sample 0. A pixel that is no edge is done: its one colour goes to every sample. An edge
 // pixel queues its other covered samples in workgroup memory; after a barrier every
 // invocation of the workgroup takes queued samples in turn, so a workgroup with few edges
-// does not leave most invocations idle while a few loop over their samples. Each sample is
-// shaded at its own position (its depth at its standard place in the pixel) and stored in
+// does not leave most invocations idle while a few loop over their samples. A pixel is
+// shaded at its centre, an edge sample at its own place (its depth at its standard position
+// in the pixel: `sample_position`), and each sample's colour is stored in
 // `sample_colors`; a fragment pass writes them into the multisampled HDR target
 // (`sample_expand.wgsl`), where the transparent pass blends and the tonemap resolves.
 // Counts go to `pixel_counts` (lighting computations) and the frame counters (edge pixels,
@@ -31,11 +32,10 @@ fn store_sample(pixel: u32, s: u32, color: vec3<f32>) {
     sample_colors[pixel * SAMPLES + s] = vec2<u32>(pack2x16float(color.rg), pack2x16float(vec2<f32>(color.b, 1.0)));
 }
 
-// Sample `s` of pixel `p`, at depth-buffer value `depth`: shaded from its cell's lights,
-// counted into the pixel.
-fn shade_sample(p: vec2<u32>, s: u32, depth: f32) -> vec3<f32> {
-    let position = world_from_screen(vec2<f32>(p) + sample_position(s), depth);
-    let surface = apply_material(raw_surface_from_gbuffer(p, s, position));
+// Sample `s` of pixel `p` at framebuffer position `xy` and depth-buffer value `depth`: shaded
+// from its cell's lights, counted into the pixel.
+fn shade_at(p: vec2<u32>, s: u32, xy: vec2<f32>, depth: f32) -> vec3<f32> {
+    let surface = apply_material(raw_surface_from_gbuffer(p, s, world_from_screen(xy, depth)));
     let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
     count_pixel(p, grid_cell_count(cell));
     return surface_base(surface) + grid_shade(surface, view_dir_to(surface.position), cell);
@@ -79,13 +79,23 @@ fn main(
         let n0 = textureLoad(gb_normal, p, 0);
         var edge = false;
         var geometry = 0u;
+        var depth_sum = 0.0;
         for (var s = 0u; s < SAMPLES; s = s + 1u) {
-            geometry += select(0u, 1u, textureLoad(gb_depth, p, s) < 1.0);
+            let d = textureLoad(gb_depth, p, s);
+            geometry += select(0u, 1u, d < 1.0);
+            depth_sum += d;
             edge = edge || (s > 0u && differs(p, s, d0, n0));
         }
         var c0 = vec3<f32>(0.0);
         if (d0 < 1.0) {
-            c0 = shade_sample(p, 0u, d0);
+            if (edge) {
+                c0 = shade_at(p, 0u, vec2<f32>(p) + sample_position(0u), d0);
+            } else {
+                // One surface over the whole pixel: the standard patterns' sample positions
+                // average to the pixel centre and depth is affine over a triangle, so the
+                // samples' mean depth is the centre's, where forward shades the pixel.
+                c0 = shade_at(p, 0u, vec2<f32>(p) + vec2<f32>(0.5), depth_sum / f32(SAMPLES));
+            }
             atomicAdd(&group_first, 1u);
         }
         store_sample(pixel, 0u, c0);
@@ -112,7 +122,8 @@ fn main(
         let local = item >> 8u;
         let s = item & 0xffu;
         let q = origin + vec2<u32>(local % SCREEN_WORKGROUP, local / SCREEN_WORKGROUP);
-        store_sample(q.y * size.x + q.x, s, shade_sample(q, s, textureLoad(gb_depth, q, s)));
+        let xy = vec2<f32>(q) + sample_position(s);
+        store_sample(q.y * size.x + q.x, s, shade_at(q, s, xy, textureLoad(gb_depth, q, s)));
     }
     check_loop(i, n);
     if (li == 0u) {

@@ -16,7 +16,8 @@ fn fs_all_lights(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
 @fragment @early_depth_test(force)
 fn fs_grid(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
-    let cell = grid_cell_transparent(v.clip.xy, view_distance_from_depth(v.clip.z));
-    let color = surface_base(s) + grid_shade(s, view_dir_to(s.position), cell);
-    return lit_blended(v.clip, color, s.alpha, grid_cell_count(cell));
+    let w = view_distance_from_depth(v.clip.z);
+    let cell = grid_cell_transparent(v.clip.xy, w);
+    let lit_by = grid_shade_fragment(s, view_dir_to(s.position), cell, w);
+    return lit_blended(v.clip, surface_base(s) + lit_by.color, s.alpha, lit_by.count);
 }

@@ -14,6 +14,11 @@
 // cannot count it (`frame/targets.rs`).
 @group(0) @binding(5) var<storage, read_write> pixel_counts: array<atomic<u32>>;
 
+// Set for pipelines drawing into multisampled targets (MSAA): the count goes to the pixel's
+// entry of `pixel_counts` instead of the count target (which such a pipeline does not have),
+// and a grid fragment checks that its cell holds it (`grid_shade_fragment`).
+override MULTISAMPLED: bool = false;
+
 // Add `count` lighting computations to pixel `p`'s count (MSAA frames).
 fn count_pixel(p: vec2<u32>, count: u32) {
     if (count > 0u) {
