@@ -36,7 +36,68 @@ fn pipeline_label(r: &RunRecord) -> String {
     if let Some(d) = r.material_draws {
         label += &format!(" [{} draws]", d.name());
     }
+    if r.msaa > 1 {
+        label += &format!(" [{}x msaa]", r.msaa);
+    }
+    if let Some(m) = r.msaa_resolve {
+        label += &format!(" [{} resolve]", m.name());
+    }
     label
+}
+
+/// MSAA (tiled-forward-shading Fig. 4.4): time, memory and the edge-aware kernels' work at
+/// every sample count the run measured, when it measured more than one.
+fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
+    let runs: Vec<&RunRecord> = results
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.summary.is_some())
+        .collect();
+    if !runs.iter().any(|r| r.msaa > 1) {
+        return;
+    }
+    s.push_str("\n### MSAA (tiled-forward-shading Fig. 4.4)\n\nEvery target holds each sample; forward pipelines shade once per pixel and surface (hardware MSAA), the deferred kernels once per pixel plus every other covered sample of an edge pixel (tiled-deferred-tricks), and the tonemap resolves after the tone curve. *Cell bounds* is the Z-reduction over every sample (§4.6).\n\n| pipeline | samples | avg ms | × ideal | render targets MiB | cell bounds ms | edge pixels | samples shaded / with geometry |\n|---|---|---|---|---|---|---|---|\n");
+    for r in runs {
+        let m = r.summary.as_ref().expect("filtered");
+        let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
+            format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
+        });
+        let bounds = m
+            .passes
+            .iter()
+            .find(|p| p.label == "assign: cell bounds")
+            .map_or("-".into(), |p| format!("{:.2}", p.ms));
+        let shading: Vec<_> = r.frames.iter().filter_map(|f| f.msaa_shading).collect();
+        let (edges, shaded) = if shading.is_empty() {
+            ("-".to_string(), "-".to_string())
+        } else {
+            let sum = |f: fn(&lightgrid::frame::MsaaShading) -> u64| {
+                shading.iter().map(f).sum::<u64>() as f64
+            };
+            let pixels = f64::from(r.width) * f64::from(r.height) * shading.len() as f64;
+            (
+                format!("{:.1}%", 100.0 * sum(|m| m.edge_pixels) / pixels),
+                format!(
+                    "{:.1}%",
+                    100.0 * sum(|m| m.shaded_samples) / sum(|m| m.geometry_samples).max(1.0)
+                ),
+            )
+        };
+        let mut pipeline = match r.gbuffer_bits {
+            Some(b) => format!("{} (g{b})", r.pipeline),
+            None => r.pipeline.clone(),
+        };
+        if let Some(m) = r.msaa_resolve {
+            pipeline += &format!(" [{} resolve]", m.name());
+        }
+        let _ = writeln!(
+            s,
+            "| {pipeline} | {} | {:.2} | {ratio} | {:.1} | {bounds} | {edges} | {shaded} |",
+            r.msaa,
+            m.gpu_ms.avg,
+            m.target_bytes as f64 / (1024.0 * 1024.0),
+        );
+    }
 }
 
 /// Test (b) of the spot culling over the scene's frames, when it was measured.
@@ -88,13 +149,15 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 26] = [
+const RESULTS_CSV_COLUMNS: [&str; 30] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
     "spot_cull",
     "lists",
     "material_draws",
+    "msaa",
+    "msaa_resolve",
     "width",
     "height",
     "tile_size",
@@ -114,6 +177,8 @@ const RESULTS_CSV_COLUMNS: [&str; 26] = [
     "grid_bytes",
     "modelled_write_bytes",
     "modelled_read_bytes",
+    "edge_pixels",
+    "shaded_samples",
     "passes",
 ];
 
@@ -127,6 +192,8 @@ struct ResultsRow<'a> {
     spot_cull: Option<&'static str>,
     lists: Option<&'static str>,
     material_draws: Option<&'static str>,
+    msaa: u32,
+    msaa_resolve: Option<&'static str>,
     width: u32,
     height: u32,
     tile_size: u32,
@@ -152,6 +219,8 @@ struct ResultsRow<'a> {
     grid_bytes: Option<u64>,
     modelled_write_bytes: Option<u64>,
     modelled_read_bytes: Option<u64>,
+    edge_pixels: Option<u64>,
+    shaded_samples: Option<u64>,
     /// `label=ms` per pass, `;`-separated.
     passes: String,
 }
@@ -195,6 +264,8 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 spot_cull: r.spot_cull.map(spot_cull_name),
                 lists: r.lists.map(|l| l.name()),
                 material_draws: r.material_draws.map(|d| d.name()),
+                msaa: r.msaa,
+                msaa_resolve: r.msaa_resolve.map(|m| m.name()),
                 width: r.width,
                 height: r.height,
                 tile_size: r.tile_size,
@@ -214,6 +285,8 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 grid_bytes: f.grid_bytes,
                 modelled_write_bytes: f.modelled_write_bytes,
                 modelled_read_bytes: f.modelled_read_bytes,
+                edge_pixels: f.msaa_shading.map(|m| m.edge_pixels),
+                shaded_samples: f.msaa_shading.map(|m| m.shaded_samples),
                 passes: f
                     .passes
                     .iter()
@@ -372,12 +445,84 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
             written,
         )?;
     }
+    msaa_charts(dir, results, written)?;
     for (scene, pipeline, frame, img) in &results.heatmaps {
         let p = dir.join(format!("heatmap_{scene}_{pipeline}_f{frame}.png"));
         save_png(img, &p)?;
         written.push(p);
     }
     Ok(())
+}
+
+/// Tiled-forward-shading Fig. 4.4: (a) average frame time and (b) render-target memory
+/// against the MSAA sample count, one line per pipeline and scene (a scene and its
+/// `-opaque` variant side by side: forward with and without transparency), when the run
+/// measured more than one sample count.
+fn msaa_charts(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Result<()> {
+    let runs: Vec<&RunRecord> = results
+        .runs
+        .iter()
+        .filter(|r| r.summary.is_some() && r.gbuffer_bits.unwrap_or(16) == 16)
+        .collect();
+    let mut counts: Vec<u32> = runs.iter().map(|r| r.msaa).collect();
+    counts.sort_unstable();
+    counts.dedup();
+    if counts.len() < 2 {
+        return Ok(());
+    }
+    // One line per scene, pipeline and resolve (a run at one sample has no resolve: it
+    // starts every line of its pipeline).
+    let resolve = |r: &RunRecord| r.msaa_resolve.map_or("", |m| m.name());
+    let mut lines: Vec<(String, String, &str)> = runs
+        .iter()
+        .filter(|r| r.msaa > 1)
+        .map(|r| (r.scene.clone(), r.pipeline.clone(), resolve(r)))
+        .collect();
+    lines.sort();
+    lines.dedup();
+    let series = |value: &dyn Fn(&RunRecord) -> f64| -> Vec<Series> {
+        lines
+            .iter()
+            .map(|(scene, pipeline, how)| Series {
+                name: if how.is_empty() {
+                    format!("{pipeline} ({scene})")
+                } else {
+                    format!("{pipeline} [{how} resolve] ({scene})")
+                },
+                points: runs
+                    .iter()
+                    .filter(|r| &r.scene == scene && &r.pipeline == pipeline)
+                    .filter(|r| r.msaa == 1 || resolve(r) == *how)
+                    .map(|r| (f64::from(r.msaa), value(r)))
+                    .collect(),
+                emphasis: false,
+            })
+            .filter(|s| s.points.len() > 1)
+            .collect()
+    };
+    let (w, h) = runs.first().map_or((0, 0), |r| (r.width, r.height));
+    let time = LineChart {
+        title: format!("MSAA: average frame time ({w}x{h}; tiled-forward-shading Fig. 4.4a)"),
+        x_label: "samples per pixel".into(),
+        y_label: "ms (log scale)".into(),
+        log_x: false,
+        log_y: true,
+        series: series(&|r| r.summary.as_ref().map_or(0.0, |m| m.gpu_ms.avg)),
+    };
+    write_chart(dir, "msaa_time", time.svg(), time.png(), written)?;
+    let memory = LineChart {
+        title: format!("MSAA: render-target memory ({w}x{h}; tiled-forward-shading Fig. 4.4b)"),
+        x_label: "samples per pixel".into(),
+        y_label: "MiB".into(),
+        log_x: false,
+        log_y: false,
+        series: series(&|r| {
+            r.summary
+                .as_ref()
+                .map_or(0.0, |m| mib(m.target_bytes as f64))
+        }),
+    };
+    write_chart(dir, "msaa_memory", memory.svg(), memory.png(), written)
 }
 
 fn mib(b: f64) -> f64 {
@@ -531,6 +676,7 @@ fn summary(results: &BenchResults) -> String {
             }
         }
         spot_ray_section(&mut s, results, scene);
+        msaa_section(&mut s, results, scene);
         s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };
@@ -675,7 +821,7 @@ mod tests {
         let row = text.lines().nth(1).unwrap();
         assert_eq!(
             row,
-            ",,16,,,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,gbuffer=0.1000;shade=0.2000"
+            ",,16,,,,0,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,gbuffer=0.1000;shade=0.2000"
         );
         let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
         assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);

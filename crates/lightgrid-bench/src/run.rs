@@ -5,7 +5,7 @@ use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
 use lightgrid::culling::GridLists;
 use lightgrid::error::Result;
-use lightgrid::frame::MaterialDraws;
+use lightgrid::frame::{MaterialDraws, MsaaResolve};
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
@@ -104,6 +104,11 @@ pub struct BenchConfig {
     /// The scenes' transparent objects (`--transparency on|off`).
     #[serde(default = "default_on")]
     pub transparency: bool,
+    /// Also measure every scene that has transparent objects without them, as the scene
+    /// `<name>-opaque` (`--transparency on,off`; tiled-forward-shading Fig. 4.4 compares
+    /// tiled forward with and without transparency).
+    #[serde(default)]
+    pub opaque_variants: bool,
     /// The materials' own shaders (`--material-shaders on|off`).
     #[serde(default = "default_on")]
     pub material_shaders: bool,
@@ -119,6 +124,14 @@ pub struct BenchConfig {
     /// per entry (the others only at 1).
     #[serde(default = "default_msaa")]
     pub msaa: Vec<u32>,
+    /// Where tiled and clustered deferred resolve MSAA (`--msaa-resolve`): each is measured
+    /// once per entry at every sample count above 1.
+    #[serde(default = "default_msaa_resolve")]
+    pub msaa_resolve: Vec<MsaaResolve>,
+}
+
+fn default_msaa_resolve() -> Vec<MsaaResolve> {
+    vec![MsaaResolve::default()]
 }
 
 fn one() -> u32 {
@@ -154,6 +167,7 @@ impl BenchConfig {
             || self.lists.is_empty()
             || self.material_draws.is_empty()
             || self.msaa.is_empty()
+            || self.msaa_resolve.is_empty()
         {
             return Err(invalid(
                 "bench",
@@ -257,6 +271,9 @@ pub struct FrameRecord {
     pub modelled_write_bytes: Option<u64>,
     pub modelled_read_bytes: Option<u64>,
     pub forward_plus_table1: Option<ForwardPlusTable1>,
+    /// MSAA deferred kernels: edge pixels, samples shaded, samples with geometry.
+    #[serde(default)]
+    pub msaa_shading: Option<lightgrid::frame::MsaaShading>,
 }
 
 /// min / avg / max of a series.
@@ -373,6 +390,9 @@ pub struct RunRecord {
     /// MSAA samples per pixel.
     #[serde(default = "one")]
     pub msaa: u32,
+    /// Where the MSAA deferred kernel resolved (deferred grid pipelines above one sample).
+    #[serde(default)]
+    pub msaa_resolve: Option<MsaaResolve>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -467,6 +487,8 @@ struct Series {
     material_draws: MaterialDraws,
     /// MSAA samples per pixel.
     msaa: u32,
+    /// Where the MSAA deferred kernel resolves (recorded above one sample).
+    msaa_resolve: Option<MsaaResolve>,
     frames: Vec<u32>,
 }
 
@@ -478,6 +500,7 @@ struct Variant {
     lists: GridLists,
     material_draws: MaterialDraws,
     msaa: u32,
+    msaa_resolve: Option<MsaaResolve>,
 }
 
 fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
@@ -498,12 +521,21 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant
                     if msaa > 1 && info.msaa != pipelines::Msaa::Supported {
                         continue;
                     }
-                    out.push(Variant {
-                        spot_cull,
-                        lists,
-                        material_draws,
-                        msaa,
-                    });
+                    // Only the deferred kernels resolve, and only with MSAA.
+                    let resolves: Vec<Option<MsaaResolve>> = if msaa > 1 && !info.forward_shading {
+                        config.msaa_resolve.iter().copied().map(Some).collect()
+                    } else {
+                        vec![None]
+                    };
+                    for msaa_resolve in resolves {
+                        out.push(Variant {
+                            spot_cull,
+                            lists,
+                            material_draws,
+                            msaa,
+                            msaa_resolve,
+                        });
+                    }
                 }
             }
         }
@@ -511,23 +543,35 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant
     out
 }
 
+/// The suffix of a scene measured without its transparent objects (`opaque_variants`).
+pub const OPAQUE_SUFFIX: &str = "-opaque";
+
 fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
-    config
-        .scenes
-        .iter()
-        .map(|name| {
-            let info = catalog::find(name)?;
-            let params = SceneParams {
-                seed: config.seed,
-                lights: config.lights.filter(|_| info.variable_lights),
-                spot_fraction: config.spot_fraction,
-                headlights: config.headlights && info.robots,
-                transparency: config.transparency || !info.transparency(),
-                material_shaders: config.material_shaders,
-            };
-            catalog::build(name, &params)
-        })
-        .collect()
+    let mut scenes = Vec::new();
+    for name in &config.scenes {
+        let info = catalog::find(name)?;
+        let params = SceneParams {
+            seed: config.seed,
+            lights: config.lights.filter(|_| info.variable_lights),
+            spot_fraction: config.spot_fraction,
+            headlights: config.headlights && info.robots,
+            transparency: config.transparency || !info.transparency(),
+            material_shaders: config.material_shaders,
+        };
+        scenes.push(catalog::build(name, &params)?);
+        if config.opaque_variants && config.transparency && info.transparency() {
+            let mut opaque = catalog::build(
+                name,
+                &SceneParams {
+                    transparency: false,
+                    ..params
+                },
+            )?;
+            opaque.name = format!("{name}{OPAQUE_SUFFIX}");
+            scenes.push(opaque);
+        }
+    }
+    Ok(scenes)
 }
 
 fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<Series>> {
@@ -575,6 +619,7 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                         lists: v.lists,
                         material_draws: v.material_draws,
                         msaa: v.msaa,
+                        msaa_resolve: v.msaa_resolve,
                         frames: frames.clone(),
                     });
                 }
@@ -633,6 +678,7 @@ impl<'a> Measuring<'a> {
             lists: series.lists,
             material_draws: series.material_draws,
             msaa: series.msaa,
+            msaa_resolve: series.msaa_resolve.unwrap_or_default(),
         }
     }
 
@@ -683,6 +729,9 @@ impl<'a> Measuring<'a> {
         }
         if series.msaa > 1 {
             cull += &format!(" {}x msaa", series.msaa);
+        }
+        if let Some(r) = series.msaa_resolve {
+            cull += &format!(" {} resolve", r.name());
         }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
@@ -798,6 +847,7 @@ impl FrameRecord {
             modelled_write_bytes: s.memory.modelled_write_bytes,
             modelled_read_bytes: s.memory.modelled_read_bytes,
             forward_plus_table1: s.memory.forward_plus_table1,
+            msaa_shading: s.msaa_shading,
         }
     }
 }
@@ -812,6 +862,7 @@ impl RunRecord {
             lists: None,
             material_draws: None,
             msaa: series.msaa,
+            msaa_resolve: series.msaa_resolve,
             width: size.0,
             height: size.1,
             tile_size: tile,

@@ -168,6 +168,7 @@ pub(crate) struct Given {
     pub(crate) material_draws: bool,
     /// `--msaa` above 1.
     pub(crate) msaa: bool,
+    pub(crate) msaa_resolve: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -178,7 +179,7 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 7] = [
+    let rules: [(&str, bool, Applies); 8] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
@@ -190,6 +191,9 @@ pub(crate) fn check_applies(
         ("--msaa", given.msaa, |p| {
             p.msaa == lightgrid::pipelines::Msaa::Supported
         }),
+        ("--msaa-resolve", given.msaa_resolve, |p| {
+            p.msaa == lightgrid::pipelines::Msaa::Supported && !p.forward_shading
+        }),
     ];
     for (flag, given, applies) in rules {
         if given && !chosen.iter().any(|p| applies(p)) {
@@ -198,10 +202,21 @@ pub(crate) fn check_applies(
                 .filter(|p| applies(p))
                 .map(|p| p.id)
                 .collect();
+            // A pipeline that refuses MSAA says why.
+            let why: Vec<String> = chosen
+                .iter()
+                .filter_map(|p| match p.msaa {
+                    lightgrid::pipelines::Msaa::Refused(why) if flag == "--msaa" => {
+                        Some(format!(" ({}: {why})", p.id))
+                    }
+                    _ => None,
+                })
+                .collect();
             let chosen: Vec<&str> = chosen.iter().map(|p| p.id).collect();
             anyhow::bail!(
-                "{flag} does not apply to {}; it applies to: {}",
+                "{flag} does not apply to {}{}; it applies to: {}",
                 chosen.join(", "),
+                why.concat(),
                 takers.join(", ")
             );
         }
@@ -241,6 +256,37 @@ pub(crate) struct RendererArgs {
     /// tiled_deferred_single refuse MSAA.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) msaa: u32,
+    /// Where tiled and clustered deferred resolve MSAA: separate (per-sample colours, then
+    /// the tonemap) or kernel (inside the shading kernel, tiled-deferred-tricks Trick 1;
+    /// frames with transparent objects resolve separately) [default: separate].
+    #[arg(long, value_enum)]
+    pub(crate) msaa_resolve: Option<MsaaResolveArg>,
+}
+
+/// `--msaa-resolve` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum MsaaResolveArg {
+    Separate,
+    Kernel,
+}
+
+impl From<MsaaResolveArg> for lightgrid::frame::MsaaResolve {
+    fn from(a: MsaaResolveArg) -> Self {
+        match a {
+            MsaaResolveArg::Separate => lightgrid::frame::MsaaResolve::Separate,
+            MsaaResolveArg::Kernel => lightgrid::frame::MsaaResolve::Kernel,
+        }
+    }
+}
+
+/// `--msaa-resolve` only means something with MSAA.
+pub(crate) fn check_msaa_resolve(resolve_given: bool, msaa: &[u32]) -> Result<()> {
+    if resolve_given && msaa.iter().all(|&n| n <= 1) {
+        anyhow::bail!(
+            "--msaa-resolve needs --msaa above 1 (it says where MSAA samples are resolved)"
+        );
+    }
+    Ok(())
 }
 
 impl RendererArgs {
@@ -257,7 +303,9 @@ impl RendererArgs {
                 .map_or(RenderSettings::default().lists, Into::into),
             material_draws: self.material_draws.map(Into::into).unwrap_or_default(),
             msaa: self.msaa,
+            msaa_resolve: self.msaa_resolve.map(Into::into).unwrap_or_default(),
         };
+        check_msaa_resolve(self.msaa_resolve.is_some(), &[self.msaa])?;
         settings.validate()?;
         Ok(settings)
     }
@@ -272,6 +320,7 @@ impl RendererArgs {
             lists: self.lists.is_some(),
             material_draws: self.material_draws.is_some(),
             msaa: self.msaa > 1,
+            msaa_resolve: self.msaa_resolve.is_some(),
         }
     }
 }

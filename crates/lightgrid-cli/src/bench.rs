@@ -28,6 +28,10 @@ pub(crate) enum Preset {
     /// every 20, grid pipelines with separate and with shared opaque/transparent lists, with
     /// forward and deferred beside them.
     Transparency,
+    /// MSAA (tiled-forward-shading Fig. 4.4 and 4.1(c)): random-fps (the paper's 1,024
+    /// random lights) with and without its translucent blocks, frames 0..259 every 20,
+    /// tiled and clustered forward and deferred at every sample count the adapter offers.
+    Msaa,
 }
 
 #[derive(Args)]
@@ -61,6 +65,10 @@ pub(crate) struct BenchArgs {
     /// [default: 1].
     #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
     pub(crate) msaa: Vec<u32>,
+    /// Where tiled and clustered deferred resolve MSAA: separate, kernel, or separate,kernel
+    /// to measure both [default: separate; the msaa preset: both].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) msaa_resolve: Vec<crate::args::MsaaResolveArg>,
     /// G-buffer precisions to measure: 16, 32 or 16,32.
     #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
     pub(crate) gbuffer: Vec<GBufferFormat>,
@@ -85,9 +93,10 @@ pub(crate) struct BenchArgs {
     /// [default: cone].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(crate) spot_cull: Vec<SpotCullArg>,
-    /// The scenes' transparent objects (robots and random scenes).
-    #[arg(long, value_enum)]
-    pub(crate) transparency: Option<OnOff>,
+    /// The scenes' transparent objects (robots and random scenes): on, off, or on,off to
+    /// also measure each scene with glass without it (as `<scene>-opaque`) [default: on].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) transparency: Vec<OnOff>,
     /// The materials' own shaders (car paint, rim); off renders every material standard.
     #[arg(long, value_enum)]
     pub(crate) material_shaders: Option<OnOff>,
@@ -126,6 +135,7 @@ pub(crate) struct BenchDefaults {
     pub(crate) spot_culls: Vec<lightgrid::pipelines::SpotCull>,
     pub(crate) lists: Vec<lightgrid::culling::GridLists>,
     pub(crate) msaa: Vec<u32>,
+    pub(crate) msaa_resolve: Vec<lightgrid::frame::MsaaResolve>,
 }
 
 /// A study of one dimension over robots-many's animation (frames every 20, the papers' size
@@ -150,6 +160,7 @@ fn study(
         spot_culls: vec![Default::default()],
         lists: default_lists(),
         msaa: vec![1],
+        msaa_resolve: vec![Default::default()],
     }
 }
 
@@ -157,7 +168,12 @@ fn default_lists() -> Vec<lightgrid::culling::GridLists> {
     vec![lightgrid::pipelines::RenderSettings::default().lists]
 }
 
-pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig> {
+/// `supported`: the MSAA sample counts the adapter offers (the msaa preset measures them all).
+pub(crate) fn bench_config(
+    a: &BenchArgs,
+    hardware: bool,
+    supported: &[u32],
+) -> Result<BenchConfig> {
     let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
     let d = match a.preset {
         None => BenchDefaults {
@@ -171,6 +187,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             spot_culls: vec![Default::default()],
             lists: default_lists(),
             msaa: vec![1],
+            msaa_resolve: vec![Default::default()],
         },
         Some(Preset::Quick) => BenchDefaults {
             scenes: vec!["robots-many"],
@@ -183,6 +200,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             spot_culls: vec![Default::default()],
             lists: default_lists(),
             msaa: vec![1],
+            msaa_resolve: vec![Default::default()],
         },
         Some(Preset::Spots) => BenchDefaults {
             spot_fraction: 1.0,
@@ -198,6 +216,23 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
                 lightgrid::culling::GridLists::Shared,
             ],
             ..study(hardware, |p| p.assign)
+        },
+        Some(Preset::Msaa) => BenchDefaults {
+            scenes: vec!["random-fps"],
+            pipelines: [
+                "tiled_forward_prez",
+                "clustered_forward",
+                "tiled_deferred",
+                "clustered_deferred",
+            ]
+            .map(String::from)
+            .to_vec(),
+            msaa: supported.to_vec(),
+            msaa_resolve: vec![
+                lightgrid::frame::MsaaResolve::Separate,
+                lightgrid::frame::MsaaResolve::Kernel,
+            ],
+            ..study(hardware, |_| false)
         },
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
@@ -215,6 +250,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
             spot_culls: vec![Default::default()],
             lists: default_lists(),
             msaa: vec![1],
+            msaa_resolve: vec![Default::default()],
         },
     };
     let (scenes, frames, size, gbuffers, repeat, pipelines) = (
@@ -263,7 +299,9 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         } else {
             a.spot_cull.iter().map(|&c| c.into()).collect()
         },
-        transparency: a.transparency.is_none_or(OnOff::on),
+        transparency: a.transparency.is_empty() || a.transparency.iter().any(|t| t.on()),
+        opaque_variants: matches!(a.preset, Some(Preset::Msaa)) && a.transparency.is_empty()
+            || a.transparency.iter().any(|t| !t.on()) && a.transparency.iter().any(|t| t.on()),
         material_shaders: a.material_shaders.is_none_or(OnOff::on),
         lists: if a.lists.is_empty() {
             d.lists.clone()
@@ -280,7 +318,13 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         } else {
             a.msaa.clone()
         },
+        msaa_resolve: if a.msaa_resolve.is_empty() {
+            d.msaa_resolve.clone()
+        } else {
+            a.msaa_resolve.iter().map(|&m| m.into()).collect()
+        },
     };
+    crate::args::check_msaa_resolve(!a.msaa_resolve.is_empty(), &config.msaa)?;
     config.validate()?;
     let chosen: Vec<_> = config
         .pipelines
@@ -295,6 +339,7 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
         lists: !a.lists.is_empty(),
         material_draws: !a.material_draws.is_empty(),
         msaa: a.msaa.iter().any(|&n| n > 1),
+        msaa_resolve: !a.msaa_resolve.is_empty(),
     };
     check_applies(given, &chosen)?;
     Ok(config)
@@ -303,7 +348,11 @@ pub(crate) fn bench_config(a: &BenchArgs, hardware: bool) -> Result<BenchConfig>
 pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     check_out_dir(&a.out)?;
     let ctx = GpuContext::new(adapter)?;
-    let config = bench_config(a, !ctx.is_software())?;
+    let config = bench_config(
+        a,
+        !ctx.is_software(),
+        &ctx.sample_counts(GBufferFormat::F16),
+    )?;
     for &n in &config.msaa {
         for &g in &config.gbuffers {
             ctx.check_sample_count(n, g)?;

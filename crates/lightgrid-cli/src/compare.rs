@@ -106,6 +106,19 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             outcome = Outcome::Interrupted(STOPPED_BY_SIGNAL.into());
             break;
         }
+        if let (true, lightgrid::pipelines::Msaa::Refused(why)) = (settings.msaa > 1, p.msaa) {
+            println!("{:<24} skipped: refuses MSAA ({why})", p.id);
+            rows.push(Row {
+                pipeline: p.id,
+                failed: None,
+                gpu_ms: None,
+                diff: None,
+                diff_note: Some(format!("skipped: refuses MSAA ({why})")),
+                lighting_computations: None,
+                ideal_lighting_computations: None,
+            });
+            continue;
+        }
         let warm = (0..a.scene.warmup)
             .try_for_each(|_| renderer.render(&scene, a.scene.frame, p.id).map(drop));
         let out = match warm.and_then(|_| renderer.render(&scene, a.scene.frame, p.id)) {

@@ -96,6 +96,7 @@ fn main() {
                         lists: None,
                         material_draws: None,
                         msaa: 1,
+                        msaa_resolve: None,
                     },
                     warmup: 1,
                 },

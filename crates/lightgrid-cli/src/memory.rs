@@ -15,20 +15,51 @@ pub(crate) struct MemoryArgs {
     /// G-buffer channel precision in bits for deferred pipelines.
     #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
     pub(crate) gbuffer: GBufferFormat,
+    /// MSAA samples per pixel, or a list (1,2,4,8): one table per count (tiled-forward-shading
+    /// Fig. 4.4). A model: any count lightgrid knows (1, 2, 4, 8, 16), whether or not this
+    /// machine's adapter offers it.
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_delimiter = ',',
+        default_value = "1"
+    )]
+    pub(crate) msaa: Vec<u32>,
 }
 
 pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
+    for &n in &a.msaa {
+        lightgrid::frame::validate_msaa(n)?;
+    }
+    for &n in &a.msaa {
+        table(a, n);
+    }
+    footer(a)
+}
+
+/// The targets and traffic of every pipeline at `samples` samples per pixel.
+fn table(a: &MemoryArgs, samples: u32) {
     let Size(w, h) = a.size;
     let settings = RenderSettings {
         gbuffer: a.gbuffer,
+        msaa: samples,
         ..Default::default()
     };
-    println!("render targets at {w}x{h}, {}-bit G-buffer (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
+    let msaa = if samples > 1 {
+        format!(", {samples}x MSAA (every target per sample)")
+    } else {
+        String::new()
+    };
+    println!("render targets at {w}x{h}, {}-bit G-buffer{msaa} (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
     println!(
         "{:<22} {:>6} {:>10}   {:>9} {:>9} {:>9} {:>9}   targets",
         "pipeline", "B/px", "total MiB", "wr B/px", "rd B/px", "wr B/lit", "rd B/lit"
     );
     for p in PIPELINES {
+        if let (true, lightgrid::pipelines::Msaa::Refused(why)) = (samples > 1, p.msaa) {
+            println!("{:<22} refuses MSAA: {why}", p.id);
+            continue;
+        }
         let m = p.memory_model(&settings);
         let t = m.traffic;
         let targets: Vec<String> = m
@@ -48,6 +79,15 @@ pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
             targets.join(", ")
         );
     }
+    println!();
+}
+
+fn footer(a: &MemoryArgs) -> Result<()> {
+    let Size(w, h) = a.size;
+    let settings = RenderSettings {
+        gbuffer: a.gbuffer,
+        ..Default::default()
+    };
     println!(
         "traffic model (deferred-shading-vs-deferred-lighting): render-target bytes per pixel and per lit pixel \
          (one lighting computation); blending counts as read + write; light data {} B per light, grid indices {} B; \

@@ -100,6 +100,28 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
             s.grid_cells_occupied.unwrap_or(0),
         );
     }
+    if s.msaa > 1 {
+        let edges = match s.msaa_shading {
+            Some(m) => format!(
+                ": {} edge pixels ({:.1}%) shaded per sample, {} samples shaded of {} with geometry ({:.1}%)",
+                m.edge_pixels,
+                100.0 * m.edge_pixels as f64 / (f64::from(s.width) * f64::from(s.height)),
+                m.shaded_samples,
+                m.geometry_samples,
+                100.0 * m.shaded_samples as f64 / m.geometry_samples.max(1) as f64
+            ),
+            None => String::new(),
+        };
+        let fallbacks = if s.msaa_fallback_fragments > 0 {
+            format!(
+                "; {} fragments off their cell's bounds lit by every light",
+                s.msaa_fallback_fragments
+            )
+        } else {
+            String::new()
+        };
+        println!("msaa {}x{edges}{fallbacks}", s.msaa);
+    }
     println!(
         "frame: {} queue submission(s), {} bytes read back and {:.2} ms waited inside the frame{}",
         s.submits,

@@ -383,7 +383,15 @@ fn bench_quick_preset_writes_its_report() {
         "summary records the command"
     );
     assert_fails_with(
-        &["bench", "--msaa", "4", "--out", dir.to_str().unwrap()],
+        &[
+            "bench",
+            "--msaa",
+            "4",
+            "--pipelines",
+            "deferred",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
         "MSAA",
     );
     assert_fails_with(

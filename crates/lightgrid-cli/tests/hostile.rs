@@ -585,6 +585,26 @@ fn counts_and_thresholds_are_bounded_where_parsed() {
             "not one of the measured frames",
         ),
         (&["report", d], "results.json: No such file"),
+        // --msaa: zero, a count no adapter has, huge, negative, NaN, one the adapter lacks
+        // (lavapipe: 1 and 4 only), and in a list.
+        (&["render", "--msaa", "0"], "must be one of 1, 2, 4, 8, 16"),
+        (&["render", "--msaa", "3"], "must be one of 1, 2, 4, 8, 16"),
+        (
+            &["compare", "--msaa", "4294967295", "--out-dir", d],
+            "must be one of 1, 2, 4, 8, 16",
+        ),
+        (&["play", "--msaa", "-4"], "invalid value '-4'"),
+        (&["render", "--msaa", "NaN"], "invalid value 'NaN'"),
+        (
+            &["memory", "--msaa", "1,0"],
+            "must be one of 1, 2, 4, 8, 16",
+        ),
+        (&["render", "--msaa", "16"], "for every target"),
+        (&["bench", "--msaa", "1,8", "--out", d], "for every target"),
+        (
+            &["render", "--pipeline", "deferred", "--msaa", "4"],
+            "--msaa does not apply to deferred (deferred: light volumes",
+        ),
     ];
     all_refused_leaving_nothing(&dir, cases);
 }

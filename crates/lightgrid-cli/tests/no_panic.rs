@@ -86,6 +86,9 @@ const NAMES: &[&str] = &[
     "separate,shared",
     "per-material",
     "uber",
+    "4",
+    "1,4",
+    "16",
 ];
 
 /// Options per command, with the safe values that keep a valid run short (tiny frames, one
@@ -108,6 +111,7 @@ const CMDS: &[Cmd] = &[
             "--material-shaders",
             "--lists",
             "--material-draws",
+            "--msaa",
             "--scene",
             "--frame",
             "--size",
@@ -136,6 +140,7 @@ const CMDS: &[Cmd] = &[
             "--material-shaders",
             "--lists",
             "--material-draws",
+            "--msaa",
             "--scene",
             "--pipeline",
             "--assign",
@@ -245,7 +250,7 @@ const CMDS: &[Cmd] = &[
     },
     Cmd {
         name: "memory",
-        flags: &["--size", "--gbuffer"],
+        flags: &["--size", "--gbuffer", "--msaa"],
         paths: &[],
         safe: &[],
     },

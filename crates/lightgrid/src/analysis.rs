@@ -196,6 +196,8 @@ pub(crate) struct AnalysisInput<'r> {
     pub io: FrameIo,
     pub reruns: u32,
     pub wall_ms: f64,
+    /// The technique resolved MSAA inside its kernel (wrote the display target itself).
+    pub resolved_in_kernel: bool,
 }
 
 /// Read the frame's copies back and compute its statistics.
@@ -306,6 +308,13 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             msaa: settings.msaa,
             msaa_shading: a.finished.msaa_shading,
             msaa_fallback_fragments: a.finished.msaa_fallback_fragments,
+            msaa_resolve: a.finished.msaa_shading.map(|_| {
+                if a.resolved_in_kernel {
+                    crate::frame::MsaaResolve::Kernel
+                } else {
+                    crate::frame::MsaaResolve::Separate
+                }
+            }),
             lighting_computations,
             ideal_lighting_computations: ideal,
             transparent_fragments: fragments.len() as u64,

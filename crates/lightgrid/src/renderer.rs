@@ -504,8 +504,10 @@ impl<'c> Renderer<'c> {
             .expect("created with the technique")
             .encode(&inputs, &mut enc, technique.transparent_lights())?;
         let (encoder, timer) = enc.parts();
-        self.tonemap
-            .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
+        if !technique.resolved_to_display() {
+            self.tonemap
+                .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
+        }
         if analysis {
             self.readbacks.encode(device, encoder, &self.targets);
         }
@@ -713,6 +715,10 @@ impl<'c> Renderer<'c> {
                 io,
                 reruns,
                 wall_ms,
+                resolved_in_kernel: self
+                    .techniques
+                    .get(info.id)
+                    .is_some_and(|t| t.resolved_to_display()),
             });
         }
     }

@@ -75,6 +75,10 @@ pub struct FrameStats {
     /// outside their cell's bounds, so they looped over every light (`grid_shade_fragment`).
     #[serde(default)]
     pub msaa_fallback_fragments: u64,
+    /// Where the MSAA deferred kernel resolved this frame: `kernel` (Trick 1) or `separate`
+    /// (per-sample buffer, tonemap); None for other frames.
+    #[serde(default)]
+    pub msaa_resolve: Option<crate::frame::MsaaResolve>,
     /// Times the light function ran this frame (tiled-shading §8): for forward pipelines the
     /// fragments shaded times the lights each looped over, for deferred ones the samples
     /// times their tile's list length. None where the adapter cannot count (no R32Float

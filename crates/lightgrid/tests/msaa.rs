@@ -13,6 +13,7 @@ mod common;
 
 use glam::{Mat4, Vec3};
 use lightgrid::culling::cell_bounds_cpu_samples;
+use lightgrid::frame::MsaaResolve;
 use lightgrid::pipelines::{Msaa, PIPELINES, REFERENCE};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{
@@ -258,9 +259,19 @@ fn edge_pixels_are_found_and_each_edge_sample_is_shaded_once() {
     let ctx = common::gpu();
     let s = wall_scene();
     let (w, h) = (96, 64);
-    for id in ["tiled_deferred", "clustered_deferred"] {
-        let mut r = Renderer::new(&ctx, w, h, msaa(16)).unwrap();
+    for (id, resolve) in [
+        ("tiled_deferred", MsaaResolve::Separate),
+        ("clustered_deferred", MsaaResolve::Separate),
+        ("tiled_deferred", MsaaResolve::Kernel),
+    ] {
+        let settings = RenderSettings {
+            msaa_resolve: resolve,
+            ..msaa(16)
+        };
+        let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
         let out = r.render(&s, 0, id).unwrap();
+        assert_eq!(out.stats.msaa_resolve, Some(resolve), "{id}");
+        let id = &format!("{id} ({} resolve)", resolve.name());
         let counts = out.counts.as_ref().expect("MSAA counts");
         let mut edges = 0u64;
         let mut shaded = 0u64;
@@ -332,6 +343,64 @@ fn check_resolve(id: &str, out: &FrameOutput, w: u32) {
         }
     }
     assert!(checked > 10, "{id}: only {checked} edge pixels checked");
+}
+
+/// Trick 1 (the resolve inside the kernel, packed 16-bit sums of the tone-mapped samples)
+/// renders what the separate resolve renders (per-sample colours in 16-bit floats, the
+/// tonemap averaging them): within rounding, on a frame without transparent objects; a
+/// frame with them resolves separately (the glass blends over every sample).
+#[test]
+fn the_in_kernel_resolve_equals_the_separate_resolve() {
+    let ctx = common::gpu();
+    let params = SceneParams {
+        transparency: false,
+        ..Default::default()
+    };
+    let opaque = catalog::build("robots-many", &params).unwrap();
+    let glass = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h) = (160, 90);
+    for id in ["tiled_deferred", "clustered_deferred"] {
+        let mut outs = Vec::new();
+        for resolve in [MsaaResolve::Separate, MsaaResolve::Kernel] {
+            let settings = RenderSettings {
+                msaa_resolve: resolve,
+                ..msaa(16)
+            };
+            let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
+            let out = r.render(&opaque, 0, id).unwrap();
+            assert_eq!(out.stats.msaa_resolve, Some(resolve), "{id}");
+            let with_glass = r.render(&glass, 0, id).unwrap();
+            assert_eq!(
+                with_glass.stats.msaa_resolve,
+                Some(MsaaResolve::Separate),
+                "{id}: transparent objects need every sample"
+            );
+            outs.push(out);
+        }
+        let cmp = common::compare_images(
+            &outs[0].image,
+            &outs[1].image,
+            common::ImageTolerance {
+                max_mean: 0.1,
+                max_p99: 1.0,
+                level: 2,
+                max_over: 0,
+            },
+        );
+        assert!(
+            cmp.passes(),
+            "{id}: kernel vs separate resolve: {}",
+            cmp.describe()
+        );
+        assert_eq!(
+            outs[0].stats.lighting_computations, outs[1].stats.lighting_computations,
+            "{id}: the same samples shaded"
+        );
+        assert_eq!(
+            outs[0].stats.msaa_shading, outs[1].stats.msaa_shading,
+            "{id}"
+        );
+    }
 }
 
 #[test]

@@ -236,6 +236,7 @@ fn a_loop_cut_short_is_counted() {
     );
     let counters = buffer(COUNTER_BYTES as usize, wgpu::BufferUsages::STORAGE);
     let bounds = buffer(16, wgpu::BufferUsages::STORAGE);
+    let pixel_counts = buffer(16, wgpu::BufferUsages::STORAGE);
     let group = bind_resources(
         device,
         "cut loop",
@@ -246,6 +247,7 @@ fn a_loop_cut_short_is_counted() {
             materials.as_entire_binding(),
             counters.as_entire_binding(),
             bounds.as_entire_binding(),
+            pixel_counts.as_entire_binding(),
         ],
     );
     let mut encoder = device.create_command_encoder(&Default::default());

@@ -12,7 +12,7 @@ pub mod targets;
 
 pub use settings::{
     validate_msaa, validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists,
-    MaterialDraws, RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
+    MaterialDraws, MsaaResolve, RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::Targets;
 

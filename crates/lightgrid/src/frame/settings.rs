@@ -22,6 +22,32 @@ pub struct RenderSettings {
     /// MSAA samples per pixel of every target (`--msaa`): 1 (none) or a count the adapter
     /// offers for every format (`GpuContext::sample_counts`).
     pub msaa: u32,
+    /// Where the MSAA deferred kernels resolve (`--msaa-resolve`).
+    pub msaa_resolve: MsaaResolve,
+}
+
+/// Where the edge-aware MSAA kernels of tiled and clustered deferred resolve their samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MsaaResolve {
+    /// Every sample's colour into a per-sample buffer, written into the multisampled HDR
+    /// target by a sample-rate pass, resolved by the tonemap (Lauritzen's flat buffer).
+    #[default]
+    Separate,
+    /// Inside the kernel (tiled-deferred-tricks, Trick 1): each pixel's tone-mapped samples
+    /// summed in workgroup memory as packed 16-bit integers with atomics, the display colour
+    /// written directly. A frame with transparent objects resolves separately (they blend
+    /// over every sample after the kernel).
+    Kernel,
+}
+
+impl MsaaResolve {
+    pub fn name(self) -> &'static str {
+        match self {
+            MsaaResolve::Separate => "separate",
+            MsaaResolve::Kernel => "kernel",
+        }
+    }
 }
 
 /// How forward pipelines draw materials with different shaders (tiled-forward-shading §4.7).
@@ -57,6 +83,7 @@ impl Default for RenderSettings {
             lists: GridLists::Separate,
             material_draws: MaterialDraws::PerMaterial,
             msaa: 1,
+            msaa_resolve: MsaaResolve::Separate,
         }
     }
 }

@@ -161,7 +161,12 @@ impl Targets {
             COUNT_FORMAT,
             U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::COPY_SRC,
         );
-        let ldr_texture = make("ldr", LDR_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+        // COPY_DST: the MSAA kernels' in-kernel resolve copies its colours in.
+        let ldr_texture = make(
+            "ldr",
+            LDR_FORMAT,
+            U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST,
+        );
         let pixel_counts = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pixel lighting counts"),
             size: if samples > 1 {

@@ -11,6 +11,7 @@ pub(crate) fn shader(samples: u32) -> ComposedShader {
         &[
             super::FULLSCREEN_WGSL,
             &crate::shader::msaa_wgsl(samples),
+            crate::shader::src::TONE,
             include_str!("tonemap.wgsl"),
         ],
     )

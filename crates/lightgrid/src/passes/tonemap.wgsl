@@ -10,10 +10,6 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
     return fullscreen_position(i);
 }
 
-fn tone(c: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(1.0) - exp(-max(c, vec3<f32>(0.0)) * EXPOSURE);
-}
-
 @fragment
 fn fs_tonemap(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(pos.xy);

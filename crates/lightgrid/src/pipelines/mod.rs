@@ -63,6 +63,11 @@ pub trait Technique {
     fn transparent_lights(&self) -> TransparentLights<'_> {
         TransparentLights::Own
     }
+    /// Did the last recorded frame write the display target itself (the MSAA kernels'
+    /// in-kernel resolve), so the tonemap must not run?
+    fn resolved_to_display(&self) -> bool {
+        false
+    }
 }
 
 /// How a pipeline renders with MSAA (`--msaa` above 1).

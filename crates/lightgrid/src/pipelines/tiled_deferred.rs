@@ -19,11 +19,12 @@ use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
 use crate::culling::{CellSource, GridBuilder, GridDims};
 use crate::error::Result;
+use crate::frame::MsaaResolve;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
     compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
 };
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, compute_pipeline_with, src, ComposedShader};
 
 /// Shared modules of a single-sample deferred compute shader (no vertex stage).
 fn deferred_parts(single_sample: &str) -> Vec<&str> {
@@ -60,6 +61,7 @@ fn kernel_shader(samples: u32) -> ComposedShader {
             &msaa,
             GBUFFER_READ_WGSL,
             src::LIGHT_GRID,
+            src::TONE,
             include_str!("tiled_deferred_msaa.wgsl"),
         ],
     )
@@ -112,6 +114,12 @@ struct SampleOutputs {
     kernel_group: wgpu::BindGroup,
     expand: wgpu::RenderPipeline,
     expand_group: wgpu::BindGroup,
+    /// The in-kernel resolve's display colours (`--msaa-resolve kernel`), copied into the
+    /// display target.
+    resolved: wgpu::Texture,
+    /// The kernel variant resolving inside (Trick 1), and whether the last frame used it.
+    resolving_kernel: Option<wgpu::ComputePipeline>,
+    resolved_last: bool,
 }
 
 impl SampleOutputs {
@@ -121,18 +129,44 @@ impl SampleOutputs {
         (w, h): (u32, u32),
         samples: u32,
     ) -> (wgpu::BindGroupLayout, Self) {
-        use crate::gpu::{bind_resources, buffer_layout, STORAGE_RW};
+        use crate::gpu::{bind_resources, STORAGE_RW};
         let buffer = crate::gpu::storage_buffer(
             device,
             "msaa sample colours",
             u64::from(w) * u64::from(h) * u64::from(samples) * 8,
         );
-        let kernel_layout = buffer_layout(device, "msaa kernel outputs (group 3)", &[STORAGE_RW]);
+        let resolved = crate::passes::render_texture(
+            device,
+            "msaa resolved in kernel",
+            wgpu::TextureFormat::Rgba8Unorm,
+            (w, h),
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
+        let kernel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("msaa kernel outputs (group 3)"),
+            entries: &[
+                crate::gpu::buffer_entry(0, STORAGE_RW),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba8Unorm,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let resolved_view = resolved.create_view(&Default::default());
         let kernel_group = bind_resources(
             device,
             "msaa kernel outputs",
             &kernel_layout,
-            &[buffer.as_entire_binding()],
+            &[
+                buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&resolved_view),
+            ],
         );
         let expand_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sample expand"),
@@ -192,8 +226,21 @@ impl SampleOutputs {
                 kernel_group,
                 expand,
                 expand_group,
+                resolved,
+                resolving_kernel: None,
+                resolved_last: false,
             },
         )
+    }
+
+    /// The in-kernel resolve's colours into the display target.
+    fn encode_copy(&self, f: &FrameInputs, enc: &mut FrameEncoder) {
+        let (encoder, _) = enc.parts();
+        encoder.copy_texture_to_texture(
+            self.resolved.as_image_copy(),
+            f.targets.ldr_texture.as_image_copy(),
+            self.resolved.size(),
+        );
     }
 
     /// The per-sample colours into the multisampled HDR target.
@@ -244,25 +291,37 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         samples,
     );
     let builder = GridBuilder::new(&ctx.grid_setup(), slices, CellSource::Depth);
-    let (outputs_layout, outputs) = if samples > 1 {
+    let (outputs_layout, mut outputs) = if samples > 1 {
         let (layout, outputs) = SampleOutputs::new(ctx.device, (w, h), samples);
         (layout, Outputs::Samples(outputs))
     } else {
         let layout = compute_outputs_layout(ctx.device);
         (layout.clone(), Outputs::Targets(layout))
     };
+    let layouts = [
+        Some(ctx.scene_layout),
+        Some(builder.layout()),
+        Some(&gbuffer.read_layout),
+        Some(&outputs_layout),
+    ];
+    let kernel = kernel_shader(samples);
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred shading",
-        &kernel_shader(samples),
+        &kernel,
         "main",
-        &[
-            Some(ctx.scene_layout),
-            Some(builder.layout()),
-            Some(&gbuffer.read_layout),
-            Some(&outputs_layout),
-        ],
+        &layouts,
     );
+    if let (Outputs::Samples(o), MsaaResolve::Kernel) = (&mut outputs, ctx.settings.msaa_resolve) {
+        o.resolving_kernel = Some(compute_pipeline_with(
+            ctx.device,
+            "tiled deferred shading (resolve in kernel)",
+            &kernel,
+            "main",
+            &layouts,
+            &[("RESOLVE_IN_KERNEL", 1.0)],
+        ));
+    }
     Box::new(TiledDeferred {
         gbuffer,
         outputs,
@@ -350,6 +409,15 @@ impl Technique for TiledDeferred {
             Outputs::Targets(layout) => compute_outputs(f.device, layout, f.targets),
             Outputs::Samples(s) => s.kernel_group.clone(),
         };
+        // Trick 1 only where nothing blends over the samples after the kernel.
+        let resolving = match &mut self.outputs {
+            Outputs::Samples(s) => {
+                s.resolved_last = s.resolving_kernel.is_some() && !f.has_transparency();
+                s.resolving_kernel.as_ref().filter(|_| s.resolved_last)
+            }
+            Outputs::Targets(_) => None,
+        };
+        let shading = resolving.unwrap_or(&self.shading);
         let (group1, label, groups) = match &mut self.variant {
             Variant::Multi { builder, label } => {
                 builder.build(f, enc)?;
@@ -377,7 +445,7 @@ impl Technique for TiledDeferred {
         };
         let (encoder, timer) = enc.parts();
         let mut pass = timer.begin_compute(encoder, label);
-        pass.set_pipeline(&self.shading);
+        pass.set_pipeline(shading);
         pass.set_bind_group(0, f.scene_bind_group, &[]);
         pass.set_bind_group(1, group1, &[]);
         pass.set_bind_group(2, &read_group, &[]);
@@ -385,9 +453,17 @@ impl Technique for TiledDeferred {
         pass.dispatch_workgroups(groups.0, groups.1, 1);
         drop(pass);
         if let Outputs::Samples(s) = &self.outputs {
-            s.encode_expand(f, enc);
+            if s.resolved_last {
+                s.encode_copy(f, enc);
+            } else {
+                s.encode_expand(f, enc);
+            }
         }
         Ok(())
+    }
+
+    fn resolved_to_display(&self) -> bool {
+        matches!(&self.outputs, Outputs::Samples(s) if s.resolved_last)
     }
 
     fn grid_builder(&mut self) -> Option<&mut GridBuilder> {

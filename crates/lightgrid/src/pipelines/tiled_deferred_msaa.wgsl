@@ -18,8 +18,40 @@
 
 // Per sample (pixel * SAMPLES + sample): HDR colour as two pack2x16float words.
 @group(3) @binding(0) var<storage, read_write> sample_colors: array<vec2<u32>>;
+// The in-kernel resolve's output: the display colour, sRGB-encoded (copied into the sRGB
+// display target, which cannot be a storage texture).
+@group(3) @binding(1) var resolved: texture_storage_2d<rgba8unorm, write>;
+
+// Resolve inside the kernel (tiled-deferred-tricks, Trick 1) instead of storing every
+// sample's colour: each pixel's tone-mapped samples, weighted 1/SAMPLES, are summed in
+// workgroup memory as 16-bit fixed point (two channels per u32, one atomicAdd per pair; the
+// weighted values are rounded down so a pixel's sum stays below 2^16 and never carries into
+// the next channel).
+override RESOLVE_IN_KERNEL: bool = false;
 
 const GROUP_PIXELS: u32 = SCREEN_WORKGROUP * SCREEN_WORKGROUP;
+// Per pixel of the workgroup: (R | G << 16, B).
+var<workgroup> accum: array<atomic<u32>, GROUP_PIXELS * 2u>;
+
+// Add `weight` of the tone-mapped `color` to local pixel `l`'s resolved colour.
+fn accumulate(l: u32, color: vec3<f32>, weight: f32) {
+    let q = vec3<u32>(floor(clamp(tone(color), vec3<f32>(0.0), vec3<f32>(1.0)) * weight * 65535.0));
+    atomicAdd(&accum[2u * l], q.r | (q.g << 16u));
+    atomicAdd(&accum[2u * l + 1u], q.b);
+}
+
+fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
+    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
+}
+
+// Sample `s` of pixel `p`: stored, or added to local pixel `l`'s resolved colour.
+fn output_sample(p: vec2<u32>, l: u32, s: u32, color: vec3<f32>, weight: f32) {
+    if (RESOLVE_IN_KERNEL) {
+        accumulate(l, color, weight);
+    } else {
+        store_sample(p.y * u32(frame.viewport.x) + p.x, s, color);
+    }
+}
 
 // The queued edge samples: (local pixel index << 8) | sample.
 var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
@@ -64,6 +96,8 @@ fn main(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
+    atomicStore(&accum[2u * li], 0u);
+    atomicStore(&accum[2u * li + 1u], 0u);
     if (li == 0u) {
         atomicStore(&queued, 0u);
         atomicStore(&group_edges, 0u);
@@ -98,14 +132,21 @@ fn main(
             }
             atomicAdd(&group_first, 1u);
         }
-        store_sample(pixel, 0u, c0);
+        let weight = 1.0 / f32(SAMPLES);
+        if (RESOLVE_IN_KERNEL && !edge) {
+            accumulate(li, c0, 1.0);
+        } else {
+            output_sample(p, li, 0u, c0, weight);
+        }
         for (var s = 1u; s < SAMPLES; s = s + 1u) {
             if (!edge) {
-                store_sample(pixel, s, c0);
+                if (!RESOLVE_IN_KERNEL) {
+                    store_sample(pixel, s, c0);
+                }
             } else if (textureLoad(gb_depth, p, s) < 1.0) {
                 queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
             } else {
-                store_sample(pixel, s, vec3<f32>(0.0));
+                output_sample(p, li, s, vec3<f32>(0.0), weight);
             }
         }
         if (edge) {
@@ -123,9 +164,19 @@ fn main(
         let s = item & 0xffu;
         let q = origin + vec2<u32>(local % SCREEN_WORKGROUP, local / SCREEN_WORKGROUP);
         let xy = vec2<f32>(q) + sample_position(s);
-        store_sample(q.y * size.x + q.x, s, shade_at(q, s, xy, textureLoad(gb_depth, q, s)));
+        let color = shade_at(q, s, xy, textureLoad(gb_depth, q, s));
+        output_sample(q, local, s, color, 1.0 / f32(SAMPLES));
     }
     check_loop(i, n);
+    if (RESOLVE_IN_KERNEL) {
+        workgroupBarrier();
+        if (p.x < size.x && p.y < size.y) {
+            let rg = atomicLoad(&accum[2u * li]);
+            let b = atomicLoad(&accum[2u * li + 1u]);
+            let c = vec3<f32>(f32(rg & 0xffffu), f32(rg >> 16u), f32(b)) / 65535.0;
+            textureStore(resolved, p, vec4<f32>(srgb_encode(c), 1.0));
+        }
+    }
     if (li == 0u) {
         atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
         atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n);

@@ -18,6 +18,8 @@ pub mod src {
         include_str!("../culling/light_grid.wgsl")
     );
     pub const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
+    /// `tone(c)`: the tone curve.
+    pub const TONE: &str = include_str!("../shading/tone.wgsl");
 }
 
 /// The modules every scene-geometry shader starts with: structs, group-0 bindings, the light
@@ -127,6 +129,18 @@ pub fn compute_pipeline(
     entry: &str,
     layouts: &[Option<&wgpu::BindGroupLayout>],
 ) -> wgpu::ComputePipeline {
+    compute_pipeline_with(device, label, shader, entry, layouts, &[])
+}
+
+/// As [`compute_pipeline`], with values for the shader's `override` constants.
+pub fn compute_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &ComposedShader,
+    entry: &str,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let module = create_module(device, shader);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
@@ -138,7 +152,10 @@ pub fn compute_pipeline(
         layout: Some(&layout),
         module: &module,
         entry_point: Some(entry),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
         cache: None,
     })
 }
