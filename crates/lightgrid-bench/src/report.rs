@@ -484,11 +484,20 @@ fn msaa_charts(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -
         lines
             .iter()
             .map(|(scene, pipeline, how)| Series {
-                name: if how.is_empty() {
-                    format!("{pipeline} ({scene})")
-                } else {
-                    format!("{pipeline} [{how} resolve] ({scene})")
-                },
+                // Short enough for the legend: [k]ernel / [s]eparate resolve, the scene's
+                // opaque variant marked.
+                name: format!(
+                    "{pipeline}{}{}",
+                    match how.chars().next() {
+                        Some(c) => format!(" [{c}]"),
+                        None => String::new(),
+                    },
+                    if scene.ends_with(crate::run::OPAQUE_SUFFIX) {
+                        " opaque"
+                    } else {
+                        ""
+                    }
+                ),
                 points: runs
                     .iter()
                     .filter(|r| &r.scene == scene && &r.pipeline == pipeline)
@@ -502,7 +511,9 @@ fn msaa_charts(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -
     };
     let (w, h) = runs.first().map_or((0, 0), |r| (r.width, r.height));
     let time = LineChart {
-        title: format!("MSAA: average frame time ({w}x{h}; tiled-forward-shading Fig. 4.4a)"),
+        title: format!(
+            "MSAA: average frame time ({w}x{h}; [k]/[s]: kernel/separate resolve; Fig. 4.4a)"
+        ),
         x_label: "samples per pixel".into(),
         y_label: "ms (log scale)".into(),
         log_x: false,

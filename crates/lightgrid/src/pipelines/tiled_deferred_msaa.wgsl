@@ -4,15 +4,16 @@
 //
 // Each invocation owns a pixel. It compares the pixel's samples (edge: a sample with or
 // without geometry where sample 0 differs, another material, a normal more than ~8 degrees
-// off (EDGE_NORMAL_COS), or a view distance more than EDGE_DEPTH_RATIO off) and shades
-// sample 0. A pixel that is no edge is done: its one colour goes to every sample. An edge
+// off (EDGE_NORMAL_COS), or a view distance more than EDGE_DEPTH_RATIO off) and shades the
+// pixel once. A pixel that is no edge is done: its one colour goes to every sample. An edge
 // pixel queues its other covered samples in workgroup memory; after a barrier every
 // invocation of the workgroup takes queued samples in turn, so a workgroup with few edges
 // does not leave most invocations idle while a few loop over their samples. A pixel is
 // shaded at its centre, an edge sample at its own place (its depth at its standard position
 // in the pixel: `sample_position`), and each sample's colour is stored in
 // `sample_colors`; a fragment pass writes them into the multisampled HDR target
-// (`sample_expand.wgsl`), where the transparent pass blends and the tonemap resolves.
+// (`sample_expand.wgsl`), where the transparent pass blends and the tonemap resolves. Or,
+// with RESOLVE_IN_KERNEL, the samples are resolved here (Trick 1, below).
 // Counts go to `pixel_counts` (lighting computations) and the frame counters (edge pixels,
 // samples shaded, samples with geometry).
 
