@@ -112,15 +112,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
             ),
             None => String::new(),
         };
-        let fallbacks = if s.msaa_fallback_fragments > 0 {
-            format!(
-                "; {} fragments off their cell's bounds lit by every light",
-                s.msaa_fallback_fragments
-            )
-        } else {
-            String::new()
-        };
-        println!("msaa {}x{edges}{fallbacks}", s.msaa);
+        println!("msaa {}x{edges}", s.msaa);
     }
     println!(
         "frame: {} queue submission(s), {} bytes read back and {:.2} ms waited inside the frame{}",

@@ -307,7 +307,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             gbuffer_bits: settings.gbuffer.bits(),
             msaa: settings.msaa,
             msaa_shading: a.finished.msaa_shading,
-            msaa_fallback_fragments: a.finished.msaa_fallback_fragments,
+            fragments_off_bounds: a.finished.fragments_off_bounds,
             msaa_resolve: a.finished.msaa_shading.map(|_| {
                 if a.resolved_in_kernel {
                     crate::frame::MsaaResolve::Kernel

@@ -93,9 +93,10 @@ pub const COUNTER_EDGE_PIXELS: u32 = 16;
 pub const COUNTER_SHADED_SAMPLES: u32 = 17;
 /// Samples with geometry the MSAA shading kernels saw (what per-sample shading would shade).
 pub const COUNTER_GEOMETRY_SAMPLES: u32 = 18;
-/// MSAA forward fragments whose shading point lay outside their cell's bounds and looped
-/// over every light instead (`grid_shade_fragment` in `light_grid.wgsl`).
-pub const COUNTER_MSAA_FALLBACKS: u32 = 19;
+/// MSAA forward fragments whose shading point lay outside their cell's bounds, so their list
+/// may miss lights (`grid_shade_fragment` in `light_grid.wgsl`): the frame is wrong when
+/// non-zero (the fragment-bounds pass keeps it zero).
+pub const COUNTER_OFF_BOUNDS_FRAGMENTS: u32 = 19;
 /// Number of slots.
 pub const COUNTER_SLOTS: u32 = 20;
 
@@ -262,8 +263,8 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
         WgslConst::U32(COUNTER_GEOMETRY_SAMPLES),
     ),
     (
-        "COUNTER_MSAA_FALLBACKS",
-        WgslConst::U32(COUNTER_MSAA_FALLBACKS),
+        "COUNTER_OFF_BOUNDS_FRAGMENTS",
+        WgslConst::U32(COUNTER_OFF_BOUNDS_FRAGMENTS),
     ),
     ("EDGE_NORMAL_COS", WgslConst::F32(EDGE_NORMAL_COS)),
     ("EDGE_DEPTH_RATIO", WgslConst::F32(EDGE_DEPTH_RATIO)),

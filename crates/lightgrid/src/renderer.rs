@@ -568,7 +568,7 @@ impl<'c> Renderer<'c> {
                 shaded_samples: r.values.shaded_samples().into(),
                 geometry_samples: r.values.geometry_samples().into(),
             }),
-            msaa_fallback_fragments: r.values.msaa_fallbacks().into(),
+            fragments_off_bounds: r.values.fragments_off_bounds().into(),
         })
     }
 
@@ -678,6 +678,15 @@ impl<'c> Renderer<'c> {
                 return Err(Error::TruncatedLoops {
                     pipeline: info.id.to_string(),
                     count: finished.truncated_loops,
+                });
+            }
+            if finished.fragments_off_bounds > 0 {
+                return Err(Error::Gpu {
+                    stage: info.id.into(),
+                    message: format!(
+                        "{} MSAA fragments lay outside their light-grid cell's bounds (their lists may miss lights); the frame is refused",
+                        finished.fragments_off_bounds
+                    ),
                 });
             }
             if finished.overflowed {

@@ -72,9 +72,10 @@ pub struct FrameStats {
     #[serde(default)]
     pub msaa_shading: Option<crate::frame::MsaaShading>,
     /// MSAA grid-forward fragments whose pixel centre (extrapolated off their triangle) lay
-    /// outside their cell's bounds, so they looped over every light (`grid_shade_fragment`).
+    /// outside their cell's bounds (`grid_shade_fragment`). An analysis frame refuses a
+    /// non-zero count, so a written file always says 0.
     #[serde(default)]
-    pub msaa_fallback_fragments: u64,
+    pub fragments_off_bounds: u64,
     /// Where the MSAA deferred kernel resolved this frame: `kernel` (Trick 1) or `separate`
     /// (per-sample buffer, tonemap); None for other frames.
     #[serde(default)]

@@ -174,12 +174,9 @@ impl GridBuilder {
             },
             enc,
         )?;
-        self.buffers.encode_bounds(
-            f.device,
-            enc.parts().0,
-            self.bounds.buffer(),
-            dims.cell_count(),
-        );
+        let checked = (source == CellSource::Depth).then(|| self.bounds.buffer());
+        self.buffers
+            .encode_bounds(f.device, f.queue, enc.parts().0, checked, dims.cell_count());
         self.last = Some(LastFrame {
             dims,
             assign,

@@ -113,6 +113,10 @@ fn bounds_union(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
 
 /// The GPU kernel and the bounds buffer it fills.
 pub struct CellBoundsPass {
+    /// With MSAA: the fragments' view distances folded into the bounds first.
+    fragments: Option<super::fragment_bounds::FragmentBounds>,
+    /// Binding 5 without MSAA (unread).
+    no_fragments: wgpu::Buffer,
     pipeline: wgpu::ComputePipeline,
     args: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -143,6 +147,7 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(2, crate::gpu::STORAGE_RW),
                 crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),
                 crate::gpu::buffer_entry(4, crate::gpu::STORAGE_RW),
+                crate::gpu::buffer_entry(5, crate::gpu::STORAGE_READ),
             ],
         });
         let s = shader(samples);
@@ -156,6 +161,10 @@ impl CellBoundsPass {
             mapped_at_creation: false,
         });
         CellBoundsPass {
+            fragments: (samples > 1).then(|| {
+                super::fragment_bounds::FragmentBounds::new(device, scene_layout, samples)
+            }),
+            no_fragments: storage_buffer(device, "no fragment bounds", 16),
             pipeline,
             args,
             layout,
@@ -196,9 +205,16 @@ impl CellBoundsPass {
     pub fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder, dims: &GridDims) {
         let (device, queue, scene, depth) =
             (f.device, f.queue, f.scene_bind_group, &f.targets.depth);
-        let (encoder, timer) = enc.parts();
         self.ensure(device, dims);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
+        if let Some(fragments) = &mut self.fragments {
+            fragments.encode(f, enc, dims, &self.params);
+        }
+        let fragment_bounds = self
+            .fragments
+            .as_ref()
+            .map_or(&self.no_fragments, |b| b.buffer());
+        let (encoder, timer) = enc.parts();
         let group = bind_resources(
             device,
             "cell bounds",
@@ -209,6 +225,7 @@ impl CellBoundsPass {
                 self.bounds.as_entire_binding(),
                 self.occupied.as_entire_binding(),
                 self.occupancy.as_entire_binding(),
+                fragment_bounds.as_entire_binding(),
             ],
         );
         encoder.clear_buffer(&self.occupancy, 0, None);

@@ -15,6 +15,21 @@
 @group(1) @binding(3) var<storage, read_write> occupied_cells: array<u32>;
 // [0]: occupied cells; [1..4]: workgroup counts for dispatch_workgroups_indirect.
 @group(1) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>, 4>;
+// With MSAA, the bounds of the fragments each cell's shading will look up
+// (`fragment_bounds.wgsl`: (0xffffffff - min bits, max bits), zero = none); unused without.
+@group(1) @binding(5) var<storage, read> fragment_bounds: array<u32>;
+
+// Cell `cell`'s fragment bounds (min > max when none).
+fn fragment_range(cell: u32) -> vec2<f32> {
+    if (SAMPLES == 1u) {
+        return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+    }
+    let lo = fragment_bounds[2u * cell];
+    if (lo == 0u) {
+        return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+    }
+    return vec2<f32>(bitcast<f32>(0xffffffffu - lo), bitcast<f32>(fragment_bounds[2u * cell + 1u]));
+}
 
 const W_INFINITY: u32 = 0x7f800000u;
 
@@ -78,12 +93,13 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     for (; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
         var b = vec2<f32>(bitcast<f32>(atomicLoad(&slice_lo[k])), bitcast<f32>(atomicLoad(&slice_hi[k])));
         let cell = k * tiles + tile;
+        b = bounds_union(b, fragment_range(cell));
         if (grid.lists != GRID_LISTS_OPAQUE) {
             let t = transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi)));
             if (grid.lists == GRID_LISTS_SHARED) {
                 b = bounds_union(b, t);
             } else {
-                write_bounds(grid.layer_cells + cell, t);
+                write_bounds(grid.layer_cells + cell, bounds_union(t, fragment_range(grid.layer_cells + cell)));
             }
         }
         write_bounds(cell, b);

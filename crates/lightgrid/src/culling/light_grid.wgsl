@@ -26,34 +26,18 @@ fn grid_light(cell: u32, i: u32) -> Light {
 
 // A forward fragment: its surface lit by the lights of `cell` (found at the fragment's pixel
 // and view distance `w`), and how many it looped. With MSAA a fragment covering part of a
-// pixel is shaded at the pixel centre, which may lie outside its triangle: its extrapolated
-// depth can leave the bounds of every sample of the cell (measured: clustered_forward 75
-// levels off at such edges). Such a fragment loops over every light instead (counted in
-// COUNTER_MSAA_FALLBACKS), so no light reaching it is ever missing.
-struct FragmentLight {
-    color: vec3<f32>,
-    count: u32,
-}
-
-fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> FragmentLight {
-    // Rare (robots-many and random-fps at 320x180: ~140 fragments a frame) but not cheap on
-    // lavapipe, whose fragment loops run as long as their longest lane over a whole block:
-    // random-fps 4x, tiled_forward_prez 87 ms with the fallback capped at 16 lights, 2.3 s
-    // with every light (measured). A GPU diverges per warp only.
-    let every_light = MULTISAMPLED && !grid_cell_holds(cell, w);
-    if (every_light) {
-        atomicAdd(&frame_counters[COUNTER_MSAA_FALLBACKS], 1u);
+// pixel is shaded at the pixel centre, which may lie off its triangle: its extrapolated depth
+// can leave the bounds of every sample of the cell (measured: clustered_forward 75 levels off
+// at such edges, lights missing). The cell bounds therefore include every fragment's `w`
+// (`fragment_bounds.wgsl`), and a fragment outside them anyway is counted
+// (COUNTER_OFF_BOUNDS_FRAGMENTS): the frame is reported wrong, never passed off as right.
+// (Looping over every light instead is no option: lavapipe runs helper lanes, whose
+// extrapolated depths leave the bounds, to the end of such a loop, 15x slower: measured.)
+fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> vec3<f32> {
+    if (MULTISAMPLED && !grid_cell_holds(cell, w)) {
+        atomicAdd(&frame_counters[COUNTER_OFF_BOUNDS_FRAGMENTS], 1u);
     }
-    var out: FragmentLight;
-    out.count = select(grid_cell_count(cell), frame.light_count, every_light);
-    out.color = vec3<f32>(0.0);
-    var i = 0u;
-    for (; i < out.count; i = i + 1u) {
-        let l = select(grid_indices[grid_cells[cell].x + i], i, every_light);
-        out.color += shade_light(s, view_dir, lights[l]);
-    }
-    check_loop(i, out.count);
-    return out;
+    return grid_shade(s, view_dir, cell);
 }
 
 // Sum of the cell's lights on the surface (Listing 1's computeLight).

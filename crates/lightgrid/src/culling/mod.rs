@@ -8,6 +8,7 @@ mod builder;
 mod bvh;
 mod bvh_gpu;
 mod cell_bounds;
+mod fragment_bounds;
 mod gather;
 mod gpu_assign;
 mod grid;
@@ -46,6 +47,7 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
     vec![
         cell_bounds::shader(1),
         cell_bounds::shader(4),
+        fragment_bounds::shader(),
         scan::shader(),
         radix_sort::shader(),
         gpu_assign::gather_shader(),

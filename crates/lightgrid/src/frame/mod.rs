@@ -179,7 +179,7 @@ pub struct FinishedFrame {
     pub overflowed: bool,
     /// The MSAA deferred kernels' edge counts (None where none ran).
     pub msaa_shading: Option<MsaaShading>,
-    /// MSAA forward fragments whose shading point lay outside their cell's bounds (shaded
-    /// with every light instead).
-    pub msaa_fallback_fragments: u64,
+    /// MSAA forward fragments whose shading point lay outside their cell's bounds, so their
+    /// lists may have missed lights: the frame is wrong when non-zero.
+    pub fragments_off_bounds: u64,
 }

@@ -8,7 +8,7 @@
 use super::{wait_idle, PassTimer};
 use crate::consts::{
     COUNTER_EDGE_PIXELS, COUNTER_GEOMETRY_SAMPLES, COUNTER_INDEX_NEEDED, COUNTER_INDEX_OUT_OF_ROOM,
-    COUNTER_MSAA_FALLBACKS, COUNTER_PAIRS_NEEDED, COUNTER_PAIRS_OUT_OF_ROOM,
+    COUNTER_OFF_BOUNDS_FRAGMENTS, COUNTER_PAIRS_NEEDED, COUNTER_PAIRS_OUT_OF_ROOM,
     COUNTER_SHADED_SAMPLES, COUNTER_SLOTS, COUNTER_TRUNCATED_LOOPS, COUNTER_WRITE_OVERFLOW,
 };
 use crate::error::{Error, Result};
@@ -54,9 +54,9 @@ impl CounterValues {
     pub fn geometry_samples(&self) -> u32 {
         self.get(COUNTER_GEOMETRY_SAMPLES)
     }
-    /// MSAA forward fragments outside their cell's bounds, shaded with every light.
-    pub fn msaa_fallbacks(&self) -> u32 {
-        self.get(COUNTER_MSAA_FALLBACKS)
+    /// MSAA forward fragments outside their cell's bounds (the frame is wrong when non-zero).
+    pub fn fragments_off_bounds(&self) -> u32 {
+        self.get(COUNTER_OFF_BOUNDS_FRAGMENTS)
     }
     /// Count and write passes disagreed (a bug, never silent).
     pub fn write_overflow(&self) -> u32 {

@@ -9,7 +9,8 @@
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let w = view_distance_from_depth(v.clip.z);
-    let lit_by = grid_shade_fragment(s, view_dir_to(s.position), grid_cell(v.clip.xy, w), w);
-    return lit(v.clip, surface_base(s) + lit_by.color, lit_by.count);
+    let cell = grid_cell(v.clip.xy, w);
+    let color = surface_base(s) + grid_shade_fragment(s, view_dir_to(s.position), cell, w);
+    return lit(v.clip, color, grid_cell_count(cell));
 }
 

@@ -18,6 +18,6 @@ fn fs_grid(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let w = view_distance_from_depth(v.clip.z);
     let cell = grid_cell_transparent(v.clip.xy, w);
-    let lit_by = grid_shade_fragment(s, view_dir_to(s.position), cell, w);
-    return lit_blended(v.clip, surface_base(s) + lit_by.color, s.alpha, lit_by.count);
+    let color = surface_base(s) + grid_shade_fragment(s, view_dir_to(s.position), cell, w);
+    return lit_blended(v.clip, color, s.alpha, grid_cell_count(cell));
 }
