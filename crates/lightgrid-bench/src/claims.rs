@@ -330,7 +330,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
                 let ratio = td / tf.max(1e-9);
                 (
                     format!(
-                        "avg ms at 4x MSAA: tiled_deferred {td:.1}, tiled_forward_prez {tf:.1}: forward {ratio:.2}x faster{}",
+                        "avg ms at 4x MSAA: tiled_deferred {td:.1}, tiled_forward_prez {tf:.1}: forward {ratio:.3}x faster{}",
                         if ratio > 2.0 { " (beyond the paper's 2x)" } else { "" }
                     ),
                     verdict(ratio >= 1.5),

@@ -56,17 +56,20 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
     if !runs.iter().any(|r| r.msaa > 1) {
         return;
     }
-    s.push_str("\n### MSAA (tiled-forward-shading Fig. 4.4)\n\nEvery target holds each sample; forward pipelines shade once per pixel and surface (hardware MSAA), the deferred kernels once per pixel plus every other covered sample of an edge pixel (tiled-deferred-tricks), and the tonemap resolves after the tone curve. *Cell bounds* is the Z-reduction over every sample (§4.6).\n\n| pipeline | samples | avg ms | × ideal | render targets MiB | cell bounds ms | edge pixels | samples shaded / with geometry |\n|---|---|---|---|---|---|---|---|\n");
+    s.push_str("\n### MSAA (tiled-forward-shading Fig. 4.4)\n\nEvery target holds each sample; forward pipelines shade once per pixel and surface (hardware MSAA), the deferred kernels once per pixel plus every other covered sample of an edge pixel (tiled-deferred-tricks), and the tonemap resolves after the tone curve. *Cell bounds* is the Z-reduction over every sample (§4.6); with MSAA, *fragment bounds* adds every fragment's pixel-centre distance to its cell first (`fragment_bounds.wgsl`).\n\n| pipeline | samples | avg ms | × ideal | render targets MiB | cell bounds ms | fragment bounds ms | edge pixels | samples shaded / with geometry |\n|---|---|---|---|---|---|---|---|---|\n");
     for r in runs {
         let m = r.summary.as_ref().expect("filtered");
         let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
             format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
         });
-        let bounds = m
-            .passes
-            .iter()
-            .find(|p| p.label == "assign: cell bounds")
-            .map_or("-".into(), |p| format!("{:.2}", p.ms));
+        let pass_ms = |label: &str| {
+            m.passes
+                .iter()
+                .find(|p| p.label == label)
+                .map_or("-".into(), |p| format!("{:.2}", p.ms))
+        };
+        let bounds = pass_ms("assign: cell bounds");
+        let fragments = pass_ms("assign: fragment bounds");
         let shading: Vec<_> = r.frames.iter().filter_map(|f| f.msaa_shading).collect();
         let (edges, shaded) = if shading.is_empty() {
             ("-".to_string(), "-".to_string())
@@ -92,7 +95,7 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
         }
         let _ = writeln!(
             s,
-            "| {pipeline} | {} | {:.2} | {ratio} | {:.1} | {bounds} | {edges} | {shaded} |",
+            "| {pipeline} | {} | {:.2} | {ratio} | {:.1} | {bounds} | {fragments} | {edges} | {shaded} |",
             r.msaa,
             m.gpu_ms.avg,
             m.target_bytes as f64 / (1024.0 * 1024.0),

@@ -35,6 +35,9 @@ pub struct GridSetup<'a> {
     pub lists: GridLists,
     /// Samples per pixel of the depth target the cell bounds read (`--msaa`).
     pub samples: u32,
+    /// A forward pass shades the opaque geometry from this grid (with MSAA its fragments'
+    /// distances go into the bounds: `fragment_bounds.rs`); deferred kernels shade samples.
+    pub forward_opaque: bool,
 }
 
 /// A built grid and what went into it (analysis).
@@ -87,7 +90,7 @@ impl GridBuilder {
             lists: ctx.lists,
             software_adapter: ctx.software_adapter,
             scene_layout: scene_layout.clone(),
-            bounds: CellBoundsPass::new(device, scene_layout, ctx.samples),
+            bounds: CellBoundsPass::new(device, scene_layout, ctx.samples, ctx.forward_opaque),
             buffers: GridBuffers::new(device),
             strategies: Vec::new(),
             last: None,

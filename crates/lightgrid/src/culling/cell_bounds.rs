@@ -129,7 +129,13 @@ pub struct CellBoundsPass {
 
 impl CellBoundsPass {
     /// The kernel over a depth target of `samples` samples per pixel.
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout, samples: u32) -> Self {
+    /// `forward_opaque`: a forward pass shades the opaque fragments from these bounds' grid.
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        samples: u32,
+        forward_opaque: bool,
+    ) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cell bounds (group 1)"),
             entries: &[
@@ -162,7 +168,12 @@ impl CellBoundsPass {
         });
         CellBoundsPass {
             fragments: (samples > 1).then(|| {
-                super::fragment_bounds::FragmentBounds::new(device, scene_layout, samples)
+                super::fragment_bounds::FragmentBounds::new(
+                    device,
+                    scene_layout,
+                    samples,
+                    forward_opaque,
+                )
             }),
             no_fragments: storage_buffer(device, "no fragment bounds", 16),
             pipeline,

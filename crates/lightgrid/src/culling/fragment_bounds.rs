@@ -20,6 +20,9 @@ pub(crate) fn shader() -> ComposedShader {
 }
 
 pub(crate) struct FragmentBounds {
+    /// Whether a forward pass shades the opaque fragments (else only the transparent ones
+    /// look cells up).
+    forward_opaque: bool,
     layout: wgpu::BindGroupLayout,
     opaque: wgpu::RenderPipeline,
     transparent: wgpu::RenderPipeline,
@@ -31,6 +34,7 @@ impl FragmentBounds {
         device: &wgpu::Device,
         scene_layout: &wgpu::BindGroupLayout,
         samples: u32,
+        forward_opaque: bool,
     ) -> Self {
         let module = create_module(device, &shader());
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
@@ -60,6 +64,7 @@ impl FragmentBounds {
             )
         };
         FragmentBounds {
+            forward_opaque,
             // The opaque shading passes test LessEqual against the pre-pass depth; the
             // transparent pass Less against the opaque depth.
             opaque: pipeline(
@@ -105,6 +110,9 @@ impl FragmentBounds {
         );
         let (encoder, timer) = enc.parts();
         encoder.clear_buffer(&self.buffer, 0, None);
+        if !self.forward_opaque && !f.has_transparency() {
+            return;
+        }
         let label = "assign: fragment bounds";
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
@@ -115,12 +123,11 @@ impl FragmentBounds {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.opaque);
-        draw_scene(&mut pass, f, &[&group]);
-        if f.has_transparency() {
-            pass.set_pipeline(&self.transparent);
-            for d in f.transparent {
-                pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
-            }
+        let opaque = if self.forward_opaque { f.opaque } else { &[] };
+        draw_scene(&mut pass, &FrameInputs { opaque, ..*f }, &[&group]);
+        pass.set_pipeline(&self.transparent);
+        for d in f.transparent {
+            pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
         }
     }
 }

@@ -43,6 +43,7 @@ impl PipelineContext<'_> {
             software_adapter: self.software_adapter,
             lists: self.settings.lists,
             samples: self.settings.msaa,
+            forward_opaque: true,
         }
     }
 }

@@ -290,7 +290,11 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         (w, h),
         samples,
     );
-    let builder = GridBuilder::new(&ctx.grid_setup(), slices, CellSource::Depth);
+    let setup = crate::culling::GridSetup {
+        forward_opaque: false,
+        ..ctx.grid_setup()
+    };
+    let builder = GridBuilder::new(&setup, slices, CellSource::Depth);
     let (outputs_layout, mut outputs) = if samples > 1 {
         let (layout, outputs) = SampleOutputs::new(ctx.device, (w, h), samples);
         (layout, Outputs::Samples(outputs))

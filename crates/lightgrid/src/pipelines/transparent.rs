@@ -74,6 +74,7 @@ impl TransparentPass {
             &crate::culling::GridSetup {
                 assign: Assign::Gather,
                 lists: GridLists::Shared,
+                forward_opaque: false,
                 ..ctx.grid_setup()
             },
             1,
