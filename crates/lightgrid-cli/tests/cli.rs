@@ -392,7 +392,7 @@ fn bench_quick_preset_writes_its_report() {
             "--out",
             dir.to_str().unwrap(),
         ],
-        "MSAA",
+        "--msaa does not apply to deferred (deferred: light volumes",
     );
     assert_fails_with(
         &["bench", "--frames", "9..3", "--out", dir.to_str().unwrap()],

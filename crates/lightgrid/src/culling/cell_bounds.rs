@@ -139,16 +139,7 @@ impl CellBoundsPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cell bounds (group 1)"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: samples > 1,
-                    },
-                    count: None,
-                },
+                crate::passes::sampled_texture_entry(0, wgpu::TextureSampleType::Depth, samples),
                 crate::gpu::buffer_entry(1, crate::gpu::UNIFORM),
                 crate::gpu::buffer_entry(2, crate::gpu::STORAGE_RW),
                 crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),

@@ -31,6 +31,59 @@ pub fn shaders() -> Vec<ComposedShader> {
 /// `fullscreen_position(vertex_index)`: a screen-covering triangle.
 pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
 
+/// What a full-screen pass (`vs_fullscreen` + one fragment entry, no depth) draws with.
+pub(crate) struct FullscreenDesc<'a> {
+    pub label: &'a str,
+    pub shader: &'a ComposedShader,
+    pub fragment_entry: &'a str,
+    pub layout: &'a wgpu::BindGroupLayout,
+    pub target: wgpu::TextureFormat,
+    /// Samples per pixel of the target.
+    pub samples: u32,
+    /// Values of the shader's `override` constants.
+    pub constants: &'a [(&'a str, f64)],
+}
+
+/// A full-screen triangle pipeline (tonemap, the MSAA sample expand).
+pub(crate) fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    d: &FullscreenDesc,
+) -> wgpu::RenderPipeline {
+    let module = crate::shader::create_module(device, d.shader);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(d.label),
+        bind_group_layouts: &[Some(d.layout)],
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(d.label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_fullscreen"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState {
+            count: d.samples,
+            ..Default::default()
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(d.fragment_entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: d.constants,
+                ..Default::default()
+            },
+            targets: &[Some(d.target.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// WGSL of a deferred compute pass's outputs (group 3).
 pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
 

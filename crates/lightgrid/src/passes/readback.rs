@@ -129,16 +129,7 @@ impl DepthSamples {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth samples"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: samples > 1,
-                    },
-                    count: None,
-                },
+                super::sampled_texture_entry(0, wgpu::TextureSampleType::Depth, samples),
                 crate::gpu::buffer_entry(1, crate::gpu::STORAGE_RW),
             ],
         });

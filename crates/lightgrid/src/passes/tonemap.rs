@@ -3,7 +3,7 @@
 
 use super::LDR_FORMAT;
 use crate::gpu::PassTimer;
-use crate::shader::{compose, create_module, ComposedShader};
+use crate::shader::{compose, ComposedShader};
 
 pub(crate) fn shader(samples: u32) -> ComposedShader {
     compose(
@@ -25,46 +25,26 @@ pub struct Tonemap {
 impl Tonemap {
     /// The tonemap of a frame with `samples` samples per pixel (above one, it resolves).
     pub fn new(device: &wgpu::Device, samples: u32) -> Self {
-        let module = create_module(device, &shader(samples));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: samples > 1,
-                },
-                count: None,
-            }],
+            entries: &[super::sampled_texture_entry(
+                0,
+                wgpu::TextureSampleType::Float { filterable: false },
+                samples,
+            )],
         });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("tonemap"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("tonemap"),
-            layout: Some(&pl),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
+        let pipeline = super::fullscreen_pipeline(
+            device,
+            &super::FullscreenDesc {
+                label: "tonemap",
+                shader: &shader(samples),
+                fragment_entry: "fs_tonemap",
+                layout: &layout,
+                target: LDR_FORMAT,
+                samples: 1,
+                constants: &[],
             },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_tonemap"),
-                compilation_options: Default::default(),
-                targets: &[Some(LDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         Tonemap { pipeline, layout }
     }
 

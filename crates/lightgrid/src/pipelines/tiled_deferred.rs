@@ -187,39 +187,18 @@ impl SampleOutputs {
             &expand_layout,
             &[buffer.as_entire_binding()],
         );
-        let module = crate::shader::create_module(device, &expand_shader(samples));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sample expand"),
-            bind_group_layouts: &[Some(&expand_layout)],
-            immediate_size: 0,
-        });
-        let expand = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sample expand"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
+        let expand = crate::passes::fullscreen_pipeline(
+            device,
+            &crate::passes::FullscreenDesc {
+                label: "sample expand",
+                shader: &expand_shader(samples),
+                fragment_entry: "fs_expand",
+                layout: &expand_layout,
+                target: crate::passes::HDR_FORMAT,
+                samples,
+                constants: &[("WIDTH", f64::from(w))],
             },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState {
-                count: samples,
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_expand"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("WIDTH", f64::from(w))],
-                    ..Default::default()
-                },
-                targets: &[Some(crate::passes::HDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         (
             kernel_layout,
             SampleOutputs {
