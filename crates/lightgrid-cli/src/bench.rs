@@ -351,11 +351,11 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     let config = bench_config(
         a,
         !ctx.is_software(),
-        &ctx.sample_counts(GBufferFormat::F16),
+        &lightgrid::frame::msaa_counts(&ctx, GBufferFormat::F16),
     )?;
     for &n in &config.msaa {
         for &g in &config.gbuffers {
-            ctx.check_sample_count(n, g)?;
+            lightgrid::frame::check_msaa(&ctx, n, g)?;
         }
     }
     let prepared = lightgrid_bench::prepare(&config)?;

@@ -101,7 +101,7 @@ pub const COUNTER_OFF_BOUNDS_FRAGMENTS: u32 = 19;
 pub const COUNTER_SLOTS: u32 = 20;
 
 /// MSAA sample counts lightgrid knows (`--msaa`); the adapter decides which it offers
-/// (`GpuContext::sample_counts`).
+/// (`frame::msaa_counts`).
 pub const MSAA_COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
 /// The standard sample positions (Vulkan `standardSampleLocations`, D3D's standard
 /// patterns) within a pixel, for `samples` samples: where a per-sample shading kernel

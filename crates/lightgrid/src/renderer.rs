@@ -164,7 +164,7 @@ impl<'c> Renderer<'c> {
     ) -> Result<Self> {
         validate_size(ctx, width, height)?;
         settings.validate()?;
-        ctx.check_sample_count(settings.msaa, settings.gbuffer)?;
+        crate::frame::check_msaa(ctx, settings.msaa, settings.gbuffer)?;
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {

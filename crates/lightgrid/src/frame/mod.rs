@@ -14,7 +14,7 @@ pub use settings::{
     validate_msaa, validate_slices, validate_tile_size, Assign, GBufferFormat, GridLists,
     MaterialDraws, MsaaResolve, RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
-pub use targets::Targets;
+pub use targets::{check_msaa, msaa_counts, Targets};
 
 use crate::error::Result;
 use crate::gpu::{read_buffer, scoped, PassTimer, PassTiming};

@@ -20,7 +20,7 @@ pub struct RenderSettings {
     /// How forward pipelines draw the material shaders (`--material-draws`).
     pub material_draws: MaterialDraws,
     /// MSAA samples per pixel of every target (`--msaa`): 1 (none) or a count the adapter
-    /// offers for every format (`GpuContext::sample_counts`).
+    /// offers for every format (`frame::msaa_counts`).
     pub msaa: u32,
     /// Where the MSAA deferred kernels resolve (`--msaa-resolve`).
     pub msaa_resolve: MsaaResolve,

@@ -13,6 +13,34 @@ pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 /// renderer sums the target. 32-bit float holds integers exactly up to 2^24 per pixel.
 pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
+/// The MSAA sample counts the adapter offers for every multisampled target of a frame (HDR
+/// colour, depth, and the G-buffer in `gbuffer`'s format), ascending; always has 1.
+pub fn msaa_counts(ctx: &crate::gpu::GpuContext, gbuffer: super::GBufferFormat) -> Vec<u32> {
+    ctx.sample_counts(&[HDR_FORMAT, DEPTH_FORMAT, gbuffer.texture_format()])
+}
+
+/// Refuse a sample count the adapter cannot render every target of a frame with.
+pub fn check_msaa(
+    ctx: &crate::gpu::GpuContext,
+    samples: u32,
+    gbuffer: super::GBufferFormat,
+) -> crate::error::Result<()> {
+    let counts = msaa_counts(ctx, gbuffer);
+    if counts.contains(&samples) {
+        return Ok(());
+    }
+    let list: Vec<String> = counts.iter().map(u32::to_string).collect();
+    Err(crate::error::Error::invalid(
+        "msaa",
+        format!(
+            "{samples} samples: this adapter ({}) supports {} for every target (with the {}-bit G-buffer)",
+            ctx.info.name,
+            list.join(", "),
+            gbuffer.bits()
+        ),
+    ))
+}
+
 /// A single-sample 2D texture of the frame's size.
 pub fn render_texture(
     device: &wgpu::Device,

@@ -212,15 +212,13 @@ impl GpuContext {
             .then_some(crate::consts::SOFTWARE_LOOP_BUDGET)
     }
 
-    /// The MSAA sample counts every format of a frame rendered with `gbuffer` supports as a
-    /// multisampled render target (HDR colour, depth, the G-buffer), ascending; always has 1.
-    pub fn sample_counts(&self, gbuffer: crate::frame::GBufferFormat) -> Vec<u32> {
-        use crate::frame::targets::{DEPTH_FORMAT, HDR_FORMAT};
+    /// The MSAA sample counts (`consts::MSAA_COUNTS`) every one of `formats` supports as a
+    /// multisampled render target, ascending; always has 1.
+    pub fn sample_counts(&self, formats: &[wgpu::TextureFormat]) -> Vec<u32> {
         let specific = self
             .device
             .features()
             .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
-        let formats = [HDR_FORMAT, DEPTH_FORMAT, gbuffer.texture_format()];
         crate::consts::MSAA_COUNTS
             .iter()
             .copied()
@@ -239,28 +237,6 @@ impl GpuContext {
                     })
             })
             .collect()
-    }
-
-    /// Refuse a sample count the adapter cannot render every target of a frame with.
-    pub fn check_sample_count(
-        &self,
-        samples: u32,
-        gbuffer: crate::frame::GBufferFormat,
-    ) -> Result<()> {
-        let counts = self.sample_counts(gbuffer);
-        if counts.contains(&samples) {
-            return Ok(());
-        }
-        let list: Vec<String> = counts.iter().map(u32::to_string).collect();
-        Err(Error::invalid(
-            "msaa",
-            format!(
-                "{samples} samples: this adapter ({}) supports {} for every target (with the {}-bit G-buffer)",
-                self.info.name,
-                list.join(", "),
-                gbuffer.bits()
-            ),
-        ))
     }
 
     /// Largest 2D texture edge the device accepts.
