@@ -149,10 +149,11 @@ pub fn msaa_sample_positions(samples: u32) -> &'static [[f32; 2]] {
 
 /// Edge detection of the MSAA deferred kernels (tiled-deferred-tricks, edge detection): two
 /// samples of a pixel belong to different surfaces when their materials differ, their
-/// normals differ by more than about 8 degrees (cosine below this), or their view distances
-/// differ by more than this fraction.
+/// normals differ by more than about 8 degrees (cosine below `EDGE_NORMAL_COS`), or the
+/// second lies off the first's tangent plane: the offset between them leaves the plane by
+/// more than `EDGE_PLANE_SIN` of its length (about 11.5 degrees).
 pub const EDGE_NORMAL_COS: f32 = 0.99;
-pub const EDGE_DEPTH_RATIO: f32 = 0.01;
+pub const EDGE_PLANE_SIN: f32 = 0.2;
 
 /// Light indices one per-cell assignment workgroup (gather, BVH walk) collects in workgroup
 /// memory before flushing them to the global index list. A cell with more lights "spills": a
@@ -267,7 +268,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
         WgslConst::U32(COUNTER_OFF_BOUNDS_FRAGMENTS),
     ),
     ("EDGE_NORMAL_COS", WgslConst::F32(EDGE_NORMAL_COS)),
-    ("EDGE_DEPTH_RATIO", WgslConst::F32(EDGE_DEPTH_RATIO)),
+    ("EDGE_PLANE_SIN", WgslConst::F32(EDGE_PLANE_SIN)),
     ("GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
     (
         "MATERIAL_SHADER_STANDARD",

@@ -49,7 +49,7 @@ fn tolerance(id: &str) -> common::ImageTolerance {
         // but each sample of an edge pixel where it lies, where forward shades each surface
         // once at the pixel centre, extrapolated off its triangle when the centre is outside
         // it: edge pixels differ by up to half a pixel's lighting gradient (measured on
-        // lavapipe over the three cases here: mean at most 0.26, p99 6, max 47, at most 6
+        // lavapipe over the three cases here: mean at most 0.16, p99 5, max 47, at most 6
         // pixels over 24 levels), on top of the 16-bit G-buffer's rounding at 1x. A missing
         // light (a 200-pixel disc 50 levels darker) breaks `max_over`.
         _ => common::ImageTolerance {
