@@ -16,6 +16,24 @@ pub(crate) fn list() -> Result<()> {
             "  {}: {} [{}, {}] {}",
             a.index, a.name, a.backend, a.device_type, a.driver
         );
+        // The sample counts need a device; an adapter that will not open one says why.
+        match lightgrid::gpu::GpuContext::new(Some(&a.index.to_string())) {
+            Ok(ctx) => {
+                let counts = |g| {
+                    lightgrid::frame::msaa_counts(&ctx, g)
+                        .iter()
+                        .map(u32::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                println!(
+                    "     --msaa: {} (with --gbuffer 32: {})",
+                    counts(lightgrid::frame::GBufferFormat::F16),
+                    counts(lightgrid::frame::GBufferFormat::F32)
+                );
+            }
+            Err(e) => println!("     cannot open a device: {e}"),
+        }
     }
     println!("scenes:");
     for s in SCENES {
@@ -23,7 +41,11 @@ pub(crate) fn list() -> Result<()> {
     }
     println!("pipelines:");
     for p in PIPELINES {
-        println!("  {:<24} {} ({})", p.id, p.description, p.paper);
+        let msaa = match p.msaa {
+            lightgrid::pipelines::Msaa::Supported => "",
+            lightgrid::pipelines::Msaa::Refused(_) => " [no MSAA]",
+        };
+        println!("  {:<24} {} ({}){msaa}", p.id, p.description, p.paper);
     }
     println!("light assignment (--assign, for grid pipelines):");
     for a in lightgrid::culling::Assign::ALL {

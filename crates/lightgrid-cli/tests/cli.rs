@@ -194,6 +194,8 @@ fn list_names_adapters_scenes_and_pipelines() {
         "forward",
         "bvh-gpu ",
         "scatter ",
+        "--msaa: 1, ",
+        "[no MSAA]",
     ] {
         assert!(out.contains(s), "list lacks {s}");
     }
