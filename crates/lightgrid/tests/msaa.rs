@@ -427,3 +427,27 @@ fn sample_counts_the_adapter_lacks_are_refused_with_the_supported_list() {
         assert!(text.contains('1') && text.contains('4'), "{n}: {text}");
     }
 }
+
+/// A view no other test uses, where a partly covered fragment's pixel centre extrapolates
+/// across its plane's horizon (scattered frame 77 at 250x141, 12-pixel tiles): its distance is
+/// negative, out of the view volume the grid covers, and the frame was refused. Such a centre
+/// is in no cell and not counted; every fragment in the view volume lies in its cell, so the
+/// grid pipelines render the frame (an analysis render refuses one with a fragment off its
+/// bounds) and agree with each other as they do with forward.
+#[test]
+fn fragments_extrapolated_out_of_the_view_volume_are_in_no_cell() {
+    let ctx = common::gpu();
+    let s = catalog::build("scattered", &SceneParams::default()).unwrap();
+    let mut r = Renderer::new(&ctx, 250, 141, msaa(12)).unwrap();
+    let tiled = r.render(&s, 77, "tiled_forward_prez").unwrap();
+    let clustered = r.render(&s, 77, "clustered_forward").unwrap();
+    for out in [&tiled, &clustered] {
+        assert_eq!(out.stats.fragments_off_bounds, 0, "{}", out.stats.pipeline);
+    }
+    let cmp = common::compare_images(&tiled.image, &clustered.image, tolerance("tiled_forward"));
+    assert!(
+        cmp.passes(),
+        "tiled vs clustered forward: {}",
+        cmp.describe()
+    );
+}

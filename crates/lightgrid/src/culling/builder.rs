@@ -177,9 +177,12 @@ impl GridBuilder {
             },
             enc,
         )?;
-        let checked = (source == CellSource::Depth).then(|| self.bounds.buffer());
-        self.buffers
-            .encode_bounds(f.device, f.queue, enc.parts().0, checked, dims.cell_count());
+        self.buffers.encode_bounds(
+            f.device,
+            enc.parts().0,
+            self.bounds.buffer(),
+            dims.cell_count(),
+        );
         self.last = Some(LastFrame {
             dims,
             assign,

@@ -20,8 +20,12 @@ fn include_fragment(cell: u32, w: f32) {
 }
 
 // A fragment within ASSIGN_DEPTH_SLACK of a slice boundary counts for both slices, as a
-// sample does in the cell-bounds kernel.
+// sample does in the cell-bounds kernel. A centre extrapolated out of the view volume (past
+// the near or far plane, or behind the camera) is in no cell (`grid_shade_fragment`).
 fn include_fragment_cells(pixel: vec2<f32>, w: f32, layer_offset: u32) {
+    if (w < frame.near || w > frame.far) {
+        return;
+    }
     let c0 = grid_cell(pixel, w * (1.0 - ASSIGN_DEPTH_SLACK)) + layer_offset;
     let c1 = grid_cell(pixel, w * (1.0 + ASSIGN_DEPTH_SLACK)) + layer_offset;
     include_fragment(c0, w);

@@ -346,16 +346,12 @@ impl GridBuffers {
     }
 
     /// Record the copy of the frame's cell bounds (`cells` of them) next to the lists, for
-    /// the shading passes' check that a fragment lies in its cell (`grid_cell_holds`); None:
-    /// the lists were built for near..far without depth bounds (`tiled_forward`), and are
-    /// not checked (an MSAA fragment extrapolated past the near or far plane looks up the
-    /// near..far list: README, "MSAA").
+    /// the shading passes' check that a fragment lies in its cell (`grid_cell_holds`).
     pub fn encode_bounds(
         &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
-        bounds: Option<&wgpu::Buffer>,
+        bounds: &wgpu::Buffer,
         cells: usize,
     ) {
         let bytes = (cells * 8) as u64;
@@ -366,13 +362,8 @@ impl GridBuffers {
                 [&self.params, &self.cells, &self.indices, &self.bounds],
             );
         }
-        match bounds {
-            Some(b) if bytes > 0 => encoder.copy_buffer_to_buffer(b, 0, &self.bounds, 0, bytes),
-            Some(_) => {}
-            None => {
-                let unbounded = vec![[0.0f32, f32::INFINITY]; cells];
-                queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&unbounded));
-            }
+        if bytes > 0 {
+            encoder.copy_buffer_to_buffer(bounds, 0, &self.bounds, 0, bytes);
         }
     }
 
