@@ -237,8 +237,12 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     // pixel and surface): the average over the pixel's samples of the lights reaching each
     // (at the pixel's centre ray, the sample's depth).
     let setup = a.setup;
-    let view_distance = setup.view_distances(&depth);
-    let fragments = rasterize(&setup, &a.transparent, &view_distance);
+    // Per sample plane, each pixel's view distance (plane 0: the pixel's visible sample).
+    let distances: Vec<Vec<f32>> = depth_samples
+        .iter()
+        .map(|plane| setup.view_distances(plane))
+        .collect();
+    let fragments = rasterize(&setup, &a.transparent, &distances[0]);
     let ideal_dims = if fragments.is_empty() {
         dims
     } else {
@@ -248,12 +252,10 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let bounds = cell_bounds_cpu_samples(&setup, &ideal_dims, &planes);
     let bounded = assign_cpu(&setup, &ideal_dims, lights, DepthRange::Cells(&bounds));
     let ideal_transparent = ideal_fragment_computations(&setup, &bounded, lights, &fragments);
-    let ideal_opaque: u64 = depth_samples
+    let ideal_opaque: u64 = distances
         .iter()
-        .map(|plane| {
-            ideal_lighting_computations(&setup, &bounded, lights, &setup.view_distances(plane))
-        })
-        .sum::<u64>();
+        .map(|d| ideal_lighting_computations(&setup, &bounded, lights, d))
+        .sum();
     let ideal = (ideal_opaque + samples / 2) / samples + ideal_transparent;
 
     let passes = a.finished.passes;

@@ -41,6 +41,13 @@ pub fn check_msaa(
     ))
 }
 
+/// Does a frame count its lighting computations in the count target (`COUNT_FORMAT`)? Where
+/// the adapter blends R32Float and without MSAA; with MSAA every pass adds into
+/// `Targets::pixel_counts` instead.
+pub fn counts_in_target(count_blend: bool, samples: u32) -> bool {
+    count_blend && samples == 1
+}
+
 /// A single-sample 2D texture of the frame's size.
 pub fn render_texture(
     device: &wgpu::Device,

@@ -200,7 +200,7 @@ pub(crate) fn lighting_attachments<'a>(
 ) -> [Option<wgpu::RenderPassColorAttachment<'a>>; 2] {
     [
         Some(crate::passes::cleared(&f.targets.hdr, wgpu::Color::BLACK)),
-        (f.count_blend && f.targets.samples == 1)
+        crate::frame::targets::counts_in_target(f.count_blend, f.targets.samples)
             .then(|| crate::passes::cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
     ]
 }
@@ -213,6 +213,9 @@ pub(crate) fn lighting_targets(
 ) -> [Option<wgpu::ColorTargetState>; 2] {
     [
         Some(crate::passes::HDR_FORMAT.into()),
-        crate::passes::count_target(count_blend && samples == 1),
+        crate::passes::count_target(crate::frame::targets::counts_in_target(
+            count_blend,
+            samples,
+        )),
     ]
 }

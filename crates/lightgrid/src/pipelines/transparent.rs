@@ -13,6 +13,7 @@
 use super::{FrameEncoder, FrameInputs, GeometryPipelineDesc, PipelineContext};
 use crate::culling::{CellSource, GridBuffers, GridBuilder, GridLists};
 use crate::error::Result;
+use crate::frame::targets::counts_in_target;
 use crate::frame::Assign;
 use crate::gpu::CounterValues;
 use crate::passes::geometry::{draw_transparent, MaterialPipelines};
@@ -81,7 +82,7 @@ impl TransparentPass {
             CellSource::Depth,
         );
         let grid_layout = GridBuffers::layout(ctx.device);
-        let targets = blended_targets(ctx.count_blend && ctx.settings.msaa == 1);
+        let targets = blended_targets(counts_in_target(ctx.count_blend, ctx.settings.msaa));
         let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
             MaterialPipelines::new(
                 ctx.device,
@@ -138,7 +139,7 @@ impl TransparentPass {
             label: Some(label),
             color_attachments: &[
                 Some(crate::passes::loaded(&f.targets.hdr)),
-                (f.count_blend && f.targets.samples == 1)
+                counts_in_target(f.count_blend, f.targets.samples)
                     .then(|| crate::passes::loaded(&f.targets.counts)),
             ],
             depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
