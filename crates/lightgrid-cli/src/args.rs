@@ -1,11 +1,14 @@
 //! Arguments and helpers every command shares: frame size, scene and renderer settings,
 //! `--assign` values, Ctrl-C handling and the progress bar.
 
+use crate::files::Files;
 use anyhow::{Context, Result};
 use clap::Args;
 use lightgrid::passes::GBufferFormat;
-use lightgrid::scene::catalog::{self, SceneParams};
+use lightgrid::scene::catalog::SceneParams;
+use lightgrid::scene::{AddLights, SceneRequest};
 use lightgrid::RenderSettings;
+use std::path::Path;
 
 /// `--assign` values.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -77,6 +80,14 @@ pub(crate) fn parse_fraction(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(v) if (0.0..=1.0).contains(&v) => Ok(v),
         _ => Err(format!("'{s}' is not a number from 0 to 1")),
+    }
+}
+
+/// A length: a finite number above 0 (and below 10^9, past which f32 arithmetic breaks).
+pub(crate) fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 1e9 => Ok(v),
+        _ => Err(format!("'{s}' is not a positive number below 1e9")),
     }
 }
 
@@ -328,9 +339,21 @@ impl RendererArgs {
 /// The options that build a catalog scene (`render`, `compare`, `play`).
 #[derive(Args, Clone)]
 pub(crate) struct SceneOptions {
-    /// Scene from the catalog (see `lightgrid list`).
+    /// Scene from the catalog (see `lightgrid list`), or a glTF 2.0 file (*.gltf or *.glb)
+    /// with its meshes, materials, cameras and KHR_lights_punctual lights.
     #[arg(long, default_value = "robots-many")]
     pub(crate) scene: String,
+    /// A glTF file's camera, by its index in the file's `cameras` (default: the first
+    /// perspective camera placed, else one fitted to the scene); the animation orbits the
+    /// scene from there.
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
+    pub(crate) camera: Option<u32>,
+    /// Scatter N point lights over the scene's bounds (any scene; 1 to 1048576).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) add_lights: Option<u32>,
+    /// Range of the lights --add-lights scatters (default: about 8 of them reach each point).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_positive)]
+    pub(crate) light_range: Option<f64>,
     /// Light count, for scenes that take one (stress: 1 to 1000000).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) lights: Option<u32>,
@@ -354,17 +377,63 @@ pub(crate) struct SceneOptions {
 }
 
 impl SceneOptions {
-    /// The catalog scene these options name, built (and its parameters checked).
-    pub(crate) fn build(&self) -> Result<lightgrid::scene::Scene> {
-        let params = SceneParams {
-            seed: self.seed,
-            lights: self.lights,
-            spot_fraction: self.spot_fraction as f32,
-            headlights: self.headlights,
-            transparency: self.transparency.on(),
-            material_shaders: self.material_shaders.on(),
+    /// The default job's scene: a catalog scene with every option at its default.
+    pub(crate) fn catalog(name: &str) -> SceneOptions {
+        SceneOptions {
+            scene: name.into(),
+            camera: None,
+            add_lights: None,
+            light_range: None,
+            lights: None,
+            seed: 1,
+            spot_fraction: 0.0,
+            headlights: false,
+            transparency: OnOff::On,
+            material_shaders: OnOff::On,
+        }
+    }
+
+    /// What these options ask for, checked (`--light-range` needs `--add-lights`).
+    pub(crate) fn request(&self) -> Result<SceneRequest> {
+        if self.light_range.is_some() && self.add_lights.is_none() {
+            anyhow::bail!("--light-range sets the range of the lights --add-lights scatters; give --add-lights N");
+        }
+        let req = SceneRequest {
+            spec: self.scene.clone(),
+            params: SceneParams {
+                seed: self.seed,
+                lights: self.lights,
+                spot_fraction: self.spot_fraction as f32,
+                headlights: self.headlights,
+                transparency: self.transparency.on(),
+                material_shaders: self.material_shaders.on(),
+            },
+            camera: self.camera.map(|c| c as usize),
+            add_lights: self.add_lights.map(|count| AddLights {
+                count,
+                range: self.light_range.map(|r| r as f32),
+            }),
         };
-        Ok(catalog::build(&self.scene, &params)?)
+        lightgrid::scene::source::check(&req)?;
+        Ok(req)
+    }
+
+    /// A glTF scene file is an input no output may replace.
+    pub(crate) fn claim(&self, files: &mut Files) -> Result<()> {
+        if lightgrid::scene::gltf::is_gltf_path(&self.scene) {
+            files.input("--scene", Path::new(&self.scene))?;
+        }
+        Ok(())
+    }
+
+    /// The scene these options name, built or loaded (warnings about skipped parts of a file
+    /// go to stderr).
+    pub(crate) fn build(&self) -> Result<lightgrid::scene::Scene> {
+        let opened = lightgrid::scene::open(&self.request()?)?;
+        for w in &opened.warnings {
+            eprintln!("warning: {}: {w}", self.scene);
+        }
+        Ok(opened.scene)
     }
 }
 

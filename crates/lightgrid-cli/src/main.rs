@@ -1,4 +1,4 @@
-//! `lightgrid`: render catalog scenes with any registry pipeline, compare images, play
+//! `lightgrid`: render catalog scenes and glTF files with any registry pipeline, compare images, play
 //! animations in real time, benchmark, list what exists. With no arguments it runs the
 //! default job: every pipeline on `robots-many`, with each image's difference from the
 //! `forward` reference. One module per command.
@@ -7,6 +7,7 @@ mod args;
 mod bench;
 mod compare;
 mod diff;
+mod export;
 mod files;
 mod list;
 mod memory;
@@ -54,6 +55,9 @@ enum Command {
     /// Play a scene's animation in real time (one submission per frame, no analysis) and
     /// print frames per second and the frame-time distribution.
     Play(play::PlayArgs),
+    /// Write a scene at one frame as a glTF 2.0 binary (.glb): geometry, materials,
+    /// KHR_lights_punctual lights with their ranges, and the camera.
+    Export(export::ExportArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -76,15 +80,7 @@ fn main() {
             cli.adapter.as_deref(),
             &compare::CompareArgs {
                 scene: SceneArgs {
-                    options: args::SceneOptions {
-                        scene: "robots-many".into(),
-                        lights: None,
-                        seed: 1,
-                        spot_fraction: 0.0,
-                        headlights: false,
-                        transparency: args::OnOff::On,
-                        material_shaders: args::OnOff::On,
-                    },
+                    options: args::SceneOptions::catalog("robots-many"),
                     frame: compare::DEFAULT_JOB_FRAME,
                     size: Some(Size(640, 360)),
                     renderer: RendererArgs {
@@ -111,6 +107,7 @@ fn main() {
         Some(Command::Report(a)) => bench::report(&a),
         Some(Command::Scaling(a)) => scaling::scaling(cli.adapter.as_deref(), &a),
         Some(Command::Play(a)) => play::play(cli.adapter.as_deref(), &a),
+        Some(Command::Export(a)) => export::export(&a),
         Some(Command::List) => list::list(),
     };
     if let Err(e) = result {

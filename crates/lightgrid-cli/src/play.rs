@@ -84,7 +84,9 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
     check_applies(a.renderer.given(), &[info])?;
     let settings = a.renderer.settings()?;
-    Files::default().output("--json", a.json.as_deref(), Kind::Data)?;
+    let mut files = Files::default();
+    files.output("--json", a.json.as_deref(), Kind::Data)?;
+    a.scene.claim(&mut files)?;
     let scene = a.scene.build()?;
     let range = match &a.frames {
         Some(s) => FrameRange::parse(s)?,

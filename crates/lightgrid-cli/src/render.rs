@@ -38,6 +38,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     files.output("--out", a.out.as_deref(), Kind::Png)?;
     files.output("--stats", a.stats.as_deref(), Kind::Data)?;
     files.output("--heatmap", a.heatmap.as_deref(), Kind::Png)?;
+    a.scene.options.claim(&mut files)?;
     let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);

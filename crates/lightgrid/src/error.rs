@@ -43,6 +43,9 @@ pub enum Error {
     /// An image that could not be decoded or encoded.
     #[error("{path}: {reason}")]
     Image { path: String, reason: String },
+    /// A glTF file that cannot be loaded: the file and what is wrong with it.
+    #[error("{path}: {reason}")]
+    Gltf { path: String, reason: String },
 }
 
 impl Error {

@@ -65,10 +65,26 @@ impl Default for SceneParams {
 /// floods); the inner cone is 50% to 90% of the outer.
 pub const SPOT_OUTER_DEGREES: (f32, f32) = (15.0, 75.0);
 
+/// A saturated random colour (random hue), as lights in the papers' scenes.
+pub(crate) fn random_light_color(rng: &mut Rng) -> Vec3 {
+    let h = rng.unit() * 6.0;
+    let s = rng.range(0.45, 0.85);
+    let x = 1.0 - (h % 2.0 - 1.0).abs();
+    let rgb = match h as u32 {
+        0 => Vec3::new(1.0, x, 0.0),
+        1 => Vec3::new(x, 1.0, 0.0),
+        2 => Vec3::new(0.0, 1.0, x),
+        3 => Vec3::new(0.0, x, 1.0),
+        4 => Vec3::new(x, 0.0, 1.0),
+        _ => Vec3::new(1.0, 0.0, x),
+    };
+    Vec3::ONE.lerp(rgb, s)
+}
+
 /// Turn `fraction` of the scene's lights into spots: each light is chosen with that
 /// probability from its own seeded stream, so the choice and the cones do not depend on the
 /// light count. Directions are uniform on the sphere.
-fn make_spots(scene: &mut Scene, seed: u64, fraction: f32) {
+pub(crate) fn make_spots(scene: &mut Scene, seed: u64, fraction: f32) {
     if fraction <= 0.0 {
         return;
     }
@@ -293,20 +309,8 @@ impl Builder {
         self.scene.lights.push(SceneLight { light, anchor });
     }
 
-    /// A saturated random colour (random hue), as lights in the papers' scenes.
     fn light_color(&mut self) -> Vec3 {
-        let h = self.rng.unit() * 6.0;
-        let s = self.rng.range(0.45, 0.85);
-        let x = 1.0 - (h % 2.0 - 1.0).abs();
-        let rgb = match h as u32 {
-            0 => Vec3::new(1.0, x, 0.0),
-            1 => Vec3::new(x, 1.0, 0.0),
-            2 => Vec3::new(0.0, 1.0, x),
-            3 => Vec3::new(0.0, x, 1.0),
-            4 => Vec3::new(x, 0.0, 1.0),
-            _ => Vec3::new(1.0, 0.0, x),
-        };
-        Vec3::ONE.lerp(rgb, s)
+        random_light_color(&mut self.rng)
     }
 
     /// Boxes standing on the ground at random heights, in a grid of `cells` over the square

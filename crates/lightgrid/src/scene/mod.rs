@@ -1,12 +1,15 @@
 //! Scenes as plain CPU data: meshes, materials, point lights, objects with motion, and a camera
 //! path. [`Scene::frame`] evaluates the animation at one frame; [`Scene::geometry`] bakes the
-//! frame's objects into one world-space vertex/index list for the GPU.
+//! frame's objects into one world-space vertex/index list for the GPU. Scenes come from the
+//! [`catalog`] or from glTF files ([`gltf`]), opened through [`source::open`].
 
 mod camera;
 pub mod catalog;
+pub mod gltf;
 mod mesh;
 mod raster;
 mod rng;
+pub mod source;
 mod view;
 
 pub use camera::{Camera, CameraPath};
@@ -14,6 +17,7 @@ pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use mesh::Mesh;
 pub use raster::{rasterize, Fragment};
 pub use rng::Rng;
+pub use source::{open, AddLights, Opened, SceneRequest};
 pub use view::{SpotCull, ViewLight, ViewSetup};
 
 use crate::consts::{MATERIAL_FLAG_TRANSPARENT, MAX_LIGHTS};

@@ -1,0 +1,209 @@
+//! A scene at one frame as a glTF 2.0 binary (`lightgrid export`): one node per object (its
+//! world transform at that frame), one mesh per (mesh, material) pair, metallic-roughness
+//! approximations of the materials for other engines with lightgrid's exact material in
+//! `extras.lightgrid`, the frame's lights through KHR_lights_punctual with their ranges, and
+//! the frame's camera.
+
+use super::import::{candela_from_intensity, ExactMaterial};
+use crate::error::{Error, Result};
+use crate::scene::{Material, Scene};
+use glam::{Quat, Vec3};
+use serde_json::{json, Value};
+use std::collections::HashMap;
+
+/// Appends typed arrays to the binary chunk, each its own buffer view and accessor.
+#[derive(Default)]
+struct Bin {
+    bytes: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Bin {
+    /// A tightly packed accessor of `count` elements of `kind`; returns its index.
+    fn push(&mut self, data: &[u8], target: u32, accessor: Value) -> usize {
+        while self.bytes.len() % 4 != 0 {
+            self.bytes.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": self.bytes.len(),
+            "byteLength": data.len(),
+            "target": target,
+        }));
+        self.bytes.extend_from_slice(data);
+        let mut accessor = accessor;
+        accessor["bufferView"] = json!(self.views.len() - 1);
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    fn vec3s(&mut self, v: &[Vec3], bounds: bool) -> usize {
+        let mut acc = json!({"componentType": 5126, "count": v.len(), "type": "VEC3"});
+        if bounds {
+            let lo = v.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
+            let hi = v.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
+            acc["min"] = json!(lo.to_array());
+            acc["max"] = json!(hi.to_array());
+        }
+        self.push(bytemuck::cast_slice(v), 34962, acc)
+    }
+}
+
+/// glTF's factors are in [0, 1].
+fn unit(v: Vec3) -> [f32; 3] {
+    v.clamp(Vec3::ZERO, Vec3::ONE).to_array()
+}
+
+/// A metallic-roughness approximation of a Blinn-Phong material (the inverse of the import
+/// rule for a dielectric: base colour = diffuse, roughness from the shininess), with the exact
+/// material in `extras.lightgrid`.
+fn material_json(m: &Material) -> Value {
+    let alpha_g = (2.0 / (m.shininess.max(1.0) + 2.0)).sqrt();
+    let base = unit(m.diffuse);
+    let mut v = json!({
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [base[0], base[1], base[2], m.alpha.clamp(0.0, 1.0)],
+            "metallicFactor": 0.0,
+            "roughnessFactor": alpha_g.sqrt().clamp(0.0, 1.0),
+        },
+        "emissiveFactor": unit(m.emissive),
+        "doubleSided": true,
+        "extras": {"lightgrid": ExactMaterial::from_material(m)},
+    });
+    if m.transparent {
+        v["alphaMode"] = json!("BLEND");
+    }
+    v
+}
+
+/// The GLB bytes of `scene` at `frame`, for frames of `size` (the camera's aspect ratio).
+pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
+    scene.validate()?;
+    let state = scene.frame(frame);
+    let mut bin = Bin::default();
+    let mut meshes = Vec::new();
+    let mut mesh_of: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut nodes = Vec::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        if scene.meshes[o.mesh].indices.is_empty() {
+            continue; // glTF accessors hold at least one element
+        }
+        let key = (o.mesh, o.material);
+        let mi = match mesh_of.get(&key) {
+            Some(&mi) => mi,
+            None => {
+                let m = &scene.meshes[o.mesh];
+                let pos = bin.vec3s(&m.positions, true);
+                let nor = bin.vec3s(&m.normals, false);
+                let uv = bin.push(
+                    bytemuck::cast_slice(&m.uvs),
+                    34962,
+                    json!({"componentType": 5126, "count": m.uvs.len(), "type": "VEC2"}),
+                );
+                let idx = bin.push(
+                    bytemuck::cast_slice(&m.indices),
+                    34963,
+                    json!({"componentType": 5125, "count": m.indices.len(), "type": "SCALAR"}),
+                );
+                meshes.push(json!({"primitives": [{
+                    "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
+                    "indices": idx,
+                    "material": o.material,
+                    "mode": 4,
+                }]}));
+                mesh_of.insert(key, meshes.len() - 1);
+                meshes.len() - 1
+            }
+        };
+        nodes.push(json!({
+            "name": format!("object {i}"),
+            "mesh": mi,
+            "matrix": state.transforms[i].to_cols_array(),
+        }));
+    }
+    let mut lights = Vec::new();
+    for (i, l) in state.lights.iter().enumerate() {
+        let mut def = json!({
+            "type": if l.spot.is_some() { "spot" } else { "point" },
+            "color": unit(l.color),
+            "intensity": candela_from_intensity(l.intensity, l.range),
+            "range": l.range,
+            "extras": {"lightgrid": {"intensity": l.intensity, "color": l.color.to_array()}},
+        });
+        let mut node = json!({
+            "name": format!("light {i}"),
+            "translation": l.position.to_array(),
+            "extensions": {"KHR_lights_punctual": {"light": i}},
+        });
+        if let Some(s) = l.spot {
+            if s.cos_outer < 0.0 {
+                return Err(Error::invalid(
+                    "export",
+                    format!("spot light {i} is wider than glTF's largest cone (90° from its axis)"),
+                ));
+            }
+            def["spot"] = json!({
+                "innerConeAngle": s.cos_inner.clamp(-1.0, 1.0).acos(),
+                "outerConeAngle": s.cos_outer.clamp(-1.0, 1.0).acos(),
+            });
+            def["extras"]["lightgrid"]["cos_inner"] = json!(s.cos_inner);
+            def["extras"]["lightgrid"]["cos_outer"] = json!(s.cos_outer);
+            let q = Quat::from_rotation_arc(Vec3::NEG_Z, s.direction);
+            node["rotation"] = json!(q.to_array());
+        }
+        lights.push(def);
+        nodes.push(node);
+    }
+    let cam = state.camera;
+    let aspect = size.0 as f32 / size.1.max(1) as f32;
+    nodes.push(json!({
+        "name": "camera",
+        "camera": 0,
+        "matrix": cam.view().inverse().to_cols_array(),
+    }));
+    let materials: Vec<Value> = scene.materials.iter().map(material_json).collect();
+    let root = json!({
+        "asset": {"version": "2.0", "generator": "lightgrid export"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": lights}},
+        "scene": 0,
+        "scenes": [{"name": scene.name, "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "cameras": [{"type": "perspective", "perspective": {
+            "yfov": cam.fov_y, "znear": cam.near, "zfar": cam.far, "aspectRatio": aspect,
+        }}],
+        "accessors": bin.accessors,
+        "bufferViews": bin.views,
+        "buffers": [{"byteLength": bin.bytes.len()}],
+    });
+    let mut json =
+        serde_json::to_vec(&root).map_err(|e| Error::invalid("export", e.to_string()))?;
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut data = bin.bytes;
+    while data.len() % 4 != 0 {
+        data.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + data.len();
+    let total = u32::try_from(total).map_err(|_| {
+        Error::invalid(
+            "export",
+            "the scene is larger than a GLB file can hold (4 GiB)",
+        )
+    })?;
+    let mut out = Vec::with_capacity(total as usize);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&total.to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(data.len() as u32).to_le_bytes());
+    out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
+    out.extend_from_slice(&data);
+    Ok(out)
+}

@@ -1,0 +1,826 @@
+//! A parsed glTF document to a lightgrid [`Scene`]: the scene's node hierarchy walked once
+//! (cycles and nodes with two parents refused), every triangle primitive instanced as an
+//! object, materials mapped to the Blinn-Phong model, KHR_lights_punctual lights placed, and
+//! a camera path fitted to the scene.
+
+use super::json::{LightDef, MaterialDef, Node, Primitive};
+use super::read::{Document, Res};
+use super::{
+    LoadOptions, EXTENSIONS_READ, LIGHT_CUTOFF, LIGHT_MATCH_FRACTION, MAX_TRIANGLES, MAX_VERTICES,
+};
+use crate::scene::{
+    Camera, CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object, Scene,
+    SceneLight, Spot,
+};
+use glam::{Mat4, Quat, Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+
+/// Frames of the orbit a loaded scene's camera follows (as long as the robots animation).
+pub const ORBIT_FRAMES: u32 = crate::scene::catalog::ROBOTS_FRAMES;
+/// Keys of the orbit (Catmull-Rom between them stays within 1% of the circle).
+const ORBIT_KEYS: u32 = 16;
+/// Width of a loaded scene's default frame (its height from the camera's aspect, else 16:9).
+const DEFAULT_WIDTH: u32 = 640;
+
+/// Everything the walk collects before the scene is assembled.
+#[derive(Default)]
+struct Walk {
+    objects: Vec<Object>,
+    meshes: Vec<Mesh>,
+    /// (glTF mesh, primitive, winding flipped) → index into `meshes`, or `None` if skipped.
+    cache: HashMap<(usize, usize, bool), Option<usize>>,
+    cameras: Vec<(usize, Mat4)>,
+    lights: Vec<(usize, Mat4)>,
+    /// Vertices and indices read from accessors, and baked into objects: each bounded.
+    read_vertices: u64,
+    read_indices: u64,
+    baked_vertices: u64,
+    baked_triangles: u64,
+    lo: Vec3,
+    hi: Vec3,
+    warnings: Vec<String>,
+}
+
+impl Walk {
+    fn warn(&mut self, w: String) {
+        if !self.warnings.contains(&w) {
+            self.warnings.push(w);
+        }
+    }
+}
+
+/// The lightgrid material a file exported by lightgrid carries in `extras.lightgrid`, so
+/// that export → load gives back the exact material (glTF's PBR model cannot express
+/// Blinn-Phong's independent specular colour or the material shaders).
+#[derive(Serialize, Deserialize)]
+pub(super) struct ExactMaterial {
+    pub diffuse: [f32; 3],
+    pub specular: [f32; 3],
+    pub shininess: f32,
+    pub emissive: [f32; 3],
+    pub ambient: [f32; 3],
+    pub alpha: f32,
+    pub transparent: bool,
+    /// "standard", "car_paint" or "rim".
+    pub shader: String,
+    pub paint: [f32; 3],
+    pub paint_power: f32,
+}
+
+impl ExactMaterial {
+    pub(super) fn from_material(m: &Material) -> ExactMaterial {
+        let (shader, paint, paint_power) = match m.shader {
+            MaterialShader::Standard => ("standard", Vec3::ZERO, 1.0),
+            MaterialShader::CarPaint { flip, power } => ("car_paint", flip, power),
+            MaterialShader::Rim { color, power } => ("rim", color, power),
+        };
+        ExactMaterial {
+            diffuse: m.diffuse.to_array(),
+            specular: m.specular.to_array(),
+            shininess: m.shininess,
+            emissive: m.emissive.to_array(),
+            ambient: m.ambient.to_array(),
+            alpha: m.alpha,
+            transparent: m.transparent,
+            shader: shader.into(),
+            paint: paint.to_array(),
+            paint_power,
+        }
+    }
+
+    fn to_material(&self) -> Option<Material> {
+        let paint = Vec3::from(self.paint);
+        let shader = match self.shader.as_str() {
+            "standard" => MaterialShader::Standard,
+            "car_paint" => MaterialShader::CarPaint {
+                flip: paint,
+                power: self.paint_power,
+            },
+            "rim" => MaterialShader::Rim {
+                color: paint,
+                power: self.paint_power,
+            },
+            _ => return None,
+        };
+        let m = Material {
+            diffuse: self.diffuse.into(),
+            specular: self.specular.into(),
+            shininess: self.shininess,
+            emissive: self.emissive.into(),
+            ambient: self.ambient.into(),
+            alpha: self.alpha,
+            transparent: self.transparent,
+            shader,
+        };
+        material_is_sane(&m).then_some(m)
+    }
+}
+
+fn material_is_sane(m: &Material) -> bool {
+    let colours = [m.diffuse, m.specular, m.emissive, m.ambient];
+    colours
+        .iter()
+        .all(|c| c.is_finite() && c.min_element() >= 0.0)
+        && m.shininess.is_finite()
+        && m.shininess >= 0.0
+        && (0.0..=1.0).contains(&m.alpha)
+}
+
+/// glTF's metallic-roughness material (§3.9.2) to Blinn-Phong, by one documented rule:
+/// diffuse = base × (1 − metallic); specular = mix(0.04, base, metallic) (the dielectric F0
+/// of the specification's BRDF, metals tinted); shininess = 2/α² − 2 with α = roughness²
+/// (the Blinn-Phong exponent whose lobe matches GGX of that α), from 1 to 2048; ambient =
+/// base; emissive = emissiveFactor. `BLEND` is drawn transparent with the base alpha.
+fn map_material(def: &MaterialDef, index: usize, walk: &mut Walk) -> Res<Material> {
+    if let Some(exact) = def
+        .extras
+        .as_ref()
+        .and_then(|e| e.get("lightgrid"))
+        .map(|v| ExactMaterial::deserialize(v))
+    {
+        match exact.ok().and_then(|e| e.to_material()) {
+            Some(m) => return Ok(m),
+            None => walk.warn(format!(
+                "material {index}: its extras.lightgrid is malformed; the glTF material is used"
+            )),
+        }
+    }
+    let pbr = def.pbr_metallic_roughness.as_ref();
+    let base = pbr.and_then(|p| p.base_color_factor).unwrap_or([1.0; 4]);
+    let metallic = pbr.and_then(|p| p.metallic_factor).unwrap_or(1.0);
+    let roughness = pbr.and_then(|p| p.roughness_factor).unwrap_or(1.0);
+    let emissive = def.emissive_factor.unwrap_or([0.0; 3]);
+    let numbers = base.iter().chain(&emissive).chain([&metallic, &roughness]);
+    for v in numbers {
+        if !v.is_finite() || *v < 0.0 {
+            return Err(format!(
+                "material {index}: factors must be finite and non-negative (found {v})"
+            ));
+        }
+    }
+    if pbr.is_some_and(|p| p.base_color_texture.is_some()) {
+        walk.warn(format!(
+            "material {index}: base colour textures are not applied; its base colour factor is used"
+        ));
+    }
+    let (metallic, roughness) = (metallic.min(1.0), roughness.min(1.0));
+    let colour = Vec3::new(base[0], base[1], base[2]);
+    let alpha_g = (roughness * roughness).max(1e-3);
+    let transparent = match def.alpha_mode.as_deref().unwrap_or("OPAQUE") {
+        "OPAQUE" | "MASK" => false,
+        "BLEND" => true,
+        other => {
+            return Err(format!(
+                "material {index}: alphaMode '{other}' is not OPAQUE, MASK or BLEND"
+            ))
+        }
+    };
+    Ok(Material {
+        diffuse: colour * (1.0 - metallic),
+        specular: Vec3::splat(0.04).lerp(colour, metallic),
+        shininess: (2.0 / (alpha_g * alpha_g) - 2.0).clamp(1.0, 2048.0),
+        emissive: emissive.into(),
+        ambient: colour,
+        alpha: if transparent { base[3].min(1.0) } else { 1.0 },
+        transparent,
+        shader: MaterialShader::Standard,
+    })
+}
+
+/// Is a `MASK` material's constant alpha below its cutoff (every fragment discarded, §3.9.4)?
+fn masked_out(def: &MaterialDef) -> bool {
+    let alpha = def
+        .pbr_metallic_roughness
+        .as_ref()
+        .and_then(|p| p.base_color_factor)
+        .map_or(1.0, |b| b[3]);
+    def.alpha_mode.as_deref() == Some("MASK") && alpha < def.alpha_cutoff.unwrap_or(0.5)
+}
+
+/// A node's local transform (§3.5.3: `matrix`, or translation × rotation × scale).
+fn local_matrix(node: &Node, index: usize) -> Res<Mat4> {
+    let m = match node.matrix {
+        Some(m) => Mat4::from_cols_array(&m),
+        None => {
+            let t = Vec3::from(node.translation.unwrap_or([0.0; 3]));
+            let r = node.rotation.unwrap_or([0.0, 0.0, 0.0, 1.0]);
+            let s = Vec3::from(node.scale.unwrap_or([1.0; 3]));
+            let q = Quat::from_array(r);
+            if !q.is_finite() || q.length_squared() < 1e-12 {
+                return Err(format!("node {index}: rotation {r:?} is not a quaternion"));
+            }
+            Mat4::from_scale_rotation_translation(s, q.normalize(), t)
+        }
+    };
+    if !m.is_finite() {
+        return Err(format!(
+            "node {index}: its transform has a NaN or infinite number"
+        ));
+    }
+    Ok(m)
+}
+
+/// Triangles of a primitive's vertex sequence (§3.7.2.1: list, strip or fan).
+fn triangulate(mode: u32, seq: &[u32]) -> Vec<u32> {
+    let n = seq.len();
+    let mut out = Vec::with_capacity(n.saturating_sub(2) * 3);
+    match mode {
+        5 => {
+            for i in 0..n.saturating_sub(2) {
+                if i % 2 == 0 {
+                    out.extend_from_slice(&[seq[i], seq[i + 1], seq[i + 2]]);
+                } else {
+                    out.extend_from_slice(&[seq[i + 1], seq[i], seq[i + 2]]);
+                }
+            }
+        }
+        6 => {
+            for i in 1..n.saturating_sub(1) {
+                out.extend_from_slice(&[seq[0], seq[i], seq[i + 1]]);
+            }
+        }
+        _ => out.extend_from_slice(&seq[..n - n % 3]),
+    }
+    out
+}
+
+/// Area-weighted vertex normals of a triangle list (flat for unshared vertices): where a file
+/// has no normals (§3.7.2.1 asks for flat normals then; shared vertices get smooth ones).
+fn computed_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+        let face = (b - a).cross(c - a);
+        for &i in t {
+            n[i as usize] += face;
+        }
+    }
+    n.into_iter().map(|v| v.normalize_or(Vec3::Y)).collect()
+}
+
+fn vec3s(flat: &[f32]) -> Vec<Vec3> {
+    flat.chunks_exact(3).map(Vec3::from_slice).collect()
+}
+
+/// The mesh of one triangle primitive, or `None` (with a warning) for points and lines.
+fn primitive_mesh(
+    doc: &Document,
+    (mi, pi): (usize, usize),
+    prim: &Primitive,
+    flipped: bool,
+    walk: &mut Walk,
+) -> Res<Option<Mesh>> {
+    let what = format!("mesh {mi} primitive {pi}");
+    let mode = prim.mode.unwrap_or(4);
+    match mode {
+        4..=6 => {}
+        0..=3 => {
+            walk.warn(format!(
+                "{what}: points and lines (mode {mode}) are not drawn; skipped"
+            ));
+            return Ok(None);
+        }
+        _ => return Err(format!("{what}: mode {mode} is not a glTF primitive mode")),
+    }
+    let Some(&pos_acc) = prim.attributes.get("POSITION") else {
+        walk.warn(format!("{what}: no POSITION attribute; skipped"));
+        return Ok(None);
+    };
+    let count = doc.root.accessors.get(pos_acc).map_or(0, |a| a.count);
+    walk.read_vertices = walk.read_vertices.saturating_add(count);
+    if walk.read_vertices > MAX_VERTICES as u64 {
+        return Err(format!(
+            "{what}: the file's meshes have more than {MAX_VERTICES} vertices"
+        ));
+    }
+    let positions = vec3s(&doc.read_floats(pos_acc, 3, &format!("{what} POSITION"))?);
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(format!(
+            "{what}: POSITION (accessor {pos_acc}) has a NaN or infinite coordinate"
+        ));
+    }
+    let seq = match prim.indices {
+        Some(i) => {
+            let n = doc.root.accessors.get(i).map_or(0, |a| a.count);
+            walk.read_indices = walk.read_indices.saturating_add(n);
+            if walk.read_indices > 3 * MAX_TRIANGLES as u64 {
+                return Err(format!(
+                    "{what}: the file's meshes have more than {MAX_TRIANGLES} triangles"
+                ));
+            }
+            let seq = doc.read_indices(i, &format!("{what} indices"))?;
+            if let Some(bad) = seq.iter().find(|&&v| v as usize >= positions.len()) {
+                return Err(format!(
+                    "{what}: index {bad} (accessor {i}) is out of range for {} vertices",
+                    positions.len()
+                ));
+            }
+            seq
+        }
+        None => (0..positions.len() as u32).collect(),
+    };
+    let mut indices = triangulate(mode, &seq);
+    if flipped {
+        for t in indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
+    }
+    let computed = computed_normals(&positions, &indices);
+    let normals = match prim.attributes.get("NORMAL") {
+        Some(&a) => {
+            let n = vec3s(&doc.read_floats(a, 3, &format!("{what} NORMAL"))?);
+            if n.len() != positions.len() || n.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "{what}: NORMAL (accessor {a}) needs one finite normal per vertex"
+                ));
+            }
+            // A zero normal cannot be normalized: use the computed one there.
+            n.iter()
+                .zip(&computed)
+                .map(|(v, c)| v.try_normalize().unwrap_or(*c))
+                .collect()
+        }
+        None => computed,
+    };
+    let uvs = match prim.attributes.get("TEXCOORD_0") {
+        Some(&a) => {
+            let uv: Vec<Vec2> = doc
+                .read_floats(a, 2, &format!("{what} TEXCOORD_0"))?
+                .chunks_exact(2)
+                .map(|c| Vec2::new(c[0], c[1]))
+                .collect();
+            if uv.len() != positions.len() || uv.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "{what}: TEXCOORD_0 (accessor {a}) needs one finite UV per vertex"
+                ));
+            }
+            uv
+        }
+        None => vec![Vec2::ZERO; positions.len()],
+    };
+    Ok(Some(Mesh {
+        positions,
+        normals,
+        uvs,
+        indices,
+    }))
+}
+
+/// Instance node `ni`'s mesh with world transform `world`.
+fn instance_mesh(
+    doc: &Document,
+    mi: usize,
+    world: Mat4,
+    materials: &MaterialMap,
+    walk: &mut Walk,
+) -> Res<()> {
+    let def = doc
+        .root
+        .meshes
+        .get(mi)
+        .ok_or_else(|| format!("mesh {mi} does not exist"))?;
+    let det = world.determinant();
+    if det.abs() < 1e-12 || !det.is_finite() {
+        walk.warn(format!(
+            "an instance of mesh {mi} has a singular transform (zero scale); skipped"
+        ));
+        return Ok(());
+    }
+    // A mirroring transform turns the winding (§3.7.4), and the renderer's two-sided lighting
+    // flips normals by the winding: flip the triangles back.
+    let flipped = det < 0.0;
+    for (pi, prim) in def.primitives.iter().enumerate() {
+        let material = match prim.material {
+            None => materials.default,
+            Some(m) => match materials.by_gltf.get(m) {
+                None => {
+                    return Err(format!(
+                        "mesh {mi} primitive {pi}: material {m} does not exist"
+                    ))
+                }
+                Some(None) => continue,
+                Some(Some(i)) => *i,
+            },
+        };
+        let key = (mi, pi, flipped);
+        let mesh = match walk.cache.get(&key) {
+            Some(m) => *m,
+            None => {
+                let m = primitive_mesh(doc, (mi, pi), prim, flipped, walk)?.map(|mesh| {
+                    walk.meshes.push(mesh);
+                    walk.meshes.len() - 1
+                });
+                walk.cache.insert(key, m);
+                m
+            }
+        };
+        let Some(mesh) = mesh else { continue };
+        let m = &walk.meshes[mesh];
+        walk.baked_vertices += m.positions.len() as u64;
+        walk.baked_triangles += m.triangle_count() as u64;
+        if walk.baked_vertices > MAX_VERTICES as u64 || walk.baked_triangles > MAX_TRIANGLES as u64
+        {
+            return Err(format!(
+                "the scene's instances add up to more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles"
+            ));
+        }
+        for p in &m.positions {
+            let w = world.transform_point3(*p);
+            walk.lo = walk.lo.min(w);
+            walk.hi = walk.hi.max(w);
+        }
+        walk.objects.push(Object {
+            mesh,
+            material,
+            local: world,
+            motion: Motion::Static,
+        });
+    }
+    Ok(())
+}
+
+/// glTF materials as scene materials: `by_gltf[i]` is material i's index, `None` for a
+/// `MASK` material whose constant alpha is under its cutoff (nothing of it is drawn).
+struct MaterialMap {
+    by_gltf: Vec<Option<usize>>,
+    default: usize,
+}
+
+/// Walk the chosen scene's node trees depth first.
+fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<()> {
+    let nodes = &doc.root.nodes;
+    let roots: Vec<usize> = match (doc.root.scene, doc.root.scenes.is_empty()) {
+        (Some(s), _) => doc
+            .root
+            .scenes
+            .get(s)
+            .ok_or_else(|| format!("the default scene {s} does not exist"))?
+            .nodes
+            .clone(),
+        (None, false) => doc.root.scenes[0].nodes.clone(),
+        (None, true) => {
+            let mut child = vec![false; nodes.len()];
+            for n in nodes {
+                for &c in &n.children {
+                    if let Some(slot) = child.get_mut(c) {
+                        *slot = true;
+                    }
+                }
+            }
+            (0..nodes.len()).filter(|&i| !child[i]).collect()
+        }
+    };
+    let mut seen = vec![false; nodes.len()];
+    let mut stack: Vec<(usize, Mat4)> = roots.iter().rev().map(|&r| (r, Mat4::IDENTITY)).collect();
+    while let Some((ni, parent)) = stack.pop() {
+        let node = nodes
+            .get(ni)
+            .ok_or_else(|| format!("node {ni} does not exist"))?;
+        if std::mem::replace(&mut seen[ni], true) {
+            return Err(format!(
+                "node {ni} is reached twice: the node graph has a cycle or a node with two parents (glTF nodes form trees)"
+            ));
+        }
+        let world = parent * local_matrix(node, ni)?;
+        if let Some(mi) = node.mesh {
+            instance_mesh(doc, mi, world, materials, walk)?;
+        }
+        if let Some(c) = node.camera {
+            walk.cameras.push((c, world));
+        }
+        if let Some(l) = node.extensions.as_ref().and_then(|e| e.lights.as_ref()) {
+            walk.lights.push((l.light, world));
+        }
+        for &c in node.children.iter().rev() {
+            stack.push((c, world));
+        }
+    }
+    Ok(())
+}
+
+/// Our intensity for a glTF light of `candela` and range `range`: the light function's
+/// window `(1 − (d/r)²)²` has no inverse-square falloff, so the two are matched at a quarter
+/// of the range (`LIGHT_MATCH_FRACTION`): there the file's light gives `I / d²`.
+pub(super) fn intensity_from_candela(candela: f32, range: f32) -> f32 {
+    let d = range * LIGHT_MATCH_FRACTION;
+    let window = (1.0 - LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION).powi(2);
+    candela / (d * d * window)
+}
+
+/// The inverse of [`intensity_from_candela`], for export.
+pub(super) fn candela_from_intensity(intensity: f32, range: f32) -> f32 {
+    let d = range * LIGHT_MATCH_FRACTION;
+    let window = (1.0 - LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION).powi(2);
+    intensity * d * d * window
+}
+
+fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<Option<Light>> {
+    let what = format!("light {index}");
+    let colour = Vec3::from(def.color.unwrap_or([1.0; 3]));
+    let candela = def.intensity.unwrap_or(1.0);
+    if !colour.is_finite() || colour.min_element() < 0.0 || !candela.is_finite() || candela < 0.0 {
+        return Err(format!(
+            "{what}: colour and intensity must be finite and non-negative"
+        ));
+    }
+    let spot = match def.kind.as_str() {
+        "point" => None,
+        "spot" => Some(
+            def.spot
+                .as_ref()
+                .map_or((0.0, std::f32::consts::FRAC_PI_4), |s| {
+                    (
+                        s.inner_cone_angle.unwrap_or(0.0),
+                        s.outer_cone_angle.unwrap_or(std::f32::consts::FRAC_PI_4),
+                    )
+                }),
+        ),
+        "directional" => {
+            walk.warn(format!(
+                "{what}: directional lights have no range (lightgrid's lights are bounded, tiled-shading §1.1); skipped"
+            ));
+            return Ok(None);
+        }
+        other => {
+            return Err(format!(
+                "{what}: type '{other}' is not point, spot or directional"
+            ))
+        }
+    };
+    let peak = candela * colour.max_element();
+    if peak <= 0.0 {
+        walk.warn(format!("{what}: zero intensity; skipped"));
+        return Ok(None);
+    }
+    let range = match def.range {
+        Some(r) if r.is_finite() && r > 0.0 => r,
+        Some(r) => return Err(format!("{what}: range {r} is not a positive number")),
+        // Inverse-square light reaches illuminance LIGHT_CUTOFF at sqrt(I / cutoff).
+        None => (peak / LIGHT_CUTOFF).sqrt(),
+    };
+    // A file lightgrid exported carries the exact numbers (the glTF ones are rounded through
+    // the candela and angle conversions).
+    let exact = def.extras.as_ref().and_then(|e| e.get("lightgrid"));
+    let number = |key: &str| {
+        exact
+            .and_then(|v| v.get(key))
+            .and_then(|v| v.as_f64())
+            .map(|v| v as f32)
+            .filter(|v| v.is_finite())
+    };
+    let intensity = number("intensity")
+        .filter(|v| *v >= 0.0)
+        .unwrap_or_else(|| intensity_from_candela(candela, range));
+    let colour = exact
+        .and_then(|v| v.get("color"))
+        .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
+        .map(Vec3::from)
+        .filter(|c| c.is_finite() && c.min_element() >= 0.0)
+        .unwrap_or(colour);
+    let position = world.transform_point3(Vec3::ZERO);
+    let spot = match spot {
+        None => None,
+        Some((inner, outer)) => {
+            let ok = inner.is_finite()
+                && outer.is_finite()
+                && inner >= 0.0
+                && inner < outer
+                && outer <= std::f32::consts::FRAC_PI_2;
+            if !ok {
+                return Err(format!(
+                    "{what}: cone angles need 0 ≤ inner < outer ≤ π/2 (found {inner}, {outer})"
+                ));
+            }
+            let dir = world.transform_vector3(Vec3::NEG_Z);
+            let dir = dir
+                .try_normalize()
+                .ok_or_else(|| format!("{what}: its node's transform has no direction"))?;
+            let mut spot = Spot::new(dir, inner, outer);
+            if let (Some(ci), Some(co)) = (number("cos_inner"), number("cos_outer")) {
+                if (-1.0..=1.0).contains(&co) && ci <= 1.0 && ci > co {
+                    (spot.cos_inner, spot.cos_outer) = (ci, co);
+                }
+            }
+            Some(spot)
+        }
+    };
+    let light = Light {
+        position,
+        color: colour,
+        intensity,
+        range,
+        spot,
+    };
+    if !light.position.is_finite() || !light.range.is_finite() || !light.intensity.is_finite() {
+        return Err(format!("{what}: its placement or range is not finite"));
+    }
+    Ok(Some(light))
+}
+
+/// The camera at the chosen node (or fitted to the bounds), as an orbit about the bounds'
+/// vertical axis starting there.
+fn camera_path(
+    doc: &Document,
+    opts: &LoadOptions,
+    walk: &mut Walk,
+) -> Res<(CameraPath, (u32, u32))> {
+    let centre = (walk.lo + walk.hi) * 0.5;
+    let radius = ((walk.hi - walk.lo).length() * 0.5).max(1e-3);
+    let placed = match opts.camera {
+        Some(n) => {
+            if n >= doc.root.cameras.len() {
+                return Err(format!(
+                    "--camera {n}: the file has {} camera(s)",
+                    doc.root.cameras.len()
+                ));
+            }
+            let world = walk
+                .cameras
+                .iter()
+                .find(|(c, _)| *c == n)
+                .map(|(_, w)| *w)
+                .ok_or_else(|| format!("--camera {n}: no node of the scene places camera {n}"))?;
+            if doc.root.cameras[n].kind != "perspective" {
+                return Err(format!(
+                    "--camera {n}: a {} camera; only perspective cameras are rendered",
+                    doc.root.cameras[n].kind
+                ));
+            }
+            Some((n, world))
+        }
+        None => {
+            let first = walk.cameras.iter().copied().find(|(c, _)| {
+                doc.root
+                    .cameras
+                    .get(*c)
+                    .is_some_and(|d| d.kind == "perspective")
+            });
+            if first.is_none() && !walk.cameras.is_empty() {
+                walk.warn("no perspective camera (orthographic ones are not rendered); one is fitted to the scene".into());
+            }
+            first
+        }
+    };
+    let mut size = (DEFAULT_WIDTH, DEFAULT_WIDTH * 9 / 16);
+    let (eye, target, fov, near, far) = match placed {
+        Some((n, world)) => {
+            let p = doc.root.cameras[n]
+                .perspective
+                .as_ref()
+                .ok_or_else(|| format!("camera {n}: perspective camera without \"perspective\""))?;
+            let ok = p.yfov.is_finite()
+                && p.yfov > 0.0
+                && p.yfov < std::f32::consts::PI
+                && p.znear.is_finite()
+                && p.znear > 0.0
+                && p.zfar.is_none_or(|f| f.is_finite() && f > p.znear);
+            if !ok {
+                return Err(format!(
+                    "camera {n}: needs 0 < yfov < π, znear > 0 and zfar > znear (finite)"
+                ));
+            }
+            if let Some(a) = p.aspect_ratio {
+                if a.is_finite() && (0.1..=10.0).contains(&a) {
+                    size.1 = ((DEFAULT_WIDTH as f32 / a).round() as u32).max(1);
+                }
+            }
+            let eye = world.transform_point3(Vec3::ZERO);
+            let forward = world
+                .transform_vector3(Vec3::NEG_Z)
+                .try_normalize()
+                .ok_or_else(|| format!("camera {n}: its node's transform has no direction"))?;
+            if forward.y.abs() > 0.9999 {
+                walk.warn(format!(
+                    "camera {n} looks straight up or down; it is tilted slightly (the camera's up is +y)"
+                ));
+            }
+            let forward = if forward.y.abs() > 0.9999 {
+                (forward + Vec3::Z * 1e-2).normalize()
+            } else {
+                forward
+            };
+            let reach = eye.distance(centre) + radius;
+            let far = p.zfar.unwrap_or(reach * 1.05);
+            (eye, eye + forward * radius.max(1.0), p.yfov, p.znear, far)
+        }
+        None => {
+            let fov = 50f32.to_radians();
+            let dist = radius / (fov * 0.5).sin() * 1.05;
+            let (el, az) = (25f32.to_radians(), 30f32.to_radians());
+            let dir = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+            let far = (dist + radius) * 1.05;
+            (centre + dir * dist, centre, fov, far / 1000.0, far)
+        }
+    };
+    let mut keys = Vec::new();
+    for k in 0..=ORBIT_KEYS {
+        let turn = Quat::from_rotation_y(k as f32 / ORBIT_KEYS as f32 * std::f32::consts::TAU);
+        let about = |p: Vec3| centre + turn * (p - centre);
+        let frame = k * (ORBIT_FRAMES - 1) / ORBIT_KEYS;
+        keys.push((frame, about(eye), about(target)));
+    }
+    let path = CameraPath {
+        keys,
+        fov_y: fov,
+        near,
+        far,
+    };
+    debug_assert_eq!(
+        path.at(0),
+        Camera {
+            eye,
+            target,
+            up: Vec3::Y,
+            fov_y: fov,
+            near,
+            far
+        }
+    );
+    Ok((path, size))
+}
+
+/// The scene a document describes.
+pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Scene, Vec<String>)> {
+    let mut walk = Walk {
+        lo: Vec3::INFINITY,
+        hi: Vec3::NEG_INFINITY,
+        ..Walk::default()
+    };
+    for ext in &doc.root.extensions_required {
+        if !EXTENSIONS_READ.contains(&ext.as_str()) {
+            return Err(format!(
+                "the file requires extension {ext}, which lightgrid does not read (it reads: {})",
+                EXTENSIONS_READ.join(", ")
+            ));
+        }
+    }
+    for ext in &doc.root.extensions_used {
+        if !EXTENSIONS_READ.contains(&ext.as_str()) {
+            walk.warn(format!("extension {ext} is not read; ignored"));
+        }
+    }
+    if doc.root.materials.len() >= crate::consts::MAX_MATERIALS {
+        return Err(format!(
+            "{} materials; at most {} are rendered",
+            doc.root.materials.len(),
+            crate::consts::MAX_MATERIALS - 1
+        ));
+    }
+    let mut materials = Vec::new();
+    let mut by_gltf = Vec::new();
+    for (i, def) in doc.root.materials.iter().enumerate() {
+        if masked_out(def) {
+            by_gltf.push(None);
+            continue;
+        }
+        materials.push(map_material(def, i, &mut walk)?);
+        by_gltf.push(Some(materials.len() - 1));
+    }
+    materials.push(map_material(
+        &MaterialDef::default(),
+        usize::MAX,
+        &mut walk,
+    )?);
+    let map = MaterialMap {
+        by_gltf,
+        default: materials.len() - 1,
+    };
+    walk_nodes(doc, &map, &mut walk)?;
+    if walk.objects.is_empty() {
+        return Err("the scene has no triangles to render".into());
+    }
+    let defs = doc
+        .root
+        .extensions
+        .as_ref()
+        .and_then(|e| e.lights.as_ref())
+        .map_or(&[][..], |l| &l.lights[..]);
+    let mut lights = Vec::new();
+    for (li, world) in std::mem::take(&mut walk.lights) {
+        let def = defs
+            .get(li)
+            .ok_or_else(|| format!("a node names light {li}, which does not exist"))?;
+        if let Some(light) = map_light(def, li, world, &mut walk)? {
+            lights.push(SceneLight {
+                light,
+                anchor: LightAnchor::World,
+            });
+        }
+        if lights.len() > crate::consts::MAX_LIGHTS as usize {
+            return Err(format!("more than {} lights", crate::consts::MAX_LIGHTS));
+        }
+    }
+    let (camera_path, default_size) = camera_path(doc, opts, &mut walk)?;
+    let scene = Scene {
+        name: name.to_string(),
+        meshes: std::mem::take(&mut walk.meshes),
+        materials,
+        objects: std::mem::take(&mut walk.objects),
+        paths: Vec::new(),
+        lights,
+        camera_path,
+        default_size,
+    };
+    Ok((scene, walk.warnings))
+}

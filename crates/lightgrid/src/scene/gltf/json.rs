@@ -1,0 +1,222 @@
+//! The part of the glTF 2.0 JSON document lightgrid reads (glTF 2.0 specification, §5
+//! "Properties Reference"). Unknown properties are ignored, as the specification asks; every
+//! index and count read here is untrusted and checked where it is used (`read.rs`,
+//! `import.rs`).
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct Root {
+    pub asset: Option<Asset>,
+    pub extensions_used: Vec<String>,
+    pub extensions_required: Vec<String>,
+    pub scene: Option<usize>,
+    pub scenes: Vec<SceneDef>,
+    pub nodes: Vec<Node>,
+    pub meshes: Vec<MeshDef>,
+    pub accessors: Vec<Accessor>,
+    pub buffer_views: Vec<BufferView>,
+    pub buffers: Vec<BufferDef>,
+    pub materials: Vec<MaterialDef>,
+    pub textures: Vec<TextureDef>,
+    pub images: Vec<ImageDef>,
+    pub cameras: Vec<CameraDef>,
+    pub extensions: Option<RootExtensions>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct Asset {
+    pub version: String,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct SceneDef {
+    pub nodes: Vec<usize>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct Node {
+    pub children: Vec<usize>,
+    pub matrix: Option<[f32; 16]>,
+    pub translation: Option<[f32; 3]>,
+    pub rotation: Option<[f32; 4]>,
+    pub scale: Option<[f32; 3]>,
+    pub mesh: Option<usize>,
+    pub camera: Option<usize>,
+    pub extensions: Option<NodeExtensions>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct NodeExtensions {
+    #[serde(rename = "KHR_lights_punctual")]
+    pub lights: Option<NodeLight>,
+}
+
+#[derive(Deserialize)]
+pub(super) struct NodeLight {
+    pub light: usize,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct MeshDef {
+    pub primitives: Vec<Primitive>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct Primitive {
+    pub attributes: BTreeMap<String, usize>,
+    pub indices: Option<usize>,
+    pub material: Option<usize>,
+    /// 0 points, 1 lines, 2 line loop, 3 line strip, 4 triangles (the default), 5 triangle
+    /// strip, 6 triangle fan.
+    pub mode: Option<u32>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct Accessor {
+    pub buffer_view: Option<usize>,
+    pub byte_offset: u64,
+    pub component_type: u32,
+    pub normalized: bool,
+    pub count: u64,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub sparse: Option<Sparse>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct Sparse {
+    pub count: u64,
+    pub indices: SparseIndices,
+    pub values: SparseValues,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct SparseIndices {
+    pub buffer_view: usize,
+    pub byte_offset: u64,
+    pub component_type: u32,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct SparseValues {
+    pub buffer_view: usize,
+    pub byte_offset: u64,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct BufferView {
+    pub buffer: usize,
+    pub byte_offset: u64,
+    pub byte_length: u64,
+    pub byte_stride: Option<u64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct BufferDef {
+    pub uri: Option<String>,
+    pub byte_length: u64,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct MaterialDef {
+    pub pbr_metallic_roughness: Option<Pbr>,
+    pub emissive_factor: Option<[f32; 3]>,
+    pub alpha_mode: Option<String>,
+    pub alpha_cutoff: Option<f32>,
+    pub extras: Option<serde_json::Value>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct Pbr {
+    pub base_color_factor: Option<[f32; 4]>,
+    pub base_color_texture: Option<TextureRef>,
+    pub metallic_factor: Option<f32>,
+    pub roughness_factor: Option<f32>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct TextureRef {
+    pub index: usize,
+    pub tex_coord: u32,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct TextureDef {
+    pub source: Option<usize>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct ImageDef {
+    pub uri: Option<String>,
+    pub buffer_view: Option<usize>,
+    pub mime_type: Option<String>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct CameraDef {
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub perspective: Option<Perspective>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct Perspective {
+    pub yfov: f32,
+    pub znear: f32,
+    pub zfar: Option<f32>,
+    pub aspect_ratio: Option<f32>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct RootExtensions {
+    #[serde(rename = "KHR_lights_punctual")]
+    pub lights: Option<LightsExt>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct LightsExt {
+    pub lights: Vec<LightDef>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct LightDef {
+    pub color: Option<[f32; 3]>,
+    pub intensity: Option<f32>,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub range: Option<f32>,
+    pub spot: Option<SpotDef>,
+    pub extras: Option<serde_json::Value>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct SpotDef {
+    pub inner_cone_angle: Option<f32>,
+    pub outer_cone_angle: Option<f32>,
+}

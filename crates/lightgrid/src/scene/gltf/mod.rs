@@ -1,0 +1,104 @@
+//! glTF 2.0 scenes in and out (`--scene FILE.gltf|.glb`, `lightgrid export`).
+//!
+//! Reading (`read.rs`, `import.rs`) treats the file as hostile: every index, offset, length
+//! and count is checked before it is used or allocated for, totals are bounded
+//! ([`MAX_VERTICES`], [`MAX_TRIANGLES`], [`MAX_FILE_BYTES`]), the node graph is walked without
+//! recursion and refused if it is not a forest, and any problem is an [`Error::Gltf`] naming
+//! the file and the problem. What the renderer cannot show (points and lines, directional
+//! lights, orthographic cameras, textures, extensions it does not know) is skipped with a
+//! warning, unless the file marks the extension required.
+//!
+//! Mapping rules (documented in README "glTF scenes"): metallic-roughness materials by
+//! `import::map_material`'s rule; KHR_lights_punctual point and spot lights keep their range,
+//! a light without one gets the distance where its inverse-square illuminance falls to
+//! [`LIGHT_CUTOFF`], and intensities are matched at [`LIGHT_MATCH_FRACTION`] of the range
+//! (`import::intensity_from_candela`). Files written by [`export`] carry lightgrid's exact
+//! material and light intensity in `extras.lightgrid`, so they load back unchanged.
+
+mod export;
+mod import;
+mod json;
+mod read;
+
+pub use export::export;
+pub use import::ORBIT_FRAMES;
+
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+use std::path::Path;
+
+/// Largest file (document, buffer or image) read.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Largest JSON document read.
+pub const MAX_JSON_BYTES: u64 = 64 << 20;
+/// Most vertices read from a file's accessors, and baked into its instances.
+pub const MAX_VERTICES: u32 = 1 << 22;
+/// Most triangles read and baked.
+pub const MAX_TRIANGLES: u32 = 1 << 23;
+/// Illuminance (lux) at which a light without a range is cut off: range = √(I / cutoff).
+pub const LIGHT_CUTOFF: f32 = 0.02;
+/// Where along its range a glTF light's inverse-square falloff and lightgrid's window agree.
+pub const LIGHT_MATCH_FRACTION: f32 = 0.25;
+/// Extensions read (a file may require these).
+pub const EXTENSIONS_READ: &[&str] = &["KHR_lights_punctual"];
+
+/// Choices for loading a file.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LoadOptions {
+    /// Index into the file's `cameras` (the first node placing it); `None`: the first
+    /// perspective camera the scene places, else one fitted to the bounds.
+    pub camera: Option<usize>,
+}
+
+/// A loaded scene and what was skipped on the way.
+#[derive(Debug)]
+pub struct Loaded {
+    pub scene: Scene,
+    pub warnings: Vec<String>,
+}
+
+/// Is `spec` a glTF file name rather than a catalog scene (ends in `.gltf` or `.glb`)?
+pub fn is_gltf_path(spec: &str) -> bool {
+    let lower = spec.to_ascii_lowercase();
+    lower.ends_with(".gltf") || lower.ends_with(".glb")
+}
+
+/// Load a `.gltf` or `.glb` file; relative URIs resolve beside it.
+pub fn load(path: &Path, opts: &LoadOptions) -> Result<Loaded> {
+    let fail = |reason: String| Error::Gltf {
+        path: path.display().to_string(),
+        reason,
+    };
+    let bytes = read::read_limited(path).map_err(fail)?;
+    let name = path
+        .file_stem()
+        .map_or("gltf".into(), |s| s.to_string_lossy().into_owned());
+    let base = path.parent().map(|p| {
+        if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        }
+    });
+    load_bytes(&bytes, &name, base, opts).map_err(|e| match e {
+        Error::Gltf { reason, .. } => fail(reason),
+        other => other,
+    })
+}
+
+/// Load a document from bytes (`base`: where relative URIs resolve; `None` refuses them).
+/// Errors name `name`.
+pub fn load_bytes(
+    bytes: &[u8],
+    name: &str,
+    base: Option<&Path>,
+    opts: &LoadOptions,
+) -> Result<Loaded> {
+    let fail = |reason: String| Error::Gltf {
+        path: name.to_string(),
+        reason,
+    };
+    let doc = read::Document::parse(bytes, base).map_err(fail)?;
+    let (scene, warnings) = import::import(&doc, name, opts).map_err(fail)?;
+    Ok(Loaded { scene, warnings })
+}

@@ -1,0 +1,234 @@
+//! Where a scene comes from (a catalog name or a glTF file) and what every command can add
+//! to it: `--add-lights N` scattered over its bounds, spot lights, no transparency. Commands
+//! open scenes only through [`open`], so a file works wherever a catalog name does.
+
+use super::catalog::{self, make_spots, random_light_color, SceneParams};
+use super::gltf::{self, LoadOptions};
+use super::{Light, LightAnchor, Rng, Scene, SceneLight};
+use crate::consts::MAX_LIGHTS;
+use crate::error::{Error, Result};
+use glam::Vec3;
+use std::path::PathBuf;
+
+/// Lights scattered over a scene's bounds (`--add-lights`), the way the papers fill their
+/// scenes: uniform in the bounding box, random hues.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AddLights {
+    pub count: u32,
+    /// `None`: [`default_added_range`].
+    pub range: Option<f32>,
+}
+
+/// Intensity of an added light (the catalog's lights are 0.35 to 1).
+pub const ADDED_LIGHT_INTENSITY: f32 = 0.5;
+/// Lights an added light's default range makes reach a point of the bounds, on average.
+pub const ADDED_LIGHT_COVERAGE: f32 = 8.0;
+
+/// A scene to open: a catalog name or a `.gltf`/`.glb` path, with the options.
+#[derive(Clone, Debug)]
+pub struct SceneRequest {
+    pub spec: String,
+    pub params: SceneParams,
+    /// `--camera N` (files only).
+    pub camera: Option<usize>,
+    pub add_lights: Option<AddLights>,
+}
+
+impl SceneRequest {
+    /// A catalog scene or file with default options.
+    pub fn new(spec: &str) -> SceneRequest {
+        SceneRequest {
+            spec: spec.to_string(),
+            params: SceneParams::default(),
+            camera: None,
+            add_lights: None,
+        }
+    }
+
+    /// Is this a glTF file (by its name) rather than a catalog scene?
+    pub fn is_file(&self) -> bool {
+        gltf::is_gltf_path(&self.spec)
+    }
+}
+
+/// An opened scene and the warnings loading it gave (skipped parts of a file).
+#[derive(Debug)]
+pub struct Opened {
+    pub scene: Scene,
+    pub warnings: Vec<String>,
+}
+
+/// Check the request's options without building or reading anything heavy.
+pub fn check(req: &SceneRequest) -> Result<()> {
+    if let Some(add) = req.add_lights {
+        check_add_lights(&add)?;
+    }
+    if req.is_file() {
+        let p = &req.params;
+        let refuse = |flag: &'static str, what: &str| {
+            Err(Error::invalid(
+                flag,
+                format!("{what}; it does not apply to glTF files"),
+            ))
+        };
+        if p.lights.is_some() {
+            return refuse(
+                "--lights",
+                "--lights sets the stress scene's light count (use --add-lights N for a file)",
+            );
+        }
+        if p.headlights {
+            return refuse(
+                "--headlights",
+                "--headlights gives the catalog's robots headlights",
+            );
+        }
+        if !(0.0..=1.0).contains(&p.spot_fraction) {
+            return Err(Error::invalid(
+                "--spot-fraction",
+                format!("{} is out of range 0 to 1", p.spot_fraction),
+            ));
+        }
+        Ok(())
+    } else {
+        if req.camera.is_some() {
+            return Err(Error::invalid(
+                "--camera",
+                "chooses a glTF file's camera; catalog scenes have their own camera path",
+            ));
+        }
+        catalog::check_params(&req.spec, &req.params).map(|_| ())
+    }
+}
+
+fn check_add_lights(add: &AddLights) -> Result<()> {
+    if add.count == 0 || add.count > MAX_LIGHTS {
+        return Err(Error::invalid(
+            "--add-lights",
+            format!("{} is out of range 1 to {MAX_LIGHTS}", add.count),
+        ));
+    }
+    if let Some(r) = add.range {
+        if !r.is_finite() || r <= 0.0 {
+            return Err(Error::invalid(
+                "--light-range",
+                format!("{r} is not a positive number"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Build or load the scene a request names, add its lights and spots, and validate it.
+pub fn open(req: &SceneRequest) -> Result<Opened> {
+    check(req)?;
+    let p = req.params;
+    let (mut scene, warnings) = if req.is_file() {
+        let loaded = gltf::load(
+            &PathBuf::from(&req.spec),
+            &LoadOptions { camera: req.camera },
+        )?;
+        let mut scene = loaded.scene;
+        if !p.transparency {
+            if !scene.has_transparency() {
+                return Err(Error::invalid(
+                    "--transparency",
+                    format!("{} has no transparent (BLEND) materials", req.spec),
+                ));
+            }
+            let transparent: Vec<bool> = scene.materials.iter().map(|m| m.transparent).collect();
+            scene.objects.retain(|o| !transparent[o.material]);
+        }
+        (scene, loaded.warnings)
+    } else {
+        // Spots are made after the added lights exist, so they are the scene's lights too; the
+        // catalog's own lights get the same cones as without --add-lights (one seeded draw per
+        // light, in order).
+        let without_spots = SceneParams {
+            spot_fraction: 0.0,
+            ..p
+        };
+        (catalog::build(&req.spec, &without_spots)?, Vec::new())
+    };
+    if let Some(add) = req.add_lights {
+        add_lights(&mut scene, &add, p.seed)?;
+    }
+    make_spots(&mut scene, p.seed, p.spot_fraction);
+    if scene.lights.is_empty() && req.is_file() {
+        return Err(Error::Gltf {
+            path: req.spec.clone(),
+            reason: "the file has no point or spot lights (KHR_lights_punctual); add some with --add-lights N".into(),
+        });
+    }
+    scene.validate()?;
+    Ok(Opened { scene, warnings })
+}
+
+/// The axis-aligned bounds of the scene's geometry at frame 0, or `None` without geometry.
+pub fn bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
+    let state = scene.frame(0);
+    let mut lo = Vec3::INFINITY;
+    let mut hi = Vec3::NEG_INFINITY;
+    for (o, m) in scene.objects.iter().zip(&state.transforms) {
+        for p in &scene.meshes[o.mesh].positions {
+            let w = m.transform_point3(*p);
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    (lo.x <= hi.x).then_some((lo, hi))
+}
+
+/// The box lights are scattered in: the scene's bounds with every side at least a tenth of
+/// the longest, grown upwards (a flat street gets a slab of air above it).
+fn light_box(lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+    let extent = hi - lo;
+    let floor = (extent.max_element() * 0.1).max(1e-3);
+    (lo, lo + extent.max(Vec3::splat(floor)))
+}
+
+/// The range at which `count` lights uniform in the box reach [`ADDED_LIGHT_COVERAGE`]
+/// lights per point on average: count × (4/3)πr³ = coverage × volume.
+pub fn default_added_range(lo: Vec3, hi: Vec3, count: u32) -> f32 {
+    let (lo, hi) = light_box(lo, hi);
+    let e = hi - lo;
+    let volume = e.x * e.y * e.z;
+    let r =
+        (3.0 * ADDED_LIGHT_COVERAGE * volume / (4.0 * std::f32::consts::PI * count as f32)).cbrt();
+    r.max(e.length() * 1e-3)
+}
+
+/// Scatter `add.count` point lights over the scene's bounds (seeded by `seed`).
+pub fn add_lights(scene: &mut Scene, add: &AddLights, seed: u64) -> Result<()> {
+    check_add_lights(add)?;
+    if scene.lights.len() as u64 + u64::from(add.count) > u64::from(MAX_LIGHTS) {
+        return Err(Error::invalid(
+            "--add-lights",
+            format!(
+                "{} lights and {} more exceed the maximum of {MAX_LIGHTS}",
+                scene.lights.len(),
+                add.count
+            ),
+        ));
+    }
+    let (lo, hi) = bounds(scene)
+        .ok_or_else(|| Error::invalid("--add-lights", "the scene has no geometry to fill"))?;
+    let range = add
+        .range
+        .unwrap_or_else(|| default_added_range(lo, hi, add.count));
+    let (lo, hi) = light_box(lo, hi);
+    let mut rng = Rng::new(seed ^ 0xadd_11647);
+    for _ in 0..add.count {
+        let position = Vec3::new(
+            rng.range(lo.x, hi.x),
+            rng.range(lo.y, hi.y),
+            rng.range(lo.z, hi.z),
+        );
+        let color = random_light_color(&mut rng);
+        scene.lights.push(SceneLight {
+            light: Light::point(position, color, ADDED_LIGHT_INTENSITY, range),
+            anchor: LightAnchor::World,
+        });
+    }
+    Ok(())
+}
