@@ -866,3 +866,29 @@ fn material_shaders_render_the_same_in_forward_and_deferred_pipelines() {
         }
     }
 }
+
+/// A glTF file (the fixture room: hierarchy, mirrored instance, strips, computed normals,
+/// metal, glass, point and spot lights, its own camera) renders through every pipeline like
+/// `forward`, with its own lights and with 256 lights added, at a size and tile no other test
+/// uses; and along its orbit.
+#[test]
+fn every_pipeline_renders_a_gltf_file_like_forward() {
+    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
+    use lightgrid::scene::source::{add_lights, AddLights};
+    let bytes = common::gltf_fixture::room().glb();
+    let mut s = load_bytes(&bytes, "room.glb", None, &LoadOptions::default())
+        .unwrap()
+        .scene;
+    check(&s, 0, (150, 94), settings(12));
+    check(&s, 90, (128, 80), settings(16));
+    add_lights(
+        &mut s,
+        &AddLights {
+            count: 256,
+            range: None,
+        },
+        3,
+    )
+    .unwrap();
+    check(&s, 40, (141, 88), settings(10));
+}

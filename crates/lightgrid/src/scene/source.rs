@@ -180,11 +180,17 @@ pub fn bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
 }
 
 /// The box lights are scattered in: the scene's bounds with every side at least a tenth of
-/// the longest, grown upwards (a flat street gets a slab of air above it).
+/// the longest (a flat street gets a slab of air above it), then grown by a tenth of each
+/// side all round but downwards (so a single object's surfaces have lights outside them).
 fn light_box(lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
     let extent = hi - lo;
     let floor = (extent.max_element() * 0.1).max(1e-3);
-    (lo, lo + extent.max(Vec3::splat(floor)))
+    let extent = extent.max(Vec3::splat(floor));
+    let margin = extent * 0.1;
+    (
+        lo - Vec3::new(margin.x, 0.0, margin.z),
+        lo + extent + margin,
+    )
 }
 
 /// The range at which `count` lights uniform in the box reach [`ADDED_LIGHT_COVERAGE`]

@@ -2,6 +2,8 @@
 //! tolerances, and the light-grid checks (CPU twin, brute-force oracle, edge-case coverage).
 #![allow(dead_code)]
 
+pub mod gltf_fixture;
+
 use glam::Vec3;
 use lightgrid::culling::{
     assign_cpu, assign_gather_cpu, cell_bounds_cpu, oracle_tile_lights, DepthRange, GridDims,

@@ -9,7 +9,7 @@ use super::{
     LoadOptions, EXTENSIONS_READ, LIGHT_CUTOFF, LIGHT_MATCH_FRACTION, MAX_TRIANGLES, MAX_VERTICES,
 };
 use crate::scene::{
-    Camera, CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object, Scene,
+    CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object, Scene,
     SceneLight, Spot,
 };
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -483,6 +483,11 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
             ));
         }
         let world = parent * local_matrix(node, ni)?;
+        if !world.is_finite() {
+            return Err(format!(
+                "node {ni}: its world transform overflows (the hierarchy's scales multiply past f32)"
+            ));
+        }
         if let Some(mi) = node.mesh {
             instance_mesh(doc, mi, world, materials, walk)?;
         }
@@ -726,17 +731,6 @@ fn camera_path(
         near,
         far,
     };
-    debug_assert_eq!(
-        path.at(0),
-        Camera {
-            eye,
-            target,
-            up: Vec3::Y,
-            fov_y: fov,
-            near,
-            far
-        }
-    );
     Ok((path, size))
 }
 
@@ -777,14 +771,23 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         materials.push(map_material(def, i, &mut walk)?);
         by_gltf.push(Some(materials.len() - 1));
     }
-    materials.push(map_material(
-        &MaterialDef::default(),
-        usize::MAX,
-        &mut walk,
-    )?);
+    // The specification's default material, for primitives without one (only if any).
+    let needs_default = doc
+        .root
+        .meshes
+        .iter()
+        .flat_map(|m| &m.primitives)
+        .any(|p| p.material.is_none());
+    if needs_default {
+        materials.push(map_material(
+            &MaterialDef::default(),
+            usize::MAX,
+            &mut walk,
+        )?);
+    }
     let map = MaterialMap {
         by_gltf,
-        default: materials.len() - 1,
+        default: materials.len().saturating_sub(1),
     };
     walk_nodes(doc, &map, &mut walk)?;
     if walk.objects.is_empty() {

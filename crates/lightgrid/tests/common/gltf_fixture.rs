@@ -1,0 +1,324 @@
+//! glTF files written by the tests: a small writer (typed arrays into one binary buffer,
+//! meshes, nodes, materials, KHR_lights_punctual lights, cameras) that emits a `.gltf` with a
+//! base64 buffer or a `.glb`, and the fixture scenes the loader and pipeline tests use.
+
+use serde_json::{json, Value};
+
+#[derive(Default, Clone)]
+pub struct GltfWriter {
+    pub bin: Vec<u8>,
+    pub accessors: Vec<Value>,
+    pub views: Vec<Value>,
+    pub meshes: Vec<Value>,
+    pub nodes: Vec<Value>,
+    pub materials: Vec<Value>,
+    pub lights: Vec<Value>,
+    pub cameras: Vec<Value>,
+    pub roots: Vec<usize>,
+}
+
+fn b64(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for i in 0..4 {
+            if i <= c.len() {
+                out.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+impl GltfWriter {
+    fn view(&mut self, data: &[u8]) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": data.len()}));
+        self.bin.extend_from_slice(data);
+        self.views.len() - 1
+    }
+
+    /// A float accessor of `kind` (VEC2, VEC3).
+    pub fn floats(&mut self, data: &[f32], kind: &str) -> usize {
+        let comps = match kind {
+            "VEC2" => 2,
+            "VEC3" => 3,
+            _ => 1,
+        };
+        let view = self.view(bytemuck::cast_slice(data));
+        let mut acc = json!({"bufferView": view, "componentType": 5126, "count": data.len() / comps, "type": kind});
+        if kind == "VEC3" {
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for p in data.chunks_exact(3) {
+                for c in 0..3 {
+                    lo[c] = lo[c].min(p[c]);
+                    hi[c] = hi[c].max(p[c]);
+                }
+            }
+            acc["min"] = json!(lo);
+            acc["max"] = json!(hi);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
+    }
+
+    pub fn indices(&mut self, data: &[u16]) -> usize {
+        let view = self.view(bytemuck::cast_slice(data));
+        self.accessors.push(json!({"bufferView": view, "componentType": 5123, "count": data.len(), "type": "SCALAR"}));
+        self.accessors.len() - 1
+    }
+
+    /// A mesh of one primitive; returns the mesh index.
+    pub fn mesh(
+        &mut self,
+        positions: &[f32],
+        normals: Option<&[f32]>,
+        indices: Option<&[u16]>,
+        material: Option<usize>,
+        mode: u32,
+    ) -> usize {
+        let pos = self.floats(positions, "VEC3");
+        let mut prim = json!({"attributes": {"POSITION": pos}, "mode": mode});
+        if let Some(n) = normals {
+            prim["attributes"]["NORMAL"] = json!(self.floats(n, "VEC3"));
+        }
+        if let Some(i) = indices {
+            prim["indices"] = json!(self.indices(i));
+        }
+        if let Some(m) = material {
+            prim["material"] = json!(m);
+        }
+        self.meshes.push(json!({"primitives": [prim]}));
+        self.meshes.len() - 1
+    }
+
+    pub fn material(&mut self, m: Value) -> usize {
+        self.materials.push(m);
+        self.materials.len() - 1
+    }
+
+    pub fn node(&mut self, n: Value) -> usize {
+        self.nodes.push(n);
+        self.nodes.len() - 1
+    }
+
+    pub fn light(&mut self, l: Value) -> usize {
+        self.lights.push(l);
+        self.lights.len() - 1
+    }
+
+    pub fn document(&self, buffer: Value) -> Value {
+        let mut doc = json!({
+            "asset": {"version": "2.0", "generator": "lightgrid tests"},
+            "scene": 0,
+            "scenes": [{"nodes": self.roots}],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": [buffer],
+        });
+        if !self.lights.is_empty() {
+            doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+            doc["extensions"] = json!({"KHR_lights_punctual": {"lights": self.lights}});
+        }
+        if !self.cameras.is_empty() {
+            doc["cameras"] = json!(self.cameras);
+        }
+        doc
+    }
+
+    /// The `.gltf` text, its buffer a base64 data: URI.
+    pub fn gltf(&self) -> Vec<u8> {
+        let uri = format!("data:application/octet-stream;base64,{}", b64(&self.bin));
+        serde_json::to_vec_pretty(&self.document(json!({"byteLength": self.bin.len(), "uri": uri})))
+            .unwrap()
+    }
+
+    /// The `.glb` bytes of a document (its buffer 0 the BIN chunk).
+    pub fn glb_of(doc: &Value, bin: &[u8]) -> Vec<u8> {
+        let mut json = serde_json::to_vec(doc).unwrap();
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let mut bin = bin.to_vec();
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let total = (12 + 8 + json.len() + 8 + bin.len()) as u32;
+        let mut out = b"glTF".to_vec();
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&total.to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        out
+    }
+
+    pub fn glb(&self) -> Vec<u8> {
+        Self::glb_of(
+            &self.document(json!({"byteLength": self.bin.len()})),
+            &self.bin,
+        )
+    }
+}
+
+/// A unit cube's 24 vertices (positions, normals) and 36 indices, centred at the origin.
+pub fn cube() -> (Vec<f32>, Vec<f32>, Vec<u16>) {
+    let mut p = Vec::new();
+    let mut n = Vec::new();
+    let mut idx = Vec::new();
+    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
+    ];
+    for (normal, u, v) in faces {
+        let base = (p.len() / 3) as u16;
+        for (a, b) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+            for c in 0..3 {
+                p.push(normal[c] * 0.5 + u[c] * a + v[c] * b);
+                n.push(normal[c]);
+            }
+        }
+        idx.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    (p, n, idx)
+}
+
+/// The fixture room: a ground quad; a node hierarchy (a rotated, translated parent with a
+/// scaled child cube and a grandchild cube); a mirrored instance (negative scale); a
+/// triangle-strip wall without normals; a non-indexed, normal-less triangle; a transparent
+/// (BLEND) cube; a metallic material; a MASK material below its cutoff (never drawn); point
+/// lights (with and without a range) and spot lights through KHR_lights_punctual; a camera.
+pub fn room() -> GltfWriter {
+    let mut w = GltfWriter::default();
+    let ground_m = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.55, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.7}}));
+    let red = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.4}}));
+    let metal = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.8, 0.3, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.3}}));
+    let glass = w.material(json!({"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [0.3, 0.6, 0.9, 0.4], "metallicFactor": 0.0, "roughnessFactor": 0.1}}));
+    let hidden = w.material(json!({"alphaMode": "MASK", "alphaCutoff": 0.5, "pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.0, 1.0, 0.2]}}));
+    let glow = w.material(json!({"emissiveFactor": [0.2, 0.05, 0.0], "pbrMetallicRoughness": {"baseColorFactor": [0.3, 0.3, 0.3, 1.0], "metallicFactor": 0.0}}));
+
+    let ground = w.mesh(
+        &[
+            -10.0, 0.0, -10.0, 10.0, 0.0, -10.0, 10.0, 0.0, 10.0, -10.0, 0.0, 10.0,
+        ],
+        Some(&[0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0]),
+        Some(&[0, 2, 1, 0, 3, 2]),
+        Some(ground_m),
+        4,
+    );
+    let (cp, cn, ci) = cube();
+    let red_cube = w.mesh(&cp, Some(&cn), Some(&ci), Some(red), 4);
+    let metal_cube = w.mesh(&cp, Some(&cn), Some(&ci), Some(metal), 4);
+    let glass_cube = w.mesh(&cp, Some(&cn), Some(&ci), Some(glass), 4);
+    let hidden_cube = w.mesh(&cp, Some(&cn), Some(&ci), Some(hidden), 4);
+    // A strip wall (two triangles from four vertices), no normals: they are computed.
+    let wall = w.mesh(
+        &[
+            -6.0, 0.0, -6.0, -6.0, 3.0, -6.0, -2.0, 0.0, -6.5, -2.0, 3.0, -6.5,
+        ],
+        None,
+        None,
+        Some(glow),
+        5,
+    );
+    // A lone non-indexed triangle without a material (the specification's default one).
+    let tri = w.mesh(
+        &[3.0, 0.0, 4.0, 5.0, 0.0, 4.0, 4.0, 2.5, 4.0],
+        None,
+        None,
+        None,
+        4,
+    );
+
+    let grandchild = w.node(
+        json!({"mesh": metal_cube, "translation": [0.0, 1.5, 0.0], "scale": [0.6, 0.6, 0.6]}),
+    );
+    let child = w.node(json!({"mesh": red_cube, "scale": [1.5, 2.0, 1.5], "translation": [0.0, 1.0, 0.0], "children": [grandchild]}));
+    let parent = w.node(json!({"translation": [-2.0, 0.0, 1.0], "rotation": [0.0, 0.3826834, 0.0, 0.9238795], "children": [child]}));
+    // Mirrored in x (determinant < 0): its winding is flipped back on load.
+    let mirrored = w.node(json!({"mesh": metal_cube, "matrix": [-1.2, 0.0, 0.0, 0.0, 0.0, 1.2, 0.0, 0.0, 0.0, 0.0, 1.2, 0.0, 3.0, 0.6, -2.0, 1.0]}));
+    let glass_node = w.node(
+        json!({"mesh": glass_cube, "translation": [1.0, 1.2, 2.5], "scale": [1.4, 1.4, 1.4]}),
+    );
+    let hidden_node = w.node(json!({"mesh": hidden_cube, "translation": [0.0, 0.5, 5.0]}));
+    let ground_node = w.node(json!({"mesh": ground}));
+    let wall_node = w.node(json!({"mesh": wall}));
+    let tri_node = w.node(json!({"mesh": tri}));
+
+    let mut light_nodes = Vec::new();
+    let points = [
+        ([-4.0, 2.0, 3.0], [1.0, 0.8, 0.6], 6.0, Some(7.0)),
+        ([2.0, 1.5, -1.0], [0.5, 0.7, 1.0], 4.0, Some(6.0)),
+        ([0.0, 4.0, 0.0], [1.0, 1.0, 1.0], 0.5, None),
+        ([5.0, 0.8, 3.0], [1.0, 0.4, 0.2], 3.0, Some(5.0)),
+    ];
+    for (pos, colour, intensity, range) in points {
+        let mut l = json!({"type": "point", "color": colour, "intensity": intensity});
+        if let Some(r) = range {
+            l["range"] = json!(r);
+        }
+        let li = w.light(l);
+        light_nodes.push(w.node(
+            json!({"translation": pos, "extensions": {"KHR_lights_punctual": {"light": li}}}),
+        ));
+    }
+    // Spots: one pointing straight down (rotation -90° about x turns -z into -y), one
+    // aimed sideways through a parent's rotation.
+    let down = w.light(json!({"type": "spot", "color": [1.0, 0.9, 0.7], "intensity": 20.0, "range": 9.0, "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}));
+    light_nodes.push(w.node(json!({"translation": [-1.0, 6.0, -3.0], "rotation": [-0.7071068, 0.0, 0.0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": down}}})));
+    let side = w.light(json!({"type": "spot", "color": [0.3, 1.0, 0.4], "intensity": 15.0, "range": 12.0, "spot": {"outerConeAngle": 0.6}}));
+    let side_node = w.node(json!({"translation": [0.0, 1.0, 0.0], "extensions": {"KHR_lights_punctual": {"light": side}}}));
+    light_nodes.push(w.node(json!({"translation": [7.0, 0.5, 0.0], "rotation": [0.0, 0.5, 0.0, 0.8660254], "children": [side_node]})));
+
+    w.cameras.push(json!({"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1, "zfar": 60.0, "aspectRatio": 1.6}}));
+    // The camera at (4, 7, 13) looking down toward the origin: a rotation about x of -25°
+    // after one about y of 17°.
+    let qy = [0.0, 0.1478094, 0.0, 0.9890159f32];
+    let qx = [-0.2164396, 0.0, 0.0, 0.9762960f32];
+    let q = quat_mul(qy, qx);
+    let camera = w.node(json!({"camera": 0, "translation": [4.0, 7.0, 13.0], "rotation": q}));
+
+    w.roots = vec![
+        ground_node,
+        parent,
+        mirrored,
+        glass_node,
+        hidden_node,
+        wall_node,
+        tri_node,
+        camera,
+    ];
+    w.roots.extend(light_nodes);
+    w
+}
+
+/// Hamilton product of two [x, y, z, w] quaternions.
+pub fn quat_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    let [ax, ay, az, aw] = a;
+    let [bx, by, bz, bw] = b;
+    [
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ]
+}
