@@ -12,6 +12,7 @@ use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{self, RenderSettings, SpotCull};
 use lightgrid::realtime::{play, PlayPlan, PlayedFrame};
 use lightgrid::scene::catalog::{self, SceneParams};
+use lightgrid::scene::{gltf, source, AddLights, SceneRequest};
 use lightgrid::stats::TimingSource;
 use lightgrid::Renderer;
 use serde::{Deserialize, Serialize};
@@ -128,6 +129,9 @@ pub struct BenchConfig {
     /// once per entry at every sample count above 1.
     #[serde(default = "default_msaa_resolve")]
     pub msaa_resolve: Vec<MsaaResolve>,
+    /// Lights scattered over every scene's bounds (`--add-lights`).
+    #[serde(default)]
+    pub add_lights: Option<AddLights>,
 }
 
 fn default_msaa_resolve() -> Vec<MsaaResolve> {
@@ -181,8 +185,18 @@ impl BenchConfig {
             pipelines::find(p)?;
         }
         for s in &self.scenes {
-            catalog::find(s)?;
+            if !gltf::is_gltf_path(s) {
+                catalog::find(s)?;
+            }
         }
+        // Scene options are checked the way `render` checks them (files included).
+        let check = |spec: &str, params: SceneParams| {
+            source::check(&SceneRequest {
+                params,
+                add_lights: self.add_lights,
+                ..SceneRequest::new(spec)
+            })
+        };
         // One rule for every command: an option that applies to nothing chosen is refused.
         // --lights goes to the scenes that take a light count; with none, the first scene's
         // check says which scenes do.
@@ -197,7 +211,7 @@ impl BenchConfig {
                 lights: Some(n),
                 ..Default::default()
             };
-            catalog::check_params(taker, &params)?;
+            check(taker, params)?;
         }
         for (flag, v, min) in [("--repeat", self.repeat, 1), ("--warmup", self.warmup, 0)] {
             if !(min..=crate::MAX_REPEATS).contains(&v) {
@@ -217,7 +231,7 @@ impl BenchConfig {
             spot_fraction: self.spot_fraction,
             ..Default::default()
         };
-        catalog::check_params(&self.scenes[0], &params)?;
+        check(&self.scenes[0], params)?;
         if self.headlights {
             // As --lights: refused only when no chosen scene has robots.
             let taker = self
@@ -229,7 +243,7 @@ impl BenchConfig {
                 headlights: true,
                 ..Default::default()
             };
-            catalog::check_params(taker, &params)?;
+            check(taker, params)?;
         }
         Ok(())
     }
@@ -549,25 +563,46 @@ pub const OPAQUE_SUFFIX: &str = "-opaque";
 fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
     let mut scenes = Vec::new();
     for name in &config.scenes {
-        let info = catalog::find(name)?;
+        // What applies to this scene: a light count and headlights only where the catalog
+        // scene takes them, transparency off only where there is some.
+        let (variable_lights, robots) = match gltf::is_gltf_path(name) {
+            true => (false, false),
+            false => {
+                let info = catalog::find(name)?;
+                (info.variable_lights, info.robots)
+            }
+        };
         let params = SceneParams {
             seed: config.seed,
-            lights: config.lights.filter(|_| info.variable_lights),
+            lights: config.lights.filter(|_| variable_lights),
             spot_fraction: config.spot_fraction,
-            headlights: config.headlights && info.robots,
-            transparency: config.transparency || !info.transparency(),
+            headlights: config.headlights && robots,
+            transparency: true,
             material_shaders: config.material_shaders,
         };
-        scenes.push(catalog::build(name, &params)?);
-        if config.opaque_variants && config.transparency && info.transparency() {
-            let mut opaque = catalog::build(
-                name,
-                &SceneParams {
-                    transparency: false,
+        let open = |transparency| {
+            source::open(&SceneRequest {
+                params: SceneParams {
+                    transparency,
                     ..params
                 },
-            )?;
-            opaque.name = format!("{name}{OPAQUE_SUFFIX}");
+                add_lights: config.add_lights,
+                ..SceneRequest::new(name)
+            })
+        };
+        let opened = open(true)?;
+        for w in &opened.warnings {
+            eprintln!("warning: {name}: {w}");
+        }
+        let has_glass = opened.scene.has_transparency();
+        if !config.transparency && has_glass {
+            scenes.push(open(false)?.scene);
+            continue;
+        }
+        scenes.push(opened.scene);
+        if config.opaque_variants && config.transparency && has_glass {
+            let mut opaque = open(false)?.scene;
+            opaque.name = format!("{}{OPAQUE_SUFFIX}", opaque.name);
             scenes.push(opaque);
         }
     }

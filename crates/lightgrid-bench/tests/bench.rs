@@ -40,6 +40,7 @@ fn config() -> BenchConfig {
         spot_fraction: 0.0,
         msaa: vec![1],
         msaa_resolve: vec![Default::default()],
+        add_lights: None,
         headlights: false,
         spot_culls: vec![Default::default()],
         transparency: true,

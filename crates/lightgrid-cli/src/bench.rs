@@ -39,7 +39,8 @@ pub(crate) struct BenchArgs {
     /// Start from a preset; flags given explicitly override it.
     #[arg(long, value_enum)]
     pub(crate) preset: Option<Preset>,
-    /// Scenes (repeat the flag or separate with commas). Default: robots-many.
+    /// Scenes: catalog names or glTF files (repeat the flag or separate with commas).
+    /// Default: robots-many.
     #[arg(long = "scene", value_delimiter = ',')]
     pub(crate) scenes: Vec<String>,
     /// `all` or a comma-separated list of pipeline ids.
@@ -69,6 +70,12 @@ pub(crate) struct BenchArgs {
     /// to measure both [default: separate; the msaa preset: both].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(crate) msaa_resolve: Vec<crate::args::MsaaResolveArg>,
+    /// Scatter N point lights over every scene's bounds (catalog scenes and glTF files).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) add_lights: Option<u32>,
+    /// Range of the lights --add-lights scatters (default: about 8 reach each point).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_positive)]
+    pub(crate) light_range: Option<f64>,
     /// G-buffer precisions to measure: 16, 32 or 16,32.
     #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
     pub(crate) gbuffer: Vec<GBufferFormat>,
@@ -323,7 +330,16 @@ pub(crate) fn bench_config(
         } else {
             a.msaa_resolve.iter().map(|&m| m.into()).collect()
         },
+        add_lights: a.add_lights.map(|count| lightgrid::scene::AddLights {
+            count,
+            range: a.light_range.map(|r| r as f32),
+        }),
     };
+    if a.light_range.is_some() && a.add_lights.is_none() {
+        anyhow::bail!(
+            "--light-range sets the range of the lights --add-lights scatters; give --add-lights N"
+        );
+    }
     crate::args::check_msaa_resolve(!a.msaa_resolve.is_empty(), &config.msaa)?;
     config.validate()?;
     let chosen: Vec<_> = config

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 
 /// Lights scattered over a scene's bounds (`--add-lights`), the way the papers fill their
 /// scenes: uniform in the bounding box, random hues.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AddLights {
     pub count: u32,
     /// `None`: [`default_added_range`].
