@@ -200,6 +200,9 @@ pub const MATERIAL_SHADER_ANY: u32 = 0xffff_ffff;
 /// Most materials a scene may have (the G-buffer stores the index in a 16-bit float, exact
 /// up to 2048).
 pub const MAX_MATERIALS: usize = 2048;
+/// Most base-colour textures a scene may have: the layers of one texture array (WebGPU's
+/// default `max_texture_array_layers`).
+pub const MAX_TEXTURES: usize = 256;
 
 /// Material flag bit: the material is transparent (blended, drawn after opaque geometry).
 pub const MATERIAL_FLAG_TRANSPARENT: u32 = 1;

@@ -40,6 +40,12 @@ pub struct GpuMaterial {
     pub paint: [f32; 3],
     /// `consts::MATERIAL_SHADER_*`.
     pub shader: u32,
+    /// Base-colour texture: its layer in the texture array + 1; 0 for none.
+    pub texture: u32,
+    /// Alpha test: fragments with alpha below are discarded; 0 for none.
+    pub alpha_cutoff: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 
 /// One vertex in world space (the CPU bakes object transforms each frame).
@@ -92,7 +98,7 @@ pub struct GridParams {
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
-const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 80);
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 96);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
 

@@ -68,31 +68,55 @@ pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
 /// stays far below a gigabyte whatever their headers declare.
 pub const MAX_DECODED_PIXELS: u64 = 8192 * 8192;
 
+/// Largest image file [`load_image`] reads.
+pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
+
 /// Read a PNG (or any format the image crate decodes) as RGBA8, refusing images larger than
 /// [`MAX_DECODED_PIXELS`] from their header, before anything is allocated.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
-    let bad = |reason: String| Error::Image {
+    let io = |cause| Error::Io {
         path: path.display().to_string(),
+        cause,
+    };
+    // Read whole, so only regular files of a bounded size (never a device or a FIFO).
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() || meta.len() > MAX_IMAGE_FILE_BYTES {
+        return Err(Error::Image {
+            path: path.display().to_string(),
+            reason: format!(
+                "not a regular image file of at most {} MiB",
+                MAX_IMAGE_FILE_BYTES >> 20
+            ),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    decode_image(&bytes, &path.display().to_string())
+}
+
+/// Decode image bytes (PNG, JPEG) as RGBA8 with [`load_image`]'s limits; errors name `name`.
+pub fn decode_image(bytes: &[u8], name: &str) -> Result<RgbaImage> {
+    let bad = |reason: String| Error::Image {
+        path: name.to_string(),
         reason,
     };
-    let mut reader = image::ImageReader::open(path)
-        .map_err(|e| bad(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| bad(e.to_string()))?;
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| bad(e.to_string()))
+    };
     // A file's header decides how much a decoder allocates: refuse what no comparison here
     // needs before decoding (MAX_DECODED_PIXELS, RGBA8 plus the decoder's own copy).
     let edge = crate::consts::MAX_FRAME_EDGE;
-    let (w, h) = reader.into_dimensions().map_err(|e| bad(e.to_string()))?;
+    let (w, h) = reader()?
+        .into_dimensions()
+        .map_err(|e| bad(e.to_string()))?;
     if w > edge || h > edge || u64::from(w) * u64::from(h) > MAX_DECODED_PIXELS {
         return Err(bad(format!(
             "declares {w}x{h} pixels; images of at most {edge} pixels per edge and {} million pixels are read",
             MAX_DECODED_PIXELS / 1_000_000
         )));
     }
-    reader = image::ImageReader::open(path)
-        .map_err(|e| bad(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| bad(e.to_string()))?;
+    let mut reader = reader()?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(edge);
     limits.max_image_height = Some(edge);

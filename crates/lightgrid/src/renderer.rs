@@ -23,6 +23,7 @@ use crate::frame::{
 };
 use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::passes::base_textures::BaseTextures;
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
 use crate::scene::{Draw, FrameState, Geometry, Scene, SpotCull};
@@ -122,6 +123,8 @@ pub struct Renderer<'c> {
     vertices: GrowBuffer,
     indices: GrowBuffer,
     scene_bind_group: wgpu::BindGroup,
+    /// The scene's base-colour textures (uploaded with its static geometry).
+    textures: BaseTextures,
     scene: Option<SceneUpload>,
     tonemap: Tonemap,
     timer: PassTimer,
@@ -183,12 +186,14 @@ impl<'c> Renderer<'c> {
             let vertices = GrowBuffer::new(device, "vertices", U::VERTEX, 1 << 20);
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
             let counters = FrameCounters::new(device, MAX_PASSES);
+            let textures = BaseTextures::new(device, &ctx.queue, &[]);
             let scene_bind_group = Self::bind_scene(
                 device,
                 &scene_layout,
                 &uniforms,
                 [&lights, &light_bounds, &materials],
                 [counters.buffer(), &targets.pixel_counts],
+                &textures,
             );
             Renderer {
                 ctx,
@@ -204,6 +209,7 @@ impl<'c> Renderer<'c> {
                 vertices,
                 indices,
                 scene_bind_group,
+                textures,
                 scene: None,
                 techniques: HashMap::new(),
                 transparent: None,
@@ -233,6 +239,7 @@ impl<'c> Renderer<'c> {
         uniforms: &wgpu::Buffer,
         [lights, light_bounds, materials]: [&GrowBuffer; 3],
         [counters, pixel_counts]: [&wgpu::Buffer; 2],
+        textures: &BaseTextures,
     ) -> wgpu::BindGroup {
         crate::gpu::bind_resources(
             device,
@@ -245,6 +252,8 @@ impl<'c> Renderer<'c> {
                 counters.as_entire_binding(),
                 light_bounds.buffer.as_entire_binding(),
                 pixel_counts.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&textures.view),
+                wgpu::BindingResource::Sampler(&textures.sampler),
             ],
         )
     }
@@ -375,9 +384,12 @@ impl<'c> Renderer<'c> {
                 device,
                 (ib.len() + std::mem::size_of_val(moving.indices.as_slice())) as u64,
             );
-            if self.materials.reserve(device, mb.len() as u64) {
-                self.rebind_scene();
-            }
+            // The textures are part of the fingerprint: a new scene gets its own (a white
+            // texel without any), and the bind group the new view.
+            self.textures = BaseTextures::new(device, queue, &scene.textures);
+            upload_bytes += self.textures.bytes;
+            self.materials.reserve(device, mb.len() as u64);
+            self.rebind_scene();
             self.vertices.write(queue, 0, vb);
             self.indices.write(queue, 0, ib);
             self.materials.write(queue, 0, mb);
@@ -458,6 +470,7 @@ impl<'c> Renderer<'c> {
             &self.uniforms,
             [&self.lights, &self.light_bounds, &self.materials],
             [self.counters.buffer(), &self.targets.pixel_counts],
+            &self.textures,
         );
     }
 

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::gltf_fixture::{room, GltfWriter};
+use common::gltf_fixture::{room, textured, GltfWriter};
 use glam::{Mat4, Quat, Vec3};
 use lightgrid::scene::catalog::{SceneParams, SCENES};
 use lightgrid::scene::gltf::{self, LoadOptions};
@@ -836,4 +836,100 @@ fn exported_catalog_scenes_render_the_same() {
             );
         }
     }
+}
+
+#[test]
+fn textures_load_with_their_materials_and_survive_export() {
+    let loaded = load(&textured().glb()).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let s = loaded.scene;
+    assert_eq!(s.textures.len(), 3);
+    assert_eq!((s.textures[0].width, s.textures[0].height), (64, 64));
+    assert_eq!(&s.textures[0].rgba[..4], &[230, 220, 200, 255]);
+    let (ground, cage, pane) = (s.materials[0], s.materials[1], s.materials[2]);
+    assert_eq!(ground.texture, Some(0));
+    assert_eq!(ground.alpha_cutoff, None);
+    assert_eq!((cage.texture, cage.alpha_cutoff), (Some(1), Some(0.5)));
+    assert!(!cage.transparent);
+    assert!(pane.transparent && pane.texture == Some(2) && (pane.alpha - 0.9).abs() < 1e-6);
+    assert!(s.meshes[0].uvs.iter().any(|uv| uv.x == 4.0));
+    // Export carries the textures (PNG, lossless) and the alpha test.
+    let back = load(&gltf::export(&s, 0, (320, 200)).unwrap())
+        .unwrap()
+        .scene;
+    assert_eq!(back.textures, s.textures);
+    assert_eq!(back.materials, s.materials);
+}
+
+#[test]
+fn broken_textures_fail_clearly() {
+    let w = textured();
+    let parts = || {
+        (
+            w.document(json!({"byteLength": w.bin.len()})),
+            w.bin.clone(),
+        )
+    };
+    let cases: Vec<Case> = vec![
+        (
+            "missing texture",
+            |d, _| {
+                d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["index"] = json!(9)
+            },
+            "texture 9 does not exist",
+        ),
+        (
+            "missing image",
+            |d, _| d["textures"][0]["source"] = json!(5),
+            "image 5 does not exist",
+        ),
+        (
+            "corrupt image",
+            |d, b| {
+                let view = d["images"][0]["bufferView"].as_u64().unwrap() as usize;
+                let at = d["bufferViews"][view]["byteOffset"].as_u64().unwrap() as usize;
+                b[at + 20..at + 40].fill(0xee);
+            },
+            "image 0",
+        ),
+        (
+            "image declaring a huge size",
+            |d, b| {
+                // The PNG header's width (IHDR, bytes 16..20) says 100,000 pixels.
+                let view = d["images"][0]["bufferView"].as_u64().unwrap() as usize;
+                let at = d["bufferViews"][view]["byteOffset"].as_u64().unwrap() as usize;
+                b[at + 16..at + 20].copy_from_slice(&100_000u32.to_be_bytes());
+            },
+            "image 0",
+        ),
+        (
+            "image without data",
+            |d, _| {
+                d["images"][0].as_object_mut().unwrap().remove("bufferView");
+            },
+            "neither a uri nor a bufferView",
+        ),
+        (
+            "negative cutoff",
+            |d, _| d["materials"][1]["alphaCutoff"] = json!(-1.0),
+            "alphaCutoff",
+        ),
+    ];
+    for (what, edit, words) in cases {
+        let (mut doc, mut bin) = parts();
+        edit(&mut doc, &mut bin);
+        let e = load(&GltfWriter::glb_of(&doc, &bin))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(words), "{what}: '{e}' does not say '{words}'");
+    }
+    // Clamped wrapping is not applied: a warning, not an error.
+    let (mut doc, bin) = parts();
+    doc["samplers"] = json!([{"wrapS": 33071}]);
+    let loaded = load(&GltfWriter::glb_of(&doc, &bin)).unwrap();
+    assert!(
+        loaded.warnings.iter().any(|w| w.contains("wrapping")),
+        "{:?}",
+        loaded.warnings
+    );
 }

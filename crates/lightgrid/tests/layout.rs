@@ -77,7 +77,11 @@ fn gpu_structs_match_wgsl() {
             ambient,
             paint_power,
             paint,
-            shader
+            shader,
+            texture,
+            alpha_cutoff,
+            _pad0,
+            _pad1
         ]
     );
     check_layout!(&module, "BvhNode", BvhNode, [lo, first, hi, count]);

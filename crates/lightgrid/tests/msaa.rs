@@ -248,6 +248,7 @@ fn wall_scene() -> Scene {
             light: Light::point(Vec3::new(0.5, 0.5, 3.0), Vec3::ONE, 4.0, 50.0),
             anchor: LightAnchor::World,
         }],
+        textures: Vec::new(),
         camera_path: CameraPath::fixed(Vec3::new(0.0, 0.0, 6.0), Vec3::ZERO, 60.0, 0.1, 100.0),
         default_size: (96, 64),
     }
@@ -450,4 +451,16 @@ fn fragments_extrapolated_out_of_the_view_volume_are_in_no_cell() {
         "tiled vs clustered forward: {}",
         cmp.describe()
     );
+}
+
+/// Alpha-tested textures at 4x: the holes of a MASK texture are cut per fragment in the
+/// depth pre-pass, the fragment-bounds pass and the shading passes alike, so every MSAA
+/// pipeline still equals `forward --msaa 4` (a glTF file's textured scene).
+#[test]
+fn every_msaa_pipeline_equals_forward_with_alpha_tested_textures() {
+    let bytes = common::gltf_fixture::textured().glb();
+    let s = lightgrid::scene::gltf::load_bytes(&bytes, "textured.glb", None, &Default::default())
+        .unwrap()
+        .scene;
+    render_all(&s, 0, (120, 76), msaa(16));
 }

@@ -892,3 +892,45 @@ fn every_pipeline_renders_a_gltf_file_like_forward() {
     .unwrap();
     check(&s, 40, (141, 88), settings(10));
 }
+
+/// Textures (a glTF file's): an opaque checkerboard, a MASK texture whose holes show what is
+/// behind them, a BLEND pane with varying alpha: every pipeline like `forward`; the alpha test
+/// and the texture really change the image (against the same file with the cage opaque and
+/// with the textures removed).
+#[test]
+fn every_pipeline_renders_textures_and_alpha_tests_like_forward() {
+    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
+    let bytes = common::gltf_fixture::textured().glb();
+    let load = |b: &[u8]| {
+        load_bytes(b, "textured.glb", None, &LoadOptions::default())
+            .unwrap()
+            .scene
+    };
+    let s = load(&bytes);
+    check(&s, 0, (150, 96), settings(16));
+    check(&s, 130, (97, 61), settings(7));
+    let ctx = common::gpu();
+    let mut r = Renderer::new(&ctx, 150, 96, settings(16)).unwrap();
+    let textured = r.render(&s, 0, REFERENCE).unwrap().image;
+    let mut opaque_cage = s.clone();
+    for m in &mut opaque_cage.materials {
+        m.alpha_cutoff = None;
+    }
+    let holes = common::pixels_over(
+        &textured,
+        &r.render(&opaque_cage, 0, REFERENCE).unwrap().image,
+        8,
+    );
+    assert!(holes > 300, "the MASK holes change only {holes} pixels");
+    let mut untextured = s.clone();
+    for m in &mut untextured.materials {
+        m.texture = None;
+        m.alpha_cutoff = None;
+    }
+    let texels = common::pixels_over(
+        &textured,
+        &r.render(&untextured, 0, REFERENCE).unwrap().image,
+        8,
+    );
+    assert!(texels > 3000, "the textures change only {texels} pixels");
+}

@@ -6,6 +6,7 @@ use crate::frame::FrameInputs;
 use crate::gpu::PassTimer;
 
 /// A render pipeline drawing the scene geometry with the shared vertex stage.
+#[derive(Clone, Copy)]
 pub(crate) struct GeometryPipelineDesc<'a> {
     pub label: &'a str,
     pub module: &'a wgpu::ShaderModule,
@@ -23,7 +24,73 @@ pub(crate) struct GeometryPipelineDesc<'a> {
 /// One pipeline per material shader (tiled-forward-shading §4.7: forward shading draws each
 /// material's geometry with its own shader), each specialised through the WGSL override
 /// `MATERIAL_SHADER`; or, for `MaterialDraws::Uber`, one pipeline branching on the material.
-pub(crate) struct MaterialPipelines(Vec<wgpu::RenderPipeline>);
+///
+/// Alpha-tested runs need more where the pass writes depth: its lighting stages force the
+/// early depth test (they count), so a fragment their alpha test discards has already written
+/// its depth and would hide what is behind it. There the alpha-tested runs first draw their
+/// depth with `fs_depth` (which discards before writing; colour writes off), then shade at
+/// equal depth without writing, through pipelines made the first time a frame has such runs.
+pub(crate) struct MaterialPipelines {
+    shading: Vec<wgpu::RenderPipeline>,
+    /// What the alpha-tested variants are made from (passes that write depth only).
+    alpha_desc: Option<OwnedDesc>,
+    alpha: std::sync::OnceLock<AlphaTested>,
+}
+
+/// A [`GeometryPipelineDesc`] that owns its parts.
+struct OwnedDesc {
+    label: String,
+    module: wgpu::ShaderModule,
+    fragment_entry: String,
+    layouts: Vec<wgpu::BindGroupLayout>,
+    color_targets: Vec<Option<wgpu::ColorTargetState>>,
+    samples: u32,
+}
+
+struct AlphaTested {
+    depth: wgpu::RenderPipeline,
+    shading: wgpu::RenderPipeline,
+}
+
+impl OwnedDesc {
+    fn alpha_tested(&self, device: &wgpu::Device) -> AlphaTested {
+        let layouts: Vec<Option<&wgpu::BindGroupLayout>> = self.layouts.iter().map(Some).collect();
+        let silent: Vec<Option<wgpu::ColorTargetState>> = self
+            .color_targets
+            .iter()
+            .map(|t| {
+                t.clone().map(|t| wgpu::ColorTargetState {
+                    write_mask: wgpu::ColorWrites::empty(),
+                    ..t
+                })
+            })
+            .collect();
+        let base = GeometryPipelineDesc {
+            label: &self.label,
+            module: &self.module,
+            fragment_entry: Some("fs_depth"),
+            layouts: &layouts,
+            color_targets: &silent,
+            depth_write: true,
+            depth_compare: wgpu::CompareFunction::Less,
+            samples: self.samples,
+        };
+        AlphaTested {
+            depth: geometry_pipeline(device, &base),
+            shading: specialised_pipeline(
+                device,
+                &GeometryPipelineDesc {
+                    fragment_entry: Some(&self.fragment_entry),
+                    color_targets: &self.color_targets,
+                    depth_write: false,
+                    depth_compare: wgpu::CompareFunction::LessEqual,
+                    ..base
+                },
+                crate::consts::MATERIAL_SHADER_ANY,
+            ),
+        }
+    }
+}
 
 impl MaterialPipelines {
     pub(crate) fn new(
@@ -32,21 +99,35 @@ impl MaterialPipelines {
         draws: crate::frame::MaterialDraws,
     ) -> Self {
         use crate::consts::{MATERIAL_SHADERS, MATERIAL_SHADER_ANY};
-        match draws {
-            crate::frame::MaterialDraws::PerMaterial => MaterialPipelines(
-                (0..MATERIAL_SHADERS)
-                    .map(|k| specialised_pipeline(device, d, k))
-                    .collect(),
-            ),
+        let shading = match draws {
+            crate::frame::MaterialDraws::PerMaterial => (0..MATERIAL_SHADERS)
+                .map(|k| specialised_pipeline(device, d, k))
+                .collect(),
             crate::frame::MaterialDraws::Uber => {
-                MaterialPipelines(vec![specialised_pipeline(device, d, MATERIAL_SHADER_ANY)])
+                vec![specialised_pipeline(device, d, MATERIAL_SHADER_ANY)]
             }
+        };
+        let alpha_desc = match (d.depth_write, d.fragment_entry) {
+            (true, Some(entry)) => Some(OwnedDesc {
+                label: format!("{} (alpha tested)", d.label),
+                module: d.module.clone(),
+                fragment_entry: entry.to_string(),
+                layouts: d.layouts.iter().flatten().map(|&l| l.clone()).collect(),
+                color_targets: d.color_targets.to_vec(),
+                samples: d.samples,
+            }),
+            _ => None,
+        };
+        MaterialPipelines {
+            shading,
+            alpha_desc,
+            alpha: std::sync::OnceLock::new(),
         }
     }
 
     /// The pipeline for draws of material shader `shader`.
     fn get(&self, shader: u32) -> &wgpu::RenderPipeline {
-        &self.0[(shader as usize).min(self.0.len() - 1)]
+        &self.shading[(shader as usize).min(self.shading.len() - 1)]
     }
 }
 
@@ -117,6 +198,49 @@ fn pipeline_with_constants(
     })
 }
 
+/// A depth-only pass: its runs drawn without a fragment stage, but alpha-tested runs with
+/// `fs_depth` (`geometry.wgsl`), which discards what the alpha test removes, so the depth
+/// buffer holds exactly the surfaces the shading passes keep.
+pub(crate) struct DepthPipelines {
+    plain: wgpu::RenderPipeline,
+    alpha_tested: wgpu::RenderPipeline,
+}
+
+impl DepthPipelines {
+    /// From a description whose `fragment_entry` is ignored.
+    pub(crate) fn new(device: &wgpu::Device, d: &GeometryPipelineDesc) -> Self {
+        DepthPipelines {
+            plain: geometry_pipeline(
+                device,
+                &GeometryPipelineDesc {
+                    fragment_entry: None,
+                    ..*d
+                },
+            ),
+            alpha_tested: geometry_pipeline(
+                device,
+                &GeometryPipelineDesc {
+                    fragment_entry: Some("fs_depth"),
+                    ..*d
+                },
+            ),
+        }
+    }
+
+    /// Bind group 0 and draw the opaque runs, each with its pipeline.
+    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass, f: &FrameInputs) {
+        bind(pass, f, &[]);
+        for d in f.opaque {
+            pass.set_pipeline(if d.alpha_test {
+                &self.alpha_tested
+            } else {
+                &self.plain
+            });
+            pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
+        }
+    }
+}
+
 /// Bind group 0 (+ `extra` from group 1 on), the scene's buffers, and draw the opaque
 /// geometry with the pipeline already set (depth, G-buffer and attribute passes).
 pub(crate) fn draw_scene(pass: &mut wgpu::RenderPass, f: &FrameInputs, extra: &[&wgpu::BindGroup]) {
@@ -155,8 +279,22 @@ fn draw_runs(
     runs: &[crate::scene::Draw],
 ) {
     bind(pass, f, extra);
+    let alpha = match &pipelines.alpha_desc {
+        Some(desc) if runs.iter().any(|d| d.alpha_test) => {
+            let alpha = pipelines.alpha.get_or_init(|| desc.alpha_tested(f.device));
+            pass.set_pipeline(&alpha.depth);
+            for d in runs.iter().filter(|d| d.alpha_test) {
+                pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
+            }
+            Some(alpha)
+        }
+        _ => None,
+    };
     for d in runs {
-        pass.set_pipeline(pipelines.get(d.shader));
+        match alpha {
+            Some(a) if d.alpha_test => pass.set_pipeline(&a.shading),
+            _ => pass.set_pipeline(pipelines.get(d.shader)),
+        }
         pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
     }
 }

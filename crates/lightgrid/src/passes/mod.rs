@@ -1,6 +1,7 @@
 //! Passes and resources several pipelines share: the render targets, the scene vertex layout,
 //! the scene bind group (group 0) and the tonemap pass.
 
+pub mod base_textures;
 mod gbuffer;
 pub(crate) mod geometry;
 mod light_volumes;
@@ -155,7 +156,8 @@ pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
     }
 }
 
-/// Layout of group 0 (`shading/scene_bindings.wgsl`): frame uniforms, lights, materials.
+/// Layout of group 0 (`shading/scene_bindings.wgsl`): frame uniforms, lights, materials,
+/// and (`passes/geometry.wgsl`) the base-colour textures.
 pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let storage = |binding, size: usize| wgpu::BindGroupLayoutEntry {
         binding,
@@ -207,6 +209,9 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 },
                 count: None,
             },
+            // The base-colour texture array and its sampler (`base_textures.rs`).
+            base_textures::layout_entries()[0],
+            base_textures::layout_entries()[1],
         ],
     })
 }

@@ -336,5 +336,5 @@ pub fn find(id: &str) -> Result<&'static PipelineInfo> {
 
 pub(crate) use crate::passes::geometry::{
     begin_lighting_pass, draw_scene, draw_scene_materials, geometry_pipeline, lighting_attachments,
-    lighting_targets, GeometryPipelineDesc, MaterialPipelines,
+    lighting_targets, DepthPipelines, GeometryPipelineDesc, MaterialPipelines,
 };

@@ -11,8 +11,8 @@
 //! cluster's list.
 
 use super::{
-    begin_lighting_pass, draw_scene, draw_scene_materials, geometry_pipeline, lighting_targets,
-    FrameEncoder, FrameInputs, MaterialPipelines,
+    begin_lighting_pass, draw_scene_materials, lighting_targets, DepthPipelines, FrameEncoder,
+    FrameInputs, MaterialPipelines,
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, TransparentLights};
 use crate::culling::{CellSource, GridBuilder};
@@ -30,7 +30,7 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 struct TiledForward {
     builder: GridBuilder,
     /// The depth pre-pass (pre-Z and clustered).
-    depth_only: Option<wgpu::RenderPipeline>,
+    depth_only: Option<DepthPipelines>,
     shading: MaterialPipelines,
     label: &'static str,
 }
@@ -77,7 +77,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
         ctx.settings.material_draws,
     );
     let depth_only = prepass.then(|| {
-        geometry_pipeline(
+        DepthPipelines::new(
             ctx.device,
             &GeometryPipelineDesc {
                 label: "depth pre-pass",
@@ -127,8 +127,7 @@ impl Technique for TiledForward {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(depth_only);
-            draw_scene(&mut pass, f, &[]);
+            depth_only.draw(&mut pass, f);
         }
         self.builder.build(f, enc)?;
         let (encoder, timer) = enc.parts();

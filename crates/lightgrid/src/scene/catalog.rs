@@ -282,6 +282,7 @@ impl Builder {
                 objects: Vec::new(),
                 paths: Vec::new(),
                 lights: Vec::new(),
+                textures: Vec::new(),
                 camera_path,
                 default_size,
             },

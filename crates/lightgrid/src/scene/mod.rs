@@ -38,6 +38,22 @@ pub struct Material {
     pub transparent: bool,
     /// How the material responds to the view (its shader).
     pub shader: MaterialShader,
+    /// Index into [`Scene::textures`] of a base-colour texture multiplying the diffuse and
+    /// ambient colours and the alpha (glTF's `baseColorTexture`), sampled at the vertices'
+    /// UVs.
+    pub texture: Option<u32>,
+    /// Alpha test (glTF's `MASK`): fragments whose alpha (`alpha` × the texture's) is below
+    /// this are discarded in every pass, depth passes included.
+    pub alpha_cutoff: Option<f32>,
+}
+
+/// A base-colour texture: sRGB-encoded RGBA8, rows top to bottom (UV (0, 0) is its first
+/// texel, as in glTF).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
 }
 
 /// A material's shader (tiled-forward-shading §4.7). Each changes only the colour the one
@@ -81,6 +97,8 @@ impl Material {
             alpha: 1.0,
             transparent: false,
             shader: MaterialShader::Standard,
+            texture: None,
+            alpha_cutoff: None,
         }
     }
 
@@ -112,6 +130,10 @@ impl Material {
             paint_power,
             paint: paint.to_array(),
             shader,
+            texture: self.texture.map_or(0, |t| t + 1),
+            alpha_cutoff: self.alpha_cutoff.unwrap_or(0.0),
+            _pad0: 0,
+            _pad1: 0,
         }
     }
 }
@@ -339,6 +361,8 @@ pub struct Scene {
     pub objects: Vec<Object>,
     pub paths: Vec<Path>,
     pub lights: Vec<SceneLight>,
+    /// Base-colour textures the materials name (loaded scenes; the catalog has none).
+    pub textures: Vec<Texture>,
     pub camera_path: CameraPath,
     /// Frame size used when the user gives none.
     pub default_size: (u32, u32),
@@ -363,6 +387,8 @@ pub struct Geometry {
 pub struct Draw {
     /// `consts::MATERIAL_SHADER_*`.
     pub shader: u32,
+    /// The run's materials are alpha tested (a depth-only pass needs a fragment stage).
+    pub alpha_test: bool,
     pub first: u32,
     pub count: u32,
 }
@@ -536,9 +562,11 @@ impl Scene {
         out
     }
 
-    /// The material shader id of object `i`.
-    fn shader_of(&self, i: usize) -> u32 {
-        self.materials[self.objects[i].material].shader.gpu().0
+    /// The material shader id of object `i`, and whether it is alpha tested: what a run of
+    /// one draw shares.
+    fn shader_of(&self, i: usize) -> (u32, bool) {
+        let m = &self.materials[self.objects[i].material];
+        (m.shader.gpu().0, m.alpha_cutoff.is_some())
     }
 
     /// Bake objects in order, merging consecutive ones with one shader into one draw (never
@@ -549,14 +577,19 @@ impl Scene {
             let first = out.indices.len() as u32;
             self.bake(&self.objects[i], m, base, out);
             let count = out.indices.len() as u32 - first;
-            let shader = self.shader_of(i);
+            let (shader, alpha_test) = self.shader_of(i);
             let mergeable = out.draws.len() > earlier;
             match out.draws.last_mut() {
-                Some(d) if mergeable && d.shader == shader && d.first + d.count == first => {
+                Some(d)
+                    if mergeable
+                        && (d.shader, d.alpha_test) == (shader, alpha_test)
+                        && d.first + d.count == first =>
+                {
                     d.count += count
                 }
                 _ => out.draws.push(Draw {
                     shader,
+                    alpha_test,
                     first,
                     count,
                 }),
@@ -602,6 +635,12 @@ impl Scene {
         }
         for m in &self.materials {
             words(&mut h, bytemuck::cast_slice(&[m.to_gpu()]));
+        }
+        // Textures by size and every 61st byte: hashing every texel each frame would cost a
+        // millisecond per megabyte, and scenes do not repaint a texture texel by texel.
+        for t in &self.textures {
+            (t.width, t.height, t.rgba.len()).hash(&mut h);
+            t.rgba.iter().step_by(61).for_each(|b| b.hash(&mut h));
         }
         h.finish()
     }
@@ -652,6 +691,34 @@ impl Scene {
                     crate::consts::MAX_MATERIALS
                 ),
             ));
+        }
+        for (i, m) in self.materials.iter().enumerate() {
+            let bad_texture = m.texture.is_some_and(|t| t as usize >= self.textures.len());
+            if bad_texture {
+                return Err(Error::invalid(
+                    "scene",
+                    format!("material {i} names a missing texture"),
+                ));
+            }
+        }
+        if self.textures.len() > crate::consts::MAX_TEXTURES {
+            return Err(Error::invalid(
+                "scene",
+                format!(
+                    "{} textures exceed the maximum of {}",
+                    self.textures.len(),
+                    crate::consts::MAX_TEXTURES
+                ),
+            ));
+        }
+        for (i, t) in self.textures.iter().enumerate() {
+            let texels = u64::from(t.width) * u64::from(t.height);
+            if t.width == 0 || t.height == 0 || t.rgba.len() as u64 != texels * 4 {
+                return Err(Error::invalid(
+                    "scene",
+                    format!("texture {i} is not {}x{} RGBA8", t.width, t.height),
+                ));
+            }
         }
         for (i, o) in self.objects.iter().enumerate() {
             let mesh = self.meshes.get(o.mesh).ok_or_else(|| {

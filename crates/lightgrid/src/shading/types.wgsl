@@ -23,6 +23,10 @@ struct Material {
     paint_power: f32,
     paint: vec3<f32>,
     shader: u32,
+    texture: u32,          // layer + 1 in `base_textures`; 0: none
+    alpha_cutoff: f32,     // alpha test (glTF MASK); 0: none
+    _pad0: u32,
+    _pad1: u32,
 }
 
 struct FrameUniforms {

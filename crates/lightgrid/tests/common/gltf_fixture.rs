@@ -2,6 +2,7 @@
 //! meshes, nodes, materials, KHR_lights_punctual lights, cameras) that emits a `.gltf` with a
 //! base64 buffer or a `.glb`, and the fixture scenes the loader and pipeline tests use.
 
+use glam::Quat;
 use serde_json::{json, Value};
 
 #[derive(Default, Clone)]
@@ -14,6 +15,8 @@ pub struct GltfWriter {
     pub materials: Vec<Value>,
     pub lights: Vec<Value>,
     pub cameras: Vec<Value>,
+    pub images: Vec<Value>,
+    pub textures: Vec<Value>,
     pub roots: Vec<usize>,
 }
 
@@ -53,7 +56,8 @@ impl GltfWriter {
             "VEC3" => 3,
             _ => 1,
         };
-        let view = self.view(bytemuck::cast_slice(data));
+        let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes);
         let mut acc = json!({"bufferView": view, "componentType": 5126, "count": data.len() / comps, "type": kind});
         if kind == "VEC3" {
             let mut lo = [f32::INFINITY; 3];
@@ -72,7 +76,8 @@ impl GltfWriter {
     }
 
     pub fn indices(&mut self, data: &[u16]) -> usize {
-        let view = self.view(bytemuck::cast_slice(data));
+        let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes);
         self.accessors.push(json!({"bufferView": view, "componentType": 5123, "count": data.len(), "type": "SCALAR"}));
         self.accessors.len() - 1
     }
@@ -99,6 +104,34 @@ impl GltfWriter {
         }
         self.meshes.push(json!({"primitives": [prim]}));
         self.meshes.len() - 1
+    }
+
+    /// A texture from a PNG in the buffer; returns the texture index.
+    pub fn png(&mut self, img: &image::RgbaImage) -> usize {
+        let mut png = Vec::new();
+        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let view = self.view(&png);
+        self.images
+            .push(json!({"bufferView": view, "mimeType": "image/png"}));
+        self.textures
+            .push(json!({"source": self.images.len() - 1, "sampler": 0}));
+        self.textures.len() - 1
+    }
+
+    /// A mesh of one indexed triangle primitive with UVs.
+    pub fn textured_mesh(
+        &mut self,
+        positions: &[f32],
+        normals: &[f32],
+        uvs: &[f32],
+        indices: &[u16],
+        material: usize,
+    ) -> usize {
+        let m = self.mesh(positions, Some(normals), Some(indices), Some(material), 4);
+        let uv = self.floats(uvs, "VEC2");
+        self.meshes[m]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+        m
     }
 
     pub fn material(&mut self, m: Value) -> usize {
@@ -134,6 +167,11 @@ impl GltfWriter {
         }
         if !self.cameras.is_empty() {
             doc["cameras"] = json!(self.cameras);
+        }
+        if !self.textures.is_empty() {
+            doc["images"] = json!(self.images);
+            doc["textures"] = json!(self.textures);
+            doc["samplers"] = json!([{}]);
         }
         doc
     }
@@ -253,7 +291,9 @@ pub fn room() -> GltfWriter {
         json!({"mesh": metal_cube, "translation": [0.0, 1.5, 0.0], "scale": [0.6, 0.6, 0.6]}),
     );
     let child = w.node(json!({"mesh": red_cube, "scale": [1.5, 2.0, 1.5], "translation": [0.0, 1.0, 0.0], "children": [grandchild]}));
-    let parent = w.node(json!({"translation": [-2.0, 0.0, 1.0], "rotation": [0.0, 0.3826834, 0.0, 0.9238795], "children": [child]}));
+    let parent = w.node(
+        json!({"translation": [-2.0, 0.0, 1.0], "rotation": rot_y(45.0), "children": [child]}),
+    );
     // Mirrored in x (determinant < 0): its winding is flipped back on load.
     let mirrored = w.node(json!({"mesh": metal_cube, "matrix": [-1.2, 0.0, 0.0, 0.0, 0.0, 1.2, 0.0, 0.0, 0.0, 0.0, 1.2, 0.0, 3.0, 0.6, -2.0, 1.0]}));
     let glass_node = w.node(
@@ -284,17 +324,19 @@ pub fn room() -> GltfWriter {
     // Spots: one pointing straight down (rotation -90° about x turns -z into -y), one
     // aimed sideways through a parent's rotation.
     let down = w.light(json!({"type": "spot", "color": [1.0, 0.9, 0.7], "intensity": 20.0, "range": 9.0, "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}));
-    light_nodes.push(w.node(json!({"translation": [-1.0, 6.0, -3.0], "rotation": [-0.7071068, 0.0, 0.0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": down}}})));
+    light_nodes.push(w.node(json!({"translation": [-1.0, 6.0, -3.0], "rotation": rot_x(-90.0), "extensions": {"KHR_lights_punctual": {"light": down}}})));
     let side = w.light(json!({"type": "spot", "color": [0.3, 1.0, 0.4], "intensity": 15.0, "range": 12.0, "spot": {"outerConeAngle": 0.6}}));
     let side_node = w.node(json!({"translation": [0.0, 1.0, 0.0], "extensions": {"KHR_lights_punctual": {"light": side}}}));
-    light_nodes.push(w.node(json!({"translation": [7.0, 0.5, 0.0], "rotation": [0.0, 0.5, 0.0, 0.8660254], "children": [side_node]})));
+    light_nodes.push(w.node(
+        json!({"translation": [7.0, 0.5, 0.0], "rotation": rot_y(60.0), "children": [side_node]}),
+    ));
 
     w.cameras.push(json!({"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1, "zfar": 60.0, "aspectRatio": 1.6}}));
     // The camera at (4, 7, 13) looking down toward the origin: a rotation about x of -25°
     // after one about y of 17°.
-    let qy = [0.0, 0.1478094, 0.0, 0.9890159f32];
-    let qx = [-0.2164396, 0.0, 0.0, 0.9762960f32];
-    let q = quat_mul(qy, qx);
+    let q = (Quat::from_rotation_y(17f32.to_radians())
+        * Quat::from_rotation_x(-25f32.to_radians()))
+    .to_array();
     let camera = w.node(json!({"camera": 0, "translation": [4.0, 7.0, 13.0], "rotation": q}));
 
     w.roots = vec![
@@ -311,14 +353,82 @@ pub fn room() -> GltfWriter {
     w
 }
 
-/// Hamilton product of two [x, y, z, w] quaternions.
-pub fn quat_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    let [ax, ay, az, aw] = a;
-    let [bx, by, bz, bw] = b;
-    [
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    ]
+/// A rotation of `deg` degrees about y, as glTF's [x, y, z, w].
+fn rot_y(deg: f32) -> [f32; 4] {
+    Quat::from_rotation_y(deg.to_radians()).to_array()
+}
+
+/// A rotation of `deg` degrees about x.
+fn rot_x(deg: f32) -> [f32; 4] {
+    Quat::from_rotation_x(deg.to_radians()).to_array()
+}
+
+/// A checkerboard `n` × `n` texels of `cells` squares, colours `a` and `b` (RGBA).
+pub fn checker(n: u32, cells: u32, a: [u8; 4], b: [u8; 4]) -> image::RgbaImage {
+    image::RgbaImage::from_fn(n, n, |x, y| {
+        let odd = (x * cells / n + y * cells / n) % 2 == 1;
+        image::Rgba(if odd { b } else { a })
+    })
+}
+
+/// The textured fixture: a ground under an opaque checkerboard (UVs repeating 4 times), a
+/// cube with a MASK texture whose transparent squares are holes (you see through them), and
+/// a BLEND pane whose texture's alpha varies; point lights and a camera.
+pub fn textured() -> GltfWriter {
+    let mut w = GltfWriter::default();
+    let board = w.png(&checker(64, 8, [230, 220, 200, 255], [40, 60, 120, 255]));
+    let holes = w.png(&checker(32, 4, [200, 60, 40, 255], [0, 0, 0, 0]));
+    let tint = w.png(&image::RgbaImage::from_fn(16, 16, |x, _| {
+        image::Rgba([80, 200, 120, (x * 16) as u8])
+    }));
+    let ground_m = w.material(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": board}, "metallicFactor": 0.0, "roughnessFactor": 0.8}}));
+    let mask_m = w.material(json!({"alphaMode": "MASK", "alphaCutoff": 0.5, "doubleSided": true, "pbrMetallicRoughness": {"baseColorTexture": {"index": holes}, "metallicFactor": 0.0, "roughnessFactor": 0.5}}));
+    let blend_m = w.material(json!({"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.9], "baseColorTexture": {"index": tint}, "metallicFactor": 0.0, "roughnessFactor": 0.2}}));
+    let ground = w.textured_mesh(
+        &[
+            -8.0, 0.0, -8.0, 8.0, 0.0, -8.0, 8.0, 0.0, 8.0, -8.0, 0.0, 8.0,
+        ],
+        &[0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0],
+        &[0.0, 0.0, 4.0, 0.0, 4.0, 4.0, 0.0, 4.0],
+        &[0, 2, 1, 0, 3, 2],
+        ground_m,
+    );
+    let (cp, cn, ci) = cube();
+    // Each face's UVs from its 4 vertices' order: (0,0) (1,0) (1,1) (0,1).
+    let cuv: Vec<f32> = (0..6)
+        .flat_map(|_| [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0])
+        .collect();
+    let cage = w.textured_mesh(&cp, &cn, &cuv, &ci, mask_m);
+    let pane = w.textured_mesh(
+        &[-3.0, 0.0, 2.0, 1.0, 0.0, 2.0, 1.0, 3.0, 2.0, -3.0, 3.0, 2.0],
+        &[0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0],
+        &[0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0],
+        &[0, 1, 2, 0, 2, 3],
+        blend_m,
+    );
+    let g = w.node(json!({"mesh": ground}));
+    let c =
+        w.node(json!({"mesh": cage, "translation": [1.5, 1.6, -1.0], "scale": [3.0, 3.0, 3.0]}));
+    let p = w.node(json!({"mesh": pane}));
+    let mut roots = vec![g, c, p];
+    for (pos, colour, range) in [
+        ([0.0, 4.0, 0.0], [1.0, 1.0, 1.0], 14.0),
+        ([1.5, 1.6, -1.0], [1.0, 0.8, 0.5], 5.0),
+        ([-5.0, 2.0, 4.0], [0.6, 0.7, 1.0], 9.0),
+    ] {
+        let l =
+            w.light(json!({"type": "point", "color": colour, "intensity": 8.0, "range": range}));
+        roots.push(w.node(
+            json!({"translation": pos, "extensions": {"KHR_lights_punctual": {"light": l}}}),
+        ));
+    }
+    w.cameras.push(
+        json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 50.0}}),
+    );
+    let q = (Quat::from_rotation_y(15f32.to_radians())
+        * Quat::from_rotation_x(-30f32.to_radians()))
+    .to_array();
+    roots.push(w.node(json!({"camera": 0, "translation": [3.0, 6.0, 11.0], "rotation": q})));
+    w.roots = roots;
+    w
 }

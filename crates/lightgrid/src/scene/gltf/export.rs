@@ -74,6 +74,13 @@ fn material_json(m: &Material) -> Value {
     if m.transparent {
         v["alphaMode"] = json!("BLEND");
     }
+    if let Some(cutoff) = m.alpha_cutoff {
+        v["alphaMode"] = json!("MASK");
+        v["alphaCutoff"] = json!(cutoff);
+    }
+    if let Some(t) = m.texture {
+        v["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": t});
+    }
     v
 }
 
@@ -163,6 +170,25 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         "matrix": cam.view().inverse().to_cols_array(),
     }));
     let materials: Vec<Value> = scene.materials.iter().map(material_json).collect();
+    // Textures as PNG images in the binary chunk, one glTF texture each (repeating).
+    let mut images = Vec::new();
+    for (i, t) in scene.textures.iter().enumerate() {
+        let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba.clone())
+            .ok_or_else(|| Error::invalid("export", format!("texture {i} is not RGBA8")))?;
+        let mut png = Vec::new();
+        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .map_err(|e| Error::invalid("export", format!("texture {i}: {e}")))?;
+        while bin.bytes.len() % 4 != 0 {
+            bin.bytes.push(0);
+        }
+        bin.views
+            .push(json!({"buffer": 0, "byteOffset": bin.bytes.len(), "byteLength": png.len()}));
+        bin.bytes.extend_from_slice(&png);
+        images.push(json!({"bufferView": bin.views.len() - 1, "mimeType": "image/png"}));
+    }
+    let textures: Vec<Value> = (0..images.len())
+        .map(|i| json!({"source": i, "sampler": 0}))
+        .collect();
     let root = json!({
         "asset": {"version": "2.0", "generator": "lightgrid export"},
         "extensionsUsed": ["KHR_lights_punctual"],
@@ -172,6 +198,9 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
+        "images": images,
+        "textures": textures,
+        "samplers": [{"wrapS": 10497, "wrapT": 10497}],
         "cameras": [{"type": "perspective", "perspective": {
             "yfov": cam.fov_y, "znear": cam.near, "zfar": cam.far, "aspectRatio": aspect,
         }}],

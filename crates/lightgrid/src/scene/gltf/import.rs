@@ -10,7 +10,7 @@ use super::{
 };
 use crate::scene::{
     CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object, Scene,
-    SceneLight, Spot,
+    SceneLight, Spot, Texture,
 };
 use glam::{Mat4, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -66,6 +66,9 @@ pub(super) struct ExactMaterial {
     pub shader: String,
     pub paint: [f32; 3],
     pub paint_power: f32,
+    /// The alpha test's cutoff (the texture is the glTF material's `baseColorTexture`).
+    #[serde(default)]
+    pub alpha_cutoff: Option<f32>,
 }
 
 impl ExactMaterial {
@@ -86,6 +89,7 @@ impl ExactMaterial {
             shader: shader.into(),
             paint: paint.to_array(),
             paint_power,
+            alpha_cutoff: m.alpha_cutoff,
         }
     }
 
@@ -112,6 +116,8 @@ impl ExactMaterial {
             alpha: self.alpha,
             transparent: self.transparent,
             shader,
+            texture: None,
+            alpha_cutoff: self.alpha_cutoff.filter(|c| c.is_finite()),
         };
         material_is_sane(&m).then_some(m)
     }
@@ -132,21 +138,30 @@ fn material_is_sane(m: &Material) -> bool {
 /// of the specification's BRDF, metals tinted); shininess = 2/α² − 2 with α = roughness²
 /// (the Blinn-Phong exponent whose lobe matches GGX of that α), from 1 to 2048; ambient =
 /// base; emissive = emissiveFactor. `BLEND` is drawn transparent with the base alpha.
-fn map_material(def: &MaterialDef, index: usize, walk: &mut Walk) -> Res<Material> {
+fn map_material(
+    def: &MaterialDef,
+    index: usize,
+    textures: &mut TextureLoader,
+    walk: &mut Walk,
+) -> Res<Material> {
+    let pbr = def.pbr_metallic_roughness.as_ref();
+    let texture = match pbr.and_then(|p| p.base_color_texture.as_ref()) {
+        Some(t) => Some(textures.load(t.index, index, walk)?),
+        None => None,
+    };
     if let Some(exact) = def
         .extras
         .as_ref()
         .and_then(|e| e.get("lightgrid"))
-        .map(|v| ExactMaterial::deserialize(v))
+        .map(ExactMaterial::deserialize)
     {
         match exact.ok().and_then(|e| e.to_material()) {
-            Some(m) => return Ok(m),
+            Some(m) => return Ok(Material { texture, ..m }),
             None => walk.warn(format!(
                 "material {index}: its extras.lightgrid is malformed; the glTF material is used"
             )),
         }
     }
-    let pbr = def.pbr_metallic_roughness.as_ref();
     let base = pbr.and_then(|p| p.base_color_factor).unwrap_or([1.0; 4]);
     let metallic = pbr.and_then(|p| p.metallic_factor).unwrap_or(1.0);
     let roughness = pbr.and_then(|p| p.roughness_factor).unwrap_or(1.0);
@@ -159,15 +174,11 @@ fn map_material(def: &MaterialDef, index: usize, walk: &mut Walk) -> Res<Materia
             ));
         }
     }
-    if pbr.is_some_and(|p| p.base_color_texture.is_some()) {
-        walk.warn(format!(
-            "material {index}: base colour textures are not applied; its base colour factor is used"
-        ));
-    }
     let (metallic, roughness) = (metallic.min(1.0), roughness.min(1.0));
     let colour = Vec3::new(base[0], base[1], base[2]);
     let alpha_g = (roughness * roughness).max(1e-3);
-    let transparent = match def.alpha_mode.as_deref().unwrap_or("OPAQUE") {
+    let mode = def.alpha_mode.as_deref().unwrap_or("OPAQUE");
+    let transparent = match mode {
         "OPAQUE" | "MASK" => false,
         "BLEND" => true,
         other => {
@@ -176,16 +187,98 @@ fn map_material(def: &MaterialDef, index: usize, walk: &mut Walk) -> Res<Materia
             ))
         }
     };
+    // MASK (§3.9.4): a constant alpha is tested here (`masked_out`); a texture's per texel.
+    let cutoff = def.alpha_cutoff.unwrap_or(0.5);
+    if !cutoff.is_finite() || cutoff < 0.0 {
+        return Err(format!(
+            "material {index}: alphaCutoff {cutoff} is not a non-negative number"
+        ));
+    }
+    let alpha_tested = mode == "MASK" && texture.is_some();
     Ok(Material {
         diffuse: colour * (1.0 - metallic),
         specular: Vec3::splat(0.04).lerp(colour, metallic),
         shininess: (2.0 / (alpha_g * alpha_g) - 2.0).clamp(1.0, 2048.0),
         emissive: emissive.into(),
         ambient: colour,
-        alpha: if transparent { base[3].min(1.0) } else { 1.0 },
+        alpha: if transparent || alpha_tested {
+            base[3].min(1.0)
+        } else {
+            1.0
+        },
         transparent,
         shader: MaterialShader::Standard,
+        texture,
+        alpha_cutoff: alpha_tested.then_some(cutoff),
     })
+}
+
+/// The file's textures as scene textures, each image decoded once (PNG or JPEG, with
+/// `image_io::decode_image`'s limits).
+struct TextureLoader<'a> {
+    doc: &'a Document,
+    by_image: HashMap<usize, u32>,
+    textures: Vec<Texture>,
+}
+
+impl TextureLoader<'_> {
+    /// Our index of glTF texture `index` (named by material `material`).
+    fn load(&mut self, index: usize, material: usize, walk: &mut Walk) -> Res<u32> {
+        let what = format!("material {material}");
+        let def = self
+            .doc
+            .root
+            .textures
+            .get(index)
+            .ok_or_else(|| format!("{what}: texture {index} does not exist"))?;
+        let source = def.source.ok_or_else(|| {
+            format!("{what}: texture {index} has no source image (an extension's?)")
+        })?;
+        if let Some(s) = def.sampler {
+            let sampler = self
+                .doc
+                .root
+                .samplers
+                .get(s)
+                .ok_or_else(|| format!("texture {index}: sampler {s} does not exist"))?;
+            let repeat = |w: Option<u32>| w.is_none_or(|w| w == 10497);
+            if !repeat(sampler.wrap_s) || !repeat(sampler.wrap_t) {
+                walk.warn(format!(
+                    "texture {index}: clamped or mirrored wrapping is not applied; textures repeat"
+                ));
+            }
+        }
+        if let Some(&t) = self.by_image.get(&source) {
+            return Ok(t);
+        }
+        if self.textures.len() >= crate::consts::MAX_TEXTURES {
+            return Err(format!(
+                "more than {} textures",
+                crate::consts::MAX_TEXTURES
+            ));
+        }
+        let image = self
+            .doc
+            .root
+            .images
+            .get(source)
+            .ok_or_else(|| format!("texture {index}: image {source} does not exist"))?;
+        let what = format!("image {source}");
+        let bytes = match (&image.uri, image.buffer_view) {
+            (Some(uri), _) => self.doc.fetch(uri, &what)?,
+            (None, Some(v)) => self.doc.view(v, &what)?.1.to_vec(),
+            (None, None) => return Err(format!("{what} has neither a uri nor a bufferView")),
+        };
+        let rgba = crate::image_io::decode_image(&bytes, &what).map_err(|e| e.to_string())?;
+        self.textures.push(Texture {
+            width: rgba.width(),
+            height: rgba.height(),
+            rgba: rgba.into_raw(),
+        });
+        let t = self.textures.len() as u32 - 1;
+        self.by_image.insert(source, t);
+        Ok(t)
+    }
 }
 
 /// Is a `MASK` material's constant alpha below its cutoff (every fragment discarded, §3.9.4)?
@@ -195,6 +288,7 @@ fn masked_out(def: &MaterialDef) -> bool {
         .as_ref()
         .and_then(|p| p.base_color_factor)
         .map_or(1.0, |b| b[3]);
+    // A texture's alpha multiplies the factor and is at most 1: the test holds with one too.
     def.alpha_mode.as_deref() == Some("MASK") && alpha < def.alpha_cutoff.unwrap_or(0.5)
 }
 
@@ -343,16 +437,28 @@ fn primitive_mesh(
         }
         None => computed,
     };
-    let uvs = match prim.attributes.get("TEXCOORD_0") {
+    // The UV set the material's base-colour texture names (TEXCOORD_0 without one).
+    let texture = prim
+        .material
+        .and_then(|m| doc.root.materials.get(m))
+        .and_then(|m| m.pbr_metallic_roughness.as_ref())
+        .and_then(|p| p.base_color_texture.as_ref());
+    let set = format!("TEXCOORD_{}", texture.map_or(0, |t| t.tex_coord));
+    if texture.is_some() && !prim.attributes.contains_key(&set) {
+        walk.warn(format!(
+            "{what}: textured without {set}; its texture is sampled at one texel"
+        ));
+    }
+    let uvs = match prim.attributes.get(&set) {
         Some(&a) => {
             let uv: Vec<Vec2> = doc
-                .read_floats(a, 2, &format!("{what} TEXCOORD_0"))?
+                .read_floats(a, 2, &format!("{what} {set}"))?
                 .chunks_exact(2)
                 .map(|c| Vec2::new(c[0], c[1]))
                 .collect();
             if uv.len() != positions.len() || uv.iter().any(|v| !v.is_finite()) {
                 return Err(format!(
-                    "{what}: TEXCOORD_0 (accessor {a}) needs one finite UV per vertex"
+                    "{what}: {set} (accessor {a}) needs one finite UV per vertex"
                 ));
             }
             uv
@@ -763,12 +869,17 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
     }
     let mut materials = Vec::new();
     let mut by_gltf = Vec::new();
+    let mut textures = TextureLoader {
+        doc,
+        by_image: HashMap::new(),
+        textures: Vec::new(),
+    };
     for (i, def) in doc.root.materials.iter().enumerate() {
         if masked_out(def) {
             by_gltf.push(None);
             continue;
         }
-        materials.push(map_material(def, i, &mut walk)?);
+        materials.push(map_material(def, i, &mut textures, &mut walk)?);
         by_gltf.push(Some(materials.len() - 1));
     }
     // The specification's default material, for primitives without one (only if any).
@@ -779,9 +890,11 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         .flat_map(|m| &m.primitives)
         .any(|p| p.material.is_none());
     if needs_default {
+        let default = MaterialDef::default();
         materials.push(map_material(
-            &MaterialDef::default(),
+            &default,
             usize::MAX,
+            &mut textures,
             &mut walk,
         )?);
     }
@@ -822,6 +935,7 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         objects: std::mem::take(&mut walk.objects),
         paths: Vec::new(),
         lights,
+        textures: textures.textures,
         camera_path,
         default_size,
     };

@@ -22,6 +22,7 @@ pub(super) struct Root {
     pub materials: Vec<MaterialDef>,
     pub textures: Vec<TextureDef>,
     pub images: Vec<ImageDef>,
+    pub samplers: Vec<SamplerDef>,
     pub cameras: Vec<CameraDef>,
     pub extensions: Option<RootExtensions>,
 }
@@ -162,6 +163,15 @@ pub(super) struct TextureRef {
 #[serde(default)]
 pub(super) struct TextureDef {
     pub source: Option<usize>,
+    pub sampler: Option<usize>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct SamplerDef {
+    /// 10497 repeat (the default), 33071 clamp, 33648 mirrored repeat.
+    pub wrap_s: Option<u32>,
+    pub wrap_t: Option<u32>,
 }
 
 #[derive(Deserialize, Default)]
