@@ -933,3 +933,46 @@ fn broken_textures_fail_clearly() {
         loaded.warnings
     );
 }
+
+/// Sparse accessors (glTF §3.6.2.3): substitutions over a base view, and over zeros without
+/// one.
+#[test]
+fn sparse_accessors_substitute_their_elements() {
+    let (mut doc, mut bin) = fixture_parts();
+    // The ground's positions (accessor 0): vertex 2 moves up to y = 5.
+    let at = bin.len();
+    bin.extend_from_slice(&2u16.to_le_bytes());
+    bin.extend_from_slice(&[0, 0]);
+    for v in [10.0f32, 5.0, 10.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    doc["buffers"][0]["byteLength"] = json!(bin.len());
+    let views = doc["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 0, "byteOffset": at, "byteLength": 2}));
+    views.push(json!({"buffer": 0, "byteOffset": at + 4, "byteLength": 12}));
+    let n = views.len();
+    doc["accessors"][0]["sparse"] = json!({
+        "count": 1,
+        "indices": {"bufferView": n - 2, "componentType": 5123},
+        "values": {"bufferView": n - 1},
+    });
+    let s = load(&GltfWriter::glb_of(&doc, &bin)).unwrap().scene;
+    let ground = &s.meshes[s.objects[0].mesh];
+    assert_eq!(ground.positions[2], Vec3::new(10.0, 5.0, 10.0));
+    assert_eq!(ground.positions[1], Vec3::new(10.0, 0.0, -10.0));
+    // Without a base view the other elements are zeros.
+    doc["accessors"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("bufferView");
+    let s = load(&GltfWriter::glb_of(&doc, &bin)).unwrap().scene;
+    let ground = &s.meshes[s.objects[0].mesh];
+    assert_eq!(ground.positions[2], Vec3::new(10.0, 5.0, 10.0));
+    assert_eq!(ground.positions[0], Vec3::ZERO);
+    // A substitution past the elements is refused.
+    doc["accessors"][0]["sparse"]["count"] = json!(9);
+    let e = load(&GltfWriter::glb_of(&doc, &bin))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("sparse"), "{e}");
+}
