@@ -203,6 +203,9 @@ pub const MAX_MATERIALS: usize = 2048;
 /// Most base-colour textures a scene may have: the layers of one texture array (WebGPU's
 /// default `max_texture_array_layers`).
 pub const MAX_TEXTURES: usize = 256;
+/// Largest edge a base-colour texture keeps: larger images are scaled down when loaded (the
+/// GPU array's layers are at most this), so 256 textures stay within 1 GiB of texels.
+pub const MAX_TEXTURE_EDGE: u32 = 1024;
 
 /// Material flag bit: the material is transparent (blended, drawn after opaque geometry).
 pub const MATERIAL_FLAG_TRANSPARENT: u32 = 1;

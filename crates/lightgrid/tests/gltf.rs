@@ -728,12 +728,12 @@ fn fuzz_budget() -> Duration {
 #[test]
 fn fuzzed_files_never_panic_or_hang() {
     let w = room();
-    let seeds = [w.glb(), w.gltf()];
+    let seeds = [w.glb(), w.gltf(), textured().glb()];
     let mut rng = lightgrid::scene::Rng::new(0xf022);
     let start = Instant::now();
     let (mut runs, mut loaded) = (0u64, 0u64);
     while start.elapsed() < fuzz_budget() {
-        let mut bytes = seeds[rng.below(2) as usize].clone();
+        let mut bytes = seeds[rng.below(seeds.len() as u32) as usize].clone();
         for _ in 0..1 + rng.below(8) {
             let at = rng.below(bytes.len() as u32) as usize;
             match rng.below(5) {

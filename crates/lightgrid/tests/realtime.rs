@@ -237,6 +237,7 @@ fn a_loop_cut_short_is_counted() {
     let counters = buffer(COUNTER_BYTES as usize, wgpu::BufferUsages::STORAGE);
     let bounds = buffer(16, wgpu::BufferUsages::STORAGE);
     let pixel_counts = buffer(16, wgpu::BufferUsages::STORAGE);
+    let textures = lightgrid::passes::base_textures::BaseTextures::new(device, &ctx.queue, &[]);
     let group = bind_resources(
         device,
         "cut loop",
@@ -248,6 +249,8 @@ fn a_loop_cut_short_is_counted() {
             counters.as_entire_binding(),
             bounds.as_entire_binding(),
             pixel_counts.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&textures.view),
+            wgpu::BindingResource::Sampler(&textures.sampler),
         ],
     );
     let mut encoder = device.create_command_encoder(&Default::default());

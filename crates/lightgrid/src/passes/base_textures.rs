@@ -4,13 +4,11 @@
 //! chain built on the CPU, and a repeating trilinear sampler. A scene without textures binds
 //! a single white texel.
 
-use crate::consts::MAX_TEXTURES;
+use crate::consts::{MAX_TEXTURES, MAX_TEXTURE_EDGE};
 use crate::scene::Texture;
 use image::imageops::FilterType;
 use wgpu::util::DeviceExt;
 
-/// Largest layer edge (textures are resampled to at most this).
-pub const MAX_TEXTURE_EDGE: u32 = 1024;
 /// Budget of the whole array with its mips; the edge halves until it fits.
 pub const MAX_TEXTURE_BYTES: u64 = 256 << 20;
 

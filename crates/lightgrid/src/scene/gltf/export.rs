@@ -123,11 +123,12 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
                 meshes.len() - 1
             }
         };
-        nodes.push(json!({
-            "name": format!("object {i}"),
-            "mesh": mi,
-            "matrix": state.transforms[i].to_cols_array(),
-        }));
+        let mut node = json!({"name": format!("object {i}"), "mesh": mi});
+        // The specification asks not to write the identity.
+        if state.transforms[i] != glam::Mat4::IDENTITY {
+            node["matrix"] = json!(state.transforms[i].to_cols_array());
+        }
+        nodes.push(node);
     }
     let mut lights = Vec::new();
     for (i, l) in state.lights.iter().enumerate() {
@@ -189,7 +190,7 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     let textures: Vec<Value> = (0..images.len())
         .map(|i| json!({"source": i, "sampler": 0}))
         .collect();
-    let root = json!({
+    let mut root = json!({
         "asset": {"version": "2.0", "generator": "lightgrid export"},
         "extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {"KHR_lights_punctual": {"lights": lights}},
@@ -198,9 +199,6 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
-        "images": images,
-        "textures": textures,
-        "samplers": [{"wrapS": 10497, "wrapT": 10497}],
         "cameras": [{"type": "perspective", "perspective": {
             "yfov": cam.fov_y, "znear": cam.near, "zfar": cam.far, "aspectRatio": aspect,
         }}],
@@ -208,6 +206,12 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         "bufferViews": bin.views,
         "buffers": [{"byteLength": bin.bytes.len()}],
     });
+    // glTF refuses empty arrays: the texture ones only where there are textures.
+    if !images.is_empty() {
+        root["images"] = json!(images);
+        root["textures"] = json!(textures);
+        root["samplers"] = json!([{"wrapS": 10497, "wrapT": 10497}]);
+    }
     let mut json =
         serde_json::to_vec(&root).map_err(|e| Error::invalid("export", e.to_string()))?;
     while json.len() % 4 != 0 {

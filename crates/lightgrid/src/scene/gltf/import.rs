@@ -269,7 +269,18 @@ impl TextureLoader<'_> {
             (None, Some(v)) => self.doc.view(v, &what)?.1.to_vec(),
             (None, None) => return Err(format!("{what} has neither a uri nor a bufferView")),
         };
-        let rgba = crate::image_io::decode_image(&bytes, &what).map_err(|e| e.to_string())?;
+        let mut rgba = crate::image_io::decode_image(&bytes, &what).map_err(|e| e.to_string())?;
+        // Keep at most MAX_TEXTURE_EDGE texels a side (the GPU array's largest layer).
+        let edge = crate::consts::MAX_TEXTURE_EDGE;
+        let (w, h) = rgba.dimensions();
+        if w.max(h) > edge {
+            let scale = edge as f32 / w.max(h) as f32;
+            let (nw, nh) = (
+                ((w as f32 * scale).round() as u32).max(1),
+                ((h as f32 * scale).round() as u32).max(1),
+            );
+            rgba = image::imageops::resize(&rgba, nw, nh, image::imageops::FilterType::Triangle);
+        }
         self.textures.push(Texture {
             width: rgba.width(),
             height: rgba.height(),
