@@ -287,6 +287,11 @@ type Case = (&'static str, fn(&mut Value, &mut Vec<u8>), &'static str);
 fn corpus() -> Vec<Case> {
     vec![
         (
+            "normalized floats",
+            |d, _| d["accessors"][0]["normalized"] = json!(true),
+            "normalized is only",
+        ),
+        (
             "no asset",
             |d, _| {
                 d.as_object_mut().unwrap().remove("asset");
@@ -975,4 +980,123 @@ fn sparse_accessors_substitute_their_elements() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("sparse"), "{e}");
+}
+
+/// What the review of the loader found, each pinned: normals computed flat (§3.7.2.1) and from
+/// the file's winding (a mirrored instance without normals is lit from the front); a loaded
+/// file with a mirrored and a sheared instance survives export and load; a repeated child is
+/// refused before it can fill the stack; very narrow spots load and 90° spots export; a
+/// camera without zfar gets a far plane past its near one; many buffers naming one file read
+/// it once.
+#[test]
+fn loader_review_cases() {
+    let w = room();
+    let s = load(&w.glb()).unwrap().scene;
+    // The strip wall (4 vertices, 2 triangles, no normals) is flat: a vertex per corner.
+    let wall = s
+        .meshes
+        .iter()
+        .find(|m| m.positions.iter().any(|p| p.z == -6.5))
+        .unwrap();
+    assert_eq!((wall.positions.len(), wall.indices.len()), (6, 6));
+    for t in wall.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| wall.positions[i as usize]);
+        let face = (b - a).cross(c - a).normalize();
+        for &i in t {
+            assert!(wall.normals[i as usize].distance(face) < 1e-5);
+        }
+    }
+    // A mirrored instance of a mesh without normals: every triangle faces its normals.
+    let (mut doc, bin) = fixture_parts();
+    let tri_mesh = doc["meshes"].as_array().unwrap().len() - 1;
+    let n = doc["nodes"].as_array().unwrap().len();
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"mesh": tri_mesh, "scale": [-1.0, 1.0, 1.0]}));
+    // And a sheared one: a rotated child of a non-uniformly scaled parent.
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"mesh": 1, "rotation": [0.0, 0.38268343, 0.0, 0.9238795]}));
+    doc["nodes"].as_array_mut().unwrap().push(
+        json!({"scale": [3.0, 1.0, 1.0], "translation": [0.0, 0.0, 6.0], "children": [n + 1]}),
+    );
+    doc["scenes"][0]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .extend([json!(n), json!(n + 2)]);
+    let s = load(&GltfWriter::glb_of(&doc, &bin)).unwrap().scene;
+    let faces_its_normals = |s: &Scene| {
+        let g = s.geometry(&s.frame(0));
+        g.indices.chunks_exact(3).all(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| g.vertices[i as usize]);
+            let face = (Vec3::from(b.position) - Vec3::from(a.position))
+                .cross(Vec3::from(c.position) - Vec3::from(a.position));
+            face.dot(Vec3::from(a.normal) + Vec3::from(b.normal) + Vec3::from(c.normal)) > 0.0
+        })
+    };
+    assert!(faces_its_normals(&s));
+    let back = load(&gltf::export(&s, 0, (320, 200)).unwrap())
+        .unwrap()
+        .scene;
+    assert!(
+        faces_its_normals(&back),
+        "export turned a mirrored mesh's winding"
+    );
+    let key = |s: &Scene| {
+        let mut v: Vec<[i64; 3]> = world_vertices(s)
+            .iter()
+            .map(|p| p.to_array().map(|c| (c * 1e3).round() as i64))
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        key(&s),
+        key(&back),
+        "the sheared and mirrored instances moved"
+    );
+    // A repeated child.
+    let (mut doc, bin) = fixture_parts();
+    doc["nodes"][1]["children"] = json!(vec![0; 100_000]);
+    let e = load(&GltfWriter::glb_of(&doc, &bin))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("reached twice"), "{e}");
+    // A very narrow spot loads; a 90° one exports.
+    let (mut doc, bin) = fixture_parts();
+    doc["extensions"]["KHR_lights_punctual"]["lights"][4]["spot"] =
+        json!({"innerConeAngle": 0.0, "outerConeAngle": 0.001});
+    let s = load(&GltfWriter::glb_of(&doc, &bin)).unwrap().scene;
+    s.validate().unwrap();
+    doc["extensions"]["KHR_lights_punctual"]["lights"][4]["spot"] =
+        json!({"outerConeAngle": std::f64::consts::FRAC_PI_2});
+    let s = load(&GltfWriter::glb_of(&doc, &bin)).unwrap().scene;
+    gltf::export(&s, 0, (64, 36)).unwrap();
+    // A far-away near plane without zfar.
+    let (mut doc, bin) = fixture_parts();
+    doc["cameras"][0]["perspective"] = json!({"yfov": 0.9, "znear": 500.0});
+    let cam = load(&GltfWriter::glb_of(&doc, &bin))
+        .unwrap()
+        .scene
+        .camera_path
+        .at(0);
+    assert!(cam.far > cam.near, "{} {}", cam.near, cam.far);
+    // 1,000 buffers naming one 4 MiB file beside the document: it is read once.
+    let dir = common::output_dir().join("gltf-shared-buffer");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("big.bin"), vec![7u8; 4 << 20]).unwrap();
+    let (mut doc, bin) = fixture_parts();
+    for _ in 0..1000 {
+        doc["buffers"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"byteLength": 1024, "uri": "big.bin"}));
+    }
+    let path = dir.join("shared.glb");
+    std::fs::write(&path, GltfWriter::glb_of(&doc, &bin)).unwrap();
+    let t = Instant::now();
+    gltf::load(&path, &LoadOptions::default()).unwrap();
+    assert!(t.elapsed() < Duration::from_secs(2), "{:?}", t.elapsed());
 }

@@ -166,7 +166,8 @@ impl Spot {
     /// A cone around `direction` (need not be unit length) with half-angles `inner` < `outer`
     /// in radians, `outer` at most π.
     pub fn new(direction: Vec3, inner: f32, outer: f32) -> Spot {
-        let cos_outer = outer.cos();
+        // A cone narrower than the falloff's width still has one.
+        let cos_outer = outer.cos().min(1.0 - SPOT_MIN_FALLOFF);
         Spot {
             direction: direction.normalize_or(Vec3::NEG_Y),
             cos_inner: inner.cos().max(cos_outer + SPOT_MIN_FALLOFF),

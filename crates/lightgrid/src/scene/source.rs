@@ -138,6 +138,15 @@ pub fn open(req: &SceneRequest) -> Result<Opened> {
             }
             let transparent: Vec<bool> = scene.materials.iter().map(|m| m.transparent).collect();
             scene.objects.retain(|o| !transparent[o.material]);
+            if scene.objects.is_empty() {
+                return Err(Error::invalid(
+                    "--transparency",
+                    format!(
+                        "{} is all transparent: off leaves nothing to render",
+                        req.spec
+                    ),
+                ));
+            }
         }
         (scene, loaded.warnings)
     } else {

@@ -6,8 +6,8 @@
 
 use super::import::{candela_from_intensity, ExactMaterial};
 use crate::error::{Error, Result};
-use crate::scene::{Material, Scene};
-use glam::{Quat, Vec3};
+use crate::scene::{Material, Mesh, Scene};
+use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};
 use std::collections::HashMap;
 
@@ -50,6 +50,42 @@ impl Bin {
     }
 }
 
+/// Is `m` a translation × rotation × scale (what a glTF node matrix must be)?
+fn is_trs(m: &Mat4) -> bool {
+    let (s, r, t) = m.to_scale_rotation_translation();
+    let back = Mat4::from_scale_rotation_translation(s, r, t);
+    let size = m.to_cols_array().iter().fold(1.0f32, |a, v| a.max(v.abs()));
+    m.is_finite() && back.abs_diff_eq(*m, size * 1e-5)
+}
+
+/// One mesh of one primitive: positions (with bounds), normals, UVs, indices.
+fn mesh_json(bin: &mut Bin, m: &Mesh, material: usize, flip: bool) -> Value {
+    let pos = bin.vec3s(&m.positions, true);
+    let nor = bin.vec3s(&m.normals, false);
+    let uv = bin.push(
+        bytemuck::cast_slice(&m.uvs),
+        34962,
+        json!({"componentType": 5126, "count": m.uvs.len(), "type": "VEC2"}),
+    );
+    let mut indices = m.indices.clone();
+    if flip {
+        for t in indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
+    }
+    let idx = bin.push(
+        bytemuck::cast_slice(&indices),
+        34963,
+        json!({"componentType": 5125, "count": m.indices.len(), "type": "SCALAR"}),
+    );
+    json!({"primitives": [{
+        "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
+        "indices": idx,
+        "material": material,
+        "mode": 4,
+    }]})
+}
+
 /// glTF's factors are in [0, 1].
 fn unit(v: Vec3) -> [f32; 3] {
     v.clamp(Vec3::ZERO, Vec3::ONE).to_array()
@@ -90,45 +126,53 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     let state = scene.frame(frame);
     let mut bin = Bin::default();
     let mut meshes = Vec::new();
-    let mut mesh_of: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut mesh_of: HashMap<(usize, usize, bool), usize> = HashMap::new();
     let mut nodes = Vec::new();
     for (i, o) in scene.objects.iter().enumerate() {
         if scene.meshes[o.mesh].indices.is_empty() {
             continue; // glTF accessors hold at least one element
         }
-        let key = (o.mesh, o.material);
-        let mi = match mesh_of.get(&key) {
-            Some(&mi) => mi,
-            None => {
-                let m = &scene.meshes[o.mesh];
-                let pos = bin.vec3s(&m.positions, true);
-                let nor = bin.vec3s(&m.normals, false);
-                let uv = bin.push(
-                    bytemuck::cast_slice(&m.uvs),
-                    34962,
-                    json!({"componentType": 5126, "count": m.uvs.len(), "type": "VEC2"}),
-                );
-                let idx = bin.push(
-                    bytemuck::cast_slice(&m.indices),
-                    34963,
-                    json!({"componentType": 5125, "count": m.indices.len(), "type": "SCALAR"}),
-                );
-                meshes.push(json!({"primitives": [{
-                    "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
-                    "indices": idx,
-                    "material": o.material,
-                    "mode": 4,
-                }]}));
-                mesh_of.insert(key, meshes.len() - 1);
+        let m = state.transforms[i];
+        // A node's matrix must be translation × rotation × scale (§3.5.3); a sheared one
+        // (a rotated child of a non-uniformly scaled parent, from a loaded file) is baked
+        // into a mesh of its own instead.
+        let trs = is_trs(&m);
+        // A mirroring matrix turns a file's winding for its readers (§3.7.4), and a scene's
+        // mesh is wound as drawn: write such a mesh wound back, so readers turn it again.
+        let flip = trs && m.determinant() < 0.0;
+        let key = (o.mesh, o.material, flip);
+        let shared = mesh_of.get(&key).copied();
+        let mi = match (trs, shared) {
+            (true, Some(mi)) => mi,
+            _ => {
+                let baked;
+                let mesh = if trs {
+                    &scene.meshes[o.mesh]
+                } else {
+                    let mut world = Mesh::default();
+                    world.append(&scene.meshes[o.mesh], m);
+                    baked = world;
+                    &baked
+                };
+                meshes.push(mesh_json(&mut bin, mesh, o.material, flip));
+                if trs {
+                    mesh_of.insert(key, meshes.len() - 1);
+                }
                 meshes.len() - 1
             }
         };
         let mut node = json!({"name": format!("object {i}"), "mesh": mi});
         // The specification asks not to write the identity.
-        if state.transforms[i] != glam::Mat4::IDENTITY {
-            node["matrix"] = json!(state.transforms[i].to_cols_array());
+        if trs && m != Mat4::IDENTITY {
+            node["matrix"] = json!(m.to_cols_array());
         }
         nodes.push(node);
+    }
+    if meshes.is_empty() {
+        return Err(Error::invalid(
+            "export",
+            format!("{} has no triangles to export", scene.name),
+        ));
     }
     let mut lights = Vec::new();
     for (i, l) in state.lights.iter().enumerate() {
@@ -145,15 +189,16 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
             "extensions": {"KHR_lights_punctual": {"light": i}},
         });
         if let Some(s) = l.spot {
-            if s.cos_outer < 0.0 {
+            // glTF's widest cone is π/2 from the axis (a rounding below 0 is that cone).
+            if s.cos_outer < -1e-6 {
                 return Err(Error::invalid(
                     "export",
                     format!("spot light {i} is wider than glTF's largest cone (90° from its axis)"),
                 ));
             }
             def["spot"] = json!({
-                "innerConeAngle": s.cos_inner.clamp(-1.0, 1.0).acos(),
-                "outerConeAngle": s.cos_outer.clamp(-1.0, 1.0).acos(),
+                "innerConeAngle": s.cos_inner.clamp(0.0, 1.0).acos(),
+                "outerConeAngle": s.cos_outer.clamp(0.0, 1.0).acos(),
             });
             def["extras"]["lightgrid"]["cos_inner"] = json!(s.cos_inner);
             def["extras"]["lightgrid"]["cos_outer"] = json!(s.cos_outer);

@@ -40,13 +40,31 @@ struct Walk {
     lo: Vec3,
     hi: Vec3,
     warnings: Vec<String>,
+    warned: std::collections::HashSet<String>,
+    more_warnings: usize,
 }
+
+/// Warnings kept; the rest are counted ("and N more").
+const MAX_WARNINGS: usize = 50;
 
 impl Walk {
     fn warn(&mut self, w: String) {
-        if !self.warnings.contains(&w) {
-            self.warnings.push(w);
+        if self.warned.insert(w.clone()) {
+            if self.warnings.len() < MAX_WARNINGS {
+                self.warnings.push(w);
+            } else {
+                self.more_warnings += 1;
+            }
         }
+    }
+
+    /// The warnings, the last saying how many more there were.
+    fn finish_warnings(&mut self) -> Vec<String> {
+        let mut w = std::mem::take(&mut self.warnings);
+        if self.more_warnings > 0 {
+            w.push(format!("... and {} more warnings", self.more_warnings));
+        }
+        w
     }
 }
 
@@ -266,7 +284,7 @@ impl TextureLoader<'_> {
         let what = format!("image {source}");
         let bytes = match (&image.uri, image.buffer_view) {
             (Some(uri), _) => self.doc.fetch(uri, &what)?,
-            (None, Some(v)) => self.doc.view(v, &what)?.1.to_vec(),
+            (None, Some(v)) => std::rc::Rc::new(self.doc.view(v, &what)?.1.to_vec()),
             (None, None) => return Err(format!("{what} has neither a uri nor a bufferView")),
         };
         let mut rgba = crate::image_io::decode_image(&bytes, &what).map_err(|e| e.to_string())?;
@@ -350,8 +368,8 @@ fn triangulate(mode: u32, seq: &[u32]) -> Vec<u32> {
     out
 }
 
-/// Area-weighted vertex normals of a triangle list (flat for unshared vertices): where a file
-/// has no normals (§3.7.2.1 asks for flat normals then; shared vertices get smooth ones).
+/// Area-weighted vertex normals of a triangle list: the stand-in for a zero normal a file
+/// gives.
 fn computed_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     let mut n = vec![Vec3::ZERO; positions.len()];
     for t in indices.chunks_exact(3) {
@@ -425,29 +443,11 @@ fn primitive_mesh(
         }
         None => (0..positions.len() as u32).collect(),
     };
-    let mut indices = triangulate(mode, &seq);
-    if flipped {
-        for t in indices.chunks_exact_mut(3) {
-            t.swap(1, 2);
-        }
+    let indices = triangulate(mode, &seq);
+    if indices.is_empty() {
+        walk.warn(format!("{what}: no triangles; skipped"));
+        return Ok(None);
     }
-    let computed = computed_normals(&positions, &indices);
-    let normals = match prim.attributes.get("NORMAL") {
-        Some(&a) => {
-            let n = vec3s(&doc.read_floats(a, 3, &format!("{what} NORMAL"))?);
-            if n.len() != positions.len() || n.iter().any(|v| !v.is_finite()) {
-                return Err(format!(
-                    "{what}: NORMAL (accessor {a}) needs one finite normal per vertex"
-                ));
-            }
-            // A zero normal cannot be normalized: use the computed one there.
-            n.iter()
-                .zip(&computed)
-                .map(|(v, c)| v.try_normalize().unwrap_or(*c))
-                .collect()
-        }
-        None => computed,
-    };
     // The UV set the material's base-colour texture names (TEXCOORD_0 without one).
     let texture = prim
         .material
@@ -476,12 +476,63 @@ fn primitive_mesh(
         }
         None => vec![Vec2::ZERO; positions.len()],
     };
-    Ok(Some(Mesh {
-        positions,
-        normals,
-        uvs,
-        indices,
-    }))
+    let mut mesh = match prim.attributes.get("NORMAL") {
+        Some(&a) => {
+            let n = vec3s(&doc.read_floats(a, 3, &format!("{what} NORMAL"))?);
+            if n.len() != positions.len() || n.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "{what}: NORMAL (accessor {a}) needs one finite normal per vertex"
+                ));
+            }
+            // A zero normal cannot be normalized: the faces around it give one.
+            let around = computed_normals(&positions, &indices);
+            let normals = n
+                .iter()
+                .zip(&around)
+                .map(|(v, c)| v.try_normalize().unwrap_or(*c))
+                .collect();
+            Mesh {
+                positions,
+                normals,
+                uvs,
+                indices,
+            }
+        }
+        None => {
+            if indices.len() > MAX_VERTICES as usize {
+                return Err(format!(
+                    "{what}: {} corners would be more than {MAX_VERTICES} vertices with flat normals",
+                    indices.len()
+                ));
+            }
+            flat_mesh(&positions, &uvs, &indices)
+        }
+    };
+    // Normals come from the file's winding; only then is it flipped for a mirroring
+    // transform.
+    if flipped {
+        for t in mesh.indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
+    }
+    Ok(Some(mesh))
+}
+
+/// A triangle list without normals as the specification asks to shade it (§3.7.2.1: flat
+/// normals): one vertex per corner, each with its face's normal.
+fn flat_mesh(positions: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Mesh {
+    let mut m = Mesh::default();
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a).normalize_or(Vec3::Y);
+        for &i in t {
+            m.indices.push(m.positions.len() as u32);
+            m.positions.push(positions[i as usize]);
+            m.uvs.push(uvs[i as usize]);
+            m.normals.push(n);
+        }
+    }
+    m
 }
 
 /// Instance node `ni`'s mesh with world transform `world`.
@@ -497,8 +548,12 @@ fn instance_mesh(
         .meshes
         .get(mi)
         .ok_or_else(|| format!("mesh {mi} does not exist"))?;
+    // Singular relative to the transform's own scale (a uniformly tiny model is fine).
     let det = world.determinant();
-    if det.abs() < 1e-12 || !det.is_finite() {
+    let scale = world.x_axis.truncate().length()
+        * world.y_axis.truncate().length()
+        * world.z_axis.truncate().length();
+    if !det.is_finite() || det.abs() <= scale * 1e-6 {
         walk.warn(format!(
             "an instance of mesh {mi} has a singular transform (zero scale); skipped"
         ));
@@ -588,17 +643,28 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
             (0..nodes.len()).filter(|&i| !child[i]).collect()
         }
     };
+    // A node is marked when it is first put on the stack, so a repeated child is refused
+    // before the stack can grow with it.
     let mut seen = vec![false; nodes.len()];
-    let mut stack: Vec<(usize, Mat4)> = roots.iter().rev().map(|&r| (r, Mat4::IDENTITY)).collect();
-    while let Some((ni, parent)) = stack.pop() {
-        let node = nodes
-            .get(ni)
-            .ok_or_else(|| format!("node {ni} does not exist"))?;
-        if std::mem::replace(&mut seen[ni], true) {
-            return Err(format!(
+    let mut mark = |ni: usize| -> Res<()> {
+        match seen.get_mut(ni) {
+            None => Err(format!("node {ni} does not exist")),
+            Some(true) => Err(format!(
                 "node {ni} is reached twice: the node graph has a cycle or a node with two parents (glTF nodes form trees)"
-            ));
+            )),
+            Some(slot) => {
+                *slot = true;
+                Ok(())
+            }
         }
+    };
+    let mut stack: Vec<(usize, Mat4)> = Vec::new();
+    for &r in roots.iter().rev() {
+        mark(r)?;
+        stack.push((r, Mat4::IDENTITY));
+    }
+    while let Some((ni, parent)) = stack.pop() {
+        let node = &nodes[ni];
         let world = parent * local_matrix(node, ni)?;
         if !world.is_finite() {
             return Err(format!(
@@ -615,6 +681,7 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
             walk.lights.push((l.light, world));
         }
         for &c in node.children.iter().rev() {
+            mark(c)?;
             stack.push((c, world));
         }
     }
@@ -740,8 +807,145 @@ fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<
     Ok(Some(light))
 }
 
-/// The camera at the chosen node (or fitted to the bounds), as an orbit about the bounds'
-/// vertical axis starting there.
+/// Where the camera path starts.
+struct Start {
+    eye: Vec3,
+    target: Vec3,
+    fov: f32,
+    near: f32,
+    far: f32,
+}
+
+/// The camera `--camera` names (checked), else the first perspective camera a node places.
+fn chosen_camera(
+    doc: &Document,
+    opts: &LoadOptions,
+    walk: &mut Walk,
+) -> Res<Option<(usize, Mat4)>> {
+    let Some(n) = opts.camera else {
+        let first = walk.cameras.iter().copied().find(|(c, _)| {
+            doc.root
+                .cameras
+                .get(*c)
+                .is_some_and(|d| d.kind == "perspective")
+        });
+        if first.is_none() && !walk.cameras.is_empty() {
+            walk.warn("no perspective camera (orthographic ones are not rendered); one is fitted to the scene".into());
+        }
+        return Ok(first);
+    };
+    if n >= doc.root.cameras.len() {
+        return Err(format!(
+            "--camera {n}: the file has {} camera(s)",
+            doc.root.cameras.len()
+        ));
+    }
+    let world = walk
+        .cameras
+        .iter()
+        .find(|(c, _)| *c == n)
+        .map(|(_, w)| *w)
+        .ok_or_else(|| format!("--camera {n}: no node of the scene places camera {n}"))?;
+    if doc.root.cameras[n].kind != "perspective" {
+        return Err(format!(
+            "--camera {n}: a {} camera; only perspective cameras are rendered",
+            doc.root.cameras[n].kind
+        ));
+    }
+    Ok(Some((n, world)))
+}
+
+/// The start at perspective camera `n` placed by `world`; its aspect ratio sets `size`.
+fn placed_start(
+    doc: &Document,
+    (n, world): (usize, Mat4),
+    (centre, radius): (Vec3, f32),
+    size: &mut (u32, u32),
+    walk: &mut Walk,
+) -> Res<Start> {
+    let p = doc.root.cameras[n]
+        .perspective
+        .as_ref()
+        .ok_or_else(|| format!("camera {n}: perspective camera without \"perspective\""))?;
+    let ok = p.yfov.is_finite()
+        && p.yfov > 0.0
+        && p.yfov < std::f32::consts::PI
+        && p.znear.is_finite()
+        && p.znear > 0.0
+        && p.zfar.is_none_or(|f| f.is_finite() && f > p.znear);
+    if !ok {
+        return Err(format!(
+            "camera {n}: needs 0 < yfov < π, znear > 0 and zfar > znear (finite)"
+        ));
+    }
+    if let Some(a) = p.aspect_ratio {
+        if a.is_finite() && (0.1..=10.0).contains(&a) {
+            size.1 = ((DEFAULT_WIDTH as f32 / a).round() as u32).max(1);
+        }
+    }
+    let eye = world.transform_point3(Vec3::ZERO);
+    let mut forward = world
+        .transform_vector3(Vec3::NEG_Z)
+        .try_normalize()
+        .ok_or_else(|| format!("camera {n}: its node's transform has no direction"))?;
+    if forward.y.abs() > 0.9999 {
+        walk.warn(format!(
+            "camera {n} looks straight up or down; it is tilted slightly (the camera's up is +y)"
+        ));
+        forward = (forward + Vec3::Z * 1e-2).normalize();
+    }
+    // Without zfar, far enough for the whole scene from anywhere on the orbit.
+    let far = p
+        .zfar
+        .unwrap_or(((eye.distance(centre) + radius) * 1.05).max(p.znear * 2.0));
+    Ok(Start {
+        eye,
+        target: eye + forward * radius.max(1.0),
+        fov: p.yfov,
+        near: p.znear,
+        far,
+    })
+}
+
+/// A camera fitted to the bounding sphere: 50° high, from 25° above and 30° round.
+fn fitted_start(centre: Vec3, radius: f32) -> Start {
+    let fov = 50f32.to_radians();
+    let dist = radius / (fov * 0.5).sin() * 1.05;
+    let (el, az) = (25f32.to_radians(), 30f32.to_radians());
+    let dir = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+    let far = (dist + radius) * 1.05;
+    Start {
+        eye: centre + dir * dist,
+        target: centre,
+        fov,
+        near: far / 1000.0,
+        far,
+    }
+}
+
+/// The orbit of [`ORBIT_FRAMES`] about the vertical axis through `centre`, from `start`
+/// (frame 0 is exactly the start).
+fn orbit(start: &Start, centre: Vec3) -> CameraPath {
+    let keys = (0..=ORBIT_KEYS)
+        .map(|k| {
+            let turn = Quat::from_rotation_y(k as f32 / ORBIT_KEYS as f32 * std::f32::consts::TAU);
+            let about = |p: Vec3| centre + turn * (p - centre);
+            (
+                k * (ORBIT_FRAMES - 1) / ORBIT_KEYS,
+                about(start.eye),
+                about(start.target),
+            )
+        })
+        .collect();
+    CameraPath {
+        keys,
+        fov_y: start.fov,
+        near: start.near,
+        far: start.far,
+    }
+}
+
+/// The camera path (an orbit from the chosen or a fitted camera) and the default size.
 fn camera_path(
     doc: &Document,
     opts: &LoadOptions,
@@ -749,106 +953,12 @@ fn camera_path(
 ) -> Res<(CameraPath, (u32, u32))> {
     let centre = (walk.lo + walk.hi) * 0.5;
     let radius = ((walk.hi - walk.lo).length() * 0.5).max(1e-3);
-    let placed = match opts.camera {
-        Some(n) => {
-            if n >= doc.root.cameras.len() {
-                return Err(format!(
-                    "--camera {n}: the file has {} camera(s)",
-                    doc.root.cameras.len()
-                ));
-            }
-            let world = walk
-                .cameras
-                .iter()
-                .find(|(c, _)| *c == n)
-                .map(|(_, w)| *w)
-                .ok_or_else(|| format!("--camera {n}: no node of the scene places camera {n}"))?;
-            if doc.root.cameras[n].kind != "perspective" {
-                return Err(format!(
-                    "--camera {n}: a {} camera; only perspective cameras are rendered",
-                    doc.root.cameras[n].kind
-                ));
-            }
-            Some((n, world))
-        }
-        None => {
-            let first = walk.cameras.iter().copied().find(|(c, _)| {
-                doc.root
-                    .cameras
-                    .get(*c)
-                    .is_some_and(|d| d.kind == "perspective")
-            });
-            if first.is_none() && !walk.cameras.is_empty() {
-                walk.warn("no perspective camera (orthographic ones are not rendered); one is fitted to the scene".into());
-            }
-            first
-        }
-    };
     let mut size = (DEFAULT_WIDTH, DEFAULT_WIDTH * 9 / 16);
-    let (eye, target, fov, near, far) = match placed {
-        Some((n, world)) => {
-            let p = doc.root.cameras[n]
-                .perspective
-                .as_ref()
-                .ok_or_else(|| format!("camera {n}: perspective camera without \"perspective\""))?;
-            let ok = p.yfov.is_finite()
-                && p.yfov > 0.0
-                && p.yfov < std::f32::consts::PI
-                && p.znear.is_finite()
-                && p.znear > 0.0
-                && p.zfar.is_none_or(|f| f.is_finite() && f > p.znear);
-            if !ok {
-                return Err(format!(
-                    "camera {n}: needs 0 < yfov < π, znear > 0 and zfar > znear (finite)"
-                ));
-            }
-            if let Some(a) = p.aspect_ratio {
-                if a.is_finite() && (0.1..=10.0).contains(&a) {
-                    size.1 = ((DEFAULT_WIDTH as f32 / a).round() as u32).max(1);
-                }
-            }
-            let eye = world.transform_point3(Vec3::ZERO);
-            let forward = world
-                .transform_vector3(Vec3::NEG_Z)
-                .try_normalize()
-                .ok_or_else(|| format!("camera {n}: its node's transform has no direction"))?;
-            if forward.y.abs() > 0.9999 {
-                walk.warn(format!(
-                    "camera {n} looks straight up or down; it is tilted slightly (the camera's up is +y)"
-                ));
-            }
-            let forward = if forward.y.abs() > 0.9999 {
-                (forward + Vec3::Z * 1e-2).normalize()
-            } else {
-                forward
-            };
-            let reach = eye.distance(centre) + radius;
-            let far = p.zfar.unwrap_or(reach * 1.05);
-            (eye, eye + forward * radius.max(1.0), p.yfov, p.znear, far)
-        }
-        None => {
-            let fov = 50f32.to_radians();
-            let dist = radius / (fov * 0.5).sin() * 1.05;
-            let (el, az) = (25f32.to_radians(), 30f32.to_radians());
-            let dir = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
-            let far = (dist + radius) * 1.05;
-            (centre + dir * dist, centre, fov, far / 1000.0, far)
-        }
+    let start = match chosen_camera(doc, opts, walk)? {
+        Some(placed) => placed_start(doc, placed, (centre, radius), &mut size, walk)?,
+        None => fitted_start(centre, radius),
     };
-    let mut keys = Vec::new();
-    for k in 0..=ORBIT_KEYS {
-        let turn = Quat::from_rotation_y(k as f32 / ORBIT_KEYS as f32 * std::f32::consts::TAU);
-        let about = |p: Vec3| centre + turn * (p - centre);
-        let frame = k * (ORBIT_FRAMES - 1) / ORBIT_KEYS;
-        keys.push((frame, about(eye), about(target)));
-    }
-    let path = CameraPath {
-        keys,
-        fov_y: fov,
-        near,
-        far,
-    };
-    Ok((path, size))
+    Ok((orbit(&start, centre), size))
 }
 
 /// The scene a document describes.
@@ -950,5 +1060,5 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         camera_path,
         default_size,
     };
-    Ok((scene, walk.warnings))
+    Ok((scene, walk.finish_warnings()))
 }

@@ -6,7 +6,10 @@
 
 use super::json::{Accessor, BufferView, Root};
 use super::{MAX_FILE_BYTES, MAX_JSON_BYTES, MAX_VERTICES};
+use std::cell::{Cell, RefCell};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 /// A reason a file cannot be read; the caller adds the file's name.
 pub(super) type Res<T> = std::result::Result<T, String>;
@@ -17,6 +20,10 @@ pub(super) struct Document {
     pub buffers: Vec<Vec<u8>>,
     /// Where relative URIs resolve (the document's folder); `None` for bytes without a file.
     base: Option<PathBuf>,
+    /// What URIs have fetched (each read once) and the bytes fetched so far: buffers and
+    /// images together stay within [`MAX_FILE_BYTES`], however many entries name them.
+    fetched: RefCell<HashMap<String, Rc<Vec<u8>>>>,
+    fetched_bytes: Cell<u64>,
 }
 
 const GLB_MAGIC: &[u8; 4] = b"glTF";
@@ -166,11 +173,13 @@ impl Document {
             root,
             buffers: Vec::new(),
             base: base.map(Path::to_path_buf),
+            fetched: RefCell::new(HashMap::new()),
+            fetched_bytes: Cell::new(0),
         };
         let defs = std::mem::take(&mut doc.root.buffers);
         for (i, def) in defs.iter().enumerate() {
-            let mut data = match (&def.uri, i, bin) {
-                (None, 0, Some(bin)) => bin.to_vec(),
+            let data: Rc<Vec<u8>> = match (&def.uri, i, bin) {
+                (None, 0, Some(bin)) => Rc::new(bin.to_vec()),
                 (None, _, _) => {
                     return Err(format!(
                         "buffer {i} has no uri and is not the GLB's binary chunk"
@@ -185,15 +194,41 @@ impl Document {
                     data.len()
                 ));
             }
-            data.truncate(def.byte_length as usize);
-            doc.buffers.push(data);
+            let kept: u64 = doc.buffers.iter().map(|b| b.len() as u64).sum();
+            if kept + def.byte_length > MAX_FILE_BYTES {
+                return Err(format!(
+                    "the buffers declare more than {} MiB",
+                    MAX_FILE_BYTES >> 20
+                ));
+            }
+            doc.buffers.push(data[..def.byte_length as usize].to_vec());
         }
         doc.root.buffers = defs;
         Ok(doc)
     }
 
+    /// The bytes a URI names (read once; all URIs together at most [`MAX_FILE_BYTES`]).
+    pub(super) fn fetch(&self, uri: &str, what: &str) -> Res<Rc<Vec<u8>>> {
+        if let Some(bytes) = self.fetched.borrow().get(uri) {
+            return Ok(bytes.clone());
+        }
+        let bytes = Rc::new(self.fetch_uncached(uri, what)?);
+        let total = self.fetched_bytes.get() + bytes.len() as u64;
+        if total > MAX_FILE_BYTES {
+            return Err(format!(
+                "{what}: the file's buffers and images add up to more than {} MiB",
+                MAX_FILE_BYTES >> 20
+            ));
+        }
+        self.fetched_bytes.set(total);
+        self.fetched
+            .borrow_mut()
+            .insert(uri.to_string(), bytes.clone());
+        Ok(bytes)
+    }
+
     /// The bytes a URI names: a base64 `data:` URI or a file relative to the document.
-    pub(super) fn fetch(&self, uri: &str, what: &str) -> Res<Vec<u8>> {
+    fn fetch_uncached(&self, uri: &str, what: &str) -> Res<Vec<u8>> {
         if let Some(rest) = uri.strip_prefix("data:") {
             let (header, payload) = rest
                 .split_once(',')
@@ -277,6 +312,11 @@ impl Document {
                 acc.kind
             ));
         }
+        if acc.normalized && matches!(acc.component_type, UNSIGNED_INT | FLOAT) {
+            return Err(format!(
+                "{what}: normalized is only for 8- and 16-bit integers (§3.6.2.1)"
+            ));
+        }
         if acc.component_type != FLOAT && !acc.normalized {
             return Err(format!(
                 "{what}: integer components that are not normalized (only floats or normalized integers are read here)"
@@ -322,88 +362,131 @@ impl Document {
                 acc.count
             ));
         }
-        let count = acc.count as usize;
-        let elem = n * size;
-        let mut out = vec![T::default(); count * n];
-        if let Some(view_index) = acc.buffer_view {
-            let (view, bytes) = self.view(view_index, what)?;
-            let stride = view.byte_stride.unwrap_or(elem as u64);
-            if stride < elem as u64 || stride > 252 {
-                return Err(format!(
-                    "{what}: byteStride {stride} for elements of {elem} bytes (4 to 252, at least the element)"
-                ));
-            }
-            if count > 0 {
-                let last = (count as u64 - 1)
-                    .checked_mul(stride)
-                    .and_then(|s| s.checked_add(acc.byte_offset))
-                    .and_then(|s| s.checked_add(elem as u64));
-                if last.is_none_or(|l| l > bytes.len() as u64) {
-                    return Err(format!(
-                        "{what}: {count} elements of {elem} bytes (stride {stride}, offset {}) overrun buffer view {view_index} of {} bytes",
-                        acc.byte_offset,
-                        bytes.len()
-                    ));
-                }
-            }
-            let base = acc.byte_offset as usize;
-            for (i, chunk) in out.chunks_exact_mut(n).enumerate() {
-                let at = base + i * stride as usize;
-                for (c, slot) in chunk.iter_mut().enumerate() {
-                    *slot = cast(component(bytes, at + c * size, acc));
-                }
-            }
+        let shape = Shape {
+            n,
+            size,
+            cast: &cast,
+        };
+        // Without a view the elements are zeros (§3.6.2.3), before any substitution.
+        let mut out = vec![T::default(); acc.count as usize * n];
+        if let Some(view) = acc.buffer_view {
+            self.read_dense(acc, view, &shape, &mut out, what)?;
         }
         if let Some(sparse) = &acc.sparse {
-            if sparse.count > acc.count {
-                return Err(format!(
-                    "{what}: {} sparse substitutions for {} elements",
-                    sparse.count, acc.count
-                ));
-            }
-            let k = sparse.count as usize;
-            let isize = match sparse.indices.component_type {
-                UNSIGNED_BYTE => 1,
-                UNSIGNED_SHORT => 2,
-                UNSIGNED_INT => 4,
-                t => return Err(format!("{what}: sparse index componentType {t}")),
-            };
-            let (_, ib) = self.view(sparse.indices.buffer_view, what)?;
-            let (_, vb) = self.view(sparse.values.buffer_view, what)?;
-            let fits = |off: u64, per: usize, bytes: &[u8]| {
-                (k as u64)
-                    .checked_mul(per as u64)
-                    .and_then(|s| s.checked_add(off))
-                    .is_some_and(|e| e <= bytes.len() as u64)
-            };
-            if !fits(sparse.indices.byte_offset, isize, ib)
-                || !fits(sparse.values.byte_offset, elem, vb)
-            {
-                return Err(format!(
-                    "{what}: sparse indices or values overrun their buffer views"
-                ));
-            }
-            let index_acc = Accessor {
-                component_type: sparse.indices.component_type,
-                ..Accessor::default()
-            };
-            for j in 0..k {
-                let at = sparse.indices.byte_offset as usize + j * isize;
-                let target = component(ib, at, &index_acc) as u64;
-                if target >= acc.count {
-                    return Err(format!(
-                        "{what}: sparse index {target} is outside its {} elements",
-                        acc.count
-                    ));
-                }
-                let vat = sparse.values.byte_offset as usize + j * elem;
-                for c in 0..n {
-                    out[target as usize * n + c] = cast(component(vb, vat + c * size, acc));
-                }
-            }
+            self.apply_sparse(acc, sparse, &shape, &mut out, what)?;
         }
         Ok(out)
     }
+
+    /// The elements stored in buffer view `view_index` (strided), each checked in range.
+    fn read_dense<T>(
+        &self,
+        acc: &Accessor,
+        view_index: usize,
+        shape: &Shape<'_, T>,
+        out: &mut [T],
+        what: &str,
+    ) -> Res<()> {
+        let (n, size) = (shape.n, shape.size);
+        let (count, elem) = (acc.count as usize, n * size);
+        let (view, bytes) = self.view(view_index, what)?;
+        let stride = view.byte_stride.unwrap_or(elem as u64);
+        if stride < elem as u64 || stride > 252 {
+            return Err(format!(
+                "{what}: byteStride {stride} for elements of {elem} bytes (4 to 252, at least the element)"
+            ));
+        }
+        if count > 0 {
+            let last = (count as u64 - 1)
+                .checked_mul(stride)
+                .and_then(|s| s.checked_add(acc.byte_offset))
+                .and_then(|s| s.checked_add(elem as u64));
+            if last.is_none_or(|l| l > bytes.len() as u64) {
+                return Err(format!(
+                    "{what}: {count} elements of {elem} bytes (stride {stride}, offset {}) overrun buffer view {view_index} of {} bytes",
+                    acc.byte_offset,
+                    bytes.len()
+                ));
+            }
+        }
+        let base = acc.byte_offset as usize;
+        for (i, chunk) in out.chunks_exact_mut(n).enumerate() {
+            let at = base + i * stride as usize;
+            for (c, slot) in chunk.iter_mut().enumerate() {
+                *slot = (shape.cast)(component(bytes, at + c * size, acc));
+            }
+        }
+        Ok(())
+    }
+
+    /// Sparse substitutions (§3.6.2.3): `count` (index, element) pairs, tightly packed in
+    /// their own views, each index inside the accessor.
+    fn apply_sparse<T>(
+        &self,
+        acc: &Accessor,
+        sparse: &super::json::Sparse,
+        shape: &Shape<'_, T>,
+        out: &mut [T],
+        what: &str,
+    ) -> Res<()> {
+        let (n, size) = (shape.n, shape.size);
+        let elem = n * size;
+        if sparse.count > acc.count {
+            return Err(format!(
+                "{what}: {} sparse substitutions for {} elements",
+                sparse.count, acc.count
+            ));
+        }
+        let k = sparse.count as usize;
+        let isize = match sparse.indices.component_type {
+            UNSIGNED_BYTE => 1,
+            UNSIGNED_SHORT => 2,
+            UNSIGNED_INT => 4,
+            t => return Err(format!("{what}: sparse index componentType {t}")),
+        };
+        let (_, ib) = self.view(sparse.indices.buffer_view, what)?;
+        let (_, vb) = self.view(sparse.values.buffer_view, what)?;
+        let fits = |off: u64, per: usize, bytes: &[u8]| {
+            (k as u64)
+                .checked_mul(per as u64)
+                .and_then(|s| s.checked_add(off))
+                .is_some_and(|e| e <= bytes.len() as u64)
+        };
+        if !fits(sparse.indices.byte_offset, isize, ib)
+            || !fits(sparse.values.byte_offset, elem, vb)
+        {
+            return Err(format!(
+                "{what}: sparse indices or values overrun their buffer views"
+            ));
+        }
+        let index_acc = Accessor {
+            component_type: sparse.indices.component_type,
+            ..Accessor::default()
+        };
+        for j in 0..k {
+            let at = sparse.indices.byte_offset as usize + j * isize;
+            let target = component(ib, at, &index_acc) as u64;
+            if target >= acc.count {
+                return Err(format!(
+                    "{what}: sparse index {target} is outside its {} elements",
+                    acc.count
+                ));
+            }
+            let vat = sparse.values.byte_offset as usize + j * elem;
+            for c in 0..n {
+                out[target as usize * n + c] = (shape.cast)(component(vb, vat + c * size, acc));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How an accessor's elements are read: components per element, bytes per component, and
+/// the conversion of each component.
+struct Shape<'a, T> {
+    n: usize,
+    size: usize,
+    cast: &'a dyn Fn(f64) -> T,
 }
 
 pub(super) const UNSIGNED_BYTE: u32 = 5121;
