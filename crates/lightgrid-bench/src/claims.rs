@@ -376,6 +376,237 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
             e,
             v,
         );
+        for (statement, source, (e, v)) in [
+            (
+                "Tiled deferred has the fastest worst case of the culling techniques",
+                "tiled-shading §8.3",
+                fastest_worst_case(r, scene),
+            ),
+            (
+                "With few lights, tiled forward shading is competitive with tiled deferred (within 25%)",
+                "tiled-shading §8.3, Table 3",
+                few_lights_competitive(r, scene),
+            ),
+            (
+                "At equal lighting computations, tiled forward with pre-Z is about four times slower than tiled deferred, plus a constant offset",
+                "tiled-shading §8.2",
+                prez_per_computation(r, scene),
+            ),
+            (
+                "Deferred-Stencil is competitive (within 25% of tiled deferred) with a 16-bit G-buffer, not with a 32-bit one",
+                "tiled-shading §8.1, Tables 2-3",
+                stencil_gbuffer(r, scene),
+            ),
+        ] {
+            claim(statement, source, e, v);
+        }
     }
     out
+}
+
+/// "Competitive" in the paper's claims: within this factor of the other's time.
+pub const COMPETITIVE: f64 = 1.25;
+/// "Close to a factor four": the fitted cost per lighting computation within this range.
+pub const FOUR_TIMES: (f64, f64) = (2.5, 6.0);
+
+fn not_measured(what: &str) -> (String, Verdict) {
+    (format!("needs {what}"), Verdict::NotMeasured)
+}
+
+/// Claim 11: the worst frame of tiled deferred against every other culling run's worst.
+fn fastest_worst_case(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    let worst: Vec<(String, f64)> = culled(r, scene)
+        .into_iter()
+        .filter_map(|x| Some((x.pipeline.clone(), x.summary.as_ref()?.gpu_ms.max)))
+        .collect();
+    fastest_worst(&worst)
+        .unwrap_or_else(|| not_measured("tiled_deferred and another culling pipeline"))
+}
+
+/// The verdict on (pipeline, worst frame ms) rows.
+pub fn fastest_worst(worst: &[(String, f64)]) -> Option<(String, Verdict)> {
+    let td = worst.iter().find(|(p, _)| p == "tiled_deferred")?.1;
+    let (other, best) = worst
+        .iter()
+        .filter(|(p, _)| p != "tiled_deferred")
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some((
+        format!(
+            "worst frame: tiled_deferred {td:.1} ms, the best other worst {other} {best:.1} ms"
+        ),
+        verdict(td <= *best),
+    ))
+}
+
+/// Claim 12, on the few-lights scene only (robots-few: one light per robot).
+fn few_lights_competitive(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    if !scene.starts_with("robots-few") {
+        return (
+            "applies to the few-lights scene (robots-few)".into(),
+            Verdict::NotMeasured,
+        );
+    }
+    let forward = ["tiled_forward", "tiled_forward_prez"]
+        .iter()
+        .filter_map(|p| Some((p.to_string(), avg_ms(find(r, scene, p, None)?)?)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    match (
+        forward,
+        find(r, scene, "tiled_deferred", None).and_then(avg_ms),
+    ) {
+        (Some((p, f)), Some(d)) => competitive(&p, f, d),
+        _ => not_measured("tiled_forward or tiled_forward_prez, and tiled_deferred"),
+    }
+}
+
+/// The verdict on a forward pipeline's and tiled deferred's average frame times.
+pub fn competitive(pipeline: &str, forward_ms: f64, deferred_ms: f64) -> (String, Verdict) {
+    (
+        format!(
+            "avg ms: {pipeline} {forward_ms:.2}, tiled_deferred {deferred_ms:.2} ({:.2}x)",
+            forward_ms / deferred_ms.max(1e-9)
+        ),
+        verdict(forward_ms <= COMPETITIVE * deferred_ms),
+    )
+}
+
+/// Least-squares line `ms = a + b × computations` over a run's frames: (a, b).
+pub fn fit_cost(frames: &[(f64, f64)]) -> Option<(f64, f64)> {
+    if frames.len() < 3 {
+        return None;
+    }
+    let n = frames.len() as f64;
+    let (mx, my) = (
+        frames.iter().map(|f| f.0).sum::<f64>() / n,
+        frames.iter().map(|f| f.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = frames.iter().map(|f| (f.0 - mx).powi(2)).sum();
+    let sxy: f64 = frames.iter().map(|f| (f.0 - mx) * (f.1 - my)).sum();
+    (sxx > 0.0).then(|| {
+        let b = sxy / sxx;
+        (my - b * mx, b)
+    })
+}
+
+/// The verdict on two fitted lines (pre-Z forward, tiled deferred): the slope ratio.
+pub fn four_times(prez: (f64, f64), deferred: (f64, f64)) -> (String, Verdict) {
+    let ratio = prez.1 / deferred.1.max(1e-18);
+    (
+        format!(
+            "fitted ms per million lighting computations: tiled_forward_prez {:.3} (+{:.1} ms), tiled_deferred {:.3} (+{:.1} ms): {ratio:.2}x",
+            prez.1 * 1e6,
+            prez.0,
+            deferred.1 * 1e6,
+            deferred.0
+        ),
+        verdict(deferred.1 > 0.0 && (FOUR_TIMES.0..=FOUR_TIMES.1).contains(&ratio)),
+    )
+}
+
+/// Claim 13: ms against lighting computations per frame, fitted for both.
+fn prez_per_computation(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    let series = |p: &str| -> Option<Vec<(f64, f64)>> {
+        find(r, scene, p, None)?
+            .frames
+            .iter()
+            .map(|f| Some((f.lighting_computations? as f64, f.gpu_ms)))
+            .collect()
+    };
+    match (
+        series("tiled_forward_prez").as_deref().and_then(fit_cost),
+        series("tiled_deferred").as_deref().and_then(fit_cost),
+    ) {
+        (Some(p), Some(d)) => four_times(p, d),
+        _ => not_measured(
+            "tiled_forward_prez and tiled_deferred over 3 or more frames whose counts vary",
+        ),
+    }
+}
+
+/// The verdict on Deferred-Stencil ÷ tiled deferred frame times at 16 and 32 bits.
+pub fn stencil_competitive(ratio16: f64, ratio32: f64) -> (String, Verdict) {
+    (
+        format!("avg ms deferred_stencil / tiled_deferred: {ratio16:.2}x with 16-bit, {ratio32:.2}x with 32-bit G-buffers"),
+        verdict(ratio16 <= COMPETITIVE && ratio32 > COMPETITIVE),
+    )
+}
+
+/// Claim 14.
+fn stencil_gbuffer(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    let ratio = |bits| {
+        let s = find(r, scene, "deferred_stencil", Some(bits))
+            .filter(|x| x.gbuffer_bits == Some(bits))?;
+        let t = find(r, scene, "tiled_deferred", Some(bits))
+            .filter(|x| x.gbuffer_bits == Some(bits))?;
+        Some(avg_ms(s)? / avg_ms(t)?.max(1e-9))
+    };
+    match (ratio(16), ratio(32)) {
+        (Some(a), Some(b)) => stencil_competitive(a, b),
+        _ => not_measured("--gbuffer 16,32 with deferred_stencil and tiled_deferred"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows(v: &[(&str, f64)]) -> Vec<(String, f64)> {
+        v.iter().map(|(p, m)| (p.to_string(), *m)).collect()
+    }
+
+    #[test]
+    fn fastest_worst_case_on_both_sides() {
+        let held = fastest_worst(&rows(&[
+            ("tiled_deferred", 20.0),
+            ("deferred", 35.0),
+            ("tiled_forward", 21.0),
+        ]));
+        assert_eq!(held.unwrap().1, Verdict::Held);
+        let not = fastest_worst(&rows(&[
+            ("tiled_deferred", 22.0),
+            ("deferred", 35.0),
+            ("tiled_forward", 21.0),
+        ]));
+        assert_eq!(not.unwrap().1, Verdict::NotHeld);
+        assert!(fastest_worst(&rows(&[("deferred", 3.0)])).is_none());
+    }
+
+    #[test]
+    fn four_times_on_both_sides() {
+        // ms = 5 + 4e-6 × n against ms = 2 + 1e-6 × n: four times, held.
+        let line = |a: f64, b: f64| -> Vec<(f64, f64)> {
+            [1e6, 2e6, 4e6, 8e6]
+                .iter()
+                .map(|&n| (n, a + b * n))
+                .collect()
+        };
+        let prez = fit_cost(&line(5.0, 4e-6)).unwrap();
+        let deferred = fit_cost(&line(2.0, 1e-6)).unwrap();
+        assert!((prez.1 - 4e-6).abs() < 1e-12 && (prez.0 - 5.0).abs() < 1e-6);
+        assert_eq!(four_times(prez, deferred).1, Verdict::Held);
+        // Equal cost per computation, or ten times: not held.
+        assert_eq!(
+            four_times(fit_cost(&line(9.0, 1e-6)).unwrap(), deferred).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            four_times(fit_cost(&line(0.0, 1e-5)).unwrap(), deferred).1,
+            Verdict::NotHeld
+        );
+        // Constant counts cannot be fitted.
+        assert!(fit_cost(&[(1.0, 2.0), (1.0, 3.0), (1.0, 4.0)]).is_none());
+    }
+
+    #[test]
+    fn few_lights_competitive_on_both_sides() {
+        assert_eq!(competitive("tiled_forward", 12.0, 10.0).1, Verdict::Held);
+        assert_eq!(competitive("tiled_forward", 13.0, 10.0).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn stencil_competitive_on_both_sides() {
+        assert_eq!(stencil_competitive(1.1, 1.6).1, Verdict::Held);
+        assert_eq!(stencil_competitive(1.4, 1.6).1, Verdict::NotHeld);
+        assert_eq!(stencil_competitive(1.1, 1.2).1, Verdict::NotHeld);
+    }
 }
