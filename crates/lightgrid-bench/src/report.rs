@@ -152,7 +152,7 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 30] = [
+const RESULTS_CSV_COLUMNS: [&str; 31] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
@@ -177,6 +177,7 @@ const RESULTS_CSV_COLUMNS: [&str; 30] = [
     "ideal_transparent_computations",
     "lights_per_tile_avg",
     "lights_per_tile_max",
+    "tile_area_computations",
     "grid_bytes",
     "modelled_write_bytes",
     "modelled_read_bytes",
@@ -219,6 +220,7 @@ struct ResultsRow<'a> {
     #[serde(serialize_with = "fixed3_opt")]
     lights_per_tile_avg: Option<f64>,
     lights_per_tile_max: Option<u32>,
+    tile_area_computations: Option<u64>,
     grid_bytes: Option<u64>,
     modelled_write_bytes: Option<u64>,
     modelled_read_bytes: Option<u64>,
@@ -285,6 +287,7 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 ideal_transparent_computations: f.ideal_transparent_computations,
                 lights_per_tile_avg: f.lights_per_tile_avg,
                 lights_per_tile_max: f.lights_per_tile_max,
+                tile_area_computations: f.tile_area_computations,
                 grid_bytes: f.grid_bytes,
                 modelled_write_bytes: f.modelled_write_bytes,
                 modelled_read_bytes: f.modelled_read_bytes,
@@ -644,6 +647,7 @@ fn summary(results: &BenchResults) -> String {
         if let Some(i) = ideal {
             let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
         }
+        fig3_counts(&mut s, results, scene);
         // The transparent overdraw: the same for every run of the scene (the analysis
         // rasterizes the frame's transparent objects).
         if let Some(r) = results
@@ -807,6 +811,50 @@ pub fn write_report(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> 
     Ok(written)
 }
 
+/// tiled-shading Fig. 3's count beside ours, for the tiled runs of `scene`: for
+/// TiledFwd-PreZ and TiledDeferred the figure counts tile area × list length (sky and partial
+/// tiles included); for TiledFwd its shaded fragments (overdraw included), as ours does.
+fn fig3_counts(s: &mut String, results: &BenchResults, scene: &str) {
+    let rows: Vec<String> = results
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.msaa == 1 && r.gbuffer_bits.unwrap_or(16) == 16)
+        .filter(|r| r.pipeline != "tiled_forward")
+        .filter_map(|r| {
+            let n = r.frames.len().max(1) as f64;
+            let area: Option<Vec<u64>> =
+                r.frames.iter().map(|f| f.tile_area_computations).collect();
+            let area = area.filter(|a| !a.is_empty())?.iter().sum::<u64>() as f64 / n;
+            // Ours, opaque samples only (the figure has no transparency).
+            let opaque: Option<f64> = r
+                .frames
+                .iter()
+                .map(|f| {
+                    let all = f.lighting_computations? as f64;
+                    Some(all - f.transparent_lighting_computations.unwrap_or(0) as f64)
+                })
+                .sum::<Option<f64>>()
+                .map(|t| t / n);
+            let ours = opaque?;
+            Some(format!(
+                "- {}: {area:.0} (ours, per visible opaque sample: {ours:.0}; {:.2}x)",
+                r.pipeline,
+                area / ours.max(1.0)
+            ))
+        })
+        .collect();
+    if !rows.is_empty() {
+        let _ = writeln!(
+            s,
+            "\ntiled-shading Fig. 3's count, tile area × list length per frame (avg; for tiled_forward the figure counts shaded fragments, as ours does):\n"
+        );
+        for r in rows {
+            let _ = writeln!(s, "{r}");
+        }
+        let _ = writeln!(s);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -835,7 +883,7 @@ mod tests {
         let row = text.lines().nth(1).unwrap();
         assert_eq!(
             row,
-            ",,16,,,,0,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,gbuffer=0.1000;shade=0.2000"
+            ",,16,,,,0,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,,gbuffer=0.1000;shade=0.2000"
         );
         let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
         assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);

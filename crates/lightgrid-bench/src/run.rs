@@ -281,6 +281,9 @@ pub struct FrameRecord {
     pub transparent_lighting_computations: Option<u64>,
     pub lights_per_tile_avg: Option<f64>,
     pub lights_per_tile_max: Option<u32>,
+    /// tiled-shading Fig. 3's count (tile area × list length, tiled grids).
+    #[serde(default)]
+    pub tile_area_computations: Option<u64>,
     pub grid_bytes: Option<u64>,
     pub modelled_write_bytes: Option<u64>,
     pub modelled_read_bytes: Option<u64>,
@@ -878,6 +881,7 @@ impl FrameRecord {
             transparent_lighting_computations: s.transparent_lighting_computations,
             lights_per_tile_avg: s.lights_per_tile_avg,
             lights_per_tile_max: s.lights_per_tile_max,
+            tile_area_computations: s.tile_area_computations,
             grid_bytes: s.memory.grid_bytes,
             modelled_write_bytes: s.memory.modelled_write_bytes,
             modelled_read_bytes: s.memory.modelled_read_bytes,

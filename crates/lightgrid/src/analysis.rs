@@ -327,6 +327,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
                 .map(|n| ideal as f64 / n as f64),
             lights_per_tile_avg: grid_is_pipelines.then(|| grid.average_lights_per_cell()),
             lights_per_tile_max: grid_is_pipelines.then(|| grid.max_lights_per_cell()),
+            tile_area_computations: grid.tile_area_computations().filter(|_| grid_is_pipelines),
             grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
             grid_cells: grid_is_pipelines.then_some(grid.cells.len() as u64),
             grid_cells_occupied: occupied,

@@ -104,6 +104,10 @@ pub struct FrameStats {
     /// builds no grid).
     pub lights_per_tile_avg: Option<f64>,
     pub lights_per_tile_max: Option<u32>,
+    /// tiled-shading Fig. 3's count for tiled grids: tile area × list length, summed over the
+    /// tiles (`LightGrid::tile_area_computations`; None for clustered grids and without one).
+    #[serde(default)]
+    pub tile_area_computations: Option<u64>,
     /// Total entries of the grid's index lists.
     pub grid_indices: Option<u64>,
     /// Cells of the grid (tiles × slices) and how many hold samples (non-empty bounds).

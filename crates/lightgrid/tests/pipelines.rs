@@ -209,6 +209,19 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
             assert_eq!(out.grid.dims.tile_size, settings.tile_size);
             assert_eq!(st.lights_per_tile_max, Some(out.grid.max_lights_per_cell()));
         }
+        // tiled-shading Fig. 3's count (tile area × list length) for tiled grids: every
+        // pixel of a tile, so never below the per-sample count of tiled deferred's opaque
+        // samples.
+        let opaque = n - st.transparent_lighting_computations.unwrap_or(0);
+        match (p.id, st.tile_area_computations) {
+            ("tiled_deferred", Some(area)) => {
+                assert!(area >= opaque, "{name}: {area} < {opaque}")
+            }
+            ("tiled_deferred", None) => panic!("{name}: no tile-area count"),
+            ("clustered_forward" | "clustered_deferred", area) => assert_eq!(area, None),
+            ("forward" | "deferred", area) => assert_eq!(area, None),
+            _ => {}
+        }
         let m = p.memory_model(&settings);
         assert_eq!(st.memory.bytes_per_pixel, m.bytes_per_pixel());
         assert_eq!(

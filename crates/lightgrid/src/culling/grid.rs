@@ -203,6 +203,34 @@ impl LightGrid {
         self.indices.len() as f64 / self.cells.len().max(1) as f64
     }
 
+    /// tiled-shading Fig. 3's count for tiled techniques: every tile's pixel area times its
+    /// list length, summed (the opaque lists; `None` for clustered grids, which the figure
+    /// does not have). It counts the sky and the partial tiles' pixels too, as the figure
+    /// does; the ideal-relative count counts visible samples only.
+    pub fn tile_area_computations(&self) -> Option<u64> {
+        let d = &self.dims;
+        if d.slices != 1 {
+            return None;
+        }
+        let area = |t: usize| {
+            let (tx, ty) = (
+                (t % d.tiles_x as usize) as u32,
+                (t / d.tiles_x as usize) as u32,
+            );
+            let w = d.tile_size.min(d.width - tx * d.tile_size);
+            let h = d.tile_size.min(d.height - ty * d.tile_size);
+            u64::from(w) * u64::from(h)
+        };
+        Some(
+            self.cells
+                .iter()
+                .take(d.tile_count())
+                .enumerate()
+                .map(|(t, c)| area(t) * u64::from(c[1]))
+                .sum(),
+        )
+    }
+
     pub fn max_lights_per_cell(&self) -> u32 {
         self.cells.iter().map(|c| c[1]).max().unwrap_or(0)
     }
@@ -377,5 +405,28 @@ impl GridBuffers {
 
     pub fn indices_buffer(&self) -> &wgpu::Buffer {
         &self.indices
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tile_area_counts_partial_tiles_by_their_pixels() {
+        // 20x10 with 8-pixel tiles: 3x2 tiles of 8x8, 8x8, 4x8 / 8x2, 8x2, 4x2 pixels.
+        let dims = GridDims::new(20, 10, 8).unwrap();
+        let lists: Vec<Vec<u32>> = [1usize, 0, 3, 2, 0, 5]
+            .iter()
+            .map(|&n| (0..n as u32).collect())
+            .collect();
+        let grid = LightGrid::from_lists(dims, &lists);
+        assert_eq!(
+            grid.tile_area_computations(),
+            Some(64 + 3 * 32 + 2 * 16 + 5 * 8)
+        );
+        let clustered =
+            LightGrid::from_lists(dims.clustered(4, 1.0, 100.0).unwrap(), &vec![vec![0]; 24]);
+        assert_eq!(clustered.tile_area_computations(), None);
     }
 }
