@@ -401,7 +401,82 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
             claim(statement, source, e, v);
         }
     }
+    out.extend(view_dependence(r));
     out
+}
+
+/// tiled-forward-shading Fig. 4.6's three claims, across random-top and random-fps (the
+/// same 1,024 lights and field, top-down and first-person).
+fn view_dependence(r: &BenchResults) -> Vec<Claim> {
+    let (top, fps) = ("random-top", "random-fps");
+    let ms = |scene: &str, p: &str| find(r, scene, p, None).and_then(avg_ms);
+    let count = |scene: &str, p: &str| find(r, scene, p, None).and_then(avg_count);
+    let (tiled, clustered) = ("tiled_forward_prez", "clustered_forward");
+    let mut out = Vec::new();
+    let mut claim = |scene: &str, statement, (evidence, verdict): (String, Verdict)| {
+        out.push(Claim {
+            scene: scene.to_string(),
+            statement,
+            source: "tiled-forward-shading Fig. 4.6",
+            evidence,
+            verdict,
+        })
+    };
+    if r.runs.iter().any(|x| x.scene == top) {
+        claim(
+            top,
+            "In the top-down view tiled forward outperforms clustered forward (6.6 vs 9.3 ms)",
+            match (ms(top, tiled), ms(top, clustered)) {
+                (Some(t), Some(c)) => faster("tiled_forward_prez", t, "clustered_forward", c),
+                _ => not_measured("tiled_forward_prez and clustered_forward"),
+            },
+        );
+    }
+    if r.runs.iter().any(|x| x.scene == fps) {
+        claim(
+            fps,
+            "In the first-person view tiled forward becomes slower than clustered forward (9.4 vs 9.1 ms)",
+            match (ms(fps, tiled), ms(fps, clustered)) {
+                (Some(t), Some(c)) => faster("clustered_forward", c, "tiled_forward_prez", t),
+                _ => not_measured("tiled_forward_prez and clustered_forward"),
+            },
+        );
+    }
+    let both = r.runs.iter().any(|x| x.scene == top) && r.runs.iter().any(|x| x.scene == fps);
+    if both {
+        let pair = |p| Some((count(top, p)?, count(fps, p)?));
+        claim(
+            "random-top vs random-fps",
+            "Clustered shading depends much less on the view than tiled shading",
+            match (pair(tiled), pair(clustered)) {
+                (Some(t), Some(c)) => less_view_dependent(t, c),
+                _ => not_measured("tiled_forward_prez and clustered_forward on both views"),
+            },
+        );
+    }
+    out
+}
+
+/// Is `a` faster than `b` (average ms)?
+pub fn faster(a: &str, a_ms: f64, b: &str, b_ms: f64) -> (String, Verdict) {
+    (
+        format!("avg ms: {a} {a_ms:.2}, {b} {b_ms:.2}"),
+        verdict(a_ms < b_ms),
+    )
+}
+
+/// The change of lighting computations from the top-down to the first-person view, (top,
+/// fps) for tiled and for clustered: clusters should change less (|ln fps/top| smaller).
+pub fn less_view_dependent(tiled: (f64, f64), clustered: (f64, f64)) -> (String, Verdict) {
+    let change = |(top, fps): (f64, f64)| fps / top.max(1.0);
+    let (t, c) = (change(tiled), change(clustered));
+    (
+        format!(
+            "avg lighting computations first-person / top-down: tiled_forward_prez {t:.2}x ({:.0} / {:.0}), clustered_forward {c:.2}x ({:.0} / {:.0})",
+            tiled.1, tiled.0, clustered.1, clustered.0
+        ),
+        verdict(c.ln().abs() < t.ln().abs()),
+    )
 }
 
 /// "Competitive" in the paper's claims: within this factor of the other's time.
@@ -601,6 +676,26 @@ mod tests {
     fn few_lights_competitive_on_both_sides() {
         assert_eq!(competitive("tiled_forward", 12.0, 10.0).1, Verdict::Held);
         assert_eq!(competitive("tiled_forward", 13.0, 10.0).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn view_dependence_on_both_sides() {
+        // Tiled triples its work in the first-person view, clusters grow 20%: held.
+        assert_eq!(
+            less_view_dependent((100.0, 300.0), (80.0, 96.0)).1,
+            Verdict::Held
+        );
+        // Clusters change as much, or shrink more than tiles grow: not held.
+        assert_eq!(
+            less_view_dependent((100.0, 150.0), (80.0, 160.0)).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            less_view_dependent((100.0, 150.0), (100.0, 50.0)).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(faster("a", 6.6, "b", 9.3).1, Verdict::Held);
+        assert_eq!(faster("a", 9.4, "b", 9.1).1, Verdict::NotHeld);
     }
 
     #[test]

@@ -18,7 +18,8 @@ pub(crate) enum Preset {
     /// CI-sized smoke run: robots-many at 160x90, 4 frames, every pipeline.
     Quick,
     /// The papers' configurations: robots-many and robots-few, frames 0..259 every 5, 16- and
-    /// 32-bit G-buffers, at 1920x1080 on a hardware GPU or 640x360 on a software one.
+    /// 32-bit G-buffers, 32-pixel tiles (the papers'), at 1920x1080 on a hardware GPU or
+    /// 640x360 on a software one.
     Paper,
     /// A scene dominated by spot lights (tiled-deferred-tricks' case): robots-many with every
     /// light a spot, frames 0..259 every 20, grid pipelines culling by sphere and by cone,
@@ -32,6 +33,11 @@ pub(crate) enum Preset {
     /// random lights) with and without its translucent blocks, frames 0..259 every 20,
     /// tiled and clustered forward and deferred at every sample count the adapter offers.
     Msaa,
+    /// Tiled against clustered forward shading (tiled-forward-shading Fig. 4.6): random-top
+    /// and random-fps (1,024 random lights, top-down and first-person) without their
+    /// translucent blocks, 32-pixel tiles, frames 0..119 every 10: the top-down view favours
+    /// tiles, the first-person view clusters, and clusters depend less on the view.
+    Clustered,
 }
 
 #[derive(Args)]
@@ -143,6 +149,10 @@ pub(crate) struct BenchDefaults {
     pub(crate) lists: Vec<lightgrid::culling::GridLists>,
     pub(crate) msaa: Vec<u32>,
     pub(crate) msaa_resolve: Vec<lightgrid::frame::MsaaResolve>,
+    /// The scenes' transparent objects (unless `--transparency` says).
+    pub(crate) transparency: bool,
+    /// The paper's tile edge (unless `--tile` says; None: the renderer's default).
+    pub(crate) tile: Option<u32>,
 }
 
 /// A study of one dimension over robots-many's animation (frames every 20, the papers' size
@@ -168,6 +178,8 @@ fn study(
         lists: default_lists(),
         msaa: vec![1],
         msaa_resolve: vec![Default::default()],
+        transparency: true,
+        tile: None,
     }
 }
 
@@ -195,6 +207,8 @@ pub(crate) fn bench_config(
             lists: default_lists(),
             msaa: vec![1],
             msaa_resolve: vec![Default::default()],
+            transparency: true,
+            tile: None,
         },
         Some(Preset::Quick) => BenchDefaults {
             scenes: vec!["robots-many"],
@@ -208,6 +222,8 @@ pub(crate) fn bench_config(
             lists: default_lists(),
             msaa: vec![1],
             msaa_resolve: vec![Default::default()],
+            transparency: true,
+            tile: None,
         },
         Some(Preset::Spots) => BenchDefaults {
             spot_fraction: 1.0,
@@ -258,6 +274,19 @@ pub(crate) fn bench_config(
             lists: default_lists(),
             msaa: vec![1],
             msaa_resolve: vec![Default::default()],
+            transparency: true,
+            // tiled-shading §8 and tiled-forward-shading use 32x32 tiles.
+            tile: Some(32),
+        },
+        Some(Preset::Clustered) => BenchDefaults {
+            scenes: vec!["random-top", "random-fps"],
+            frames: "0..119:10",
+            pipelines: ["tiled_forward_prez", "clustered_forward"]
+                .map(String::from)
+                .to_vec(),
+            transparency: false,
+            tile: Some(32),
+            ..study(hardware, |_| false)
         },
     };
     let (scenes, frames, size, gbuffers, repeat, pipelines) = (
@@ -286,7 +315,10 @@ pub(crate) fn bench_config(
         pipelines,
         frames: FrameRange::parse(a.frames.as_deref().unwrap_or(frames))?,
         size: a.size.map(|Size(w, h)| (w, h)).or(size),
-        tile_size: a.tile.unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
+        tile_size: a
+            .tile
+            .or(d.tile)
+            .unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
         slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
         assign: a.assign.unwrap_or(AssignArg::Auto).into(),
         gbuffers: if a.gbuffer.is_empty() {
@@ -306,7 +338,11 @@ pub(crate) fn bench_config(
         } else {
             a.spot_cull.iter().map(|&c| c.into()).collect()
         },
-        transparency: a.transparency.is_empty() || a.transparency.iter().any(|t| t.on()),
+        transparency: if a.transparency.is_empty() {
+            d.transparency
+        } else {
+            a.transparency.iter().any(|t| t.on())
+        },
         opaque_variants: matches!(a.preset, Some(Preset::Msaa)) && a.transparency.is_empty()
             || a.transparency.iter().any(|t| !t.on()) && a.transparency.iter().any(|t| t.on()),
         material_shaders: a.material_shaders.is_none_or(OnOff::on),
