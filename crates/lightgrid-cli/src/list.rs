@@ -39,6 +39,10 @@ pub(crate) fn list() -> Result<()> {
     for s in SCENES {
         println!("  {:<12} {}", s.name, s.description);
     }
+    println!(
+        "  {:<12} a glTF 2.0 file: meshes, materials, textures, cameras, KHR_lights_punctual lights (--add-lights N fills any scene)",
+        "FILE.gltf|.glb"
+    );
     println!("pipelines:");
     for p in PIPELINES {
         let msaa = match p.msaa {
