@@ -397,6 +397,11 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
                 "tiled-shading §8.1, Tables 2-3",
                 stencil_gbuffer(r, scene),
             ),
+            (
+                "Deferred lighting writes more than deferred shading once more than 0.5 lights reach a pixel on average (the traffic model at the measured lights per pixel)",
+                "deferred-shading-vs-deferred-lighting",
+                write_break_even(r, scene),
+            ),
         ] {
             claim(statement, source, e, v);
         }
@@ -621,6 +626,50 @@ fn stencil_gbuffer(r: &BenchResults, scene: &str) -> (String, Verdict) {
     }
 }
 
+/// The blog's write break-even: deferred shading writes 20 B per pixel + 8 per lit pixel,
+/// deferred lighting 16 + 16, so lighting writes more above 0.5 lights per pixel.
+pub const WRITE_BREAK_EVEN: f64 = 0.5;
+
+/// The verdict on the measured lights per pixel and the two pipelines' modelled writes per
+/// frame: lighting writes more exactly when the lights per pixel pass the break-even.
+pub fn writes_more(
+    lights_per_pixel: f64,
+    lighting_bytes: f64,
+    shading_bytes: f64,
+) -> (String, Verdict) {
+    let more = lighting_bytes > shading_bytes;
+    (
+        format!(
+            "{lights_per_pixel:.2} lights per pixel (deferred's lighting computations / pixels); modelled writes per frame: light_prepass {:.1} MiB, deferred {:.1} MiB",
+            lighting_bytes / 1048576.0,
+            shading_bytes / 1048576.0
+        ),
+        verdict(more == (lights_per_pixel > WRITE_BREAK_EVEN)),
+    )
+}
+
+/// Claim 15: lights per pixel from deferred's counts, writes from the traffic model.
+fn write_break_even(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    let writes = |p| -> Option<f64> {
+        let x = find(r, scene, p, None)?;
+        let w: Option<Vec<u64>> = x.frames.iter().map(|f| f.modelled_write_bytes).collect();
+        let w = w.filter(|w| !w.is_empty())?;
+        Some(w.iter().sum::<u64>() as f64 / w.len() as f64)
+    };
+    let lights_per_pixel = find(r, scene, "deferred", None).and_then(|x| {
+        let pixels = f64::from(x.width) * f64::from(x.height);
+        Some(avg_count(x)? / pixels.max(1.0))
+    });
+    match (
+        lights_per_pixel,
+        writes("light_prepass"),
+        writes("deferred"),
+    ) {
+        (Some(l), Some(lp), Some(ds)) => writes_more(l, lp, ds),
+        _ => not_measured("deferred and light_prepass"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -696,6 +745,15 @@ mod tests {
         );
         assert_eq!(faster("a", 6.6, "b", 9.3).1, Verdict::Held);
         assert_eq!(faster("a", 9.4, "b", 9.1).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn write_break_even_on_both_sides() {
+        // Above 0.5 lights per pixel the pre-pass should write more; below, less.
+        assert_eq!(writes_more(2.0, 30.0, 20.0).1, Verdict::Held);
+        assert_eq!(writes_more(2.0, 10.0, 20.0).1, Verdict::NotHeld);
+        assert_eq!(writes_more(0.2, 10.0, 20.0).1, Verdict::Held);
+        assert_eq!(writes_more(0.2, 30.0, 20.0).1, Verdict::NotHeld);
     }
 
     #[test]
