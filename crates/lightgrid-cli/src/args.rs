@@ -83,6 +83,20 @@ pub(crate) fn parse_fraction(s: &str) -> Result<f64, String> {
     }
 }
 
+/// `--add-lights N [--light-range R]` (`render`, `compare`, `play`, `export`, `bench`):
+/// `--light-range` alone is refused.
+pub(crate) fn added_lights(count: Option<u32>, range: Option<f64>) -> Result<Option<AddLights>> {
+    if range.is_some() && count.is_none() {
+        anyhow::bail!(
+            "--light-range sets the range of the lights --add-lights scatters; give --add-lights N"
+        );
+    }
+    Ok(count.map(|count| AddLights {
+        count,
+        range: range.map(|r| r as f32),
+    }))
+}
+
 /// A length: a finite number above 0 (and below 10^9, past which f32 arithmetic breaks).
 pub(crate) fn parse_positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -393,11 +407,8 @@ impl SceneOptions {
         }
     }
 
-    /// What these options ask for, checked (`--light-range` needs `--add-lights`).
+    /// What these options ask for, checked.
     pub(crate) fn request(&self) -> Result<SceneRequest> {
-        if self.light_range.is_some() && self.add_lights.is_none() {
-            anyhow::bail!("--light-range sets the range of the lights --add-lights scatters; give --add-lights N");
-        }
         let req = SceneRequest {
             spec: self.scene.clone(),
             params: SceneParams {
@@ -409,10 +420,7 @@ impl SceneOptions {
                 material_shaders: self.material_shaders.on(),
             },
             camera: self.camera.map(|c| c as usize),
-            add_lights: self.add_lights.map(|count| AddLights {
-                count,
-                range: self.light_range.map(|r| r as f32),
-            }),
+            add_lights: added_lights(self.add_lights, self.light_range)?,
         };
         lightgrid::scene::source::check(&req)?;
         Ok(req)

@@ -366,16 +366,8 @@ pub(crate) fn bench_config(
         } else {
             a.msaa_resolve.iter().map(|&m| m.into()).collect()
         },
-        add_lights: a.add_lights.map(|count| lightgrid::scene::AddLights {
-            count,
-            range: a.light_range.map(|r| r as f32),
-        }),
+        add_lights: crate::args::added_lights(a.add_lights, a.light_range)?,
     };
-    if a.light_range.is_some() && a.add_lights.is_none() {
-        anyhow::bail!(
-            "--light-range sets the range of the lights --add-lights scatters; give --add-lights N"
-        );
-    }
     crate::args::check_msaa_resolve(!a.msaa_resolve.is_empty(), &config.msaa)?;
     config.validate()?;
     let chosen: Vec<_> = config

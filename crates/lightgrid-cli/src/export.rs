@@ -39,14 +39,6 @@ pub(crate) fn export(a: &ExportArgs) -> Result<()> {
     files.output("--out", Some(&a.out), Kind::Data)?;
     a.scene.claim(&mut files)?;
     let scene = a.scene.build()?;
-    if a.frame >= scene.frame_count() {
-        bail!(
-            "--frame {}: {} has frames 0 to {}",
-            a.frame,
-            scene.name,
-            scene.frame_count() - 1
-        );
-    }
     let (w, h) = Size::or_scene(a.size, &scene);
     let bytes = lightgrid::scene::gltf::export(&scene, a.frame, (w, h))?;
     write_atomic(&a.out, &bytes)?;

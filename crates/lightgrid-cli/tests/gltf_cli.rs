@@ -275,7 +275,7 @@ fn bad_files_and_options_are_refused_and_touch_nothing() {
                 "--out",
                 s(&new_glb),
             ],
-            "has frames 0 to 259",
+            "is past the end of robots-few (frames 0..=259)",
         ),
         (
             vec!["export", "--scene", "nope", "--out", s(&new_glb)],

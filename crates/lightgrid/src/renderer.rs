@@ -331,17 +331,7 @@ impl<'c> Renderer<'c> {
 
     /// The animation at `frame`, with its lights checked (count, NaN, ranges).
     fn validated_frame(scene: &Scene, frame: u32) -> Result<FrameState> {
-        let frames = scene.frame_count();
-        if frame >= frames {
-            return Err(Error::invalid(
-                "frame",
-                format!(
-                    "{frame} is past the end of {} (frames 0..={})",
-                    scene.name,
-                    frames - 1
-                ),
-            ));
-        }
+        scene.check_frame(frame)?;
         let state = scene.frame(frame);
         if state.lights.len() > MAX_LIGHTS as usize {
             return Err(Error::invalid(

@@ -241,11 +241,19 @@ pub fn check_params(name: &str, params: &SceneParams) -> Result<&'static SceneIn
                 scenes_where(SceneInfo::transparency)
             ),
         )),
-        _ if !(0.0..=1.0).contains(&params.spot_fraction) => Err(Error::invalid(
+        _ => check_spot_fraction(params.spot_fraction).map(|()| info),
+    }
+}
+
+/// `--spot-fraction` is a fraction, for catalog scenes and files alike.
+pub(crate) fn check_spot_fraction(fraction: f32) -> Result<()> {
+    if (0.0..=1.0).contains(&fraction) {
+        Ok(())
+    } else {
+        Err(Error::invalid(
             "--spot-fraction",
-            format!("{} is out of range 0 to 1", params.spot_fraction),
-        )),
-        _ => Ok(info),
+            format!("{fraction} is out of range 0 to 1"),
+        ))
     }
 }
 

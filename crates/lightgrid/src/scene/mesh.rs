@@ -2,6 +2,14 @@
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+/// The axis-aligned bounds (min, max) of `points`; `None` for no points.
+pub fn bounds_of(points: impl IntoIterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
+    points.into_iter().fold(None, |b, p| match b {
+        None => Some((p, p)),
+        Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
+    })
+}
+
 /// An indexed triangle mesh (counter-clockwise front faces).
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -22,15 +30,13 @@ impl Mesh {
 
     /// Centre of the axis-aligned bounds (the origin for an empty mesh).
     pub fn centre(&self) -> Vec3 {
-        let lo = self.positions.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
-        let hi = self
-            .positions
-            .iter()
-            .fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
-        if self.positions.is_empty() {
-            Vec3::ZERO
-        } else {
-            (lo + hi) * 0.5
+        bounds_of(self.positions.iter().copied()).map_or(Vec3::ZERO, |(lo, hi)| (lo + hi) * 0.5)
+    }
+
+    /// Reverse every triangle's winding (front faces become back faces).
+    pub fn flip_winding(&mut self) {
+        for t in self.indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
         }
     }
 

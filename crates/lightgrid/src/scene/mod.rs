@@ -14,7 +14,7 @@ mod view;
 
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
-pub use mesh::Mesh;
+pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};
 pub use rng::Rng;
 pub use source::{open, AddLights, Opened, SceneRequest};
@@ -440,6 +440,22 @@ pub struct FrameState {
 impl Scene {
     pub fn frame_count(&self) -> u32 {
         self.camera_path.frame_count()
+    }
+
+    /// Refuse a frame past the end of the animation.
+    pub fn check_frame(&self, frame: u32) -> Result<()> {
+        let frames = self.frame_count();
+        if frame >= frames {
+            return Err(Error::invalid(
+                "frame",
+                format!(
+                    "{frame} is past the end of {} (frames 0..={})",
+                    self.name,
+                    frames - 1
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn motion_transform(&self, motion: &Motion, frame: u32) -> Mat4 {

@@ -4,7 +4,7 @@
 
 use super::catalog::{self, make_spots, random_light_color, SceneParams};
 use super::gltf::{self, LoadOptions};
-use super::{Light, LightAnchor, Rng, Scene, SceneLight};
+use super::{bounds_of, Light, LightAnchor, Rng, Scene, SceneLight};
 use crate::consts::MAX_LIGHTS;
 use crate::error::{Error, Result};
 use glam::Vec3;
@@ -83,13 +83,7 @@ pub fn check(req: &SceneRequest) -> Result<()> {
                 "--headlights gives the catalog's robots headlights",
             );
         }
-        if !(0.0..=1.0).contains(&p.spot_fraction) {
-            return Err(Error::invalid(
-                "--spot-fraction",
-                format!("{} is out of range 0 to 1", p.spot_fraction),
-            ));
-        }
-        Ok(())
+        catalog::check_spot_fraction(p.spot_fraction)
     } else {
         if req.camera.is_some() {
             return Err(Error::invalid(
@@ -176,16 +170,18 @@ pub fn open(req: &SceneRequest) -> Result<Opened> {
 /// The axis-aligned bounds of the scene's geometry at frame 0, or `None` without geometry.
 pub fn bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
     let state = scene.frame(0);
-    let mut lo = Vec3::INFINITY;
-    let mut hi = Vec3::NEG_INFINITY;
-    for (o, m) in scene.objects.iter().zip(&state.transforms) {
-        for p in &scene.meshes[o.mesh].positions {
-            let w = m.transform_point3(*p);
-            lo = lo.min(w);
-            hi = hi.max(w);
-        }
-    }
-    (lo.x <= hi.x).then_some((lo, hi))
+    bounds_of(
+        scene
+            .objects
+            .iter()
+            .zip(&state.transforms)
+            .flat_map(|(o, m)| {
+                scene.meshes[o.mesh]
+                    .positions
+                    .iter()
+                    .map(move |p| m.transform_point3(*p))
+            }),
+    )
 }
 
 /// The box lights are scattered in: the scene's bounds with every side at least a tenth of

@@ -6,7 +6,7 @@
 
 use super::import::{candela_from_intensity, ExactMaterial};
 use crate::error::{Error, Result};
-use crate::scene::{Material, Mesh, Scene};
+use crate::scene::{bounds_of, Material, Mesh, Scene};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};
 use std::collections::HashMap;
@@ -40,9 +40,7 @@ impl Bin {
 
     fn vec3s(&mut self, v: &[Vec3], bounds: bool) -> usize {
         let mut acc = json!({"componentType": 5126, "count": v.len(), "type": "VEC3"});
-        if bounds {
-            let lo = v.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
-            let hi = v.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
+        if let Some((lo, hi)) = bounds_of(v.iter().copied()).filter(|_| bounds) {
             acc["min"] = json!(lo.to_array());
             acc["max"] = json!(hi.to_array());
         }
@@ -60,6 +58,15 @@ fn is_trs(m: &Mat4) -> bool {
 
 /// One mesh of one primitive: positions (with bounds), normals, UVs, indices.
 fn mesh_json(bin: &mut Bin, m: &Mesh, material: usize, flip: bool) -> Value {
+    let rewound;
+    let m = if flip {
+        let mut copy = m.clone();
+        copy.flip_winding();
+        rewound = copy;
+        &rewound
+    } else {
+        m
+    };
     let pos = bin.vec3s(&m.positions, true);
     let nor = bin.vec3s(&m.normals, false);
     let uv = bin.push(
@@ -67,14 +74,8 @@ fn mesh_json(bin: &mut Bin, m: &Mesh, material: usize, flip: bool) -> Value {
         34962,
         json!({"componentType": 5126, "count": m.uvs.len(), "type": "VEC2"}),
     );
-    let mut indices = m.indices.clone();
-    if flip {
-        for t in indices.chunks_exact_mut(3) {
-            t.swap(1, 2);
-        }
-    }
     let idx = bin.push(
-        bytemuck::cast_slice(&indices),
+        bytemuck::cast_slice(&m.indices),
         34963,
         json!({"componentType": 5125, "count": m.indices.len(), "type": "SCALAR"}),
     );
@@ -123,6 +124,7 @@ fn material_json(m: &Material) -> Value {
 /// The GLB bytes of `scene` at `frame`, for frames of `size` (the camera's aspect ratio).
 pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     scene.validate()?;
+    scene.check_frame(frame)?;
     let state = scene.frame(frame);
     let mut bin = Bin::default();
     let mut meshes = Vec::new();

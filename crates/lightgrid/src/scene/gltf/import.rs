@@ -9,8 +9,8 @@ use super::{
     LoadOptions, EXTENSIONS_READ, LIGHT_CUTOFF, LIGHT_MATCH_FRACTION, MAX_TRIANGLES, MAX_VERTICES,
 };
 use crate::scene::{
-    CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object, Scene,
-    SceneLight, Spot, Texture,
+    bounds_of, CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object,
+    Scene, SceneLight, Spot, Texture,
 };
 use glam::{Mat4, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -37,8 +37,6 @@ struct Walk {
     read_indices: u64,
     baked_vertices: u64,
     baked_triangles: u64,
-    lo: Vec3,
-    hi: Vec3,
     warnings: Vec<String>,
     warned: std::collections::HashSet<String>,
     more_warnings: usize,
@@ -511,9 +509,7 @@ fn primitive_mesh(
     // Normals come from the file's winding; only then is it flipped for a mirroring
     // transform.
     if flipped {
-        for t in mesh.indices.chunks_exact_mut(3) {
-            t.swap(1, 2);
-        }
+        mesh.flip_winding();
     }
     Ok(Some(mesh))
 }
@@ -596,11 +592,6 @@ fn instance_mesh(
             return Err(format!(
                 "the scene's instances add up to more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles"
             ));
-        }
-        for p in &m.positions {
-            let w = world.transform_point3(*p);
-            walk.lo = walk.lo.min(w);
-            walk.hi = walk.hi.max(w);
         }
         walk.objects.push(Object {
             mesh,
@@ -951,8 +942,18 @@ fn camera_path(
     opts: &LoadOptions,
     walk: &mut Walk,
 ) -> Res<(CameraPath, (u32, u32))> {
-    let centre = (walk.lo + walk.hi) * 0.5;
-    let radius = ((walk.hi - walk.lo).length() * 0.5).max(1e-3);
+    // The objects are static and placed by their world matrices.
+    let placed = walk.objects.iter().flat_map(|o| {
+        walk.meshes[o.mesh]
+            .positions
+            .iter()
+            .map(move |p| o.local.transform_point3(*p))
+    });
+    let (lo, hi) = bounds_of(placed)
+        .filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
+        .ok_or("the scene's geometry has no finite bounds")?;
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let mut size = (DEFAULT_WIDTH, DEFAULT_WIDTH * 9 / 16);
     let start = match chosen_camera(doc, opts, walk)? {
         Some(placed) => placed_start(doc, placed, (centre, radius), &mut size, walk)?,
@@ -963,11 +964,7 @@ fn camera_path(
 
 /// The scene a document describes.
 pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Scene, Vec<String>)> {
-    let mut walk = Walk {
-        lo: Vec3::INFINITY,
-        hi: Vec3::NEG_INFINITY,
-        ..Walk::default()
-    };
+    let mut walk = Walk::default();
     for ext in &doc.root.extensions_required {
         if !EXTENSIONS_READ.contains(&ext.as_str()) {
             return Err(format!(
