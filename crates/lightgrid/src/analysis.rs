@@ -5,8 +5,8 @@
 //! (`GridBuilder::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
-    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_computations, ideal_lighting_computations,
-    BuiltGrid, DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
+    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_counts, ideal_pixel_counts, BuiltGrid,
+    DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
 };
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
@@ -36,6 +36,10 @@ pub struct FrameOutput {
     pub depth_samples: Vec<Vec<f32>>,
     /// Per pixel, the lighting computations of every pass (None where not countable).
     pub counts: Option<Vec<u32>>,
+    /// Per pixel, the ideal of [`FrameStats::ideal_lighting_computations`]: the lights
+    /// reaching its visible sample (averaged over its samples with MSAA) and each
+    /// transparent fragment in front of it.
+    pub ideal_counts: Vec<f32>,
     /// The frame's camera and size.
     pub setup: ViewSetup,
 }
@@ -251,11 +255,23 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let planes: Vec<&[f32]> = depth_samples.iter().map(Vec::as_slice).collect();
     let bounds = cell_bounds_cpu_samples(&setup, &ideal_dims, &planes);
     let bounded = assign_cpu(&setup, &ideal_dims, lights, DepthRange::Cells(&bounds));
-    let ideal_transparent = ideal_fragment_computations(&setup, &bounded, lights, &fragments);
-    let ideal_opaque: u64 = distances
-        .iter()
-        .map(|d| ideal_lighting_computations(&setup, &bounded, lights, d))
-        .sum();
+    let fragment_ideal = ideal_fragment_counts(&setup, &bounded, lights, &fragments);
+    let ideal_transparent: u64 = fragment_ideal.iter().map(|&n| u64::from(n)).sum();
+    // Per pixel: the opaque ideal averaged over the samples, plus the transparent fragments'.
+    let mut ideal_counts = vec![0f32; (width * height) as usize];
+    let mut ideal_opaque = 0u64;
+    for d in &distances {
+        for (acc, n) in ideal_counts
+            .iter_mut()
+            .zip(ideal_pixel_counts(&setup, &bounded, lights, d))
+        {
+            ideal_opaque += u64::from(n);
+            *acc += n as f32 / samples as f32;
+        }
+    }
+    for (f, &n) in fragments.iter().zip(&fragment_ideal) {
+        ideal_counts[(f.y * width + f.x) as usize] += n as f32;
+    }
     let ideal = (ideal_opaque + samples / 2) / samples + ideal_transparent;
 
     let passes = a.finished.passes;
@@ -344,6 +360,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         depth,
         depth_samples,
         counts,
+        ideal_counts,
         setup,
     })
 }

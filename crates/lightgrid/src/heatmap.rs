@@ -9,7 +9,7 @@ use crate::culling::LightGrid;
 use image::{Rgba, RgbaImage};
 
 /// Blue → green → red ramp over t in [0, 1].
-fn ramp(t: f32) -> [f32; 3] {
+pub fn ramp(t: f32) -> [f32; 3] {
     let t = t.clamp(0.0, 1.0);
     if t < 0.5 {
         let u = t * 2.0;
@@ -66,42 +66,14 @@ pub fn heatmap(frame: &RgbaImage, grid: &LightGrid, view_distance: Option<&[f32]
     let (w, h) = frame.dimensions();
     let scale = (w / 320).max(1);
     let legend_h = 14 * scale;
-    let tile_max = grid.tile_max_counts();
-    let dims = grid.dims;
-    let count_at = |x: u32, y: u32| match view_distance {
-        Some(vd) if dims.slices > 1 => {
-            let d = vd[(y * w + x) as usize];
-            if d.is_finite() {
-                grid.cells[dims.cell_of(x, y, d)][1]
-            } else {
-                tile_max[dims.tile_of(x, y)]
-            }
-        }
-        _ => tile_max[dims.tile_of(x, y)],
-    };
-    let counts: Vec<u32> = frame
-        .enumerate_pixels()
-        .map(|(x, y, _)| count_at(x, y))
-        .collect();
+    let counts = cell_counts(grid, view_distance);
     let max = counts.iter().copied().max().unwrap_or(0).max(1);
+    let tinted = tint(frame, &counts, max, grid.dims.tile_size);
     // The legend needs room for its bar and two numbers: frames narrower than that get a
     // black margin on the right instead of a legend drawn off the image.
     let out_w = w.max(LEGEND_MIN_WIDTH * scale);
     let mut out = RgbaImage::from_pixel(out_w, h + legend_h, Rgba([0, 0, 0, 255]));
-    for (x, y, p) in frame.enumerate_pixels() {
-        let count = counts[(y * w + x) as usize];
-        let c = ramp(count as f32 / max as f32);
-        let luma = (0.2 * p[0] as f32 + 0.6 * p[1] as f32 + 0.2 * p[2] as f32) / 255.0;
-        let px = |i: usize| ((0.55 * c[i] + 0.45 * luma) * 255.0) as u8;
-        let on_edge = x % grid.dims.tile_size == 0 || y % grid.dims.tile_size == 0;
-        let v = if count == 0 {
-            [(luma * 90.0) as u8; 3]
-        } else {
-            [px(0), px(1), px(2)]
-        };
-        let v = if on_edge { v.map(|c| c / 2) } else { v };
-        out.put_pixel(x, y, Rgba([v[0], v[1], v[2], 255]));
-    }
+    image::imageops::replace(&mut out, &tinted, 0, 0);
     // Legend: the ramp from 0 to max lights per tile, labelled at both ends.
     let (bar_x0, bar_x1) = (
         14 * scale,
@@ -124,5 +96,52 @@ pub fn heatmap(frame: &RgbaImage, grid: &LightGrid, view_distance: Option<&[f32]
     }
     draw_number(&mut out, 2 * scale, h + 3 * scale, 0, scale);
     draw_number(&mut out, bar_x1 + 3 * scale, h + 3 * scale, max, scale);
+    out
+}
+
+/// Per pixel (row-major), the light count of the cell it reads: its tile's fullest list, or for
+/// a clustered grid with `view_distance` the cluster of its visible sample (the tile's fullest
+/// where it has none).
+pub fn cell_counts(grid: &LightGrid, view_distance: Option<&[f32]>) -> Vec<u32> {
+    let dims = grid.dims;
+    let tile_max = grid.tile_max_counts();
+    let (w, h) = (dims.width, dims.height);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| match view_distance {
+            Some(vd) if dims.slices > 1 => {
+                let d = vd[(y * w + x) as usize];
+                if d.is_finite() {
+                    grid.cells[dims.cell_of(x, y, d)][1]
+                } else {
+                    tile_max[dims.tile_of(x, y)]
+                }
+            }
+            _ => tile_max[dims.tile_of(x, y)],
+        })
+        .collect()
+}
+
+/// `frame` dimmed and tinted per pixel by `values[i] / max` on [`ramp`]; zero values stay
+/// dark grey, and the tile grid (`tile_size`; 0 for none) is drawn at half brightness.
+pub fn tint(frame: &RgbaImage, values: &[u32], max: u32, tile_size: u32) -> RgbaImage {
+    let (w, h) = frame.dimensions();
+    let max = max.max(1);
+    let mut out = RgbaImage::new(w, h);
+    for (x, y, p) in frame.enumerate_pixels() {
+        let value = values[(y * w + x) as usize];
+        let c = ramp(value as f32 / max as f32);
+        let luma = (0.2 * p[0] as f32 + 0.6 * p[1] as f32 + 0.2 * p[2] as f32) / 255.0;
+        let px = |i: usize| ((0.55 * c[i] + 0.45 * luma) * 255.0) as u8;
+        let on_edge = tile_size > 0 && (x % tile_size == 0 || y % tile_size == 0);
+        let v = if value == 0 {
+            [(luma * 90.0) as u8; 3]
+        } else {
+            [px(0), px(1), px(2)]
+        };
+        let v = if on_edge { v.map(|c| c / 2) } else { v };
+        out.put_pixel(x, y, Rgba([v[0], v[1], v[2], 255]));
+    }
+    debug_assert_eq!(out.dimensions(), (w, h));
     out
 }

@@ -7,6 +7,7 @@
 pub mod analysis;
 pub mod consts;
 pub mod culling;
+pub mod debug_view;
 pub mod error;
 pub mod frame;
 pub mod gpu;

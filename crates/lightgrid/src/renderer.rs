@@ -266,6 +266,13 @@ impl<'c> Renderer<'c> {
         self.settings
     }
 
+    /// The display target (tone-mapped sRGB, `passes::LDR_FORMAT`) the last submitted frame
+    /// writes: what a window shows. Sampling it after [`Renderer::render_frame`] on the same
+    /// queue reads that frame.
+    pub fn display_view(&self) -> &wgpu::TextureView {
+        &self.targets.ldr
+    }
+
     fn prepare_technique(&mut self, info: &'static pipelines::PipelineInfo) -> Result<()> {
         if let (true, pipelines::Msaa::Refused(reason)) = (self.settings.msaa > 1, info.msaa) {
             return Err(Error::invalid(

@@ -30,8 +30,8 @@ pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, GridLists, LightGrid};
 pub use oracle::{
-    ideal_fragment_computations, ideal_lighting_computations, oracle_fragment_lights,
-    oracle_tile_lights,
+    ideal_fragment_computations, ideal_fragment_counts, ideal_lighting_computations,
+    ideal_pixel_counts, oracle_fragment_lights, oracle_tile_lights,
 };
 pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
 pub use spot_ray::{ray_test_count, RayTestCount};

@@ -68,27 +68,41 @@ pub fn ideal_lighting_computations(
     lights: &[Light],
     view_distance: &[f32],
 ) -> u64 {
+    ideal_pixel_counts(setup, grid, lights, view_distance)
+        .iter()
+        .map(|&n| u64::from(n))
+        .sum()
+}
+
+/// [`ideal_lighting_computations`] per pixel (row-major; 0 where there is no sample): the
+/// viewer's wasted-work view subtracts it from the pipeline's counts.
+pub fn ideal_pixel_counts(
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[Light],
+    view_distance: &[f32],
+) -> Vec<u32> {
     let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
     let dims = grid.dims;
-    (0..dims.height)
-        .into_par_iter()
-        .map(|y| {
-            let mut n = 0u64;
-            for x in 0..dims.width {
+    let mut out = vec![0u32; (dims.width * dims.height) as usize];
+    out.par_chunks_mut(dims.width as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let y = y as u32;
+            for (x, n) in (0..dims.width).zip(row.iter_mut()) {
                 let w = view_distance[(y * dims.width + x) as usize];
                 if !w.is_finite() {
                     continue;
                 }
                 let p = setup.sample_position(x, y, w);
-                for &l in grid.cell(dims.cell_of(x, y, w)) {
-                    if view_lights[l as usize].reaches(p) {
-                        n += 1;
-                    }
-                }
+                *n = grid
+                    .cell(dims.cell_of(x, y, w))
+                    .iter()
+                    .filter(|&&l| view_lights[l as usize].reaches(p))
+                    .count() as u32;
             }
-            n
-        })
-        .sum()
+        });
+    out
 }
 
 /// For every cell, the lights reaching at least one of the transparent fragments that read it
@@ -121,6 +135,19 @@ pub fn ideal_fragment_computations(
     lights: &[Light],
     fragments: &[Fragment],
 ) -> u64 {
+    ideal_fragment_counts(setup, grid, lights, fragments)
+        .iter()
+        .map(|&n| u64::from(n))
+        .sum()
+}
+
+/// [`ideal_fragment_computations`] per fragment, in the order of `fragments`.
+pub fn ideal_fragment_counts(
+    setup: &ViewSetup,
+    grid: &LightGrid,
+    lights: &[Light],
+    fragments: &[Fragment],
+) -> Vec<u32> {
     let view_lights: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
     let dims = grid.dims;
     fragments
@@ -130,7 +157,7 @@ pub fn ideal_fragment_computations(
             grid.cell(dims.transparent_cell_of(f.x, f.y, f.w))
                 .iter()
                 .filter(|&&l| view_lights[l as usize].reaches(p))
-                .count() as u64
+                .count() as u32
         })
-        .sum()
+        .collect()
 }

@@ -196,11 +196,12 @@ impl Targets {
             COUNT_FORMAT,
             U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::COPY_SRC,
         );
-        // COPY_DST: the MSAA kernels' in-kernel resolve copies its colours in.
+        // COPY_DST: the MSAA kernels' in-kernel resolve copies its colours in;
+        // TEXTURE_BINDING: the viewer draws it onto its window.
         let ldr_texture = make(
             "ldr",
             LDR_FORMAT,
-            U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST,
+            U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST | U::TEXTURE_BINDING,
         );
         let pixel_counts = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pixel lighting counts"),

@@ -12,6 +12,8 @@ use crate::error::{Error, Result};
 
 /// A device ready to render, with what was learnt about its adapter.
 pub struct GpuContext {
+    /// The instance the adapter came from (a window's surface is created from it).
+    pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
@@ -41,8 +43,15 @@ const NO_ADAPTER_HELP: &str = "no GPU adapter found. lightgrid needs a Vulkan, M
 adapter (GL cannot run its render targets); on a machine without a GPU install Mesa's software Vulkan driver: \
 `sudo apt-get install -y mesa-vulkan-drivers libvulkan1` (Debian/Ubuntu)";
 
-fn instance() -> wgpu::Instance {
-    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+/// A display handle for the instance: a window system's display (the viewer's), or none for
+/// headless rendering.
+pub type Display = Box<dyn wgpu::wgt::WgpuHasDisplayHandle>;
+
+fn instance(display: Option<Display>) -> wgpu::Instance {
+    wgpu::Instance::new(match display {
+        Some(d) => wgpu::InstanceDescriptor::new_with_display_handle_from_env(d),
+        None => wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
+    })
 }
 
 fn rank(info: &wgpu::AdapterInfo) -> u32 {
@@ -75,7 +84,7 @@ fn summarize(index: usize, info: &wgpu::AdapterInfo) -> AdapterSummary {
 
 /// Every adapter wgpu sees, in preference order (index 0 is the default choice).
 pub fn list_adapters() -> Vec<AdapterSummary> {
-    sorted_adapters(&instance())
+    sorted_adapters(&instance(None))
         .iter()
         .enumerate()
         .map(|(i, a)| summarize(i, &a.get_info()))
@@ -95,7 +104,13 @@ fn matches(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
 impl GpuContext {
     /// Pick an adapter (the best one, or the one `wanted` names) and create a device on it.
     pub fn new(wanted: Option<&str>) -> Result<Self> {
-        let instance = instance();
+        Self::with_display(None, wanted)
+    }
+
+    /// [`GpuContext::new`] on an instance that knows a window system's `display`, so that
+    /// surfaces of its windows can be created ([`GpuContext::instance`]).
+    pub fn with_display(display: Option<Display>, wanted: Option<&str>) -> Result<Self> {
+        let instance = instance(display);
         let adapters = sorted_adapters(&instance);
         if adapters.is_empty() {
             return Err(Error::NoAdapter(NO_ADAPTER_HELP.to_string()));
@@ -136,10 +151,10 @@ impl GpuContext {
             }
         }
         .expect("checked above");
-        Self::from_adapter(adapter)
+        Self::from_adapter(instance, adapter)
     }
 
-    fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+    fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut features = wgpu::Features::empty();
@@ -178,6 +193,7 @@ impl GpuContext {
             eprintln!("lightgrid: uncaptured GPU error: {e}");
         }));
         Ok(Self {
+            instance,
             adapter,
             device,
             queue,

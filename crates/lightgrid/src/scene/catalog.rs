@@ -31,7 +31,7 @@ pub const STRESS_DEFAULT_LIGHTS: u32 = 10_000;
 pub const STRESS_MAX_LIGHTS: u32 = 1_000_000;
 
 /// What the user can vary when building a catalog scene.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneParams {
     pub seed: u64,
     /// Light count; only scenes with `variable_lights` accept it.

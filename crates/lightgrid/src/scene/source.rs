@@ -25,7 +25,7 @@ pub const ADDED_LIGHT_INTENSITY: f32 = 0.5;
 pub const ADDED_LIGHT_COVERAGE: f32 = 8.0;
 
 /// A scene to open: a catalog name or a `.gltf`/`.glb` path, with the options.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SceneRequest {
     pub spec: String,
     pub params: SceneParams,

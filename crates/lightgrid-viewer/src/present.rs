@@ -1,0 +1,265 @@
+//! Putting a frame on the window: the renderer's display target (or a debug view's image)
+//! drawn over the whole surface by one full-screen triangle, then the panel. The same drawing
+//! into an offscreen texture of the surface's format gives the screenshot of exactly what the
+//! window shows.
+
+use anyhow::{Context, Result};
+
+const BLIT_WGSL: &str = r#"
+override ENCODE_SRGB: bool = false;
+
+@group(0) @binding(0) var source: texture_2d<f32>;
+
+struct VsOut { @builtin(position) pos: vec4<f32> };
+
+@vertex
+fn vs(@builtin(vertex_index) i: u32) -> VsOut {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return VsOut(vec4<f32>(uv * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0), 0.0, 1.0));
+}
+
+fn encode(c: f32) -> f32 {
+    if c <= 0.0031308 { return c * 12.92; }
+    return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+
+@fragment
+fn fs(v: VsOut) -> @location(0) vec4<f32> {
+    // One texel per pixel: the source has the surface's size (a resize recreates both).
+    let dims = vec2<i32>(textureDimensions(source));
+    let p = min(vec2<i32>(v.pos.xy), dims - vec2<i32>(1));
+    let c = textureLoad(source, p, 0);
+    if ENCODE_SRGB {
+        return vec4<f32>(encode(c.r), encode(c.g), encode(c.b), 1.0);
+    }
+    return vec4<f32>(c.rgb, 1.0);
+}
+"#;
+
+/// The full-screen copy of an sRGB source onto a surface of `format`.
+pub struct Blit {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    pub format: wgpu::TextureFormat,
+}
+
+impl Blit {
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Blit {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("viewer blit"),
+            source: wgpu::ShaderSource::Wgsl(BLIT_WGSL.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("viewer blit"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("viewer blit"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        // An sRGB surface encodes on write; a linear one gets the encoding from the shader,
+        // so both show the display target's bytes.
+        let constants = [("ENCODE_SRGB", if format.is_srgb() { 0.0 } else { 1.0 })];
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("viewer blit"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                targets: &[Some(format.into())],
+            }),
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        Blit {
+            pipeline,
+            layout,
+            format,
+        }
+    }
+
+    /// Record the copy of `source` onto `target` (cleared first).
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::TextureView,
+        target: &wgpu::TextureView,
+    ) {
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("viewer blit"),
+            layout: &self.layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(source),
+            }],
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("viewer blit"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// A texture of the display format (`LDR_FORMAT`) holding a CPU image: a debug view.
+pub fn upload_image(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    image: &image::RgbaImage,
+) -> wgpu::TextureView {
+    let (width, height) = image.dimensions();
+    let size = wgpu::Extent3d {
+        width,
+        height,
+        depth_or_array_layers: 1,
+    };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("debug view"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: lightgrid::passes::LDR_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        image.as_raw(),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(4 * width),
+            rows_per_image: Some(height),
+        },
+        size,
+    );
+    texture.create_view(&Default::default())
+}
+
+/// An offscreen target of the surface's format the screenshot is drawn into.
+pub struct Capture {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+    width: u32,
+    height: u32,
+}
+
+impl Capture {
+    pub fn new(
+        device: &wgpu::Device,
+        format: wgpu::TextureFormat,
+        (width, height): (u32, u32),
+    ) -> Capture {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("screenshot"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Capture {
+            texture,
+            view,
+            width,
+            height,
+        }
+    }
+
+    /// Wait for what was drawn and return it as RGBA (BGRA surfaces swizzled).
+    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<image::RgbaImage> {
+        let row = (4 * self.width).div_ceil(256) * 256;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("screenshot"),
+            size: u64::from(row) * u64::from(self.height),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            self.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit([encoder.finish()]);
+        let bytes =
+            lightgrid::gpu::read_buffer(device, &buffer).context("reading the screenshot back")?;
+        let bgra = matches!(
+            self.texture.format(),
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        );
+        let mut out = Vec::with_capacity((4 * self.width * self.height) as usize);
+        for y in 0..self.height as usize {
+            let line = &bytes[y * row as usize..][..4 * self.width as usize];
+            for px in line.chunks_exact(4) {
+                if bgra {
+                    out.extend_from_slice(&[px[2], px[1], px[0], 255]);
+                } else {
+                    out.extend_from_slice(&[px[0], px[1], px[2], 255]);
+                }
+            }
+        }
+        Ok(image::RgbaImage::from_raw(self.width, self.height, out).expect("size matches"))
+    }
+}

@@ -1,0 +1,154 @@
+//! Scripted sessions (`lightgrid view --script`): steps run at displayed-frame numbers, so a
+//! test or a demo can switch pipelines, resize the window, change the view and take
+//! screenshots without a person at the keyboard.
+//!
+//! Syntax: steps separated by `;`, each `at N ACTION` (N: the displayed frame, from 0) or a bare
+//! `ACTION` (frame 0). Actions:
+//! `pipeline ID`, `tile N`, `msaa N`, `view shaded|lights|bounds|wasted`, `resize WxH`,
+//! `frame F` (jump the animation), `pause`, `play`, `panel on|off`, `screenshot FILE.png`.
+
+use lightgrid::debug_view::DebugView;
+use std::path::PathBuf;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    Pipeline(String),
+    Tile(u32),
+    Msaa(u32),
+    View(DebugView),
+    Resize(u32, u32),
+    Frame(u32),
+    Pause,
+    Play,
+    Panel(bool),
+    Screenshot(PathBuf),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    pub at: u32,
+    pub action: Action,
+}
+
+fn number(word: Option<&str>, what: &str, step: &str) -> Result<u32, String> {
+    let w = word.ok_or_else(|| format!("'{step}': {what} needs a number"))?;
+    w.parse::<u32>()
+        .map_err(|_| format!("'{step}': '{w}' is not a whole number ({what})"))
+}
+
+/// Parse a script; steps come back in frame order (steps of one frame in their written order).
+pub fn parse(script: &str) -> Result<Vec<Step>, String> {
+    let mut steps = Vec::new();
+    for raw in script.split(';') {
+        let step = raw.trim();
+        if step.is_empty() {
+            continue;
+        }
+        let mut words = step.split_whitespace().peekable();
+        let mut at = 0;
+        if words.peek() == Some(&"at") {
+            words.next();
+            at = number(words.next(), "at", step)?;
+        }
+        let verb = words
+            .next()
+            .ok_or_else(|| format!("'{step}': an action is missing after 'at {at}'"))?;
+        let arg = words.next();
+        let action = match verb {
+            "pipeline" => Action::Pipeline(
+                arg.ok_or_else(|| format!("'{step}': pipeline needs an id"))?
+                    .to_string(),
+            ),
+            "tile" => Action::Tile(number(arg, "tile", step)?),
+            "msaa" => Action::Msaa(number(arg, "msaa", step)?),
+            "view" => Action::View(arg.and_then(DebugView::parse).ok_or_else(|| {
+                format!("'{step}': view is one of shaded, lights, bounds, wasted")
+            })?),
+            "resize" => {
+                let a = arg.ok_or_else(|| format!("'{step}': resize needs WIDTHxHEIGHT"))?;
+                let (w, h) = a
+                    .split_once(['x', 'X'])
+                    .ok_or_else(|| format!("'{step}': '{a}' is not WIDTHxHEIGHT"))?;
+                let w = number(Some(w), "resize width", step)?;
+                let h = number(Some(h), "resize height", step)?;
+                if w == 0 || h == 0 {
+                    return Err(format!("'{step}': both edges must be at least 1"));
+                }
+                if w > lightgrid::consts::MAX_FRAME_EDGE || h > lightgrid::consts::MAX_FRAME_EDGE {
+                    return Err(format!(
+                        "'{step}': edges above {} are not supported",
+                        lightgrid::consts::MAX_FRAME_EDGE
+                    ));
+                }
+                Action::Resize(w, h)
+            }
+            "frame" => Action::Frame(number(arg, "frame", step)?),
+            "pause" => Action::Pause,
+            "play" => Action::Play,
+            "panel" => match arg {
+                Some("on") => Action::Panel(true),
+                Some("off") => Action::Panel(false),
+                _ => return Err(format!("'{step}': panel is on or off")),
+            },
+            "screenshot" => {
+                let p = arg.ok_or_else(|| format!("'{step}': screenshot needs a file"))?;
+                Action::Screenshot(PathBuf::from(p))
+            }
+            other => return Err(format!("'{step}': unknown action '{other}'")),
+        };
+        let takes_arg = !matches!(action, Action::Pause | Action::Play);
+        if words.next().is_some() || (!takes_arg && arg.is_some()) {
+            return Err(format!("'{step}': too many words"));
+        }
+        steps.push(Step { at, action });
+    }
+    steps.sort_by_key(|s| s.at);
+    Ok(steps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_every_action_in_frame_order() {
+        let s = parse(
+            "frame 40; pause; at 9 view heatmap; at 3 pipeline tiled_deferred; at 6 resize 300x200; at 9 screenshot a.png; at 12 panel off; tile 32; msaa 4; play",
+        )
+        .unwrap();
+        let at: Vec<u32> = s.iter().map(|s| s.at).collect();
+        assert_eq!(at, vec![0, 0, 0, 0, 0, 3, 6, 9, 9, 12]);
+        assert_eq!(s[0].action, Action::Frame(40));
+        assert_eq!(s[5].action, Action::Pipeline("tiled_deferred".into()));
+        assert_eq!(s[6].action, Action::Resize(300, 200));
+        assert_eq!(s[7].action, Action::View(DebugView::LightsPerCell));
+        assert_eq!(s[8].action, Action::Screenshot("a.png".into()));
+        assert_eq!(s[9].action, Action::Panel(false));
+    }
+
+    #[test]
+    fn refuses_what_it_cannot_run() {
+        for bad in [
+            "at",
+            "at x pause",
+            "at 3",
+            "fly away",
+            "tile",
+            "tile -4",
+            "tile NaN",
+            "resize 300",
+            "resize 0x",
+            "resize 0x10",
+            "resize 99999x10",
+            "view sideways",
+            "panel maybe",
+            "pause now",
+            "pipeline",
+            "screenshot",
+            "frame 1 2",
+        ] {
+            assert!(parse(bad).is_err(), "{bad} parsed");
+        }
+        assert_eq!(parse(" ; ;").unwrap(), vec![]);
+    }
+}
