@@ -5,17 +5,16 @@
 
 use anyhow::{Context, Result};
 
+use lightgrid::passes::{draw_fullscreen, fullscreen_pipeline, texture_entry, FullscreenDesc};
+
 const BLIT_WGSL: &str = r#"
 override ENCODE_SRGB: bool = false;
 
 @group(0) @binding(0) var source: texture_2d<f32>;
 
-struct VsOut { @builtin(position) pos: vec4<f32> };
-
 @vertex
-fn vs(@builtin(vertex_index) i: u32) -> VsOut {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return VsOut(vec4<f32>(uv * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0), 0.0, 1.0));
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    return fullscreen_position(i);
 }
 
 fn encode(c: f32) -> f32 {
@@ -24,10 +23,10 @@ fn encode(c: f32) -> f32 {
 }
 
 @fragment
-fn fs(v: VsOut) -> @location(0) vec4<f32> {
+fn fs_blit(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     // One texel per pixel: the source has the surface's size (a resize recreates both).
     let dims = vec2<i32>(textureDimensions(source));
-    let p = min(vec2<i32>(v.pos.xy), dims - vec2<i32>(1));
+    let p = min(vec2<i32>(pos.xy), dims - vec2<i32>(1));
     let c = textureLoad(source, p, 0);
     if ENCODE_SRGB {
         return vec4<f32>(encode(c.r), encode(c.g), encode(c.b), 1.0);
@@ -45,55 +44,32 @@ pub struct Blit {
 
 impl Blit {
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Blit {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("viewer blit"),
-            source: wgpu::ShaderSource::Wgsl(BLIT_WGSL.into()),
-        });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("viewer blit"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("viewer blit"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
+            entries: &[texture_entry(
+                0,
+                wgpu::TextureSampleType::Float { filterable: false },
+            )],
         });
         // An sRGB surface encodes on write; a linear one gets the encoding from the shader,
         // so both show the display target's bytes.
         let constants = [("ENCODE_SRGB", if format.is_srgb() { 0.0 } else { 1.0 })];
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("viewer blit"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
+        let shader = lightgrid::shader::compose(
+            "viewer blit",
+            &[lightgrid::passes::FULLSCREEN_WGSL, BLIT_WGSL],
+        );
+        let pipeline = fullscreen_pipeline(
+            device,
+            &FullscreenDesc {
+                label: "viewer blit",
+                shader: &shader,
+                fragment_entry: "fs_blit",
+                layout: &layout,
+                target: format,
+                samples: 1,
+                constants: &constants,
             },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                targets: &[Some(format.into())],
-            }),
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         Blit {
             pipeline,
             layout,
@@ -109,33 +85,15 @@ impl Blit {
         source: &wgpu::TextureView,
         target: &wgpu::TextureView,
     ) {
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("viewer blit"),
-            layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(source),
-            }],
-        });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("viewer blit"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.draw(0..3, 0..1);
+        draw_fullscreen(
+            device,
+            encoder,
+            "viewer blit",
+            (&self.pipeline, &self.layout),
+            source,
+            target,
+            None,
+        );
     }
 }
 

@@ -33,7 +33,7 @@ pub fn shaders() -> Vec<ComposedShader> {
 pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
 
 /// What a full-screen pass (`vs_fullscreen` + one fragment entry, no depth) draws with.
-pub(crate) struct FullscreenDesc<'a> {
+pub struct FullscreenDesc<'a> {
     pub label: &'a str,
     pub shader: &'a ComposedShader,
     pub fragment_entry: &'a str,
@@ -45,11 +45,8 @@ pub(crate) struct FullscreenDesc<'a> {
     pub constants: &'a [(&'a str, f64)],
 }
 
-/// A full-screen triangle pipeline (tonemap, the MSAA sample expand).
-pub(crate) fn fullscreen_pipeline(
-    device: &wgpu::Device,
-    d: &FullscreenDesc,
-) -> wgpu::RenderPipeline {
+/// A full-screen triangle pipeline (tonemap, the MSAA sample expand, the viewer's blit).
+pub fn fullscreen_pipeline(device: &wgpu::Device, d: &FullscreenDesc) -> wgpu::RenderPipeline {
     let module = crate::shader::create_module(device, d.shader);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(d.label),
@@ -83,6 +80,47 @@ pub(crate) fn fullscreen_pipeline(
         multiview_mask: None,
         cache: None,
     })
+}
+
+/// Record a full-screen pass of `pipeline` (a [`fullscreen_pipeline`] whose group 0 is one
+/// texture, `layout`) reading `source` into `out`, cleared to black first.
+#[allow(clippy::too_many_arguments)]
+pub fn draw_fullscreen(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    (pipeline, layout): (&wgpu::RenderPipeline, &wgpu::BindGroupLayout),
+    source: &wgpu::TextureView,
+    out: &wgpu::TextureView,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) {
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::TextureView(source),
+        }],
+    });
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: out,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &bind, &[]);
+    pass.draw(0..3, 0..1);
 }
 
 /// WGSL of a deferred compute pass's outputs (group 3).
