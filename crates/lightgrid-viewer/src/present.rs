@@ -5,7 +5,9 @@
 
 use anyhow::{Context, Result};
 
-use lightgrid::passes::{draw_fullscreen, fullscreen_pipeline, texture_entry, FullscreenDesc};
+use lightgrid::passes::{
+    draw_fullscreen, fullscreen_pipeline, texture_entry, FullscreenDesc, Readback,
+};
 
 const BLIT_WGSL: &str = r#"
 override ENCODE_SRGB: bool = false;
@@ -176,47 +178,22 @@ impl Capture {
 
     /// Wait for what was drawn and return it as RGBA (BGRA surfaces swizzled).
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<image::RgbaImage> {
-        let row = (4 * self.width).div_ceil(256) * 256;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("screenshot"),
-            size: u64::from(row) * u64::from(self.height),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let readback = Readback::new(device, "screenshot", self.width, self.height);
         let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            self.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(self.height),
-                },
-            },
-            wgpu::Extent3d {
-                width: self.width,
-                height: self.height,
-                depth_or_array_layers: 1,
-            },
-        );
+        readback.encode(&mut encoder, &self.texture, wgpu::TextureAspect::All);
         queue.submit([encoder.finish()]);
-        let bytes =
-            lightgrid::gpu::read_buffer(device, &buffer).context("reading the screenshot back")?;
+        let mut out = readback
+            .read(device)
+            .context("reading the screenshot back")?;
         let bgra = matches!(
             self.texture.format(),
             wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
         );
-        let mut out = Vec::with_capacity((4 * self.width * self.height) as usize);
-        for y in 0..self.height as usize {
-            let line = &bytes[y * row as usize..][..4 * self.width as usize];
-            for px in line.chunks_exact(4) {
-                if bgra {
-                    out.extend_from_slice(&[px[2], px[1], px[0], 255]);
-                } else {
-                    out.extend_from_slice(&[px[0], px[1], px[2], 255]);
-                }
+        for px in out.chunks_exact_mut(4) {
+            if bgra {
+                px.swap(0, 2);
             }
+            px[3] = 255;
         }
         Ok(image::RgbaImage::from_raw(self.width, self.height, out).expect("size matches"))
     }
