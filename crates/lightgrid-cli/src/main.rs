@@ -14,6 +14,7 @@ mod memory;
 mod play;
 mod render;
 mod scaling;
+mod view;
 
 use args::{RendererArgs, SceneArgs, Size};
 use clap::{Parser, Subcommand};
@@ -58,6 +59,9 @@ enum Command {
     /// Write a scene at one frame as a glTF 2.0 binary (.glb): geometry, materials,
     /// KHR_lights_punctual lights with their ranges, and the camera.
     Export(export::ExportArgs),
+    /// Open the interactive viewer: fly through a scene, switch pipelines and settings live,
+    /// see lights per cell, cell depth bounds and wasted work, frame and GPU times.
+    View(view::ViewArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -108,6 +112,7 @@ fn main() {
         Some(Command::Scaling(a)) => scaling::scaling(cli.adapter.as_deref(), &a),
         Some(Command::Play(a)) => play::play(cli.adapter.as_deref(), &a),
         Some(Command::Export(a)) => export::export(&a),
+        Some(Command::View(a)) => view::view(cli.adapter.as_deref(), &a),
         Some(Command::List) => list::list(),
     };
     if let Err(e) = result {
