@@ -463,6 +463,12 @@ pub(crate) struct SceneArgs {
     pub(crate) warmup: u32,
 }
 
+/// `--view`: a debug view's name.
+pub(crate) fn parse_view(s: &str) -> Result<lightgrid::debug_view::DebugView, String> {
+    lightgrid::debug_view::DebugView::parse(s)
+        .ok_or_else(|| format!("'{s}': one of shaded, lights, bounds, wasted"))
+}
+
 pub(crate) fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
     match s {
         "16" => Ok(GBufferFormat::F16),

@@ -5,6 +5,7 @@ use crate::args::{check_applies, timing_label, SceneArgs, Size};
 use crate::files::{Files, Kind};
 use anyhow::Result;
 use clap::Args;
+use lightgrid::debug_view::{self, DebugView};
 use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::{encode_png, write_atomic};
 use lightgrid::pipelines::{self, REFERENCE};
@@ -21,6 +22,11 @@ pub(crate) struct RenderArgs {
     /// Image to write (a *.png file).
     #[arg(long)]
     pub(crate) out: Option<PathBuf>,
+    /// What --out shows: the shaded frame, or a debug view of it (the viewer's): lights
+    /// (lights per cell), bounds (cell depth-bound spans) or wasted (lighting computations
+    /// above the ideal, per pixel).
+    #[arg(long, default_value = "shaded", value_parser = crate::args::parse_view)]
+    pub(crate) view: DebugView,
     /// Statistics to write (JSON).
     #[arg(long)]
     pub(crate) stats: Option<PathBuf>,
@@ -50,7 +56,20 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     // Every output is made before any is written, so a failure leaves all of them untouched.
     let mut writes: Vec<(&PathBuf, Vec<u8>)> = Vec::new();
     if let Some(path) = &a.out {
-        writes.push((path, encode_png(&out.image, path)?));
+        match debug_view::draw(a.view, &out) {
+            None => writes.push((path, encode_png(&out.image, path)?)),
+            Some(d) => {
+                println!(
+                    "{}: 0 to {} {}{}{}",
+                    a.view.name(),
+                    d.max,
+                    d.unit,
+                    d.total.map_or(String::new(), |t| format!(", {t} in all")),
+                    d.note.map_or(String::new(), |n| format!(" ({n})"))
+                );
+                writes.push((path, encode_png(&d.image, path)?));
+            }
+        }
     }
     if let Some(path) = &a.heatmap {
         let view_distance = out.view_distances();

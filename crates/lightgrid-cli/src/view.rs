@@ -7,16 +7,22 @@ use crate::files::{Files, Kind};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use lightgrid::debug_view::DebugView;
-use lightgrid::pipelines::{self, REFERENCE};
+use lightgrid::pipelines;
 use lightgrid_viewer::script::{self, Action, Step};
 use std::path::PathBuf;
+
+/// The pipeline the viewer opens with: tiled deferred shading (tiled-shading §2), the
+/// fastest on lavapipe at the catalog scenes' sizes (README, results).
+const DEFAULT_PIPELINE: &str = "tiled_deferred";
 
 #[derive(Args)]
 pub(crate) struct ViewArgs {
     #[command(flatten)]
     pub(crate) scene: SceneOptions,
-    /// Pipeline to start with (see `lightgrid list`; the panel and [ ] switch live).
-    #[arg(long, default_value = REFERENCE)]
+    /// Pipeline to start with (see `lightgrid list`; the panel and [ ] switch live). The
+    /// default is a culled one: `forward` loops every light per fragment, seconds per frame
+    /// on a software adapter.
+    #[arg(long, default_value = DEFAULT_PIPELINE)]
     pub(crate) pipeline: String,
     /// Window size WIDTHxHEIGHT in pixels (default: the scene's own size).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_size)]
@@ -29,7 +35,7 @@ pub(crate) struct ViewArgs {
     pub(crate) paused: bool,
     /// View to start with: shaded, lights (lights per cell), bounds (cell depth bounds) or
     /// wasted (lighting computations above the ideal, per pixel).
-    #[arg(long, default_value = "shaded", value_parser = parse_view)]
+    #[arg(long, default_value = "shaded", value_parser = crate::args::parse_view)]
     pub(crate) view: DebugView,
     /// A scripted session: steps `at N ACTION` separated by `;` (N: settled frames shown).
     /// Actions: pipeline ID, tile N, msaa N, view V, resize WxH, frame F, pause, play,
@@ -45,10 +51,6 @@ pub(crate) struct ViewArgs {
     pub(crate) screenshot: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) renderer: RendererArgs,
-}
-
-fn parse_view(s: &str) -> Result<DebugView, String> {
-    DebugView::parse(s).ok_or_else(|| format!("'{s}': one of shaded, lights, bounds, wasted"))
 }
 
 /// A script's steps, with what can be checked before a window opens checked.

@@ -86,6 +86,11 @@ pub struct ViewReport {
 /// Open the window and run until it is closed, `Esc` is pressed or `exit_after_frames`
 /// have been shown.
 pub fn run(opts: ViewOptions) -> Result<ViewReport> {
+    let opened = lightgrid::scene::open(&opts.request)?;
+    for w in &opened.warnings {
+        eprintln!("warning: {}: {w}", opts.request.spec);
+    }
+    opened.scene.check_frame(opts.frame)?;
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!(
             "cannot open a window: {e} (is a display available? set DISPLAY or WAYLAND_DISPLAY; \
@@ -102,11 +107,6 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
             *l = Some(format!("{reason:?}: {message}"));
         }
     });
-    let opened = lightgrid::scene::open(&opts.request)?;
-    for w in &opened.warnings {
-        eprintln!("warning: {}: {w}", opts.request.spec);
-    }
-    opened.scene.check_frame(opts.frame)?;
     let (jobs, job_rx) = mpsc::channel();
     let (done_tx, done) = mpsc::channel();
     let ctx = &ctx;
@@ -432,6 +432,8 @@ impl<'c> App<'c> {
                 Renderer::new(self.ctx, w, h, next.settings).map_err(|e| e.to_string())?;
         }
         self.applied = next;
+        // A script's or key's change is the panel's draft from now on too.
+        self.draft = self.applied.clone();
         self.generation += 1;
         self.figures.restart_times();
         if let Some(win) = &self.win {

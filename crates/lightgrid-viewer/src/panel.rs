@@ -209,6 +209,7 @@ fn scene(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
             added > 0,
             egui::Slider::new(&mut range, 0.0..=100.0)
                 .logarithmic(true)
+                .max_decimals(2)
                 .text("added range (0: default)"),
         )
         .changed();
@@ -228,10 +229,10 @@ fn animation(ui: &mut egui::Ui, info: &PanelInfo, actions: &mut Vec<PanelAction>
         {
             actions.push(PanelAction::TogglePause);
         }
-        if ui.button("◀").clicked() {
+        if ui.button("step -1").clicked() {
             actions.push(PanelAction::Step(-1));
         }
-        if ui.button("▶").clicked() {
+        if ui.button("step +1").clicked() {
             actions.push(PanelAction::Step(1));
         }
     });

@@ -1,0 +1,392 @@
+//! `lightgrid view` as a user runs it, in a real window on a virtual X display (Xvfb, which
+//! CI installs): scripted sessions switch pipelines, resize the window and toggle the debug
+//! views, and their screenshots must equal the headless renders of the same views. A test
+//! here fails (never passes) when the window cannot be made: Xvfb missing, no adapter able
+//! to present, or the viewer refusing to start.
+
+mod support;
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+use support::{assert_fails_with, lightgrid, stderr, temp_dir};
+
+/// A virtual X server on a display number it chose itself (`-displayfd`), so tests can run
+/// side by side and never use the developer's own display.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Xvfb {
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1280x1024x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| {
+                panic!(
+                    "the viewer tests need Xvfb (`apt-get install xvfb`; .ci/run installs it): {e}"
+                )
+            });
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .expect("Xvfb prints its display number");
+        let n: u32 = line
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("Xvfb gave no display number: {line:?}"));
+        Xvfb {
+            child,
+            display: format!(":{n}"),
+        }
+    }
+
+    /// Run `lightgrid` on this display; None when it was still running after `limit`.
+    fn run(&self, args: &[&str], limit: Duration) -> (Option<i32>, String) {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+            .args(args)
+            .env("DISPLAY", &self.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run lightgrid");
+        let mut err = child.stderr.take().unwrap();
+        let reader = std::thread::spawn(move || {
+            let mut s = String::new();
+            let _ = std::io::Read::read_to_string(&mut err, &mut s);
+            s
+        });
+        let start = Instant::now();
+        loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                return (status.code(), reader.join().unwrap());
+            }
+            if start.elapsed() > limit {
+                let _ = child.kill();
+                let _ = child.wait();
+                panic!(
+                    "{args:?} still running after {limit:?}:\n{}",
+                    reader.join().unwrap()
+                );
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn run_ok(&self, args: &[&str]) -> String {
+        let (code, err) = self.run(args, Duration::from_secs(600));
+        assert_eq!(code, Some(0), "{args:?} failed:\n{err}");
+        assert!(!err.contains("panicked"), "{args:?}:\n{err}");
+        err
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn load(path: &Path) -> image::RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
+}
+
+/// Largest channel difference per pixel: (mean, max) in 8-bit levels.
+fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
+    assert_eq!(a.dimensions(), b.dimensions(), "image sizes differ");
+    let mut sum = 0u64;
+    let mut max = 0u8;
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        let d = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap();
+        sum += u64::from(d);
+        max = max.max(d);
+    }
+    (sum as f64 / f64::from(a.width() * a.height()), max)
+}
+
+fn render(args: &[&str]) {
+    let o = lightgrid(args);
+    assert!(o.status.success(), "{args:?}:\n{}", stderr(&o));
+}
+
+/// The session: start on one pipeline, switch, resize to a size that is no multiple
+/// of the tile, show each debug view, back to shaded, hide the panel, leave with a
+/// screenshot. Every screenshot equals the headless render of its view.
+#[test]
+fn a_scripted_session_shows_what_the_headless_renderer_renders() {
+    let x = Xvfb::start();
+    let dir = temp_dir("view-session");
+    let shot = dir.join("shot.png");
+    let views = ["lights", "bounds", "wasted"];
+    let mut script =
+        String::from("frame 40; pause; at 2 pipeline tiled_deferred; at 4 resize 300x200");
+    for (i, v) in views.iter().enumerate() {
+        let at = 6 + 2 * i;
+        script += &format!(
+            "; at {at} view {v}; at {} screenshot {}",
+            at + 1,
+            dir.join(format!("window-{v}.png")).display()
+        );
+    }
+    script += "; at 12 view shaded; at 14 panel off";
+    let err = x.run_ok(&[
+        "view",
+        "--scene",
+        "robots-many",
+        "--pipeline",
+        "clustered_forward",
+        "--size",
+        "320x240",
+        "--script",
+        &script,
+        "--exit-after-frames",
+        "16",
+        "--screenshot",
+        shot.to_str().unwrap(),
+    ]);
+    assert!(err.contains("4 screenshot(s) written"), "{err}");
+    assert!(err.contains("0 had shader loops cut short"), "{err}");
+
+    let headless = |view: &str, extra: &[&str]| {
+        let out = dir.join(format!("render-{view}.png"));
+        let mut args = vec![
+            "render",
+            "--scene",
+            "robots-many",
+            "--pipeline",
+            "tiled_deferred",
+            "--frame",
+            "40",
+            "--size",
+            "300x200",
+            "--view",
+            view,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        render(&args);
+        load(&out)
+    };
+    let heatmap = dir.join("heatmap.png");
+    let reference = headless("shaded", &["--heatmap", heatmap.to_str().unwrap()]);
+    let shot = load(&shot);
+    assert_eq!(
+        shot.dimensions(),
+        (300, 200),
+        "the window's resize did not reach the frame"
+    );
+    // Tolerance: the blit decodes and re-encodes sRGB in floating point (one level at most);
+    // the frame itself is the same pipeline, frame and size.
+    let (mean, max) = difference(&shot, &reference);
+    assert!(
+        max <= 2 && mean < 0.05,
+        "screenshot vs render: mean {mean}, max {max}"
+    );
+    for v in views {
+        let window = load(&dir.join(format!("window-{v}.png")));
+        let (mean, max) = difference(&window, &headless(v, &[]));
+        assert!(
+            max <= 2 && mean < 0.05,
+            "{v}: window vs render --view: mean {mean}, max {max}"
+        );
+        let (mean, _) = difference(&window, &shot);
+        assert!(
+            mean > 5.0,
+            "the {v} view looks like the shaded frame (mean {mean})"
+        );
+    }
+    // The lights-per-cell view is the heatmap `render --heatmap` draws, without its legend.
+    let lights = load(&dir.join("window-lights.png"));
+    let heatmap = image::imageops::crop_imm(&load(&heatmap), 0, 0, 300, 200).to_image();
+    let (mean, max) = difference(&lights, &heatmap);
+    assert!(
+        max <= 2 && mean < 0.05,
+        "lights view vs heatmap: mean {mean}, max {max}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Every pipeline the registry has, flipped through live in one window at 1x, shows the
+/// image its reference renders (`forward`, or the one with the same approximations).
+#[test]
+fn flipping_through_every_pipeline_keeps_the_image() {
+    let x = Xvfb::start();
+    let dir = temp_dir("view-flip");
+    let ids: Vec<&str> = lightgrid::pipelines::PIPELINES
+        .iter()
+        .map(|p| p.id)
+        .collect();
+    let mut script = String::from("frame 120; pause");
+    for (i, id) in ids.iter().enumerate() {
+        let at = 1 + 2 * i;
+        script += &format!(
+            "; at {at} pipeline {id}; at {} screenshot {}",
+            at + 1,
+            dir.join(format!("{id}.png")).display()
+        );
+    }
+    let frames = (2 * ids.len() + 2).to_string();
+    x.run_ok(&[
+        "view",
+        "--scene",
+        "robots-few",
+        "--size",
+        "203x117",
+        "--tile",
+        "12",
+        "--script",
+        &script,
+        "--exit-after-frames",
+        &frames,
+    ]);
+    for p in lightgrid::pipelines::PIPELINES {
+        let reference = load(&dir.join(format!("{}.png", p.reference)));
+        assert_eq!(reference.dimensions(), (203, 117));
+        let id = p.id;
+        let (mean, max) = difference(&load(&dir.join(format!("{id}.png"))), &reference);
+        eprintln!("{id} vs {}: mean {mean:.4}, max {max}", p.reference);
+        // tests/pipelines.rs allows the G-buffer's 16-bit rounding and the light-volume
+        // meshes' tessellation a few levels; a missing light shows as tens of levels.
+        assert!(
+            mean < 0.6 && max <= 24,
+            "{id} vs forward: mean {mean}, max {max}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A failing step of a script ends the session with its reason, and nothing is written.
+#[test]
+fn a_script_step_that_cannot_run_fails_the_session() {
+    let x = Xvfb::start();
+    let dir = temp_dir("view-refused");
+    let shot = dir.join("never.png");
+    let (code, err) = x.run(
+        &[
+            "view",
+            "--scene",
+            "robots-few",
+            "--size",
+            "96x64",
+            "--pipeline",
+            "deferred",
+            "--script",
+            "pause; at 1 msaa 4",
+            "--exit-after-frames",
+            "4",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        Duration::from_secs(300),
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("does not render with MSAA"), "{err}");
+    assert!(!shot.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// No display: a clear error and a non-zero exit, never a pass.
+#[test]
+fn without_a_display_the_viewer_says_so() {
+    let o = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .args(["view", "--scene", "robots-few", "--exit-after-frames", "1"])
+        .env("DISPLAY", ":4095")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(err.contains("cannot open a window"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+/// What the command line can refuse before a window opens.
+#[test]
+fn bad_view_options_are_refused_before_a_window_opens() {
+    let dir = temp_dir("view-bad");
+    let d = dir.to_str().unwrap();
+    let shot = format!("{d}/a.png");
+    assert_fails_with(&["view", "--screenshot", &shot], "--exit-after-frames");
+    for n in ["0", "-1", "1001", "NaN", "abc"] {
+        assert_fails_with(&["view", "--exit-after-frames", n], "--exit-after-frames");
+    }
+    assert_fails_with(
+        &["view", "--exit-after-frames", "1", "--screenshot", d],
+        "--screenshot",
+    );
+    assert_fails_with(
+        &[
+            "view",
+            "--exit-after-frames",
+            "1",
+            "--screenshot",
+            &format!("{d}/a.jpg"),
+        ],
+        ".png",
+    );
+    assert_fails_with(
+        &[
+            "view",
+            "--exit-after-frames",
+            "1",
+            "--screenshot",
+            "/dev/null",
+        ],
+        "--screenshot",
+    );
+    let twice = format!("at 1 screenshot {shot}; at 2 screenshot {shot}");
+    assert_fails_with(&["view", "--script", &twice], "both name");
+    assert_fails_with(
+        &[
+            "view",
+            "--script",
+            &format!("at 1 screenshot {shot}"),
+            "--exit-after-frames",
+            "2",
+            "--screenshot",
+            &shot,
+        ],
+        "both name",
+    );
+    for (script, needle) in [
+        ("tile 3", "tile"),
+        ("tile 65", "tile"),
+        ("msaa 3", "msaa"),
+        ("pipeline nope", "nope"),
+        ("resize 0x10", "at least 1"),
+        ("at -1 pause", "not a whole number"),
+        ("view sideways", "view is one of"),
+        ("fly away", "unknown action"),
+    ] {
+        assert_fails_with(&["view", "--script", script], needle);
+    }
+    assert_fails_with(&["view", "--view", "sideways"], "--view");
+    assert_fails_with(&["view", "--size", "0x10"], "--size");
+    assert_fails_with(
+        &["view", "--pipeline", "deferred", "--msaa", "4"],
+        "does not apply",
+    );
+    assert_fails_with(&["view", "--frame", "100000"], "past the end");
+    assert!(
+        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "nothing is written"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
