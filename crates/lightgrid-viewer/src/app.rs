@@ -51,6 +51,8 @@ pub const SETTLE: Duration = Duration::from_millis(100);
 const DRAFT_SETTLE: Duration = Duration::from_millis(300);
 /// A scripted run that stays pending this long has a step that cannot complete.
 const SCRIPT_PATIENCE: Duration = Duration::from_secs(60);
+/// The smallest window the panel is drawn in.
+const MIN_PANEL_WINDOW: (u32, u32) = (240, 160);
 /// A debug view is refreshed this often while the animation plays.
 const DEBUG_REFRESH: Duration = Duration::from_millis(250);
 
@@ -685,7 +687,10 @@ impl<'c> App<'c> {
             message: self.message.as_deref(),
             applying: self.draft != self.applied,
         };
-        let panel_on = self.panel;
+        // A window too small for the panel leaves it out rather than letting egui shrink it
+        // to that size (it would stay shrunk when the window grows back).
+        let (sw, sh) = win.surface.size();
+        let panel_on = self.panel && sw >= MIN_PANEL_WINDOW.0 && sh >= MIN_PANEL_WINDOW.1;
         let draft = &mut self.draft;
         let mut actions = Vec::new();
         let output = win.egui.ctx.run_pass(input, |ctx| {

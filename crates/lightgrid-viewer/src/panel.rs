@@ -62,13 +62,13 @@ pub fn draw(ctx: &egui::Context, draft: &mut Controls, info: &PanelInfo) -> Vec<
             ui.separator();
             technique(ui, draft, info);
             ui.separator();
-            scene(ui, draft, info);
-            ui.separator();
-            animation(ui, info, &mut actions);
-            ui.separator();
             debug_views(ui, draft, info, &mut actions);
             ui.separator();
             figures(ui, info);
+            ui.separator();
+            animation(ui, info, &mut actions);
+            ui.separator();
+            scene(ui, draft, info);
             ui.separator();
             ui.horizontal(|ui| {
                 if ui.button("screenshot (F12)").clicked() {
