@@ -272,6 +272,67 @@ fn flipping_through_every_pipeline_keeps_the_image() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The scene's options changed live reopen the scene: the frame equals a headless render
+/// made with those options from the start.
+#[test]
+fn scene_options_changed_live_equal_a_render_with_them() {
+    let x = Xvfb::start();
+    let dir = temp_dir("view-scene");
+    let shot = dir.join("shot.png");
+    x.run_ok(&[
+        "view",
+        "--scene",
+        "robots-few",
+        "--size",
+        "200x120",
+        "--frame",
+        "30",
+        "--script",
+        "pause; at 1 add-lights 200; at 2 spots 0.5; at 3 transparency off; at 4 pipeline clustered_forward",
+        "--exit-after-frames",
+        "6",
+        "--screenshot",
+        shot.to_str().unwrap(),
+    ]);
+    let reference = dir.join("reference.png");
+    let before = dir.join("before.png");
+    let common = [
+        "render",
+        "--scene",
+        "robots-few",
+        "--size",
+        "200x120",
+        "--frame",
+        "30",
+        "--pipeline",
+        "clustered_forward",
+    ];
+    let mut with = common.to_vec();
+    with.extend([
+        "--add-lights",
+        "200",
+        "--spot-fraction",
+        "0.5",
+        "--transparency",
+        "off",
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
+    render(&with);
+    let mut without = common.to_vec();
+    without.extend(["--out", before.to_str().unwrap()]);
+    render(&without);
+    let shot = load(&shot);
+    let (mean, max) = difference(&shot, &load(&reference));
+    assert!(
+        max <= 2 && mean < 0.05,
+        "screenshot vs render: mean {mean}, max {max}"
+    );
+    let (mean, _) = difference(&shot, &load(&before));
+    assert!(mean > 1.0, "the options changed nothing (mean {mean})");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A failing step of a script ends the session with its reason, and nothing is written.
 #[test]
 fn a_script_step_that_cannot_run_fails_the_session() {
@@ -374,6 +435,8 @@ fn bad_view_options_are_refused_before_a_window_opens() {
         ("at -1 pause", "not a whole number"),
         ("view sideways", "view is one of"),
         ("fly away", "unknown action"),
+        ("spots 2", "from 0 to 1"),
+        ("transparency maybe", "on or off"),
     ] {
         assert_fails_with(&["view", "--script", script], needle);
     }

@@ -369,6 +369,14 @@ impl<'c> App<'c> {
             Action::Tile(n) => next.settings.tile_size = *n,
             Action::Msaa(n) => next.settings.msaa = *n,
             Action::View(v) => next.view = *v,
+            Action::Spots(f) => next.request.params.spot_fraction = *f,
+            Action::Transparency(on) => next.request.params.transparency = *on,
+            Action::AddLights(n) => {
+                next.request.add_lights = (*n > 0).then_some(lightgrid::scene::AddLights {
+                    count: *n,
+                    range: None,
+                })
+            }
             Action::Resize(w, h) => {
                 let win = self.win.as_ref().context("no window")?;
                 let _ = win

@@ -5,7 +5,9 @@
 //! Syntax: steps separated by `;`, each `at N ACTION` (N: the displayed frame, from 0) or a bare
 //! `ACTION` (frame 0). Actions:
 //! `pipeline ID`, `tile N`, `msaa N`, `view shaded|lights|bounds|wasted`, `resize WxH`,
-//! `frame F` (jump the animation), `pause`, `play`, `panel on|off`, `screenshot FILE.png`.
+//! `frame F` (jump the animation), `pause`, `play`, `panel on|off`, `screenshot FILE.png`,
+//! and the scene's options (the scene is opened again): `spots F` (the spot fraction, 0 to
+//! 1), `transparency on|off`, `add-lights N` (N scattered lights; 0 removes them).
 
 use lightgrid::debug_view::DebugView;
 use std::path::PathBuf;
@@ -22,6 +24,9 @@ pub enum Action {
     Play,
     Panel(bool),
     Screenshot(PathBuf),
+    Spots(f32),
+    Transparency(bool),
+    AddLights(u32),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -83,6 +88,28 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                 Action::Resize(w, h)
             }
             "frame" => Action::Frame(number(arg, "frame", step)?),
+            "spots" => {
+                let a = arg.ok_or_else(|| format!("'{step}': spots needs a fraction"))?;
+                match a.parse::<f32>() {
+                    Ok(f) if (0.0..=1.0).contains(&f) => Action::Spots(f),
+                    _ => return Err(format!("'{step}': '{a}' is not a number from 0 to 1")),
+                }
+            }
+            "transparency" => match arg {
+                Some("on") => Action::Transparency(true),
+                Some("off") => Action::Transparency(false),
+                _ => return Err(format!("'{step}': transparency is on or off")),
+            },
+            "add-lights" => {
+                let n = number(arg, "add-lights", step)?;
+                if n > lightgrid::consts::MAX_LIGHTS {
+                    return Err(format!(
+                        "'{step}': at most {} lights",
+                        lightgrid::consts::MAX_LIGHTS
+                    ));
+                }
+                Action::AddLights(n)
+            }
             "pause" => Action::Pause,
             "play" => Action::Play,
             "panel" => match arg {
@@ -124,6 +151,17 @@ mod tests {
         assert_eq!(s[7].action, Action::View(DebugView::LightsPerCell));
         assert_eq!(s[8].action, Action::Screenshot("a.png".into()));
         assert_eq!(s[9].action, Action::Panel(false));
+        let s = parse("spots 0.25; transparency off; add-lights 0; add-lights 300").unwrap();
+        let actions: Vec<Action> = s.into_iter().map(|s| s.action).collect();
+        assert_eq!(
+            actions,
+            vec![
+                Action::Spots(0.25),
+                Action::Transparency(false),
+                Action::AddLights(0),
+                Action::AddLights(300)
+            ]
+        );
     }
 
     #[test]
@@ -146,6 +184,13 @@ mod tests {
             "pipeline",
             "screenshot",
             "frame 1 2",
+            "spots",
+            "spots NaN",
+            "spots -0.5",
+            "spots 1.5",
+            "transparency maybe",
+            "add-lights -1",
+            "add-lights 99999999",
         ] {
             assert!(parse(bad).is_err(), "{bad} parsed");
         }
