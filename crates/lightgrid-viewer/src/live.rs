@@ -141,12 +141,17 @@ mod tests {
         }
         // 10 frames of 100 ms make the newest second.
         assert!((live.fps().unwrap() - 10.0).abs() < 1e-9);
+        // Half a second of 10 ms frames and half of the older 100 ms ones: 55 frames.
         for _ in 0..50 {
+            live.displayed(10.0);
+        }
+        assert!((live.fps().unwrap() - 55.0).abs() < 1e-9);
+        for _ in 0..100 {
             live.displayed(10.0);
         }
         assert!((live.fps().unwrap() - 100.0).abs() < 1e-9);
         live.displayed(f64::NAN);
-        assert_eq!(live.displayed, 151);
+        assert_eq!(live.displayed, 251);
         assert!(live.frame_ms.len() <= HISTORY);
     }
 
