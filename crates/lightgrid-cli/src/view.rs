@@ -104,9 +104,11 @@ pub(crate) fn view(adapter: Option<&str>, a: &ViewArgs) -> Result<()> {
         screenshot: a.screenshot.clone(),
     })?;
     eprintln!(
-        "{} frames shown on {}; {} overflowed their lists, {} had shader loops cut short{}",
+        "{} frames shown on {} ({} fps over the last second, GPU {} ms); {} overflowed their lists, {} had shader loops cut short{}",
         report.frames,
         report.adapter,
+        report.fps.map_or("-".into(), |f| format!("{f:.1}")),
+        report.gpu_ms.map_or("n/a".into(), |m| format!("{m:.1}")),
         report.overflowed,
         report.truncated,
         if report.screenshots.is_empty() {

@@ -170,6 +170,33 @@ const CMDS: &[Cmd] = &[
         ],
     },
     Cmd {
+        name: "view",
+        flags: &[
+            "--spot-fraction",
+            "--transparency",
+            "--msaa",
+            "--scene",
+            "--add-lights",
+            "--pipeline",
+            "--assign",
+            "--frame",
+            "--size",
+            "--view",
+            "--script",
+            "--exit-after-frames",
+            "--tile",
+            "--slices",
+            "--gbuffer",
+            "--lights",
+        ],
+        paths: &["--screenshot"],
+        safe: &[
+            ("--size", "8x8"),
+            ("--exit-after-frames", "2"),
+            ("--scene", "robots-few"),
+        ],
+    },
+    Cmd {
         name: "compare",
         flags: &[
             "--spot-fraction",

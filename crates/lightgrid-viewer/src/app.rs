@@ -83,6 +83,10 @@ pub struct ViewReport {
     pub screenshots: Vec<PathBuf>,
     pub overflowed: u64,
     pub truncated: u64,
+    /// Frames per second over the last second shown, and the mean GPU milliseconds of the
+    /// newest frames (up to the live figures' history).
+    pub fps: Option<f64>,
+    pub gpu_ms: Option<f64>,
 }
 
 /// Open the window and run until it is closed, `Esc` is pressed or `exit_after_frames`
@@ -117,7 +121,14 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
         let mut app = App::new(ctx, opts, opened.scene, jobs, done, lost);
         let ran = event_loop.run_app(&mut app);
         // Dropping the app drops the job sender, which ends the worker.
-        let App { fatal, report, .. } = app;
+        let App {
+            fatal,
+            mut report,
+            figures,
+            ..
+        } = app;
+        report.fps = figures.fps();
+        report.gpu_ms = LiveFigures::recent_mean(&figures.gpu_ms, crate::live::HISTORY);
         ran.context("the window's event loop failed")?;
         match fatal {
             Some(e) => Err(e),
