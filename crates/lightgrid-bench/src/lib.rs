@@ -3,11 +3,13 @@
 //! lighting computations, the ideal count, lights per tile and the memory model; then
 //! `report` writes results.json / results.csv / plots / summary.md and `claims` checks the
 //! papers' claims against the measurements. `scaling` measures light assignment strategies
-//! against the light count. [`plot`] draws the charts (plotters, with an embedded font).
+//! against the light count; [`advise`] times the candidate configurations of one scene on
+//! this adapter and recommends one. [`plot`] draws the charts (plotters, with an embedded font).
 //!
 //! Everything renders through the `lightgrid` library; this crate only plans, measures and
 //! writes.
 
+pub mod advise;
 mod claims;
 mod outdir;
 pub mod plot;

@@ -3,6 +3,7 @@
 //! default job: every pipeline on `robots-many`, with each image's difference from the
 //! `forward` reference. One module per command.
 
+mod advise;
 mod args;
 mod bench;
 mod compare;
@@ -62,6 +63,9 @@ enum Command {
     /// Open the interactive viewer: fly through a scene, switch pipelines and settings live,
     /// see lights per cell, cell depth bounds and wasted work, frame and GPU times.
     View(view::ViewArgs),
+    /// Time every pipeline, tile size and assignment strategy on one scene on this adapter
+    /// within a budget, and recommend the fastest with its reasons.
+    Advise(advise::AdviseArgs),
     /// List adapters, scenes and pipelines.
     List,
 }
@@ -113,6 +117,7 @@ fn main() {
         Some(Command::Play(a)) => play::play(cli.adapter.as_deref(), &a),
         Some(Command::Export(a)) => export::export(&a),
         Some(Command::View(a)) => view::view(cli.adapter.as_deref(), &a),
+        Some(Command::Advise(a)) => advise::advise(cli.adapter.as_deref(), &a),
         Some(Command::List) => list::list(),
     };
     if let Err(e) = result {

@@ -48,7 +48,16 @@ pub fn serve(ctx: &GpuContext, jobs: Receiver<Job>, done: Sender<Done>) {
     let mut scene: Option<(Arc<Scene>, Scene)> = None;
     for job in jobs {
         let start = std::time::Instant::now();
-        let result = run(ctx, &mut renderer, &mut scene, &job).map(|(stats, image)| Analysed {
+        // A panic in an analysis frame is this job's error, not the window's: the renderer
+        // that panicked is dropped and the next job makes a new one.
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            run(ctx, &mut renderer, &mut scene, &job)
+        }))
+        .unwrap_or_else(|_| {
+            renderer = None;
+            Err("the analysis frame panicked".to_string())
+        })
+        .map(|(stats, image)| Analysed {
             stats,
             image,
             seconds: start.elapsed().as_secs_f64(),

@@ -51,6 +51,11 @@ pub const SETTLE: Duration = Duration::from_millis(100);
 const DRAFT_SETTLE: Duration = Duration::from_millis(300);
 /// A scripted run that stays pending this long has a step that cannot complete.
 const SCRIPT_PATIENCE: Duration = Duration::from_secs(60);
+/// Frames a screenshot waits for one whose lists did not overflow.
+const MAX_SCREENSHOT_RETRIES: u32 = 10;
+/// How long to wait before trying again when the surface gave no frame (occluded, timed
+/// out): rendering unseen frames as fast as possible would only load the machine.
+const SKIP_PAUSE: Duration = Duration::from_millis(16);
 /// The smallest window the panel is drawn in.
 const MIN_PANEL_WINDOW: (u32, u32) = (240, 160);
 /// A debug view is refreshed this often while the animation plays.
@@ -191,6 +196,8 @@ struct App<'c> {
     scene: Scene,
     frame: u32,
     playing: bool,
+    /// The frame was just chosen (a jump or a step): show it before the animation moves on.
+    hold_frame: bool,
     fly: Option<FlyCamera>,
     fly_speed: f32,
     keys: HashSet<KeyCode>,
@@ -212,8 +219,14 @@ struct App<'c> {
     settled: u32,
     pending_since: Option<Instant>,
     screenshots: VecDeque<PathBuf>,
+    /// Frames the front screenshot was put off because they were shown wrong.
+    screenshot_retries: u32,
+    /// A size a script asked the window for, until the surface has it.
+    requested_size: Option<(u32, u32)>,
     leaving: bool,
     last_display: Option<Instant>,
+    /// No redraw before this (the surface gave no frame).
+    idle_until: Option<Instant>,
     /// The newest submitted frame's serial, and recent finished frames' (serial, report).
     submitted: Option<u64>,
     recent: VecDeque<FinishedFrame>,
@@ -250,6 +263,7 @@ impl<'c> App<'c> {
             scene,
             frame: opts.frame,
             playing: !opts.paused,
+            hold_frame: true,
             fly: None,
             fly_speed,
             keys: HashSet::new(),
@@ -269,8 +283,11 @@ impl<'c> App<'c> {
             settled: 0,
             pending_since: None,
             screenshots: VecDeque::new(),
+            screenshot_retries: 0,
+            requested_size: None,
             leaving: false,
             last_display: None,
+            idle_until: None,
             submitted: None,
             recent: VecDeque::new(),
             lost,
@@ -333,6 +350,35 @@ impl<'c> App<'c> {
         })
     }
 
+    /// Put `renderer` in the window's place: its frames are numbered anew, so nothing of the
+    /// old one's reports may be read as its own.
+    fn replace_renderer(&mut self, renderer: Renderer<'c>) {
+        if let Some(win) = &mut self.win {
+            win.renderer = renderer;
+            win.debug_texture = None;
+        }
+        self.recent.clear();
+        self.submitted = None;
+        self.generation += 1;
+        self.figures.restart_times();
+    }
+
+    /// A newly opened scene in place of the old one (the animation frame kept if it has it).
+    fn set_scene(&mut self, scene: Scene) {
+        self.frame = self.frame.min(scene.frame_count() - 1);
+        self.base = Arc::new(scene.clone());
+        self.scene = scene;
+        self.generation += 1;
+    }
+
+    fn set_playing(&mut self, on: bool) {
+        if self.playing != on {
+            self.playing = on;
+            // A paused view must show its own frame: the debug view is made again.
+            self.generation += 1;
+        }
+    }
+
     fn title(&self) -> String {
         format!("lightgrid: {} / {}", self.scene.name, self.applied.pipeline)
     }
@@ -348,29 +394,36 @@ impl<'c> App<'c> {
         let wrong_size = win.renderer.size() != render_size(self.ctx, win.surface.size());
         let debug_stale = self.applied.view != DebugView::Shaded
             && self.analysis.failed_generation != Some(self.generation)
-            && !self
-                .analysis
-                .latest
-                .as_ref()
-                .is_some_and(|(g, _, a)| *g == self.generation && a.image.is_some());
-        size_settling || wrong_size || self.draft != self.applied || debug_stale
+            && !self.analysis_current(true);
+        let resize_asked = self.requested_size.is_some_and(|s| s != win.surface.size());
+        size_settling || wrong_size || resize_asked || self.draft != self.applied || debug_stale
     }
 
-    fn run_due_steps(&mut self) -> Result<()> {
-        while let Some(step) = self.script.get(self.next_step) {
-            if step.at > self.settled {
-                break;
-            }
-            let step = step.clone();
-            self.next_step += 1;
-            self.run_step(&step)
-                .with_context(|| format!("script step at {}: {:?}", step.at, step.action))?;
-            if self.draft != self.applied {
-                // One change at a time: the next steps wait until this one is applied.
-                break;
-            }
+    /// The newest analysis frame shows the current state (and, paused, the current frame);
+    /// with `image`, it also has the debug view's image.
+    fn analysis_current(&self, image: bool) -> bool {
+        self.analysis.latest.as_ref().is_some_and(|(g, _, a)| {
+            *g == self.generation
+                && (self.playing || a.stats.frame == self.frame)
+                && (!image || a.image.is_some())
+        })
+    }
+
+    /// Run the next step when it is due: one step per frame, so each step's change is
+    /// shown (and settled) before the next one runs, and none while a screenshot waits.
+    fn run_due_step(&mut self) -> Result<()> {
+        if !self.screenshots.is_empty() {
+            return Ok(());
         }
-        Ok(())
+        let Some(step) = self.script.get(self.next_step).cloned() else {
+            return Ok(());
+        };
+        if step.at > self.settled {
+            return Ok(());
+        }
+        self.next_step += 1;
+        self.run_step(&step)
+            .with_context(|| format!("script step at {}: {:?}", step.at, step.action))
     }
 
     fn run_step(&mut self, step: &Step) -> Result<()> {
@@ -393,20 +446,21 @@ impl<'c> App<'c> {
                 let _ = win
                     .window
                     .request_inner_size(winit::dpi::PhysicalSize::new(*w, *h));
+                // Pending until the surface has it (X11 answers with a later event).
+                self.requested_size = Some((*w, *h));
                 return Ok(());
             }
             Action::Frame(f) => {
                 self.scene.check_frame(*f)?;
-                self.frame = *f;
-                self.generation += 1;
+                self.jump_to(*f);
                 return Ok(());
             }
             Action::Pause => {
-                self.playing = false;
+                self.set_playing(false);
                 return Ok(());
             }
             Action::Play => {
-                self.playing = true;
+                self.set_playing(true);
                 return Ok(());
             }
             Action::Panel(on) => {
@@ -433,8 +487,23 @@ impl<'c> App<'c> {
         if let Some(why) = refusal(info, &next.settings) {
             return Err(why);
         }
-        if rebuild == Rebuild::Scene {
-            let opened = lightgrid::scene::open(&next.request).map_err(|e| e.to_string())?;
+        // Everything is made before anything is replaced, so a failure leaves the viewer as
+        // it was.
+        let opened = match rebuild {
+            Rebuild::Scene => {
+                Some(lightgrid::scene::open(&next.request).map_err(|e| e.to_string())?)
+            }
+            _ => None,
+        };
+        let renderer = match rebuild {
+            Rebuild::Scene | Rebuild::Renderer => {
+                let win = self.win.as_ref().ok_or("no window")?;
+                let (w, h) = win.renderer.size();
+                Some(Renderer::new(self.ctx, w, h, next.settings).map_err(|e| e.to_string())?)
+            }
+            _ => None,
+        };
+        if let Some(opened) = opened {
             if let Some(w) = opened.warnings.first() {
                 self.message = Some(format!(
                     "{} (and {} more warnings)",
@@ -442,15 +511,10 @@ impl<'c> App<'c> {
                     opened.warnings.len() - 1
                 ));
             }
-            self.frame = self.frame.min(opened.scene.frame_count() - 1);
-            self.base = Arc::new(opened.scene.clone());
-            self.scene = opened.scene;
+            self.set_scene(opened.scene);
         }
-        if rebuild >= Rebuild::Renderer {
-            let win = self.win.as_mut().ok_or("no window")?;
-            let (w, h) = win.renderer.size();
-            win.renderer =
-                Renderer::new(self.ctx, w, h, next.settings).map_err(|e| e.to_string())?;
+        if let Some(r) = renderer {
+            self.replace_renderer(r);
         }
         self.applied = next;
         // A script's or key's change is the panel's draft from now on too.
@@ -498,17 +562,19 @@ impl<'c> App<'c> {
         let good = self.last_good.clone();
         // A new renderer for the old settings whatever the difference, so nothing of the
         // failed one stays.
-        let win = self.win.as_mut().context("no window")?;
+        let win = self.win.as_ref().context("no window")?;
         let (w, h) = win.renderer.size();
-        win.renderer = Renderer::new(self.ctx, w, h, good.settings)?;
+        let renderer = Renderer::new(self.ctx, w, h, good.settings)?;
         if self.applied.request != good.request {
             let opened = lightgrid::scene::open(&good.request)?;
-            self.base = Arc::new(opened.scene.clone());
-            self.scene = opened.scene;
+            self.set_scene(opened.scene);
         }
+        self.replace_renderer(renderer);
         self.applied = good.clone();
         self.draft = good;
-        self.generation += 1;
+        if let Some(win) = &self.win {
+            win.window.set_title(&self.title());
+        }
         Ok(())
     }
 
@@ -524,10 +590,8 @@ impl<'c> App<'c> {
         if wanted == win.renderer.size() || settling {
             return Ok(());
         }
-        win.renderer = Renderer::new(self.ctx, wanted.0, wanted.1, self.applied.settings)?;
-        win.debug_texture = None;
-        self.generation += 1;
-        self.figures.restart_times();
+        let renderer = Renderer::new(self.ctx, wanted.0, wanted.1, self.applied.settings)?;
+        self.replace_renderer(renderer);
         Ok(())
     }
 
@@ -538,9 +602,10 @@ impl<'c> App<'c> {
             bail!("the GPU device was lost ({reason}); restart the viewer");
         }
         let now = Instant::now();
+        self.check_patience(now)?;
         self.collect_analysis()?;
         if !self.pending(now) {
-            self.run_due_steps()?;
+            self.run_due_step()?;
         }
         self.apply_draft(now)?;
         self.follow_size(now)?;
@@ -582,7 +647,7 @@ impl<'c> App<'c> {
             fly.advance(m, dt);
             self.generation += 1;
         }
-        if self.playing {
+        if self.playing && !std::mem::take(&mut self.hold_frame) {
             self.frame = (self.frame + 1) % self.scene.frame_count();
         }
         self.scene.camera_path = match &self.fly {
@@ -603,8 +668,17 @@ impl<'c> App<'c> {
 
     /// Render and present one frame; false when nothing was shown.
     fn render(&mut self) -> Result<bool> {
+        let ctx = self.ctx;
         let pipeline = self.applied.pipeline.clone();
         let win = self.win.as_mut().context("no window")?;
+        // The surface first: a frame is rendered only when it can be shown.
+        let texture = match win.surface.acquire(ctx)? {
+            Acquired::Frame(t) => t,
+            Acquired::Skip => {
+                self.idle_until = Some(Instant::now() + SKIP_PAUSE);
+                return Ok(false);
+            }
+        };
         match win
             .renderer
             .render_frame(&self.scene, self.frame, &pipeline)
@@ -620,7 +694,7 @@ impl<'c> App<'c> {
         }
         let finished = win.renderer.poll_finished()?;
         self.observe(finished);
-        self.present()
+        self.present(texture)
     }
 
     fn observe(&mut self, finished: Vec<FinishedFrame>) {
@@ -643,13 +717,9 @@ impl<'c> App<'c> {
         }
     }
 
-    fn present(&mut self) -> Result<bool> {
+    fn present(&mut self, texture: wgpu::SurfaceTexture) -> Result<bool> {
         let ctx = self.ctx;
         let win = self.win.as_mut().context("no window")?;
-        let texture = match win.surface.acquire(ctx)? {
-            Acquired::Frame(t) => t,
-            Acquired::Skip => return Ok(false),
-        };
         let target = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let source = Self::source(win, self.applied.view);
@@ -676,6 +746,7 @@ impl<'c> App<'c> {
         encoder: &mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
     ) -> Result<Vec<PanelAction>> {
+        let analysis_current = self.analysis_current(false);
         let win = self.win.as_mut().context("no window")?;
         let input = win.egui.state.take_egui_input(&win.window);
         let before = self.draft.clone();
@@ -700,7 +771,7 @@ impl<'c> App<'c> {
                 .analysis
                 .latest
                 .as_ref()
-                .map(|(g, _, a)| (a, *g == self.generation)),
+                .map(|(_, _, a)| (a, analysis_current)),
             analysing: self.analysis.in_flight,
             sample_every_second: self.analysis.every_second,
             message: self.message.as_deref(),
@@ -783,12 +854,9 @@ impl<'c> App<'c> {
 
     fn panel_action(&mut self, a: PanelAction) {
         match a {
-            PanelAction::TogglePause => self.playing = !self.playing,
+            PanelAction::TogglePause => self.set_playing(!self.playing),
             PanelAction::Step(d) => self.step(d),
-            PanelAction::JumpTo(f) => {
-                self.frame = f.min(self.scene.frame_count() - 1);
-                self.generation += 1;
-            }
+            PanelAction::JumpTo(f) => self.jump_to(f.min(self.scene.frame_count() - 1)),
             PanelAction::FollowPath => {
                 self.fly = None;
                 self.generation += 1;
@@ -803,8 +871,14 @@ impl<'c> App<'c> {
 
     fn step(&mut self, d: i32) {
         let n = self.scene.frame_count() as i64;
-        self.playing = false;
-        self.frame = (i64::from(self.frame) + i64::from(d)).rem_euclid(n) as u32;
+        self.set_playing(false);
+        self.jump_to((i64::from(self.frame) + i64::from(d)).rem_euclid(n) as u32);
+    }
+
+    /// Show animation frame `f` next.
+    fn jump_to(&mut self, f: u32) {
+        self.frame = f;
+        self.hold_frame = true;
         self.generation += 1;
     }
 
@@ -822,32 +896,72 @@ impl<'c> App<'c> {
 
     // --- after the frame: screenshots, the script's clock, leaving, analysis ---------------
 
-    fn after_frame(&mut self, event_loop: &ActiveEventLoop, now: Instant) -> Result<()> {
-        let pending = self.pending(now);
-        if pending {
-            let since = *self.pending_since.get_or_insert(now);
-            if self.scripted && now.duration_since(since) > SCRIPT_PATIENCE {
-                let win = self.win.as_ref().context("no window")?;
-                bail!(
-                    "the scripted session waited {}s for the view to settle (window {:?}, renderer {:?})",
-                    SCRIPT_PATIENCE.as_secs(),
-                    win.surface.size(),
-                    win.renderer.size()
-                );
+    /// A scripted run that has waited too long (for a settled view or a screenshot) ends
+    /// with what it waited for, rather than hanging.
+    fn check_patience(&mut self, now: Instant) -> Result<()> {
+        if let Some(s) = self.requested_size {
+            if self.win.as_ref().is_some_and(|w| w.surface.size() == s) {
+                self.requested_size = None;
             }
-        } else {
+        }
+        let waiting = self.pending(now) || !self.screenshots.is_empty();
+        if !waiting {
             self.pending_since = None;
+            return Ok(());
+        }
+        let since = *self.pending_since.get_or_insert(now);
+        if self.scripted && now.duration_since(since) > SCRIPT_PATIENCE {
+            let win = self.win.as_ref().context("no window")?;
+            bail!(
+                "the scripted session waited {} s for the view to settle (window {:?}{}, renderer {:?}, {} screenshot(s) waiting)",
+                SCRIPT_PATIENCE.as_secs(),
+                win.surface.size(),
+                self.requested_size
+                    .map_or(String::new(), |s| format!(" of the {s:?} asked for")),
+                win.renderer.size(),
+                self.screenshots.len()
+            );
+        }
+        Ok(())
+    }
+
+    fn after_frame(&mut self, event_loop: &ActiveEventLoop, now: Instant) -> Result<()> {
+        if !self.pending(now) {
             if let Some(path) = self.screenshots.front().cloned() {
-                match self.screenshot(&path) {
-                    Ok(Shot::Taken) => {
-                        eprintln!("screenshot {}", path.display());
+                let taken = match self.screenshot(&path) {
+                    Ok(Shot::Retry) if self.screenshot_retries < MAX_SCREENSHOT_RETRIES => {
+                        self.screenshot_retries += 1;
+                        Ok(false)
+                    }
+                    Ok(Shot::Retry) => Err(anyhow!(
+                        "{}: {MAX_SCREENSHOT_RETRIES} frames in a row overflowed their light lists; no screenshot written",
+                        path.display()
+                    )),
+                    Ok(Shot::Taken) => Ok(true),
+                    Err(e) => Err(e),
+                };
+                match taken {
+                    Ok(false) => {}
+                    Ok(true) => {
+                        eprintln!(
+                            "screenshot {} ({}, frame {}, {}, {:?})",
+                            path.display(),
+                            self.applied.pipeline,
+                            self.frame,
+                            self.applied.view.name(),
+                            self.win
+                                .as_ref()
+                                .map(|w| w.renderer.size())
+                                .unwrap_or_default()
+                        );
                         self.screenshots.pop_front();
+                        self.screenshot_retries = 0;
                         self.report.screenshots.push(path);
                     }
-                    Ok(Shot::Retry) => {}
                     Err(e) if self.scripted => return Err(e),
                     Err(e) => {
                         self.screenshots.pop_front();
+                        self.screenshot_retries = 0;
                         self.message = Some(format!("{e:#}"));
                     }
                 }
@@ -887,7 +1001,7 @@ impl<'c> App<'c> {
             let finished = win.renderer.finish()?;
             self.observe(finished);
             let serial = self.submitted.context("no frame rendered yet")?;
-            let Some(report) = self.recent.iter().find(|f| f.serial == serial) else {
+            let Some(report) = self.recent.iter().rfind(|f| f.serial == serial) else {
                 return Ok(Shot::Retry);
             };
             if report.truncated_loops > 0 || report.fragments_off_bounds > 0 {
@@ -969,10 +1083,7 @@ impl<'c> App<'c> {
         let since = a.last_request.map(|t| now.duration_since(t));
         let due = |every: Duration| since.is_none_or(|s| s >= every);
         let want = if self.applied.view != DebugView::Shaded {
-            let current = a
-                .latest
-                .as_ref()
-                .is_some_and(|(g, _, _)| *g == self.generation);
+            let current = self.analysis_current(false);
             (!current && a.failed_generation != Some(self.generation))
                 || (self.playing && due(DEBUG_REFRESH))
         } else {
@@ -1014,7 +1125,7 @@ impl<'c> App<'c> {
         }
         match code {
             KeyCode::Escape => event_loop.exit(),
-            KeyCode::Space => self.playing = !self.playing,
+            KeyCode::Space => self.set_playing(!self.playing),
             KeyCode::Period => self.step(1),
             KeyCode::Comma => self.step(-1),
             KeyCode::BracketRight => self.cycle_pipeline(1),
@@ -1155,7 +1266,15 @@ impl ApplicationHandler for App<'_> {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if let Some(t) = self.idle_until {
+            if Instant::now() < t {
+                event_loop.set_control_flow(ControlFlow::WaitUntil(t));
+                return;
+            }
+            self.idle_until = None;
+            event_loop.set_control_flow(ControlFlow::Wait);
+        }
         if let Some(win) = &self.win {
             let size = win.window.inner_size();
             // Minimised: no frames until the window comes back (a Resized event).

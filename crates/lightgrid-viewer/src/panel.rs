@@ -209,7 +209,6 @@ fn scene(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
             added > 0,
             egui::Slider::new(&mut range, 0.0..=100.0)
                 .logarithmic(true)
-                .max_decimals(2)
                 .text("added range (0: default)"),
         )
         .changed();

@@ -23,6 +23,9 @@ pub struct WindowSurface {
     surface: wgpu::Surface<'static>,
     pub config: wgpu::SurfaceConfiguration,
     window: Arc<Window>,
+    /// The last texture was suboptimal: configure before the next is acquired (not while
+    /// one is held, which wgpu refuses).
+    reconfigure: bool,
 }
 
 /// What acquiring a frame gave.
@@ -77,6 +80,7 @@ impl WindowSurface {
             surface,
             config,
             window,
+            reconfigure: false,
         };
         if size.width > 0 && size.height > 0 {
             s.surface.configure(&ctx.device, &s.config);
@@ -112,14 +116,15 @@ impl WindowSurface {
         if size.width == 0 || size.height == 0 {
             return Ok(Acquired::Skip);
         }
-        if (size.width, size.height) != self.size() {
+        if (size.width, size.height) != self.size() || self.reconfigure {
+            self.reconfigure = false;
             self.resize(ctx);
         }
         Ok(match self.surface.get_current_texture() {
             C::Success(t) => Acquired::Frame(t),
             C::Suboptimal(t) => {
                 // Draw this one; the next frame gets a reconfigured surface.
-                self.resize(ctx);
+                self.reconfigure = true;
                 Acquired::Frame(t)
             }
             C::Timeout | C::Occluded => Acquired::Skip,

@@ -1,0 +1,617 @@
+//! `lightgrid advise`: which configuration to render a scene with on this adapter, measured
+//! rather than modelled. Forward+ §5 leaves choosing the tile size automatically as future
+//! work; the papers' tables show the answer moves with the scene, the light count, the
+//! resolution and the hardware (tiled-shading §8: tiled deferred fastest in the worst case,
+//! tiled forward competitive with few lights), so the advisor times the candidates here.
+//!
+//! Steps, within a wall-clock budget:
+//! 1. **Survey**: every pipeline that reproduces `forward`'s image, at the default tile and
+//!    the `auto` strategy, brute-force `forward` last (it is the reference, rarely the answer).
+//! 2. **Refine**: for the fastest grid pipelines of the survey, the other tile sizes and then
+//!    the other assignment strategies at their best tile.
+//!
+//! Each candidate plays a few frames spread over the animation on the real-time path
+//! (`realtime::play`, the same frame loop `lightgrid play` and the viewer use) after one
+//! warm-up frame; a candidate whose warm-up frame shows it cannot finish inside what is left
+//! of the budget is skipped, saying so. One analysis frame at the middle of the animation
+//! gives its lighting computations against the ideal. The ranking is by median frame time;
+//! the recommendation says why, against the runner-up.
+
+use crate::run::Progress;
+use lightgrid::frame::{Assign, RenderSettings};
+use lightgrid::gpu::GpuContext;
+use lightgrid::pipelines::{self, Msaa, PipelineInfo, REFERENCE};
+use lightgrid::realtime::{play, PlayPlan};
+use lightgrid::scene::Scene;
+use lightgrid::Renderer;
+use serde::Serialize;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+/// Tile edges the refinement tries besides the default (the papers' 8, 16 and 32: Forward+
+/// §5 measures 8x8 to 32x32; tiled-shading §8 and tiled-forward-shading use 32).
+pub const TILES: [u32; 3] = [8, 16, 32];
+/// Grid pipelines of the survey refined with the other tiles and strategies.
+pub const REFINE_TOP: usize = 3;
+/// Frames each candidate plays (spread over the animation).
+pub const FRAMES: usize = 4;
+
+/// One configuration to measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Candidate {
+    pub pipeline: &'static str,
+    /// The tile edge (grid pipelines only).
+    pub tile: Option<u32>,
+    /// The strategy, `auto` resolved (pipelines with an `--assign` grid only).
+    pub assign: Option<&'static str>,
+}
+
+impl Candidate {
+    pub fn label(&self) -> String {
+        let mut s = self.pipeline.to_string();
+        if let Some(t) = self.tile {
+            s += &format!(" tile {t}");
+        }
+        if let Some(a) = self.assign {
+            s += &format!(" assign {a}");
+        }
+        s
+    }
+}
+
+/// How measuring a candidate ended.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "lowercase")]
+pub enum Outcome {
+    Measured {
+        /// Median wall time from one frame to the next on the real-time path.
+        frame_ms: f64,
+        /// Median GPU time (timestamps), where the adapter has them.
+        gpu_ms: Option<f64>,
+        /// Frames whose lists overflowed or whose loops were cut short (a wrong frame).
+        wrong_frames: usize,
+    },
+    Skipped {
+        reason: String,
+    },
+    Failed {
+        reason: String,
+    },
+}
+
+/// A candidate with what was measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measurement {
+    #[serde(flatten)]
+    pub candidate: Candidate,
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Render targets plus the grid, bytes (targets only where no analysis frame ran).
+    pub memory_bytes: u64,
+    pub lighting_computations: Option<u64>,
+    pub ideal_lighting_computations: Option<u64>,
+    pub efficiency: Option<f64>,
+    /// Renders with MSAA (some sample count above 1).
+    pub msaa: bool,
+}
+
+impl Measurement {
+    pub fn frame_ms(&self) -> Option<f64> {
+        match self.outcome {
+            Outcome::Measured {
+                frame_ms,
+                wrong_frames: 0,
+                ..
+            } => Some(frame_ms),
+            _ => None,
+        }
+    }
+}
+
+/// What `advise` found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Advice {
+    pub scene: String,
+    pub adapter: String,
+    pub width: u32,
+    pub height: u32,
+    pub budget_s: f64,
+    pub elapsed_s: f64,
+    /// Every candidate, fastest first (unmeasured ones last, in the order tried).
+    pub ranking: Vec<Measurement>,
+    pub recommendation: Option<Recommendation>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Recommendation {
+    #[serde(flatten)]
+    pub candidate: Candidate,
+    /// The command-line options that select it.
+    pub options: String,
+    pub reasons: Vec<String>,
+}
+
+/// The pipelines the advisor considers: those whose image is `forward`'s (the mono-specular
+/// variants trade image quality for speed and are compared with their own reference).
+pub fn considered() -> Vec<&'static PipelineInfo> {
+    pipelines::PIPELINES
+        .iter()
+        .filter(|p| p.reference == REFERENCE)
+        .collect()
+}
+
+/// Step 1: every considered pipeline at the default tile and `auto`, the reference last.
+pub fn survey(assign_auto: &'static str) -> Vec<Candidate> {
+    let mut out: Vec<Candidate> = considered()
+        .into_iter()
+        .map(|p| Candidate {
+            pipeline: p.id,
+            tile: p.uses_grid.then_some(lightgrid::consts::DEFAULT_TILE_SIZE),
+            assign: p.assign.then_some(assign_auto),
+        })
+        .collect();
+    out.sort_by_key(|c| c.pipeline == REFERENCE);
+    out
+}
+
+/// Step 2: for the fastest `REFINE_TOP` grid pipelines measured so far, the other tiles at
+/// their strategy, then the other strategies at their best tile. Candidates already in
+/// `done` are left out.
+pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
+    let ranked = rank(done.to_vec());
+    let top: Vec<Candidate> = ranked
+        .iter()
+        .filter(|m| m.frame_ms().is_some() && m.candidate.tile.is_some())
+        .map(|m| m.candidate)
+        .fold(Vec::new(), |mut seen: Vec<Candidate>, c| {
+            if !seen.iter().any(|s| s.pipeline == c.pipeline) {
+                seen.push(c);
+            }
+            seen
+        })
+        .into_iter()
+        .take(REFINE_TOP)
+        .collect();
+    let mut out = Vec::new();
+    let push = |c: Candidate, out: &mut Vec<Candidate>| {
+        if !done.iter().any(|m| m.candidate == c) && !out.contains(&c) {
+            out.push(c);
+        }
+    };
+    for c in &top {
+        for t in TILES {
+            push(
+                Candidate {
+                    tile: Some(t),
+                    ..*c
+                },
+                &mut out,
+            );
+        }
+    }
+    for c in &top {
+        if c.assign.is_some() {
+            for a in Assign::ALL.iter().filter(|a| **a != Assign::Auto) {
+                push(
+                    Candidate {
+                        assign: Some(a.name()),
+                        ..*c
+                    },
+                    &mut out,
+                );
+            }
+        }
+    }
+    out
+}
+
+/// Fastest first; measured before unmeasured (kept in the order tried); equal times by
+/// memory.
+pub fn rank(mut all: Vec<Measurement>) -> Vec<Measurement> {
+    all.sort_by(|a, b| match (a.frame_ms(), b.frame_ms()) {
+        (Some(x), Some(y)) => x.total_cmp(&y).then(a.memory_bytes.cmp(&b.memory_bytes)),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => std::cmp::Ordering::Equal,
+    });
+    all
+}
+
+fn mib(bytes: u64) -> String {
+    format!("{:.1} MiB", bytes as f64 / f64::from(1u32 << 20))
+}
+
+/// The options that select `c` on the command line.
+pub fn options(c: &Candidate) -> String {
+    let mut s = format!("--pipeline {}", c.pipeline);
+    if let Some(t) = c.tile {
+        s += &format!(" --tile {t}");
+    }
+    if let Some(a) = c.assign {
+        s += &format!(" --assign {a}");
+    }
+    s
+}
+
+/// The fastest measured candidate, and why: its time against the runner-up's (and against
+/// the brute-force reference's when measured), its memory against the runner-up's, its
+/// lighting computations against the ideal, and what it supports.
+pub fn recommend(ranking: &[Measurement]) -> Option<Recommendation> {
+    let best = ranking.first().filter(|m| m.frame_ms().is_some())?;
+    let ms = best.frame_ms()?;
+    let mut reasons = vec![format!(
+        "fastest measured: median {ms:.2} ms per frame ({:.1} fps)",
+        1000.0 / ms.max(1e-9)
+    )];
+    if let Some(next) = ranking.get(1).filter(|m| m.frame_ms().is_some()) {
+        let other = next.frame_ms().unwrap_or(ms);
+        reasons.push(format!(
+            "{:.2}x the speed of the runner-up, {} ({other:.2} ms){}",
+            other / ms.max(1e-9),
+            next.candidate.label(),
+            if other / ms.max(1e-9) < 1.05 {
+                ": within 5%, a tie on this adapter"
+            } else {
+                ""
+            }
+        ));
+        let more = best.memory_bytes as f64 / next.memory_bytes.max(1) as f64;
+        reasons.push(format!(
+            "{} of render targets and grid ({:.2}x the runner-up's {})",
+            mib(best.memory_bytes),
+            more,
+            mib(next.memory_bytes)
+        ));
+    } else {
+        reasons.push(format!(
+            "{} of render targets and grid",
+            mib(best.memory_bytes)
+        ));
+    }
+    if let Some(reference) = ranking
+        .iter()
+        .find(|m| m.candidate.pipeline == REFERENCE && m.frame_ms().is_some())
+        .filter(|m| m.candidate != best.candidate)
+    {
+        let r = reference.frame_ms().unwrap_or(ms);
+        reasons.push(format!(
+            "{:.1}x faster than brute-force forward ({r:.2} ms)",
+            r / ms.max(1e-9)
+        ));
+    }
+    if let (Some(n), Some(ideal), Some(e)) = (
+        best.lighting_computations,
+        best.ideal_lighting_computations,
+        best.efficiency,
+    ) {
+        reasons.push(format!(
+            "{n} lighting computations for an ideal of {ideal} ({:.0}% efficient)",
+            e * 100.0
+        ));
+    }
+    reasons.push(if best.msaa {
+        "renders with MSAA; transparent objects are lit from its grid".into()
+    } else {
+        "does not render with MSAA (choose the best MSAA-capable row for that)".into()
+    });
+    Some(Recommendation {
+        candidate: best.candidate,
+        options: options(&best.candidate),
+        reasons,
+    })
+}
+
+/// What `advise` measures.
+pub struct AdvisePlan<'a> {
+    pub scene: &'a Scene,
+    pub size: (u32, u32),
+    pub budget: Duration,
+    /// Settings beside tile and strategy (MSAA, G-buffer, ...), as given.
+    pub base: RenderSettings,
+}
+
+/// Measure the survey, then the refinements, within the budget.
+pub fn advise(
+    ctx: &GpuContext,
+    plan: &AdvisePlan,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&Progress),
+) -> lightgrid::Result<Advice> {
+    let start = Instant::now();
+    let auto = plan
+        .base
+        .assign
+        .resolve(plan.scene.lights.len(), ctx.is_software())
+        .name();
+    let n = plan.scene.frame_count();
+    let frames: Vec<u32> = (0..FRAMES as u32)
+        .map(|i| (u64::from(n) * u64::from(i) / FRAMES as u64) as u32)
+        .collect();
+    let mut done: Vec<Measurement> = Vec::new();
+    let mut queue = survey(auto);
+    let mut refined = false;
+    let mut total = queue.len() as u64;
+    loop {
+        let Some(c) = (!queue.is_empty()).then(|| queue.remove(0)) else {
+            if refined {
+                break;
+            }
+            refined = true;
+            queue = refine(&done);
+            total += queue.len() as u64;
+            if queue.is_empty() {
+                break;
+            }
+            continue;
+        };
+        progress(&Progress {
+            done: done.len() as u64,
+            total,
+            label: c.label(),
+        });
+        let left = plan.budget.saturating_sub(start.elapsed());
+        let m = if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            skipped(plan, c, "interrupted".into())
+        } else if left.is_zero() {
+            skipped(plan, c, "the budget was spent".into())
+        } else {
+            measure(ctx, plan, c, &frames, left, stop)
+        };
+        done.push(m);
+    }
+    let ranking = rank(done);
+    Ok(Advice {
+        scene: plan.scene.name.clone(),
+        adapter: ctx.adapter_label(),
+        width: plan.size.0,
+        height: plan.size.1,
+        budget_s: plan.budget.as_secs_f64(),
+        elapsed_s: start.elapsed().as_secs_f64(),
+        recommendation: recommend(&ranking),
+        ranking,
+    })
+}
+
+fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
+    RenderSettings {
+        tile_size: c.tile.unwrap_or(plan.base.tile_size),
+        assign: c
+            .assign
+            .and_then(|a| Assign::ALL.into_iter().find(|x| x.name() == a))
+            .unwrap_or(plan.base.assign),
+        ..plan.base
+    }
+}
+
+fn info(c: &Candidate) -> &'static PipelineInfo {
+    pipelines::find(c.pipeline).expect("candidates come from the registry")
+}
+
+fn skipped(plan: &AdvisePlan, c: Candidate, reason: String) -> Measurement {
+    let settings = settings_of(plan, &c);
+    Measurement {
+        candidate: c,
+        outcome: Outcome::Skipped { reason },
+        memory_bytes: info(&c)
+            .memory_model(&settings)
+            .target_bytes(plan.size.0, plan.size.1),
+        lighting_computations: None,
+        ideal_lighting_computations: None,
+        efficiency: None,
+        msaa: !matches!(info(&c).msaa, Msaa::Refused(_)),
+    }
+}
+
+fn measure(
+    ctx: &GpuContext,
+    plan: &AdvisePlan,
+    c: Candidate,
+    frames: &[u32],
+    left: Duration,
+    stop: &AtomicBool,
+) -> Measurement {
+    let mut m = skipped(plan, c, String::new());
+    match try_measure(ctx, plan, &c, frames, left, stop, &mut m) {
+        Ok(outcome) => m.outcome = outcome,
+        Err(e) => {
+            m.outcome = Outcome::Failed {
+                reason: e.to_string(),
+            }
+        }
+    }
+    m
+}
+
+fn try_measure(
+    ctx: &GpuContext,
+    plan: &AdvisePlan,
+    c: &Candidate,
+    frames: &[u32],
+    left: Duration,
+    stop: &AtomicBool,
+    m: &mut Measurement,
+) -> lightgrid::Result<Outcome> {
+    let settings = settings_of(plan, c);
+    let mut renderer = Renderer::new(ctx, plan.size.0, plan.size.1, settings)?;
+    // The warm-up frame (shader compilation included) bounds what one frame costs.
+    let t = Instant::now();
+    renderer.render_frame(plan.scene, frames[frames.len() / 2], c.pipeline)?;
+    renderer.finish()?;
+    let first = t.elapsed();
+    // The frames to play, their queue fill, and the analysis frame.
+    let needed = first * (frames.len() as u32 + crate::PLAY_QUEUE_FILL + 1);
+    if needed > left.saturating_sub(first) {
+        return Ok(Outcome::Skipped {
+            reason: format!(
+                "its first frame took {:.2} s: {} frames would not fit in the {:.1} s of budget left",
+                first.as_secs_f64(),
+                frames.len() as u32 + crate::PLAY_QUEUE_FILL + 1,
+                left.saturating_sub(first).as_secs_f64()
+            ),
+        });
+    }
+    let run = play(
+        &mut renderer,
+        &PlayPlan {
+            scene: plan.scene,
+            pipeline: c.pipeline,
+            frames,
+            passes: 1,
+            warmup: crate::PLAY_QUEUE_FILL,
+        },
+        stop,
+        &mut |_, _| {},
+    )?;
+    if run.interrupted {
+        return Ok(Outcome::Skipped {
+            reason: "interrupted".into(),
+        });
+    }
+    let out = renderer.render(plan.scene, frames[frames.len() / 2], c.pipeline)?;
+    m.memory_bytes = out.stats.memory.target_bytes + out.stats.memory.grid_bytes.unwrap_or(0);
+    m.lighting_computations = out.stats.lighting_computations;
+    m.ideal_lighting_computations = Some(out.stats.ideal_lighting_computations);
+    m.efficiency = out.stats.efficiency;
+    Ok(Outcome::Measured {
+        frame_ms: run.frame_ms().map_or(f64::NAN, |d| d.median),
+        gpu_ms: run.gpu_ms().map(|d| d.median),
+        wrong_frames: run.overflow_frames() + run.truncated_frames(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn measured(pipeline: &'static str, tile: Option<u32>, ms: f64, mem: u64) -> Measurement {
+        Measurement {
+            candidate: Candidate {
+                pipeline,
+                tile,
+                assign: tile.map(|_| "cpu"),
+            },
+            outcome: Outcome::Measured {
+                frame_ms: ms,
+                gpu_ms: Some(ms * 0.9),
+                wrong_frames: 0,
+            },
+            memory_bytes: mem,
+            lighting_computations: Some(1000),
+            ideal_lighting_computations: Some(500),
+            efficiency: Some(0.5),
+            msaa: true,
+        }
+    }
+
+    #[test]
+    fn the_survey_has_every_pipeline_of_forwards_image_once_reference_last() {
+        let s = survey("cpu");
+        assert_eq!(s.len(), considered().len());
+        assert_eq!(s.last().unwrap().pipeline, REFERENCE);
+        assert!(s.iter().all(|c| !c.pipeline.ends_with("_mono")));
+        for c in &s {
+            let p = pipelines::find(c.pipeline).unwrap();
+            assert_eq!(c.tile.is_some(), p.uses_grid, "{}", c.pipeline);
+            assert_eq!(c.assign.is_some(), p.assign, "{}", c.pipeline);
+        }
+    }
+
+    #[test]
+    fn ranking_puts_the_fastest_correct_frames_first() {
+        let mut wrong = measured("tiled_forward", Some(16), 1.0, 10);
+        wrong.outcome = Outcome::Measured {
+            frame_ms: 1.0,
+            gpu_ms: None,
+            wrong_frames: 2,
+        };
+        let mut skipped = measured("forward", None, 0.5, 1);
+        skipped.outcome = Outcome::Skipped {
+            reason: "slow".into(),
+        };
+        let r = rank(vec![
+            skipped,
+            measured("deferred", None, 30.0, 50),
+            wrong,
+            measured("tiled_deferred", Some(16), 20.0, 40),
+            measured("clustered_forward", Some(16), 20.0, 30),
+        ]);
+        let order: Vec<&str> = r.iter().map(|m| m.candidate.pipeline).collect();
+        // Equal times: less memory first; wrong frames and skipped ones after the measured.
+        assert_eq!(
+            order,
+            vec![
+                "clustered_forward",
+                "tiled_deferred",
+                "deferred",
+                "forward",
+                "tiled_forward"
+            ]
+        );
+    }
+
+    #[test]
+    fn refinement_tries_tiles_then_strategies_of_the_top_grid_pipelines() {
+        let done = vec![
+            measured("tiled_deferred", Some(16), 10.0, 1),
+            measured("clustered_forward", Some(16), 12.0, 1),
+            measured("deferred", None, 11.0, 1),
+            measured("tiled_forward", Some(16), 13.0, 1),
+            measured("tiled_forward_prez", Some(16), 14.0, 1),
+        ];
+        let r = refine(&done);
+        let pipelines: std::collections::BTreeSet<&str> = r.iter().map(|c| c.pipeline).collect();
+        // The top three grid pipelines; `deferred` has no grid to refine.
+        assert_eq!(
+            pipelines,
+            ["clustered_forward", "tiled_deferred", "tiled_forward"].into()
+        );
+        assert!(r.iter().all(|c| !done.iter().any(|d| d.candidate == *c)));
+        assert!(r.contains(&Candidate {
+            pipeline: "tiled_deferred",
+            tile: Some(32),
+            assign: Some("cpu")
+        }));
+        assert!(r.contains(&Candidate {
+            pipeline: "tiled_deferred",
+            tile: Some(16),
+            assign: Some("gather")
+        }));
+        assert!(!r.iter().any(|c| c.assign == Some("auto")));
+    }
+
+    #[test]
+    fn the_recommendation_gives_its_reasons_against_the_runner_up() {
+        let r = rank(vec![
+            measured("forward", None, 400.0, 10 << 20),
+            measured("tiled_deferred", Some(16), 20.0, 40 << 20),
+            measured("clustered_forward", Some(32), 10.0, 20 << 20),
+        ]);
+        let rec = recommend(&r).unwrap();
+        assert_eq!(rec.candidate.pipeline, "clustered_forward");
+        assert_eq!(
+            rec.options,
+            "--pipeline clustered_forward --tile 32 --assign cpu"
+        );
+        let text = rec.reasons.join("\n");
+        assert!(
+            text.contains("2.00x the speed of the runner-up, tiled_deferred"),
+            "{text}"
+        );
+        assert!(
+            text.contains("40.0x faster than brute-force forward"),
+            "{text}"
+        );
+        assert!(text.contains("20.0 MiB"), "{text}");
+        assert!(text.contains("50% efficient"), "{text}");
+        // A tie is called a tie.
+        let r = rank(vec![
+            measured("tiled_deferred", Some(16), 10.2, 1),
+            measured("clustered_forward", Some(16), 10.0, 1),
+        ]);
+        assert!(recommend(&r).unwrap().reasons[1].contains("a tie"));
+        // Nothing measured: no recommendation.
+        let mut s = measured("forward", None, 1.0, 1);
+        s.outcome = Outcome::Failed { reason: "x".into() };
+        assert!(recommend(&[s]).is_none());
+    }
+}
