@@ -197,6 +197,23 @@ const CMDS: &[Cmd] = &[
         ],
     },
     Cmd {
+        name: "advise",
+        flags: &[
+            "--scene",
+            "--size",
+            "--budget",
+            "--add-lights",
+            "--spot-fraction",
+            "--lights",
+        ],
+        paths: &["--json"],
+        safe: &[
+            ("--size", "8x8"),
+            ("--budget", "1"),
+            ("--scene", "robots-few"),
+        ],
+    },
+    Cmd {
         name: "compare",
         flags: &[
             "--spot-fraction",
