@@ -42,6 +42,9 @@ fn pipeline_label(r: &RunRecord) -> String {
     if let Some(m) = r.msaa_resolve {
         label += &format!(" [{} resolve]", m.name());
     }
+    if let Some(b) = r.depth_bounds {
+        label += &format!(" [bounds {}]", b.name());
+    }
     label
 }
 
@@ -152,7 +155,7 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 31] = [
+const RESULTS_CSV_COLUMNS: [&str; 32] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
@@ -161,6 +164,7 @@ const RESULTS_CSV_COLUMNS: [&str; 31] = [
     "material_draws",
     "msaa",
     "msaa_resolve",
+    "depth_bounds",
     "width",
     "height",
     "tile_size",
@@ -198,6 +202,7 @@ struct ResultsRow<'a> {
     material_draws: Option<&'static str>,
     msaa: u32,
     msaa_resolve: Option<&'static str>,
+    depth_bounds: Option<&'static str>,
     width: u32,
     height: u32,
     tile_size: u32,
@@ -271,6 +276,7 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 material_draws: r.material_draws.map(|d| d.name()),
                 msaa: r.msaa,
                 msaa_resolve: r.msaa_resolve.map(|m| m.name()),
+                depth_bounds: r.depth_bounds.map(|b| b.name()),
                 width: r.width,
                 height: r.height,
                 tile_size: r.tile_size,

@@ -5,7 +5,7 @@ use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
 use lightgrid::culling::GridLists;
 use lightgrid::error::Result;
-use lightgrid::frame::{MaterialDraws, MsaaResolve};
+use lightgrid::frame::{DepthBounds, MaterialDraws, MsaaResolve};
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
@@ -132,6 +132,14 @@ pub struct BenchConfig {
     /// Lights scattered over every scene's bounds (`--add-lights`).
     #[serde(default)]
     pub add_lights: Option<AddLights>,
+    /// Which cell depth bounds grids built from depth cull by (`--depth-bounds`): every
+    /// pipeline with such a grid is measured once per entry.
+    #[serde(default = "default_depth_bounds")]
+    pub depth_bounds: Vec<DepthBounds>,
+}
+
+fn default_depth_bounds() -> Vec<DepthBounds> {
+    vec![DepthBounds::default()]
 }
 
 fn default_msaa_resolve() -> Vec<MsaaResolve> {
@@ -172,6 +180,7 @@ impl BenchConfig {
             || self.material_draws.is_empty()
             || self.msaa.is_empty()
             || self.msaa_resolve.is_empty()
+            || self.depth_bounds.is_empty()
         {
             return Err(invalid(
                 "bench",
@@ -410,6 +419,10 @@ pub struct RunRecord {
     /// Where the MSAA deferred kernel resolved (deferred grid pipelines above one sample).
     #[serde(default)]
     pub msaa_resolve: Option<MsaaResolve>,
+    /// The cell depth bounds culled by, when the run measured more than one
+    /// (`--depth-bounds`; pipelines whose grid is bounded by depth).
+    #[serde(default)]
+    pub depth_bounds: Option<DepthBounds>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -506,6 +519,8 @@ struct Series {
     msaa: u32,
     /// Where the MSAA deferred kernel resolves (recorded above one sample).
     msaa_resolve: Option<MsaaResolve>,
+    /// Which depth bounds the grid culls by; recorded when more than one is measured.
+    depth_bounds: DepthBounds,
     frames: Vec<u32>,
 }
 
@@ -518,6 +533,7 @@ struct Variant {
     material_draws: MaterialDraws,
     msaa: u32,
     msaa_resolve: Option<MsaaResolve>,
+    depth_bounds: DepthBounds,
 }
 
 fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
@@ -545,13 +561,16 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant
                         vec![None]
                     };
                     for msaa_resolve in resolves {
-                        out.push(Variant {
-                            spot_cull,
-                            lists,
-                            material_draws,
-                            msaa,
-                            msaa_resolve,
-                        });
+                        for &depth_bounds in used(&config.depth_bounds, info.depth_bounds) {
+                            out.push(Variant {
+                                spot_cull,
+                                lists,
+                                material_draws,
+                                msaa,
+                                msaa_resolve,
+                                depth_bounds,
+                            });
+                        }
                     }
                 }
             }
@@ -658,6 +677,7 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                         material_draws: v.material_draws,
                         msaa: v.msaa,
                         msaa_resolve: v.msaa_resolve,
+                        depth_bounds: v.depth_bounds,
                         frames: frames.clone(),
                     });
                 }
@@ -717,6 +737,7 @@ impl<'a> Measuring<'a> {
             material_draws: series.material_draws,
             msaa: series.msaa,
             msaa_resolve: series.msaa_resolve.unwrap_or_default(),
+            depth_bounds: series.depth_bounds,
         }
     }
 
@@ -770,6 +791,9 @@ impl<'a> Measuring<'a> {
         }
         if let Some(r) = series.msaa_resolve {
             cull += &format!(" {} resolve", r.name());
+        }
+        if self.config.depth_bounds.len() > 1 && info.depth_bounds {
+            cull += &format!(" bounds {}", series.depth_bounds.name());
         }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
@@ -902,6 +926,7 @@ impl RunRecord {
             material_draws: None,
             msaa: series.msaa,
             msaa_resolve: series.msaa_resolve,
+            depth_bounds: None,
             width: size.0,
             height: size.1,
             tile_size: tile,
@@ -1044,6 +1069,9 @@ impl PreparedBench {
             }
             if config.material_draws.len() > 1 && series.info.forward_shading {
                 record.material_draws = Some(series.material_draws);
+            }
+            if config.depth_bounds.len() > 1 && series.info.depth_bounds {
+                record.depth_bounds = Some(series.depth_bounds);
             }
             let mut bytes = (0, 0);
             let end = m.series(scene, series, &mut record, &mut bytes, &mut results);

@@ -41,6 +41,7 @@ fn config() -> BenchConfig {
         msaa: vec![1],
         msaa_resolve: vec![Default::default()],
         add_lights: None,
+        depth_bounds: vec![Default::default()],
         headlights: false,
         spot_culls: vec![Default::default()],
         transparency: true,

@@ -194,6 +194,7 @@ pub(crate) struct Given {
     /// `--msaa` above 1.
     pub(crate) msaa: bool,
     pub(crate) msaa_resolve: bool,
+    pub(crate) depth_bounds: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -204,7 +205,7 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 8] = [
+    let rules: [(&str, bool, Applies); 9] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
@@ -219,6 +220,7 @@ pub(crate) fn check_applies(
         ("--msaa-resolve", given.msaa_resolve, |p| {
             p.msaa == lightgrid::pipelines::Msaa::Supported && !p.forward_shading
         }),
+        ("--depth-bounds", given.depth_bounds, |p| p.depth_bounds),
     ];
     for (flag, given, applies) in rules {
         if given && !chosen.iter().any(|p| applies(p)) {
@@ -286,6 +288,32 @@ pub(crate) struct RendererArgs {
     /// frames with transparent objects resolve separately) [default: separate].
     #[arg(long, value_enum)]
     pub(crate) msaa_resolve: Option<MsaaResolveArg>,
+    /// Which cell depth bounds grids built from the depth buffer cull lights by: both, min
+    /// (far side open), max (near side open) or none (every cell spans its slice)
+    /// (tiled-forward-shading §4.4) [default: both].
+    #[arg(long, value_enum)]
+    pub(crate) depth_bounds: Option<DepthBoundsArg>,
+}
+
+/// `--depth-bounds` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum DepthBoundsArg {
+    Both,
+    Min,
+    Max,
+    None,
+}
+
+impl From<DepthBoundsArg> for lightgrid::frame::DepthBounds {
+    fn from(a: DepthBoundsArg) -> Self {
+        use lightgrid::frame::DepthBounds as D;
+        match a {
+            DepthBoundsArg::Both => D::Both,
+            DepthBoundsArg::Min => D::Min,
+            DepthBoundsArg::Max => D::Max,
+            DepthBoundsArg::None => D::None,
+        }
+    }
 }
 
 /// `--msaa-resolve` values.
@@ -329,6 +357,7 @@ impl RendererArgs {
             material_draws: self.material_draws.map(Into::into).unwrap_or_default(),
             msaa: self.msaa,
             msaa_resolve: self.msaa_resolve.map(Into::into).unwrap_or_default(),
+            depth_bounds: self.depth_bounds.map(Into::into).unwrap_or_default(),
         };
         check_msaa_resolve(self.msaa_resolve.is_some(), &[self.msaa])?;
         settings.validate()?;
@@ -346,6 +375,7 @@ impl RendererArgs {
             material_draws: self.material_draws.is_some(),
             msaa: self.msaa > 1,
             msaa_resolve: self.msaa_resolve.is_some(),
+            depth_bounds: self.depth_bounds.is_some(),
         }
     }
 }

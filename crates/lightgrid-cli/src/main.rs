@@ -101,6 +101,7 @@ fn main() {
                         material_draws: None,
                         msaa: 1,
                         msaa_resolve: None,
+                        depth_bounds: None,
                     },
                     warmup: 1,
                 },

@@ -185,6 +185,13 @@ pub const SCREEN_WORKGROUP: u32 = 8;
 /// `GridParams::lists` values (`frame::GridLists`): lists over opaque samples only, one list
 /// shared by opaque and transparent fragments, or separate lists (a second layer of cells).
 pub const GRID_LISTS_OPAQUE: u32 = 0;
+/// Which cell depth bounds light assignment uses (`--depth-bounds`; `DepthBounds` in
+/// `frame/settings.rs`): both, the minimum only (far side open), the maximum only (near side
+/// open), or none (every cell spans its slice).
+pub const DEPTH_BOUNDS_BOTH: u32 = 0;
+pub const DEPTH_BOUNDS_MIN: u32 = 1;
+pub const DEPTH_BOUNDS_MAX: u32 = 2;
+pub const DEPTH_BOUNDS_NONE: u32 = 3;
 pub const GRID_LISTS_SHARED: u32 = 1;
 pub const GRID_LISTS_SEPARATE: u32 = 2;
 
@@ -276,6 +283,10 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("EDGE_NORMAL_COS", WgslConst::F32(EDGE_NORMAL_COS)),
     ("EDGE_PLANE_SIN", WgslConst::F32(EDGE_PLANE_SIN)),
     ("GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
+    ("DEPTH_BOUNDS_BOTH", WgslConst::U32(DEPTH_BOUNDS_BOTH)),
+    ("DEPTH_BOUNDS_MIN", WgslConst::U32(DEPTH_BOUNDS_MIN)),
+    ("DEPTH_BOUNDS_MAX", WgslConst::U32(DEPTH_BOUNDS_MAX)),
+    ("DEPTH_BOUNDS_NONE", WgslConst::U32(DEPTH_BOUNDS_NONE)),
     (
         "MATERIAL_SHADER_STANDARD",
         WgslConst::U32(MATERIAL_SHADER_STANDARD),

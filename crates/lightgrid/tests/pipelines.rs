@@ -10,6 +10,7 @@
 mod common;
 
 use lightgrid::culling::{LightGrid, ViewSetup};
+use lightgrid::frame::DepthBounds;
 use lightgrid::image_io::{diff, save_png};
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::Assign;
@@ -539,7 +540,15 @@ fn check_assign(
     let grid = &out.grid;
     let near_far = id == "tiled_forward";
     if !near_far {
-        common::check_cell_bounds(&what, &setup, &grid.dims, &bounds, &out.depth, 2);
+        common::check_opened_cell_bounds(
+            &what,
+            &setup,
+            &grid.dims,
+            &bounds,
+            &out.depth,
+            2,
+            r.settings().depth_bounds,
+        );
     }
     common::check_grid_against_twin(
         &what,
@@ -641,6 +650,63 @@ fn strategies_at_odd_sizes_and_tiles() {
         8,
         &["tiled_forward_prez", "clustered_forward"],
     );
+}
+
+/// `--depth-bounds`: in every mode the GPU cell bounds equal their twin's opened bounds, the
+/// grid is its strategy's twin and holds every light the oracle finds, the image is the
+/// reference's, and opening the bounds never lowers the count (both <= min, max <= none),
+/// on a size and tile that do not divide.
+#[test]
+fn depth_bound_modes_open_the_bounds_and_keep_the_image() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h, frame) = (203, 117, 120);
+    let reference = Renderer::new(&ctx, w, h, settings(12))
+        .unwrap()
+        .render(&s, frame, REFERENCE)
+        .unwrap()
+        .image;
+    for id in ["tiled_forward_prez", "clustered_forward", "tiled_deferred"] {
+        let counts: Vec<u64> = DepthBounds::ALL
+            .iter()
+            .map(|&depth_bounds| {
+                for assign in [Assign::Cpu, Assign::Gather] {
+                    let settings = RenderSettings {
+                        tile_size: 12,
+                        slices: 16,
+                        assign,
+                        depth_bounds,
+                        ..Default::default()
+                    };
+                    let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
+                    check_assign(&mut r, &s, frame, id, &reference);
+                }
+                let mut r = Renderer::new(
+                    &ctx,
+                    w,
+                    h,
+                    RenderSettings {
+                        tile_size: 12,
+                        slices: 16,
+                        assign: Assign::Cpu,
+                        depth_bounds,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                let out = r.render(&s, frame, id).unwrap();
+                out.stats.lighting_computations.unwrap()
+            })
+            .collect();
+        let [both, min, max, none] = counts[..] else {
+            unreachable!()
+        };
+        assert!(
+            both <= min && both <= max && min <= none && max <= none,
+            "{id}: both {both}, min {min}, max {max}, none {none}"
+        );
+        assert!(none > both, "{id}: opening the bounds changed nothing");
+    }
 }
 
 /// Enough lights for a BVH with inner levels, a sort over several blocks and cells with

@@ -38,6 +38,8 @@ pub struct GridSetup<'a> {
     /// A forward pass shades the opaque geometry from this grid (with MSAA its fragments'
     /// distances go into the bounds: `fragment_bounds.rs`); deferred kernels shade samples.
     pub forward_opaque: bool,
+    /// Which side of the depth bounds assignment culls by (`--depth-bounds`).
+    pub depth_bounds: crate::frame::DepthBounds,
 }
 
 /// A built grid and what went into it (analysis).
@@ -90,7 +92,13 @@ impl GridBuilder {
             lists: ctx.lists,
             software_adapter: ctx.software_adapter,
             scene_layout: scene_layout.clone(),
-            bounds: CellBoundsPass::new(device, scene_layout, ctx.samples, ctx.forward_opaque),
+            bounds: CellBoundsPass::new(
+                device,
+                scene_layout,
+                ctx.samples,
+                ctx.forward_opaque,
+                ctx.depth_bounds,
+            ),
             buffers: GridBuffers::new(device),
             strategies: Vec::new(),
             last: None,

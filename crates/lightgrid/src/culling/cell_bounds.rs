@@ -8,15 +8,17 @@
 //!
 //! GPU kernel: `cell_bounds.wgsl`, one workgroup per tile. CPU twin: [`cell_bounds_cpu`].
 //! Without a depth pre-pass (`tiled_forward`) every cell gets `[near, far]` instead.
+//! `--depth-bounds` (`DepthBounds`) then opens one side of each occupied cell's bounds, or
+//! both sides of every cell, to the cell's slice: twin [`open_bounds`].
 
 use super::{GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
-use crate::frame::{FrameEncoder, FrameInputs};
+use crate::frame::{DepthBounds, FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
-pub(crate) fn shader(samples: u32) -> ComposedShader {
+pub(crate) fn shader(samples: u32, depth_bounds: DepthBounds) -> ComposedShader {
     compose(
         "cell_bounds",
         &[
@@ -24,9 +26,36 @@ pub(crate) fn shader(samples: u32) -> ComposedShader {
             src::SCENE_BINDINGS,
             src::GRID_CELL,
             &crate::shader::msaa_wgsl(samples),
+            &format!("const DEPTH_BOUNDS: u32 = {}u;\n", depth_bounds.id()),
             include_str!("cell_bounds.wgsl"),
         ],
     )
+}
+
+/// `--depth-bounds` applied to the opaque cells' `bounds` (as the kernel's `open_bounds`
+/// does): `Min` opens an occupied cell's far side to its slice's far end, `Max` its near
+/// side to the slice's near end, `None` gives every cell (occupied or not) its slice's
+/// whole range. Bounds only widen, so no light a cell's samples need is lost.
+pub fn open_bounds(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    depth_bounds: DepthBounds,
+    bounds: &mut [[f32; 2]],
+) {
+    if depth_bounds == DepthBounds::Both {
+        return;
+    }
+    for (cell, b) in bounds.iter_mut().enumerate().take(dims.layer_cells()) {
+        let [lo, hi] = dims.slice_range(dims.slice_of_cell(cell));
+        let span = [lo.max(setup.near), hi.min(setup.far)];
+        *b = match depth_bounds {
+            DepthBounds::Both => *b,
+            DepthBounds::None => bounds_union(*b, span),
+            _ if b[0] > b[1] => *b,
+            DepthBounds::Min => [b[0], b[1].max(span[1])],
+            DepthBounds::Max => [b[0].min(span[0]), b[1]],
+        };
+    }
 }
 
 /// The bounds of a cell without samples.
@@ -135,6 +164,7 @@ impl CellBoundsPass {
         scene_layout: &wgpu::BindGroupLayout,
         samples: u32,
         forward_opaque: bool,
+        depth_bounds: DepthBounds,
     ) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cell bounds (group 1)"),
@@ -147,7 +177,7 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(5, crate::gpu::STORAGE_READ),
             ],
         });
-        let s = shader(samples);
+        let s = shader(samples, depth_bounds);
         let layouts = [Some(scene_layout), Some(&layout)];
         let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);

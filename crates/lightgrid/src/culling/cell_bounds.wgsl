@@ -102,7 +102,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
                 write_bounds(grid.layer_cells + cell, bounds_union(t, fragment_range(grid.layer_cells + cell)));
             }
         }
-        write_bounds(cell, b);
+        write_bounds(cell, open_bounds(k, b));
     }
     check_loop(k, grid.slices);
 }
@@ -112,6 +112,41 @@ fn write_bounds(cell: u32, b: vec2<f32>) {
     if (b.x <= b.y) {
         occupied_cells[atomicAdd(&occupancy[0], 1u)] = cell;
     }
+}
+
+// `--depth-bounds` (DEPTH_BOUNDS, composed in by cell_bounds.rs): one side of an occupied
+// cell's bounds opened to its slice's end, or (none) every cell given its whole slice.
+// Twin: `open_bounds` in cell_bounds.rs.
+fn open_bounds(k: u32, b: vec2<f32>) -> vec2<f32> {
+    if (DEPTH_BOUNDS == DEPTH_BOUNDS_BOTH) {
+        return b;
+    }
+    let span = slice_span(k);
+    if (DEPTH_BOUNDS == DEPTH_BOUNDS_NONE) {
+        return bounds_union(b, span);
+    }
+    if (b.x > b.y) {
+        return b;
+    }
+    if (DEPTH_BOUNDS == DEPTH_BOUNDS_MIN) {
+        return vec2<f32>(b.x, max(b.y, span.y));
+    }
+    return vec2<f32>(min(b.x, span.x), b.y);
+}
+
+// The view-distance range of slice k, within near..far.
+fn slice_span(k: u32) -> vec2<f32> {
+    var lo = frame.near;
+    var hi = frame.far;
+    if (grid.slices > 1u) {
+        if (k > 0u) {
+            lo = max(lo, exp((f32(k) - grid.slice_bias) / grid.slice_scale));
+        }
+        if (k + 1u < grid.slices) {
+            hi = min(hi, exp((f32(k + 1u) - grid.slice_bias) / grid.slice_scale));
+        }
+    }
+    return vec2<f32>(lo, hi);
 }
 
 // Where transparent fragments of slice k can lie in a tile whose opaque maximum is

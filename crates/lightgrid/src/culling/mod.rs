@@ -25,7 +25,9 @@ pub use crate::scene::{ViewLight, ViewSetup};
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
 pub use builder::{BuiltGrid, CellSource, GridBuilder, GridSetup};
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
-pub use cell_bounds::{cell_bounds_cpu, cell_bounds_cpu_samples, CellBoundsPass, EMPTY_CELL};
+pub use cell_bounds::{
+    cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
+};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, GridLists, LightGrid};
@@ -45,8 +47,11 @@ pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
 /// Every assignment shader, for the validation test.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
     vec![
-        cell_bounds::shader(1),
-        cell_bounds::shader(4),
+        cell_bounds::shader(1, crate::frame::DepthBounds::Both),
+        cell_bounds::shader(4, crate::frame::DepthBounds::Both),
+        cell_bounds::shader(1, crate::frame::DepthBounds::Min),
+        cell_bounds::shader(1, crate::frame::DepthBounds::Max),
+        cell_bounds::shader(4, crate::frame::DepthBounds::None),
         fragment_bounds::shader(),
         scan::shader(),
         radix_sort::shader(),

@@ -24,6 +24,57 @@ pub struct RenderSettings {
     pub msaa: u32,
     /// Where the MSAA deferred kernels resolve (`--msaa-resolve`).
     pub msaa_resolve: MsaaResolve,
+    /// Which cell depth bounds light assignment uses (`--depth-bounds`), for grids built
+    /// from the depth buffer.
+    pub depth_bounds: DepthBounds,
+}
+
+/// The cell depth bounds light assignment culls by, for grids built from a depth buffer
+/// (tiled-forward-shading §4.4 measures no pre-Z → pre-Z → pre-Z + bounds as 22.4 → 15.6 →
+/// 10.9 ms; §4.4 and §4.8 note that one side of the bounds can be enough).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DepthBounds {
+    /// `[min, max]` of the cell's samples (Forward+'s tile depth bounds).
+    #[default]
+    Both,
+    /// `[min, slice far]`: lights behind every sample are culled, those in front are not.
+    Min,
+    /// `[slice near, max]`: lights in front of every sample are culled (the far side only
+    /// bounds what the depth buffer hides).
+    Max,
+    /// Every cell spans its slice (`[near, far]` for a tile), occupied or not: the grid a
+    /// pre-Z pass would build without reading depth.
+    None,
+}
+
+impl DepthBounds {
+    pub const ALL: [DepthBounds; 4] = [
+        DepthBounds::Both,
+        DepthBounds::Min,
+        DepthBounds::Max,
+        DepthBounds::None,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            DepthBounds::Both => "both",
+            DepthBounds::Min => "min",
+            DepthBounds::Max => "max",
+            DepthBounds::None => "none",
+        }
+    }
+
+    /// The WGSL constant (`consts::DEPTH_BOUNDS_*`).
+    pub fn id(self) -> u32 {
+        use crate::consts::*;
+        match self {
+            DepthBounds::Both => DEPTH_BOUNDS_BOTH,
+            DepthBounds::Min => DEPTH_BOUNDS_MIN,
+            DepthBounds::Max => DEPTH_BOUNDS_MAX,
+            DepthBounds::None => DEPTH_BOUNDS_NONE,
+        }
+    }
 }
 
 /// Where the edge-aware MSAA kernels of tiled and clustered deferred resolve their samples.
@@ -84,6 +135,7 @@ impl Default for RenderSettings {
             material_draws: MaterialDraws::PerMaterial,
             msaa: 1,
             msaa_resolve: MsaaResolve::Separate,
+            depth_bounds: DepthBounds::Both,
         }
     }
 }

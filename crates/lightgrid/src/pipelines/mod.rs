@@ -44,6 +44,7 @@ impl PipelineContext<'_> {
             lists: self.settings.lists,
             samples: self.settings.msaa,
             forward_opaque: true,
+            depth_bounds: self.settings.depth_bounds,
         }
     }
 }
@@ -95,6 +96,9 @@ pub struct PipelineInfo {
     pub assign: bool,
     /// Its grid is clustered: `--slices` view-depth slices per tile.
     pub clustered: bool,
+    /// Its grid's cells are bounded by the depth of their samples (a depth pre-pass or a
+    /// G-buffer read before assignment): `--depth-bounds` chooses which side it culls by.
+    pub depth_bounds: bool,
     /// Shades the opaque geometry in a forward pass, a pipeline per material shader
     /// (`--material-draws`; every pipeline's transparent pass does too).
     pub forward_shading: bool,
@@ -138,6 +142,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: true,
         clustered: false,
+        depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
         shaders: forward::shaders,
@@ -152,6 +157,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: true,
         clustered: false,
+        depth_bounds: false,
         reference: "forward_mono",
         msaa: Msaa::Supported,
         shaders: forward::shaders,
@@ -166,6 +172,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: true,
         forward_shading: true,
         clustered: false,
+        depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
         shaders: tiled_forward::shaders,
@@ -180,6 +187,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: true,
         forward_shading: true,
         clustered: false,
+        depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
         shaders: tiled_forward::shaders,
@@ -194,6 +202,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: true,
         forward_shading: false,
         clustered: false,
+        depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
         shaders: tiled_deferred::shaders,
@@ -208,6 +217,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: false,
         clustered: false,
+        depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Refused("its one kernel shades one sample per invocation; edge-aware per-sample shading is implemented in tiled_deferred and clustered_deferred"),
         shaders: tiled_deferred::shaders_single,
@@ -222,6 +232,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: true,
         forward_shading: true,
         clustered: true,
+        depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
         shaders: tiled_forward::shaders,
@@ -236,6 +247,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: true,
         forward_shading: false,
         clustered: true,
+        depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
         shaders: tiled_deferred::shaders,
@@ -250,6 +262,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: false,
         clustered: false,
+        depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: deferred::shaders,
@@ -264,6 +277,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: false,
         clustered: false,
+        depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: deferred::shaders,
@@ -278,6 +292,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: false,
         clustered: false,
+        depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: light_prepass::shaders,
@@ -292,6 +307,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         assign: false,
         forward_shading: false,
         clustered: false,
+        depth_bounds: false,
         reference: "forward_mono",
         msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
         shaders: light_prepass::shaders,

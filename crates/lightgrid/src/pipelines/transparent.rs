@@ -76,6 +76,8 @@ impl TransparentPass {
                 assign: Assign::Gather,
                 lists: GridLists::Shared,
                 forward_opaque: false,
+                // Not the technique's grid: `--depth-bounds` is about that one.
+                depth_bounds: crate::frame::DepthBounds::Both,
                 ..ctx.grid_setup()
             },
             1,

@@ -344,7 +344,29 @@ pub fn check_cell_bounds(
     depth: &[f32],
     max_occupancy_differences: usize,
 ) {
-    let cpu = cell_bounds_cpu(setup, dims, depth);
+    check_opened_cell_bounds(
+        what,
+        setup,
+        dims,
+        bounds,
+        depth,
+        max_occupancy_differences,
+        lightgrid::frame::DepthBounds::Both,
+    )
+}
+
+/// [`check_cell_bounds`] with `--depth-bounds` applied to the twin (`open_bounds`).
+pub fn check_opened_cell_bounds(
+    what: &str,
+    setup: &ViewSetup,
+    dims: &GridDims,
+    bounds: &[[f32; 2]],
+    depth: &[f32],
+    max_occupancy_differences: usize,
+    depth_bounds: lightgrid::frame::DepthBounds,
+) {
+    let mut cpu = cell_bounds_cpu(setup, dims, depth);
+    lightgrid::culling::open_bounds(setup, dims, depth_bounds, &mut cpu);
     assert_eq!(bounds.len(), cpu.len(), "{what}: cell count");
     let mut emptiness = 0;
     let near = |a: f32, b: f32, rel: f32| (a - b).abs() <= rel * b.abs();
