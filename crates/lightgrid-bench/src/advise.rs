@@ -6,9 +6,11 @@
 //!
 //! Steps, within a wall-clock budget:
 //! 1. **Survey**: every pipeline that reproduces `forward`'s image, at the default tile and
-//!    the `auto` strategy, brute-force `forward` last (it is the reference, rarely the answer).
+//!    the `auto` strategy, but brute-force `forward` itself.
 //! 2. **Refine**: for the fastest grid pipelines of the survey, the other tile sizes and then
 //!    the other assignment strategies at their best tile.
+//! 3. **Reference**: `forward` last, with what is left of the budget (it is the baseline the
+//!    reasons compare with, rarely the answer, and the slowest by far on many lights).
 //!
 //! Each candidate plays a few frames spread over the animation on the real-time path
 //! (`realtime::play`, the same frame loop `lightgrid play` and the viewer use) after one
@@ -140,19 +142,25 @@ pub fn considered() -> Vec<&'static PipelineInfo> {
         .collect()
 }
 
-/// Step 1: every considered pipeline at the default tile and `auto`, the reference last.
+/// Step 1: every considered pipeline but the reference at the default tile and `auto`.
 pub fn survey(assign_auto: &'static str) -> Vec<Candidate> {
-    let mut out: Vec<Candidate> = considered()
+    considered()
         .into_iter()
+        .filter(|p| p.id != REFERENCE)
         .map(|p| Candidate {
             pipeline: p.id,
             tile: p.uses_grid.then_some(lightgrid::consts::DEFAULT_TILE_SIZE),
             assign: p.assign.then_some(assign_auto),
         })
-        .collect();
-    out.sort_by_key(|c| c.pipeline == REFERENCE);
-    out
+        .collect()
 }
+
+/// Step 3: brute force, the baseline.
+pub const REFERENCE_CANDIDATE: Candidate = Candidate {
+    pipeline: REFERENCE,
+    tile: None,
+    assign: None,
+};
 
 /// Step 2: for the fastest `REFINE_TOP` grid pipelines measured so far, the other tiles at
 /// their strategy, then the other strategies at their best tile. Candidates already in
@@ -329,19 +337,20 @@ pub fn advise(
         .collect();
     let mut done: Vec<Measurement> = Vec::new();
     let mut queue = survey(auto);
-    let mut refined = false;
-    let mut total = queue.len() as u64;
+    // The steps after the survey, made from what it measured when it is done.
+    let mut next_steps = 2;
+    let mut total = queue.len() as u64 + 1;
     loop {
         let Some(c) = (!queue.is_empty()).then(|| queue.remove(0)) else {
-            if refined {
-                break;
+            match next_steps {
+                2 => {
+                    queue = refine(&done);
+                    total += queue.len() as u64;
+                }
+                1 => queue = vec![REFERENCE_CANDIDATE],
+                _ => break,
             }
-            refined = true;
-            queue = refine(&done);
-            total += queue.len() as u64;
-            if queue.is_empty() {
-                break;
-            }
+            next_steps -= 1;
             continue;
         };
         progress(&Progress {
@@ -504,10 +513,10 @@ mod tests {
     }
 
     #[test]
-    fn the_survey_has_every_pipeline_of_forwards_image_once_reference_last() {
+    fn the_survey_has_every_pipeline_of_forwards_image_once_but_the_reference() {
         let s = survey("cpu");
-        assert_eq!(s.len(), considered().len());
-        assert_eq!(s.last().unwrap().pipeline, REFERENCE);
+        assert_eq!(s.len(), considered().len() - 1);
+        assert!(s.iter().all(|c| c.pipeline != REFERENCE));
         assert!(s.iter().all(|c| !c.pipeline.ends_with("_mono")));
         for c in &s {
             let p = pipelines::find(c.pipeline).unwrap();

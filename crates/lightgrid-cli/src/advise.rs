@@ -112,7 +112,12 @@ fn print_table(advice: &Advice) {
             m.candidate.label(),
             ms,
             gpu,
-            format!("{:.1} MiB", m.memory_bytes as f64 / f64::from(1u32 << 20)),
+            match m.outcome {
+                Outcome::Measured { .. } => {
+                    format!("{:.1} MiB", m.memory_bytes as f64 / f64::from(1u32 << 20))
+                }
+                _ => "-".into(),
+            },
             m.efficiency
                 .map_or("-".into(), |e| format!("{:.0}%", e * 100.0)),
             note,
