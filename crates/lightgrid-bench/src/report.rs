@@ -889,7 +889,7 @@ mod tests {
         let row = text.lines().nth(1).unwrap();
         assert_eq!(
             row,
-            ",,16,,,,0,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,,gbuffer=0.1000;shade=0.2000"
+            ",,16,,,,0,,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,,gbuffer=0.1000;shade=0.2000"
         );
         let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
         assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);
