@@ -339,6 +339,8 @@ pub fn advise(
     let mut queue = survey(auto);
     // The steps after the survey, made from what it measured when it is done.
     let mut next_steps = 2;
+    // The shortest whole measurement so far (renderer, warm-up, frames, analysis).
+    let mut quickest: Option<Duration> = None;
     let mut total = queue.len() as u64 + 1;
     loop {
         let Some(c) = (!queue.is_empty()).then(|| queue.remove(0)) else {
@@ -361,10 +363,17 @@ pub fn advise(
         let left = plan.budget.saturating_sub(start.elapsed());
         let m = if stop.load(std::sync::atomic::Ordering::Relaxed) {
             skipped(plan, c, "interrupted".into())
-        } else if left.is_zero() {
+        } else if left.is_zero() || quickest.is_some_and(|q| left < q) {
+            // Not even the quickest candidate so far would fit in what is left.
             skipped(plan, c, "the budget was spent".into())
         } else {
-            measure(ctx, plan, c, &frames, left, stop)
+            let t = Instant::now();
+            let m = measure(ctx, plan, c, &frames, left, stop);
+            if matches!(m.outcome, Outcome::Measured { .. }) {
+                let took = t.elapsed();
+                quickest = Some(quickest.map_or(took, |q| q.min(took)));
+            }
+            m
         };
         done.push(m);
     }
