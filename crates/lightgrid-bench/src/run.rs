@@ -92,6 +92,9 @@ pub struct BenchConfig {
     pub lights: Option<u32>,
     /// Frame whose lights-per-tile heatmap goes into the report (None: the middle one).
     pub heatmap_frame: Option<u32>,
+    /// The heatmap's scale: 0 to this many lights (None: the frame's own maximum).
+    #[serde(default)]
+    pub heatmap_max: Option<u32>,
     /// Fraction of each scene's lights made spots (`--spot-fraction`).
     #[serde(default)]
     pub spot_fraction: f32,
@@ -823,7 +826,12 @@ impl<'a> Measuring<'a> {
             let heatmaps = &mut results.heatmaps;
             if f == heatmap_frame && wants_heatmap && !heatmaps.iter().any(|h| h.0 == scene.name) {
                 let view_distance = out.view_distances();
-                let map = lightgrid::heatmap::heatmap(&out.image, &out.grid, Some(&view_distance));
+                let map = lightgrid::heatmap::heatmap_scaled(
+                    &out.image,
+                    &out.grid,
+                    Some(&view_distance),
+                    self.config.heatmap_max,
+                );
                 heatmaps.push((scene.name.clone(), info.id.to_string(), f, map));
             }
             let tested = |t: &SpotRayTest| t.scene == scene.name && t.frame == f;

@@ -38,6 +38,11 @@ pub(crate) enum Preset {
     /// translucent blocks, 32-pixel tiles, frames 0..119 every 10: the top-down view favours
     /// tiles, the first-person view clusters, and clusters depend less on the view.
     Clustered,
+    /// The Forward+ demo (forward-plus §5): `scattered` with its 3,072 moving lights at
+    /// 1280x720 (640x360 on a software adapter), 8x8 tiles, Forward+ (tiled forward with
+    /// pre-Z) beside tiled deferred, deferred and deferred lighting, frames 0..259 every 20,
+    /// the lights-per-tile heatmap on Fig. 2(b)'s fixed 0 to 50 scale.
+    ForwardPlus,
     /// Depth bounds (tiled-forward-shading §4.4, 22.4 → 15.6 → 10.9 ms): tiled forward
     /// without pre-Z, then tiled and clustered forward with pre-Z culling by no bounds, the
     /// minimum only, the maximum only and both, on robots-many, frames 0..259 every 20,
@@ -133,6 +138,11 @@ pub(crate) struct BenchArgs {
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
+    /// The heatmap's colour scale: 0 to N lights per tile, 1 to 1000000, counts above N
+    /// shown as N (default: each frame's own maximum; the forward-plus preset: 50, as
+    /// Forward+ Fig. 2(b)).
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub(crate) heatmap_max: Option<u32>,
     /// Output directory (created; files an earlier run wrote there and this one does not are
     /// removed; two runs into one directory at once are refused).
     #[arg(long, default_value = "bench")]
@@ -144,6 +154,9 @@ pub(crate) struct ReportArgs {
     /// The benchmark directory (reads results.json, writes the report files next to it).
     pub(crate) dir: PathBuf,
 }
+
+/// Forward+ Fig. 2(b)'s lights-per-tile scale (the forward-plus preset's heatmap).
+const FORWARD_PLUS_HEATMAP_MAX: u32 = 50;
 
 /// What a preset (or no preset) sets before explicit flags override it.
 pub(crate) struct BenchDefaults {
@@ -292,6 +305,21 @@ pub(crate) fn bench_config(
             tile: Some(32),
             depth_bounds: vec![Default::default()],
         },
+        Some(Preset::ForwardPlus) => BenchDefaults {
+            scenes: vec!["scattered"],
+            size: Some(if hardware { (1280, 720) } else { (640, 360) }),
+            pipelines: [
+                "tiled_forward_prez",
+                "tiled_deferred",
+                "deferred",
+                "light_prepass",
+            ]
+            .map(String::from)
+            .to_vec(),
+            // forward-plus §5: 8x8 tiles.
+            tile: Some(8),
+            ..study(hardware, |_| false)
+        },
         Some(Preset::DepthBounds) => BenchDefaults {
             pipelines: ["tiled_forward", "tiled_forward_prez", "clustered_forward"]
                 .map(String::from)
@@ -354,6 +382,9 @@ pub(crate) fn bench_config(
         seed: a.seed,
         lights: a.lights,
         heatmap_frame: a.heatmap_frame,
+        heatmap_max: a
+            .heatmap_max
+            .or(matches!(a.preset, Some(Preset::ForwardPlus)).then_some(FORWARD_PLUS_HEATMAP_MAX)),
         spot_fraction: a.spot_fraction.map_or(d.spot_fraction, |f| f as f32),
         headlights: a.headlights,
         spot_culls: if a.spot_cull.is_empty() {

@@ -34,6 +34,10 @@ pub(crate) struct RenderArgs {
     /// without a CPU grid the depth-bounded grid used for the ideal count.
     #[arg(long)]
     pub(crate) heatmap: Option<PathBuf>,
+    /// The heatmap's colour scale: 0 to N lights per cell, 1 to 1000000 (default: the
+    /// frame's own maximum); Forward+ Fig. 2(b) uses 50.
+    #[arg(long, allow_hyphen_values = true, requires = "heatmap", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub(crate) heatmap_max: Option<u32>,
 }
 
 pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
@@ -73,7 +77,12 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     }
     if let Some(path) = &a.heatmap {
         let view_distance = out.view_distances();
-        let map = lightgrid::heatmap::heatmap(&out.image, &out.grid, Some(&view_distance));
+        let map = lightgrid::heatmap::heatmap_scaled(
+            &out.image,
+            &out.grid,
+            Some(&view_distance),
+            a.heatmap_max,
+        );
         writes.push((path, encode_png(&map, path)?));
     }
     if let Some(path) = &a.stats {

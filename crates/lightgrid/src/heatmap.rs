@@ -63,11 +63,25 @@ const LEGEND_MIN_WIDTH: u32 = 96;
 /// `view_distance`: the frame's per-pixel view distance (infinite for no sample), which a
 /// clustered grid's view needs to find each pixel's cluster.
 pub fn heatmap(frame: &RgbaImage, grid: &LightGrid, view_distance: Option<&[f32]>) -> RgbaImage {
+    heatmap_scaled(frame, grid, view_distance, None)
+}
+
+/// [`heatmap`] on a fixed scale `0..=max` (counts above it show as the top of the ramp), so
+/// frames and runs compare by colour (Forward+ Fig. 2(b) uses 0 to 50); `None`: the frame's
+/// own maximum.
+pub fn heatmap_scaled(
+    frame: &RgbaImage,
+    grid: &LightGrid,
+    view_distance: Option<&[f32]>,
+    max: Option<u32>,
+) -> RgbaImage {
     let (w, h) = frame.dimensions();
     let scale = (w / 320).max(1);
     let legend_h = 14 * scale;
     let counts = cell_counts(grid, view_distance);
-    let max = counts.iter().copied().max().unwrap_or(0).max(1);
+    let max = max
+        .unwrap_or_else(|| counts.iter().copied().max().unwrap_or(0))
+        .max(1);
     let tinted = tint(frame, &counts, max, grid.dims.tile_size);
     // The legend needs room for its bar and two numbers: frames narrower than that get a
     // black margin on the right instead of a legend drawn off the image.

@@ -278,3 +278,37 @@ fn geometry_runs_are_grouped_by_material_shader() {
         }
     }
 }
+
+/// `scattered`'s lights move as in the Forward+ demo: at frame 0 where they were placed, then
+/// each around a circle of its own (never further than its diameter from the start), all of
+/// them moving, the geometry unchanged.
+#[test]
+fn scattered_lights_circle_from_their_places() {
+    use lightgrid::scene::LightAnchor;
+    let scene = catalog::build("scattered", &SceneParams::default()).unwrap();
+    let start = scene.frame(0);
+    for f in [1, 45, 130, 259] {
+        let state = scene.frame(f);
+        let mut moved = 0;
+        for ((l, now), then) in scene.lights.iter().zip(&state.lights).zip(&start.lights) {
+            let LightAnchor::Circle { radius, .. } = l.anchor else {
+                panic!("every scattered light moves")
+            };
+            assert_eq!(then.position, l.light.position, "frame 0 is the placement");
+            let d = now.position - then.position;
+            assert!(d.y.abs() < 1e-4, "lights circle a vertical axis");
+            assert!(
+                d.length() <= 2.0 * radius + 1e-3,
+                "frame {f}: {d} off a {radius} circle"
+            );
+            moved += usize::from(d.length() > 1e-3);
+            assert_eq!((now.range, now.intensity), (then.range, then.intensity));
+        }
+        assert_eq!(moved, scene.lights.len(), "frame {f}: every light moved");
+    }
+    assert_eq!(
+        start.transforms,
+        scene.frame(259).transforms,
+        "the geometry stays put"
+    );
+}

@@ -344,6 +344,28 @@ pub enum LightAnchor {
     World,
     /// Offset from the object's motion frame.
     Object(usize),
+    /// Circling a vertical axis: at frame 0 where `light.position` says, then around a
+    /// circle of `radius` through it, a turn every `frames_per_turn` frames, the axis at
+    /// angle `phase` from it (the Forward+ demo's moving lights).
+    Circle {
+        radius: f32,
+        frames_per_turn: f32,
+        phase: f32,
+    },
+}
+
+/// Where a light on [`LightAnchor::Circle`] is at `frame`, starting at `start`.
+pub fn circle_position(
+    start: Vec3,
+    radius: f32,
+    frames_per_turn: f32,
+    phase: f32,
+    frame: u32,
+) -> Vec3 {
+    let turn = std::f32::consts::TAU * frame as f32 / frames_per_turn.max(1.0);
+    let at = |a: f32| Vec3::new(a.cos(), 0.0, a.sin()) * radius;
+    // The offset first, so frame 0 is exactly the start.
+    start + (at(phase + turn) - at(phase))
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -488,6 +510,20 @@ impl Scene {
             .iter()
             .map(|l| match l.anchor {
                 LightAnchor::World => l.light,
+                LightAnchor::Circle {
+                    radius,
+                    frames_per_turn,
+                    phase,
+                } => Light {
+                    position: circle_position(
+                        l.light.position,
+                        radius,
+                        frames_per_turn,
+                        phase,
+                        frame,
+                    ),
+                    ..l.light
+                },
                 LightAnchor::Object(o) => Light {
                     position: motion[o].transform_point3(l.light.position),
                     spot: l.light.spot.map(|s| Spot {

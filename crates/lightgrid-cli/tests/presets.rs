@@ -1,0 +1,140 @@
+//! The benchmark presets of issue 17 at smoke size: each runs, measures what it is for and
+//! writes its claims with evidence.
+
+mod support;
+
+use support::{assert_fails_with, lightgrid, stderr, temp_dir};
+
+fn bench(args: &[&str]) -> std::path::PathBuf {
+    let dir = temp_dir(&format!("preset-{}", args[1]));
+    let out = dir.join("b");
+    let mut all = vec!["bench"];
+    all.extend(args);
+    all.extend(["--out", out.to_str().unwrap()]);
+    let o = lightgrid(&all);
+    assert!(o.status.success(), "{all:?}: {}", stderr(&o));
+    out
+}
+
+#[test]
+fn depth_bounds_preset_measures_every_step_and_checks_its_claims() {
+    let out = bench(&[
+        "--preset",
+        "depth-bounds",
+        "--size",
+        "96x54",
+        "--frames",
+        "0..259:130",
+    ]);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|c| *c == "depth_bounds").unwrap();
+    let pipe = header.iter().position(|c| *c == "pipeline").unwrap();
+    let mut seen = std::collections::BTreeSet::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        seen.insert((f[pipe].to_string(), f[col].to_string()));
+    }
+    for p in ["tiled_forward_prez", "clustered_forward"] {
+        for b in ["both", "min", "max", "none"] {
+            assert!(
+                seen.contains(&(p.to_string(), b.to_string())),
+                "{p} {b}: {seen:?}"
+            );
+        }
+    }
+    assert!(seen.contains(&("tiled_forward".to_string(), String::new())));
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for claim in [
+        "A depth pre-pass alone makes tiled forward shading faster",
+        "Depth bounds after the pre-pass make it faster again",
+        "One side of the depth bounds (min or max only) is enough",
+        "With clusters too, one side of the depth bounds",
+    ] {
+        let line = summary
+            .lines()
+            .find(|l| l.contains(claim))
+            .unwrap_or_else(|| panic!("no claim '{claim}' in summary.md"));
+        assert!(line.contains("avg ms"), "{line}");
+        assert!(!line.contains("not measured"), "{line}");
+    }
+    assert!(
+        summary.contains("tiled_forward_prez [bounds min]"),
+        "series rows are labelled"
+    );
+}
+
+#[test]
+fn forward_plus_preset_draws_the_heatmap_on_the_papers_scale() {
+    let out = bench(&[
+        "--preset",
+        "forward-plus",
+        "--size",
+        "96x54",
+        "--frames",
+        "0..259:259",
+    ]);
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(v["config"]["heatmap_max"], 50);
+    assert_eq!(v["config"]["tile_size"], 8);
+    assert_eq!(v["config"]["scenes"][0], "scattered");
+    let runs = v["runs"].as_array().unwrap();
+    assert!(runs.iter().any(|r| r["pipeline"] == "tiled_forward_prez"));
+    let heatmap = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            p.file_name()
+                .unwrap()
+                .to_str()
+                .unwrap()
+                .starts_with("heatmap_scattered")
+        })
+        .expect("a heatmap");
+    let img = image::open(heatmap).unwrap().to_rgba8();
+    assert_eq!(img.width(), 96, "the frame's width (the legend fits)");
+}
+
+#[test]
+fn a_fixed_heatmap_scale_changes_the_colours_and_is_checked() {
+    let dir = temp_dir("heatmap-max");
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    for (path, max) in [(&a, None), (&b, Some("5"))] {
+        let mut args = vec![
+            "render",
+            "--scene",
+            "robots-few",
+            "--pipeline",
+            "tiled_deferred",
+            "--size",
+            "64x36",
+            "--heatmap",
+            path.to_str().unwrap(),
+        ];
+        if let Some(m) = max {
+            args.extend(["--heatmap-max", m]);
+        }
+        let o = lightgrid(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert_ne!(
+        image::open(&a).unwrap().to_rgba8(),
+        image::open(&b).unwrap().to_rgba8(),
+        "a scale of 5 saturates what the frame's own maximum does not"
+    );
+    for bad in ["0", "-1", "NaN", "1000001"] {
+        assert_fails_with(
+            &[
+                "render",
+                "--heatmap",
+                a.to_str().unwrap(),
+                "--heatmap-max",
+                bad,
+            ],
+            "--heatmap-max",
+        );
+    }
+    assert_fails_with(&["render", "--heatmap-max", "50"], "--heatmap");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
