@@ -425,7 +425,120 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
     }
     out.extend(view_dependence(r));
     out.extend(depth_bound_claims(r));
+    out.extend(range_claims(r));
     out
+}
+
+/// tiled-forward-shading Fig. 4.2(a) over a `--range-scale` sweep: as the lights grow, the
+/// tiles list more of them until tiling culls nothing, and the gain over brute force shrinks.
+fn range_claims(r: &BenchResults) -> Vec<Claim> {
+    use crate::run::RANGE_SUFFIX;
+    let mut bases: Vec<&str> = r
+        .runs
+        .iter()
+        .filter_map(|x| x.scene.split_once(RANGE_SUFFIX).map(|(b, _)| b))
+        .collect();
+    bases.dedup();
+    let mut out = Vec::new();
+    for base in bases {
+        // (factor, run name) in factor order.
+        let mut scenes: Vec<(f64, String)> = r
+            .runs
+            .iter()
+            .filter_map(|x| {
+                let f = x.scene.strip_prefix(base)?.strip_prefix(RANGE_SUFFIX)?;
+                Some((f.parse::<f64>().ok()?, x.scene.clone()))
+            })
+            .collect();
+        scenes.sort_by(|a, b| a.0.total_cmp(&b.0));
+        scenes.dedup();
+        let mut listed = Vec::new();
+        let mut speedups = Vec::new();
+        for (f, scene) in &scenes {
+            let tiled = find(r, scene, "tiled_deferred", None);
+            let share = tiled.and_then(|t| {
+                Some(t.summary.as_ref()?.lights_per_tile_avg? / f64::from(t.lights?.max(1)))
+            });
+            if let Some(s) = share {
+                listed.push((*f, s));
+            }
+            let ms = |p| find(r, scene, p, None).and_then(avg_ms);
+            if let (Some(fw), Some(t)) = (ms("forward"), ms("tiled_deferred")) {
+                speedups.push((*f, fw / t.max(1e-9)));
+            }
+        }
+        let mut claim = |statement, (evidence, verdict): (String, Verdict)| {
+            out.push(Claim {
+                scene: format!(
+                    "{base} (light ranges x{})",
+                    scenes
+                        .iter()
+                        .map(|s| s.0.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", x")
+                ),
+                statement,
+                source: "tiled-forward-shading §4.2, Fig. 4.2(a)",
+                evidence,
+                verdict,
+            })
+        };
+        claim(
+            "Lights too large leave nothing to cull: as the ranges grow every tile lists more of the lights, until (almost: 90%) all of them",
+            if listed.len() >= 2 {
+                tiles_fill_up(&listed)
+            } else {
+                not_measured("tiled_deferred at two or more --range-scale factors")
+            },
+        );
+        claim(
+            "The gain of tiled shading over brute force shrinks as the lights grow",
+            if speedups.len() >= 2 {
+                gain_shrinks(&speedups)
+            } else {
+                not_measured("forward and tiled_deferred at two or more --range-scale factors")
+            },
+        );
+    }
+    out
+}
+
+/// The share of all lights an average tile lists, per range factor: it must not fall as the
+/// factor grows (within 2%), and reach [`ALL_LIGHTS`] at the largest.
+pub fn tiles_fill_up(share: &[(f64, f64)]) -> (String, Verdict) {
+    let rising = share.windows(2).all(|w| w[1].1 >= w[0].1 * 0.98);
+    let last = share.last().map_or(0.0, |s| s.1);
+    (
+        format!(
+            "lights per tile / all lights: {}",
+            share
+                .iter()
+                .map(|(f, s)| format!("x{f} {:.1}%", s * 100.0))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        verdict(rising && last >= ALL_LIGHTS),
+    )
+}
+
+/// "Almost all" the lights of the scene in an average tile's list.
+pub const ALL_LIGHTS: f64 = 0.9;
+
+/// The speed-up of tiled deferred over forward, per range factor: it must not grow as the
+/// factor grows (within 5%: frame-time noise).
+pub fn gain_shrinks(speedup: &[(f64, f64)]) -> (String, Verdict) {
+    let falling = speedup.windows(2).all(|w| w[1].1 <= w[0].1 * 1.05);
+    (
+        format!(
+            "forward ms / tiled_deferred ms: {}",
+            speedup
+                .iter()
+                .map(|(f, s)| format!("x{f} {s:.1}x"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        verdict(falling),
+    )
 }
 
 /// tiled-forward-shading §4.4's steps (no pre-Z → pre-Z → pre-Z + depth bounds: 22.4 →
@@ -783,6 +896,25 @@ mod tests {
 
     fn rows(v: &[(&str, f64)]) -> Vec<(String, f64)> {
         v.iter().map(|(p, m)| (p.to_string(), *m)).collect()
+    }
+
+    #[test]
+    fn range_sweep_claims_on_both_sides() {
+        let full = [(0.5, 0.01), (1.0, 0.03), (4.0, 0.5), (16.0, 0.92)];
+        assert_eq!(tiles_fill_up(&full).1, Verdict::Held);
+        // Not reaching all the lights, or falling on the way, does not hold.
+        assert_eq!(tiles_fill_up(&full[..3]).1, Verdict::NotHeld);
+        assert_eq!(
+            tiles_fill_up(&[(1.0, 0.5), (2.0, 0.3), (4.0, 0.95)]).1,
+            Verdict::NotHeld
+        );
+        assert!(tiles_fill_up(&full).0.contains("x16 92.0%"));
+        let shrinking = [(0.5, 50.0), (1.0, 32.0), (2.0, 32.5), (16.0, 2.1)];
+        assert_eq!(gain_shrinks(&shrinking).1, Verdict::Held);
+        assert_eq!(
+            gain_shrinks(&[(1.0, 10.0), (2.0, 12.0)]).1,
+            Verdict::NotHeld
+        );
     }
 
     #[test]

@@ -95,6 +95,11 @@ pub struct BenchConfig {
     /// The heatmap's scale: 0 to this many lights (None: the frame's own maximum).
     #[serde(default)]
     pub heatmap_max: Option<u32>,
+    /// Every scene measured once per factor with all its lights' ranges scaled by it, as
+    /// `<scene>-range-x<factor>` (`--range-scale`; tiled-forward-shading Fig. 4.2(a): lights
+    /// too large leave nothing for tiling to cull). Empty: the scenes as they are.
+    #[serde(default)]
+    pub range_scales: Vec<f32>,
     /// Fraction of each scene's lights made spots (`--spot-fraction`).
     #[serde(default)]
     pub spot_fraction: f32,
@@ -175,6 +180,7 @@ fn default_lists() -> Vec<GridLists> {
 
 impl BenchConfig {
     pub fn validate(&self) -> Result<()> {
+        check_range_scales(&self.range_scales)?;
         if self.scenes.is_empty()
             || self.pipelines.is_empty()
             || self.gbuffers.is_empty()
@@ -429,6 +435,9 @@ pub struct RunRecord {
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
+    /// The scene's light count (from the analysis renders).
+    #[serde(default)]
+    pub lights: Option<u32>,
     pub timing: TimingSource,
     /// False when the run was interrupted before its last frame.
     pub complete: bool,
@@ -624,6 +633,12 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             scenes.push(open(false)?.scene);
             continue;
         }
+        if !config.range_scales.is_empty() {
+            for &f in &config.range_scales {
+                scenes.push(range_scaled(&opened.scene, f));
+            }
+            continue;
+        }
         scenes.push(opened.scene);
         if config.opaque_variants && config.transparency && has_glass {
             let mut opaque = open(false)?.scene;
@@ -632,6 +647,32 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
         }
     }
     Ok(scenes)
+}
+
+/// The name suffix of a scene measured with its light ranges scaled (`range_scales`).
+pub const RANGE_SUFFIX: &str = "-range-x";
+
+/// `scene` with every light's range multiplied by `factor`, named for it.
+fn range_scaled(scene: &lightgrid::scene::Scene, factor: f32) -> lightgrid::scene::Scene {
+    let mut s = scene.clone();
+    s.name = format!("{}{RANGE_SUFFIX}{factor}", scene.name);
+    for l in &mut s.lights {
+        l.light.range *= factor;
+    }
+    s
+}
+
+/// Refuse range factors that are not finite and positive (or absurd).
+fn check_range_scales(scales: &[f32]) -> Result<()> {
+    for &f in scales {
+        if !(f.is_finite() && f > 0.0 && f <= 1000.0) {
+            return Err(invalid(
+                "--range-scale",
+                format!("{f} is not a factor from above 0 to 1000"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<Series>> {
@@ -822,6 +863,7 @@ impl<'a> Measuring<'a> {
             self.done += 1;
             let s = &out.stats;
             record.timing = s.timing;
+            record.lights = Some(s.lights);
             *bytes = (s.memory.bytes_per_pixel, s.memory.target_bytes);
             let heatmaps = &mut results.heatmaps;
             if f == heatmap_frame && wants_heatmap && !heatmaps.iter().any(|h| h.0 == scene.name) {
@@ -935,6 +977,7 @@ impl RunRecord {
             msaa: series.msaa,
             msaa_resolve: series.msaa_resolve,
             depth_bounds: None,
+            lights: None,
             width: size.0,
             height: size.1,
             tile_size: tile,

@@ -43,6 +43,7 @@ fn config() -> BenchConfig {
         add_lights: None,
         depth_bounds: vec![Default::default()],
         heatmap_max: None,
+        range_scales: vec![],
         headlights: false,
         spot_culls: vec![Default::default()],
         transparency: true,

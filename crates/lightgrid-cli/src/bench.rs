@@ -43,6 +43,10 @@ pub(crate) enum Preset {
     /// pre-Z) beside tiled deferred, deferred and deferred lighting, frames 0..259 every 20,
     /// the lights-per-tile heatmap on Fig. 2(b)'s fixed 0 to 50 scale.
     ForwardPlus,
+    /// Light ranges (tiled-forward-shading Fig. 4.2(a)): robots-many with every light's
+    /// range scaled by 0.5 to 16, `forward`, `tiled_forward_prez` and `tiled_deferred`, frames
+    /// 0..259 every 65, at 320x180 on a software adapter: where tiling stops paying.
+    LightRange,
     /// Depth bounds (tiled-forward-shading §4.4, 22.4 → 15.6 → 10.9 ms): tiled forward
     /// without pre-Z, then tiled and clustered forward with pre-Z culling by no bounds, the
     /// minimum only, the maximum only and both, on robots-many, frames 0..259 every 20,
@@ -143,6 +147,10 @@ pub(crate) struct BenchArgs {
     /// Forward+ Fig. 2(b)).
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub(crate) heatmap_max: Option<u32>,
+    /// Measure every scene once per factor with all its lights' ranges scaled by it
+    /// (a list, e.g. 0.5,1,2,4; each above 0 and at most 1000), as `<scene>-range-x<factor>`.
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = crate::args::parse_positive)]
+    pub(crate) range_scale: Vec<f64>,
     /// Output directory (created; files an earlier run wrote there and this one does not are
     /// removed; two runs into one directory at once are refused).
     #[arg(long, default_value = "bench")]
@@ -154,6 +162,10 @@ pub(crate) struct ReportArgs {
     /// The benchmark directory (reads results.json, writes the report files next to it).
     pub(crate) dir: PathBuf,
 }
+
+/// The light-range preset's factors: half the scene's ranges to sixteen times (robots-many's
+/// 12.5 to 200, the length of its street).
+const LIGHT_RANGE_SCALES: [f32; 6] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
 
 /// Forward+ Fig. 2(b)'s lights-per-tile scale (the forward-plus preset's heatmap).
 const FORWARD_PLUS_HEATMAP_MAX: u32 = 50;
@@ -320,6 +332,14 @@ pub(crate) fn bench_config(
             tile: Some(8),
             ..study(hardware, |_| false)
         },
+        Some(Preset::LightRange) => BenchDefaults {
+            pipelines: ["forward", "tiled_forward_prez", "tiled_deferred"]
+                .map(String::from)
+                .to_vec(),
+            frames: "0..259:65",
+            size: Some(if hardware { (1280, 720) } else { (320, 180) }),
+            ..study(hardware, |_| false)
+        },
         Some(Preset::DepthBounds) => BenchDefaults {
             pipelines: ["tiled_forward", "tiled_forward_prez", "clustered_forward"]
                 .map(String::from)
@@ -382,6 +402,15 @@ pub(crate) fn bench_config(
         seed: a.seed,
         lights: a.lights,
         heatmap_frame: a.heatmap_frame,
+        range_scales: if a.range_scale.is_empty() {
+            if matches!(a.preset, Some(Preset::LightRange)) {
+                LIGHT_RANGE_SCALES.to_vec()
+            } else {
+                Vec::new()
+            }
+        } else {
+            a.range_scale.iter().map(|&f| f as f32).collect()
+        },
         heatmap_max: a
             .heatmap_max
             .or(matches!(a.preset, Some(Preset::ForwardPlus)).then_some(FORWARD_PLUS_HEATMAP_MAX)),

@@ -138,3 +138,65 @@ fn a_fixed_heatmap_scale_changes_the_colours_and_is_checked() {
     assert_fails_with(&["render", "--heatmap-max", "50"], "--heatmap");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn light_range_preset_sweeps_the_ranges_and_checks_fig_4_2a() {
+    let out = bench(&[
+        "--preset",
+        "light-range",
+        "--size",
+        "64x36",
+        "--frames",
+        "0..259:259",
+    ]);
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    let scenes: std::collections::BTreeSet<&str> = v["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["scene"].as_str().unwrap())
+        .collect();
+    for f in ["0.5", "1", "2", "4", "8", "16"] {
+        assert!(
+            scenes.contains(format!("robots-many-range-x{f}").as_str()),
+            "{scenes:?}"
+        );
+    }
+    // Lights per tile grow with the range (the same lights, larger spheres).
+    let per_tile = |f: &str| {
+        v["runs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| {
+                r["scene"] == format!("robots-many-range-x{f}") && r["pipeline"] == "tiled_deferred"
+            })
+            .unwrap()["summary"]["lights_per_tile_avg"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(per_tile("0.5") < per_tile("4") && per_tile("4") < per_tile("16"));
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for claim in [
+        "Lights too large leave nothing to cull",
+        "The gain of tiled shading over brute force shrinks",
+    ] {
+        let line = summary.lines().find(|l| l.contains(claim)).expect(claim);
+        assert!(!line.contains("not measured"), "{line}");
+    }
+    let fresh = out.with_file_name("never");
+    for bad in ["0", "-1", "NaN", "1001"] {
+        assert_fails_with(
+            &[
+                "bench",
+                "--range-scale",
+                bad,
+                "--out",
+                fresh.to_str().unwrap(),
+            ],
+            "--range-scale",
+        );
+    }
+    assert!(!fresh.exists(), "a refused run creates nothing");
+}
