@@ -6,8 +6,8 @@
 mod support;
 
 use proptest::prelude::*;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 /// Values any option may get: numbers at and past every bound, non-numbers, sizes.
 const VALUES: &[&str] = &[
@@ -398,33 +398,6 @@ fn args_of(
     args
 }
 
-/// Run with a time limit; None when the limit passed (the process is killed).
-fn run_limited(args: &[String], limit: Duration) -> Option<(Option<i32>, String)> {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run lightgrid");
-    let mut err = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = std::io::Read::read_to_string(&mut err, &mut s);
-        s
-    });
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            return Some((status.code(), reader.join().unwrap()));
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            return None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
 
 proptest! {
     #![proptest_config(ProptestConfig {
@@ -445,7 +418,9 @@ proptest! {
         let args = args_of(&CMDS[c], &opts, adapter, &d);
         // A valid run of these sizes takes seconds; one still going after this is reported
         // as a hang.
-        let outcome = run_limited(&args, Duration::from_secs(120));
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_lightgrid"));
+        cmd.args(&args);
+        let outcome = support::run_limited(cmd, Duration::from_secs(120)).ok();
         std::fs::remove_dir_all(&dir).unwrap();
         let (code, err) = outcome.unwrap_or_else(|| panic!("{args:?} still running after 120 s"));
         // Shown with --nocapture: which cases ran and which were refused, and why.

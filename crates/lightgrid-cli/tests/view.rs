@@ -9,7 +9,7 @@ mod support;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use support::{assert_fails_with, lightgrid, stderr, temp_dir};
 
 /// A virtual X server on a display number it chose itself (`-displayfd`), so tests can run
@@ -53,37 +53,14 @@ impl Xvfb {
         }
     }
 
-    /// Run `lightgrid` on this display; None when it was still running after `limit`.
+    /// Run `lightgrid` on this display; panics when it is still running after `limit`.
     fn run(&self, args: &[&str], limit: Duration) -> (Option<i32>, String) {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
-            .args(args)
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_lightgrid"));
+        cmd.args(args)
             .env("DISPLAY", &self.display)
-            .env_remove("WAYLAND_DISPLAY")
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("run lightgrid");
-        let mut err = child.stderr.take().unwrap();
-        let reader = std::thread::spawn(move || {
-            let mut s = String::new();
-            let _ = std::io::Read::read_to_string(&mut err, &mut s);
-            s
-        });
-        let start = Instant::now();
-        loop {
-            if let Some(status) = child.try_wait().unwrap() {
-                return (status.code(), reader.join().unwrap());
-            }
-            if start.elapsed() > limit {
-                let _ = child.kill();
-                let _ = child.wait();
-                panic!(
-                    "{args:?} still running after {limit:?}:\n{}",
-                    reader.join().unwrap()
-                );
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
+            .env_remove("WAYLAND_DISPLAY");
+        support::run_limited(cmd, limit)
+            .unwrap_or_else(|err| panic!("{args:?} still running after {limit:?}:\n{err}"))
     }
 
     fn run_ok(&self, args: &[&str]) -> String {

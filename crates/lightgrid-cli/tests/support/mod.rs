@@ -2,7 +2,8 @@
 #![allow(dead_code)]
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 pub fn lightgrid(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lightgrid"))
@@ -31,4 +32,32 @@ pub fn assert_fails_with(args: &[&str], needle: &str) {
         "{args:?}: stderr lacks '{needle}':\n{err}"
     );
     assert!(!err.contains("panicked"), "{args:?} panicked:\n{err}");
+}
+
+/// Run `cmd` (stdout discarded, stderr kept) with a time limit: its exit code and stderr, or
+/// the stderr so far in `Err` when the limit passed (the process is killed).
+pub fn run_limited(mut cmd: Command, limit: Duration) -> Result<(Option<i32>, String), String> {
+    let mut child = cmd
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run lightgrid");
+    let mut err = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = std::io::Read::read_to_string(&mut err, &mut s);
+        s
+    });
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return Ok((status.code(), reader.join().unwrap()));
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(reader.join().unwrap());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
