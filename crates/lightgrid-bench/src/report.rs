@@ -463,6 +463,11 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
         save_png(img, &p)?;
         written.push(p);
     }
+    for (scene, img) in &results.thumbnails {
+        let p = dir.join(format!("thumbnails_{scene}.png"));
+        save_png(img, &p)?;
+        written.push(p);
+    }
     Ok(())
 }
 
@@ -606,6 +611,18 @@ fn summary(results: &BenchResults) -> String {
     let (scenes, _) = scenes_and_bits(results);
     for scene in &scenes {
         let _ = writeln!(s, "\n## {scene}\n");
+        if results.thumbnails.iter().any(|t| &t.0 == scene) {
+            let frames: Vec<String> = super::run::THUMBNAIL_FRAMES
+                .iter()
+                .map(u32::to_string)
+                .collect();
+            let _ = writeln!(
+                s,
+                "![{scene}: frames {} (those the animation has)](thumbnails_{scene}.png)\n\n*Frames {} of the animation, as tiled-shading Fig. 2 shows them.*\n",
+                frames.join(", "),
+                frames.join(", ")
+            );
+        }
         s.push_str("| pipeline | G-buffer | avg ms | min / max ms | real-time fps | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };

@@ -475,6 +475,50 @@ pub struct BenchResults {
     /// Lights-per-tile heatmaps: (scene, pipeline, frame, image).
     #[serde(skip)]
     pub heatmaps: Vec<(String, String, u32, RgbaImage)>,
+    /// Per scene, the frames of [`THUMBNAIL_FRAMES`] side by side (tiled-shading Fig. 2's
+    /// views along the animation), as rendered by the run's first grid pipeline.
+    #[serde(skip)]
+    pub thumbnails: Vec<(String, RgbaImage)>,
+}
+
+/// The animation frames tiled-shading Fig. 2 shows (those past a scene's end are left out).
+pub const THUMBNAIL_FRAMES: [u32; 4] = [0, 86, 186, 259];
+/// Width of one thumbnail, pixels.
+pub const THUMBNAIL_WIDTH: u32 = 200;
+
+/// The frames of [`THUMBNAIL_FRAMES`] a scene has, rendered by `pipeline` and scaled to
+/// [`THUMBNAIL_WIDTH`], side by side with a 2-pixel gap.
+fn thumbnails(
+    renderer: &mut Renderer,
+    scene: &lightgrid::scene::Scene,
+    pipeline: &str,
+) -> Result<RgbaImage> {
+    let mut shots = Vec::new();
+    for f in THUMBNAIL_FRAMES
+        .into_iter()
+        .filter(|&f| f < scene.frame_count())
+    {
+        let out = renderer.render(scene, f, pipeline)?;
+        let (w, h) = out.image.dimensions();
+        let th = (h * THUMBNAIL_WIDTH / w.max(1)).max(1);
+        shots.push(image::imageops::resize(
+            &out.image,
+            THUMBNAIL_WIDTH,
+            th,
+            image::imageops::FilterType::Triangle,
+        ));
+    }
+    let h = shots.iter().map(|s| s.height()).max().unwrap_or(1);
+    let n = shots.len() as u32;
+    let mut strip = RgbaImage::from_pixel(
+        (n * (THUMBNAIL_WIDTH + 2)).saturating_sub(2).max(1),
+        h,
+        image::Rgba([0, 0, 0, 255]),
+    );
+    for (i, s) in shots.iter().enumerate() {
+        image::imageops::replace(&mut strip, s, i as i64 * i64::from(THUMBNAIL_WIDTH + 2), 0);
+    }
+    Ok(strip)
 }
 
 /// Test (b) on one frame (see [`BenchResults::spot_ray_tests`]).
@@ -1086,6 +1130,7 @@ impl PreparedBench {
             runs: Vec::new(),
             spot_ray_tests: Vec::new(),
             heatmaps: Vec::new(),
+            thumbnails: Vec::new(),
         };
         let heatmap_pipeline = config
             .pipelines
@@ -1149,6 +1194,28 @@ impl PreparedBench {
                         }
                     ));
                     break;
+                }
+            }
+        }
+        if results.outcome.is_complete() {
+            m.tick("thumbnails".into());
+            let pipeline = m
+                .heatmap_pipeline
+                .clone()
+                .unwrap_or_else(|| config.pipelines[0].clone());
+            for scene in scenes {
+                let size = config.size.unwrap_or(scene.default_size);
+                let settings = RenderSettings {
+                    tile_size: config.tile_size,
+                    slices: config.slices,
+                    ..Default::default()
+                };
+                let strip = Renderer::new(ctx, size.0, size.1, settings)
+                    .and_then(|mut r| thumbnails(&mut r, scene, &pipeline));
+                match strip {
+                    Ok(img) => results.thumbnails.push((scene.name.clone(), img)),
+                    // A picture is not worth failing a finished run for: the report says.
+                    Err(e) => eprintln!("thumbnails of {}: {e}", scene.name),
                 }
             }
         }

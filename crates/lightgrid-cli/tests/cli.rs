@@ -384,6 +384,15 @@ fn bench_quick_preset_writes_its_report() {
         summary.contains("bench --preset quick"),
         "summary records the command"
     );
+    // tiled-shading Fig. 2's frames 0, 86, 186 and 259, side by side, linked from the report.
+    let strip = image::open(dir.join("thumbnails_robots-many.png"))
+        .unwrap()
+        .to_rgba8();
+    assert_eq!(strip.width(), 4 * 200 + 3 * 2);
+    assert!(summary.contains("](thumbnails_robots-many.png)"));
+    let thumb =
+        |i: u32| image::imageops::crop_imm(&strip, i * 202, 0, 200, strip.height()).to_image();
+    assert_ne!(thumb(0), thumb(3), "frames 0 and 259 differ");
     assert_fails_with(
         &[
             "bench",

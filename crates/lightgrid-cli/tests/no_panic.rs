@@ -398,7 +398,6 @@ fn args_of(
     args
 }
 
-
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 96,
