@@ -2,7 +2,8 @@
 //! the renderer's own instance (`GpuContext::with_display`), the real-time frame of
 //! `lightgrid::Renderer` blitted onto it each redraw, an egui panel to switch pipelines and
 //! settings live, and analysis frames on a worker thread for the debug views and counts.
-//! - [`app`]: the window, its event handling and the order of one redraw;
+//! - [`app`]: the window, its event handling and the order of one redraw (one file per
+//!   part of it);
 //! - [`analysis`]: the worker that renders analysis frames so the window never waits;
 //! - [`panel`]: the egui panel (it edits a draft of [`controls::Controls`]);
 //! - [`live`]: frame times, GPU pass times, fps and the wrong-frame counters;

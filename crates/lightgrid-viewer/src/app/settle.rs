@@ -1,0 +1,218 @@
+//! What holds a scripted session and how changes are applied: a frame is *settled* when no
+//! resize, change or stale debug view is pending; script steps run one per settled frame;
+//! a change switches the pipeline, makes a renderer or reopens the scene, and a failing
+//! one goes back to the last state that rendered.
+
+use super::*;
+
+impl<'c> App<'c> {
+    /// Something the next frames will change by themselves: scripts and screenshots wait.
+    pub(super) fn pending(&self, now: Instant) -> bool {
+        let Some(win) = &self.win else { return true };
+        let size_settling = win
+            .size_changed_at
+            .is_some_and(|t| now.duration_since(t) < SETTLE);
+        let wrong_size = win.renderer.size() != render_size(self.ctx, win.surface.size());
+        let debug_stale = self.applied.view != DebugView::Shaded
+            && self.analysis.failed_generation != Some(self.generation)
+            && !self.analysis_current(true);
+        let resize_asked = self.requested_size.is_some_and(|s| s != win.surface.size());
+        size_settling || wrong_size || resize_asked || self.draft != self.applied || debug_stale
+    }
+
+    /// The newest analysis frame shows the current state (and, paused, the current frame);
+    /// with `image`, it also has the debug view's image.
+    pub(super) fn analysis_current(&self, image: bool) -> bool {
+        self.analysis.latest.as_ref().is_some_and(|(g, _, a)| {
+            *g == self.generation
+                && (self.playing || a.stats.frame == self.frame)
+                && (!image || a.image.is_some())
+        })
+    }
+
+    /// Run the next step when it is due: one step per frame, so each step's change is
+    /// shown (and settled) before the next one runs, and none while a screenshot waits.
+    pub(super) fn run_due_step(&mut self) -> Result<()> {
+        if !self.screenshots.is_empty() {
+            return Ok(());
+        }
+        let Some(step) = self.script.get(self.next_step).cloned() else {
+            return Ok(());
+        };
+        if step.at > self.settled {
+            return Ok(());
+        }
+        self.next_step += 1;
+        self.run_step(&step)
+            .with_context(|| format!("script step at {}: {:?}", step.at, step.action))
+    }
+
+    pub(super) fn run_step(&mut self, step: &Step) -> Result<()> {
+        let mut next = self.applied.clone();
+        match &step.action {
+            Action::Pipeline(id) => next.pipeline = pipelines::find(id)?.id.to_string(),
+            Action::Tile(n) => next.settings.tile_size = *n,
+            Action::Msaa(n) => next.settings.msaa = *n,
+            Action::View(v) => next.view = *v,
+            Action::Spots(f) => next.request.params.spot_fraction = *f,
+            Action::Transparency(on) => next.request.params.transparency = *on,
+            Action::AddLights(n) => {
+                next.request.add_lights = (*n > 0).then_some(lightgrid::scene::AddLights {
+                    count: *n,
+                    range: None,
+                })
+            }
+            Action::Resize(w, h) => {
+                let win = self.win.as_ref().context("no window")?;
+                let _ = win
+                    .window
+                    .request_inner_size(winit::dpi::PhysicalSize::new(*w, *h));
+                // Pending until the surface has it (X11 answers with a later event).
+                self.requested_size = Some((*w, *h));
+                return Ok(());
+            }
+            Action::Frame(f) => {
+                self.scene.check_frame(*f)?;
+                self.jump_to(*f);
+                return Ok(());
+            }
+            Action::Pause => {
+                self.set_playing(false);
+                return Ok(());
+            }
+            Action::Play => {
+                self.set_playing(true);
+                return Ok(());
+            }
+            Action::Panel(on) => {
+                self.panel = *on;
+                return Ok(());
+            }
+            Action::Screenshot(path) => {
+                self.screenshots.push_back(path.clone());
+                return Ok(());
+            }
+        }
+        self.apply(next).map_err(|e| anyhow!(e))
+    }
+
+    // --- applying changes -------------------------------------------------------------------
+
+    /// Go to `next`: switch, make a renderer or reopen the scene, as the change needs.
+    pub(super) fn apply(&mut self, next: Controls) -> Result<(), String> {
+        let rebuild = self.applied.rebuild_for(&next);
+        if rebuild == Rebuild::Nothing {
+            return Ok(());
+        }
+        let info = pipelines::find(&next.pipeline).map_err(|e| e.to_string())?;
+        if let Some(why) = refusal(info, &next.settings) {
+            return Err(why);
+        }
+        // Everything is made before anything is replaced, so a failure leaves the viewer as
+        // it was.
+        let opened = match rebuild {
+            Rebuild::Scene => {
+                Some(lightgrid::scene::open(&next.request).map_err(|e| e.to_string())?)
+            }
+            _ => None,
+        };
+        let renderer = match rebuild {
+            Rebuild::Scene | Rebuild::Renderer => {
+                let win = self.win.as_ref().ok_or("no window")?;
+                let (w, h) = win.renderer.size();
+                Some(Renderer::new(self.ctx, w, h, next.settings).map_err(|e| e.to_string())?)
+            }
+            _ => None,
+        };
+        if let Some(opened) = opened {
+            if let Some(w) = opened.warnings.first() {
+                self.message = Some(format!(
+                    "{} (and {} more warnings)",
+                    w,
+                    opened.warnings.len() - 1
+                ));
+            }
+            self.set_scene(opened.scene);
+        }
+        if let Some(r) = renderer {
+            self.replace_renderer(r);
+        }
+        self.applied = next;
+        // A script's or key's change is the panel's draft from now on too.
+        self.draft = self.applied.clone();
+        self.generation += 1;
+        self.figures.restart_times();
+        if let Some(win) = &self.win {
+            win.window.set_title(&self.title());
+        }
+        Ok(())
+    }
+
+    /// Apply the panel's draft once it has stopped changing (a pipeline or view at once).
+    pub(super) fn apply_draft(&mut self, now: Instant) -> Result<()> {
+        if self.draft == self.applied {
+            return Ok(());
+        }
+        let quick = self.applied.rebuild_for(&self.draft) == Rebuild::Switch;
+        let still = self
+            .draft_edited
+            .is_none_or(|t| now.duration_since(t) >= DRAFT_SETTLE);
+        if !(quick || still) {
+            return Ok(());
+        }
+        let next = self.draft.clone();
+        if let Err(e) = self.apply(next) {
+            if self.scripted {
+                bail!("{e}");
+            }
+            self.message = Some(e);
+            self.draft = self.applied.clone();
+        }
+        Ok(())
+    }
+
+    /// A frame failed to render: go back to the last state that rendered, or give up.
+    pub(super) fn recover(&mut self, e: lightgrid::Error) -> Result<()> {
+        if self.applied == self.last_good || self.scripted {
+            return Err(anyhow!(e).context(format!("rendering with {}", self.applied.pipeline)));
+        }
+        self.message = Some(format!(
+            "{}: {e}; back to the last setting that rendered",
+            self.applied.pipeline
+        ));
+        let good = self.last_good.clone();
+        // A new renderer for the old settings whatever the difference, so nothing of the
+        // failed one stays.
+        let win = self.win.as_ref().context("no window")?;
+        let (w, h) = win.renderer.size();
+        let renderer = Renderer::new(self.ctx, w, h, good.settings)?;
+        if self.applied.request != good.request {
+            let opened = lightgrid::scene::open(&good.request)?;
+            self.set_scene(opened.scene);
+        }
+        self.replace_renderer(renderer);
+        self.applied = good.clone();
+        self.draft = good;
+        if let Some(win) = &self.win {
+            win.window.set_title(&self.title());
+        }
+        Ok(())
+    }
+
+    /// Make a renderer at the window's size once it has settled.
+    pub(super) fn follow_size(&mut self, now: Instant) -> Result<()> {
+        let Some(win) = &mut self.win else {
+            return Ok(());
+        };
+        let wanted = render_size(self.ctx, win.surface.size());
+        let settling = win
+            .size_changed_at
+            .is_some_and(|t| now.duration_since(t) < SETTLE);
+        if wanted == win.renderer.size() || settling {
+            return Ok(());
+        }
+        let renderer = Renderer::new(self.ctx, wanted.0, wanted.1, self.applied.settings)?;
+        self.replace_renderer(renderer);
+        Ok(())
+    }
+}
