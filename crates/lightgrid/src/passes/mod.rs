@@ -150,17 +150,28 @@ pub fn compute_outputs(
     layout: &wgpu::BindGroupLayout,
     targets: &Targets,
 ) -> wgpu::BindGroup {
+    compute_outputs_to(device, layout, &targets.hdr, &targets.counts)
+}
+
+/// Group 3 with another RGBA16F target in the colour's place (the tiled light pre-pass's
+/// irradiance).
+pub fn compute_outputs_to(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    color: &wgpu::TextureView,
+    counts: &wgpu::TextureView,
+) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("compute outputs"),
         layout,
         entries: &[
             wgpu::BindGroupEntry {
                 binding: 0,
-                resource: wgpu::BindingResource::TextureView(&targets.hdr),
+                resource: wgpu::BindingResource::TextureView(color),
             },
             wgpu::BindGroupEntry {
                 binding: 1,
-                resource: wgpu::BindingResource::TextureView(&targets.counts),
+                resource: wgpu::BindingResource::TextureView(counts),
             },
         ],
     })

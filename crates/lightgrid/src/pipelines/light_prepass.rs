@@ -11,20 +11,28 @@
 //!
 //! Groups: pass 1: 0 scene. Pass 2: 0 scene, 1 depth-copy source, 2 attributes + depth.
 //! Pass 3: 0 scene, 1 irradiance.
+//!
+//! `tiled_light_prepass` is compute-based deferred lighting [And11], the baseline Forward+ is
+//! measured against (forward-plus §5, Fig. 3): pass 2 is the tile grid (`GridBuilder`, as
+//! every grid pipeline) and one compute pass, one invocation per pixel, that loops its tile's
+//! lights and writes the mono irradiance (`tiled_light_prepass.wgsl`). Its groups: 0 scene,
+//! 1 grid, 2 attributes + depth, 3 irradiance + count (storage).
 
 use super::RenderSettings;
 use super::{
     draw_scene, geometry_pipeline, FrameEncoder, FrameInputs, GeometryPipelineDesc,
-    PipelineContext, Technique,
+    PipelineContext, Technique, TransparentLights,
 };
+use crate::consts::SCREEN_WORKGROUP;
+use crate::culling::{CellSource, GridBuilder};
 use crate::error::Result;
-use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
+use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
     additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
     FULLSCREEN_WGSL, HDR_FORMAT, VOLUME_WGSL,
 };
 use crate::passes::{cleared, render_texture, texture_entry, VOLUME_DEPTH_BYTES};
-use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
+use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShader, SCENE_PARTS};
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
 /// rounded up to what every adapter renders and blends.
@@ -40,12 +48,58 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
     vec![compose("light_prepass", &parts)]
 }
 
+/// The tiled variant's shaders: the light pre-pass's and the irradiance kernel.
+pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
+    let mut out = shaders();
+    out.push(tiled_kernel());
+    out
+}
+
+fn tiled_kernel() -> ComposedShader {
+    compose(
+        "tiled_light_prepass",
+        &[
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            src::LIGHTING,
+            &crate::shader::msaa_wgsl(1),
+            src::LIGHT_GRID,
+            include_str!("tiled_light_prepass.wgsl"),
+        ],
+    )
+}
+
+/// Which light pre-pass.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// Diffuse and specular irradiance targets, light volumes.
+    Full,
+    /// Specular luminance in the diffuse alpha, light volumes.
+    Mono,
+    /// Mono irradiance accumulated per tile in a compute pass [And11].
+    Tiled,
+}
+
+/// How the irradiance is accumulated (pass 2).
+enum Irradiance {
+    /// Each light's volume rasterized, blending into the irradiance targets.
+    Volumes {
+        volumes: LightVolumes,
+        copy: wgpu::RenderPipeline,
+        pipelines: [wgpu::RenderPipeline; 3],
+    },
+    /// The tile grid, then one compute pass over the pixels.
+    Tiled {
+        builder: Box<GridBuilder>,
+        kernel: wgpu::ComputePipeline,
+        outputs_layout: wgpu::BindGroupLayout,
+    },
+}
+
 struct LightPrepass {
     mono: bool,
     attributes: wgpu::RenderPipeline,
-    volumes: LightVolumes,
-    copy: wgpu::RenderPipeline,
-    irradiance: [wgpu::RenderPipeline; 3],
+    irradiance: Irradiance,
     shade: wgpu::RenderPipeline,
     attr_view: wgpu::TextureView,
     diffuse_view: wgpu::TextureView,
@@ -67,11 +121,95 @@ fn texture_layout(
 }
 
 fn target(device: &wgpu::Device, label: &str, w: u32, h: u32) -> wgpu::TextureView {
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-    render_texture(device, label, TARGET_FORMAT, (w, h), usage).create_view(&Default::default())
+    target_for(
+        device,
+        label,
+        (w, h),
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    )
 }
 
-fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
+/// A target read by a later pass and written as `written` (a render attachment or storage).
+fn target_for(
+    device: &wgpu::Device,
+    label: &str,
+    size: (u32, u32),
+    written: wgpu::TextureUsages,
+) -> wgpu::TextureView {
+    let usage = written | wgpu::TextureUsages::TEXTURE_BINDING;
+    render_texture(device, label, TARGET_FORMAT, size, usage).create_view(&Default::default())
+}
+
+/// Pass 2 of the light-volume variants.
+fn volume_irradiance(
+    ctx: &PipelineContext,
+    module: &wgpu::ShaderModule,
+    attr_layout: &wgpu::BindGroupLayout,
+    mono: bool,
+) -> Irradiance {
+    let device = ctx.device;
+    let (w, h) = (ctx.dims.width, ctx.dims.height);
+    let volumes = LightVolumes::new(device, w, h);
+    let irr_targets = [
+        Some(additive(TARGET_FORMAT)),
+        (!mono).then(|| additive(TARGET_FORMAT)),
+        ctx.count_blend.then(|| additive(COUNT_FORMAT)),
+    ];
+    let layouts = [Some(ctx.scene_layout), None, Some(attr_layout)];
+    let entry = if mono {
+        "fs_irradiance_mono"
+    } else {
+        "fs_irradiance"
+    };
+    let pipelines = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full].map(|draw| {
+        volumes.pipeline(
+            device,
+            &VolumePipelineDesc {
+                label: "light pre-pass irradiance",
+                module,
+                fragment_entry: entry,
+                layouts: &layouts,
+                color_targets: &irr_targets,
+                draw,
+            },
+        )
+    });
+    Irradiance::Volumes {
+        copy: volumes.copy_pipeline(device, module, ctx.scene_layout, &irr_targets),
+        volumes,
+        pipelines,
+    }
+}
+
+/// Pass 2 of the tiled variant: the grid over the attributes pass's depth, and the kernel.
+fn tiled_irradiance(ctx: &PipelineContext, attr_layout: &wgpu::BindGroupLayout) -> Irradiance {
+    let setup = crate::culling::GridSetup {
+        forward_opaque: false,
+        ..ctx.grid_setup()
+    };
+    let builder = GridBuilder::new(&setup, 1, CellSource::Depth);
+    let outputs_layout = crate::passes::compute_outputs_layout(ctx.device);
+    let kernel = compute_pipeline(
+        ctx.device,
+        "tiled light pre-pass irradiance",
+        &tiled_kernel(),
+        "main",
+        &[
+            Some(ctx.scene_layout),
+            Some(builder.layout()),
+            Some(attr_layout),
+            Some(&outputs_layout),
+        ],
+    );
+    Irradiance::Tiled {
+        builder: Box::new(builder),
+        kernel,
+        outputs_layout,
+    }
+}
+
+fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
+    let mono = mode != Mode::Full;
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let module = create_module(device, &shaders()[0]);
@@ -88,7 +226,6 @@ fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
             samples: 1,
         },
     );
-    let volumes = LightVolumes::new(device, w, h);
     let attr_layout = texture_layout(
         device,
         "light pre-pass attributes",
@@ -99,30 +236,14 @@ fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
         "light pre-pass irradiance",
         wgpu::TextureSampleType::Float { filterable: false },
     );
-    let irr_targets = [
-        Some(additive(TARGET_FORMAT)),
-        (!mono).then(|| additive(TARGET_FORMAT)),
-        ctx.count_blend.then(|| additive(COUNT_FORMAT)),
-    ];
-    let layouts = [Some(ctx.scene_layout), None, Some(&attr_layout)];
-    let entry = if mono {
-        "fs_irradiance_mono"
-    } else {
-        "fs_irradiance"
+    let irradiance = match mode {
+        Mode::Tiled => tiled_irradiance(ctx, &attr_layout),
+        _ => volume_irradiance(ctx, &module, &attr_layout, mono),
     };
-    let irradiance = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full].map(|draw| {
-        volumes.pipeline(
-            device,
-            &VolumePipelineDesc {
-                label: "light pre-pass irradiance",
-                module: &module,
-                fragment_entry: entry,
-                layouts: &layouts,
-                color_targets: &irr_targets,
-                draw,
-            },
-        )
-    });
+    let written = match mode {
+        Mode::Tiled => wgpu::TextureUsages::STORAGE_BINDING,
+        _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
+    };
     let shade = geometry_pipeline(
         device,
         &GeometryPipelineDesc {
@@ -139,12 +260,10 @@ fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
     Box::new(LightPrepass {
         mono,
         attributes,
-        copy: volumes.copy_pipeline(device, &module, ctx.scene_layout, &irr_targets),
-        volumes,
         irradiance,
         shade,
         attr_view: target(device, "attributes (normal, shininess)", w, h),
-        diffuse_view: target(device, "diffuse irradiance", w, h),
+        diffuse_view: target_for(device, "diffuse irradiance", (w, h), written),
         specular_view: (!mono).then(|| target(device, "specular irradiance", w, h)),
         attr_layout,
         irr_layout,
@@ -152,11 +271,15 @@ fn create(ctx: &PipelineContext, mono: bool) -> Box<dyn Technique> {
 }
 
 pub(super) fn create_full(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create(ctx, false)
+    create(ctx, Mode::Full)
 }
 
 pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create(ctx, true)
+    create(ctx, Mode::Mono)
+}
+
+pub(super) fn create_tiled(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create(ctx, Mode::Tiled)
 }
 
 fn bind_two(
@@ -181,10 +304,69 @@ fn bind_two(
     })
 }
 
+impl LightPrepass {
+    /// Pass 2 with light volumes: the depth copy, then each volume class blending in.
+    fn encode_volumes(
+        &mut self,
+        f: &FrameInputs,
+        enc: &mut FrameEncoder,
+        attr_group: &wgpu::BindGroup,
+    ) -> Result<()> {
+        let LightPrepass {
+            irradiance,
+            mono,
+            diffuse_view,
+            specular_view,
+            ..
+        } = self;
+        let Irradiance::Volumes {
+            volumes,
+            copy,
+            pipelines,
+        } = irradiance
+        else {
+            unreachable!("called for the volume variants only")
+        };
+        let classes = classify_lights(&f.setup, f.lights, false);
+        volumes.upload(f.device, f.queue, &classes);
+        let copy_group = volumes.copy_bind_group(f.device, &f.targets.depth);
+        let label = if *mono {
+            "irradiance (mono specular)"
+        } else {
+            "irradiance"
+        };
+        let (encoder, timer) = enc.parts();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[
+                Some(cleared(diffuse_view, wgpu::Color::TRANSPARENT)),
+                specular_view
+                    .as_ref()
+                    .map(|v| cleared(v, wgpu::Color::TRANSPARENT)),
+                f.count_blend
+                    .then(|| cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
+            ],
+            depth_stencil_attachment: Some(volumes.attachment()),
+            timestamp_writes: timer.render_pass(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        volumes.draw_depth_copy(&mut pass, f.scene_bind_group, &*copy, &copy_group);
+        pass.set_bind_group(2, attr_group, &[]);
+        for (pipeline, draw) in
+            pipelines
+                .iter()
+                .zip([VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full])
+        {
+            pass.set_pipeline(pipeline);
+            volumes.draw(&mut pass, draw);
+        }
+        Ok(())
+    }
+}
+
 impl Technique for LightPrepass {
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
-        let classes = classify_lights(&f.setup, f.lights, false);
-        self.volumes.upload(f.device, f.queue, &classes);
         let attr_group = bind_two(
             f.device,
             &self.attr_layout,
@@ -194,13 +376,11 @@ impl Technique for LightPrepass {
         // Mono has no specular target; its shader reads only binding 0.
         let specular = self.specular_view.as_ref().unwrap_or(&self.diffuse_view);
         let irr_group = bind_two(f.device, &self.irr_layout, &self.diffuse_view, specular);
-        let copy_group = self.volumes.copy_bind_group(f.device, &f.targets.depth);
-        let color = cleared;
-        let (encoder, timer) = enc.parts();
         {
+            let (encoder, timer) = enc.parts();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("light pre-pass attributes"),
-                color_attachments: &[Some(color(&self.attr_view, wgpu::Color::TRANSPARENT))],
+                color_attachments: &[Some(cleared(&self.attr_view, wgpu::Color::TRANSPARENT))],
                 depth_stencil_attachment: Some(crate::passes::cleared_depth(&f.targets.depth)),
                 timestamp_writes: timer.render_pass("light pre-pass attributes"),
                 occlusion_query_set: None,
@@ -209,42 +389,41 @@ impl Technique for LightPrepass {
             pass.set_pipeline(&self.attributes);
             draw_scene(&mut pass, f, &[]);
         }
-        {
-            let label = if self.mono {
-                "irradiance (mono specular)"
-            } else {
-                "irradiance"
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(label),
-                color_attachments: &[
-                    Some(color(&self.diffuse_view, wgpu::Color::TRANSPARENT)),
-                    self.specular_view
-                        .as_ref()
-                        .map(|v| color(v, wgpu::Color::TRANSPARENT)),
-                    f.count_blend
-                        .then(|| color(&f.targets.counts, wgpu::Color::TRANSPARENT)),
-                ],
-                depth_stencil_attachment: Some(self.volumes.attachment()),
-                timestamp_writes: timer.render_pass(label),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            self.volumes
-                .draw_depth_copy(&mut pass, f.scene_bind_group, &self.copy, &copy_group);
-            pass.set_bind_group(2, &attr_group, &[]);
-            for (pipeline, draw) in
-                self.irradiance
-                    .iter()
-                    .zip([VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full])
-            {
-                pass.set_pipeline(pipeline);
-                self.volumes.draw(&mut pass, draw);
+        if matches!(self.irradiance, Irradiance::Volumes { .. }) {
+            self.encode_volumes(f, enc, &attr_group)?;
+        }
+        match &mut self.irradiance {
+            Irradiance::Volumes { .. } => {}
+            Irradiance::Tiled {
+                builder,
+                kernel,
+                outputs_layout,
+            } => {
+                builder.build(f, enc)?;
+                let outputs = crate::passes::compute_outputs_to(
+                    f.device,
+                    outputs_layout,
+                    &self.diffuse_view,
+                    &f.targets.counts,
+                );
+                let (encoder, timer) = enc.parts();
+                let mut pass = timer.begin_compute(encoder, "tiled irradiance (mono specular)");
+                pass.set_pipeline(kernel);
+                pass.set_bind_group(0, f.scene_bind_group, &[]);
+                pass.set_bind_group(1, builder.bind_group(), &[]);
+                pass.set_bind_group(2, &attr_group, &[]);
+                pass.set_bind_group(3, &outputs, &[]);
+                pass.dispatch_workgroups(
+                    f.targets.width.div_ceil(SCREEN_WORKGROUP),
+                    f.targets.height.div_ceil(SCREEN_WORKGROUP),
+                    1,
+                );
             }
         }
+        let (encoder, timer) = enc.parts();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light pre-pass shading"),
-            color_attachments: &[Some(color(&f.targets.hdr, wgpu::Color::BLACK))],
+            color_attachments: &[Some(cleared(&f.targets.hdr, wgpu::Color::BLACK))],
             depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
             timestamp_writes: timer.render_pass("light pre-pass shading"),
             occlusion_query_set: None,
@@ -253,6 +432,22 @@ impl Technique for LightPrepass {
         pass.set_pipeline(&self.shade);
         draw_scene(&mut pass, f, &[&irr_group]);
         Ok(())
+    }
+
+    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+        match &mut self.irradiance {
+            Irradiance::Tiled { builder, .. } => Some(builder),
+            Irradiance::Volumes { .. } => None,
+        }
+    }
+
+    /// The tiled variant's grid lights the transparent objects too; the volume variants have
+    /// none, so the pass builds one.
+    fn transparent_lights(&self) -> TransparentLights<'_> {
+        match &self.irradiance {
+            Irradiance::Tiled { builder, .. } => TransparentLights::Grid(builder),
+            Irradiance::Volumes { .. } => TransparentLights::Own,
+        }
     }
 }
 
@@ -294,6 +489,28 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
             read_per_pixel: DEPTH_BYTES + irr,
             write_per_lit: irr,
             read_per_lit: DEPTH_BYTES + TARGET_BYTES + irr + LIGHT_BYTES,
+        },
+    )
+}
+
+/// The tiled variant [And11]: depth, attributes, one (mono) irradiance target and HDR, no
+/// volume depth-stencil. Per pixel: the attributes pass writes depth and attributes, the
+/// cell-bounds kernel reads depth, the irradiance kernel reads depth and attributes once and
+/// writes the irradiance once, the shading pass reads it and writes HDR. Per lighting
+/// computation: an index and a light, accumulated in registers (no blending).
+pub(super) fn memory_tiled(_: &RenderSettings) -> MemoryModel {
+    MemoryModel::new(
+        &[
+            ("depth", DEPTH_BYTES),
+            ("attributes (normal, exponent)", TARGET_BYTES),
+            ("irradiance (diffuse, mono specular)", TARGET_BYTES),
+            ("hdr", HDR_BYTES),
+        ],
+        Traffic {
+            write_per_pixel: DEPTH_BYTES + 2 * TARGET_BYTES + HDR_BYTES,
+            read_per_pixel: 2 * DEPTH_BYTES + 2 * TARGET_BYTES,
+            write_per_lit: 0,
+            read_per_lit: INDEX_BYTES + LIGHT_BYTES,
         },
     )
 }

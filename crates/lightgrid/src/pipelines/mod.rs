@@ -82,6 +82,7 @@ pub enum Msaa {
 }
 
 const LIGHT_VOLUMES_MSAA: &str = "light volumes shade per pixel; per-sample shading of the stencil-marked edge pixels is not implemented";
+const LIGHT_PREPASS_MSAA: &str = "its irradiance is accumulated per pixel; per-sample irradiance for edge pixels is not implemented";
 
 /// One registry row.
 pub struct PipelineInfo {
@@ -313,6 +314,21 @@ pub const PIPELINES: &[PipelineInfo] = &[
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,
         memory: light_prepass::memory_mono,
+    },
+    PipelineInfo {
+        id: "tiled_light_prepass",
+        description: "compute-based deferred lighting: attributes pre-pass, one compute pass per tile accumulating its lights into one irradiance target (mono specular), a second geometry pass applying the materials",
+        paper: "forward-plus §5 (its baseline [And11]), deferred-shading-vs-deferred-lighting",
+        uses_grid: true,
+        assign: true,
+        forward_shading: false,
+        clustered: false,
+        depth_bounds: true,
+        reference: "forward_mono",
+        msaa: Msaa::Refused(LIGHT_PREPASS_MSAA),
+        shaders: light_prepass::shaders_tiled,
+        create: light_prepass::create_tiled,
+        memory: light_prepass::memory_tiled,
     },
 ];
 
