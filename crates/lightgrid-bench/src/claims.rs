@@ -302,6 +302,19 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
         };
         claim("Forward+ (tiled forward with pre-Z and culling) is faster in total than deferred lighting", "forward-plus §5, Fig. 3", e, v);
 
+        // 6b. The same against the paper's own baseline, compute-based deferred lighting.
+        let (e, v) = match (
+            find(r, scene, "tiled_forward_prez", None),
+            find(r, scene, "tiled_light_prepass", None),
+        ) {
+            (Some(fp), Some(cd)) => match (stages(fp), stages(cd)) {
+                (Some(a), Some(b)) => forward_plus_stages(&a, &b),
+                _ => not(),
+            },
+            _ => not(),
+        };
+        claim("Forward+ is faster in total than compute-based deferred lighting [And11], stage by stage: pre-pass, light culling and lighting, final shading", "forward-plus §5, Fig. 3", e, v);
+
         // 7. Tiled deferred vs tiled forward in the plain case.
         let (e, v) = match (
             find(r, scene, "tiled_deferred", None).and_then(avg_ms),
@@ -615,6 +628,43 @@ fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
     out
 }
 
+/// Forward+ Fig. 3's three stages of a run, average ms: the pre-pass (depth, or the light
+/// pre-pass's attributes), light culling and lighting (the grid's passes and a separate
+/// lighting pass where there is one), and the final shading (the opaque shading pass; the
+/// transparent pass and the tonemap are left out, as the figure has neither).
+pub fn stages(x: &RunRecord) -> Option<[f64; 3]> {
+    let passes = &x.summary.as_ref()?.passes;
+    let mut s = [0.0; 3];
+    for p in passes {
+        let l = p.label.as_str();
+        let stage = if l.contains("pre-pass attributes") || l == "depth pre-pass" {
+            0
+        } else if l.starts_with("assign") || l.contains("irradiance") {
+            1
+        } else if l.contains("shading") {
+            2
+        } else {
+            continue;
+        };
+        s[stage] += p.ms;
+    }
+    (s.iter().sum::<f64>() > 0.0).then_some(s)
+}
+
+/// Is Forward+ faster in total over the three stages than compute-based deferred lighting?
+pub fn forward_plus_stages(forward_plus: &[f64; 3], deferred: &[f64; 3]) -> (String, Verdict) {
+    let total = |s: &[f64; 3]| s.iter().sum::<f64>();
+    let show = |s: &[f64; 3]| format!("{:.1} + {:.1} + {:.1} = {:.1}", s[0], s[1], s[2], total(s));
+    (
+        format!(
+            "avg ms (pre-pass + culling and lighting + final shading): tiled_forward_prez {}, tiled_light_prepass {}",
+            show(forward_plus),
+            show(deferred)
+        ),
+        verdict(total(forward_plus) < total(deferred)),
+    )
+}
+
 /// "Enough": one side of the bounds within this factor of both sides' time.
 pub const ONE_SIDE_ENOUGH: f64 = 1.10;
 
@@ -896,6 +946,17 @@ mod tests {
 
     fn rows(v: &[(&str, f64)]) -> Vec<(String, f64)> {
         v.iter().map(|(p, m)| (p.to_string(), *m)).collect()
+    }
+
+    #[test]
+    fn forward_plus_stages_on_both_sides() {
+        let (e, v) = forward_plus_stages(&[1.0, 2.0, 5.0], &[2.0, 3.0, 4.0]);
+        assert_eq!(v, Verdict::Held);
+        assert!(e.contains("1.0 + 2.0 + 5.0 = 8.0"), "{e}");
+        assert_eq!(
+            forward_plus_stages(&[1.0, 2.0, 7.0], &[2.0, 3.0, 4.0]).1,
+            Verdict::NotHeld
+        );
     }
 
     #[test]

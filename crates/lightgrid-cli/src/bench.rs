@@ -40,7 +40,8 @@ pub(crate) enum Preset {
     Clustered,
     /// The Forward+ demo (forward-plus §5): `scattered` with its 3,072 moving lights at
     /// 1280x720 (640x360 on a software adapter), 8x8 tiles, Forward+ (tiled forward with
-    /// pre-Z) beside tiled deferred, deferred and deferred lighting, frames 0..259 every 20,
+    /// pre-Z) beside its baseline, compute-based deferred lighting (`tiled_light_prepass`),
+    /// and tiled deferred, deferred and deferred lighting, frames 0..259 every 20,
     /// the lights-per-tile heatmap on Fig. 2(b)'s fixed 0 to 50 scale.
     ForwardPlus,
     /// Light ranges (tiled-forward-shading Fig. 4.2(a)): robots-many with every light's
@@ -322,6 +323,7 @@ pub(crate) fn bench_config(
             size: Some(if hardware { (1280, 720) } else { (640, 360) }),
             pipelines: [
                 "tiled_forward_prez",
+                "tiled_light_prepass",
                 "tiled_deferred",
                 "deferred",
                 "light_prepass",

@@ -84,7 +84,7 @@ enum Mode {
 enum Irradiance {
     /// Each light's volume rasterized, blending into the irradiance targets.
     Volumes {
-        volumes: LightVolumes,
+        volumes: Box<LightVolumes>,
         copy: wgpu::RenderPipeline,
         pipelines: [wgpu::RenderPipeline; 3],
     },
@@ -149,7 +149,7 @@ fn volume_irradiance(
 ) -> Irradiance {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let volumes = LightVolumes::new(device, w, h);
+    let volumes = Box::new(LightVolumes::new(device, w, h));
     let irr_targets = [
         Some(additive(TARGET_FORMAT)),
         (!mono).then(|| additive(TARGET_FORMAT)),
