@@ -45,6 +45,9 @@ fn pipeline_label(r: &RunRecord) -> String {
     if let Some(b) = r.depth_bounds {
         label += &format!(" [bounds {}]", b.name());
     }
+    if let Some(d) = r.depth_reduction {
+        label += &format!(" [{} reduction]", d.name());
+    }
     label
 }
 

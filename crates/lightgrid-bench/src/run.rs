@@ -5,7 +5,7 @@ use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
 use lightgrid::culling::GridLists;
 use lightgrid::error::Result;
-use lightgrid::frame::{DepthBounds, MaterialDraws, MsaaResolve};
+use lightgrid::frame::{DepthBounds, DepthReduction, MaterialDraws, MsaaResolve};
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
@@ -144,6 +144,14 @@ pub struct BenchConfig {
     /// pipeline with such a grid is measured once per entry.
     #[serde(default = "default_depth_bounds")]
     pub depth_bounds: Vec<DepthBounds>,
+    /// How the cell-bounds kernel reduces depths (`--depth-reduction`): every pipeline with a
+    /// grid built from depth is measured once per entry.
+    #[serde(default = "default_depth_reductions")]
+    pub depth_reductions: Vec<DepthReduction>,
+}
+
+fn default_depth_reductions() -> Vec<DepthReduction> {
+    vec![DepthReduction::default()]
 }
 
 fn default_depth_bounds() -> Vec<DepthBounds> {
@@ -190,6 +198,7 @@ impl BenchConfig {
             || self.msaa.is_empty()
             || self.msaa_resolve.is_empty()
             || self.depth_bounds.is_empty()
+            || self.depth_reductions.is_empty()
         {
             return Err(invalid(
                 "bench",
@@ -432,6 +441,9 @@ pub struct RunRecord {
     /// (`--depth-bounds`; pipelines whose grid is bounded by depth).
     #[serde(default)]
     pub depth_bounds: Option<DepthBounds>,
+    /// The depth reduction, when the run measured more than one (`--depth-reduction`).
+    #[serde(default)]
+    pub depth_reduction: Option<DepthReduction>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -577,6 +589,7 @@ struct Series {
     msaa_resolve: Option<MsaaResolve>,
     /// Which depth bounds the grid culls by; recorded when more than one is measured.
     depth_bounds: DepthBounds,
+    depth_reduction: DepthReduction,
     frames: Vec<u32>,
 }
 
@@ -590,6 +603,7 @@ struct Variant {
     msaa: u32,
     msaa_resolve: Option<MsaaResolve>,
     depth_bounds: DepthBounds,
+    depth_reduction: DepthReduction,
 }
 
 fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
@@ -618,14 +632,19 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant
                     };
                     for msaa_resolve in resolves {
                         for &depth_bounds in used(&config.depth_bounds, info.depth_bounds) {
-                            out.push(Variant {
-                                spot_cull,
-                                lists,
-                                material_draws,
-                                msaa,
-                                msaa_resolve,
-                                depth_bounds,
-                            });
+                            for &depth_reduction in
+                                used(&config.depth_reductions, info.depth_bounds)
+                            {
+                                out.push(Variant {
+                                    spot_cull,
+                                    lists,
+                                    material_draws,
+                                    msaa,
+                                    msaa_resolve,
+                                    depth_bounds,
+                                    depth_reduction,
+                                });
+                            }
                         }
                     }
                 }
@@ -766,6 +785,7 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                         msaa: v.msaa,
                         msaa_resolve: v.msaa_resolve,
                         depth_bounds: v.depth_bounds,
+                        depth_reduction: v.depth_reduction,
                         frames: frames.clone(),
                     });
                 }
@@ -826,6 +846,7 @@ impl<'a> Measuring<'a> {
             msaa: series.msaa,
             msaa_resolve: series.msaa_resolve.unwrap_or_default(),
             depth_bounds: series.depth_bounds,
+            depth_reduction: series.depth_reduction,
         }
     }
 
@@ -882,6 +903,9 @@ impl<'a> Measuring<'a> {
         }
         if self.config.depth_bounds.len() > 1 && info.depth_bounds {
             cull += &format!(" bounds {}", series.depth_bounds.name());
+        }
+        if self.config.depth_reductions.len() > 1 && info.depth_bounds {
+            cull += &format!(" {} reduction", series.depth_reduction.name());
         }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
@@ -1021,6 +1045,7 @@ impl RunRecord {
             msaa: series.msaa,
             msaa_resolve: series.msaa_resolve,
             depth_bounds: None,
+            depth_reduction: None,
             lights: None,
             width: size.0,
             height: size.1,
@@ -1168,6 +1193,9 @@ impl PreparedBench {
             }
             if config.depth_bounds.len() > 1 && series.info.depth_bounds {
                 record.depth_bounds = Some(series.depth_bounds);
+            }
+            if config.depth_reductions.len() > 1 && series.info.depth_bounds {
+                record.depth_reduction = Some(series.depth_reduction);
             }
             let mut bytes = (0, 0);
             let end = m.series(scene, series, &mut record, &mut bytes, &mut results);

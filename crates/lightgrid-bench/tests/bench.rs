@@ -42,6 +42,7 @@ fn config() -> BenchConfig {
         msaa_resolve: vec![Default::default()],
         add_lights: None,
         depth_bounds: vec![Default::default()],
+        depth_reductions: vec![Default::default()],
         heatmap_max: None,
         range_scales: vec![],
         headlights: false,

@@ -195,6 +195,7 @@ pub(crate) struct Given {
     pub(crate) msaa: bool,
     pub(crate) msaa_resolve: bool,
     pub(crate) depth_bounds: bool,
+    pub(crate) depth_reduction: bool,
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
@@ -205,7 +206,7 @@ pub(crate) fn check_applies(
 ) -> Result<()> {
     use lightgrid::pipelines::{PipelineInfo, PIPELINES};
     type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 9] = [
+    let rules: [(&str, bool, Applies); 10] = [
         ("--slices", given.slices, |p| p.clustered),
         ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
         ("--assign", given.assign, |p| p.assign),
@@ -221,6 +222,9 @@ pub(crate) fn check_applies(
             p.msaa == lightgrid::pipelines::Msaa::Supported && !p.forward_shading
         }),
         ("--depth-bounds", given.depth_bounds, |p| p.depth_bounds),
+        ("--depth-reduction", given.depth_reduction, |p| {
+            p.depth_bounds
+        }),
     ];
     for (flag, given, applies) in rules {
         if given && !chosen.iter().any(|p| applies(p)) {
@@ -293,6 +297,27 @@ pub(crate) struct RendererArgs {
     /// (tiled-forward-shading §4.4) [default: both].
     #[arg(long, value_enum)]
     pub(crate) depth_bounds: Option<DepthBoundsArg>,
+    /// How the cell-bounds kernel of grids built from depth reduces a tile's samples:
+    /// atomics (every sample into workgroup memory) or subgroup (registers, then one subgroup
+    /// min/max; tiled grids, adapters with subgroups; tiled-shading §8) [default: atomics].
+    #[arg(long, value_enum)]
+    pub(crate) depth_reduction: Option<DepthReductionArg>,
+}
+
+/// `--depth-reduction` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum DepthReductionArg {
+    Atomics,
+    Subgroup,
+}
+
+impl From<DepthReductionArg> for lightgrid::frame::DepthReduction {
+    fn from(a: DepthReductionArg) -> Self {
+        match a {
+            DepthReductionArg::Atomics => lightgrid::frame::DepthReduction::Atomics,
+            DepthReductionArg::Subgroup => lightgrid::frame::DepthReduction::Subgroup,
+        }
+    }
 }
 
 /// `--depth-bounds` values.
@@ -358,6 +383,7 @@ impl RendererArgs {
             msaa: self.msaa,
             msaa_resolve: self.msaa_resolve.map(Into::into).unwrap_or_default(),
             depth_bounds: self.depth_bounds.map(Into::into).unwrap_or_default(),
+            depth_reduction: self.depth_reduction.map(Into::into).unwrap_or_default(),
         };
         check_msaa_resolve(self.msaa_resolve.is_some(), &[self.msaa])?;
         settings.validate()?;
@@ -376,6 +402,7 @@ impl RendererArgs {
             msaa: self.msaa > 1,
             msaa_resolve: self.msaa_resolve.is_some(),
             depth_bounds: self.depth_bounds.is_some(),
+            depth_reduction: self.depth_reduction.is_some(),
         }
     }
 }

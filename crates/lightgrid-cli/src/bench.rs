@@ -91,6 +91,10 @@ pub(crate) struct BenchArgs {
     /// list (both,min,max,none) [default: both; the depth-bounds preset: all four].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub(crate) depth_bounds: Vec<crate::args::DepthBoundsArg>,
+    /// How the cell-bounds kernel reduces depths: atomics, subgroup or atomics,subgroup to
+    /// measure both (subgroup: adapters with subgroups) [default: atomics].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub(crate) depth_reduction: Vec<crate::args::DepthReductionArg>,
     /// Where tiled and clustered deferred resolve MSAA: separate, kernel, or separate,kernel
     /// to measure both [default: separate; the msaa preset: both].
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -457,6 +461,11 @@ pub(crate) fn bench_config(
         } else {
             a.depth_bounds.iter().map(|&b| b.into()).collect()
         },
+        depth_reductions: if a.depth_reduction.is_empty() {
+            vec![Default::default()]
+        } else {
+            a.depth_reduction.iter().map(|&r| r.into()).collect()
+        },
     };
     crate::args::check_msaa_resolve(!a.msaa_resolve.is_empty(), &config.msaa)?;
     config.validate()?;
@@ -475,6 +484,7 @@ pub(crate) fn bench_config(
         msaa: a.msaa.iter().any(|&n| n > 1),
         msaa_resolve: !a.msaa_resolve.is_empty(),
         depth_bounds: !a.depth_bounds.is_empty(),
+        depth_reduction: !a.depth_reduction.is_empty(),
     };
     check_applies(given, &chosen)?;
     Ok(config)

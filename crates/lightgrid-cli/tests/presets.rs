@@ -200,3 +200,37 @@ fn light_range_preset_sweeps_the_ranges_and_checks_fig_4_2a() {
     }
     assert!(!fresh.exists(), "a refused run creates nothing");
 }
+
+#[test]
+fn both_depth_reductions_are_measured_side_by_side() {
+    let out = bench(&[
+        "--pipelines",
+        "tiled_deferred,forward",
+        "--depth-reduction",
+        "atomics,subgroup",
+        "--size",
+        "64x36",
+        "--frames",
+        "0..259:130",
+    ]);
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        summary.contains("tiled_deferred [subgroup reduction]"),
+        "series rows are labelled"
+    );
+    let line = summary
+        .lines()
+        .find(|l| l.contains("A subgroup (warp-level) min/max reduction"))
+        .expect("the claim");
+    assert!(line.contains("cell-bounds pass avg ms: atomics"), "{line}");
+    assert_fails_with(
+        &[
+            "render",
+            "--pipeline",
+            "forward",
+            "--depth-reduction",
+            "subgroup",
+        ],
+        "--depth-reduction does not apply to forward",
+    );
+}

@@ -168,6 +168,15 @@ impl<'c> Renderer<'c> {
         validate_size(ctx, width, height)?;
         settings.validate()?;
         crate::frame::check_msaa(ctx, settings.msaa, settings.gbuffer)?;
+        if settings.depth_reduction == crate::frame::DepthReduction::Subgroup && !ctx.subgroups {
+            return Err(Error::invalid(
+                "depth reduction",
+                format!(
+                    "subgroup: {} has no subgroup operations; use atomics",
+                    ctx.adapter_label()
+                ),
+            ));
+        }
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {

@@ -728,6 +728,41 @@ fn depth_bound_modes_open_the_bounds_and_keep_the_image() {
     }
 }
 
+/// `--depth-reduction subgroup` reduces to the same cell bounds as the atomics (the twin's),
+/// so the grids and images are the same, on tiled grids (where it applies) and clustered ones
+/// (which keep the atomics); an adapter without subgroups refuses it instead.
+#[test]
+fn subgroup_depth_reduction_gives_the_twins_bounds() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h, frame) = (203, 117, 60);
+    let subgroup = |assign| RenderSettings {
+        tile_size: 12,
+        slices: 16,
+        assign,
+        depth_reduction: lightgrid::frame::DepthReduction::Subgroup,
+        ..Default::default()
+    };
+    if !ctx.subgroups {
+        let e = Renderer::new(&ctx, w, h, subgroup(Assign::Cpu))
+            .err()
+            .unwrap();
+        assert!(e.to_string().contains("no subgroup operations"), "{e}");
+        return;
+    }
+    let reference = Renderer::new(&ctx, w, h, settings(12))
+        .unwrap()
+        .render(&s, frame, REFERENCE)
+        .unwrap()
+        .image;
+    for assign in [Assign::Cpu, Assign::Gather] {
+        let mut r = Renderer::new(&ctx, w, h, subgroup(assign)).unwrap();
+        for id in ["tiled_forward_prez", "tiled_deferred", "clustered_forward"] {
+            check_assign(&mut r, &s, frame, id, &reference);
+        }
+    }
+}
+
 /// Enough lights for a BVH with inner levels, a sort over several blocks and cells with
 /// hundreds of lights.
 #[test]

@@ -40,6 +40,8 @@ pub struct GridSetup<'a> {
     pub forward_opaque: bool,
     /// Which side of the depth bounds assignment culls by (`--depth-bounds`).
     pub depth_bounds: crate::frame::DepthBounds,
+    /// How the cell-bounds kernel reduces depths (`--depth-reduction`).
+    pub depth_reduction: crate::frame::DepthReduction,
 }
 
 /// A built grid and what went into it (analysis).
@@ -98,6 +100,7 @@ impl GridBuilder {
                 ctx.samples,
                 ctx.forward_opaque,
                 ctx.depth_bounds,
+                ctx.depth_reduction,
             ),
             buffers: GridBuffers::new(device),
             strategies: Vec::new(),

@@ -14,11 +14,15 @@
 use super::{GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
-use crate::frame::{DepthBounds, FrameEncoder, FrameInputs};
+use crate::frame::{DepthBounds, DepthReduction, FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
-pub(crate) fn shader(samples: u32, depth_bounds: DepthBounds) -> ComposedShader {
+pub(crate) fn shader(
+    samples: u32,
+    depth_bounds: DepthBounds,
+    reduction: DepthReduction,
+) -> ComposedShader {
     compose(
         "cell_bounds",
         &[
@@ -27,10 +31,40 @@ pub(crate) fn shader(samples: u32, depth_bounds: DepthBounds) -> ComposedShader 
             src::GRID_CELL,
             &crate::shader::msaa_wgsl(samples),
             &format!("const DEPTH_BOUNDS: u32 = {}u;\n", depth_bounds.id()),
+            match reduction {
+                DepthReduction::Atomics => ATOMIC_REDUCTION_WGSL,
+                DepthReduction::Subgroup => SUBGROUP_REDUCTION_WGSL,
+            },
             include_str!("cell_bounds.wgsl"),
         ],
     )
 }
+
+/// `--depth-reduction atomics`: every sample goes into workgroup memory with atomics
+/// (`include_depth`); the register path is never taken, its reduction never called.
+const ATOMIC_REDUCTION_WGSL: &str = "
+const SUBGROUP_REDUCTION: bool = false;
+fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {}
+";
+
+/// `--depth-reduction subgroup` (tiled-shading §8's warp-level reduction): each invocation's
+/// samples in registers, one subgroup min/max, one atomic per subgroup. Only composed for an
+/// adapter with subgroups (the device feature; WGSL's `enable subgroups;` is left out, which
+/// naga rejects).
+const SUBGROUP_REDUCTION_WGSL: &str = "
+const SUBGROUP_REDUCTION: bool = true;
+fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {
+    let l = subgroupMin(lo);
+    let h = subgroupMax(hi);
+    let t = subgroupMax(tile_max);
+    // One lane per subgroup writes (naga has no subgroupElect): the first active one.
+    if (li == subgroupBroadcastFirst(li)) {
+        atomicMin(&slice_lo[0], l);
+        atomicMax(&slice_hi[0], h);
+        atomicMax(&tile_hi, t);
+    }
+}
+";
 
 /// `--depth-bounds` applied to the opaque cells' `bounds` (as the kernel's `open_bounds`
 /// does): `Min` opens an occupied cell's far side to its slice's far end, `Max` its near
@@ -165,6 +199,7 @@ impl CellBoundsPass {
         samples: u32,
         forward_opaque: bool,
         depth_bounds: DepthBounds,
+        reduction: DepthReduction,
     ) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cell bounds (group 1)"),
@@ -177,7 +212,7 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(5, crate::gpu::STORAGE_READ),
             ],
         });
-        let s = shader(samples, depth_bounds);
+        let s = shader(samples, depth_bounds, reduction);
         let layouts = [Some(scene_layout), Some(&layout)];
         let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);

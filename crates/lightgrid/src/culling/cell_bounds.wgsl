@@ -72,6 +72,12 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     workgroupBarrier();
     let size = textureDimensions(depth_tex);
     let origin = wg.xy * grid.tile_size;
+    // `--depth-reduction subgroup` on a tiled grid: this invocation's samples in registers
+    // (bit patterns, ordered as the distances are), reduced across the subgroup below.
+    let registers = SUBGROUP_REDUCTION && grid.slices == 1u;
+    var lo = W_INFINITY;
+    var hi = 0u;
+    var t_hi = 0u;
     var y = lid.y;
     for (; y < grid.tile_size; y = y + TILE_THREADS) {
         var x = lid.x;
@@ -79,13 +85,26 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
             let p = origin + vec2<u32>(x, y);
             if (p.x < size.x && p.y < size.y) {
                 for (var s = 0u; s < SAMPLES; s = s + 1u) {
-                    include_depth(textureLoad(depth_tex, p, s));
+                    let d = textureLoad(depth_tex, p, s);
+                    if (registers) {
+                        let w = view_distance_from_depth(d);
+                        t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, d < 1.0)));
+                        if (d < 1.0) {
+                            lo = min(lo, bitcast<u32>(w));
+                            hi = max(hi, bitcast<u32>(w));
+                        }
+                    } else {
+                        include_depth(d);
+                    }
                 }
             }
         }
         check_loop(x, grid.tile_size);
     }
     check_loop(y, grid.tile_size);
+    if (registers) {
+        subgroup_reduce(lo, hi, t_hi, li);
+    }
     workgroupBarrier();
     let tile = wg.y * grid.tiles_x + wg.x;
     let tiles = grid.tiles_x * grid.tiles_y;

@@ -46,12 +46,15 @@ pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
 
 /// Every assignment shader, for the validation test.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
+    use crate::frame::{DepthBounds, DepthReduction};
     vec![
-        cell_bounds::shader(1, crate::frame::DepthBounds::Both),
-        cell_bounds::shader(4, crate::frame::DepthBounds::Both),
-        cell_bounds::shader(1, crate::frame::DepthBounds::Min),
-        cell_bounds::shader(1, crate::frame::DepthBounds::Max),
-        cell_bounds::shader(4, crate::frame::DepthBounds::None),
+        cell_bounds::shader(1, DepthBounds::Both, DepthReduction::Atomics),
+        cell_bounds::shader(4, DepthBounds::Both, DepthReduction::Atomics),
+        cell_bounds::shader(1, DepthBounds::Min, DepthReduction::Atomics),
+        cell_bounds::shader(1, DepthBounds::Max, DepthReduction::Atomics),
+        cell_bounds::shader(4, DepthBounds::None, DepthReduction::Atomics),
+        cell_bounds::shader(1, DepthBounds::Both, DepthReduction::Subgroup),
+        cell_bounds::shader(4, DepthBounds::Both, DepthReduction::Subgroup),
         fragment_bounds::shader(),
         scan::shader(),
         radix_sort::shader(),

@@ -11,8 +11,9 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_msaa, validate_slices, validate_tile_size, Assign, DepthBounds, GBufferFormat,
-    GridLists, MaterialDraws, MsaaResolve, RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
+    validate_msaa, validate_slices, validate_tile_size, Assign, DepthBounds, DepthReduction,
+    GBufferFormat, GridLists, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
+    AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};
 

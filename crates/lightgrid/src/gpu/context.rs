@@ -22,6 +22,8 @@ pub struct GpuContext {
     pub timestamps: bool,
     /// R32Float can be blended, so forward pipelines can count lighting computations.
     pub count_blend: bool,
+    /// Subgroup operations are enabled (`--depth-reduction subgroup`).
+    pub subgroups: bool,
 }
 
 /// One line of `lightgrid list`.
@@ -173,6 +175,9 @@ impl GpuContext {
         // Sample counts beyond WebGPU's 1 and 4 (and MSAA of 32-bit float G-buffers) are
         // adapter-specific format features (`--msaa`, [`GpuContext::sample_counts`]).
         features |= adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+        // Subgroup operations for the depth reduction (tiled-shading §8), where there are any.
+        let subgroups = adapter.features().contains(wgpu::Features::SUBGROUP);
+        features |= adapter.features() & wgpu::Features::SUBGROUP;
         let desc = wgpu::DeviceDescriptor {
             label: Some("lightgrid"),
             required_features: features,
@@ -200,6 +205,7 @@ impl GpuContext {
             info,
             timestamps,
             count_blend,
+            subgroups,
         })
     }
 

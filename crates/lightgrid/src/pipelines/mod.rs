@@ -45,6 +45,7 @@ impl PipelineContext<'_> {
             samples: self.settings.msaa,
             forward_opaque: true,
             depth_bounds: self.settings.depth_bounds,
+            depth_reduction: self.settings.depth_reduction,
         }
     }
 }

@@ -78,6 +78,7 @@ impl TransparentPass {
                 forward_opaque: false,
                 // Not the technique's grid: `--depth-bounds` is about that one.
                 depth_bounds: crate::frame::DepthBounds::Both,
+                depth_reduction: crate::frame::DepthReduction::Atomics,
                 ..ctx.grid_setup()
             },
             1,
