@@ -43,10 +43,14 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
     parts.extend([
         FULLSCREEN_WGSL,
         VOLUME_WGSL,
+        ATTRIBUTES_WGSL,
         include_str!("light_prepass.wgsl"),
     ]);
     vec![compose("light_prepass", &parts)]
 }
+
+/// Group 2 of the irradiance passes and the surface they read from it (both variants).
+const ATTRIBUTES_WGSL: &str = include_str!("light_prepass_attributes.wgsl");
 
 /// The tiled variant's shaders: the light pre-pass's and the irradiance kernel.
 pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
@@ -64,6 +68,7 @@ fn tiled_kernel() -> ComposedShader {
             src::LIGHTING,
             &crate::shader::msaa_wgsl(1),
             src::LIGHT_GRID,
+            ATTRIBUTES_WGSL,
             include_str!("tiled_light_prepass.wgsl"),
         ],
     )

@@ -8,9 +8,7 @@ fn fs_attributes(v: VertexOut, @builtin(front_facing) front: bool) -> @location(
     return vec4<f32>(s.normal, s.shininess);
 }
 
-// --- 2. irradiance: group 2 = attributes + scene depth
-@group(2) @binding(0) var attr_normal_shininess: texture_2d<f32>;
-@group(2) @binding(1) var attr_depth: texture_depth_2d;
+// --- 2. irradiance: group 2 = attributes + scene depth (light_prepass_attributes.wgsl)
 
 struct IrradianceOut {
     @location(0) diffuse: vec4<f32>,
@@ -25,11 +23,7 @@ fn irradiance_terms(v: VolumeOut, out_terms: ptr<function, LightTerms>) -> bool 
     if (depth >= 1.0) {
         return false;
     }
-    let a = textureLoad(attr_normal_shininess, p, 0);
-    var s: Surface;
-    s.position = world_from_depth(p, depth);
-    s.normal = normalize(a.xyz);
-    s.shininess = a.w;
+    let s = attributes_surface(p, depth);
     *out_terms = light_terms(s, view_dir_to(s.position), lights[v.light]);
     return true;
 }

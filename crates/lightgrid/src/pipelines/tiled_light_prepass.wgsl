@@ -3,11 +3,9 @@
 // pixel reads depth and the normal + exponent once, finds its tile, and accumulates the
 // tile's lights' diffuse irradiance and specular luminance (the monochrome compromise of
 // deferred-shading-vs-deferred-lighting) into one RGBA16F target; the light pre-pass's
-// shading pass then applies the materials. Group 1: the grid; 2: attributes + depth;
-// 3: the irradiance target and the count target (storage).
+// shading pass then applies the materials. Group 1: the grid; 2: attributes + depth
+// (light_prepass_attributes.wgsl); 3: the irradiance target and the count target (storage).
 
-@group(2) @binding(0) var attr_normal_shininess: texture_2d<f32>;
-@group(2) @binding(1) var attr_depth: texture_depth_2d;
 @group(3) @binding(0) var out_irradiance: texture_storage_2d<rgba16float, write>;
 @group(3) @binding(1) var out_count: texture_storage_2d<r32float, write>;
 
@@ -24,11 +22,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         textureStore(out_count, p, vec4<f32>(0.0));
         return;
     }
-    let a = textureLoad(attr_normal_shininess, p, 0);
-    var s: Surface;
-    s.position = world_from_depth(p, depth);
-    s.normal = normalize(a.xyz);
-    s.shininess = a.w;
+    let s = attributes_surface(p, depth);
     let view_dir = view_dir_to(s.position);
     let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
     let count = grid_cell_count(cell);
