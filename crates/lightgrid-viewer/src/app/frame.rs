@@ -113,8 +113,6 @@ impl<'c> App<'c> {
             }
             self.recent.push_back(f);
         }
-        self.report.overflowed = self.figures.overflowed;
-        self.report.truncated = self.figures.truncated;
     }
 
     /// The image the window shows now: the debug view's (once one came back) or the frame.
@@ -158,7 +156,6 @@ impl<'c> App<'c> {
         let win = self.win.as_mut().context("no window")?;
         let input = win.egui.state.take_egui_input(&win.window);
         let before = self.draft.clone();
-        let msaa = lightgrid::frame::msaa_counts(self.ctx, self.draft.settings.gbuffer);
         let adapter = self.report.adapter.clone();
         let info = PanelInfo {
             adapter: &adapter,
@@ -173,7 +170,10 @@ impl<'c> App<'c> {
             flying: self.fly.is_some(),
             fly_speed: self.fly_speed,
             render_size: win.renderer.size(),
-            msaa_counts: &msaa,
+            msaa_counts: match self.draft.settings.gbuffer {
+                GBufferFormat::F16 => &self.msaa_counts[0],
+                GBufferFormat::F32 => &self.msaa_counts[1],
+            },
             figures: &self.figures,
             analysis: self
                 .analysis

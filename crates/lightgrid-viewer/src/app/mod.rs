@@ -31,6 +31,7 @@ use crate::script::{Action, Step};
 use crate::surface::{Acquired, WindowSurface};
 use anyhow::{anyhow, bail, Context, Result};
 use lightgrid::debug_view::DebugView;
+use lightgrid::frame::GBufferFormat;
 use lightgrid::gpu::GpuContext;
 use lightgrid::pipelines::{self, PIPELINES};
 use lightgrid::scene::{Scene, SceneRequest};
@@ -141,6 +142,8 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
             ..
         } = app;
         report.fps = figures.fps();
+        report.overflowed = figures.overflowed;
+        report.truncated = figures.truncated;
         report.gpu_ms = LiveFigures::recent_mean(&figures.gpu_ms, crate::live::HISTORY);
         ran.context("the window's event loop failed")?;
         match fatal {
@@ -241,6 +244,9 @@ struct App<'c> {
     lost: Arc<Mutex<Option<String>>>,
     fatal: Option<anyhow::Error>,
     report: ViewReport,
+    /// The MSAA counts the adapter offers with a 16- and a 32-bit G-buffer (queried once:
+    /// the panel shows them every frame).
+    msaa_counts: [Vec<u32>; 2],
 }
 
 impl<'c> App<'c> {
@@ -304,6 +310,8 @@ impl<'c> App<'c> {
                 adapter: ctx.adapter_label(),
                 ..Default::default()
             },
+            msaa_counts: [GBufferFormat::F16, GBufferFormat::F32]
+                .map(|g| lightgrid::frame::msaa_counts(ctx, g)),
         }
     }
 
