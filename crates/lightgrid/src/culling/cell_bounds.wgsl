@@ -172,16 +172,9 @@ fn slice_span(k: u32) -> vec2<f32> {
 // `tile_max`: in front of it, behind the near plane, inside the slice's range widened by
 // twice the slack (the fragment's slice is computed in f32). Twin: `transparent_bounds`.
 fn transparent_bounds(k: u32, tile_max: f32) -> vec2<f32> {
-    var lo = frame.near;
-    var hi = tile_max;
-    if (grid.slices > 1u) {
-        if (k > 0u) {
-            lo = max(lo, exp((f32(k) - grid.slice_bias) / grid.slice_scale) * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
-        }
-        if (k + 1u < grid.slices) {
-            hi = min(hi, exp((f32(k + 1u) - grid.slice_bias) / grid.slice_scale) * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
-        }
-    }
+    let span = slice_span(k);
+    let lo = max(frame.near, span.x * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
+    let hi = min(tile_max, span.y * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
     if (lo > hi) {
         return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
     }
