@@ -362,10 +362,22 @@ pub fn advise(
         });
         let left = plan.budget.saturating_sub(start.elapsed());
         let m = if stop.load(std::sync::atomic::Ordering::Relaxed) {
-            skipped(plan, c, "interrupted".into())
+            unmeasured(
+                plan,
+                c,
+                Outcome::Skipped {
+                    reason: "interrupted".into(),
+                },
+            )
         } else if left.is_zero() || quickest.is_some_and(|q| left < q) {
             // Not even the quickest candidate so far would fit in what is left.
-            skipped(plan, c, "the budget was spent".into())
+            unmeasured(
+                plan,
+                c,
+                Outcome::Skipped {
+                    reason: "the budget was spent".into(),
+                },
+            )
         } else {
             let t = Instant::now();
             let m = measure(ctx, plan, c, &frames, left, stop);
@@ -405,11 +417,13 @@ fn info(c: &Candidate) -> &'static PipelineInfo {
     pipelines::find(c.pipeline).expect("candidates come from the registry")
 }
 
-fn skipped(plan: &AdvisePlan, c: Candidate, reason: String) -> Measurement {
+/// `c` ending in `outcome`, with what is known without rendering it: its render targets'
+/// bytes and whether it renders with MSAA (a measurement fills in the rest).
+fn unmeasured(plan: &AdvisePlan, c: Candidate, outcome: Outcome) -> Measurement {
     let settings = settings_of(plan, &c);
     Measurement {
         candidate: c,
-        outcome: Outcome::Skipped { reason },
+        outcome,
         memory_bytes: info(&c)
             .memory_model(&settings)
             .target_bytes(plan.size.0, plan.size.1),
@@ -428,15 +442,20 @@ fn measure(
     left: Duration,
     stop: &AtomicBool,
 ) -> Measurement {
-    let mut m = skipped(plan, c, String::new());
-    match try_measure(ctx, plan, &c, frames, left, stop, &mut m) {
-        Ok(outcome) => m.outcome = outcome,
-        Err(e) => {
-            m.outcome = Outcome::Failed {
-                reason: e.to_string(),
-            }
-        }
-    }
+    // The outcome is set below; a failure keeps what was known before it.
+    let mut m = unmeasured(
+        plan,
+        c,
+        Outcome::Failed {
+            reason: String::new(),
+        },
+    );
+    m.outcome = match try_measure(ctx, plan, &c, frames, left, stop, &mut m) {
+        Ok(outcome) => outcome,
+        Err(e) => Outcome::Failed {
+            reason: e.to_string(),
+        },
+    };
     m
 }
 
