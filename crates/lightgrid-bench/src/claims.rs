@@ -432,6 +432,16 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
                 "deferred-shading-vs-deferred-lighting",
                 write_break_even(r, scene),
             ),
+            (
+                "With monochrome specular on both sides, deferred lighting writes as much as deferred shading (the traffic model at the measured lights per pixel)",
+                "deferred-shading-vs-deferred-lighting (the compromise)",
+                mono_break_even(r, scene, Side::Writes),
+            ),
+            (
+                "With monochrome specular on both sides, deferred lighting reads less than deferred shading once more than 2 lights reach a pixel on average",
+                "deferred-shading-vs-deferred-lighting (the compromise)",
+                mono_break_even(r, scene, Side::Reads),
+            ),
         ] {
             claim(statement, source, e, v);
         }
@@ -966,23 +976,94 @@ pub fn writes_more(
 
 /// Claim 15: lights per pixel from deferred's counts, writes from the traffic model.
 fn write_break_even(r: &BenchResults, scene: &str) -> (String, Verdict) {
-    let writes = |p| -> Option<f64> {
-        let x = find(r, scene, p, None)?;
-        let w: Option<Vec<u64>> = x.frames.iter().map(|f| f.modelled_write_bytes).collect();
-        let w = w.filter(|w| !w.is_empty())?;
-        Some(w.iter().sum::<u64>() as f64 / w.len() as f64)
-    };
-    let lights_per_pixel = find(r, scene, "deferred", None).and_then(|x| {
-        let pixels = f64::from(x.width) * f64::from(x.height);
-        Some(avg_count(x)? / pixels.max(1.0))
-    });
     match (
-        lights_per_pixel,
-        writes("light_prepass"),
-        writes("deferred"),
+        lights_per_pixel(r, scene),
+        modelled(r, scene, "light_prepass", Side::Writes),
+        modelled(r, scene, "deferred", Side::Writes),
     ) {
         (Some(l), Some(lp), Some(ds)) => writes_more(l, lp, ds),
         _ => not_measured("deferred and light_prepass"),
+    }
+}
+
+/// Lights reaching a pixel on average: deferred's lighting computations per pixel (each
+/// volume fragment that runs the light function is a lit pixel).
+fn lights_per_pixel(r: &BenchResults, scene: &str) -> Option<f64> {
+    let x = find(r, scene, "deferred", None)?;
+    let pixels = f64::from(x.width) * f64::from(x.height);
+    Some(avg_count(x)? / pixels.max(1.0))
+}
+
+/// Which side of the traffic model a claim weighs: bytes written or bytes read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    Writes,
+    Reads,
+}
+
+/// A run's modelled bytes per frame (the traffic model applied to each frame's pixels and
+/// lighting computations), averaged over its frames.
+fn modelled(r: &BenchResults, scene: &str, pipeline: &str, side: Side) -> Option<f64> {
+    let x = find(r, scene, pipeline, None)?;
+    let bytes: Option<Vec<u64>> = x
+        .frames
+        .iter()
+        .map(|f| match side {
+            Side::Writes => f.modelled_write_bytes,
+            Side::Reads => f.modelled_read_bytes,
+        })
+        .collect();
+    let bytes = bytes.filter(|b| !b.is_empty())?;
+    Some(bytes.iter().sum::<u64>() as f64 / bytes.len() as f64)
+}
+
+/// The blog's mono-specular break-evens. With the specular monochrome on both sides (deferred
+/// lighting keeps it in the diffuse irradiance's alpha, deferred shading in the diffuse
+/// albedo's), its layouts give shading 16 B written per pixel + 8 per lit pixel and 20 read per
+/// lit pixel, lighting 16 + 8 written and 8 per pixel + 16 per lit pixel read: equal writes,
+/// and fewer reads for lighting above 2 lights per pixel.
+pub const MONO_READ_BREAK_EVEN: f64 = 2.0;
+/// Modelled writes within this fraction of each other count as equal.
+pub const EQUAL_WRITES: f64 = 0.05;
+
+/// The verdict on the measured lights per pixel and the mono-specular pipelines' modelled
+/// bytes per frame: writes are equal (within [`EQUAL_WRITES`]), or lighting reads less exactly
+/// when the lights per pixel pass [`MONO_READ_BREAK_EVEN`].
+pub fn mono_traffic(
+    side: Side,
+    lights_per_pixel: f64,
+    lighting_bytes: f64,
+    shading_bytes: f64,
+) -> (String, Verdict) {
+    let what = match side {
+        Side::Writes => "writes",
+        Side::Reads => "reads",
+    };
+    let evidence = format!(
+        "{lights_per_pixel:.2} lights per pixel (deferred's lighting computations / pixels); modelled {what} per frame: light_prepass_mono {:.1} MiB, deferred_mono {:.1} MiB ({:.2}x)",
+        lighting_bytes / 1048576.0,
+        shading_bytes / 1048576.0,
+        lighting_bytes / shading_bytes.max(1.0)
+    );
+    let held = match side {
+        Side::Writes => (lighting_bytes - shading_bytes).abs() <= EQUAL_WRITES * shading_bytes,
+        Side::Reads => {
+            (lighting_bytes < shading_bytes) == (lights_per_pixel > MONO_READ_BREAK_EVEN)
+        }
+    };
+    (evidence, verdict(held))
+}
+
+/// Claims 16 and 17: lights per pixel from deferred's counts, bytes from the traffic models of
+/// the two mono-specular pipelines.
+fn mono_break_even(r: &BenchResults, scene: &str, side: Side) -> (String, Verdict) {
+    match (
+        lights_per_pixel(r, scene),
+        modelled(r, scene, "light_prepass_mono", side),
+        modelled(r, scene, "deferred_mono", side),
+    ) {
+        (Some(l), Some(lp), Some(ds)) => mono_traffic(side, l, lp, ds),
+        _ => not_measured("deferred, light_prepass_mono and deferred_mono"),
     }
 }
 
@@ -1117,6 +1198,46 @@ mod tests {
         assert_eq!(writes_more(2.0, 10.0, 20.0).1, Verdict::NotHeld);
         assert_eq!(writes_more(0.2, 10.0, 20.0).1, Verdict::Held);
         assert_eq!(writes_more(0.2, 30.0, 20.0).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn mono_break_evens_on_both_sides() {
+        // Writes: equal within 5% holds, whichever side is larger; beyond it does not.
+        assert_eq!(
+            mono_traffic(Side::Writes, 3.0, 103.0, 100.0).1,
+            Verdict::Held
+        );
+        assert_eq!(
+            mono_traffic(Side::Writes, 3.0, 97.0, 100.0).1,
+            Verdict::Held
+        );
+        assert_eq!(
+            mono_traffic(Side::Writes, 3.0, 80.0, 100.0).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            mono_traffic(Side::Writes, 0.1, 120.0, 100.0).1,
+            Verdict::NotHeld
+        );
+        // Reads: lighting should read less above 2 lights per pixel and more below.
+        assert_eq!(mono_traffic(Side::Reads, 3.0, 90.0, 100.0).1, Verdict::Held);
+        assert_eq!(
+            mono_traffic(Side::Reads, 3.0, 110.0, 100.0).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            mono_traffic(Side::Reads, 1.0, 110.0, 100.0).1,
+            Verdict::Held
+        );
+        assert_eq!(
+            mono_traffic(Side::Reads, 1.0, 90.0, 100.0).1,
+            Verdict::NotHeld
+        );
+        let (e, _) = mono_traffic(Side::Reads, 2.5, 2097152.0, 4194304.0);
+        assert!(
+            e.contains("reads") && e.contains("2.0 MiB") && e.contains("(0.50x)"),
+            "{e}"
+        );
     }
 
     #[test]

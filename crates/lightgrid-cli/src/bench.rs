@@ -306,11 +306,11 @@ pub(crate) fn bench_config(
             size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
             gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
             repeat: if hardware { 3 } else { 1 },
-            // forward_mono only exists as light_prepass_mono's test reference.
-            pipelines: all
+            // The references of the mono-specular pipelines only exist to test their images.
+            pipelines: PIPELINES
                 .iter()
-                .filter(|p| *p != "forward_mono")
-                .cloned()
+                .filter(|p| p.reference != p.id || p.id == lightgrid::pipelines::REFERENCE)
+                .map(|p| p.id.to_string())
                 .collect(),
             spot_fraction: 0.0,
             spot_culls: vec![Default::default()],

@@ -118,6 +118,14 @@ const TOLERANCES: &[Tolerance] = &[
         why: "as deferred",
     },
     Tolerance {
+        id: "deferred_mono",
+        max_mean: 0.5,
+        max_p99: 2.0,
+        level: 4,
+        max_over: GBUFFER_OVER,
+        why: "as deferred, against forward_mono_albedo (the same one-value specular albedo)",
+    },
+    Tolerance {
         id: "light_prepass",
         max_mean: 0.5,
         max_p99: 2.0,
@@ -159,7 +167,7 @@ fn tolerance(id: &str) -> common::ImageTolerance {
     }
 }
 
-/// A pipeline that is its own reference (`forward`, `forward_mono`).
+/// A pipeline that is its own reference (`forward`, `forward_mono`, `forward_mono_albedo`).
 fn is_reference(p: &PipelineInfo) -> bool {
     p.reference == p.id
 }
@@ -258,6 +266,7 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
     // Deferred lighting runs the light function on the same volume fragments as deferred.
     assert_eq!(counts["light_prepass"], counts["deferred"]);
     assert_eq!(counts["light_prepass_mono"], counts["deferred"]);
+    assert_eq!(counts["deferred_mono"], counts["deferred"]);
 }
 
 /// Transparency (tiled-shading §4, tiled-forward-shading §4.5): every pipeline draws the
@@ -998,6 +1007,45 @@ fn material_shaders_render_the_same_in_forward_and_deferred_pipelines() {
             );
         }
     }
+}
+
+/// Mono-specular deferred shading (the blog's fair counterpart of `light_prepass_mono`) on a
+/// scene whose specular colours are tinted, unlike the catalog's grey ones: its one-value
+/// albedo really changes the image (against `forward`), and it matches its reference
+/// `forward_mono_albedo`, which makes the same approximation.
+#[test]
+fn deferred_mono_matches_its_reference_with_coloured_specular() {
+    let mut s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    for (i, m) in s.materials.iter_mut().enumerate() {
+        let tints = [
+            glam::Vec3::new(1.0, 0.45, 0.1),
+            glam::Vec3::new(0.1, 0.6, 1.0),
+        ];
+        m.specular *= tints[i % 2] * 1.5;
+    }
+    let ctx = common::gpu();
+    let (w, h) = (173, 109);
+    let mut r = Renderer::new(&ctx, w, h, settings(16)).unwrap();
+    let full = r.render(&s, 150, REFERENCE).unwrap().image;
+    let reference = r.render(&s, 150, "forward_mono_albedo").unwrap().image;
+    let mono = r.render(&s, 150, "deferred_mono").unwrap().image;
+    let tinted = common::pixels_over(&full, &reference, 8);
+    assert!(
+        tinted > 200,
+        "the one-value albedo changes only {tinted} pixels"
+    );
+    let cmp = common::compare_images(&reference, &mono, tolerance("deferred_mono"));
+    assert!(
+        cmp.passes(),
+        "deferred_mono vs forward_mono_albedo: {}",
+        cmp.describe()
+    );
+    let against_forward = common::compare_images(&full, &mono, tolerance("deferred_mono"));
+    assert!(
+        !against_forward.passes(),
+        "deferred_mono equals forward with tinted specular: {}",
+        against_forward.describe()
+    );
 }
 
 /// A glTF file (the fixture room: hierarchy, mirrored instance, strips, computed normals,

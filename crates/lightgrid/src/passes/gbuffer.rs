@@ -1,6 +1,7 @@
 //! The G-buffer pass and the group-2 bindings deferred compute passes read it through
-//! (`gbuffer_read.wgsl`). Four colour targets of four channels, 16-bit float by default or
-//! 32-bit (`--gbuffer 32`), as tiled-shading §8 measures both; depth is the shared target.
+//! (`gbuffer_read.wgsl` + the layout's specular piece). Four colour targets of four channels
+//! (three in the mono-specular layout), 16-bit float by default or 32-bit (`--gbuffer 32`), as
+//! tiled-shading §8 measures both; depth is the shared target.
 
 use super::geometry::{draw_scene, geometry_pipeline, GeometryPipelineDesc};
 use super::Targets;
@@ -16,19 +17,80 @@ pub(crate) fn shader() -> ComposedShader {
     compose("gbuffer", &parts)
 }
 
-/// WGSL a deferred compute shader includes to read the G-buffer.
-pub const GBUFFER_READ_WGSL: &str = include_str!("gbuffer_read.wgsl");
+/// WGSL a deferred pass includes to read the full G-buffer ([`GBufferLayout::Full`]).
+pub const GBUFFER_READ_WGSL: &str = concat!(
+    include_str!("gbuffer_read.wgsl"),
+    include_str!("gbuffer_specular.wgsl")
+);
 
+/// WGSL a deferred pass includes to read the mono-specular G-buffer.
+pub const GBUFFER_READ_MONO_WGSL: &str = concat!(
+    include_str!("gbuffer_read.wgsl"),
+    include_str!("gbuffer_specular_mono.wgsl")
+);
+
+/// The targets by location (and group-2 binding): normal + material, diffuse, specular +
+/// exponent, the light-independent term.
 const TARGET_NAMES: [&str; 4] = [
     "gbuffer normal",
     "gbuffer diffuse",
     "gbuffer specular",
     "gbuffer base",
 ];
+/// The location of the specular target, which the mono-specular layout leaves out.
+const SPECULAR: usize = 2;
+/// The group-2 binding of the depth the G-buffer was rendered with.
+const DEPTH_BINDING: u32 = 4;
+
+/// What the G-buffer stores (deferred-shading-vs-deferred-lighting).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GBufferLayout {
+    /// Normal + material, diffuse, specular colour + exponent, light-independent term.
+    Full,
+    /// The blog's fair counterpart of mono-specular deferred lighting: the specular albedo as
+    /// one value in the diffuse target's alpha (`mono_albedo`), no specular target.
+    MonoSpecular,
+}
+
+impl GBufferLayout {
+    /// Colour targets written per pixel.
+    pub fn targets(self) -> u32 {
+        match self {
+            GBufferLayout::Full => 4,
+            GBufferLayout::MonoSpecular => 3,
+        }
+    }
+
+    /// Targets a lighting computation reads (every one but the light-independent term).
+    pub fn lit_reads(self) -> u32 {
+        self.targets() - 1
+    }
+
+    /// The WGSL that reads this layout (group 2).
+    pub fn read_wgsl(self) -> &'static str {
+        match self {
+            GBufferLayout::Full => GBUFFER_READ_WGSL,
+            GBufferLayout::MonoSpecular => GBUFFER_READ_MONO_WGSL,
+        }
+    }
+
+    fn fragment_entry(self) -> &'static str {
+        match self {
+            GBufferLayout::Full => "fs_gbuffer",
+            GBufferLayout::MonoSpecular => "fs_gbuffer_mono",
+        }
+    }
+
+    fn has(self, location: usize) -> bool {
+        location != SPECULAR || self == GBufferLayout::Full
+    }
+}
 
 pub struct GBuffer {
     pub format: GBufferFormat,
-    views: Vec<wgpu::TextureView>,
+    pub layout: GBufferLayout,
+    /// By location; `None` where the layout has no target.
+    views: Vec<Option<wgpu::TextureView>>,
     pipeline: wgpu::RenderPipeline,
     pub read_layout: wgpu::BindGroupLayout,
 }
@@ -38,33 +100,40 @@ impl GBuffer {
         device: &wgpu::Device,
         scene_layout: &wgpu::BindGroupLayout,
         format: GBufferFormat,
+        layout: GBufferLayout,
         size: (u32, u32),
         samples: u32,
     ) -> Self {
         let tf = format.texture_format();
-        let views = TARGET_NAMES
+        let views: Vec<Option<wgpu::TextureView>> = TARGET_NAMES
             .iter()
-            .map(|name| {
-                super::multisampled_texture(
-                    device,
-                    name,
-                    tf,
-                    size,
-                    samples,
-                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                )
-                .create_view(&Default::default())
+            .enumerate()
+            .map(|(location, name)| {
+                layout.has(location).then(|| {
+                    super::multisampled_texture(
+                        device,
+                        name,
+                        tf,
+                        size,
+                        samples,
+                        wgpu::TextureUsages::RENDER_ATTACHMENT
+                            | wgpu::TextureUsages::TEXTURE_BINDING,
+                    )
+                    .create_view(&Default::default())
+                })
             })
             .collect();
         let module = create_module(device, &shader());
-        let targets: Vec<Option<wgpu::ColorTargetState>> =
-            (0..4).map(|_| Some(tf.into())).collect();
+        let targets: Vec<Option<wgpu::ColorTargetState>> = views
+            .iter()
+            .map(|v| v.as_ref().map(|_| tf.into()))
+            .collect();
         let pipeline = geometry_pipeline(
             device,
             &GeometryPipelineDesc {
                 label: "gbuffer",
                 module: &module,
-                fragment_entry: Some("fs_gbuffer"),
+                fragment_entry: Some(layout.fragment_entry()),
                 layouts: &[Some(scene_layout)],
                 color_targets: &targets,
                 depth_write: true,
@@ -74,25 +143,31 @@ impl GBuffer {
         );
         GBuffer {
             format,
+            layout,
+            read_layout: Self::read_layout(device, &views, samples),
             views,
             pipeline,
-            read_layout: Self::read_layout(device, samples),
         }
     }
 
-    fn read_layout(device: &wgpu::Device, samples: u32) -> wgpu::BindGroupLayout {
+    /// Bindings 0-3 are the targets by location (those the layout has), 4 the depth.
+    fn read_layout(
+        device: &wgpu::Device,
+        views: &[Option<wgpu::TextureView>],
+        samples: u32,
+    ) -> wgpu::BindGroupLayout {
         let tex =
             |binding, sample_type| super::sampled_texture_entry(binding, sample_type, samples);
         let float = wgpu::TextureSampleType::Float { filterable: false };
+        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..)
+            .zip(views)
+            .filter(|(_, v)| v.is_some())
+            .map(|(binding, _)| tex(binding, float))
+            .collect();
+        entries.push(tex(DEPTH_BINDING, wgpu::TextureSampleType::Depth));
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer read (group 2)"),
-            entries: &[
-                tex(0, float),
-                tex(1, float),
-                tex(2, float),
-                tex(3, float),
-                tex(4, wgpu::TextureSampleType::Depth),
-            ],
+            entries: &entries,
         })
     }
 
@@ -102,16 +177,15 @@ impl GBuffer {
             binding,
             resource: wgpu::BindingResource::TextureView(v),
         };
+        let mut entries: Vec<wgpu::BindGroupEntry> = (0..)
+            .zip(&self.views)
+            .filter_map(|(binding, v)| Some(view(binding, v.as_ref()?)))
+            .collect();
+        entries.push(view(DEPTH_BINDING, &targets.depth));
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer read"),
             layout: &self.read_layout,
-            entries: &[
-                view(0, &self.views[0]),
-                view(1, &self.views[1]),
-                view(2, &self.views[2]),
-                view(3, &self.views[3]),
-                view(4, &targets.depth),
-            ],
+            entries: &entries,
         })
     }
 
@@ -127,7 +201,7 @@ impl GBuffer {
             .iter()
             .map(|v| {
                 Some(wgpu::RenderPassColorAttachment {
-                    view: v,
+                    view: v.as_ref()?,
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {

@@ -4,7 +4,8 @@
 
 @group(2) @binding(0) var gb_normal: SampleTexture;
 @group(2) @binding(1) var gb_diffuse: SampleTexture;
-@group(2) @binding(2) var gb_specular: SampleTexture;
+// Binding 2, the specular target, is declared by the layout's piece (gbuffer_specular*.wgsl):
+// the mono-specular layout has none.
 @group(2) @binding(3) var gb_base: SampleTexture;
 @group(2) @binding(4) var gb_depth: DepthTexture;
 
@@ -18,17 +19,18 @@ fn surface_from_gbuffer(p: vec2<u32>, depth: f32) -> Surface {
 fn raw_surface_from_gbuffer(p: vec2<u32>, s: u32, position: vec3<f32>) -> Surface {
     let n = textureLoad(gb_normal, p, s);
     let d = textureLoad(gb_diffuse, p, s);
-    let sp = textureLoad(gb_specular, p, s);
     let b = textureLoad(gb_base, p, s);
     var out: Surface;
     out.position = position;
     out.normal = normalize(n.xyz);
     out.diffuse = d.rgb;
-    out.alpha = d.a;
-    out.specular = sp.rgb;
-    out.shininess = sp.a;
+    // The G-buffer holds opaque samples only (alpha-tested ones passed): no lighting reads it.
+    out.alpha = 1.0;
     out.emissive = b.rgb;
     out.ambient = vec3<f32>(0.0);
     out.material = u32(n.w + 0.5);
+    let sp = gbuffer_specular(p, s, d, out.material);
+    out.specular = sp.rgb;
+    out.shininess = sp.a;
     return out;
 }

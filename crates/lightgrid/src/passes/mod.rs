@@ -12,7 +12,7 @@ pub use crate::frame::targets::{
     cleared, cleared_depth, loaded, loaded_depth, multisampled_texture, render_texture, Targets,
     COUNT_FORMAT, DEPTH_FORMAT, HDR_FORMAT, LDR_FORMAT,
 };
-pub use gbuffer::{GBuffer, GBufferFormat, GBUFFER_READ_WGSL};
+pub use gbuffer::{GBuffer, GBufferFormat, GBufferLayout, GBUFFER_READ_WGSL};
 pub use light_volumes::{
     additive, classify_lights, LightVolumes, VolumeClasses, VolumeDraw, VolumePipelineDesc,
     VOLUME_DEPTH_BYTES, VOLUME_DEPTH_FORMAT, VOLUME_WGSL,

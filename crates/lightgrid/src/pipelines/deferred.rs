@@ -1,7 +1,9 @@
-//! `deferred` and `deferred_stencil`: classic deferred shading with light volumes
-//! (tiled-shading §1.1, §8 "Deferred" and "Deferred-Stencil").
+//! `deferred`, `deferred_stencil` and `deferred_mono`: classic deferred shading with light
+//! volumes (tiled-shading §1.1, §8 "Deferred" and "Deferred-Stencil"), and its mono-specular
+//! form, the fair counterpart of `light_prepass_mono` (deferred-shading-vs-deferred-lighting).
 //!
-//! 1. G-buffer pass (shared with tiled deferred; 16- or 32-bit channels).
+//! 1. G-buffer pass (shared with tiled deferred; 16- or 32-bit channels); `deferred_mono`'s
+//!    keeps the specular albedo as one value in the diffuse target (`GBufferLayout`).
 //! 2. One render pass into HDR + counts, depth-tested against a depth-stencil copy:
 //!    a. copy the scene depth (full screen);
 //!    b. the light-independent term (full screen);
@@ -21,14 +23,26 @@ use crate::passes::{
     additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_DEPTH_FORMAT,
     VOLUME_WGSL,
 };
-use crate::passes::{GBuffer, COUNT_FORMAT, FULLSCREEN_WGSL, GBUFFER_READ_WGSL, HDR_FORMAT};
+use crate::passes::{GBuffer, GBufferLayout, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT};
 use crate::shader::{compose, create_module, src, ComposedShader};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
+    vec![shader(GBufferLayout::Full)]
+}
+
+pub(super) fn shaders_mono() -> Vec<ComposedShader> {
+    vec![shader(GBufferLayout::MonoSpecular)]
+}
+
+fn shader(layout: GBufferLayout) -> ComposedShader {
     // Light volumes shade single-sample G-buffers only (`PipelineInfo::msaa`).
     let single_sample = crate::shader::msaa_wgsl(1);
-    vec![compose(
-        "deferred",
+    let name = match layout {
+        GBufferLayout::Full => "deferred",
+        GBufferLayout::MonoSpecular => "deferred_mono",
+    };
+    compose(
+        name,
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
@@ -37,10 +51,10 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
             FULLSCREEN_WGSL,
             VOLUME_WGSL,
             &single_sample,
-            GBUFFER_READ_WGSL,
+            layout.read_wgsl(),
             include_str!("deferred.wgsl"),
         ],
-    )]
+    )
 }
 
 struct Deferred {
@@ -63,12 +77,28 @@ pub(super) fn volume_targets(count_blend: bool) -> [Option<wgpu::ColorTargetStat
     ]
 }
 
-fn create(ctx: &PipelineContext, stencil: bool) -> Box<dyn Technique> {
+/// Which samples inside a light's volume are shaded.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Cull {
+    /// Every fragment of the volume's front (or back) faces that passes the depth test.
+    Volumes,
+    /// Only the samples a z-fail stencil pass marks inside the volume.
+    Stencil,
+}
+
+fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn Technique> {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let gbuffer = GBuffer::new(device, ctx.scene_layout, ctx.settings.gbuffer, (w, h), 1);
+    let gbuffer = GBuffer::new(
+        device,
+        ctx.scene_layout,
+        ctx.settings.gbuffer,
+        layout,
+        (w, h),
+        1,
+    );
     let volumes = LightVolumes::new(device, w, h);
-    let module = create_module(device, &shaders()[0]);
+    let module = create_module(device, &shader(layout));
     let targets = volume_targets(ctx.count_blend);
     let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
     let volume = |label, fragment_entry, draw| {
@@ -118,7 +148,7 @@ fn create(ctx: &PipelineContext, stencil: bool) -> Box<dyn Technique> {
             cache: None,
         })
     };
-    let stencil = stencil.then(|| {
+    let stencil = (cull == Cull::Stencil).then(|| {
         (
             volume("stencil mark", "fs_light", VolumeDraw::StencilMark),
             volume("stencil light", "fs_light", VolumeDraw::StencilLight),
@@ -137,11 +167,15 @@ fn create(ctx: &PipelineContext, stencil: bool) -> Box<dyn Technique> {
 }
 
 pub(super) fn create_plain(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create(ctx, false)
+    create(ctx, Cull::Volumes, GBufferLayout::Full)
 }
 
 pub(super) fn create_stencil(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create(ctx, true)
+    create(ctx, Cull::Stencil, GBufferLayout::Full)
+}
+
+pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create(ctx, Cull::Volumes, GBufferLayout::MonoSpecular)
 }
 
 impl Technique for Deferred {
@@ -196,19 +230,31 @@ impl Technique for Deferred {
 /// target and write the copy and HDR. Per lighting computation: read depth, three G-buffer
 /// targets and the light, blend into HDR (read + write).
 pub(super) fn memory(settings: &RenderSettings) -> MemoryModel {
+    memory_with(settings, GBufferLayout::Full)
+}
+
+/// As `memory` with three G-buffer targets, two of them read per lighting computation (the
+/// blog's mono-specular deferred shading: the specular target's bytes saved per pixel and per
+/// lit pixel).
+pub(super) fn memory_mono(settings: &RenderSettings) -> MemoryModel {
+    memory_with(settings, GBufferLayout::MonoSpecular)
+}
+
+fn memory_with(settings: &RenderSettings, layout: GBufferLayout) -> MemoryModel {
     let g = settings.gbuffer.bytes_per_target();
+    let name = format!("gbuffer ({} targets)", layout.targets());
     MemoryModel::new(
         &[
             ("depth", DEPTH_BYTES),
-            ("gbuffer (4 targets)", 4 * g),
+            (&name, layout.targets() * g),
             ("hdr", HDR_BYTES),
             ("volume depth-stencil", VOLUME_DEPTH_BYTES),
         ],
         Traffic {
-            write_per_pixel: DEPTH_BYTES + 4 * g + VOLUME_DEPTH_BYTES + HDR_BYTES,
+            write_per_pixel: DEPTH_BYTES + layout.targets() * g + VOLUME_DEPTH_BYTES + HDR_BYTES,
             read_per_pixel: 2 * DEPTH_BYTES + g,
             write_per_lit: HDR_BYTES,
-            read_per_lit: DEPTH_BYTES + 3 * g + HDR_BYTES + LIGHT_BYTES,
+            read_per_lit: DEPTH_BYTES + layout.lit_reads() * g + HDR_BYTES + LIGHT_BYTES,
         },
     )
 }

@@ -31,6 +31,11 @@ pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
     create_with(ctx, "fs_mono")
 }
 
+/// `forward_mono_albedo`: the same, with `deferred_mono`'s one-value specular albedo.
+pub(super) fn create_mono_albedo(ctx: &PipelineContext) -> Box<dyn Technique> {
+    create_with(ctx, "fs_mono_albedo")
+}
+
 fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let pipelines = MaterialPipelines::new(

@@ -30,3 +30,14 @@ fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let color = surface_base(s) + diffuse * s.diffuse + mono_specular(diffuse, specular) * s.specular;
     return lit(v.clip, color, frame.light_count);
 }
+
+// forward_mono_albedo: the reference for deferred_mono: every light for every fragment, with
+// the specular albedo reduced to one value as deferred_mono's G-buffer stores it.
+// Early depth test forced, as fs_main.
+@fragment @early_depth_test(force)
+fn fs_mono_albedo(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
+    var s = surface_from_vertex(v, front);
+    s.specular = mono_albedo(s.specular);
+    let color = surface_base(s) + shade_all_lights(s, view_dir_to(s.position));
+    return lit(v.clip, color, frame.light_count);
+}

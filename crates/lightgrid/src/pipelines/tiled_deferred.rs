@@ -22,7 +22,8 @@ use crate::error::Result;
 use crate::frame::MsaaResolve;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
-    compute_outputs, compute_outputs_layout, GBuffer, COMPUTE_OUTPUTS_WGSL, GBUFFER_READ_WGSL,
+    compute_outputs, compute_outputs_layout, GBuffer, GBufferLayout, COMPUTE_OUTPUTS_WGSL,
+    GBUFFER_READ_WGSL,
 };
 use crate::shader::{compose, compute_pipeline, compute_pipeline_with, src, ComposedShader};
 
@@ -266,6 +267,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         ctx.device,
         ctx.scene_layout,
         ctx.settings.gbuffer,
+        GBufferLayout::Full,
         (w, h),
         samples,
     );
@@ -323,6 +325,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
         ctx.device,
         ctx.scene_layout,
         ctx.settings.gbuffer,
+        GBufferLayout::Full,
         (w, h),
         1,
     );

@@ -130,3 +130,10 @@ fn mono_specular(diffuse_irradiance: vec3<f32>, specular_luminance: f32) -> vec3
     }
     return diffuse_irradiance * (specular_luminance / l);
 }
+
+// The same compromise on the deferred-shading side (the blog's fair counterpart): the
+// specular albedo as one value, its luminance, in every channel. Exact for grey specular
+// (every catalog material); a coloured one (a glTF metal) loses its tint.
+fn mono_albedo(specular: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(luminance(specular));
+}
