@@ -966,7 +966,7 @@ pub fn writes_more(
     let more = lighting_bytes > shading_bytes;
     (
         format!(
-            "{lights_per_pixel:.2} lights per pixel (deferred's lighting computations / pixels); modelled writes per frame: light_prepass {:.1} MiB, deferred {:.1} MiB",
+            "{lights_per_pixel:.2} lights per pixel (deferred's opaque lighting computations / pixels); modelled writes per frame: light_prepass {:.1} MiB, deferred {:.1} MiB",
             lighting_bytes / 1048576.0,
             shading_bytes / 1048576.0
         ),
@@ -986,12 +986,22 @@ fn write_break_even(r: &BenchResults, scene: &str) -> (String, Verdict) {
     }
 }
 
-/// Lights reaching a pixel on average: deferred's lighting computations per pixel (each
-/// volume fragment that runs the light function is a lit pixel).
+/// Lights reaching a pixel on average: deferred's opaque lighting computations per pixel
+/// (each volume fragment that runs the light function is a lit pixel; the transparent pass
+/// is outside the blog's model).
 fn lights_per_pixel(r: &BenchResults, scene: &str) -> Option<f64> {
     let x = find(r, scene, "deferred", None)?;
     let pixels = f64::from(x.width) * f64::from(x.height);
-    Some(avg_count(x)? / pixels.max(1.0))
+    let opaque: Option<Vec<f64>> = x
+        .frames
+        .iter()
+        .map(|f| {
+            let n = f.lighting_computations?;
+            Some(n.saturating_sub(f.transparent_lighting_computations.unwrap_or(0)) as f64)
+        })
+        .collect();
+    let opaque = opaque.filter(|o| !o.is_empty())?;
+    Some(opaque.iter().sum::<f64>() / opaque.len() as f64 / pixels.max(1.0))
 }
 
 /// Which side of the traffic model a claim weighs: bytes written or bytes read.
@@ -1040,7 +1050,7 @@ pub fn mono_traffic(
         Side::Reads => "reads",
     };
     let evidence = format!(
-        "{lights_per_pixel:.2} lights per pixel (deferred's lighting computations / pixels); modelled {what} per frame: light_prepass_mono {:.1} MiB, deferred_mono {:.1} MiB ({:.2}x)",
+        "{lights_per_pixel:.2} lights per pixel (deferred's opaque lighting computations / pixels); modelled {what} per frame: light_prepass_mono {:.1} MiB, deferred_mono {:.1} MiB ({:.2}x)",
         lighting_bytes / 1048576.0,
         shading_bytes / 1048576.0,
         lighting_bytes / shading_bytes.max(1.0)
@@ -1062,9 +1072,45 @@ fn mono_break_even(r: &BenchResults, scene: &str, side: Side) -> (String, Verdic
         modelled(r, scene, "light_prepass_mono", side),
         modelled(r, scene, "deferred_mono", side),
     ) {
-        (Some(l), Some(lp), Some(ds)) => mono_traffic(side, l, lp, ds),
+        (Some(l), Some(lp), Some(ds)) => {
+            let (evidence, v) = mono_traffic(side, l, lp, ds);
+            let budgets = [
+                budget(r, scene, "light_prepass_mono", side),
+                budget(r, scene, "deferred_mono", side),
+            ];
+            match budgets {
+                [Some(a), Some(b)] => (
+                    format!("{evidence}; bytes per pixel + per lit pixel: light_prepass_mono {a}, deferred_mono {b}"),
+                    v,
+                ),
+                _ => (evidence, v),
+            }
+        }
         _ => not_measured("deferred, light_prepass_mono and deferred_mono"),
     }
+}
+
+/// A run's traffic budget on one side, as "P + L" (bytes per pixel + per lit pixel), from the
+/// registry's model at the run's G-buffer precision.
+fn budget(r: &BenchResults, scene: &str, pipeline: &str, side: Side) -> Option<String> {
+    use lightgrid::frame::GBufferFormat;
+    let x = find(r, scene, pipeline, None)?;
+    let gbuffer = match x.gbuffer_bits {
+        Some(32) => GBufferFormat::F32,
+        _ => GBufferFormat::F16,
+    };
+    let settings = lightgrid::RenderSettings {
+        gbuffer,
+        ..Default::default()
+    };
+    let t = lightgrid::pipelines::find(pipeline)
+        .ok()?
+        .memory_model(&settings)
+        .traffic;
+    Some(match side {
+        Side::Writes => format!("{} + {}", t.write_per_pixel, t.write_per_lit),
+        Side::Reads => format!("{} + {}", t.read_per_pixel, t.read_per_lit),
+    })
 }
 
 #[cfg(test)]

@@ -296,10 +296,15 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let occupied = cell_bounds
         .as_ref()
         .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
+    // The traffic models describe the opaque pipeline (a lit pixel is a lighting computation
+    // of its deferred or forward pass); the transparent pass, forward-shaded by every
+    // pipeline, is outside them.
+    let opaque_lighting_computations =
+        lighting_computations.map(|n| n - transparent_lighting_computations.unwrap_or(0));
     let memory = frame_memory(
         a.info.memory_model(&settings),
         (width, height),
-        lighting_computations,
+        opaque_lighting_computations,
         grid_is_pipelines.then_some(&grid),
     );
     Ok(FrameOutput {
