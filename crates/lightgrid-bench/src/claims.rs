@@ -976,12 +976,15 @@ pub fn writes_more(
 
 /// Claim 15: lights per pixel from deferred's counts, writes from the traffic model.
 fn write_break_even(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    let pair = ["light_prepass", "deferred"];
     match (
         lights_per_pixel(r, scene),
-        modelled(r, scene, "light_prepass", Side::Writes),
-        modelled(r, scene, "deferred", Side::Writes),
+        modelled(r, scene, pair[0], Side::Writes),
+        modelled(r, scene, pair[1], Side::Writes),
     ) {
-        (Some(l), Some(lp), Some(ds)) => writes_more(l, lp, ds),
+        (Some(l), Some(lp), Some(ds)) => {
+            with_budgets(writes_more(l, lp, ds), r, scene, pair, Side::Writes)
+        }
         _ => not_measured("deferred and light_prepass"),
     }
 }
@@ -1067,32 +1070,70 @@ pub fn mono_traffic(
 /// Claims 16 and 17: lights per pixel from deferred's counts, bytes from the traffic models of
 /// the two mono-specular pipelines.
 fn mono_break_even(r: &BenchResults, scene: &str, side: Side) -> (String, Verdict) {
+    let pair = ["light_prepass_mono", "deferred_mono"];
     match (
         lights_per_pixel(r, scene),
-        modelled(r, scene, "light_prepass_mono", side),
-        modelled(r, scene, "deferred_mono", side),
+        modelled(r, scene, pair[0], side),
+        modelled(r, scene, pair[1], side),
     ) {
         (Some(l), Some(lp), Some(ds)) => {
-            let (evidence, v) = mono_traffic(side, l, lp, ds);
-            let budgets = [
-                budget(r, scene, "light_prepass_mono", side),
-                budget(r, scene, "deferred_mono", side),
-            ];
-            match budgets {
-                [Some(a), Some(b)] => (
-                    format!("{evidence}; bytes per pixel + per lit pixel: light_prepass_mono {a}, deferred_mono {b}"),
-                    v,
-                ),
-                _ => (evidence, v),
-            }
+            with_budgets(mono_traffic(side, l, lp, ds), r, scene, pair, side)
         }
         _ => not_measured("deferred, light_prepass_mono and deferred_mono"),
     }
 }
 
-/// A run's traffic budget on one side, as "P + L" (bytes per pixel + per lit pixel), from the
-/// registry's model at the run's G-buffer precision.
-fn budget(r: &BenchResults, scene: &str, pipeline: &str, side: Side) -> Option<String> {
+/// A break-even claim's evidence with the reason behind it: the two layouts' budgets (bytes
+/// per pixel + per lit pixel, from the registry's models at the runs' G-buffer precision) and
+/// the lights per pixel where they cross.
+fn with_budgets(
+    (evidence, v): (String, Verdict),
+    r: &BenchResults,
+    scene: &str,
+    [lighting, shading]: [&str; 2],
+    side: Side,
+) -> (String, Verdict) {
+    match (budget(r, scene, lighting, side), budget(r, scene, shading, side)) {
+        (Some(a), Some(b)) => (
+            format!(
+                "{evidence}; bytes per pixel + per lit pixel: {lighting} {} + {}, {shading} {} + {} ({})",
+                a.0,
+                a.1,
+                b.0,
+                b.1,
+                crossing(a, b)
+            ),
+            v,
+        ),
+        _ => (evidence, v),
+    }
+}
+
+/// Where two budgets `(per pixel, per lit pixel)` cross, said from the first's side: the
+/// lights per pixel above which it moves more bytes, or that it never does.
+pub fn crossing(lighting: (u32, u32), shading: (u32, u32)) -> String {
+    let per_pixel = f64::from(lighting.0) - f64::from(shading.0);
+    let per_lit = f64::from(lighting.1) - f64::from(shading.1);
+    let l = -per_pixel / per_lit;
+    match (per_lit > 0.0, per_lit < 0.0) {
+        (true, _) if l > 0.0 => format!("lighting moves more above {l:.2} lights per pixel"),
+        (true, _) => "lighting moves more at any light count".to_string(),
+        (_, true) if l > 0.0 => format!("lighting moves less above {l:.2} lights per pixel"),
+        (_, true) => "lighting moves less at any light count".to_string(),
+        _ if per_pixel > 0.0 => {
+            format!("lighting moves {per_pixel} B per pixel more at any light count")
+        }
+        _ if per_pixel < 0.0 => format!(
+            "lighting moves {} B per pixel less at any light count",
+            -per_pixel
+        ),
+        _ => "equal at any light count".to_string(),
+    }
+}
+
+/// A run's traffic budget on one side, `(per pixel, per lit pixel)`, from the registry's model
+/// at the run's G-buffer precision.
+fn budget(r: &BenchResults, scene: &str, pipeline: &str, side: Side) -> Option<(u32, u32)> {
     use lightgrid::frame::GBufferFormat;
     let x = find(r, scene, pipeline, None)?;
     let gbuffer = match x.gbuffer_bits {
@@ -1108,8 +1149,8 @@ fn budget(r: &BenchResults, scene: &str, pipeline: &str, side: Side) -> Option<S
         .memory_model(&settings)
         .traffic;
     Some(match side {
-        Side::Writes => format!("{} + {}", t.write_per_pixel, t.write_per_lit),
-        Side::Reads => format!("{} + {}", t.read_per_pixel, t.read_per_lit),
+        Side::Writes => (t.write_per_pixel, t.write_per_lit),
+        Side::Reads => (t.read_per_pixel, t.read_per_lit),
     })
 }
 
@@ -1244,6 +1285,33 @@ mod tests {
         assert_eq!(writes_more(2.0, 10.0, 20.0).1, Verdict::NotHeld);
         assert_eq!(writes_more(0.2, 10.0, 20.0).1, Verdict::Held);
         assert_eq!(writes_more(0.2, 30.0, 20.0).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn crossings_of_two_budgets() {
+        // The blog's own layouts: 16 + 16 against 20 + 8 written crosses at 0.5.
+        assert_eq!(
+            crossing((16, 16), (20, 8)),
+            "lighting moves more above 0.50 lights per pixel"
+        );
+        // Mono reads: 8 + 16 against 0 + 20: less above 2.
+        assert_eq!(
+            crossing((8, 16), (0, 20)),
+            "lighting moves less above 2.00 lights per pixel"
+        );
+        assert_eq!(
+            crossing((12, 68), (16, 76)),
+            "lighting moves less at any light count"
+        );
+        assert_eq!(
+            crossing((30, 16), (20, 8)),
+            "lighting moves more at any light count"
+        );
+        assert_eq!(
+            crossing((24, 8), (40, 8)),
+            "lighting moves 16 B per pixel less at any light count"
+        );
+        assert_eq!(crossing((4, 8), (4, 8)), "equal at any light count");
     }
 
     #[test]

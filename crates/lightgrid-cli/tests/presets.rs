@@ -234,3 +234,108 @@ fn both_depth_reductions_are_measured_side_by_side() {
         "--depth-reduction does not apply to forward",
     );
 }
+
+/// The line of `claim` on `scene` in summary.md, which must have a verdict.
+fn measured_claim<'a>(summary: &'a str, scene: &str, claim: &str) -> &'a str {
+    let line = summary
+        .lines()
+        .find(|l| l.starts_with(&format!("| {scene} |")) && l.contains(claim))
+        .unwrap_or_else(|| panic!("no claim '{claim}' on {scene} in summary.md"));
+    assert!(
+        line.contains("**held**") || line.contains("**did not hold**"),
+        "{line}"
+    );
+    line
+}
+
+#[test]
+fn paper_preset_measures_every_pipeline_and_checks_the_papers_claims() {
+    let out = bench(&[
+        "--preset",
+        "paper",
+        "--size",
+        "96x54",
+        "--frames",
+        "0..259:100",
+    ]);
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    let runs = v["runs"].as_array().unwrap();
+    // Every pipeline but the mono-specular references, on both scenes, at the papers' tiles.
+    for p in lightgrid::pipelines::PIPELINES {
+        let only_a_reference = p.reference == p.id && p.id != lightgrid::pipelines::REFERENCE;
+        for scene in ["robots-many", "robots-few"] {
+            let n = runs
+                .iter()
+                .filter(|r| r["scene"] == scene && r["pipeline"] == p.id)
+                .count();
+            let expected = if only_a_reference {
+                0
+            } else if p.uses_gbuffer() {
+                2
+            } else {
+                1
+            };
+            assert_eq!(n, expected, "{scene} {}", p.id);
+        }
+    }
+    assert!(runs.iter().all(|r| r["tile_size"] == 32), "32-pixel tiles");
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for (scene, claim) in [
+        ("robots-many", "Tiled deferred has the fastest worst case"),
+        (
+            "robots-few",
+            "With few lights, tiled forward shading is competitive",
+        ),
+        (
+            "robots-many",
+            "tiled forward with pre-Z is about four times slower",
+        ),
+        ("robots-many", "Deferred-Stencil is competitive"),
+        (
+            "robots-many",
+            "Forward+ is faster in total than compute-based deferred lighting",
+        ),
+    ] {
+        measured_claim(&summary, scene, claim);
+    }
+    // The blog's break-evens, with the layouts' budgets and crossing as the reason.
+    for scene in ["robots-many", "robots-few"] {
+        for claim in [
+            "writes more than deferred shading once more than 0.5 lights",
+            "With monochrome specular on both sides, deferred lighting writes as much",
+            "With monochrome specular on both sides, deferred lighting reads less",
+        ] {
+            let line = measured_claim(&summary, scene, claim);
+            assert!(line.contains("bytes per pixel + per lit pixel"), "{line}");
+        }
+    }
+}
+
+#[test]
+fn clustered_preset_checks_fig_4_6_on_both_views() {
+    let out = bench(&[
+        "--preset",
+        "clustered",
+        "--size",
+        "96x54",
+        "--frames",
+        "0..119:60",
+    ]);
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    measured_claim(
+        &summary,
+        "random-top",
+        "In the top-down view tiled forward outperforms",
+    );
+    measured_claim(
+        &summary,
+        "random-fps",
+        "In the first-person view tiled forward becomes slower",
+    );
+    measured_claim(
+        &summary,
+        "random-top vs random-fps",
+        "Clustered shading depends much less on the view",
+    );
+}
