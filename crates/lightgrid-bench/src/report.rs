@@ -1,7 +1,7 @@
 //! Writing a benchmark's results: results.json, results.csv, plots (PNG + SVG) and
 //! summary.md. Every file is written whole or not at all.
 
-use super::{evaluate_claims, BenchResults, RunRecord};
+use super::{evaluate_claims, BenchResults, RunRecord, Verdict};
 use crate::invalid;
 use crate::plot::{LineChart, Series, StackedBars};
 use lightgrid::error::{Error, Result};
@@ -767,8 +767,16 @@ fn summary(results: &BenchResults) -> String {
             );
         }
     }
-    s.push_str("\n## The papers' claims on this adapter\n\n| scene | claim | source | measured | verdict |\n|---|---|---|---|---|\n");
-    for c in evaluate_claims(results) {
+    s.push_str("\n## The papers' claims on this adapter\n\n");
+    let (checked, unchecked): (Vec<_>, Vec<_>) = evaluate_claims(results)
+        .into_iter()
+        .partition(|c| c.verdict != Verdict::NotMeasured);
+    if checked.is_empty() {
+        s.push_str("No claim could be checked with these runs.\n");
+    } else {
+        s.push_str("| scene | claim | source | measured | verdict |\n|---|---|---|---|---|\n");
+    }
+    for c in &checked {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | **{}** |",
@@ -778,6 +786,30 @@ fn summary(results: &BenchResults) -> String {
             c.evidence,
             c.verdict.label()
         );
+    }
+    // The claims this run's pipelines and settings cannot speak to, once each with the
+    // scenes, so a focused run's table holds only what it measured.
+    let mut missing: Vec<(&str, &str, &str, Vec<&str>)> = Vec::new();
+    for c in &unchecked {
+        match missing
+            .iter_mut()
+            .find(|m| m.0 == c.statement && m.2 == c.evidence)
+        {
+            Some(m) => m.3.push(&c.scene),
+            None => missing.push((c.statement, c.source, &c.evidence, vec![&c.scene])),
+        }
+    }
+    if !missing.is_empty() {
+        s.push_str(
+            "\nNot checked by this run (each needs runs or settings it did not include):\n\n",
+        );
+        for (statement, source, evidence, scenes) in missing {
+            let _ = writeln!(
+                s,
+                "- {statement} ({source}), {}: {evidence}",
+                scenes.join(", ")
+            );
+        }
     }
     s.push_str("\nFiles: `results.json` (per-frame series and summaries), `results.csv` (one row per frame), `frame_time_*` (Fig. 2 style), `lighting_*` (Fig. 3 style, ideal dashed), `passes_*` (per-pass stacked bars), `heatmap_*` (lights per tile).\n");
     s

@@ -253,6 +253,19 @@ fn a_run_writes_every_file_with_consistent_summaries() {
             "summary lacks claim {}",
             c.statement
         );
+        // A checked claim is a row of the table; one this run cannot check is listed once
+        // below it, with every scene, instead of a table row per scene.
+        let row = format!("| {} | {} |", c.scene, c.statement);
+        let listed = format!("- {} (", c.statement);
+        match c.verdict {
+            Verdict::NotMeasured => {
+                assert!(
+                    !summary.contains(&row) && summary.matches(&listed).count() == 1,
+                    "{row}"
+                )
+            }
+            _ => assert!(summary.contains(&row), "{row}"),
+        }
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
