@@ -607,6 +607,7 @@ struct Variant {
 }
 
 fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
+    /// The entries of a setting to measure: all where it applies, else the first.
     fn used<T: Copy>(all: &[T], applies: bool) -> &[T] {
         if applies {
             all
@@ -614,44 +615,62 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant
             &all[..1]
         }
     }
-    let mut out = Vec::new();
-    for &spot_cull in used(&config.spot_culls, info.uses_grid) {
-        // Only pipelines with an `--assign` grid build transparent lists.
-        for &lists in used(&config.lists, info.assign) {
-            for &material_draws in used(&config.material_draws, info.forward_shading) {
-                for &msaa in &config.msaa {
-                    // A pipeline refusing MSAA is measured without it only.
-                    if msaa > 1 && info.msaa != pipelines::Msaa::Supported {
-                        continue;
-                    }
-                    // Only the deferred kernels resolve, and only with MSAA.
-                    let resolves: Vec<Option<MsaaResolve>> = if msaa > 1 && !info.forward_shading {
-                        config.msaa_resolve.iter().copied().map(Some).collect()
-                    } else {
-                        vec![None]
-                    };
-                    for msaa_resolve in resolves {
-                        for &depth_bounds in used(&config.depth_bounds, info.depth_bounds) {
-                            for &depth_reduction in
-                                used(&config.depth_reductions, info.depth_bounds)
-                            {
-                                out.push(Variant {
-                                    spot_cull,
-                                    lists,
-                                    material_draws,
-                                    msaa,
-                                    msaa_resolve,
-                                    depth_bounds,
-                                    depth_reduction,
-                                });
-                            }
-                        }
-                    }
-                }
-            }
-        }
+    /// Every variant once per value, in order (the product, last dimension fastest).
+    fn times<T: Copy>(out: Vec<Variant>, values: &[T], set: fn(&mut Variant, T)) -> Vec<Variant> {
+        out.iter()
+            .flat_map(|v| {
+                values.iter().map(move |&x| {
+                    let mut v = *v;
+                    set(&mut v, x);
+                    v
+                })
+            })
+            .collect()
     }
-    out
+    let mut out = vec![Variant {
+        spot_cull: config.spot_culls[0],
+        lists: config.lists[0],
+        material_draws: config.material_draws[0],
+        msaa: 1,
+        msaa_resolve: None,
+        depth_bounds: config.depth_bounds[0],
+        depth_reduction: config.depth_reductions[0],
+    }];
+    out = times(out, used(&config.spot_culls, info.uses_grid), |v, x| {
+        v.spot_cull = x
+    });
+    // Only pipelines with an `--assign` grid build transparent lists.
+    out = times(out, used(&config.lists, info.assign), |v, x| v.lists = x);
+    out = times(
+        out,
+        used(&config.material_draws, info.forward_shading),
+        |v, x| v.material_draws = x,
+    );
+    // A pipeline refusing MSAA is measured without it only.
+    let msaa: Vec<u32> = (config.msaa.iter().copied())
+        .filter(|&m| m == 1 || info.msaa == pipelines::Msaa::Supported)
+        .collect();
+    out = times(out, &msaa, |v, x| v.msaa = x);
+    // Only the deferred kernels resolve, and only with MSAA.
+    let resolves: Vec<Option<MsaaResolve>> =
+        config.msaa_resolve.iter().copied().map(Some).collect();
+    out = out
+        .into_iter()
+        .flat_map(|v| match v.msaa > 1 && !info.forward_shading {
+            true => times(vec![v], &resolves, |v, x| v.msaa_resolve = x),
+            false => vec![v],
+        })
+        .collect();
+    out = times(
+        out,
+        used(&config.depth_bounds, info.depth_bounds),
+        |v, x| v.depth_bounds = x,
+    );
+    times(
+        out,
+        used(&config.depth_reductions, info.depth_bounds),
+        |v, x| v.depth_reduction = x,
+    )
 }
 
 /// The suffix of a scene measured without its transparent objects (`opaque_variants`).
