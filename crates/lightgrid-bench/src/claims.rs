@@ -1289,64 +1289,51 @@ mod tests {
 
     #[test]
     fn crossings_of_two_budgets() {
-        // The blog's own layouts: 16 + 16 against 20 + 8 written crosses at 0.5.
-        assert_eq!(
-            crossing((16, 16), (20, 8)),
-            "lighting moves more above 0.50 lights per pixel"
-        );
-        // Mono reads: 8 + 16 against 0 + 20: less above 2.
-        assert_eq!(
-            crossing((8, 16), (0, 20)),
-            "lighting moves less above 2.00 lights per pixel"
-        );
-        assert_eq!(
-            crossing((12, 68), (16, 76)),
-            "lighting moves less at any light count"
-        );
-        assert_eq!(
-            crossing((30, 16), (20, 8)),
-            "lighting moves more at any light count"
-        );
-        assert_eq!(
-            crossing((24, 8), (40, 8)),
-            "lighting moves 16 B per pixel less at any light count"
-        );
-        assert_eq!(crossing((4, 8), (4, 8)), "equal at any light count");
+        // (lighting's budget, shading's, where they cross). The blog's own layouts: 16 + 16
+        // against 20 + 8 written crosses at 0.5; its mono reads, 8 + 16 against 0 + 20, at 2.
+        for (lighting, shading, expected) in [
+            (
+                (16, 16),
+                (20, 8),
+                "lighting moves more above 0.50 lights per pixel",
+            ),
+            (
+                (8, 16),
+                (0, 20),
+                "lighting moves less above 2.00 lights per pixel",
+            ),
+            ((12, 68), (16, 76), "lighting moves less at any light count"),
+            ((30, 16), (20, 8), "lighting moves more at any light count"),
+            (
+                (24, 8),
+                (40, 8),
+                "lighting moves 16 B per pixel less at any light count",
+            ),
+            ((4, 8), (4, 8), "equal at any light count"),
+        ] {
+            assert_eq!(crossing(lighting, shading), expected);
+        }
     }
 
     #[test]
     fn mono_break_evens_on_both_sides() {
-        // Writes: equal within 5% holds, whichever side is larger; beyond it does not.
-        assert_eq!(
-            mono_traffic(Side::Writes, 3.0, 103.0, 100.0).1,
-            Verdict::Held
-        );
-        assert_eq!(
-            mono_traffic(Side::Writes, 3.0, 97.0, 100.0).1,
-            Verdict::Held
-        );
-        assert_eq!(
-            mono_traffic(Side::Writes, 3.0, 80.0, 100.0).1,
-            Verdict::NotHeld
-        );
-        assert_eq!(
-            mono_traffic(Side::Writes, 0.1, 120.0, 100.0).1,
-            Verdict::NotHeld
-        );
-        // Reads: lighting should read less above 2 lights per pixel and more below.
-        assert_eq!(mono_traffic(Side::Reads, 3.0, 90.0, 100.0).1, Verdict::Held);
-        assert_eq!(
-            mono_traffic(Side::Reads, 3.0, 110.0, 100.0).1,
-            Verdict::NotHeld
-        );
-        assert_eq!(
-            mono_traffic(Side::Reads, 1.0, 110.0, 100.0).1,
-            Verdict::Held
-        );
-        assert_eq!(
-            mono_traffic(Side::Reads, 1.0, 90.0, 100.0).1,
-            Verdict::NotHeld
-        );
+        use Verdict::{Held, NotHeld};
+        // (side, lights per pixel, lighting's bytes against shading's 100, verdict). Writes:
+        // equal within 5% holds, whichever side is larger; beyond it does not. Reads: lighting
+        // should read less above 2 lights per pixel and more below.
+        for (side, l, lighting, expected) in [
+            (Side::Writes, 3.0, 103.0, Held),
+            (Side::Writes, 3.0, 97.0, Held),
+            (Side::Writes, 3.0, 80.0, NotHeld),
+            (Side::Writes, 0.1, 120.0, NotHeld),
+            (Side::Reads, 3.0, 90.0, Held),
+            (Side::Reads, 3.0, 110.0, NotHeld),
+            (Side::Reads, 1.0, 110.0, Held),
+            (Side::Reads, 1.0, 90.0, NotHeld),
+        ] {
+            let (e, v) = mono_traffic(side, l, lighting, 100.0);
+            assert_eq!(v, expected, "{side:?} at {l} lights per pixel: {e}");
+        }
         let (e, _) = mono_traffic(Side::Reads, 2.5, 2097152.0, 4194304.0);
         assert!(
             e.contains("reads") && e.contains("2.0 MiB") && e.contains("(0.50x)"),
