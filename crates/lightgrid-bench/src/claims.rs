@@ -308,8 +308,8 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
             find(r, scene, "tiled_light_prepass", None),
         ) {
             (Some(fp), Some(cd)) => match (stages(fp), stages(cd)) {
-                (Some(a), Some(b)) => forward_plus_stages(&a, &b),
-                _ => not(),
+                (Ok(a), Ok(b)) => forward_plus_stages(&a, &b),
+                (Err(e), _) | (_, Err(e)) => (e, Verdict::NotMeasured),
             },
             _ => not(),
         };
@@ -687,24 +687,35 @@ fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
 /// Forward+ Fig. 3's three stages of a run, average ms: the pre-pass (depth, or the light
 /// pre-pass's attributes), light culling and lighting (the grid's passes and a separate
 /// lighting pass where there is one), and the final shading (the opaque shading pass; the
-/// transparent pass and the tonemap are left out, as the figure has neither).
-pub fn stages(x: &RunRecord) -> Option<[f64; 3]> {
-    let passes = &x.summary.as_ref()?.passes;
+/// transparent pass and the tonemap are left out, as the figure has neither). A pass this does
+/// not know is an error naming it, so a renamed pass is reported, never moved to another stage
+/// or dropped.
+pub fn stages(x: &RunRecord) -> std::result::Result<[f64; 3], String> {
+    let passes = &x.summary.as_ref().ok_or("no summary")?.passes;
     let mut s = [0.0; 3];
     for p in passes {
-        let l = p.label.as_str();
-        let stage = if l.contains("pre-pass attributes") || l == "depth pre-pass" {
-            0
-        } else if l.starts_with("assign") || l.contains("irradiance") {
-            1
-        } else if l.contains("shading") {
-            2
-        } else {
-            continue;
-        };
-        s[stage] += p.ms;
+        if let Some(stage) = fig3_stage(&p.label)
+            .map_err(|_| format!("{}'s pass '{}' has no Fig. 3 stage", x.pipeline, p.label))?
+        {
+            s[stage] += p.ms;
+        }
     }
-    (s.iter().sum::<f64>() > 0.0).then_some(s)
+    match s.iter().all(|&ms| ms > 0.0) {
+        true => Ok(s),
+        false => Err(format!("{} has an empty Fig. 3 stage: {s:?}", x.pipeline)),
+    }
+}
+
+/// The Fig. 3 stage of a pass label (0 pre-pass, 1 culling and lighting, 2 final shading),
+/// `None` for the passes the figure has no stage for, `Err` for a label it does not know.
+pub fn fig3_stage(label: &str) -> std::result::Result<Option<usize>, ()> {
+    Ok(Some(match label {
+        "depth pre-pass" | "light pre-pass attributes" => 0,
+        l if l.starts_with("assign") || l.contains("irradiance") => 1,
+        l if l.contains("shading") => 2,
+        "transparent" | "tonemap" => return Ok(None),
+        _ => return Err(()),
+    }))
 }
 
 /// Is Forward+ faster in total over the three stages than compute-based deferred lighting?
@@ -1168,6 +1179,24 @@ mod tests {
         assert_eq!(v, Verdict::Held);
         assert!(e.contains("(6.00x)"), "{e}");
         assert_eq!(subgroup_faster("p", 8.4, 12.7).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn fig3_stages_of_pass_labels() {
+        for (label, stage) in [
+            ("depth pre-pass", Some(0)),
+            ("light pre-pass attributes", Some(0)),
+            ("assign: cell bounds", Some(1)),
+            ("assign: gather spill", Some(1)),
+            ("tiled irradiance (mono specular)", Some(1)),
+            ("tiled forward shading (pre-z)", Some(2)),
+            ("light pre-pass shading", Some(2)),
+            ("transparent", None),
+            ("tonemap", None),
+        ] {
+            assert_eq!(fig3_stage(label), Ok(stage), "{label}");
+        }
+        assert_eq!(fig3_stage("depth prepass"), Err(()), "an unknown label");
     }
 
     #[test]

@@ -97,6 +97,18 @@ fn forward_plus_preset_draws_the_heatmap_on_the_papers_scale() {
         .expect("a heatmap");
     let img = image::open(heatmap).unwrap().to_rgba8();
     assert_eq!(img.width(), 96, "the frame's width (the legend fits)");
+    // Fig. 3's stages: every pass of both pipelines has its stage (a renamed pass would make
+    // the claim unmeasured, naming the pass).
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    let line = measured_claim(
+        &summary,
+        "scattered",
+        "Forward+ is faster in total than compute-based deferred lighting",
+    );
+    assert!(
+        line.contains("pre-pass + culling and lighting + final shading"),
+        "{line}"
+    );
 }
 
 #[test]

@@ -88,7 +88,6 @@ impl GBufferLayout {
 
 pub struct GBuffer {
     pub format: GBufferFormat,
-    pub layout: GBufferLayout,
     /// By location; `None` where the layout has no target.
     views: Vec<Option<wgpu::TextureView>>,
     pipeline: wgpu::RenderPipeline,
@@ -143,7 +142,6 @@ impl GBuffer {
         );
         GBuffer {
             format,
-            layout,
             read_layout: Self::read_layout(device, &views, samples),
             views,
             pipeline,
