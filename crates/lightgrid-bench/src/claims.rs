@@ -2,6 +2,7 @@
 //! source, the evidence measured on this adapter, and whether it held.
 
 use super::{BenchResults, RunRecord};
+use crate::report::run_name;
 use lightgrid::frame::DepthBounds;
 use serde::Serialize;
 
@@ -182,7 +183,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
                 let others: Vec<(String, f64)> = culled(r, scene)
                     .into_iter()
                     .filter(|x| x.pipeline != "deferred_stencil")
-                    .filter_map(|x| avg_count(x).map(|c| (x.pipeline.clone(), c)))
+                    .filter_map(|x| avg_count(x).map(|c| (run_name(x), c)))
                     .collect();
                 let best = others.iter().min_by(|a, b| a.1.total_cmp(&b.1));
                 match best {
@@ -231,7 +232,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
                     .iter()
                     .map(|f| f.lighting_computations.map(|n| n as f64))
                     .collect();
-                correlation(&t, &c?).map(|k| (x.pipeline.clone(), k))
+                correlation(&t, &c?).map(|k| (run_name(x), k))
             })
             .collect();
         corr.sort_by(|a, b| a.1.total_cmp(&b.1));

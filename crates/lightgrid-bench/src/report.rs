@@ -16,7 +16,9 @@ pub const REPORT_FILES: &[&str] = &["results.json", "results.csv", "summary.md"]
 /// Version of the results.json layout (documented in README).
 pub const SCHEMA_VERSION: u32 = 3;
 
-fn run_name(r: &RunRecord) -> String {
+/// A run as the summary names it: the pipeline, the variant settings it was measured under
+/// and its G-buffer precision.
+pub(crate) fn run_name(r: &RunRecord) -> String {
     match r.gbuffer_bits {
         Some(b) => format!("{} (g{b})", pipeline_label(r)),
         None => pipeline_label(r),
