@@ -1,0 +1,488 @@
+//! The papers' claims, checked against a benchmark's measurements. Each claim names its
+//! source, the evidence measured on this adapter, and whether it held.
+
+use super::{BenchResults, RunRecord};
+
+mod deferred_lighting;
+mod forward_plus;
+mod tiled_forward_shading;
+mod tiled_shading;
+
+use crate::report::run_name;
+use deferred_lighting::*;
+use forward_plus::*;
+use lightgrid::frame::DepthBounds;
+use serde::Serialize;
+use tiled_forward_shading::*;
+use tiled_shading::*;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Verdict {
+    Held,
+    NotHeld,
+    /// The pipelines or settings the claim needs were not in the run.
+    NotMeasured,
+}
+
+impl Verdict {
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Held => "held",
+            Verdict::NotHeld => "did not hold",
+            Verdict::NotMeasured => "not measured",
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Claim {
+    pub scene: String,
+    pub statement: &'static str,
+    pub source: &'static str,
+    pub evidence: String,
+    pub verdict: Verdict,
+}
+
+/// The run of `pipeline` on `scene`, with the 16-bit G-buffer if it has one (or `bits`).
+fn find<'a>(
+    r: &'a BenchResults,
+    scene: &str,
+    pipeline: &str,
+    bits: Option<u32>,
+) -> Option<&'a RunRecord> {
+    find_msaa(r, scene, pipeline, bits, 1)
+}
+
+/// As [`find`], at `samples` MSAA samples per pixel.
+fn find_msaa<'a>(
+    r: &'a BenchResults,
+    scene: &str,
+    pipeline: &str,
+    bits: Option<u32>,
+    samples: u32,
+) -> Option<&'a RunRecord> {
+    r.runs.iter().find(|x| {
+        x.scene == scene
+            && x.pipeline == pipeline
+            && x.msaa == samples
+            && (x.gbuffer_bits.is_none() || x.gbuffer_bits == bits.or(Some(16)))
+            && x.depth_bounds.is_none_or(|b| b == DepthBounds::Both)
+    })
+}
+
+/// The run of `pipeline` on `scene` culling by `bounds` (`--depth-bounds`), without MSAA.
+fn find_bounds<'a>(
+    r: &'a BenchResults,
+    scene: &str,
+    pipeline: &str,
+    bounds: DepthBounds,
+) -> Option<&'a RunRecord> {
+    r.runs.iter().find(|x| {
+        x.scene == scene
+            && x.pipeline == pipeline
+            && x.msaa == 1
+            && x.depth_bounds.unwrap_or_default() == bounds
+    })
+}
+
+/// The average GPU time of the cell-bounds pass (the Z-reduction) of a run.
+fn cell_bounds_ms(x: &RunRecord) -> Option<f64> {
+    x.summary
+        .as_ref()?
+        .passes
+        .iter()
+        .find(|p| p.label == "assign: cell bounds")
+        .map(|p| p.ms)
+}
+
+fn avg_ms(x: &RunRecord) -> Option<f64> {
+    x.summary.as_ref().map(|s| s.gpu_ms.avg)
+}
+
+fn avg_count(x: &RunRecord) -> Option<f64> {
+    x.summary.as_ref()?.lighting_computations.map(|s| s.avg)
+}
+
+/// Pearson correlation of two series (None when either is constant or too short).
+fn correlation(a: &[f64], b: &[f64]) -> Option<f64> {
+    if a.len() < 3 {
+        return None;
+    }
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let (va, vb): (f64, f64) = (
+        a.iter().map(|x| (x - ma).powi(2)).sum(),
+        b.iter().map(|y| (y - mb).powi(2)).sum(),
+    );
+    (va > 0.0 && vb > 0.0).then(|| cov / (va * vb).sqrt())
+}
+
+fn verdict(ok: bool) -> Verdict {
+    if ok {
+        Verdict::Held
+    } else {
+        Verdict::NotHeld
+    }
+}
+
+/// Pipelines that cull (everything but the brute-force references).
+fn culled<'a>(r: &'a BenchResults, scene: &str) -> Vec<&'a RunRecord> {
+    r.runs
+        .iter()
+        .filter(|x| {
+            x.scene == scene
+                && !x.pipeline.starts_with("forward")
+                && x.gbuffer_bits.unwrap_or(16) == 16
+                && x.msaa == 1
+        })
+        .collect()
+}
+
+/// A claim checked on each scene: its statement, its source and the check.
+type PerScene = (
+    &'static str,
+    &'static str,
+    fn(&BenchResults, &str) -> (String, Verdict),
+);
+
+/// The claims checked on every scene of a run, in the order summary.md lists them.
+const PER_SCENE: &[PerScene] = &[
+    (
+        "Tiled deferred shading is much less variable than traditional deferred shading",
+        "tiled-shading §8.1, Fig. 2",
+        variability,
+    ),
+    (
+        "Deferred-Stencil performs the fewest lighting computations (closest to the ideal)",
+        "tiled-shading §8, Fig. 3",
+        stencil_fewest,
+    ),
+    (
+        "Tiled forward is the least efficient and is substantially improved by a pre-Z pass and depth bounds",
+        "tiled-shading §8, Fig. 3",
+        tiled_forward_worst,
+    ),
+    (
+        "Frame times follow the lighting computations: a roughly fixed cost per lighting operation",
+        "tiled-shading §8, Figs. 2-3",
+        time_follows_computations,
+    ),
+    (
+        "Traditional deferred slows with a fatter G-buffer; tiled deferred is much less affected",
+        "tiled-shading §8.1, Tables 2-3",
+        gbuffer_size,
+    ),
+    (
+        "Forward+ (tiled forward with pre-Z and culling) is faster in total than deferred lighting",
+        "forward-plus §5, Fig. 3",
+        forward_plus_vs_deferred,
+    ),
+    (
+        "Forward+ is faster in total than compute-based deferred lighting [And11], stage by stage: pre-pass, light culling and lighting, final shading",
+        "forward-plus §5, Fig. 3",
+        forward_plus_by_stages,
+    ),
+    (
+        "Tiled deferred outperforms tiled forward (with pre-Z) in the plain case, by about 25%",
+        "tiled-forward-shading Fig. 4.1(a)",
+        plain_case,
+    ),
+    (
+        "Deferred lighting gives at most a marginal GPU advantage over deferred shading",
+        "deferred-shading-vs-deferred-lighting",
+        lighting_marginal,
+    ),
+    (
+        "At 4x MSAA tiled forward outperforms tiled deferred with equal quality by 1.5 to 2 times",
+        "tiled-forward-shading Fig. 4.1(c)",
+        msaa_forward_faster,
+    ),
+    (
+        "The Z-reduction over every sample grows almost linearly with the sample count (0.75 ms at 1x to 5.1 ms at 8x)",
+        "tiled-forward-shading §4.6",
+        z_reduction_scales,
+    ),
+    (
+        "Tiled deferred has the fastest worst case of the culling techniques",
+        "tiled-shading §8.3",
+        fastest_worst_case,
+    ),
+    (
+        "With few lights, tiled forward shading is competitive with tiled deferred (within 25%)",
+        "tiled-shading §8.3, Table 3",
+        few_lights_competitive,
+    ),
+    (
+        "At equal lighting computations, tiled forward with pre-Z is about four times slower than tiled deferred, plus a constant offset",
+        "tiled-shading §8.2",
+        prez_per_computation,
+    ),
+    (
+        "Deferred-Stencil is competitive (within 25% of tiled deferred) with a 16-bit G-buffer, not with a 32-bit one",
+        "tiled-shading §8.1, Tables 2-3",
+        stencil_gbuffer,
+    ),
+    (
+        "Deferred lighting writes more than deferred shading once more than 0.5 lights reach a pixel on average (the traffic model at the measured lights per pixel)",
+        "deferred-shading-vs-deferred-lighting",
+        write_break_even,
+    ),
+    (
+        "With monochrome specular on both sides, deferred lighting writes as much as deferred shading (the traffic model at the measured lights per pixel)",
+        "deferred-shading-vs-deferred-lighting (the compromise)",
+        mono_writes,
+    ),
+    (
+        "With monochrome specular on both sides, deferred lighting reads less than deferred shading once more than 2 lights reach a pixel on average",
+        "deferred-shading-vs-deferred-lighting (the compromise)",
+        mono_reads,
+    ),
+];
+
+pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
+    let mut out = Vec::new();
+    let mut scenes: Vec<&str> = r.runs.iter().map(|x| x.scene.as_str()).collect();
+    scenes.dedup();
+    for scene in scenes {
+        for &(statement, source, check) in PER_SCENE {
+            let (evidence, verdict) = check(r, scene);
+            out.push(Claim {
+                scene: scene.to_string(),
+                statement,
+                source,
+                evidence,
+                verdict,
+            });
+        }
+    }
+    out.extend(view_dependence(r));
+    out.extend(depth_bound_claims(r));
+    out.extend(range_claims(r));
+    out.extend(reduction_claims(r));
+    out
+}
+
+/// The evidence of a claim whose runs the benchmark did not include.
+fn missing() -> (String, Verdict) {
+    (
+        "needs runs that are missing".to_string(),
+        Verdict::NotMeasured,
+    )
+}
+
+fn not_measured(what: &str) -> (String, Verdict) {
+    (format!("needs {what}"), Verdict::NotMeasured)
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows(v: &[(&str, f64)]) -> Vec<(String, f64)> {
+        v.iter().map(|(p, m)| (p.to_string(), *m)).collect()
+    }
+
+    #[test]
+    fn subgroup_reduction_claim_on_both_sides() {
+        let (e, v) = subgroup_faster("tiled_deferred", 6.0, 1.0);
+        assert_eq!(v, Verdict::Held);
+        assert!(e.contains("(6.00x)"), "{e}");
+        assert_eq!(subgroup_faster("p", 8.4, 12.7).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn fig3_stages_of_pass_labels() {
+        for (label, stage) in [
+            ("depth pre-pass", Some(0)),
+            ("light pre-pass attributes", Some(0)),
+            ("assign: cell bounds", Some(1)),
+            ("assign: gather spill", Some(1)),
+            ("tiled irradiance (mono specular)", Some(1)),
+            ("tiled forward shading (pre-z)", Some(2)),
+            ("light pre-pass shading", Some(2)),
+            ("transparent", None),
+            ("tonemap", None),
+        ] {
+            assert_eq!(fig3_stage(label), Ok(stage), "{label}");
+        }
+        assert_eq!(fig3_stage("depth prepass"), Err(()), "an unknown label");
+    }
+
+    #[test]
+    fn forward_plus_stages_on_both_sides() {
+        let (e, v) = forward_plus_stages(&[1.0, 2.0, 5.0], &[2.0, 3.0, 4.0]);
+        assert_eq!(v, Verdict::Held);
+        assert!(e.contains("1.0 + 2.0 + 5.0 = 8.0"), "{e}");
+        assert_eq!(
+            forward_plus_stages(&[1.0, 2.0, 7.0], &[2.0, 3.0, 4.0]).1,
+            Verdict::NotHeld
+        );
+    }
+
+    #[test]
+    fn range_sweep_claims_on_both_sides() {
+        let full = [(0.5, 0.01), (1.0, 0.03), (4.0, 0.5), (16.0, 0.92)];
+        assert_eq!(tiles_fill_up(&full).1, Verdict::Held);
+        // Not reaching all the lights, or falling on the way, does not hold.
+        assert_eq!(tiles_fill_up(&full[..3]).1, Verdict::NotHeld);
+        assert_eq!(
+            tiles_fill_up(&[(1.0, 0.5), (2.0, 0.3), (4.0, 0.95)]).1,
+            Verdict::NotHeld
+        );
+        assert!(tiles_fill_up(&full).0.contains("x16 92.0%"));
+        let shrinking = [(0.5, 50.0), (1.0, 32.0), (2.0, 32.5), (16.0, 2.1)];
+        assert_eq!(gain_shrinks(&shrinking).1, Verdict::Held);
+        assert_eq!(
+            gain_shrinks(&[(1.0, 10.0), (2.0, 12.0)]).1,
+            Verdict::NotHeld
+        );
+    }
+
+    #[test]
+    fn one_side_of_the_bounds_on_both_sides() {
+        assert_eq!(one_side_enough("p", 10.0, 10.9, 14.0).1, Verdict::Held);
+        assert_eq!(one_side_enough("p", 10.0, 14.0, 10.5).1, Verdict::Held);
+        assert_eq!(one_side_enough("p", 10.0, 11.5, 12.0).1, Verdict::NotHeld);
+        let (evidence, _) = one_side_enough("tiled_forward_prez", 10.0, 11.0, 12.0);
+        assert!(evidence.contains("1.10x both"), "{evidence}");
+    }
+
+    #[test]
+    fn fastest_worst_case_on_both_sides() {
+        let held = fastest_worst(&rows(&[
+            ("tiled_deferred", 20.0),
+            ("deferred", 35.0),
+            ("tiled_forward", 21.0),
+        ]));
+        assert_eq!(held.unwrap().1, Verdict::Held);
+        let not = fastest_worst(&rows(&[
+            ("tiled_deferred", 22.0),
+            ("deferred", 35.0),
+            ("tiled_forward", 21.0),
+        ]));
+        assert_eq!(not.unwrap().1, Verdict::NotHeld);
+        assert!(fastest_worst(&rows(&[("deferred", 3.0)])).is_none());
+    }
+
+    #[test]
+    fn four_times_on_both_sides() {
+        // ms = 5 + 4e-6 × n against ms = 2 + 1e-6 × n: four times, held.
+        let line = |a: f64, b: f64| -> Vec<(f64, f64)> {
+            [1e6, 2e6, 4e6, 8e6]
+                .iter()
+                .map(|&n| (n, a + b * n))
+                .collect()
+        };
+        let prez = fit_cost(&line(5.0, 4e-6)).unwrap();
+        let deferred = fit_cost(&line(2.0, 1e-6)).unwrap();
+        assert!((prez.1 - 4e-6).abs() < 1e-12 && (prez.0 - 5.0).abs() < 1e-6);
+        assert_eq!(four_times(prez, deferred).1, Verdict::Held);
+        // Equal cost per computation, or ten times: not held.
+        assert_eq!(
+            four_times(fit_cost(&line(9.0, 1e-6)).unwrap(), deferred).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            four_times(fit_cost(&line(0.0, 1e-5)).unwrap(), deferred).1,
+            Verdict::NotHeld
+        );
+        // Constant counts cannot be fitted.
+        assert!(fit_cost(&[(1.0, 2.0), (1.0, 3.0), (1.0, 4.0)]).is_none());
+    }
+
+    #[test]
+    fn few_lights_competitive_on_both_sides() {
+        assert_eq!(competitive("tiled_forward", 12.0, 10.0).1, Verdict::Held);
+        assert_eq!(competitive("tiled_forward", 13.0, 10.0).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn view_dependence_on_both_sides() {
+        // Tiled triples its work in the first-person view, clusters grow 20%: held.
+        assert_eq!(
+            less_view_dependent((100.0, 300.0), (80.0, 96.0)).1,
+            Verdict::Held
+        );
+        // Clusters change as much, or shrink more than tiles grow: not held.
+        assert_eq!(
+            less_view_dependent((100.0, 150.0), (80.0, 160.0)).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            less_view_dependent((100.0, 150.0), (100.0, 50.0)).1,
+            Verdict::NotHeld
+        );
+        assert_eq!(faster("a", 6.6, "b", 9.3).1, Verdict::Held);
+        assert_eq!(faster("a", 9.4, "b", 9.1).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn write_break_even_on_both_sides() {
+        // Above 0.5 lights per pixel the pre-pass should write more; below, less.
+        assert_eq!(writes_more(2.0, 30.0, 20.0).1, Verdict::Held);
+        assert_eq!(writes_more(2.0, 10.0, 20.0).1, Verdict::NotHeld);
+        assert_eq!(writes_more(0.2, 10.0, 20.0).1, Verdict::Held);
+        assert_eq!(writes_more(0.2, 30.0, 20.0).1, Verdict::NotHeld);
+    }
+
+    #[test]
+    fn crossings_of_two_budgets() {
+        // (lighting's budget, shading's, where they cross). The blog's own layouts: 16 + 16
+        // against 20 + 8 written crosses at 0.5; its mono reads, 8 + 16 against 0 + 20, at 2.
+        for (lighting, shading, expected) in [
+            (
+                (16, 16),
+                (20, 8),
+                "lighting moves more above 0.50 lights per pixel",
+            ),
+            (
+                (8, 16),
+                (0, 20),
+                "lighting moves less above 2.00 lights per pixel",
+            ),
+            ((12, 68), (16, 76), "lighting moves less at any light count"),
+            ((30, 16), (20, 8), "lighting moves more at any light count"),
+            (
+                (24, 8),
+                (40, 8),
+                "lighting moves 16 B per pixel less at any light count",
+            ),
+            ((4, 8), (4, 8), "equal at any light count"),
+        ] {
+            assert_eq!(crossing(lighting, shading), expected);
+        }
+    }
+
+    #[test]
+    fn mono_break_evens_on_both_sides() {
+        use Verdict::{Held, NotHeld};
+        // (side, lights per pixel, lighting's bytes against shading's 100, verdict). Writes:
+        // equal within 5% holds, whichever side is larger; beyond it does not. Reads: lighting
+        // should read less above 2 lights per pixel and more below.
+        for (side, l, lighting, expected) in [
+            (Side::Writes, 3.0, 103.0, Held),
+            (Side::Writes, 3.0, 97.0, Held),
+            (Side::Writes, 3.0, 80.0, NotHeld),
+            (Side::Writes, 0.1, 120.0, NotHeld),
+            (Side::Reads, 3.0, 90.0, Held),
+            (Side::Reads, 3.0, 110.0, NotHeld),
+            (Side::Reads, 1.0, 110.0, Held),
+            (Side::Reads, 1.0, 90.0, NotHeld),
+        ] {
+            let (e, v) = mono_traffic(side, l, lighting, 100.0);
+            assert_eq!(v, expected, "{side:?} at {l} lights per pixel: {e}");
+        }
+        let (e, _) = mono_traffic(Side::Reads, 2.5, 2097152.0, 4194304.0);
+        assert!(
+            e.contains("reads") && e.contains("2.0 MiB") && e.contains("(0.50x)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn stencil_competitive_on_both_sides() {
+        assert_eq!(stencil_competitive(1.1, 1.6).1, Verdict::Held);
+        assert_eq!(stencil_competitive(1.4, 1.6).1, Verdict::NotHeld);
+        assert_eq!(stencil_competitive(1.1, 1.2).1, Verdict::NotHeld);
+    }
+}
