@@ -1,7 +1,7 @@
 //! The papers' claims, checked against a benchmark's measurements. Each claim names its
 //! source, the evidence measured on this adapter, and whether it held. One file per paper
-//! holds its checks; [`PER_SCENE`] lists those run on every scene, in summary.md's order, and
-//! [`evaluate_claims`] adds the families that compare runs across scenes or settings.
+//! holds its checks; `PER_SCENE` lists those run on every scene, in summary.md's order, and
+//! `evaluate_claims` adds the families that compare runs across scenes or settings.
 
 use super::{BenchResults, RunRecord};
 
