@@ -195,24 +195,16 @@ pub(crate) struct BenchDefaults {
     pub(crate) depth_bounds: Vec<lightgrid::frame::DepthBounds>,
 }
 
-/// A study of one dimension over robots-many's animation (frames every 20, the papers' size
-/// on a hardware GPU): the pipelines `studied` picks, with `forward` and `deferred` beside
-/// them.
-fn study(
-    hardware: bool,
-    studied: fn(&lightgrid::pipelines::PipelineInfo) -> bool,
-) -> BenchDefaults {
+/// Without a preset: robots-many's animation every 5 frames (the paper's 5 fps sampling) at
+/// the scene's size, every pipeline, the renderer's default settings.
+fn everything() -> BenchDefaults {
     BenchDefaults {
         scenes: vec!["robots-many"],
-        frames: "0..259:20",
-        size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+        frames: "0..259:5",
+        size: None,
         gbuffers: vec![GBufferFormat::F16],
-        repeat: if hardware { 3 } else { 1 },
-        pipelines: PIPELINES
-            .iter()
-            .filter(|p| studied(p) || p.id == "forward" || p.id == "deferred")
-            .map(|p| p.id.to_string())
-            .collect(),
+        repeat: 1,
+        pipelines: PIPELINES.iter().map(|p| p.id.to_string()).collect(),
         spot_fraction: 0.0,
         spot_culls: vec![Default::default()],
         lists: default_lists(),
@@ -221,6 +213,26 @@ fn study(
         transparency: true,
         tile: None,
         depth_bounds: vec![Default::default()],
+    }
+}
+
+/// A study of one dimension over robots-many's animation (frames every 20, the papers' size
+/// on a hardware GPU): the pipelines `studied` picks, with `forward` and `deferred` beside
+/// them.
+fn study(
+    hardware: bool,
+    studied: fn(&lightgrid::pipelines::PipelineInfo) -> bool,
+) -> BenchDefaults {
+    BenchDefaults {
+        frames: "0..259:20",
+        size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+        repeat: if hardware { 3 } else { 1 },
+        pipelines: PIPELINES
+            .iter()
+            .filter(|p| studied(p) || p.id == "forward" || p.id == "deferred")
+            .map(|p| p.id.to_string())
+            .collect(),
+        ..everything()
     }
 }
 
@@ -236,37 +248,11 @@ pub(crate) fn bench_config(
 ) -> Result<BenchConfig> {
     let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
     let d = match a.preset {
-        None => BenchDefaults {
-            scenes: vec!["robots-many"],
-            frames: "0..259:5",
-            size: None,
-            gbuffers: vec![GBufferFormat::F16],
-            repeat: 1,
-            pipelines: all.clone(),
-            spot_fraction: 0.0,
-            spot_culls: vec![Default::default()],
-            lists: default_lists(),
-            msaa: vec![1],
-            msaa_resolve: vec![Default::default()],
-            transparency: true,
-            tile: None,
-            depth_bounds: vec![Default::default()],
-        },
+        None => everything(),
         Some(Preset::Quick) => BenchDefaults {
-            scenes: vec!["robots-many"],
             frames: "0..259:86",
             size: Some((160, 90)),
-            gbuffers: vec![GBufferFormat::F16],
-            repeat: 1,
-            pipelines: all.clone(),
-            spot_fraction: 0.0,
-            spot_culls: vec![Default::default()],
-            lists: default_lists(),
-            msaa: vec![1],
-            msaa_resolve: vec![Default::default()],
-            transparency: true,
-            tile: None,
-            depth_bounds: vec![Default::default()],
+            ..everything()
         },
         Some(Preset::Spots) => BenchDefaults {
             spot_fraction: 1.0,
@@ -302,7 +288,6 @@ pub(crate) fn bench_config(
         },
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
-            frames: "0..259:5",
             size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
             gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
             repeat: if hardware { 3 } else { 1 },
@@ -312,15 +297,9 @@ pub(crate) fn bench_config(
                 .filter(|p| p.reference != p.id || p.id == lightgrid::pipelines::REFERENCE)
                 .map(|p| p.id.to_string())
                 .collect(),
-            spot_fraction: 0.0,
-            spot_culls: vec![Default::default()],
-            lists: default_lists(),
-            msaa: vec![1],
-            msaa_resolve: vec![Default::default()],
-            transparency: true,
             // tiled-shading §8 and tiled-forward-shading use 32x32 tiles.
             tile: Some(32),
-            depth_bounds: vec![Default::default()],
+            ..everything()
         },
         Some(Preset::ForwardPlus) => BenchDefaults {
             scenes: vec!["scattered"],
