@@ -327,6 +327,15 @@ fn paper_preset_measures_every_pipeline_and_checks_the_papers_claims() {
             let line = measured_claim(&summary, scene, claim);
             assert!(line.contains("bytes per pixel + per lit pixel"), "{line}");
         }
+        let line = measured_claim(
+            &summary,
+            scene,
+            "deferred lighting needs less render-target memory",
+        );
+        assert!(
+            line.contains("light_prepass_mono 32 B, deferred_mono 40 B"),
+            "{line}"
+        );
     }
 }
 

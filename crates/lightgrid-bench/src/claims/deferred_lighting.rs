@@ -19,6 +19,41 @@ pub(super) fn lighting_marginal(r: &BenchResults, scene: &str) -> (String, Verdi
     }
 }
 
+/// The blog's mono-specular compromise on both sides: deferred lighting then needs as little as
+/// 16 bytes per pixel against deferred shading's 20. The verdict compares the two pipelines'
+/// render targets per pixel; their times are given as information.
+pub fn less_memory(
+    lighting_bytes: u32,
+    shading_bytes: u32,
+    lighting_ms: Option<f64>,
+    shading_ms: Option<f64>,
+) -> (String, Verdict) {
+    let times = match (lighting_ms, shading_ms) {
+        (Some(l), Some(d)) => format!("; avg ms: light_prepass_mono {l:.1}, deferred_mono {d:.1}"),
+        _ => String::new(),
+    };
+    (
+        format!(
+            "render targets per pixel: light_prepass_mono {lighting_bytes} B, deferred_mono {shading_bytes} B{times}"
+        ),
+        verdict(lighting_bytes < shading_bytes),
+    )
+}
+
+/// Claim 18: the mono-specular pipelines' render targets, as the runs recorded them.
+pub(super) fn mono_memory(r: &BenchResults, scene: &str) -> (String, Verdict) {
+    let bytes = |p| Some(find(r, scene, p, None)?.summary.as_ref()?.bytes_per_pixel);
+    match (bytes("light_prepass_mono"), bytes("deferred_mono")) {
+        (Some(l), Some(d)) => less_memory(
+            l,
+            d,
+            find(r, scene, "light_prepass_mono", None).and_then(avg_ms),
+            find(r, scene, "deferred_mono", None).and_then(avg_ms),
+        ),
+        _ => not_measured("light_prepass_mono and deferred_mono"),
+    }
+}
+
 /// The blog's write break-even: deferred shading writes 20 B per pixel + 8 per lit pixel,
 /// deferred lighting 16 + 16, so lighting writes more above 0.5 lights per pixel.
 pub const WRITE_BREAK_EVEN: f64 = 0.5;

@@ -240,6 +240,11 @@ const PER_SCENE: &[PerScene] = &[
         "deferred-shading-vs-deferred-lighting (the compromise)",
         mono_reads,
     ),
+    (
+        "With monochrome specular on both sides, deferred lighting needs less render-target memory per pixel than deferred shading (16 against 20 bytes)",
+        "deferred-shading-vs-deferred-lighting (the compromise)",
+        mono_memory,
+    ),
 ];
 
 pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
@@ -479,6 +484,15 @@ mod tests {
             e.contains("reads") && e.contains("2.0 MiB") && e.contains("(0.50x)"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn mono_memory_on_both_sides() {
+        let (e, v) = less_memory(32, 40, Some(178.0), Some(199.0));
+        assert_eq!(v, Verdict::Held);
+        assert!(e.contains("32 B") && e.contains("178.0"), "{e}");
+        assert_eq!(less_memory(40, 40, None, None).1, Verdict::NotHeld);
+        assert_eq!(less_memory(48, 40, None, None).1, Verdict::NotHeld);
     }
 
     #[test]
