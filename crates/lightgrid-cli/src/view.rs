@@ -4,7 +4,7 @@
 
 use crate::args::{check_applies, parse_size, RendererArgs, SceneOptions, Size, MAX_COUNT};
 use crate::files::{Files, Kind};
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use lightgrid::debug_view::DebugView;
 use lightgrid::pipelines;
@@ -79,9 +79,6 @@ pub(crate) fn view(adapter: Option<&str>, a: &ViewArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
     check_applies(a.renderer.given(), &[info])?;
     let settings = a.renderer.settings()?;
-    if let Some(why) = lightgrid_viewer::controls::refusal(info, &settings) {
-        bail!("{why}");
-    }
     let mut files = Files::default();
     files.output("--screenshot", a.screenshot.as_deref(), Kind::Png)?;
     let script = match &a.script {

@@ -26,5 +26,5 @@ pub mod stats;
 pub use analysis::FrameOutput;
 pub use error::{Error, Result};
 pub use frame::{FinishedFrame, RenderSettings, SubmittedFrame};
-pub use renderer::{validate_size, Renderer, MAX_FRAMES_IN_FLIGHT};
+pub use renderer::{max_frame_edge, validate_size, Renderer, MAX_FRAMES_IN_FLIGHT};
 pub use stats::{FrameStats, TimingSource};

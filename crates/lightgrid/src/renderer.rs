@@ -140,9 +140,14 @@ pub struct Renderer<'c> {
     finished: Vec<FinishedFrame>,
 }
 
+/// The longest frame edge: lightgrid's limit or the adapter's, whichever is smaller.
+pub fn max_frame_edge(ctx: &GpuContext) -> u32 {
+    ctx.max_texture_edge().min(MAX_FRAME_EDGE)
+}
+
 /// Check a frame size against lightgrid's and the adapter's limits.
 pub fn validate_size(ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
-    let limit = ctx.max_texture_edge().min(MAX_FRAME_EDGE);
+    let limit = max_frame_edge(ctx);
     if width == 0 || height == 0 {
         return Err(Error::invalid(
             "size",

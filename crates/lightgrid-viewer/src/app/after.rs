@@ -127,7 +127,7 @@ impl<'c> App<'c> {
         }
         let win = self.win.as_ref().context("no window")?;
         let size = match (&self.analysis.latest, debug) {
-            (Some((_, _, a)), true) => a
+            (Some((_, a)), true) => a
                 .image
                 .as_ref()
                 .map_or(win.renderer.size(), |i| i.image.dimensions()),
@@ -143,8 +143,7 @@ impl<'c> App<'c> {
         );
         ctx.queue.submit([encoder.finish()]);
         let image = capture.read(&ctx.device, &ctx.queue)?;
-        let bytes = lightgrid::image_io::encode_png(&image, path)?;
-        lightgrid::image_io::write_atomic(path, &bytes)?;
+        lightgrid::image_io::save_png(&image, path)?;
         Ok(Shot::Taken)
     }
 
@@ -155,9 +154,8 @@ impl<'c> App<'c> {
                     self.analysis.in_flight = false;
                     match done.result {
                         Ok(a) => {
-                            self.analysis.serial += 1;
                             self.upload_debug(&a);
-                            self.analysis.latest = Some((done.generation, self.analysis.serial, a));
+                            self.analysis.latest = Some((done.generation, a));
                         }
                         Err(e) if self.scripted => bail!("analysis frame: {e}"),
                         Err(e) => {
@@ -174,12 +172,10 @@ impl<'c> App<'c> {
 
     pub(super) fn upload_debug(&mut self, a: &Analysed) {
         let Some(win) = &mut self.win else { return };
-        win.debug_texture = a.image.as_ref().map(|img| {
-            (
-                self.analysis.serial,
-                upload_image(&self.ctx.device, &self.ctx.queue, &img.image),
-            )
-        });
+        win.debug_texture = a
+            .image
+            .as_ref()
+            .map(|img| upload_image(&self.ctx.device, &self.ctx.queue, &img.image));
     }
 
     /// Send the next analysis job: continuously while a debug view shows, else on demand or

@@ -118,7 +118,7 @@ impl<'c> App<'c> {
     /// The image the window shows now: the debug view's (once one came back) or the frame.
     pub(super) fn source<'a>(win: &'a Win, view: DebugView) -> &'a wgpu::TextureView {
         match (&win.debug_texture, view) {
-            (Some((_, t)), v) if v != DebugView::Shaded => t,
+            (Some(t), v) if v != DebugView::Shaded => t,
             _ => win.renderer.display_view(),
         }
     }
@@ -179,7 +179,7 @@ impl<'c> App<'c> {
                 .analysis
                 .latest
                 .as_ref()
-                .map(|(_, _, a)| (a, analysis_current)),
+                .map(|(_, a)| (a, analysis_current)),
             analysing: self.analysis.in_flight,
             sample_every_second: self.analysis.every_second,
             message: self.message.as_deref(),

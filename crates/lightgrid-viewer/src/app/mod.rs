@@ -160,8 +160,8 @@ struct Win<'c> {
     blit: Blit,
     egui: EguiLayer,
     renderer: Renderer<'c>,
-    /// The debug view's image on the GPU, with the analysis result it came from.
-    debug_texture: Option<(u64, wgpu::TextureView)>,
+    /// The debug view's image of the newest analysis result, on the GPU.
+    debug_texture: Option<wgpu::TextureView>,
     size_changed_at: Option<Instant>,
 }
 
@@ -175,9 +175,8 @@ struct EguiLayer {
 #[derive(Default)]
 struct AnalysisState {
     in_flight: bool,
-    /// The newest result, its state generation and a serial (which result it is).
-    latest: Option<(u64, u64, Analysed)>,
-    serial: u64,
+    /// The newest result and the state generation it was rendered for.
+    latest: Option<(u64, Analysed)>,
     failed_generation: Option<u64>,
     last_request: Option<Instant>,
     every_second: bool,
@@ -403,9 +402,7 @@ impl<'c> App<'c> {
 /// The renderer's size for a surface: the surface's, within lightgrid's and the adapter's
 /// limits (a larger window shows the frame's edge repeated).
 fn render_size(ctx: &GpuContext, (w, h): (u32, u32)) -> (u32, u32) {
-    let limit = ctx
-        .max_texture_edge()
-        .min(lightgrid::consts::MAX_FRAME_EDGE);
+    let limit = lightgrid::max_frame_edge(ctx);
     (w.clamp(1, limit), h.clamp(1, limit))
 }
 

@@ -23,7 +23,7 @@ impl<'c> App<'c> {
     /// The newest analysis frame shows the current state (and, paused, the current frame);
     /// with `image`, it also has the debug view's image.
     pub(super) fn analysis_current(&self, image: bool) -> bool {
-        self.analysis.latest.as_ref().is_some_and(|(g, _, a)| {
+        self.analysis.latest.as_ref().is_some_and(|(g, a)| {
             *g == self.generation
                 && (self.playing || a.stats.frame == self.frame)
                 && (!image || a.image.is_some())
@@ -124,7 +124,7 @@ impl<'c> App<'c> {
             }
             _ => None,
         };
-        if let Some(opened) = opened {
+        let scene = opened.map(|opened| {
             if let Some(w) = opened.warnings.first() {
                 self.message = Some(format!(
                     "{} (and {} more warnings)",
@@ -132,7 +132,16 @@ impl<'c> App<'c> {
                     opened.warnings.len() - 1
                 ));
             }
-            self.set_scene(opened.scene);
+            opened.scene
+        });
+        self.install(next, scene, renderer);
+        Ok(())
+    }
+
+    /// Put what `apply` or `recover` made in place and make `next` the applied state.
+    fn install(&mut self, next: Controls, scene: Option<Scene>, renderer: Option<Renderer<'c>>) {
+        if let Some(scene) = scene {
+            self.set_scene(scene);
         }
         if let Some(r) = renderer {
             self.replace_renderer(r);
@@ -145,7 +154,6 @@ impl<'c> App<'c> {
         if let Some(win) = &self.win {
             win.window.set_title(&self.title());
         }
-        Ok(())
     }
 
     /// Apply the panel's draft once it has stopped changing (a pipeline or view at once).
@@ -186,16 +194,11 @@ impl<'c> App<'c> {
         let win = self.win.as_ref().context("no window")?;
         let (w, h) = win.renderer.size();
         let renderer = Renderer::new(self.ctx, w, h, good.settings)?;
-        if self.applied.request != good.request {
-            let opened = lightgrid::scene::open(&good.request)?;
-            self.set_scene(opened.scene);
-        }
-        self.replace_renderer(renderer);
-        self.applied = good.clone();
-        self.draft = good;
-        if let Some(win) = &self.win {
-            win.window.set_title(&self.title());
-        }
+        let scene = match self.applied.request != good.request {
+            true => Some(lightgrid::scene::open(&good.request)?.scene),
+            false => None,
+        };
+        self.install(good, scene, Some(renderer));
         Ok(())
     }
 
