@@ -225,14 +225,19 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         None
     };
     let lighting_computations = counts.as_deref().map(sum);
-    // The transparent pass's share: the counts after it minus those before it.
-    let transparent_lighting_computations = match lighting_computations {
+    // The opaque passes' share (the counts before the transparent pass) and the transparent
+    // pass's (the rest). The traffic models describe the opaque pipeline (a lit pixel is a
+    // lighting computation of its deferred or forward pass); the transparent pass,
+    // forward-shaded by every pipeline, is outside them.
+    let opaque_lighting_computations = match lighting_computations {
         Some(all) if !a.transparent.is_empty() => {
-            Some(all.saturating_sub(sum(&a.readbacks.opaque_counts.read(device)?)))
+            Some(sum(&a.readbacks.opaque_counts.read(device)?).min(all))
         }
-        Some(_) => Some(0),
-        None => None,
+        all => all,
     };
+    let transparent_lighting_computations = lighting_computations
+        .zip(opaque_lighting_computations)
+        .map(|(all, opaque)| all - opaque);
 
     // The ideal: for each visible sample and each transparent fragment in front of it, the
     // lights reaching it. The depth-bounded CPU grid (with transparent lists when there are
@@ -296,11 +301,6 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let occupied = cell_bounds
         .as_ref()
         .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
-    // The traffic models describe the opaque pipeline (a lit pixel is a lighting computation
-    // of its deferred or forward pass); the transparent pass, forward-shaded by every
-    // pipeline, is outside them.
-    let opaque_lighting_computations =
-        lighting_computations.map(|n| n - transparent_lighting_computations.unwrap_or(0));
     let memory = frame_memory(
         a.info.memory_model(&settings),
         (width, height),

@@ -55,10 +55,7 @@ pub enum GBufferLayout {
 impl GBufferLayout {
     /// Colour targets written per pixel.
     pub fn targets(self) -> u32 {
-        match self {
-            GBufferLayout::Full => 4,
-            GBufferLayout::MonoSpecular => 3,
-        }
+        (0..TARGET_NAMES.len()).filter(|&l| self.has(l)).count() as u32
     }
 
     /// Targets a lighting computation reads (every one but the light-independent term).

@@ -394,11 +394,8 @@ impl Technique for LightPrepass {
             pass.set_pipeline(&self.attributes);
             draw_scene(&mut pass, f, &[]);
         }
-        if matches!(self.irradiance, Irradiance::Volumes { .. }) {
-            self.encode_volumes(f, enc, &attr_group)?;
-        }
         match &mut self.irradiance {
-            Irradiance::Volumes { .. } => {}
+            Irradiance::Volumes { .. } => self.encode_volumes(f, enc, &attr_group)?,
             Irradiance::Tiled {
                 builder,
                 kernel,

@@ -793,6 +793,10 @@ fn scattered(p: &SceneParams) -> Scene {
         );
     }
     b.object(blocks, shiny, Motion::Static);
+    // The demo's lights move (forward-plus §5): each circles an axis of its own, from its
+    // place at frame 0, with radii and speeds from a stream of their own (so the rest of the
+    // scene, and frame 0, are as before).
+    let mut motion = Rng::new(p.seed ^ 0x5ca7_7e2e_d11f_0a75);
     for _ in 0..SCATTERED_LIGHTS {
         let light = Light {
             position: Vec3::new(
@@ -805,18 +809,12 @@ fn scattered(p: &SceneParams) -> Scene {
             range: 10.0,
             spot: None,
         };
-        b.light(light, LightAnchor::World);
-    }
-    // The demo's lights move (forward-plus §5): each circles an axis of its own, from its
-    // place at frame 0, with radii and speeds from a stream of their own (so the rest of the
-    // scene, and frame 0, are as before).
-    let mut motion = Rng::new(p.seed ^ 0x5ca7_7e2e_d11f_0a75);
-    for l in &mut b.scene.lights {
-        l.anchor = LightAnchor::Circle {
+        let anchor = LightAnchor::Circle {
             radius: motion.range(2.0, 8.0),
             frames_per_turn: motion.range(60.0, 240.0),
             phase: motion.range(0.0, std::f32::consts::TAU),
         };
+        b.light(light, anchor);
     }
     b.scene
 }
