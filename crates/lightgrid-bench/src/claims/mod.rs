@@ -63,26 +63,34 @@ fn find_msaa<'a>(
     bits: Option<u32>,
     samples: u32,
 ) -> Option<&'a RunRecord> {
-    r.runs.iter().find(|x| {
-        x.scene == scene
-            && x.pipeline == pipeline
-            && x.msaa == samples
-            && (x.gbuffer_bits.is_none() || x.gbuffer_bits == bits.or(Some(16)))
-            && x.depth_bounds.is_none_or(|b| b == DepthBounds::Both)
-    })
+    find_run(r, scene, pipeline, bits, samples, DepthBounds::Both)
 }
 
-/// The run of `pipeline` on `scene` culling by `bounds` (`--depth-bounds`), without MSAA.
+/// As [`find`], culling by `bounds` (`--depth-bounds`).
 fn find_bounds<'a>(
     r: &'a BenchResults,
     scene: &str,
     pipeline: &str,
     bounds: DepthBounds,
 ) -> Option<&'a RunRecord> {
+    find_run(r, scene, pipeline, None, 1, bounds)
+}
+
+/// The one search the three above name: a run recorded without a depth-bounds setting
+/// culled by both bounds (the default).
+fn find_run<'a>(
+    r: &'a BenchResults,
+    scene: &str,
+    pipeline: &str,
+    bits: Option<u32>,
+    samples: u32,
+    bounds: DepthBounds,
+) -> Option<&'a RunRecord> {
     r.runs.iter().find(|x| {
         x.scene == scene
             && x.pipeline == pipeline
-            && x.msaa == 1
+            && x.msaa == samples
+            && (x.gbuffer_bits.is_none() || x.gbuffer_bits == bits.or(Some(16)))
             && x.depth_bounds.unwrap_or_default() == bounds
     })
 }
@@ -272,10 +280,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
 
 /// The evidence of a claim whose runs the benchmark did not include.
 fn missing() -> (String, Verdict) {
-    (
-        "needs runs that are missing".to_string(),
-        Verdict::NotMeasured,
-    )
+    not_measured("runs that are missing")
 }
 
 fn not_measured(what: &str) -> (String, Verdict) {
