@@ -127,11 +127,18 @@ pub(super) fn reduction_claims(r: &BenchResults) -> Vec<Claim> {
         .iter()
         .filter(|x| x.depth_reduction == Some(DepthReduction::Atomics))
     {
+        // The same series in every other setting.
         let Some(y) = r.runs.iter().find(|y| {
-            y.scene == x.scene
+            y.depth_reduction == Some(DepthReduction::Subgroup)
+                && y.scene == x.scene
                 && y.pipeline == x.pipeline
                 && y.msaa == x.msaa
-                && y.depth_reduction == Some(DepthReduction::Subgroup)
+                && y.msaa_resolve == x.msaa_resolve
+                && y.gbuffer_bits == x.gbuffer_bits
+                && y.depth_bounds == x.depth_bounds
+                && y.spot_cull == x.spot_cull
+                && y.lists == x.lists
+                && y.material_draws == x.material_draws
         }) else {
             continue;
         };
