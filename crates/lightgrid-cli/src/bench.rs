@@ -193,6 +193,12 @@ pub(crate) struct BenchDefaults {
     /// The paper's tile edge (unless `--tile` says; None: the renderer's default).
     pub(crate) tile: Option<u32>,
     pub(crate) depth_bounds: Vec<lightgrid::frame::DepthBounds>,
+    /// Light-range factors to measure each scene with (empty: the scene's own ranges).
+    pub(crate) range_scales: Vec<f32>,
+    /// The lights-per-tile heatmap's fixed scale (None: each frame's own maximum).
+    pub(crate) heatmap_max: Option<u32>,
+    /// Each scene also without its transparent objects (unless `--transparency` says).
+    pub(crate) opaque_variants: bool,
 }
 
 /// Without a preset: robots-many's animation every 5 frames (the paper's 5 fps sampling) at
@@ -213,6 +219,9 @@ fn everything() -> BenchDefaults {
         transparency: true,
         tile: None,
         depth_bounds: vec![Default::default()],
+        range_scales: Vec::new(),
+        heatmap_max: None,
+        opaque_variants: false,
     }
 }
 
@@ -284,6 +293,8 @@ pub(crate) fn bench_config(
                 lightgrid::frame::MsaaResolve::Separate,
                 lightgrid::frame::MsaaResolve::Kernel,
             ],
+            // Fig. 4.4 measures the scene with and without its translucent blocks.
+            opaque_variants: true,
             ..study(hardware, |_| false)
         },
         Some(Preset::Paper) => BenchDefaults {
@@ -313,8 +324,9 @@ pub(crate) fn bench_config(
             ]
             .map(String::from)
             .to_vec(),
-            // forward-plus §5: 8x8 tiles.
+            // forward-plus §5: 8x8 tiles, Fig. 2(b)'s fixed lights-per-tile scale.
             tile: Some(8),
+            heatmap_max: Some(FORWARD_PLUS_HEATMAP_MAX),
             ..study(hardware, |_| false)
         },
         Some(Preset::LightRange) => BenchDefaults {
@@ -323,6 +335,7 @@ pub(crate) fn bench_config(
                 .to_vec(),
             frames: "0..259:65",
             size: Some(if hardware { (1280, 720) } else { (320, 180) }),
+            range_scales: LIGHT_RANGE_SCALES.to_vec(),
             ..study(hardware, |_| false)
         },
         Some(Preset::DepthBounds) => BenchDefaults {
@@ -388,17 +401,11 @@ pub(crate) fn bench_config(
         lights: a.lights,
         heatmap_frame: a.heatmap_frame,
         range_scales: if a.range_scale.is_empty() {
-            if matches!(a.preset, Some(Preset::LightRange)) {
-                LIGHT_RANGE_SCALES.to_vec()
-            } else {
-                Vec::new()
-            }
+            d.range_scales.clone()
         } else {
             a.range_scale.iter().map(|&f| f as f32).collect()
         },
-        heatmap_max: a
-            .heatmap_max
-            .or(matches!(a.preset, Some(Preset::ForwardPlus)).then_some(FORWARD_PLUS_HEATMAP_MAX)),
+        heatmap_max: a.heatmap_max.or(d.heatmap_max),
         spot_fraction: a.spot_fraction.map_or(d.spot_fraction, |f| f as f32),
         headlights: a.headlights,
         spot_culls: if a.spot_cull.is_empty() {
@@ -411,7 +418,7 @@ pub(crate) fn bench_config(
         } else {
             a.transparency.iter().any(|t| t.on())
         },
-        opaque_variants: matches!(a.preset, Some(Preset::Msaa)) && a.transparency.is_empty()
+        opaque_variants: d.opaque_variants && a.transparency.is_empty()
             || a.transparency.iter().any(|t| !t.on()) && a.transparency.iter().any(|t| t.on()),
         material_shaders: a.material_shaders.is_none_or(OnOff::on),
         lists: if a.lists.is_empty() {
