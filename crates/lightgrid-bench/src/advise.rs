@@ -442,33 +442,22 @@ fn measure(
     left: Duration,
     stop: &AtomicBool,
 ) -> Measurement {
-    // The outcome is set below; a failure keeps what was known before it.
-    let mut m = unmeasured(
-        plan,
-        c,
-        Outcome::Failed {
-            reason: String::new(),
-        },
-    );
-    m.outcome = match try_measure(ctx, plan, &c, frames, left, stop, &mut m) {
-        Ok(outcome) => outcome,
-        Err(e) => Outcome::Failed {
-            reason: e.to_string(),
-        },
-    };
-    m
+    try_measure(ctx, plan, c, frames, left, stop).unwrap_or_else(|e| {
+        let reason = e.to_string();
+        unmeasured(plan, c, Outcome::Failed { reason })
+    })
 }
 
+/// The candidate's measurement, or skipped with the reason (its known facts only).
 fn try_measure(
     ctx: &GpuContext,
     plan: &AdvisePlan,
-    c: &Candidate,
+    c: Candidate,
     frames: &[u32],
     left: Duration,
     stop: &AtomicBool,
-    m: &mut Measurement,
-) -> lightgrid::Result<Outcome> {
-    let settings = settings_of(plan, c);
+) -> lightgrid::Result<Measurement> {
+    let settings = settings_of(plan, &c);
     let mut renderer = Renderer::new(ctx, plan.size.0, plan.size.1, settings)?;
     // The warm-up frame (shader compilation included) bounds what one frame costs.
     let t = Instant::now();
@@ -478,14 +467,13 @@ fn try_measure(
     // The frames to play, their queue fill, and the analysis frame.
     let needed = first * (frames.len() as u32 + crate::PLAY_QUEUE_FILL + 1);
     if needed > left.saturating_sub(first) {
-        return Ok(Outcome::Skipped {
-            reason: format!(
-                "its first frame took {:.2} s: {} frames would not fit in the {:.1} s of budget left",
-                first.as_secs_f64(),
-                frames.len() as u32 + crate::PLAY_QUEUE_FILL + 1,
-                left.saturating_sub(first).as_secs_f64()
-            ),
-        });
+        let reason = format!(
+            "its first frame took {:.2} s: {} frames would not fit in the {:.1} s of budget left",
+            first.as_secs_f64(),
+            frames.len() as u32 + crate::PLAY_QUEUE_FILL + 1,
+            left.saturating_sub(first).as_secs_f64()
+        );
+        return Ok(unmeasured(plan, c, Outcome::Skipped { reason }));
     }
     let run = play(
         &mut renderer,
@@ -500,19 +488,21 @@ fn try_measure(
         &mut |_, _| {},
     )?;
     if run.interrupted {
-        return Ok(Outcome::Skipped {
-            reason: "interrupted".into(),
-        });
+        let reason = "interrupted".into();
+        return Ok(unmeasured(plan, c, Outcome::Skipped { reason }));
     }
     let out = renderer.render(plan.scene, frames[frames.len() / 2], c.pipeline)?;
-    m.memory_bytes = out.stats.memory.target_bytes + out.stats.memory.grid_bytes.unwrap_or(0);
-    m.lighting_computations = out.stats.lighting_computations;
-    m.ideal_lighting_computations = Some(out.stats.ideal_lighting_computations);
-    m.efficiency = out.stats.efficiency;
-    Ok(Outcome::Measured {
+    let outcome = Outcome::Measured {
         frame_ms: run.frame_ms().map_or(f64::NAN, |d| d.median),
         gpu_ms: run.gpu_ms().map(|d| d.median),
         wrong_frames: run.overflow_frames() + run.truncated_frames(),
+    };
+    Ok(Measurement {
+        memory_bytes: out.stats.memory.target_bytes + out.stats.memory.grid_bytes.unwrap_or(0),
+        lighting_computations: out.stats.lighting_computations,
+        ideal_lighting_computations: Some(out.stats.ideal_lighting_computations),
+        efficiency: out.stats.efficiency,
+        ..unmeasured(plan, c, outcome)
     })
 }
 
