@@ -903,16 +903,16 @@ impl<'a> Measuring<'a> {
         } else {
             String::new()
         };
-        let mut cull = if self.config.spot_culls.len() > 1 && info.uses_grid {
-            format!(" {:?}", series.spot_cull).to_lowercase()
-        } else {
-            String::new()
+        // The settings the record names (those measured in more than one way).
+        let mut cull = match record.spot_cull {
+            Some(c) => format!(" {c:?}").to_lowercase(),
+            None => String::new(),
         };
-        if self.config.lists.len() > 1 && info.assign {
-            cull += &format!(" {} lists", series.lists.name());
+        if let Some(l) = record.lists {
+            cull += &format!(" {} lists", l.name());
         }
-        if self.config.material_draws.len() > 1 && info.forward_shading {
-            cull += &format!(" {} draws", series.material_draws.name());
+        if let Some(d) = record.material_draws {
+            cull += &format!(" {} draws", d.name());
         }
         if series.msaa > 1 {
             cull += &format!(" {}x msaa", series.msaa);
@@ -920,11 +920,11 @@ impl<'a> Measuring<'a> {
         if let Some(r) = series.msaa_resolve {
             cull += &format!(" {} resolve", r.name());
         }
-        if self.config.depth_bounds.len() > 1 && info.depth_bounds {
-            cull += &format!(" bounds {}", series.depth_bounds.name());
+        if let Some(b) = record.depth_bounds {
+            cull += &format!(" bounds {}", b.name());
         }
-        if self.config.depth_reductions.len() > 1 && info.depth_bounds {
-            cull += &format!(" {} reduction", series.depth_reduction.name());
+        if let Some(d) = record.depth_reduction {
+            cull += &format!(" {} reduction", d.name());
         }
         let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
