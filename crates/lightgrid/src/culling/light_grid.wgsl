@@ -44,6 +44,20 @@ fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> ve
     return grid_shade(s, view_dir, cell);
 }
 
+// The cell's lights' diffuse irradiance (rgb) and specular luminance (a): the light
+// pre-pass's monochrome compromise, summed as the tiled light pre-pass stores it.
+fn grid_irradiance_mono(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec4<f32> {
+    var acc = vec4<f32>(0.0);
+    let count = grid_cell_count(cell);
+    var i = 0u;
+    for (; i < count; i = i + 1u) {
+        let t = light_terms(s, view_dir, grid_light(cell, i));
+        acc += vec4<f32>(t.diffuse, luminance(t.specular));
+    }
+    check_loop(i, count);
+    return acc;
+}
+
 // Sum of the cell's lights on the surface (Listing 1's computeLight).
 fn grid_shade(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec3<f32> {
     var acc = vec3<f32>(0.0);

@@ -69,6 +69,7 @@ fn tiled_kernel() -> ComposedShader {
             &crate::shader::msaa_wgsl(1),
             src::LIGHT_GRID,
             ATTRIBUTES_WGSL,
+            crate::passes::COMPUTE_OUTPUTS_WGSL,
             include_str!("tiled_light_prepass.wgsl"),
         ],
     )
