@@ -45,6 +45,23 @@ pub struct Claim {
     pub verdict: Verdict,
 }
 
+impl Claim {
+    fn new(
+        scene: impl Into<String>,
+        statement: &'static str,
+        source: &'static str,
+        (evidence, verdict): (String, Verdict),
+    ) -> Self {
+        Claim {
+            scene: scene.into(),
+            statement,
+            source,
+            evidence,
+            verdict,
+        }
+    }
+}
+
 /// The run of `pipeline` on `scene`, with the 16-bit G-buffer if it has one (or `bits`).
 fn find<'a>(
     r: &'a BenchResults,
@@ -261,14 +278,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
     scenes.dedup();
     for scene in scenes {
         for &(statement, source, check) in PER_SCENE {
-            let (evidence, verdict) = check(r, scene);
-            out.push(Claim {
-                scene: scene.to_string(),
-                statement,
-                source,
-                evidence,
-                verdict,
-            });
+            out.push(Claim::new(scene, statement, source, check(r, scene)));
         }
     }
     out.extend(view_dependence(r));

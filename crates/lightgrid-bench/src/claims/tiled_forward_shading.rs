@@ -104,22 +104,16 @@ pub(super) fn range_claims(r: &BenchResults) -> Vec<Claim> {
                 speedups.push((*f, fw / t.max(1e-9)));
             }
         }
-        let mut claim = |statement, (evidence, verdict): (String, Verdict)| {
-            out.push(Claim {
-                scene: format!(
-                    "{base} (light ranges x{})",
-                    scenes
-                        .iter()
-                        .map(|s| s.0.to_string())
-                        .collect::<Vec<_>>()
-                        .join(", x")
-                ),
-                statement,
-                source: "tiled-forward-shading §4.2, Fig. 4.2(a)",
-                evidence,
-                verdict,
-            })
-        };
+        let name = format!(
+            "{base} (light ranges x{})",
+            scenes
+                .iter()
+                .map(|s| s.0.to_string())
+                .collect::<Vec<_>>()
+                .join(", x")
+        );
+        let source = "tiled-forward-shading §4.2, Fig. 4.2(a)";
+        let mut claim = |statement, result| out.push(Claim::new(&name, statement, source, result));
         claim(
             "Lights too large leave nothing to cull: as the ranges grow every tile lists more of the lights, until (almost: 90%) all of them",
             if listed.len() >= 2 {
@@ -192,15 +186,8 @@ pub(super) fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
     let mut out = Vec::new();
     for scene in scenes {
         let ms = |p: &str, b| find_bounds(r, scene, p, b).and_then(avg_ms);
-        let mut claim = |statement, (evidence, verdict): (String, Verdict)| {
-            out.push(Claim {
-                scene: scene.to_string(),
-                statement,
-                source: "tiled-forward-shading §4.4",
-                evidence,
-                verdict,
-            })
-        };
+        let source = "tiled-forward-shading §4.4";
+        let mut claim = |statement, result| out.push(Claim::new(scene, statement, source, result));
         claim(
             "A depth pre-pass alone makes tiled forward shading faster (22.4 → 15.6 ms)",
             match (
@@ -275,15 +262,9 @@ pub(super) fn view_dependence(r: &BenchResults) -> Vec<Claim> {
     let count = |scene: &str, p: &str| find(r, scene, p, None).and_then(avg_count);
     let (tiled, clustered) = ("tiled_forward_prez", "clustered_forward");
     let mut out = Vec::new();
-    let mut claim = |scene: &str, statement, (evidence, verdict): (String, Verdict)| {
-        out.push(Claim {
-            scene: scene.to_string(),
-            statement,
-            source: "tiled-forward-shading Fig. 4.6",
-            evidence,
-            verdict,
-        })
-    };
+    let source = "tiled-forward-shading Fig. 4.6";
+    let mut claim =
+        |scene: &str, statement, result| out.push(Claim::new(scene, statement, source, result));
     if r.runs.iter().any(|x| x.scene == top) {
         claim(
             top,

@@ -142,17 +142,16 @@ pub(super) fn reduction_claims(r: &BenchResults) -> Vec<Claim> {
         }) else {
             continue;
         };
-        let (evidence, verdict) = match (cell_bounds_ms(x), cell_bounds_ms(y)) {
+        let result = match (cell_bounds_ms(x), cell_bounds_ms(y)) {
             (Some(a), Some(s)) => subgroup_faster(&x.pipeline, a, s),
             _ => not_measured("the cell-bounds pass's timestamps"),
         };
-        out.push(Claim {
-            scene: x.scene.clone(),
-            statement: "A subgroup (warp-level) min/max reduction of the tile depths is faster than workgroup atomics (6x at 16x16 tiles)",
-            source: "tiled-shading §8",
-            evidence,
-            verdict,
-        });
+        out.push(Claim::new(
+            x.scene.as_str(),
+            "A subgroup (warp-level) min/max reduction of the tile depths is faster than workgroup atomics (6x at 16x16 tiles)",
+            "tiled-shading §8",
+            result,
+        ));
     }
     out
 }
