@@ -19,21 +19,25 @@ impl<'c> App<'c> {
         if repeat {
             return;
         }
+        // The keys for the panel's buttons do what the buttons do.
+        let action = match code {
+            KeyCode::Space => Some(PanelAction::TogglePause),
+            KeyCode::Period => Some(PanelAction::Step(1)),
+            KeyCode::Comma => Some(PanelAction::Step(-1)),
+            KeyCode::KeyI => Some(PanelAction::Analyse),
+            KeyCode::KeyC => Some(PanelAction::FollowPath),
+            KeyCode::F12 | KeyCode::KeyP => Some(PanelAction::Screenshot),
+            _ => None,
+        };
+        if let Some(a) = action {
+            return self.panel_action(a);
+        }
         match code {
             KeyCode::Escape => event_loop.exit(),
-            KeyCode::Space => self.set_playing(!self.playing),
-            KeyCode::Period => self.step(1),
-            KeyCode::Comma => self.step(-1),
             KeyCode::BracketRight => self.cycle_pipeline(1),
             KeyCode::BracketLeft => self.cycle_pipeline(-1),
             KeyCode::KeyV => self.draft.view = self.draft.view.next(),
             KeyCode::KeyH | KeyCode::F1 => self.panel = !self.panel,
-            KeyCode::KeyI => self.analysis.wanted_now = true,
-            KeyCode::KeyC => {
-                self.fly = None;
-                self.generation += 1;
-            }
-            KeyCode::F12 | KeyCode::KeyP => self.queue_user_screenshot(),
             _ => {}
         }
     }
