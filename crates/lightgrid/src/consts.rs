@@ -185,6 +185,9 @@ pub const SCREEN_WORKGROUP: u32 = 8;
 /// `GridParams::lists` values (`frame::GridLists`): lists over opaque samples only, one list
 /// shared by opaque and transparent fragments, or separate lists (a second layer of cells).
 pub const GRID_LISTS_OPAQUE: u32 = 0;
+pub const GRID_LISTS_SHARED: u32 = 1;
+pub const GRID_LISTS_SEPARATE: u32 = 2;
+
 /// Which cell depth bounds light assignment uses (`--depth-bounds`; `DepthBounds` in
 /// `frame/settings.rs`): both, the minimum only (far side open), the maximum only (near side
 /// open), or none (every cell spans its slice).
@@ -192,8 +195,6 @@ pub const DEPTH_BOUNDS_BOTH: u32 = 0;
 pub const DEPTH_BOUNDS_MIN: u32 = 1;
 pub const DEPTH_BOUNDS_MAX: u32 = 2;
 pub const DEPTH_BOUNDS_NONE: u32 = 3;
-pub const GRID_LISTS_SHARED: u32 = 1;
-pub const GRID_LISTS_SEPARATE: u32 = 2;
 
 /// Material shaders (`scene::MaterialShader`, tiled-forward-shading §4.7): the id each
 /// material carries, and the value of the WGSL override `MATERIAL_SHADER` that makes a
