@@ -160,7 +160,7 @@ fn fps(r: &super::run::RunRecord) -> String {
 }
 
 /// The columns of results.csv, in order (the header [`ResultsRow`] serializes to).
-const RESULTS_CSV_COLUMNS: [&str; 32] = [
+const RESULTS_CSV_COLUMNS: [&str; 33] = [
     "scene",
     "pipeline",
     "gbuffer_bits",
@@ -170,6 +170,7 @@ const RESULTS_CSV_COLUMNS: [&str; 32] = [
     "msaa",
     "msaa_resolve",
     "depth_bounds",
+    "depth_reduction",
     "width",
     "height",
     "tile_size",
@@ -208,6 +209,7 @@ struct ResultsRow<'a> {
     msaa: u32,
     msaa_resolve: Option<&'static str>,
     depth_bounds: Option<&'static str>,
+    depth_reduction: Option<&'static str>,
     width: u32,
     height: u32,
     tile_size: u32,
@@ -282,6 +284,7 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 msaa: r.msaa,
                 msaa_resolve: r.msaa_resolve.map(|m| m.name()),
                 depth_bounds: r.depth_bounds.map(|b| b.name()),
+                depth_reduction: r.depth_reduction.map(|d| d.name()),
                 width: r.width,
                 height: r.height,
                 tile_size: r.tile_size,
@@ -943,7 +946,7 @@ mod tests {
         let row = text.lines().nth(1).unwrap();
         assert_eq!(
             row,
-            ",,16,,,,0,,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,,gbuffer=0.1000;shade=0.2000"
+            ",,16,,,,0,,,,0,0,0,,0,0.0000,0.0000,0.0000,0.0000,0.0000,,0,0,0,1.500,,,,,,,,gbuffer=0.1000;shade=0.2000"
         );
         let empty = csv_bytes("results", &RESULTS_CSV_COLUMNS, Vec::<ResultsRow>::new()).unwrap();
         assert_eq!(String::from_utf8(empty).unwrap().lines().count(), 1);

@@ -241,6 +241,20 @@ fn both_depth_reductions_are_measured_side_by_side() {
         .find(|l| l.contains("A subgroup (warp-level) min/max reduction"))
         .expect("the claim");
     assert!(line.contains("cell-bounds pass avg ms: atomics"), "{line}");
+    // results.csv tells the two series apart.
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|c| *c == "depth_reduction")
+        .expect("a depth_reduction column");
+    let seen: std::collections::BTreeSet<&str> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.contains(",tiled_deferred,"))
+        .map(|l| l.split(',').nth(col).unwrap())
+        .collect();
+    assert_eq!(seen, ["atomics", "subgroup"].into_iter().collect());
     assert_fails_with(
         &[
             "render",
