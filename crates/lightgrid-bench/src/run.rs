@@ -488,7 +488,7 @@ pub struct BenchResults {
     #[serde(skip)]
     pub heatmaps: Vec<(String, String, u32, RgbaImage)>,
     /// Per scene, the frames of [`THUMBNAIL_FRAMES`] side by side (tiled-shading Fig. 2's
-    /// views along the animation), as rendered by the run's first grid pipeline.
+    /// views along the animation), as rendered by the heatmap's pipeline (else the first one).
     #[serde(skip)]
     pub thumbnails: Vec<(String, RgbaImage)>,
 }
