@@ -30,7 +30,7 @@ pub struct FrameOutput {
     /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
     /// their CPU twin); None for pipelines without a grid.
     pub cell_bounds: Option<Vec<[f32; 2]>>,
-    /// The frame's depth buffer (row-major, [0, 1], 1 = no geometry); with MSAA its sample 0.
+    /// The frame's depth buffer (row-major, reversed-Z: `crate::depth`); with MSAA its sample 0.
     pub depth: Vec<f32>,
     /// Every sample of the depth buffer, one plane per sample (one plane without MSAA).
     pub depth_samples: Vec<Vec<f32>>,

@@ -58,15 +58,20 @@ pub struct GpuVertex {
     pub material: u32,
 }
 
-/// Per-frame uniforms: camera matrices, viewport and light count.
+/// Per-frame uniforms: camera matrices, viewport and light count. Positions on the GPU are
+/// camera-relative (world minus `eye`, world-aligned): `view` is a rotation, and the
+/// projection is reversed-Z (`crate::depth`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct FrameUniforms {
+    /// Camera-relative space to view space (a rotation).
     pub view: [[f32; 4]; 4],
     pub proj: [[f32; 4]; 4],
     pub view_proj: [[f32; 4]; 4],
-    pub inv_view_proj: [[f32; 4]; 4],
-    pub camera_pos: [f32; 3],
+    /// View space to camera-relative space (the inverse of `view`, a rotation).
+    pub inv_view: [[f32; 4]; 4],
+    /// The camera's world position: the vertex stage subtracts it (camera-relative space).
+    pub eye: [f32; 3],
     pub light_count: u32,
     pub viewport: [f32; 2],
     pub near: f32,

@@ -8,6 +8,7 @@ pub mod analysis;
 pub mod consts;
 pub mod culling;
 pub mod debug_view;
+pub mod depth;
 pub mod error;
 pub mod frame;
 pub mod gpu;

@@ -439,8 +439,10 @@ impl<'c> Renderer<'c> {
     fn upload_frame_data(&mut self, state: &FrameState) -> u64 {
         let ctx = self.ctx;
         let device = &ctx.device;
-        let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu()).collect();
-        let bounds: Vec<[f32; 4]> = state.lights.iter().map(|l| l.bounds_gpu()).collect();
+        // Lights and geometry are drawn and shaded camera-relative (`ViewSetup::relative`).
+        let eye = state.camera.eye;
+        let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu(eye)).collect();
+        let bounds: Vec<[f32; 4]> = state.lights.iter().map(|l| l.bounds_gpu(eye)).collect();
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
         let bb: &[u8] = bytemuck::cast_slice(&bounds);
         let grew_lights = self.lights.reserve(device, lb.len() as u64);
@@ -450,15 +452,15 @@ impl<'c> Renderer<'c> {
         self.lights.write(&ctx.queue, 0, lb);
         self.light_bounds.write(&ctx.queue, 0, bb);
         let (width, height) = self.size();
-        let view = state.camera.view();
+        let view = state.camera.rotation();
         let proj = state.camera.proj(width as f32 / height as f32);
         let view_proj = proj * view;
         let uniforms = FrameUniforms {
             view: view.to_cols_array_2d(),
             proj: proj.to_cols_array_2d(),
             view_proj: view_proj.to_cols_array_2d(),
-            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-            camera_pos: state.camera.eye.to_array(),
+            inv_view: view.transpose().to_cols_array_2d(),
+            eye: eye.to_array(),
             light_count: state.lights.len() as u32,
             viewport: [width as f32, height as f32],
             near: state.camera.near,

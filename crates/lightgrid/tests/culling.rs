@@ -43,8 +43,7 @@ fn random_case(rng: &mut Rng) -> Case {
     };
     let (w, h) = (17 + rng.below(90), 9 + rng.below(70));
     let setup = ViewSetup::new(&camera, w, h);
-    let inv_view = setup.view.inverse();
-    let world = |v: Vec3| inv_view.transform_point3(v);
+    let world = |v: Vec3| setup.world_point(v);
     let color = Vec3::ONE;
     let mut lights = Vec::new();
     for k in 0..24 {
@@ -106,13 +105,12 @@ fn random_case(rng: &mut Rng) -> Case {
     }
 }
 
-/// A depth buffer ([0, 1] values) with sky, smooth surfaces, near-plane samples and noise.
+/// A depth buffer (reversed-Z values, `lightgrid::depth`) with sky, smooth surfaces,
+/// near-plane samples and noise.
 fn random_depth(rng: &mut Rng, case: &Case) -> Vec<f32> {
     let s = &case.setup;
-    let to_ndc = |w: f32| {
-        let r = s.far / (s.near - s.far);
-        (r * s.near / w - r).clamp(0.0, 0.999_999)
-    };
+    // Geometry never reaches the background value (0) exactly.
+    let to_ndc = |w: f32| s.depth_of(w).clamp(1e-7, 1.0);
     let (a, b, c) = (
         rng.range(0.5, 30.0),
         rng.range(-20.0, 20.0),
@@ -126,7 +124,7 @@ fn random_depth(rng: &mut Rng, case: &Case) -> Vec<f32> {
             );
             let roll = rng.unit();
             if roll < 0.15 {
-                1.0
+                lightgrid::depth::CLEAR
             } else if roll < 0.2 {
                 to_ndc(s.near)
             } else {
@@ -464,7 +462,7 @@ fn light_bvh_is_well_formed() {
                 if node.is_leaf() {
                     let l = bvh.order[k as usize] as usize;
                     seen[l] += 1;
-                    let c = setup.view.transform_point3(lights[l].position);
+                    let c = setup.view_point(lights[l].position);
                     let r = Vec3::splat(lights[l].range);
                     assert!(
                         contains(&node, c - r, c + r),
@@ -643,11 +641,8 @@ fn cell_bounds_ignore_sky_mark_empty_cells_and_cover_slice_boundaries() {
     let s = ViewSetup::new(&camera, 10, 5);
     let tiles = GridDims::new(10, 5, 4).unwrap();
     assert_eq!((tiles.tiles_x, tiles.tiles_y), (3, 2));
-    let to_depth = |w: f32| {
-        let r = s.far / (s.near - s.far);
-        r * s.near / w - r
-    };
-    let mut depth = vec![1.0f32; 50];
+    let to_depth = |w: f32| s.depth_of(w);
+    let mut depth = vec![lightgrid::depth::CLEAR; 50];
     depth[0] = to_depth(2.0);
     depth[13] = to_depth(1.0); // (3, 1): tile 0
     depth[9] = to_depth(50.0); // (9, 0): tile 2, a partial tile
@@ -827,7 +822,7 @@ fn spot_bounds_and_cone_test_never_lose_a_lit_point() {
                 dist <= r * (1.0 + 1e-5) + 1e-5,
                 "case {case}: lit point outside the bound"
             );
-            let pv = setup.view.transform_point3(p);
+            let pv = setup.view_point(p);
             assert!(v.reaches(pv), "view-space reach disagrees");
             let around = pv + Vec3::new(rng.range(-1.0, 1.0), 0.0, 0.0);
             assert!(
@@ -848,7 +843,7 @@ fn spot_bounds_and_cone_test_never_lose_a_lit_point() {
                     rng.range(-1.0, 1.0),
                     rng.range(-1.0, 1.0),
                 ) * light.range;
-            let pv = setup.view.transform_point3(p);
+            let pv = setup.view_point(p);
             if !light.reaches(p) && !v.may_reach_sphere(pv, 0.01) {
                 rejected += 1;
             }

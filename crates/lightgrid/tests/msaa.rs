@@ -190,7 +190,11 @@ fn check_edge_shading(name: &str, out: &FrameOutput, (w, h): (u32, u32)) {
     let geometry: u64 = out
         .depth_samples
         .iter()
-        .map(|p| p.iter().filter(|&&d| d < 1.0).count() as u64)
+        .map(|p| {
+            p.iter()
+                .filter(|&&d| !lightgrid::depth::is_background(d))
+                .count() as u64
+        })
         .sum();
     assert_eq!(
         m.geometry_samples, geometry,
@@ -280,7 +284,11 @@ fn edge_pixels_are_found_and_each_edge_sample_is_shaded_once() {
         let mut edges = 0u64;
         let mut shaded = 0u64;
         for p in 0..(w * h) as usize {
-            let covered: Vec<bool> = out.depth_samples.iter().map(|d| d[p] < 1.0).collect();
+            let covered: Vec<bool> = out
+                .depth_samples
+                .iter()
+                .map(|d| !lightgrid::depth::is_background(d[p]))
+                .collect();
             let n = covered.iter().filter(|&&c| c).count() as u32;
             let edge = n > 0 && n < SAMPLES;
             let expected = if edge { n } else { u32::from(covered[0]) };
@@ -317,7 +325,12 @@ fn check_resolve(id: &str, out: &FrameOutput, w: u32) {
             ((c + 0.055) / 1.055).powf(2.4)
         }
     };
-    let covered = |p: usize| out.depth_samples.iter().filter(|d| d[p] < 1.0).count() as f64;
+    let covered = |p: usize| {
+        out.depth_samples
+            .iter()
+            .filter(|d| !lightgrid::depth::is_background(d[p]))
+            .count() as f64
+    };
     let mut checked = 0;
     for y in 1..out.image.height() - 1 {
         for x in 1..w - 1 {

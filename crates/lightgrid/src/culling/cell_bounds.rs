@@ -122,7 +122,7 @@ pub fn cell_bounds_cpu_samples(
         {
             let d = depth[(y * dims.width + x) as usize];
             let tile = dims.tile_of(x, y);
-            if d >= 1.0 {
+            if crate::depth::is_background(d) {
                 tile_max[tile] = tile_max[tile].max(setup.far);
                 continue;
             }

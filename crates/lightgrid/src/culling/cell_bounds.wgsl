@@ -40,8 +40,8 @@ var<workgroup> slice_hi: array<atomic<u32>, MAX_SLICES>;
 
 // A depth-buffer value: the tile maximum, and the slices its view distance lies in.
 fn include_depth(d: f32) {
-    atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), d < 1.0)));
-    if (d < 1.0) {
+    atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), !is_background(d))));
+    if (!is_background(d)) {
         let w = view_distance_from_depth(d);
         let bits = bitcast<u32>(w);
         let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
@@ -88,8 +88,8 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
                     let d = textureLoad(depth_tex, p, s);
                     if (registers) {
                         let w = view_distance_from_depth(d);
-                        t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, d < 1.0)));
-                        if (d < 1.0) {
+                        t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
+                        if (!is_background(d)) {
                             lo = min(lo, bitcast<u32>(w));
                             hi = max(hi, bitcast<u32>(w));
                         }

@@ -64,17 +64,17 @@ impl FragmentBounds {
         };
         FragmentBounds {
             forward_opaque,
-            // The opaque shading passes test LessEqual against the pre-pass depth; the
-            // transparent pass Less against the opaque depth.
+            // The tests of the passes whose fragments these bound: the opaque shading passes'
+            // against the pre-pass depth, the transparent pass's against the opaque depth.
             opaque: pipeline(
                 "assign: fragment bounds (opaque)",
                 "fs_opaque",
-                wgpu::CompareFunction::LessEqual,
+                crate::depth::SURFACE,
             ),
             transparent: pipeline(
                 "assign: fragment bounds (transparent)",
                 "fs_transparent",
-                wgpu::CompareFunction::Less,
+                crate::depth::NEARER,
             ),
             layout,
             buffer: storage_buffer(device, "fragment bounds", 1 << 14),

@@ -1,6 +1,6 @@
 // Per-tile depth min/max over a depth texture, for a workgroup of TILE_THREADS x TILE_THREADS
-// invocations striding over one tile (any tile size). Depth 1.0 (cleared, no geometry) is
-// ignored; a tile without samples returns min > max. Positive floats order like their bit
+// invocations striding over one tile (any tile size). The background (`is_background`: no
+// geometry) is ignored; a tile without samples returns min > max. Positive floats order like their bit
 // patterns, so workgroup u32 atomics do the reduction.
 
 var<workgroup> tile_depth_min: atomic<u32>;
@@ -24,7 +24,7 @@ fn reduce_tile_depth(depth_tex: texture_depth_2d, tile: vec2<u32>, tile_size: u3
             let p = origin + vec2<u32>(x, y);
             if (p.x < dims.x && p.y < dims.y) {
                 let d = textureLoad(depth_tex, p, 0);
-                if (d < 1.0) {
+                if (!is_background(d)) {
                     lo = min(lo, d);
                     hi = max(hi, d);
                 }

@@ -53,10 +53,11 @@ fn frustum_sphere(ndc_lo: vec2<f32>, ndc_hi: vec2<f32>, w0: f32, w1: f32) -> vec
     return vec4<f32>(centre, radius);
 }
 
-// View-distance range of a tile's [min, max] depth-buffer values (an empty tile stays empty:
-// the map is monotonic).
+// View-distance range of a tile's [min, max] depth-buffer values. Reversed-Z: the greatest
+// depth is the nearest sample, so the ends swap (an empty tile, min > max, stays empty: the
+// map is monotonic).
 fn depth_to_w_range(depth_range: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(view_distance_from_depth(depth_range.x), view_distance_from_depth(depth_range.y));
+    return vec2<f32>(view_distance_from_depth(depth_range.y), view_distance_from_depth(depth_range.x));
 }
 
 // Does the view-space sphere (c, r) reach into the frustum (side planes and depth range)?

@@ -100,12 +100,12 @@ pub fn cleared(
     }
 }
 
-/// The scene depth attachment, cleared to the far plane and stored.
+/// The scene depth attachment, cleared to the background (`depth::CLEAR`) and stored.
 pub fn cleared_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
     wgpu::RenderPassDepthStencilAttachment {
         view,
         depth_ops: Some(wgpu::Operations {
-            load: wgpu::LoadOp::Clear(1.0),
+            load: wgpu::LoadOp::Clear(crate::depth::CLEAR),
             store: wgpu::StoreOp::Store,
         }),
         stencil_ops: None,

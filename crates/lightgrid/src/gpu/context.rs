@@ -175,6 +175,8 @@ impl GpuContext {
         // Sample counts beyond WebGPU's 1 and 4 (and MSAA of 32-bit float G-buffers) are
         // adapter-specific format features (`--msaa`, [`GpuContext::sample_counts`]).
         features |= adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+        // A float depth copy for the light-volume passes (`passes::volume_depth_format`).
+        features |= adapter.features() & wgpu::Features::DEPTH32FLOAT_STENCIL8;
         // Subgroup operations for the depth reduction (tiled-shading §8), where there are any.
         let subgroups = adapter.features().contains(wgpu::Features::SUBGROUP);
         features |= adapter.features() & wgpu::Features::SUBGROUP;

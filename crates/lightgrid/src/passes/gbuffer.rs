@@ -133,7 +133,7 @@ impl GBuffer {
                 layouts: &[Some(scene_layout)],
                 color_targets: &targets,
                 depth_write: true,
-                depth_compare: wgpu::CompareFunction::Less,
+                depth_compare: crate::depth::SURFACE,
                 samples,
             },
         );

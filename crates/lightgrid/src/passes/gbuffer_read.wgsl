@@ -12,7 +12,7 @@
 // The surface stored at pixel `p`, its material's shader applied (the branch of deferred
 // shading on the stored material); the light-independent term travels as `emissive`.
 fn surface_from_gbuffer(p: vec2<u32>, depth: f32) -> Surface {
-    return apply_material(raw_surface_from_gbuffer(p, 0u, world_from_depth(p, depth)));
+    return apply_material(raw_surface_from_gbuffer(p, 0u, position_from_depth(p, depth)));
 }
 
 // Sample `s` of pixel `p` as stored, at world position `position`.

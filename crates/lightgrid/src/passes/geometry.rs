@@ -72,7 +72,7 @@ impl OwnedDesc {
             layouts: &layouts,
             color_targets: &silent,
             depth_write: true,
-            depth_compare: wgpu::CompareFunction::Less,
+            depth_compare: crate::depth::SURFACE,
             samples: self.samples,
         };
         AlphaTested {
@@ -83,7 +83,7 @@ impl OwnedDesc {
                     fragment_entry: Some(&self.fragment_entry),
                     color_targets: &self.color_targets,
                     depth_write: false,
-                    depth_compare: wgpu::CompareFunction::LessEqual,
+                    depth_compare: crate::depth::SURFACE,
                     ..base
                 },
                 crate::consts::MATERIAL_SHADER_ANY,

@@ -10,7 +10,7 @@ struct VertexIn {
 
 struct VertexOut {
     @builtin(position) @invariant clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
+    @location(0) position: vec3<f32>,  // camera-relative
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) @interpolate(flat) material: u32,
@@ -19,8 +19,11 @@ struct VertexOut {
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
     var out: VertexOut;
-    out.clip = frame.view_proj * vec4<f32>(v.position, 1.0);
-    out.world = v.position;
+    // Camera-relative (scene_bindings.wgsl): the difference of two nearby f32 world
+    // positions is exact, so a scene far from the origin keeps its precision from here on.
+    let p = v.position - frame.eye;
+    out.clip = frame.view_proj * vec4<f32>(p, 1.0);
+    out.position = p;
     out.normal = v.normal;
     out.uv = v.uv;
     out.material = v.material;
@@ -65,7 +68,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     let base = base_colour(m, v.uv);
     alpha_test(m, m.alpha * base.a);
     var s: Surface;
-    s.position = v.world;
+    s.position = v.position;
     // Two-sided: flip the normal on back faces so thin geometry is lit from both sides.
     s.normal = normalize(select(-v.normal, v.normal, front_facing));
     s.diffuse = m.diffuse * base.rgb;

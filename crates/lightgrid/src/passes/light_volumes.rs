@@ -51,9 +51,25 @@ fn cone_volume_extent(l: &Light, center: Vec3) -> f32 {
     apex.distance(center).max(ring) * 1.01
 }
 
-pub const VOLUME_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
-/// Bytes per pixel of [`VOLUME_DEPTH_FORMAT`] (24-bit depth + 8-bit stencil).
-pub const VOLUME_DEPTH_BYTES: u32 = 4;
+/// The volume passes' depth-stencil format: a float depth copy of the scene depth, so the
+/// volume tests keep reversed-Z's precision (`crate::depth`): with a 24-bit unorm copy a
+/// znear of 10⁻⁶ leaves everything beyond ~10 units within a few steps of 0. Adapters
+/// without `DEPTH32FLOAT_STENCIL8` (rare: every Vulkan, Metal and DX12 GPU in wgpu's tests
+/// has it, as has lavapipe) fall back to `Depth24PlusStencil8`.
+pub fn volume_depth_format(device: &wgpu::Device) -> wgpu::TextureFormat {
+    if device
+        .features()
+        .contains(wgpu::Features::DEPTH32FLOAT_STENCIL8)
+    {
+        wgpu::TextureFormat::Depth32FloatStencil8
+    } else {
+        wgpu::TextureFormat::Depth24PlusStencil8
+    }
+}
+
+/// Bytes per pixel of the volume depth-stencil target in the memory model: 32-bit float
+/// depth + 8-bit stencil ([`volume_depth_format`]).
+pub const VOLUME_DEPTH_BYTES: u32 = 5;
 pub const VOLUME_WGSL: &str = include_str!("light_volume.wgsl");
 
 const RINGS: u32 = 8;
@@ -199,6 +215,8 @@ pub struct LightVolumes {
     ranges: [Range<u32>; 4],
     cones_from: [u32; 4],
     pub depth: wgpu::TextureView,
+    /// [`volume_depth_format`] on this device.
+    pub depth_format: wgpu::TextureFormat,
     copy_layout: wgpu::BindGroupLayout,
 }
 
@@ -240,10 +258,11 @@ impl LightVolumes {
             usage: wgpu::BufferUsages::INDEX,
         });
         let sphere_count = sphere.indices.len() as u32;
+        let depth_format = volume_depth_format(device);
         let depth = super::render_texture(
             device,
             "light volume depth-stencil",
-            VOLUME_DEPTH_FORMAT,
+            depth_format,
             (width, height),
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
@@ -271,6 +290,7 @@ impl LightVolumes {
             ranges: Default::default(),
             cones_from: [0; 4],
             depth,
+            depth_format,
             copy_layout,
         }
     }
@@ -305,11 +325,17 @@ impl LightVolumes {
     /// A pipeline for one kind of volume draw (see [`VolumeDraw`]).
     pub fn pipeline(&self, device: &wgpu::Device, d: &VolumePipelineDesc) -> wgpu::RenderPipeline {
         use wgpu::{CompareFunction as C, Face, StencilFaceState, StencilOperation as Op};
+        // Reversed-Z (`crate::depth`): a front face in front of the scene surface, a back
+        // face behind it.
         let (cull, compare, vertex_entry) = match d.draw {
-            VolumeDraw::Front => (Some(Face::Back), C::LessEqual, "vs_volume"),
-            VolumeDraw::Back => (Some(Face::Front), C::GreaterEqual, "vs_volume"),
+            VolumeDraw::Front => (Some(Face::Back), crate::depth::NEARER_OR_EQUAL, "vs_volume"),
+            VolumeDraw::Back => (
+                Some(Face::Front),
+                crate::depth::FARTHER_OR_EQUAL,
+                "vs_volume",
+            ),
             VolumeDraw::Full => (None, C::Always, "vs_volume_fullscreen"),
-            VolumeDraw::StencilMark => (None, C::LessEqual, "vs_volume"),
+            VolumeDraw::StencilMark => (None, crate::depth::NEARER_OR_EQUAL, "vs_volume"),
             VolumeDraw::StencilLight => (Some(Face::Front), C::Always, "vs_volume"),
         };
         let stencil = match d.draw {
@@ -390,7 +416,7 @@ impl LightVolumes {
                 ..Default::default()
             },
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: VOLUME_DEPTH_FORMAT,
+                format: self.depth_format,
                 depth_write_enabled: Some(false),
                 depth_compare: Some(compare),
                 stencil,
@@ -443,7 +469,7 @@ impl LightVolumes {
             },
             primitive: Default::default(),
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: VOLUME_DEPTH_FORMAT,
+                format: self.depth_format,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::Always),
                 stencil: Default::default(),
@@ -496,7 +522,7 @@ impl LightVolumes {
         wgpu::RenderPassDepthStencilAttachment {
             view: &self.depth,
             depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
+                load: wgpu::LoadOp::Clear(crate::depth::CLEAR),
                 store: wgpu::StoreOp::Discard,
             }),
             stencil_ops: Some(wgpu::Operations {

@@ -20,8 +20,7 @@ use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::VOLUME_DEPTH_BYTES;
 use crate::passes::{
-    additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_DEPTH_FORMAT,
-    VOLUME_WGSL,
+    additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_WGSL,
 };
 use crate::passes::{GBuffer, GBufferLayout, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT};
 use crate::shader::{compose, create_module, src, ComposedShader};
@@ -131,7 +130,7 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
             },
             primitive: Default::default(),
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: VOLUME_DEPTH_FORMAT,
+                format: volumes.depth_format,
                 depth_write_enabled: Some(false),
                 depth_compare: Some(wgpu::CompareFunction::Always),
                 stencil: Default::default(),

@@ -6,7 +6,7 @@
 fn fs_light(v: VolumeOut) -> LitOut {
     let p = vec2<u32>(v.clip.xy);
     let depth = textureLoad(gb_depth, p, 0);
-    if (depth >= 1.0) {
+    if (is_background(depth)) {
         discard;
     }
     let s = surface_from_gbuffer(p, depth);
@@ -19,7 +19,7 @@ fn fs_base(@builtin(position) pos: vec4<f32>) -> LitOut {
     let p = vec2<u32>(pos.xy);
     let depth = textureLoad(gb_depth, p, 0);
     var color = vec3<f32>(0.0);
-    if (depth < 1.0) {
+    if (!is_background(depth)) {
         color = textureLoad(gb_base, p, 0).rgb;
     }
     return lit(pos, color, 0u);

@@ -47,7 +47,7 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
             layouts: &[Some(ctx.scene_layout)],
             color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
             depth_write: true,
-            depth_compare: wgpu::CompareFunction::Less,
+            depth_compare: crate::depth::SURFACE,
             samples: ctx.settings.msaa,
         },
         ctx.settings.material_draws,

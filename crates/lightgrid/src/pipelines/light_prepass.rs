@@ -228,7 +228,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             layouts: &[Some(ctx.scene_layout)],
             color_targets: &[Some(TARGET_FORMAT.into())],
             depth_write: true,
-            depth_compare: wgpu::CompareFunction::Less,
+            depth_compare: crate::depth::SURFACE,
             samples: 1,
         },
     );
@@ -259,7 +259,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             layouts: &[Some(ctx.scene_layout), Some(&irr_layout)],
             color_targets: &[Some(HDR_FORMAT.into())],
             depth_write: false,
-            depth_compare: wgpu::CompareFunction::LessEqual,
+            depth_compare: crate::depth::SURFACE,
             samples: 1,
         },
     );

@@ -20,7 +20,7 @@ struct IrradianceOut {
 fn irradiance_terms(v: VolumeOut, out_terms: ptr<function, LightTerms>) -> bool {
     let p = vec2<u32>(v.clip.xy);
     let depth = textureLoad(attr_depth, p, 0);
-    if (depth >= 1.0) {
+    if (is_background(depth)) {
         return false;
     }
     let s = attributes_surface(p, depth);

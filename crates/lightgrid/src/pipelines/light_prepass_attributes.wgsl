@@ -9,7 +9,7 @@
 fn attributes_surface(p: vec2<u32>, depth: f32) -> Surface {
     let a = textureLoad(attr_normal_shininess, p, 0);
     var s: Surface;
-    s.position = world_from_depth(p, depth);
+    s.position = position_from_depth(p, depth);
     s.normal = normalize(a.xyz);
     s.shininess = a.w;
     return s;

@@ -9,7 +9,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let p = gid.xy;
     let depth = textureLoad(gb_depth, p, 0);
-    if (depth >= 1.0) {
+    if (is_background(depth)) {
         write_sample(p, vec3<f32>(0.0), 0u);
         return;
     }

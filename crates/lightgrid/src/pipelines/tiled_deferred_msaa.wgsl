@@ -68,7 +68,7 @@ fn store_sample(pixel: u32, s: u32, color: vec3<f32>) {
 // Sample `s` of pixel `p` at framebuffer position `xy` and depth-buffer value `depth`: shaded
 // from its cell's lights, counted into the pixel.
 fn shade_at(p: vec2<u32>, s: u32, xy: vec2<f32>, depth: f32) -> vec3<f32> {
-    let surface = apply_material(raw_surface_from_gbuffer(p, s, world_from_screen(xy, depth)));
+    let surface = apply_material(raw_surface_from_gbuffer(p, s, position_from_screen(xy, depth)));
     let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
     count_pixel(p, grid_cell_count(cell));
     return surface_base(surface) + grid_shade(surface, view_dir_to(surface.position), cell);
@@ -82,10 +82,10 @@ fn shade_at(p: vec2<u32>, s: u32, xy: vec2<f32>, depth: f32) -> vec3<f32> {
 // depth-ratio test marked 90% of the pixels).
 fn differs(p: vec2<u32>, s: u32, d0: f32, n0: vec4<f32>) -> bool {
     let d = textureLoad(gb_depth, p, s);
-    if ((d < 1.0) != (d0 < 1.0)) {
+    if (is_background(d) != is_background(d0)) {
         return true;
     }
-    if (d0 >= 1.0) {
+    if (is_background(d0)) {
         return false;
     }
     let n = textureLoad(gb_normal, p, s);
@@ -93,8 +93,8 @@ fn differs(p: vec2<u32>, s: u32, d0: f32, n0: vec4<f32>) -> bool {
     if (u32(n.w + 0.5) != u32(n0.w + 0.5) || dot(normalize(n.xyz), normal0) < EDGE_NORMAL_COS) {
         return true;
     }
-    let p0 = world_from_screen(vec2<f32>(p) + sample_position(0u), d0);
-    let offset = world_from_screen(vec2<f32>(p) + sample_position(s), d) - p0;
+    let p0 = position_from_screen(vec2<f32>(p) + sample_position(0u), d0);
+    let offset = position_from_screen(vec2<f32>(p) + sample_position(s), d) - p0;
     return abs(dot(normal0, offset)) > EDGE_PLANE_SIN * length(offset);
 }
 
@@ -124,12 +124,12 @@ fn main(
         var depth_sum = 0.0;
         for (var s = 0u; s < SAMPLES; s = s + 1u) {
             let d = textureLoad(gb_depth, p, s);
-            geometry += select(0u, 1u, d < 1.0);
+            geometry += select(1u, 0u, is_background(d));
             depth_sum += d;
             edge = edge || (s > 0u && differs(p, s, d0, n0));
         }
         var c0 = vec3<f32>(0.0);
-        if (d0 < 1.0) {
+        if (!is_background(d0)) {
             if (edge) {
                 c0 = shade_at(p, 0u, vec2<f32>(p) + sample_position(0u), d0);
             } else {
@@ -151,7 +151,7 @@ fn main(
                 if (!RESOLVE_IN_KERNEL) {
                     store_sample(pixel, s, c0);
                 }
-            } else if (textureLoad(gb_depth, p, s) < 1.0) {
+            } else if (!is_background(textureLoad(gb_depth, p, s))) {
                 queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
             } else {
                 output_sample(p, li, s, vec3<f32>(0.0), weight);

@@ -33,11 +33,11 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
 
     // 3. This invocation's sample.
     let inside = local.x < tile.tile_size && local.y < tile.tile_size && p.x < screen.x && p.y < screen.y;
-    var depth = 1.0;
+    var depth = 0.0;
     if (inside) {
         depth = textureLoad(gb_depth, p, 0);
     }
-    let shaded = inside && depth < 1.0;
+    let shaded = inside && !is_background(depth);
     var s: Surface;
     var view_dir = vec3<f32>(0.0);
     if (shaded) {

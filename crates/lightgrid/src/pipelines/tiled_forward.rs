@@ -67,11 +67,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             layouts: &[Some(ctx.scene_layout), Some(builder.layout())],
             color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
             depth_write: !prepass,
-            depth_compare: if prepass {
-                wgpu::CompareFunction::LessEqual
-            } else {
-                wgpu::CompareFunction::Less
-            },
+            depth_compare: crate::depth::SURFACE,
             samples: ctx.settings.msaa,
         },
         ctx.settings.material_draws,
@@ -86,7 +82,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
                 layouts: &[Some(ctx.scene_layout)],
                 color_targets: &[],
                 depth_write: true,
-                depth_compare: wgpu::CompareFunction::Less,
+                depth_compare: crate::depth::SURFACE,
                 samples: ctx.settings.msaa,
             },
         )

@@ -96,7 +96,7 @@ impl TransparentPass {
                     layouts,
                     color_targets: &targets,
                     depth_write: false,
-                    depth_compare: wgpu::CompareFunction::Less,
+                    depth_compare: crate::depth::NEARER,
                     samples: ctx.settings.msaa,
                 },
                 ctx.settings.material_draws,

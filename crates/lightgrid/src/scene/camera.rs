@@ -1,7 +1,7 @@
 //! Perspective camera and the camera path of an animation.
 //!
-//! Conventions: right-handed world, y up; view space looks down -z; clip depth is WebGPU's
-//! [0, 1] (near maps to 0).
+//! Conventions: right-handed world, y up; view space looks down -z; clip depth is reversed-Z
+//! in WebGPU's [0, 1] (near maps to 1, far to 0: `crate::depth`).
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -17,7 +17,15 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// World space to view space (for files: the glTF export's camera node).
     pub fn view(&self) -> Mat4 {
+        self.rotation() * Mat4::from_translation(-self.eye)
+    }
+
+    /// Camera-relative space to view space: [`Self::view`] without the translation. The
+    /// renderer draws and shades in camera-relative space (world positions minus the eye),
+    /// so a scene far from the origin loses no precision to a large translation in f32.
+    pub fn rotation(&self) -> Mat4 {
         let f = (self.target - self.eye).normalize();
         let s = f.cross(self.up).normalize();
         let u = s.cross(f);
@@ -25,20 +33,22 @@ impl Camera {
             Vec4::new(s.x, u.x, -f.x, 0.0),
             Vec4::new(s.y, u.y, -f.y, 0.0),
             Vec4::new(s.z, u.z, -f.z, 0.0),
-            Vec4::new(-s.dot(self.eye), -u.dot(self.eye), f.dot(self.eye), 1.0),
+            Vec4::W,
         )
     }
 
-    /// Right-handed perspective with depth 0 at `near` and 1 at `far`.
+    /// Right-handed reversed-Z perspective: depth 1 at `near` and 0 at `far`
+    /// (`depth = A / w - B`, `crate::depth`).
     pub fn proj(&self, aspect: f32) -> Mat4 {
         let h = 1.0 / (self.fov_y * 0.5).tan();
         let w = h / aspect;
-        let r = self.far / (self.near - self.far);
+        let (a, b) = crate::depth::coefficients(self.near, self.far);
+        // clip.z = b z + a, clip.w = -z: depth = a / w - b for w = -z.
         Mat4::from_cols(
             Vec4::new(w, 0.0, 0.0, 0.0),
             Vec4::new(0.0, h, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, r, -1.0),
-            Vec4::new(0.0, 0.0, r * self.near, 0.0),
+            Vec4::new(0.0, 0.0, b, -1.0),
+            Vec4::new(0.0, 0.0, a, 0.0),
         )
     }
 }

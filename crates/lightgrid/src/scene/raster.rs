@@ -21,7 +21,7 @@ pub struct Fragment {
 pub fn rasterize(setup: &ViewSetup, triangles: &[[Vec3; 3]], opaque_w: &[f32]) -> Vec<Fragment> {
     let mut out = Vec::new();
     for t in triangles {
-        let view = t.map(|p| setup.view.transform_point3(p));
+        let view = t.map(|p| setup.view_point(p));
         let clipped = clip_near(&view, setup.near);
         for i in 1..clipped.len().saturating_sub(1) {
             raster_triangle(

@@ -2,6 +2,10 @@
 //! near/far, frame size; and the conversions between pixels, depth and view space.
 //!
 //! View space is right-handed with the camera looking down -z; "view distance" `w = -z`.
+//! The GPU works in camera-relative space (world minus the eye, world-aligned): `view` maps
+//! it to view space and carries no translation, and [`ViewSetup::relative`] takes a world
+//! point there the way the renderer's upload and vertex stage do, so the CPU twins see the
+//! same numbers as the kernels however far from the origin the scene lies.
 
 use super::{Camera, Light};
 use crate::consts::CONE_SLACK;
@@ -21,7 +25,10 @@ pub enum SpotCull {
 
 #[derive(Clone, Copy, Debug)]
 pub struct ViewSetup {
+    /// Camera-relative space to view space: a rotation (`Camera::rotation`).
     pub view: Mat4,
+    /// The camera's world position: camera-relative space's origin.
+    pub eye: Vec3,
     /// proj[0][0] and proj[1][1]: x_ndc = p00 * x / w, y_ndc = p11 * y / w.
     pub p00: f32,
     pub p11: f32,
@@ -140,7 +147,8 @@ impl ViewSetup {
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
         let proj = camera.proj(width as f32 / height as f32);
         ViewSetup {
-            view: camera.view(),
+            view: camera.rotation(),
+            eye: camera.eye,
             p00: proj.x_axis.x,
             p11: proj.y_axis.y,
             near: camera.near,
@@ -151,12 +159,28 @@ impl ViewSetup {
         }
     }
 
+    /// A world point in camera-relative space, computed as the GPU computes it (an f32
+    /// difference, exact for points near the eye however large their coordinates).
+    pub fn relative(&self, world: Vec3) -> Vec3 {
+        world - self.eye
+    }
+
+    /// A world point in view space.
+    pub fn view_point(&self, world: Vec3) -> Vec3 {
+        self.view.transform_point3(self.relative(world))
+    }
+
+    /// A view-space point in the world ([`Self::view_point`]'s inverse).
+    pub fn world_point(&self, view: Vec3) -> Vec3 {
+        self.view.transpose().transform_point3(view) + self.eye
+    }
+
     pub fn to_view(&self, l: &Light) -> ViewLight {
         let (center, radius) = l.bounding_sphere();
         ViewLight {
-            center: self.view.transform_point3(center),
+            center: self.view_point(center),
             radius,
-            apex: self.view.transform_point3(l.position),
+            apex: self.view_point(l.position),
             range: l.range,
             cone: l.spot.map(|s| {
                 let axis = self
@@ -198,24 +222,21 @@ impl ViewSetup {
         (center, radius)
     }
 
-    /// The view distance of every sample of a depth buffer ([0, 1], 1 = no geometry: infinite).
+    /// The view distance of every sample of a depth buffer (reversed-Z, `crate::depth`;
+    /// infinite where it holds no geometry).
     pub fn view_distances(&self, depth: &[f32]) -> Vec<f32> {
-        depth
-            .iter()
-            .map(|&d| {
-                if d < 1.0 {
-                    self.view_distance(d)
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect()
+        depth.iter().map(|&d| self.view_distance(d)).collect()
     }
 
-    /// View distance of a [0, 1] depth-buffer value (inverse of the projection's depth).
-    pub fn view_distance(&self, ndc_depth: f32) -> f32 {
-        let r = self.far / (self.near - self.far);
-        r * self.near / (ndc_depth + r)
+    /// View distance of a depth-buffer value (the projection's inverse; infinite for the
+    /// background).
+    pub fn view_distance(&self, depth: f32) -> f32 {
+        crate::depth::view_distance(depth, self.near, self.far)
+    }
+
+    /// The depth-buffer value the projection gives view distance `w`.
+    pub fn depth_of(&self, w: f32) -> f32 {
+        crate::depth::depth_of(w, self.near, self.far)
     }
 
     /// View-space position of the sample at the centre of pixel (x, y) at view distance `w`.

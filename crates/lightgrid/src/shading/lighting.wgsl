@@ -4,8 +4,8 @@
 // A shading sample: everything the light function needs, wherever it came from
 // (interpolated vertex data or a G-buffer).
 struct Surface {
-    position: vec3<f32>,   // world space
-    normal: vec3<f32>,     // world space, unit length
+    position: vec3<f32>,   // camera-relative (world minus the eye; scene_bindings.wgsl)
+    normal: vec3<f32>,     // world orientation, unit length
     diffuse: vec3<f32>,
     alpha: f32,
     specular: vec3<f32>,

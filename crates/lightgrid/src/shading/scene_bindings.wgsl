@@ -35,27 +35,38 @@ fn check_loop(stopped: u32, bound: u32) {
     }
 }
 
-// Unit vector from a world-space point to the eye.
-fn view_dir_to(world: vec3<f32>) -> vec3<f32> {
-    return normalize(frame.camera_pos - world);
+// Unit vector from a point (camera-relative, as every position on the GPU) to the eye.
+fn view_dir_to(position: vec3<f32>) -> vec3<f32> {
+    return normalize(-position);
 }
 
-// World position of the sample at the centre of pixel `p` with depth-buffer value `depth`.
-fn world_from_depth(p: vec2<u32>, depth: f32) -> vec3<f32> {
-    return world_from_screen(vec2<f32>(p) + vec2<f32>(0.5), depth);
+// Does a depth-buffer value hold no geometry? Reversed-Z (depth.rs): 1 at the near plane,
+// 0 at the far plane and for the cleared background.
+fn is_background(depth: f32) -> bool {
+    return depth <= 0.0;
 }
 
-// World position of the sample at framebuffer position `xy` (pixels, y down) with
-// depth-buffer value `depth`.
-fn world_from_screen(xy: vec2<f32>, depth: f32) -> vec3<f32> {
+// Camera-relative position of the sample at the centre of pixel `p` with depth-buffer value
+// `depth`.
+fn position_from_depth(p: vec2<u32>, depth: f32) -> vec3<f32> {
+    return position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), depth);
+}
+
+// Camera-relative position of the sample at framebuffer position `xy` (pixels, y down) with
+// depth-buffer value `depth`: its view distance from the projection's inverse, then back
+// from view space by the inverse rotation. No 4x4 inverse of a projection is involved, so
+// a tiny near plane costs no precision.
+fn position_from_screen(xy: vec2<f32>, depth: f32) -> vec3<f32> {
     let uv = xy / frame.viewport;
-    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
-    let h = frame.inv_view_proj * ndc;
-    return h.xyz / h.w;
+    let w = view_distance_from_depth(depth);
+    let v = vec3<f32>((uv.x * 2.0 - 1.0) * w / frame.proj[0][0], (1.0 - uv.y * 2.0) * w / frame.proj[1][1], -w);
+    return (frame.inv_view * vec4<f32>(v, 0.0)).xyz;
 }
 
-// View distance (-z in view space) of a depth-buffer value (the projection's inverse).
+// View distance (-z in view space) of a depth-buffer value: the inverse of the reversed-Z
+// projection's depth = A / w - B, whose coefficients are the projection's z row
+// (proj[3][2] = A, proj[2][2] = B; depth.rs computes them in f64). The background (0) maps
+// to the far plane.
 fn view_distance_from_depth(depth: f32) -> f32 {
-    let r = frame.far / (frame.near - frame.far);
-    return r * frame.near / (depth + r);
+    return frame.proj[3][2] / (depth + frame.proj[2][2]);
 }

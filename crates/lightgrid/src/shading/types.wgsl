@@ -33,8 +33,8 @@ struct FrameUniforms {
     view: mat4x4<f32>,
     proj: mat4x4<f32>,
     view_proj: mat4x4<f32>,
-    inv_view_proj: mat4x4<f32>,
-    camera_pos: vec3<f32>,
+    inv_view: mat4x4<f32>,   // view space -> camera-relative space (a rotation)
+    eye: vec3<f32>,          // the camera's world position (camera-relative space's origin)
     light_count: u32,
     viewport: vec2<f32>,
     near: f32,

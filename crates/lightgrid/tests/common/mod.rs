@@ -242,7 +242,7 @@ pub fn random_spot(rng: &mut Rng, position: Vec3, eye: Vec3) -> Option<Spot> {
 /// camera, crossing the near plane, behind the camera reaching forward, centred just outside a
 /// screen edge, and scattered through the frustum (one of each in turn, the last twice).
 pub fn edge_case_lights(rng: &mut Rng, camera: &Camera, setup: &ViewSetup, n: usize) -> Vec<Light> {
-    let world = setup.view.inverse();
+    let world = |v: Vec3| setup.world_point(v);
     let mut lights = Vec::with_capacity(n);
     for k in 0..n {
         let r = rng.range(0.3, 10.0);
@@ -278,7 +278,7 @@ pub fn edge_case_lights(rng: &mut Rng, camera: &Camera, setup: &ViewSetup, n: us
                 )
             }
         };
-        let position = world.transform_point3(v);
+        let position = world(v);
         lights.push(Light {
             position,
             color: Vec3::new(rng.unit(), rng.unit(), rng.unit()),
