@@ -26,7 +26,7 @@ use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::base_textures::BaseTextures;
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
-use crate::scene::{Draw, FrameState, Geometry, Scene, SpotCull};
+use crate::scene::{Draw, FrameState, Geometry, Light, Scene, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::time::Instant;
 
@@ -441,8 +441,9 @@ impl<'c> Renderer<'c> {
         let device = &ctx.device;
         // Lights and geometry are drawn and shaded camera-relative (`ViewSetup::relative`).
         let eye = state.camera.eye;
-        let gpu_lights: Vec<GpuLight> = state.lights.iter().map(|l| l.to_gpu(eye)).collect();
-        let bounds: Vec<[f32; 4]> = state.lights.iter().map(|l| l.bounds_gpu(eye)).collect();
+        let relative: Vec<_> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
+        let gpu_lights: Vec<GpuLight> = relative.iter().map(Light::to_gpu).collect();
+        let bounds: Vec<[f32; 4]> = relative.iter().map(Light::bounds_gpu).collect();
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
         let bb: &[u8] = bytemuck::cast_slice(&bounds);
         let grew_lights = self.lights.reserve(device, lb.len() as u64);

@@ -177,7 +177,37 @@ fn check_scene(scene: &str, frame: u32, size: (u32, u32), settings: RenderSettin
     check(&s, frame, size, settings);
 }
 
-fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: RenderSettings) {
+fn check(s: &lightgrid::scene::Scene, frame: u32, size: (u32, u32), settings: RenderSettings) {
+    let counts = check_images(s, frame, size, settings);
+    // Depth bounds can only remove work (tiled-shading Fig. 3).
+    assert!(counts["tiled_forward_prez"] <= counts["tiled_forward"]);
+    // Pre-Z forward shades each visible sample with the same grid as tiled deferred; only
+    // coplanar fragments passing the equal-depth test twice can add to it.
+    let (prez, deferred) = (counts["tiled_forward_prez"], counts["tiled_deferred"]);
+    assert!(
+        prez >= deferred && prez as f64 <= deferred as f64 * 1.01,
+        "prez {prez} vs deferred {deferred}"
+    );
+    // Clusters are tiles cut by depth slices (and clipped to the tiles' depth bounds): never
+    // more lights per sample than the depth-bounded tiles.
+    assert!(counts["clustered_forward"] <= counts["tiled_forward_prez"]);
+    assert!(counts["clustered_deferred"] <= counts["tiled_deferred"]);
+    // The stencil test culls per sample: never more work than the plain volumes.
+    assert!(counts["deferred_stencil"] <= counts["deferred"]);
+    // Deferred lighting runs the light function on the same volume fragments as deferred.
+    assert_eq!(counts["light_prepass"], counts["deferred"]);
+    assert_eq!(counts["light_prepass_mono"], counts["deferred"]);
+    assert_eq!(counts["deferred_mono"], counts["deferred"]);
+}
+
+/// Every pipeline's image against its reference within its tolerance, with the counts'
+/// relations to the ideal and the memory model; returns each pipeline's count.
+fn check_images(
+    s: &lightgrid::scene::Scene,
+    frame: u32,
+    (w, h): (u32, u32),
+    settings: RenderSettings,
+) -> std::collections::HashMap<&'static str, u64> {
     let ctx = common::gpu();
     let scene = &s.name;
     let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
@@ -255,25 +285,7 @@ fn check(s: &lightgrid::scene::Scene, frame: u32, (w, h): (u32, u32), settings: 
         );
         counts.insert(p.id, n);
     }
-    // Depth bounds can only remove work (tiled-shading Fig. 3).
-    assert!(counts["tiled_forward_prez"] <= counts["tiled_forward"]);
-    // Pre-Z forward shades each visible sample with the same grid as tiled deferred; only
-    // coplanar fragments passing the LessEqual test twice can add to it.
-    let (prez, deferred) = (counts["tiled_forward_prez"], counts["tiled_deferred"]);
-    assert!(
-        prez >= deferred && prez as f64 <= deferred as f64 * 1.01,
-        "prez {prez} vs deferred {deferred}"
-    );
-    // Clusters are tiles cut by depth slices (and clipped to the tiles' depth bounds): never
-    // more lights per sample than the depth-bounded tiles.
-    assert!(counts["clustered_forward"] <= counts["tiled_forward_prez"]);
-    assert!(counts["clustered_deferred"] <= counts["tiled_deferred"]);
-    // The stencil test culls per sample: never more work than the plain volumes.
-    assert!(counts["deferred_stencil"] <= counts["deferred"]);
-    // Deferred lighting runs the light function on the same volume fragments as deferred.
-    assert_eq!(counts["light_prepass"], counts["deferred"]);
-    assert_eq!(counts["light_prepass_mono"], counts["deferred"]);
-    assert_eq!(counts["deferred_mono"], counts["deferred"]);
+    counts
 }
 
 /// Transparency (tiled-shading §4, tiled-forward-shading §4.5): every pipeline draws the
@@ -1121,4 +1133,193 @@ fn every_pipeline_renders_textures_and_alpha_tests_like_forward() {
         8,
     );
     assert!(texels > 3000, "the textures change only {texels} pixels");
+}
+
+// Real content (issue 35): cameras from real files (a znear of 10⁻⁶, a zfar of 10⁶), scenes
+// far from the origin, coplanar surfaces and thin parallel fins. Standard-Z depth and
+// world-space reconstruction put pipelines up to 205 levels off `forward` on these; with
+// reversed-Z and camera-relative shading (`lightgrid::depth`) every pipeline stays within
+// the tolerances above.
+
+/// `s` with its camera's near and far planes replaced.
+fn with_planes(s: &Scene, near: f32, far: f32) -> Scene {
+    let mut s = s.clone();
+    s.camera_path.near = near;
+    s.camera_path.far = far;
+    s.name = format!("{}-near{near:e}-far{far:e}", s.name);
+    s
+}
+
+/// `s` moved by `d`: static objects, paths, world and circling lights, and the camera.
+fn moved(s: &Scene, d: glam::Vec3) -> Scene {
+    use lightgrid::scene::LightAnchor;
+    let mut s = s.clone();
+    let t = glam::Mat4::from_translation(d);
+    for o in s.objects.iter_mut().filter(|o| o.is_static()) {
+        o.local = t * o.local;
+    }
+    for q in s.paths.iter_mut().flat_map(|p| p.points.iter_mut()) {
+        *q += d;
+    }
+    for l in &mut s.lights {
+        if !matches!(l.anchor, LightAnchor::Object(_)) {
+            l.light.position += d;
+        }
+    }
+    for k in &mut s.camera_path.keys {
+        k.1 += d;
+        k.2 += d;
+    }
+    s.name = format!("{}-moved{:e}", s.name, d.length());
+    s
+}
+
+#[test]
+fn real_camera_planes_render_like_forward() {
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    for (near, far) in [(1e-6, 100.0), (1e-4, 1e4), (0.05, 1e6), (1e-6, 1e6)] {
+        check(&with_planes(&s, near, far), 200, (128, 72), settings(16));
+    }
+}
+
+#[test]
+fn scenes_far_from_the_origin_render_like_forward() {
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    for d in [1e5, 1e6] {
+        check(
+            &moved(&s, glam::Vec3::new(d, 0.0, -d)),
+            200,
+            (128, 72),
+            settings(16),
+        );
+    }
+}
+
+/// The grid of every strategy holds every light the oracle finds, and equals its CPU twin,
+/// for the hardest combination: a camera with znear 10⁻⁶ and zfar 10⁶ in a scene 10⁶ units
+/// from the origin.
+#[test]
+fn the_grid_holds_the_oracles_lights_for_a_tiny_near_plane_far_from_the_origin() {
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let s = with_planes(&moved(&s, glam::Vec3::new(-7e5, 3e5, 7e5)), 1e-6, 1e6);
+    check_strategies(
+        &s,
+        120,
+        (136, 77),
+        16,
+        32,
+        &[
+            "tiled_forward_prez",
+            "clustered_deferred",
+            "tiled_light_prepass",
+        ],
+    );
+}
+
+/// A ground drawn twice with the same vertices (an exact tie: different materials at equal
+/// depth), a smaller quad on the same plane with other vertices (near-ties), and thin
+/// parallel fins whose faces touch (2CylinderEngine's fins), under a camera with a small
+/// near plane and a huge far plane.
+fn coplanar_scene() -> Scene {
+    use glam::Vec3;
+    use lightgrid::scene::{
+        CameraPath, Light, LightAnchor, Material, Mesh, Motion, Object, SceneLight,
+    };
+    let mut meshes = vec![
+        Mesh::ground(-6.0, -6.0, 6.0, 6.0, 0.0),
+        Mesh::ground(-2.0, -1.0, 3.0, 4.0, 0.0),
+    ];
+    let mut fins = Mesh::default();
+    for i in 0..12 {
+        let x = -3.0 + i as f32 * 0.25;
+        // Each fin's +x face lies on the next fin's -x face.
+        fins.append(
+            &Mesh::block(
+                Vec3::new(x, 0.0, -4.0),
+                Vec3::new(x + 0.25, 1.0 + 0.1 * i as f32, -3.5),
+            ),
+            glam::Mat4::IDENTITY,
+        );
+    }
+    meshes.push(fins);
+    let object = |mesh, material| Object {
+        mesh,
+        material,
+        local: glam::Mat4::IDENTITY,
+        motion: Motion::Static,
+    };
+    let mut lights = Vec::new();
+    for i in 0..24 {
+        let a = i as f32 * 0.9;
+        let colour = Vec3::new(0.5 + 0.5 * a.sin(), 0.6, 0.5 + 0.5 * a.cos());
+        lights.push(SceneLight {
+            light: Light::point(
+                Vec3::new(
+                    a.cos() * (1.0 + 0.2 * i as f32),
+                    0.4 + 0.05 * i as f32,
+                    a.sin() * 3.0,
+                ),
+                colour,
+                2.0,
+                3.0 + 0.1 * i as f32,
+            ),
+            anchor: LightAnchor::World,
+        });
+    }
+    Scene {
+        name: "coplanar".into(),
+        meshes,
+        materials: vec![
+            Material::plain(Vec3::new(0.3, 0.6, 0.3), 0.2, 16.0),
+            Material::plain(Vec3::new(0.9, 0.2, 0.2), 0.2, 16.0),
+            Material::plain(Vec3::new(0.2, 0.3, 0.9), 0.5, 32.0),
+            Material::plain(Vec3::new(0.7, 0.7, 0.7), 0.8, 64.0),
+        ],
+        objects: vec![object(0, 0), object(0, 1), object(1, 2), object(2, 3)],
+        paths: Vec::new(),
+        lights,
+        textures: Vec::new(),
+        camera_path: CameraPath::fixed(
+            Vec3::new(0.5, 3.0, 7.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            60.0,
+            0.01,
+            1e6,
+        ),
+        default_size: (128, 72),
+    }
+}
+
+/// One surface per pixel: every pipeline, with or without a pre-pass, picks the same one of
+/// two coplanar surfaces as `forward`: the last drawn (`lightgrid::depth::SURFACE`).
+#[test]
+fn every_pipeline_picks_the_same_coplanar_surface_as_forward() {
+    let s = coplanar_scene();
+    let ctx = common::gpu();
+    let (w, h) = (128, 72);
+    let reference = Renderer::new(&ctx, w, h, settings(16))
+        .unwrap()
+        .render(&s, 0, REFERENCE)
+        .unwrap();
+    // The ground is drawn green, then red with the same vertices: the image is the one
+    // without the green ground (the last drawn wins), and not the one without the red.
+    let without = |object: usize| {
+        let mut t = s.clone();
+        t.objects.remove(object);
+        Renderer::new(&ctx, w, h, settings(16))
+            .unwrap()
+            .render(&t, 0, REFERENCE)
+            .unwrap()
+            .image
+    };
+    let (last, _) = diff(&reference.image, &without(0)).unwrap();
+    assert!(last.max <= 1.0, "the red ground drawn last shows: {last:?}");
+    let (first, _) = diff(&reference.image, &without(1)).unwrap();
+    assert!(
+        first.mean > 10.0,
+        "the green ground drawn first is hidden: {first:?}"
+    );
+    for (size, tile) in [((128, 72), 16), ((97, 61), 7)] {
+        check_images(&s, 0, size, settings(tile));
+    }
 }

@@ -100,7 +100,8 @@ pub fn classify_lights(setup: &ViewSetup, lights: &[Light], stencil: bool) -> Vo
         let v = setup.to_view(l);
         let w = -v.center.z;
         let r = if cone_volume(l) {
-            cone_volume_extent(l, l.bounding_sphere().0)
+            let l = l.relative_to(setup.eye);
+            cone_volume_extent(&l, l.bounding_sphere().0)
         } else {
             v.radius * ENCLOSING_SCALE
         };

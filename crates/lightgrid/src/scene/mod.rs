@@ -217,15 +217,24 @@ impl Light {
         view::reaches(p - self.position, self.range, cone)
     }
 
-    /// The light as the GPU reads it, placed in camera-relative space (`eye` its origin:
-    /// `ViewSetup::relative`).
-    pub fn to_gpu(&self, eye: Vec3) -> GpuLight {
+    /// The same light with `origin` moved to the origin: in camera-relative space for the
+    /// eye (`ViewSetup::relative`). Everything derived from it (the bounding sphere of a
+    /// spot) is then computed near the origin, where f32 is precise.
+    pub fn relative_to(&self, origin: Vec3) -> Light {
+        Light {
+            position: self.position - origin,
+            ..*self
+        }
+    }
+
+    /// The light as the GPU reads it (in camera-relative space: [`Self::relative_to`]).
+    pub fn to_gpu(&self) -> GpuLight {
         let (direction, cos_outer, cos_inner) = match self.spot {
             None => (Vec3::ZERO, POINT_LIGHT_COS, POINT_LIGHT_COS),
             Some(s) => (s.direction, s.cos_outer, s.cos_inner),
         };
         GpuLight {
-            position: (self.position - eye).to_array(),
+            position: self.position.to_array(),
             range: self.range,
             radiance: (self.color * self.intensity).to_array(),
             cos_inner,
@@ -234,11 +243,9 @@ impl Light {
         }
     }
 
-    /// The bounding sphere as the GPU's `light_bounds` entry: centre (camera-relative, as
-    /// [`Self::to_gpu`]) and radius.
-    pub fn bounds_gpu(&self, eye: Vec3) -> [f32; 4] {
+    /// The bounding sphere as the GPU's `light_bounds` entry: centre and radius.
+    pub fn bounds_gpu(&self) -> [f32; 4] {
         let (c, r) = self.bounding_sphere();
-        let c = c - eye;
         [c.x, c.y, c.z, r]
     }
 

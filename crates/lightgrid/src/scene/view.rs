@@ -175,12 +175,15 @@ impl ViewSetup {
         self.view.transpose().transform_point3(view) + self.eye
     }
 
+    /// A light in view space, its bounding sphere computed camera-relative as the GPU's
+    /// (`Light::relative_to`).
     pub fn to_view(&self, l: &Light) -> ViewLight {
+        let l = &l.relative_to(self.eye);
         let (center, radius) = l.bounding_sphere();
         ViewLight {
-            center: self.view_point(center),
+            center: self.view.transform_point3(center),
             radius,
-            apex: self.view_point(l.position),
+            apex: self.view.transform_point3(l.position),
             range: l.range,
             cone: l.spot.map(|s| {
                 let axis = self
