@@ -54,6 +54,34 @@ pub fn view_distance(depth: f32, near: f32, far: f32) -> f32 {
     a / (depth + b)
 }
 
+/// The smallest `near / far` a camera may have: below it `B` (the depth just before the far
+/// plane) nears f32's smallest normal number, which GPUs flush to zero, and a surface there
+/// would read as the background. Real files stop far above it (10⁻¹² for znear 10⁻⁶ and
+/// zfar 10⁶).
+pub const MIN_NEAR_FAR_RATIO: f32 = 1e-30;
+
+/// Can the depth buffer hold a camera with these planes? `0 < near < far`, both finite, and
+/// `near / far` at least [`MIN_NEAR_FAR_RATIO`]: otherwise the frame is refused, never
+/// rendered with depths that lost the surfaces.
+pub fn check_planes(near: f32, far: f32) -> crate::Result<()> {
+    if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
+        return Err(crate::Error::invalid(
+            "camera",
+            format!("needs finite planes with 0 < near < far; near {near}, far {far}"),
+        ));
+    }
+    if near / far < MIN_NEAR_FAR_RATIO {
+        return Err(crate::Error::invalid(
+            "camera",
+            format!(
+                "near {near} / far {far} is below {MIN_NEAR_FAR_RATIO:e}: the depth buffer \
+                 cannot tell surfaces near the far plane from the background"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// `(A, B)` of `depth = A / w - B`, computed in f64 so a tiny near plane loses nothing.
 pub fn coefficients(near: f32, far: f32) -> (f32, f32) {
     let (n, f) = (f64::from(near), f64::from(far));
@@ -80,6 +108,23 @@ mod tests {
             }
         }
         assert_eq!(view_distance(CLEAR, 0.1, 100.0), f32::INFINITY);
+    }
+
+    #[test]
+    fn cameras_the_depth_buffer_cannot_hold_are_refused() {
+        assert!(check_planes(1e-6, 1e6).is_ok());
+        assert!(check_planes(1e-20, 1e9).is_ok());
+        for (near, far) in [
+            (0.0, 1.0),
+            (-1.0, 1.0),
+            (1.0, 1.0),
+            (2.0, 1.0),
+            (f32::NAN, 1.0),
+            (0.1, f32::INFINITY),
+            (1e-30, 1e6),
+        ] {
+            assert!(check_planes(near, far).is_err(), "near {near} far {far}");
+        }
     }
 
     #[test]

@@ -354,6 +354,7 @@ impl<'c> Renderer<'c> {
     fn validated_frame(scene: &Scene, frame: u32) -> Result<FrameState> {
         scene.check_frame(frame)?;
         let state = scene.frame(frame);
+        crate::depth::check_planes(state.camera.near, state.camera.far)?;
         if state.lights.len() > MAX_LIGHTS as usize {
             return Err(Error::invalid(
                 "lights",
