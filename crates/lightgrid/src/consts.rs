@@ -36,6 +36,11 @@ pub const TILE_LIGHT_BATCH: u32 = 1024;
 /// round-off can never drop a light that reaches a sample.
 pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 
+/// The narrowest slicing range a clustered grid takes (`hi / lo`, `culling/depth_range.rs`):
+/// a frame whose samples all lie at one view distance (a wall facing the camera) still gets
+/// slices of a finite scale.
+pub const SLICING_MIN_RATIO: f32 = 1.01;
+
 /// Relative and absolute widening of a cell's bounding sphere in the spot-cone test (CPU and
 /// GPU), so f32 round-off can never drop a spot that reaches a sample.
 pub const CONE_SLACK: f32 = 1e-3;
@@ -235,6 +240,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
+    ("SLICING_MIN_RATIO", WgslConst::F32(SLICING_MIN_RATIO)),
     ("CONE_SLACK", WgslConst::F32(CONE_SLACK)),
     ("CONE_VOLUME_MIN_COS", WgslConst::F32(CONE_VOLUME_MIN_COS)),
     ("CONE_VOLUME_SEGMENTS", WgslConst::U32(CONE_VOLUME_SEGMENTS)),

@@ -1323,3 +1323,51 @@ fn every_pipeline_picks_the_same_coplanar_surface_as_forward() {
         check_images(&s, 0, size, settings(tile));
     }
 }
+
+/// Clusters' depth slices follow the samples (`culling/depth_range.rs`): the grid's slicing
+/// range is the frame's sample range (the CPU twin's, from the frame's depth) for the CPU
+/// and a GPU strategy alike, and a camera with znear 10⁻⁶ / zfar 10⁶ clusters as tightly as
+/// the scene's own planes (slices over near..far would leave nearly all of them empty and
+/// the clusters no better than depth-bounded tiles).
+#[test]
+fn cluster_slices_follow_the_samples_depth_range() {
+    use lightgrid::culling::{depth_range_cpu, slicing_range};
+    let ctx = common::gpu();
+    let own = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let tiny = with_planes(&own, 1e-6, 1e6);
+    let (w, h, frame) = (160, 90, 200);
+    let mut counts = Vec::new();
+    for assign in [Assign::Cpu, Assign::Gather] {
+        let settings = RenderSettings {
+            assign,
+            slices: 32,
+            ..settings(16)
+        };
+        let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
+        for s in [&own, &tiny] {
+            let out = r.render(s, frame, "clustered_forward").unwrap();
+            let camera = s.frame(frame).camera;
+            let setup = ViewSetup::new(&camera, w, h);
+            let samples = depth_range_cpu(&setup, &[&out.depth]);
+            let [lo, hi] = slicing_range(samples, camera.near, camera.far);
+            let d = out.grid.dims;
+            let what = format!("{} --assign {}", s.name, assign.name());
+            assert!(
+                (d.near - lo).abs() <= 1e-5 * lo && (d.far - hi).abs() <= 1e-5 * hi,
+                "{what}: sliced over [{}, {}], the samples span [{lo}, {hi}]",
+                d.near,
+                d.far
+            );
+            assert!(lo > 1.0 && hi < 1e3, "{what}: samples within [{lo}, {hi}]");
+            counts.push((what, out.stats.lighting_computations.unwrap()));
+        }
+    }
+    eprintln!("{counts:?}");
+    for pair in counts.chunks(2) {
+        let (own, tiny) = (pair[0].1 as f64, pair[1].1 as f64);
+        assert!(
+            (tiny - own).abs() <= 0.01 * own,
+            "{pair:?}: the camera's planes changed how tightly clusters cull"
+        );
+    }
+}

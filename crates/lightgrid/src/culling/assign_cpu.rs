@@ -280,6 +280,15 @@ pub(super) fn create_strategy(_: &StrategyContext) -> Box<dyn AssignStrategy> {
 
 impl AssignStrategy for CpuStrategy {
     fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
+        // The slices the GPU spread over the frame's depth range (read back with the bounds:
+        // the papers' CPU pipeline waits for the depth anyway).
+        let dims = &match a.range {
+            Some(range) => {
+                let [lo, hi] = range.download(enc)?;
+                a.dims.clustered(a.dims.slices, lo, hi)?
+            }
+            None => *a.dims,
+        };
         let cell_bounds: Option<Vec<[f32; 2]>> = match a.source {
             CellSource::NearFar => None,
             CellSource::Depth => {
@@ -292,7 +301,7 @@ impl AssignStrategy for CpuStrategy {
             None => DepthRange::NearFar,
             Some(b) => DepthRange::Cells(b),
         };
-        let grid = assign_cpu(&a.f.setup, a.dims, a.f.lights, range);
+        let grid = assign_cpu(&a.f.setup, dims, a.f.lights, range);
         let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
         check_index_capacity(a.f.device, grid.indices.len() as u64, "cpu")?;
         a.grid.upload(a.f.device, a.f.queue, &grid);

@@ -1,4 +1,6 @@
 //! [`GridBuilder`]: how every grid-reading pipeline gets its light grid. One frame:
+//! 0. for a clustered grid over the depth buffer, the depth range its slices are spread over
+//!    (`depth_range.rs`: the samples' view distances, not near..far);
 //! 1. the cell bounds (`cell_bounds.rs`): from the depth buffer on the GPU, or `[near, far]`
 //!    for a pipeline without a depth pre-pass;
 //! 2. light assignment by the strategy `--assign` names (resolved per frame for `auto`), one
@@ -10,6 +12,7 @@
 //!    ([`GridBuilder::download`]); rendering alone never does.
 
 use super::cell_bounds::CellBoundsPass;
+use super::depth_range::DepthRangePass;
 use super::gpu_assign::read_grid;
 use super::registry::find_strategy;
 pub use super::strategy::CellSource;
@@ -64,6 +67,8 @@ struct LastFrame {
     cell_bounds: Option<Vec<[f32; 2]>>,
     /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
     near_far: [f32; 2],
+    /// The slices were spread on the GPU (`dims` holds near..far until read back).
+    sliced_on_gpu: bool,
 }
 
 pub struct GridBuilder {
@@ -75,6 +80,8 @@ pub struct GridBuilder {
     software_adapter: bool,
     scene_layout: wgpu::BindGroupLayout,
     bounds: CellBoundsPass,
+    /// Step 0, for a clustered grid over the depth buffer.
+    range: Option<DepthRangePass>,
     buffers: GridBuffers,
     /// Strategies created so far (on first use).
     strategies: Vec<(Assign, Box<dyn AssignStrategy>)>,
@@ -82,8 +89,8 @@ pub struct GridBuilder {
 }
 
 impl GridBuilder {
-    /// `slices` 1 builds a tiled grid, more a clustered one (slices between the camera's near
-    /// and far planes each frame).
+    /// `slices` 1 builds a tiled grid, more a clustered one (slices spread each frame over
+    /// the samples' depth range, or between the camera's near and far planes without depth).
     pub fn new(ctx: &GridSetup, slices: u32, source: CellSource) -> Self {
         let (device, scene_layout) = (ctx.device, ctx.scene_layout);
         GridBuilder {
@@ -102,6 +109,8 @@ impl GridBuilder {
                 ctx.depth_bounds,
                 ctx.depth_reduction,
             ),
+            range: (slices > 1 && source == CellSource::Depth)
+                .then(|| DepthRangePass::new(device, scene_layout, ctx.samples)),
             buffers: GridBuffers::new(device),
             strategies: Vec::new(),
             last: None,
@@ -161,6 +170,14 @@ impl GridBuilder {
             CellSource::Depth if f.has_transparency() => self.lists,
             _ => GridLists::Opaque,
         });
+        if let Some(range) = &self.range {
+            range.encode(
+                f,
+                enc,
+                &dims,
+                &[self.bounds.params_buffer(), self.buffers.params_buffer()],
+            );
+        }
         match self.source {
             CellSource::Depth => self.bounds.encode(f, enc, &dims),
             CellSource::NearFar => {
@@ -183,6 +200,7 @@ impl GridBuilder {
                 f,
                 grid: &mut self.buffers,
                 bounds: &self.bounds,
+                range: self.range.as_ref(),
                 dims: &dims,
                 source,
             },
@@ -201,6 +219,7 @@ impl GridBuilder {
             cpu_grid: run.cpu_grid,
             cell_bounds: run.cell_bounds,
             near_far: [f.setup.near, f.setup.far],
+            sliced_on_gpu: self.range.is_some(),
         });
         Ok(())
     }
@@ -231,6 +250,13 @@ impl GridBuilder {
         let grid = match &last.cpu_grid {
             Some(g) => g.clone(),
             None => {
+                let dims = match &self.range {
+                    Some(range) if last.sliced_on_gpu => {
+                        let [lo, hi] = range.read(device, queue)?;
+                        last.dims.clustered(last.dims.slices, lo, hi)?
+                    }
+                    _ => last.dims,
+                };
                 let strategy = self
                     .strategies
                     .iter()
@@ -241,7 +267,7 @@ impl GridBuilder {
                     device,
                     queue,
                     &self.buffers,
-                    &last.dims,
+                    &dims,
                     strategy.grid_entries(values),
                 )?
             }

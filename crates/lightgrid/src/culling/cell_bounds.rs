@@ -323,6 +323,11 @@ impl CellBoundsPass {
         queue.write_buffer(&self.occupancy, 0, bytemuck::cast_slice(&[n, x, y, 1]));
     }
 
+    /// The grid's parameters the kernel reads (a uniform buffer).
+    pub(crate) fn params_buffer(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
     /// The bounds on the GPU (`array<vec2<f32>>`, one per cell).
     pub fn buffer(&self) -> &wgpu::Buffer {
         &self.bounds

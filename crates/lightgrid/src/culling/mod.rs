@@ -8,6 +8,7 @@ mod builder;
 mod bvh;
 mod bvh_gpu;
 mod cell_bounds;
+mod depth_range;
 mod fragment_bounds;
 mod gather;
 mod gpu_assign;
@@ -28,6 +29,7 @@ pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, Lig
 pub use cell_bounds::{
     cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
 };
+pub use depth_range::{depth_range_cpu, slicing_range, DepthRangePass};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, GridLists, LightGrid};
@@ -55,6 +57,8 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
         cell_bounds::shader(4, DepthBounds::None, DepthReduction::Atomics),
         cell_bounds::shader(1, DepthBounds::Both, DepthReduction::Subgroup),
         cell_bounds::shader(4, DepthBounds::Both, DepthReduction::Subgroup),
+        depth_range::shader(1),
+        depth_range::shader(4),
         fragment_bounds::shader(),
         scan::shader(),
         radix_sort::shader(),

@@ -8,6 +8,7 @@
 //! lists did not fit is reported by those counters, never passed off as right.
 
 use super::cell_bounds::CellBoundsPass;
+use super::depth_range::DepthRangePass;
 use super::{GridBuffers, GridDims, LightGrid};
 use crate::error::{Error, Result};
 use crate::frame::{FrameEncoder, FrameInputs};
@@ -20,6 +21,9 @@ pub struct AssignFrame<'a, 'f> {
     pub grid: &'a mut GridBuffers,
     /// The cell bounds it reads (recorded before it in the same encoder).
     pub bounds: &'a CellBoundsPass,
+    /// For a clustered grid over the depth buffer, where the frame's slicing range is (the
+    /// GPU spreads the slices: `dims` holds near..far until it is read back).
+    pub range: Option<&'a DepthRangePass>,
     pub dims: &'a GridDims,
     /// Where the bounds came from (`NearFar`: every cell spans near..far).
     pub source: CellSource,

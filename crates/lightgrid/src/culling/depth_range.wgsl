@@ -1,0 +1,68 @@
+// depth_range: where a clustered grid's depth slices go. Spread exponentially over near..far
+// (tiled-forward-shading §4.8), a camera with znear 10⁻⁶ and zfar 10⁶ puts nearly every slice
+// where no sample is and the clusters degenerate into tiles; spread over the view-distance
+// range of the frame's samples, they cut the depth the frame actually has.
+// 1. `reduce`: one invocation per pixel (every sample of it), a workgroup min/max in shared
+//    memory, one global atomic per workgroup into `range` (view-distance bit patterns:
+//    positive floats order like their bits).
+// 2. `finish` (one invocation): the slicing range, `range` clamped to near..far (near..far
+//    when the frame has no samples) and kept at least SLICING_MIN_RATIO wide, written back
+//    to `range`, and the grid's parameters with the slices spread over it into `params_out`,
+//    which the builder copies over every uniform copy of the grid's parameters.
+// CPU twins: `depth_range_cpu` and `slicing_range` (depth_range.rs).
+
+@group(1) @binding(0) var depth_tex: DepthTexture;
+@group(1) @binding(1) var<uniform> grid: GridParams;
+@group(1) @binding(2) var<storage, read_write> range: array<atomic<u32>, 2>;
+@group(1) @binding(3) var<storage, read_write> params_out: GridParams;
+
+const W_INFINITY: u32 = 0x7f800000u;
+
+var<workgroup> wg_lo: atomic<u32>;
+var<workgroup> wg_hi: atomic<u32>;
+
+@compute @workgroup_size(TILE_THREADS, TILE_THREADS)
+fn reduce(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    if (li == 0u) {
+        atomicStore(&wg_lo, W_INFINITY);
+        atomicStore(&wg_hi, 0u);
+    }
+    workgroupBarrier();
+    let size = textureDimensions(depth_tex);
+    if (gid.x < size.x && gid.y < size.y) {
+        for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            let d = textureLoad(depth_tex, gid.xy, s);
+            if (!is_background(d)) {
+                let bits = bitcast<u32>(view_distance_from_depth(d));
+                atomicMin(&wg_lo, bits);
+                atomicMax(&wg_hi, bits);
+            }
+        }
+    }
+    workgroupBarrier();
+    if (li == 0u) {
+        atomicMin(&range[0], atomicLoad(&wg_lo));
+        atomicMax(&range[1], atomicLoad(&wg_hi));
+    }
+}
+
+@compute @workgroup_size(1)
+fn finish() {
+    var lo = bitcast<f32>(atomicLoad(&range[0]));
+    var hi = bitcast<f32>(atomicLoad(&range[1]));
+    if (lo > hi) {
+        lo = frame.near;
+        hi = frame.far;
+    }
+    lo = clamp(lo, frame.near, frame.far);
+    hi = max(clamp(hi, frame.near, frame.far), lo * SLICING_MIN_RATIO);
+    atomicStore(&range[0], bitcast<u32>(lo));
+    atomicStore(&range[1], bitcast<u32>(hi));
+    // GridDims::slice_params' formula over [lo, hi].
+    var p = grid;
+    let s = f32(grid.slices);
+    let span = log(hi / lo);
+    p.slice_scale = s / span;
+    p.slice_bias = -s * log(lo) / span;
+    params_out = p;
+}
