@@ -15,6 +15,7 @@ fn the_ideal_per_pixel_and_the_wasted_work_add_up_to_the_frame_counts() {
     let (w, h) = (173, 111);
     let mut renderer = Renderer::new(&ctx, w, h, RenderSettings::default()).unwrap();
     let mut wasted = Vec::new();
+    let mut gpu_fragments: Option<Vec<f32>> = None;
     for id in ["forward", "tiled_deferred", "clustered_forward"] {
         let out = renderer.render(&scene, 60, id).unwrap();
         assert!(
@@ -46,10 +47,42 @@ fn the_ideal_per_pixel_and_the_wasted_work_add_up_to_the_frame_counts() {
                 wasted.push((id, total));
             }
         }
-        assert!(counts
+        // The per-pixel ideal counts the transparent fragments the CPU rasterizes; the GPU
+        // can rasterize a pixel centre within round-off of a triangle edge the other way (a
+        // fill rule in f32 against fixed-point subpixels), leaving that pixel's count short
+        // of an ideal it never shades. `forward`'s count says how many fragments the GPU
+        // shaded per pixel (each loops every light): every pixel the GPU shaded as often as
+        // the CPU rasterized gets at least its ideal, and the others must stay rare.
+        let lights = out.stats.lights as f32;
+        let gpu_fragments = gpu_fragments
+            .get_or_insert_with(|| counts.iter().map(|&c| c as f32 / lights).collect());
+        let state = scene.frame(60);
+        let opaque_w = out.setup.view_distances(&out.depth);
+        let mut cpu_fragments: Vec<f32> = opaque_w
             .iter()
-            .zip(&out.ideal_counts)
-            .all(|(&c, &i)| c as f32 + 1e-3 >= i));
+            .map(|w| if w.is_finite() { 1.0 } else { 0.0 })
+            .collect();
+        let glass = scene.geometry(&state).transparent_triangles(0);
+        for f in lightgrid::scene::rasterize(&out.setup, &glass, &opaque_w) {
+            cpu_fragments[(f.y * w + f.x) as usize] += 1.0;
+        }
+        let mut unshaded = 0;
+        for (p, (&c, &i)) in counts.iter().zip(&out.ideal_counts).enumerate() {
+            if gpu_fragments[p] + 1e-3 < cpu_fragments[p] {
+                unshaded += 1;
+            } else {
+                assert!(
+                    c as f32 + 1e-3 >= i,
+                    "{id}: pixel ({}, {}) looped {c} lights, {i} reach its samples",
+                    p as u32 % w,
+                    p as u32 / w
+                );
+            }
+        }
+        assert!(
+            unshaded <= (w * h) as usize / 1000,
+            "{id}: {unshaded} pixels where the GPU rasterized fewer fragments than the CPU"
+        );
     }
     // Brute force wastes the most: culling is what the view shows.
     assert!(

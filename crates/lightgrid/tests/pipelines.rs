@@ -1371,3 +1371,23 @@ fn cluster_slices_follow_the_samples_depth_range() {
         );
     }
 }
+
+/// A camera whose planes the depth buffer cannot hold is refused with the reason, in every
+/// pipeline, never rendered with its surfaces read as background.
+#[test]
+fn cameras_the_depth_buffer_cannot_hold_are_refused() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let mut r = Renderer::new(&ctx, 64, 36, settings(16)).unwrap();
+    for (near, far) in [(1e-35, 1e6), (10.0, 10.0), (5.0, 1.0)] {
+        let bad = with_planes(&s, near, far);
+        for p in PIPELINES {
+            let e = match r.render(&bad, 0, p.id) {
+                Ok(_) => panic!("{} rendered near {near} far {far}", p.id),
+                Err(e) => e.to_string(),
+            };
+            assert!(e.contains("near"), "{}: {e}", p.id);
+        }
+    }
+    assert!(r.render(&with_planes(&s, 1e-20, 1e6), 0, REFERENCE).is_ok());
+}
