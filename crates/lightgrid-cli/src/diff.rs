@@ -37,11 +37,13 @@ pub(crate) fn diff_cmd(a: &DiffArgs) -> Result<()> {
         save_png(&vis, p)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string(&d)?);
+        outln!("{}", serde_json::to_string(&d)?);
     } else {
-        println!(
+        outln!(
             "mean {:.4}  p99 {}  max {}  (8-bit sRGB levels, largest channel per pixel)",
-            d.mean, d.p99, d.max
+            d.mean,
+            d.p99,
+            d.max
         );
     }
     let mut over = Vec::new();
