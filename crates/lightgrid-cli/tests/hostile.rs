@@ -1160,3 +1160,12 @@ fn a_second_signal_exits_at_once_leaving_no_temporary_files() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn light_values_out_of_bounds_are_refused_with_the_cause() {
+    // A range whose square is no longer a normal f32: named as too small, not "not finite".
+    fails_with(
+        &render(&["--add-lights", "5", "--light-range", "1e-30"]),
+        "--light-range: 1e-30 is outside 1e-6",
+    );
+}

@@ -109,6 +109,16 @@ fn check_add_lights(add: &AddLights) -> Result<()> {
                 format!("{r} is not a positive number"),
             ));
         }
+        let lim = &super::LIGHT_LIMITS;
+        if r < lim.min_range || r > lim.max_range {
+            return Err(Error::invalid(
+                "--light-range",
+                format!(
+                    "{r:e} is outside {:e} to {:e} (a light's range squared must stay a normal f32)",
+                    lim.min_range, lim.max_range
+                ),
+            ));
+        }
     }
     Ok(())
 }
