@@ -1169,3 +1169,56 @@ fn light_values_out_of_bounds_are_refused_with_the_cause() {
         "--light-range: 1e-30 is outside 1e-6",
     );
 }
+
+#[test]
+fn export_refuses_what_its_import_cannot_read() {
+    let dir = temp_dir("export-limit");
+    let glb = dir.join("many.glb");
+    // 200,000 lights: a JSON part of about 90 MB, past the 64 MiB the import reads.
+    let o = lightgrid(&[
+        "export",
+        "--scene",
+        "stress",
+        "--lights",
+        "200000",
+        "--out",
+        s(&glb),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("200000 lights")
+            && err.contains("more than the 64 MiB")
+            && err.contains("own import refuses"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "nothing written"
+    );
+    // Below the limit the export is written and reads back.
+    let o = lightgrid(&[
+        "export",
+        "--scene",
+        "stress",
+        "--lights",
+        "20000",
+        "--out",
+        s(&glb),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = lightgrid(&[
+        "render",
+        "--scene",
+        s(&glb),
+        "--size",
+        "8x8",
+        "--warmup",
+        "0",
+        "--out",
+        s(&dir.join("x.png")),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
