@@ -51,7 +51,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Render a frame with every pipeline and compare each with the forward reference.
     Compare(compare::CompareArgs),
-    /// Per-pixel difference of two images, in 8-bit sRGB levels.
+    /// Per-pixel difference of two images, in 8-bit sRGB levels of the colour channels; a
+    /// difference in alpha is reported beside it (alpha_max), not measured in it.
     Diff(diff::DiffArgs),
     /// Render-target memory and the traffic model of every pipeline at a frame size.
     Memory(memory::MemoryArgs),
