@@ -1222,3 +1222,21 @@ fn export_refuses_what_its_import_cannot_read() {
     assert!(o.status.success(), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn report_checks_its_input_before_writing() {
+    let dir = temp_dir("report-check");
+    let o = quick_bench(&dir, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A results.json edited so a scene name would leave the directory.
+    let mut v = json(&dir.join("results.json"));
+    v["runs"][0]["scene"] = "../../elsewhere".into();
+    std::fs::write(dir.join("results.json"), serde_json::to_vec(&v).unwrap()).unwrap();
+    let before = snapshot(&dir);
+    assert_fails_with(
+        &["report", s(&dir)],
+        "scene name \"../../elsewhere\" cannot be part of a file name",
+    );
+    assert_eq!(snapshot(&dir), before, "summary.md and the rest untouched");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -173,7 +173,14 @@ pub fn open(req: &SceneRequest) -> Result<Opened> {
             reason: "the file has no point or spot lights (KHR_lights_punctual); add some with --add-lights N".into(),
         });
     }
-    scene.validate()?;
+    // A file's scene that fails validation (a value from its extras, say) names the file.
+    scene.validate().map_err(|e| match req.is_file() {
+        true => Error::Gltf {
+            path: req.spec.clone(),
+            reason: e.to_string(),
+        },
+        false => e,
+    })?;
     Ok(Opened { scene, warnings })
 }
 
