@@ -380,3 +380,136 @@ fn process_alive(pid: u32) -> bool {
         true
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("lightgrid-outdir-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// One run of `command` writing `files` (name, content) and committing them.
+    fn run(dir: &Path, command: &str, files: &[(&str, &str)], earlier: Earlier) -> Result<()> {
+        let out = OutDir::claim(dir, command, false)?;
+        let written: Vec<PathBuf> = files
+            .iter()
+            .map(|(n, c)| {
+                let p = out.staging().join(n);
+                std::fs::write(&p, c).unwrap();
+                p
+            })
+            .collect();
+        out.commit(&written, earlier).map(drop)
+    }
+
+    #[test]
+    fn each_command_replaces_and_removes_only_its_own_files() {
+        let dir = scratch("own");
+        run(
+            &dir,
+            "bench",
+            &[("results.json", "b1"), ("old.png", "b1")],
+            Earlier::Remove,
+        )
+        .unwrap();
+        run(&dir, "compare", &[("forward.png", "c1")], Earlier::Remove).unwrap();
+        // bench again without old.png: its own old.png goes, compare's file stays.
+        run(&dir, "bench", &[("results.json", "b2")], Earlier::Remove).unwrap();
+        assert_eq!(
+            names(&dir),
+            [
+                ".lightgrid-files-bench",
+                ".lightgrid-files-compare",
+                "forward.png",
+                "results.json"
+            ]
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("results.json")).unwrap(),
+            "b2"
+        );
+        // Keep (report): earlier files stay listed and in place.
+        run(&dir, "compare", &[("compare.json", "c2")], Earlier::Keep).unwrap();
+        assert!(dir.join("forward.png").exists());
+        let listed = std::fs::read_to_string(dir.join(manifest_name("compare"))).unwrap();
+        assert!(
+            listed.contains("forward.png") && listed.contains("compare.json"),
+            "{listed}"
+        );
+        // Another command's file is not replaced: refused, the file as it was, the run's
+        // files kept aside.
+        let e = run(&dir, "scaling", &[("results.json", "s1")], Earlier::Remove)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("results.json (written by `lightgrid bench`)"),
+            "{e}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("results.json")).unwrap(),
+            "b2"
+        );
+        let aside = names(&dir)
+            .into_iter()
+            .find(|n| n.starts_with("lightgrid-scaling-"));
+        assert!(aside.is_some(), "{:?}", names(&dir));
+        // No staging directory or lock stays after a run, whatever its end.
+        assert!(!names(&dir)
+            .iter()
+            .any(|n| n.starts_with(STAGING_PREFIX) || n == LOCK_FILE));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_run_that_fails_before_committing_changes_nothing() {
+        let dir = scratch("fail");
+        run(&dir, "bench", &[("results.json", "b1")], Earlier::Remove).unwrap();
+        let before = names(&dir);
+        {
+            let out = OutDir::claim(&dir, "bench", false).unwrap();
+            std::fs::write(out.staging().join("results.json"), "half").unwrap();
+            // Dropped without commit: a write failed part-way.
+        }
+        assert_eq!(names(&dir), before);
+        assert_eq!(
+            std::fs::read_to_string(dir.join("results.json")).unwrap(),
+            "b1"
+        );
+        // A staging directory of a killed run is removed by the next claim.
+        std::fs::create_dir(dir.join(format!("{STAGING_PREFIX}999999999"))).unwrap();
+        drop(OutDir::claim(&dir, "bench", false).unwrap());
+        assert_eq!(names(&dir), before);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_foreign_directory_needs_force() {
+        let dir = scratch("foreign");
+        std::fs::create_dir_all(&dir).unwrap();
+        check_out_dir(&dir, false).unwrap();
+        std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+        let e = check_out_dir(&dir, false).unwrap_err().to_string();
+        assert!(
+            e.contains("not made by lightgrid (it holds notes.txt)"),
+            "{e}"
+        );
+        check_out_dir(&dir, true).unwrap();
+        assert!(OutDir::claim(&dir, "bench", false).is_err());
+        drop(OutDir::claim(&dir, "bench", true).unwrap());
+        assert_eq!(names(&dir), ["notes.txt"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
