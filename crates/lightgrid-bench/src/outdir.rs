@@ -77,6 +77,7 @@ fn own_name(name: &str) -> bool {
 /// directory or does not exist yet, its nearest existing ancestor is a writable directory,
 /// and, unless `force`, an existing `dir` is empty or was made by lightgrid (it holds a
 /// manifest), so no file of the user's is replaced by a run they did not mean to put there.
+/// `force` true checks writability only.
 pub fn check_out_dir(dir: &Path, force: bool) -> Result<()> {
     let mut existing = dir.to_path_buf();
     loop {

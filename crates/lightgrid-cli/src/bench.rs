@@ -482,7 +482,9 @@ pub(crate) fn bench_config(
 }
 
 pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
-    check_out_dir(&a.out, a.force)?;
+    // Only whether it can be written, here: what the directory holds is checked by the claim
+    // below, after the options (which a user fixes first) and before anything is rendered.
+    check_out_dir(&a.out, true)?;
     let ctx = GpuContext::new(adapter)?;
     let config = bench_config(
         a,

@@ -80,7 +80,9 @@ fn diff_cell(
 
 pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let settings = a.scene.renderer.settings()?;
-    check_out_dir(&a.out_dir, a.force)?;
+    // Only whether it can be written, here: what the directory holds is checked by the claim
+    // below, after the options (which a user fixes first) and before anything is rendered.
+    check_out_dir(&a.out_dir, true)?;
     let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);

@@ -66,7 +66,9 @@ pub(crate) struct ScalingArgs {
 }
 
 pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
-    check_out_dir(&a.out, a.force)?;
+    // Only whether it can be written, here: what the directory holds is checked by the claim
+    // below, after the options (which a user fixes first) and before anything is rendered.
+    check_out_dir(&a.out, true)?;
     let info = lightgrid::pipelines::find(&a.pipeline)?;
     let given = Given {
         slices: a.slices.is_some(),
