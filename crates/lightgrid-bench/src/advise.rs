@@ -122,6 +122,9 @@ pub struct Advice {
     /// Every candidate, fastest first (unmeasured ones last, in the order tried).
     pub ranking: Vec<Measurement>,
     pub recommendation: Option<Recommendation>,
+    /// Stopped by a signal (Ctrl-C or SIGTERM): the candidates after it were not measured, so
+    /// the recommendation is the best of a part only, and the command exits non-zero.
+    pub interrupted: bool,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -399,6 +402,7 @@ pub fn advise(
         elapsed_s: start.elapsed().as_secs_f64(),
         recommendation: recommend(&ranking),
         ranking,
+        interrupted: stop.load(std::sync::atomic::Ordering::Relaxed),
     })
 }
 

@@ -18,7 +18,10 @@ mod run;
 mod scaling;
 
 pub use claims::{evaluate_claims, Claim, Verdict};
-pub use outdir::{check_out_dir, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE, STOPPED_BY_SIGNAL};
+pub use outdir::{
+    check_out_dir, manifest_name, Earlier, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE,
+    STOPPED_BY_SIGNAL,
+};
 pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     prepare, run, BenchConfig, BenchResults, FrameRange, FrameRecord, PreparedBench, Progress,

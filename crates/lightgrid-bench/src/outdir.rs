@@ -2,7 +2,6 @@
 //! into ([`OutDir`]): checked before anything is created, locked against a second run, and
 //! cleared of the files an earlier run wrote there once the new ones are in place.
 
-use lightgrid::image_io::check_writable;
 use lightgrid::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -41,8 +40,18 @@ pub const STOPPED_BY_SIGNAL: &str = "stopped by a signal (Ctrl-C or SIGTERM)";
 
 /// Name of the lock file a run holds in its output directory.
 pub const LOCK_FILE: &str = ".lightgrid.lock";
-/// Name of the list of files the last run wrote into the directory.
+/// Start of the names of the lists of files each command's last run wrote into a directory
+/// ([`manifest_name`]); a directory holding one was made by lightgrid.
 pub const MANIFEST_FILE: &str = ".lightgrid-files";
+/// Start of the name of the directory a run writes its files into before they are moved into
+/// place together ([`OutDir::commit`]), followed by the process id.
+const STAGING_PREFIX: &str = ".lightgrid-run-";
+
+/// The list of the files `command`'s last run wrote: one per command, so a command removes
+/// only its own earlier files (a compare never removes a bench's results).
+pub fn manifest_name(command: &str) -> String {
+    format!("{MANIFEST_FILE}-{command}")
+}
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
     move |cause| Error::Io {
@@ -51,13 +60,25 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
     }
 }
 
-/// Check that `dir` can be a run's output directory without creating anything: it is a
-/// directory or does not exist yet, and its nearest existing ancestor is a writable directory.
-pub fn check_out_dir(dir: &Path) -> Result<()> {
-    let invalid = |reason: String| Error::Invalid {
+fn invalid(reason: String) -> Error {
+    Error::Invalid {
         what: "output directory",
         reason,
-    };
+    }
+}
+
+/// Names lightgrid keeps for itself in an output directory (manifests, the lock, temporary
+/// files and staging directories): not a user's files.
+fn own_name(name: &str) -> bool {
+    name.starts_with(".lightgrid")
+}
+
+/// Check that `dir` can be a run's output directory without creating anything: it is a
+/// directory or does not exist yet, its nearest existing ancestor is a writable directory,
+/// and, unless `force`, an existing `dir` is empty or was made by lightgrid (it holds a
+/// manifest), so no file of the user's is replaced by a run they did not mean to put there.
+/// `force` true checks writability only.
+pub fn check_out_dir(dir: &Path, force: bool) -> Result<()> {
     let mut existing = dir.to_path_buf();
     loop {
         match std::fs::metadata(&existing) {
@@ -77,21 +98,79 @@ pub fn check_out_dir(dir: &Path) -> Result<()> {
             },
         }
     }
-    check_writable(&existing.join("probe"))
+    let probe = lightgrid::image_io::Temporary::new(
+        existing.join(format!(".lightgrid-{}.probe", std::process::id())),
+    );
+    std::fs::write(probe.path(), b"").map_err(|cause| Error::Io {
+        path: format!(
+            "cannot create the output directory {} ({} refuses new files)",
+            dir.display(),
+            existing.display()
+        ),
+        cause,
+    })?;
+    drop(probe);
+    if existing == dir && !force {
+        check_not_foreign(dir)?;
+    }
+    Ok(())
 }
 
-/// A run's output directory, created and locked; the lock goes when this is dropped.
+/// Refuse an existing directory that holds files and no manifest of lightgrid's.
+fn check_not_foreign(dir: &Path) -> Result<()> {
+    let mut foreign = Vec::new();
+    let mut made_here = false;
+    for entry in std::fs::read_dir(dir).map_err(io(dir))? {
+        let name = entry.map_err(io(dir))?.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with(MANIFEST_FILE) {
+            made_here = true;
+        } else if !own_name(&name) {
+            foreign.push(name.into_owned());
+        }
+    }
+    if made_here || foreign.is_empty() {
+        return Ok(());
+    }
+    foreign.sort();
+    let more = if foreign.len() > 3 { ", ..." } else { "" };
+    foreign.truncate(3);
+    Err(invalid(format!(
+        "{} is not empty and was not made by lightgrid (it holds {}{more}); name a new or empty directory, or give --force to write into it (files of the same names are replaced)",
+        dir.display(),
+        foreign.join(", ")
+    )))
+}
+
+/// A run's output directory, created and locked; the lock goes when this is dropped. Files
+/// are written into [`OutDir::staging`] and moved into place together by [`OutDir::commit`],
+/// so a run that fails part-way (a full disk) leaves the directory as the last run left it.
 pub struct OutDir {
     dir: PathBuf,
     lock: PathBuf,
+    command: String,
+    force: bool,
+    staging: lightgrid::image_io::Temporary,
+}
+
+/// What [`OutDir::commit`] does with the files of the command's earlier run that this one did
+/// not write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Earlier {
+    /// Remove them: nothing from an earlier run sits beside the new files as if it belonged
+    /// to them (a pipeline that failed this time).
+    Remove,
+    /// Keep them (`report` rewrites part of a bench's files and keeps its heatmaps).
+    Keep,
 }
 
 impl OutDir {
-    /// Create `dir` (after [`check_out_dir`]) and take its lock. A second run into the same
-    /// directory is refused while the first is alive; a lock left by a process that no
-    /// longer exists is taken over.
-    pub fn claim(dir: &Path) -> Result<OutDir> {
-        check_out_dir(dir)?;
+    /// Create `dir` (after [`check_out_dir`]) and take its lock for `command` (`bench`,
+    /// `compare`, `scaling`: whose manifest the run's files go into). A second run into the
+    /// same directory is refused while the first is alive; a lock left by a process that no
+    /// longer exists is taken over, and its staging directories removed.
+    pub fn claim(dir: &Path, command: &str, force: bool) -> Result<OutDir> {
+        check_out_dir(dir, force)?;
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let lock = dir.join(LOCK_FILE);
         for _ in 0..2 {
@@ -103,23 +182,28 @@ impl OutDir {
                 Ok(mut f) => {
                     use std::io::Write;
                     let _ = writeln!(f, "{}", std::process::id());
-                    return Ok(OutDir {
+                    let out = OutDir {
                         dir: dir.to_path_buf(),
                         lock,
-                    });
+                        command: command.to_string(),
+                        force,
+                        staging: lightgrid::image_io::Temporary::new(
+                            dir.join(format!("{STAGING_PREFIX}{}", std::process::id())),
+                        ),
+                    };
+                    out.remove_stale_staging();
+                    std::fs::create_dir(out.staging()).map_err(io(out.staging()))?;
+                    return Ok(out);
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                     let holder = std::fs::read_to_string(&lock).unwrap_or_default();
                     let pid = holder.trim().parse::<u32>().ok();
                     if pid.is_some_and(process_alive) {
-                        return Err(Error::Invalid {
-                            what: "output directory",
-                            reason: format!(
-                                "another lightgrid run (pid {}) is writing to {}; wait for it or choose another directory",
-                                holder.trim(),
-                                dir.display()
-                            ),
-                        });
+                        return Err(invalid(format!(
+                            "another lightgrid run (pid {}) is writing to {}; wait for it or choose another directory",
+                            holder.trim(),
+                            dir.display()
+                        )));
                     }
                     // Left by a run that was killed: take it over.
                     let _ = std::fs::remove_file(&lock);
@@ -127,43 +211,155 @@ impl OutDir {
                 Err(e) => return Err(io(&lock)(e)),
             }
         }
-        Err(Error::Invalid {
-            what: "output directory",
-            reason: format!("cannot take the lock {}", lock.display()),
-        })
+        Err(invalid(format!("cannot take the lock {}", lock.display())))
     }
 
+    /// Staging directories of runs that were killed (they hold the lock, so none is alive).
+    fn remove_stale_staging(&self) {
+        let Ok(entries) = std::fs::read_dir(&self.dir) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name();
+            let stale = name
+                .to_str()
+                .and_then(|n| n.strip_prefix(STAGING_PREFIX))
+                .and_then(|pid| pid.parse::<u32>().ok())
+                .is_some_and(|pid| !process_alive(pid));
+            if stale {
+                let _ = std::fs::remove_dir_all(e.path());
+            }
+        }
+    }
+
+    /// The directory the run names.
     pub fn path(&self) -> &Path {
         &self.dir
     }
 
-    /// After the run's files are written: remove the files the previous run listed that this
-    /// one did not write (a pipeline, scene or plot it no longer has), so nothing from an
-    /// earlier run sits beside the new files as if it belonged to them; then list this run's.
-    pub fn replace_earlier_files(&self, written: &[PathBuf]) -> Result<Vec<PathBuf>> {
-        let manifest = self.dir.join(MANIFEST_FILE);
+    /// Where the run writes its files (inside [`OutDir::path`], on the same file system); they
+    /// reach the directory only through [`OutDir::commit`].
+    pub fn staging(&self) -> &Path {
+        self.staging.path()
+    }
+
+    /// The names listed in `manifest` (plain names only: nothing outside the directory).
+    fn listed(&self, manifest: &str) -> Vec<String> {
+        std::fs::read_to_string(self.dir.join(manifest))
+            .unwrap_or_default()
+            .lines()
+            .map(str::trim)
+            .filter(|n| !n.is_empty() && !n.contains(['/', '\\']) && !own_name(n))
+            .map(String::from)
+            .collect()
+    }
+
+    /// After every file of the run is written into [`OutDir::staging`] (`written`): move them
+    /// into the directory, then deal with the command's earlier files as `earlier` says, and
+    /// list this run's files in the command's manifest. A file that another command's run
+    /// wrote, or that lightgrid did not write, is never replaced unless `--force` was given:
+    /// the run is refused before anything moves and its files are kept in a directory of their
+    /// own that the error names. Returns the files in place and the files removed.
+    pub fn commit(
+        &self,
+        written: &[PathBuf],
+        earlier: Earlier,
+    ) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
+        let own = manifest_name(&self.command);
+        let old = self.listed(&own);
         let names: Vec<String> = written
             .iter()
             .filter_map(|p| p.file_name())
             .map(|n| n.to_string_lossy().into_owned())
             .collect();
-        let mut removed = Vec::new();
-        if let Ok(old) = std::fs::read_to_string(&manifest) {
-            for name in old.lines().map(str::trim).filter(|n| !n.is_empty()) {
-                // Only plain names this tool wrote into this directory.
-                let plain = !name.contains('/') && !name.contains('\\') && !name.starts_with('.');
-                if plain && !names.iter().any(|n| n == name) {
-                    let p = self.dir.join(name);
-                    if std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file())
-                        && std::fs::remove_file(&p).is_ok()
-                    {
-                        removed.push(p);
-                    }
-                }
+        // Other commands' manifests, to refuse replacing their files and to hand over the
+        // names a forced run took.
+        let mut others: Vec<(String, Vec<String>)> = Vec::new();
+        for e in std::fs::read_dir(&self.dir)
+            .map_err(io(&self.dir))?
+            .flatten()
+        {
+            let m = e.file_name().to_string_lossy().into_owned();
+            if m.starts_with(MANIFEST_FILE) && m != own {
+                let list = self.listed(&m);
+                others.push((m, list));
             }
         }
-        lightgrid::image_io::write_atomic(&manifest, (names.join("\n") + "\n").as_bytes())?;
-        Ok(removed)
+        // Files an earlier version listed in its one shared manifest are anyone's to replace.
+        let legacy = self.listed(MANIFEST_FILE);
+        let taken: Vec<&String> = names
+            .iter()
+            .filter(|n| !old.contains(n) && !legacy.contains(n))
+            .filter(|n| std::fs::symlink_metadata(self.dir.join(n)).is_ok())
+            .collect();
+        if !self.force && !taken.is_empty() {
+            let owner = |n: &String| {
+                others
+                    .iter()
+                    .find(|(_, l)| l.contains(n))
+                    .and_then(|(m, _)| m.strip_prefix(MANIFEST_FILE)?.strip_prefix('-'))
+                    .map_or("not written by lightgrid".to_string(), |c| {
+                        format!("written by `lightgrid {c}`")
+                    })
+            };
+            let list: Vec<String> = taken
+                .iter()
+                .take(3)
+                .map(|n| format!("{n} ({})", owner(n)))
+                .collect();
+            let kept = self
+                .dir
+                .join(format!("lightgrid-{}-{}", self.command, std::process::id()));
+            let kept_note = match std::fs::rename(self.staging(), &kept) {
+                Ok(()) => format!("this run's files are in {}", kept.display()),
+                Err(e) => format!("this run's files could not be kept: {e}"),
+            };
+            return Err(invalid(format!(
+                "{} already holds {}{}; nothing there was replaced ({kept_note}); give --force to replace them, or choose another directory",
+                self.dir.display(),
+                list.join(", "),
+                if taken.len() > 3 { ", ..." } else { "" }
+            )));
+        }
+        // Listed first with the old files too: a run stopped while files move leaves them all
+        // listed, and the next run of the command removes what it does not write again.
+        let mut both = old.clone();
+        both.extend(names.iter().filter(|n| !old.contains(n)).cloned());
+        self.write_manifest(&own, &both)?;
+        let mut placed = Vec::new();
+        for (from, name) in written.iter().zip(&names) {
+            let to = self.dir.join(name);
+            std::fs::rename(from, &to).map_err(io(&to))?;
+            placed.push(to);
+        }
+        for (m, list) in &others {
+            if list.iter().any(|n| names.contains(n)) {
+                let rest: Vec<String> = list
+                    .iter()
+                    .filter(|n| !names.contains(n))
+                    .cloned()
+                    .collect();
+                self.write_manifest(m, &rest)?;
+            }
+        }
+        let mut removed = Vec::new();
+        let mut listed = names.clone();
+        for name in old.iter().filter(|n| !names.contains(n)) {
+            let p = self.dir.join(name);
+            let file = std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file());
+            if earlier == Earlier::Remove && file && std::fs::remove_file(&p).is_ok() {
+                removed.push(p);
+            } else if file {
+                listed.push(name.clone());
+            }
+        }
+        self.write_manifest(&own, &listed)?;
+        Ok((placed, removed))
+    }
+
+    fn write_manifest(&self, manifest: &str, names: &[String]) -> Result<()> {
+        let text: String = names.iter().map(|n| format!("{n}\n")).collect();
+        lightgrid::image_io::write_atomic(&self.dir.join(manifest), text.as_bytes())
     }
 }
 
@@ -183,5 +379,138 @@ fn process_alive(pid: u32) -> bool {
         Path::new(&format!("/proc/{pid}")).exists()
     } else {
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("lightgrid-outdir-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// One run of `command` writing `files` (name, content) and committing them.
+    fn run(dir: &Path, command: &str, files: &[(&str, &str)], earlier: Earlier) -> Result<()> {
+        let out = OutDir::claim(dir, command, false)?;
+        let written: Vec<PathBuf> = files
+            .iter()
+            .map(|(n, c)| {
+                let p = out.staging().join(n);
+                std::fs::write(&p, c).unwrap();
+                p
+            })
+            .collect();
+        out.commit(&written, earlier).map(drop)
+    }
+
+    #[test]
+    fn each_command_replaces_and_removes_only_its_own_files() {
+        let dir = scratch("own");
+        run(
+            &dir,
+            "bench",
+            &[("results.json", "b1"), ("old.png", "b1")],
+            Earlier::Remove,
+        )
+        .unwrap();
+        run(&dir, "compare", &[("forward.png", "c1")], Earlier::Remove).unwrap();
+        // bench again without old.png: its own old.png goes, compare's file stays.
+        run(&dir, "bench", &[("results.json", "b2")], Earlier::Remove).unwrap();
+        assert_eq!(
+            names(&dir),
+            [
+                ".lightgrid-files-bench",
+                ".lightgrid-files-compare",
+                "forward.png",
+                "results.json"
+            ]
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("results.json")).unwrap(),
+            "b2"
+        );
+        // Keep (report): earlier files stay listed and in place.
+        run(&dir, "compare", &[("compare.json", "c2")], Earlier::Keep).unwrap();
+        assert!(dir.join("forward.png").exists());
+        let listed = std::fs::read_to_string(dir.join(manifest_name("compare"))).unwrap();
+        assert!(
+            listed.contains("forward.png") && listed.contains("compare.json"),
+            "{listed}"
+        );
+        // Another command's file is not replaced: refused, the file as it was, the run's
+        // files kept aside.
+        let e = run(&dir, "scaling", &[("results.json", "s1")], Earlier::Remove)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("results.json (written by `lightgrid bench`)"),
+            "{e}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("results.json")).unwrap(),
+            "b2"
+        );
+        let aside = names(&dir)
+            .into_iter()
+            .find(|n| n.starts_with("lightgrid-scaling-"));
+        assert!(aside.is_some(), "{:?}", names(&dir));
+        // No staging directory or lock stays after a run, whatever its end.
+        assert!(!names(&dir)
+            .iter()
+            .any(|n| n.starts_with(STAGING_PREFIX) || n == LOCK_FILE));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_run_that_fails_before_committing_changes_nothing() {
+        let dir = scratch("fail");
+        run(&dir, "bench", &[("results.json", "b1")], Earlier::Remove).unwrap();
+        let before = names(&dir);
+        {
+            let out = OutDir::claim(&dir, "bench", false).unwrap();
+            std::fs::write(out.staging().join("results.json"), "half").unwrap();
+            // Dropped without commit: a write failed part-way.
+        }
+        assert_eq!(names(&dir), before);
+        assert_eq!(
+            std::fs::read_to_string(dir.join("results.json")).unwrap(),
+            "b1"
+        );
+        // A staging directory of a killed run is removed by the next claim.
+        std::fs::create_dir(dir.join(format!("{STAGING_PREFIX}999999999"))).unwrap();
+        drop(OutDir::claim(&dir, "bench", false).unwrap());
+        assert_eq!(names(&dir), before);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_foreign_directory_needs_force() {
+        let dir = scratch("foreign");
+        std::fs::create_dir_all(&dir).unwrap();
+        check_out_dir(&dir, false).unwrap();
+        std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+        let e = check_out_dir(&dir, false).unwrap_err().to_string();
+        assert!(
+            e.contains("not made by lightgrid (it holds notes.txt)"),
+            "{e}"
+        );
+        check_out_dir(&dir, true).unwrap();
+        assert!(OutDir::claim(&dir, "bench", false).is_err());
+        drop(OutDir::claim(&dir, "bench", true).unwrap());
+        assert_eq!(names(&dir), ["notes.txt"]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

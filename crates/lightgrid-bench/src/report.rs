@@ -840,7 +840,40 @@ pub fn read_results(path: &Path) -> Result<BenchResults> {
             ))
         }
     }
-    serde_json::from_value(v).map_err(|e| invalid("results", format!("{}: {e}", path.display())))
+    let results: BenchResults = serde_json::from_value(v)
+        .map_err(|e| invalid("results", format!("{}: {e}", path.display())))?;
+    check_names(&results)
+        .map_err(|reason| invalid("results", format!("{}: {reason}", path.display())))?;
+    Ok(results)
+}
+
+/// Scene and pipeline names become parts of the report's file names: refuse, before anything
+/// is written, a results file (edited, or from elsewhere) whose names would not be one plain
+/// file name in the directory.
+fn check_names(results: &BenchResults) -> std::result::Result<(), String> {
+    let names = results
+        .runs
+        .iter()
+        .flat_map(|r| [("scene", &r.scene), ("pipeline", &r.pipeline)])
+        .chain(results.thumbnails.iter().map(|t| ("scene", &t.0)))
+        .chain(
+            results
+                .heatmaps
+                .iter()
+                .flat_map(|h| [("scene", &h.0), ("pipeline", &h.1)]),
+        );
+    for (what, name) in names {
+        let plain = !name.is_empty()
+            && name.len() <= 128
+            && !name.starts_with('.')
+            && !name.contains(['/', '\\', '\0']);
+        if !plain {
+            return Err(format!(
+                "{what} name {name:?} cannot be part of a file name (1 to 128 bytes, no '/', '\\' or leading '.')"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Write every report file into `dir` (created if missing). Returns the paths written.

@@ -678,6 +678,9 @@ pub const OPAQUE_SUFFIX: &str = "-opaque";
 
 fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
     let mut scenes = Vec::new();
+    // Scene ids: two files with one file name (a/model.glb, b/model.glb) would be one scene
+    // in the results and the report's files; the later ones get a number ("model-2").
+    let mut ids: Vec<String> = Vec::new();
     for name in &config.scenes {
         // What applies to this scene: a light count and headlights only where the catalog
         // scene takes them, transparency off only where there is some.
@@ -706,10 +709,25 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 ..SceneRequest::new(name)
             })
         };
-        let opened = open(true)?;
+        let mut opened = open(true)?;
         for w in &opened.warnings {
             eprintln!("warning: {name}: {w}");
         }
+        let id = unique_id(&opened.scene.name, &ids);
+        if id != opened.scene.name {
+            eprintln!(
+                "warning: {name}: another scene is named {}; this one is {id} in the results",
+                opened.scene.name
+            );
+        }
+        ids.push(id.clone());
+        opened.scene.name = id.clone();
+        let open = |transparency| {
+            open(transparency).map(|mut o| {
+                o.scene.name = id.clone();
+                o
+            })
+        };
         let has_glass = opened.scene.has_transparency();
         if !config.transparency && has_glass {
             scenes.push(open(false)?.scene);
@@ -729,6 +747,17 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
         }
     }
     Ok(scenes)
+}
+
+/// `name`, or `name-2`, `name-3`, ... when an earlier scene of the run took it.
+fn unique_id(name: &str, taken: &[String]) -> String {
+    (1..)
+        .map(|k| match k {
+            1 => name.to_string(),
+            k => format!("{name}-{k}"),
+        })
+        .find(|id| !taken.contains(id))
+        .expect("an unbounded range has a free number")
 }
 
 /// The name suffix of a scene measured with its light ranges scaled (`range_scales`).

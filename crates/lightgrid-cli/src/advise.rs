@@ -73,9 +73,14 @@ pub(crate) fn advise(adapter: Option<&str>, a: &AdviseArgs) -> Result<()> {
         write_atomic(path, &json)?;
     }
     if to_stdout {
-        println!("{}", String::from_utf8_lossy(&json));
+        outln!("{}", String::from_utf8_lossy(&json));
     } else {
-        print_table(&advice);
+        print_table(&advice)?;
+    }
+    if advice.interrupted {
+        bail!(
+            "interrupted by a signal (Ctrl-C or SIGTERM): only the candidates measured before it are ranked, so the recommendation is not the advice a full run gives"
+        );
     }
     if advice.recommendation.is_none() {
         bail!("no configuration was measured within the budget; give a larger --budget or a smaller --size");
@@ -83,10 +88,15 @@ pub(crate) fn advise(adapter: Option<&str>, a: &AdviseArgs) -> Result<()> {
     Ok(())
 }
 
-fn print_table(advice: &Advice) {
-    println!(
+fn print_table(advice: &Advice) -> Result<()> {
+    outln!(
         "{:<4} {:<44} {:>10} {:>9} {:>10} {:>10}  note",
-        "rank", "configuration", "frame ms", "GPU ms", "memory", "efficiency"
+        "rank",
+        "configuration",
+        "frame ms",
+        "GPU ms",
+        "memory",
+        "efficiency"
     );
     for (i, m) in advice.ranking.iter().enumerate() {
         let (ms, gpu, note) = match &m.outcome {
@@ -106,7 +116,7 @@ fn print_table(advice: &Advice) {
             Outcome::Skipped { reason } => ("-".into(), "-".into(), format!("skipped: {reason}")),
             Outcome::Failed { reason } => ("-".into(), "-".into(), format!("failed: {reason}")),
         };
-        println!(
+        outln!(
             "{:<4} {:<44} {:>10} {:>9} {:>10} {:>10}  {}{}",
             i + 1,
             m.candidate.label(),
@@ -124,16 +134,17 @@ fn print_table(advice: &Advice) {
             if m.msaa { "" } else { " (no MSAA)" }
         );
     }
-    println!(
+    outln!(
         "\n{} candidates in {:.1} s of a {:.0} s budget",
         advice.ranking.len(),
         advice.elapsed_s,
         advice.budget_s
     );
     if let Some(r) = &advice.recommendation {
-        println!("recommended: {}", r.options);
+        outln!("recommended: {}", r.options);
         for reason in &r.reasons {
-            println!("  - {reason}");
+            outln!("  - {reason}");
         }
     }
+    Ok(())
 }

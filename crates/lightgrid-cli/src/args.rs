@@ -552,19 +552,41 @@ pub(crate) fn format_duration(secs: f64) -> String {
     }
 }
 
-/// A flag set by the first Ctrl-C or SIGTERM (long runs stop after the current frame and
-/// write what they measured, marked interrupted); a second one exits at once.
-pub(crate) fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let flag = stop.clone();
+/// Set by the first Ctrl-C or SIGTERM while a long run is listening ([`stop_on_ctrl_c`]).
+static STOP: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicBool>> =
+    std::sync::OnceLock::new();
+/// Whether a long run is listening for [`STOP`].
+static LISTENING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+fn stop_flag() -> std::sync::Arc<std::sync::atomic::AtomicBool> {
+    STOP.get_or_init(Default::default).clone()
+}
+
+/// Install the one Ctrl-C / SIGTERM handler of the process, before any command runs: a signal
+/// that ends the process first removes the temporary files being written
+/// (`image_io::remove_temporaries`), so an interrupted export or render leaves no partial
+/// file. While a long run listens ([`stop_on_ctrl_c`]) the first signal only asks it to stop.
+pub(crate) fn handle_signals() -> Result<()> {
+    use std::sync::atomic::Ordering;
+    let stop = stop_flag();
     ctrlc::set_handler(move || {
-        if flag.swap(true, std::sync::atomic::Ordering::SeqCst) {
-            std::process::exit(130);
+        if LISTENING.load(Ordering::SeqCst) && !stop.swap(true, Ordering::SeqCst) {
+            eprintln!("\nstopping after the current frame and writing what was measured (again to abort without writing)...");
+            return;
         }
-        eprintln!("\nstopping after the current frame and writing what was measured (again to abort without writing)...");
+        // Held until the exit, so no temporary is made (and left) after the removal.
+        let _held = lightgrid::image_io::remove_temporaries();
+        std::process::exit(130);
     })
-    .context("cannot install the Ctrl-C / SIGTERM handler")?;
-    Ok(stop)
+    .context("cannot install the Ctrl-C / SIGTERM handler")
+}
+
+/// A flag set by the first Ctrl-C or SIGTERM (long runs stop after the current frame and
+/// write what they measured, marked interrupted); a second one exits at once, removing the
+/// temporary files ([`handle_signals`]).
+pub(crate) fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    LISTENING.store(true, std::sync::atomic::Ordering::SeqCst);
+    Ok(stop_flag())
 }
 
 /// A progress bar with an ETA on stderr: redrawn in place at most every 200 ms on a terminal,

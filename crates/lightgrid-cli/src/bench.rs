@@ -156,10 +156,15 @@ pub(crate) struct BenchArgs {
     /// (a list, e.g. 0.5,1,2,4; each above 0 and at most 1000), as `<scene>-range-x<factor>`.
     #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = crate::args::parse_positive)]
     pub(crate) range_scale: Vec<f64>,
-    /// Output directory (created; files an earlier run wrote there and this one does not are
-    /// removed; two runs into one directory at once are refused).
+    /// Output directory (created; files an earlier bench run wrote there and this one does not
+    /// are removed, other commands' files are kept; an existing directory lightgrid did not
+    /// make must be empty; two runs into one directory at once are refused).
     #[arg(long, default_value = "bench")]
     pub(crate) out: PathBuf,
+    /// Write into an existing directory that lightgrid did not make and that is not empty,
+    /// and over files there that lightgrid (or another command of it) did not write.
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 #[derive(Args)]
@@ -477,7 +482,9 @@ pub(crate) fn bench_config(
 }
 
 pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
-    check_out_dir(&a.out)?;
+    // Only whether it can be written, here: what the directory holds is checked by the claim
+    // below, after the options (which a user fixes first) and before anything is rendered.
+    check_out_dir(&a.out, true)?;
     let ctx = GpuContext::new(adapter)?;
     let config = bench_config(
         a,
@@ -490,7 +497,7 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         }
     }
     let prepared = lightgrid_bench::prepare(&config)?;
-    let dir = OutDir::claim(&a.out)?;
+    let dir = OutDir::claim(&a.out, "bench", a.force)?;
     let stop = stop_on_ctrl_c()?;
     eprintln!(
         "benchmark on {}: {} scene(s), {} pipeline(s), frames {}..{} every {}, writing to {}",
@@ -507,8 +514,8 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     let mut results = prepared.run(&ctx, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
-    let written = lightgrid_bench::write_report(&a.out, &results)?;
-    dir.replace_earlier_files(&written)?;
+    let written = lightgrid_bench::write_report(dir.staging(), &results)?;
+    let (written, _) = dir.commit(&written, lightgrid_bench::Earlier::Remove)?;
     let claims = lightgrid_bench::evaluate_claims(&results);
     let held = claims
         .iter()
@@ -518,7 +525,7 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         .iter()
         .filter(|c| c.verdict != lightgrid_bench::Verdict::NotMeasured)
         .count();
-    println!(
+    outln!(
         "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
         results.runs.len(),
         format_duration(start.elapsed().as_secs_f64()),
@@ -530,9 +537,13 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
 
 pub(crate) fn report(a: &ReportArgs) -> Result<()> {
     let results = lightgrid_bench::read_results(&a.dir.join("results.json"))?;
-    let _lock = OutDir::claim(&a.dir)?;
-    let written = lightgrid_bench::write_report(&a.dir, &results)?;
-    println!(
+    // The bench's files are the report's: they are rewritten under the bench's manifest, the
+    // heatmaps and anything else the run wrote kept. Written aside first, so a report that
+    // fails part-way changes nothing.
+    let dir = OutDir::claim(&a.dir, "bench", false)?;
+    let written = lightgrid_bench::write_report(dir.staging(), &results)?;
+    let (written, _) = dir.commit(&written, lightgrid_bench::Earlier::Keep)?;
+    outln!(
         "{} files rewritten in {} (heatmaps are kept from the run)",
         written.len(),
         a.dir.display()

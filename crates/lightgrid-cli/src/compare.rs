@@ -8,7 +8,7 @@ use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::{diff, encode_png, write_atomic, DiffSummary};
 use lightgrid::pipelines::{PIPELINES, REFERENCE};
 use lightgrid::Renderer;
-use lightgrid_bench::{check_out_dir, OutDir, Outcome, STOPPED_BY_SIGNAL};
+use lightgrid_bench::{check_out_dir, Earlier, OutDir, Outcome, STOPPED_BY_SIGNAL};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -20,6 +20,10 @@ pub(crate) struct CompareArgs {
     /// Directory for the images and statistics.
     #[arg(long, default_value = "out")]
     pub(crate) out_dir: PathBuf,
+    /// Write into an existing directory that lightgrid did not make and that is not empty,
+    /// and over files there that lightgrid (or another command of it) did not write.
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// Frame of `robots-many` the default job renders: street level, looking down the street.
@@ -76,23 +80,32 @@ fn diff_cell(
 
 pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let settings = a.scene.renderer.settings()?;
-    check_out_dir(&a.out_dir)?;
+    // Only whether it can be written, here: what the directory holds is checked by the claim
+    // below, after the options (which a user fixes first) and before anything is rendered.
+    check_out_dir(&a.out_dir, true)?;
     let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);
     let mut renderer = Renderer::new(&ctx, w, h, settings)?;
-    let dir = OutDir::claim(&a.out_dir)?;
+    let dir = OutDir::claim(&a.out_dir, "compare", a.force)?;
     let stop = stop_on_ctrl_c()?;
-    println!(
+    outln!(
         "{} frame {} at {w}x{h}, {} lights, on {}",
         scene.name,
         a.scene.frame,
         scene.lights.len(),
         ctx.adapter_label()
     );
-    println!(
+    outln!(
         "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
-        "pipeline", "time ms", "diff mean", "p99", "max", "lighting comp", "x ideal", "lights/tile"
+        "pipeline",
+        "time ms",
+        "diff mean",
+        "p99",
+        "max",
+        "lighting comp",
+        "x ideal",
+        "lights/tile"
     );
     // Reference images by id; `forward` is rendered first (registry order).
     let mut references: HashMap<&str, image::RgbaImage> = Default::default();
@@ -107,7 +120,7 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             break;
         }
         if let (true, lightgrid::pipelines::Msaa::Refused(why)) = (settings.msaa > 1, p.msaa) {
-            println!("{:<24} skipped: refuses MSAA ({why})", p.id);
+            outln!("{:<24} skipped: refuses MSAA ({why})", p.id);
             rows.push(Row {
                 pipeline: p.id,
                 failed: None,
@@ -124,7 +137,7 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         let out = match warm.and_then(|_| renderer.render(&scene, a.scene.frame, p.id)) {
             Ok(o) => o,
             Err(e) => {
-                println!("{:<24} failed: {e}", p.id);
+                outln!("{:<24} failed: {e}", p.id);
                 rows.push(Row {
                     pipeline: p.id,
                     failed: Some(e.to_string()),
@@ -137,8 +150,8 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
                 continue;
             }
         };
-        let png = a.out_dir.join(format!("{}.png", p.id));
-        let stats = a.out_dir.join(format!("{}.json", p.id));
+        let png = dir.staging().join(format!("{}.png", p.id));
+        let stats = dir.staging().join(format!("{}.json", p.id));
         for (path, bytes) in [
             (png.clone(), encode_png(&out.image, &png)?),
             (stats, serde_json::to_vec_pretty(&out.stats)?),
@@ -190,9 +203,16 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         if let Some(assign) = &s.assign {
             assigned_by.get_or_insert_with(|| assign.clone());
         }
-        println!(
+        outln!(
             "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
-            p.id, time, mean, p99, max, comps, ratio, per_tile
+            p.id,
+            time,
+            mean,
+            p99,
+            max,
+            comps,
+            ratio,
+            per_tile
         );
         rows.push(Row {
             pipeline: p.id,
@@ -208,12 +228,12 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         }
     }
     for n in &notes {
-        println!("{n}");
+        outln!("{n}");
     }
     if !ctx.timestamps {
-        println!("* wall clock: this adapter has no timestamp queries");
+        outln!("* wall clock: this adapter has no timestamp queries");
     }
-    println!(
+    outln!(
         "diff in 8-bit sRGB levels vs {REFERENCE}; 'x ideal' = lighting computations / ideal (one per light reaching a visible sample); lights/tile = avg/max per cell of the pipeline's grid ({}px tiles; clusters for clustered_*), built by --assign {}",
         a.scene.renderer.tile,
         assigned_by.as_deref().unwrap_or("-")
@@ -237,12 +257,12 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         rows: &rows,
         notes: &notes,
     };
-    let path = a.out_dir.join(COMPARE_JSON);
+    let path = dir.staging().join(COMPARE_JSON);
     write_atomic(&path, &serde_json::to_vec_pretty(&summary)?)?;
     written.push(path);
     // Images of pipelines that failed this time must not stay from an earlier run.
-    dir.replace_earlier_files(&written)?;
-    println!(
+    dir.commit(&written, Earlier::Remove)?;
+    outln!(
         "images and stats in {} ({COMPARE_JSON}: the table)",
         a.out_dir.display()
     );

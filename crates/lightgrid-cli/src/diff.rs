@@ -11,7 +11,7 @@ use std::path::PathBuf;
 pub(crate) struct DiffArgs {
     pub(crate) a: PathBuf,
     pub(crate) b: PathBuf,
-    /// Print a JSON object {"mean", "p99", "max"} instead of text.
+    /// Print a JSON object {"mean", "p99", "max", "alpha_max"} instead of text.
     #[arg(long)]
     pub(crate) json: bool,
     /// Exit with status 1 when the mean difference is above this (a number at least 0).
@@ -36,13 +36,30 @@ pub(crate) fn diff_cmd(a: &DiffArgs) -> Result<()> {
     if let Some(p) = &a.diff_image {
         save_png(&vis, p)?;
     }
+    // The measure is of colour (what the renderer's images differ in); alpha, which a user's
+    // image may carry, is reported beside it rather than silently dropped.
+    let alpha_max = img_a
+        .pixels()
+        .zip(img_b.pixels())
+        .map(|(pa, pb)| pa[3].abs_diff(pb[3]))
+        .max()
+        .unwrap_or(0);
     if a.json {
-        println!("{}", serde_json::to_string(&d)?);
+        let mut v = serde_json::to_value(d)?;
+        v["alpha_max"] = alpha_max.into();
+        outln!("{}", serde_json::to_string(&v)?);
     } else {
-        println!(
-            "mean {:.4}  p99 {}  max {}  (8-bit sRGB levels, largest channel per pixel)",
-            d.mean, d.p99, d.max
+        outln!(
+            "mean {:.4}  p99 {}  max {}  (8-bit sRGB levels, largest colour channel per pixel)",
+            d.mean,
+            d.p99,
+            d.max
         );
+        if alpha_max == 0 {
+            outln!("alpha: equal");
+        } else {
+            outln!("alpha: differs by up to {alpha_max} levels (not part of the measure above)");
+        }
     }
     let mut over = Vec::new();
     if let Some(m) = a.max_mean.filter(|&m| d.mean > m) {

@@ -42,7 +42,7 @@ pub(crate) fn export(a: &ExportArgs) -> Result<()> {
     let (w, h) = Size::or_scene(a.size, &scene);
     let bytes = lightgrid::scene::gltf::export(&scene, a.frame, (w, h))?;
     write_atomic(&a.out, &bytes)?;
-    println!(
+    outln!(
         "{} frame {}: {} objects, {} lights, camera at {}x{} written to {} ({} bytes)",
         scene.name,
         a.frame,

@@ -6,15 +6,19 @@ use lightgrid::pipelines::PIPELINES;
 use lightgrid::scene::catalog::SCENES;
 
 pub(crate) fn list() -> Result<()> {
-    println!("adapters (in order of preference):");
+    outln!("adapters (in order of preference):");
     let adapters = list_adapters();
     if adapters.is_empty() {
-        println!("  none found: install mesa-vulkan-drivers for a software Vulkan adapter");
+        outln!("  none found: install mesa-vulkan-drivers for a software Vulkan adapter");
     }
     for a in adapters {
-        println!(
+        outln!(
             "  {}: {} [{}, {}] {}",
-            a.index, a.name, a.backend, a.device_type, a.driver
+            a.index,
+            a.name,
+            a.backend,
+            a.device_type,
+            a.driver
         );
         // The sample counts need a device; an adapter that will not open one says why.
         match lightgrid::gpu::GpuContext::new(Some(&a.index.to_string())) {
@@ -26,34 +30,34 @@ pub(crate) fn list() -> Result<()> {
                         .collect::<Vec<_>>()
                         .join(", ")
                 };
-                println!(
+                outln!(
                     "     --msaa: {} (with --gbuffer 32: {})",
                     counts(lightgrid::frame::GBufferFormat::F16),
                     counts(lightgrid::frame::GBufferFormat::F32)
                 );
             }
-            Err(e) => println!("     cannot open a device: {e}"),
+            Err(e) => outln!("     cannot open a device: {e}"),
         }
     }
-    println!("scenes:");
+    outln!("scenes:");
     for s in SCENES {
-        println!("  {:<12} {}", s.name, s.description);
+        outln!("  {:<12} {}", s.name, s.description);
     }
-    println!(
+    outln!(
         "  {:<12} a glTF 2.0 file: meshes, materials, textures, cameras, KHR_lights_punctual lights (--add-lights N fills any scene)",
         "FILE.gltf|.glb"
     );
-    println!("pipelines:");
+    outln!("pipelines:");
     for p in PIPELINES {
         let msaa = match p.msaa {
             lightgrid::pipelines::Msaa::Supported => "",
             lightgrid::pipelines::Msaa::Refused(_) => " [no MSAA]",
         };
-        println!("  {:<24} {} ({}){msaa}", p.id, p.description, p.paper);
+        outln!("  {:<24} {} ({}){msaa}", p.id, p.description, p.paper);
     }
-    println!("light assignment (--assign, for grid pipelines):");
+    outln!("light assignment (--assign, for grid pipelines):");
     for a in lightgrid::culling::Assign::ALL {
-        println!("  {:<10} {}", a.name(), a.description());
+        outln!("  {:<10} {}", a.name(), a.description());
     }
     Ok(())
 }

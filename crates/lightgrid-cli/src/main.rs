@@ -3,6 +3,9 @@
 //! default job: every pipeline on `robots-many`, with each image's difference from the
 //! `forward` reference. One module per command.
 
+#[macro_use]
+mod out;
+
 mod advise;
 mod args;
 mod bench;
@@ -32,6 +35,10 @@ struct Cli {
     /// the adapter's name (e.g. llvmpipe). Default: the best one (hardware first).
     #[arg(long, global = true)]
     adapter: Option<String>,
+    /// For the default job: write into out/ even if it holds files lightgrid did not write
+    /// (files of the same names are replaced). Commands take their own --force.
+    #[arg(long)]
+    force: bool,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -44,7 +51,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Render a frame with every pipeline and compare each with the forward reference.
     Compare(compare::CompareArgs),
-    /// Per-pixel difference of two images, in 8-bit sRGB levels.
+    /// Per-pixel difference of two images, in 8-bit sRGB levels of the colour channels; a
+    /// difference in alpha is reported beside it (alpha_max), not measured in it.
     Diff(diff::DiffArgs),
     /// Render-target memory and the traffic model of every pipeline at a frame size.
     Memory(memory::MemoryArgs),
@@ -85,6 +93,14 @@ fn default_sigpipe() {
 fn main() {
     default_sigpipe();
     let cli = Cli::parse();
+    if cli.force && cli.command.is_some() {
+        eprintln!("error: --force before a command applies to the default job only; give it after the command (lightgrid bench --force ...)");
+        std::process::exit(2);
+    }
+    if let Err(e) = args::handle_signals() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
     let result = match cli.command {
         None => compare::compare(
             cli.adapter.as_deref(),
@@ -109,6 +125,7 @@ fn main() {
                     warmup: 1,
                 },
                 out_dir: PathBuf::from("out"),
+                force: cli.force,
             },
         ),
         Some(Command::Render(a)) => render::render(cli.adapter.as_deref(), &a),
@@ -124,6 +141,8 @@ fn main() {
         Some(Command::Advise(a)) => advise::advise(cli.adapter.as_deref(), &a),
         Some(Command::List) => list::list(),
     };
+    // Output still buffered must reach stdout, or the command fails saying so.
+    let result = result.and_then(|()| out::flush());
     if let Err(e) = result {
         eprintln!("error: {e:#}");
         std::process::exit(1);

@@ -32,13 +32,13 @@ pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
         lightgrid::frame::validate_msaa(n)?;
     }
     for &n in &a.msaa {
-        table(a, n);
+        table(a, n)?;
     }
     footer(a)
 }
 
 /// The targets and traffic of every pipeline at `samples` samples per pixel.
-fn table(a: &MemoryArgs, samples: u32) {
+fn table(a: &MemoryArgs, samples: u32) -> Result<()> {
     let Size(w, h) = a.size;
     let settings = RenderSettings {
         gbuffer: a.gbuffer,
@@ -50,14 +50,20 @@ fn table(a: &MemoryArgs, samples: u32) {
     } else {
         String::new()
     };
-    println!("render targets at {w}x{h}, {}-bit G-buffer{msaa} (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
-    println!(
+    outln!("render targets at {w}x{h}, {}-bit G-buffer{msaa} (the lighting-count target is a statistics aid, not counted)", a.gbuffer.bits());
+    outln!(
         "{:<22} {:>6} {:>10}   {:>9} {:>9} {:>9} {:>9}   targets",
-        "pipeline", "B/px", "total MiB", "wr B/px", "rd B/px", "wr B/lit", "rd B/lit"
+        "pipeline",
+        "B/px",
+        "total MiB",
+        "wr B/px",
+        "rd B/px",
+        "wr B/lit",
+        "rd B/lit"
     );
     for p in PIPELINES {
         if let (true, lightgrid::pipelines::Msaa::Refused(why)) = (samples > 1, p.msaa) {
-            println!("{:<22} refuses MSAA: {why}", p.id);
+            outln!("{:<22} refuses MSAA: {why}", p.id);
             continue;
         }
         let m = p.memory_model(&settings);
@@ -67,7 +73,7 @@ fn table(a: &MemoryArgs, samples: u32) {
             .iter()
             .map(|t| format!("{} {}", t.name, t.bytes_per_pixel))
             .collect();
-        println!(
+        outln!(
             "{:<22} {:>6} {:>10.2}   {:>9} {:>9} {:>9} {:>9}   {}",
             p.id,
             m.bytes_per_pixel(),
@@ -79,7 +85,8 @@ fn table(a: &MemoryArgs, samples: u32) {
             targets.join(", ")
         );
     }
-    println!();
+    outln!();
+    Ok(())
 }
 
 fn footer(a: &MemoryArgs) -> Result<()> {
@@ -88,7 +95,7 @@ fn footer(a: &MemoryArgs) -> Result<()> {
         gbuffer: a.gbuffer,
         ..Default::default()
     };
-    println!(
+    outln!(
         "traffic model (deferred-shading-vs-deferred-lighting): render-target bytes per pixel and per lit pixel \
          (one lighting computation); blending counts as read + write; light data {} B per light, grid indices {} B; \
          tiled pipelines also upload their grid each frame (see --stats memory.grid_bytes)",
@@ -102,7 +109,7 @@ fn footer(a: &MemoryArgs) -> Result<()> {
     let clusters = tiles.clustered(slices, 1.0, 2.0)?;
     let kib = |d: &lightgrid::culling::GridDims| (d.cell_count() * 8) as f64 / 1024.0;
     let separate = lightgrid::culling::GridLists::Separate;
-    println!(
+    outln!(
         "light grid cells (8 B each) at tile {tile}: tiled {} cells = {:.1} KiB, clustered ({slices} slices) {} cells = {:.1} KiB; \
          with transparent objects and --lists separate a second layer: {:.1} and {:.1} KiB (the index lists depend on the frame: --stats memory.grid_bytes)",
         tiles.cell_count(),

@@ -142,7 +142,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
         })
     })?;
     eprintln!();
-    print_summary(&run);
+    print_summary(&run)?;
     if let Some(path) = &a.json {
         let json = PlayJson {
             scene: &scene.name,
@@ -183,7 +183,7 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     Ok(())
 }
 
-fn print_summary(run: &PlayRun) {
+fn print_summary(run: &PlayRun) -> Result<()> {
     let dist = |d: Option<Distribution>| {
         d.map_or("n/a".into(), |d| {
             format!(
@@ -192,10 +192,10 @@ fn print_summary(run: &PlayRun) {
             )
         })
     };
-    println!("{} frames, {:.2} fps", run.frames.len(), run.fps());
-    println!("frame ms (wall, frame to frame): {}", dist(run.frame_ms()));
-    println!("GPU ms (timestamp span):          {}", dist(run.gpu_ms()));
-    println!(
+    outln!("{} frames, {:.2} fps", run.frames.len(), run.fps());
+    outln!("frame ms (wall, frame to frame): {}", dist(run.frame_ms()));
+    outln!("GPU ms (timestamp span):          {}", dist(run.gpu_ms()));
+    outln!(
         "per frame: {:.2} submissions, {:.0} bytes read back, {:.0} bytes uploaded; {} frames overflowed their lists, {} had truncated loops",
         run.submits_per_frame(),
         run.readback_bytes_per_frame(),
@@ -203,4 +203,5 @@ fn print_summary(run: &PlayRun) {
         run.overflow_frames(),
         run.truncated_frames()
     );
+    Ok(())
 }

@@ -63,7 +63,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         match debug_view::draw(a.view, &out) {
             None => writes.push((path, encode_png(&out.image, path)?)),
             Some(d) => {
-                println!(
+                outln!(
                     "{}: 0 to {} {}{}{}",
                     a.view.name(),
                     d.max,
@@ -92,7 +92,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         write_atomic(path, &bytes)?;
     }
     let s = &out.stats;
-    println!(
+    outln!(
         "{} / {} frame {} at {}x{}: {} lights, {:.2} ms ({}) on {}",
         s.scene,
         s.pipeline,
@@ -104,7 +104,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         timing_label(s.timing),
         s.adapter
     );
-    println!(
+    outln!(
         "lighting computations {} (ideal {}, efficiency {}){}",
         s.lighting_computations
             .map_or("n/a".into(), |n| n.to_string()),
@@ -118,7 +118,7 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         }
     );
     if let (Some(assign), Some(indices)) = (&s.assign, s.grid_indices) {
-        println!(
+        outln!(
             "light assignment {assign}: {} ms ({} ms GPU timestamps{}), {indices} index entries in {} cells ({} with samples)",
             s.assign_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
             s.assign_gpu_ms.map_or("n/a".into(), |ms| format!("{ms:.2}")),
@@ -141,9 +141,9 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
             ),
             None => String::new(),
         };
-        println!("msaa {}x{edges}", s.msaa);
+        outln!("msaa {}x{edges}", s.msaa);
     }
-    println!(
+    outln!(
         "frame: {} queue submission(s), {} bytes read back and {:.2} ms waited inside the frame{}",
         s.submits,
         s.readback_bytes,

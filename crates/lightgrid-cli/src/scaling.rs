@@ -54,14 +54,21 @@ pub(crate) struct ScalingArgs {
     /// run at larger light counts.
     #[arg(long = "budget", allow_hyphen_values = true, default_value_t = 5.0, value_parser = parse_non_negative)]
     pub(crate) budget_s: f64,
-    /// Output directory (created; files an earlier run wrote there and this one does not are
-    /// removed; two runs into one directory at once are refused).
+    /// Output directory (created; files an earlier scaling run wrote there and this one does not
+    /// are removed, other commands' files are kept; an existing directory lightgrid did not
+    /// make must be empty; two runs into one directory at once are refused).
     #[arg(long, default_value = "scaling")]
     pub(crate) out: PathBuf,
+    /// Write into an existing directory that lightgrid did not make and that is not empty,
+    /// and over files there that lightgrid (or another command of it) did not write.
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
-    check_out_dir(&a.out)?;
+    // Only whether it can be written, here: what the directory holds is checked by the claim
+    // below, after the options (which a user fixes first) and before anything is rendered.
+    check_out_dir(&a.out, true)?;
     let info = lightgrid::pipelines::find(&a.pipeline)?;
     let given = Given {
         slices: a.slices.is_some(),
@@ -83,7 +90,7 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     };
     config.validate()?;
     let ctx = GpuContext::new(adapter)?;
-    let dir = OutDir::claim(&a.out)?;
+    let dir = OutDir::claim(&a.out, "scaling", a.force)?;
     let stop = stop_on_ctrl_c()?;
     eprintln!(
         "light assignment scaling on {}: {} at {}x{}, {} light counts x {} strategies, writing to {}",
@@ -100,11 +107,11 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     let mut results = lightgrid_bench::run_scaling(&ctx, &config, &stop, &mut progress)?;
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
-    let written = lightgrid_bench::write_scaling(&results, &a.out)?;
-    dir.replace_earlier_files(&written)?;
-    println!("{}", lightgrid_bench::scaling_table(&results));
-    println!("{}", lightgrid_bench::scaling_growth(&results));
-    println!(
+    let written = lightgrid_bench::write_scaling(&results, dir.staging())?;
+    dir.commit(&written, lightgrid_bench::Earlier::Remove)?;
+    outln!("{}", lightgrid_bench::scaling_table(&results));
+    outln!("{}", lightgrid_bench::scaling_growth(&results));
+    outln!(
         "{} points in {}; {} in {}",
         results.points.len(),
         format_duration(start.elapsed().as_secs_f64()),

@@ -128,3 +128,49 @@ fn bad_advise_options_are_refused() {
     assert!(std::fs::read_dir(&dir).unwrap().next().is_none());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_interrupted_advice_exits_1_and_says_so() {
+    use std::io::{BufRead, BufReader};
+    let dir = temp_dir("advise-interrupted");
+    let json = dir.join("advice.json");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .args([
+            "advise",
+            "--scene",
+            "robots-few",
+            "--size",
+            "64x36",
+            "--budget",
+            "60",
+            "--json",
+            json.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Once it measures (its first progress line), one SIGTERM: stop, not abort.
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
+        line.clear();
+    }
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(1), "{rest}");
+    assert!(
+        rest.contains("interrupted by a signal") && !rest.contains("panicked"),
+        "{rest}"
+    );
+    // What was measured is written, marked interrupted.
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["interrupted"], true);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -145,6 +145,24 @@ fn diff_prints_json_and_enforces_thresholds() {
     assert_eq!(v["max"], 40.0);
     assert!((v["mean"].as_f64().unwrap() - 2.0).abs() < 1e-9, "{v}");
     assert_eq!(v["p99"], 40.0);
+    assert_eq!(v["alpha_max"], 0, "{v}");
+    // Alpha is not in the measure, and said to differ rather than dropped silently.
+    let c = dir.join("c.png");
+    write_png(&c, |x, _| [50, 50, 50, if x == 3 { 100 } else { 255 }]);
+    let o = lightgrid(&["diff", a.to_str().unwrap(), c.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (v["max"].as_f64(), v["alpha_max"].as_u64()),
+        (Some(0.0), Some(155))
+    );
+    let o = lightgrid(&["diff", a.to_str().unwrap(), c.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("alpha: differs by up to 155 levels (not part of the measure above)"),
+        "{text}"
+    );
+    let o = lightgrid(&["diff", a.to_str().unwrap(), a.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("alpha: equal"));
     let over = lightgrid(&[
         "diff",
         a.to_str().unwrap(),

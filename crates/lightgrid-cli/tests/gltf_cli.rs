@@ -369,3 +369,48 @@ fn skipped_parts_are_warnings_and_required_ones_errors() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn two_files_with_one_name_are_two_scenes_in_a_bench() {
+    let dir = temp_dir("gltf-same-name");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    let (ga, gb) = (a.join("model.glb"), b.join("model.glb"));
+    ok(&["export", "--scene", "robots-few", "--out", s(&ga)]);
+    ok(&["export", "--scene", "random-top", "--out", s(&gb)]);
+    let bench = dir.join("bench");
+    let scenes = format!("{},{}", s(&ga), s(&gb));
+    let o = lightgrid(&[
+        "bench",
+        "--scene",
+        &scenes,
+        "--pipelines",
+        "forward",
+        "--frames",
+        "0",
+        "--size",
+        "16x8",
+        "--warmup",
+        "0",
+        "--out",
+        s(&bench),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("another scene is named model; this one is model-2"),
+        "{}",
+        stderr(&o)
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(bench.join("results.json")).unwrap()).unwrap();
+    let mut names: Vec<&str> = v["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["scene"].as_str().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["model", "model-2"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -320,7 +320,7 @@ fn compare_says_when_the_reference_failed() {
     std::fs::write(dir.join("forward.png"), b"earlier").unwrap();
     std::fs::write(dir.join("mine.txt"), b"not lightgrid's").unwrap();
     std::fs::write(
-        dir.join(lightgrid_bench::MANIFEST_FILE),
+        dir.join(lightgrid_bench::manifest_name("compare")),
         "forward.png\nforward.json\n",
     )
     .unwrap();
@@ -795,4 +795,448 @@ fn out_of_memory_at_target_creation_says_so_with_the_size() {
         !err.contains("Validation Error") && !err.contains("panicked"),
         "{err}"
     );
+}
+
+/// The files in `dir` (hidden ones too) with their bytes, sorted by name.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap();
+            (p.file_name().unwrap().to_string_lossy().into_owned(), bytes)
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+fn names(snapshot: &[(String, Vec<u8>)]) -> Vec<&str> {
+    snapshot.iter().map(|(n, _)| n.as_str()).collect()
+}
+
+/// A quick bench into `dir` (robots-few, forward, one frame at 32x18).
+fn quick_bench(dir: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "bench",
+        "--scene",
+        "robots-few",
+        "--pipelines",
+        "forward",
+        "--size",
+        "32x18",
+        "--frames",
+        "0",
+        "--warmup",
+        "0",
+        "--out",
+        s(dir),
+    ];
+    args.extend_from_slice(extra);
+    lightgrid(&args)
+}
+
+/// A quick compare into `dir` (robots-few at 8x8, every pipeline).
+fn quick_compare(dir: &Path, extra: &[&str]) -> Vec<String> {
+    let mut v: Vec<String> = [
+        "compare",
+        "--scene",
+        "robots-few",
+        "--size",
+        "8x8",
+        "--warmup",
+        "0",
+        "--out-dir",
+        s(dir),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    v.extend(extra.iter().map(|s| s.to_string()));
+    v
+}
+
+/// A quick scaling run into `dir`.
+fn quick_scaling(dir: &Path) -> Vec<&str> {
+    vec![
+        "scaling",
+        "--lights",
+        "100",
+        "--assign",
+        "cpu",
+        "--size",
+        "32x16",
+        "--warmup",
+        "0",
+        "--out",
+        s(dir),
+    ]
+}
+
+#[test]
+fn a_failed_write_to_stdout_is_a_message_and_exit_1() {
+    let dir = temp_dir("stdout-full");
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([9, 9, 9, 255]))
+        .save(&a)
+        .unwrap();
+    std::fs::copy(&a, &b).unwrap();
+    let png = dir.join("r.png");
+    let cases: Vec<Vec<String>> = vec![
+        vec!["list".into()],
+        vec!["memory".into(), "--size".into(), "64x64".into()],
+        vec!["diff".into(), "--json".into(), s(&a).into(), s(&b).into()],
+        render(&["--out", s(&png)]),
+    ];
+    for args in cases {
+        // `lightgrid list > /dev/full`: every write fails with ENOSPC.
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+            .args(&args)
+            .stdout(full)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("cannot write to standard output: No space left on device"),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn each_command_keeps_to_its_own_files_in_a_shared_directory() {
+    let dir = temp_dir("shared-dir");
+    let o = quick_bench(&dir, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bench = snapshot(&dir);
+    assert!(names(&bench).contains(&"summary.md"), "{:?}", names(&bench));
+    // A compare and a scaling run into the bench's directory: the bench stays whole.
+    let o = run(&quick_compare(&dir, &[]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = lightgrid(&quick_scaling(&dir));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let after = snapshot(&dir);
+    for (name, bytes) in bench.iter().filter(|(n, _)| !n.starts_with(".lightgrid")) {
+        let now = after.iter().find(|(n, _)| n == name);
+        assert!(
+            now.is_some_and(|(_, b)| b == bytes),
+            "{name} changed or lost"
+        );
+    }
+    for f in ["compare.json", "forward.png", "scaling.json"] {
+        assert!(names(&after).contains(&f), "{f}: {:?}", names(&after));
+    }
+    // A second bench replaces its own files only.
+    let o = quick_bench(&dir, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let again = snapshot(&dir);
+    for f in [
+        "compare.json",
+        "forward.png",
+        "scaling.json",
+        "results.json",
+    ] {
+        assert!(names(&again).contains(&f), "{f}: {:?}", names(&again));
+    }
+    // A file of the user's in a directory lightgrid made is not replaced either: the run is
+    // refused and its files kept aside.
+    std::fs::remove_file(dir.join("forward.png")).unwrap();
+    let mut manifest =
+        std::fs::read_to_string(dir.join(lightgrid_bench::manifest_name("compare"))).unwrap();
+    manifest = manifest.replace("forward.png\n", "");
+    std::fs::write(
+        dir.join(lightgrid_bench::manifest_name("compare")),
+        manifest,
+    )
+    .unwrap();
+    std::fs::write(dir.join("forward.png"), b"mine").unwrap();
+    let o = run(&quick_compare(&dir, &[]));
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("already holds forward.png (not written by lightgrid)")
+            && err.contains("--force"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(dir.join("forward.png")).unwrap(), b"mine");
+    assert!(
+        std::fs::read_dir(&dir).unwrap().any(|e| e
+            .unwrap()
+            .file_name()
+            .to_string_lossy()
+            .starts_with("lightgrid-compare-")),
+        "the refused run's files are kept aside"
+    );
+    let o = run(&quick_compare(&dir, &["--force"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read(dir.join("forward.png")).unwrap(), b"mine");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_directory_lightgrid_did_not_make_is_refused_unless_empty_or_forced() {
+    let dir = temp_dir("foreign-dir");
+    std::fs::write(dir.join("summary.md"), b"my notes").unwrap();
+    std::fs::write(dir.join("mine.txt"), b"mine").unwrap();
+    let before = snapshot(&dir);
+    let compare = quick_compare(&dir, &[]);
+    let compare: Vec<&str> = compare.iter().map(String::as_str).collect();
+    for args in [
+        vec!["bench", "--preset", "quick", "--out", s(&dir)],
+        compare,
+        quick_scaling(&dir),
+    ] {
+        assert_fails_with(&args, "is not empty and was not made by lightgrid");
+        assert_eq!(snapshot(&dir), before, "{args:?} changed the directory");
+    }
+    // The default job writes into out/ by the same rule.
+    let cwd = temp_dir("foreign-cwd");
+    std::fs::create_dir(cwd.join("out")).unwrap();
+    std::fs::write(cwd.join("out/results.csv"), b"a,b\n").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .current_dir(&cwd)
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(
+        !o.status.success() && err.contains("was not made by lightgrid"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(cwd.join("out")).unwrap().count(), 1);
+    // --force belongs after the command it is for.
+    assert_fails_with(&["--force", "list"], "default job only");
+    // Forced, a compare writes beside the user's files and leaves them.
+    let o = run(&quick_compare(&dir, &["--force"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(dir.join("summary.md")).unwrap(), b"my notes");
+    assert_eq!(std::fs::read(dir.join("mine.txt")).unwrap(), b"mine");
+    assert!(dir.join("compare.json").exists());
+    // An empty directory needs no --force.
+    let empty = temp_dir("empty-dir");
+    let o = quick_bench(&empty, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for d in [dir, cwd, empty] {
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}
+
+/// Run lightgrid with files limited to `bytes` (RLIMIT_FSIZE, SIGXFSZ ignored): a write past
+/// it fails with EFBIG as a full disk fails with ENOSPC, without root or a small file system.
+fn with_file_size_limit(args: &[&str], bytes: u64) -> std::process::Output {
+    use std::os::unix::process::CommandExt;
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lightgrid"));
+    cmd.args(args);
+    // SAFETY: only async-signal-safe calls between fork and exec.
+    unsafe {
+        cmd.pre_exec(move || {
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            let limit = libc::rlimit {
+                rlim_cur: bytes,
+                rlim_max: bytes,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    cmd.output().unwrap()
+}
+
+#[test]
+fn a_run_whose_writes_fail_part_way_leaves_the_earlier_run_whole() {
+    let dir = temp_dir("fsize");
+    let o = run(&quick_compare(&dir, &[]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = snapshot(&dir);
+    // The images and per-pipeline stats fit under 3000 bytes; compare.json (about 5 KB) does
+    // not: the run fails after writing most of its files.
+    let args = quick_compare(&dir, &[]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = with_file_size_limit(&args, 3000);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("compare.json") && err.contains("File too large"),
+        "{err}"
+    );
+    assert_eq!(
+        snapshot(&dir),
+        before,
+        "the directory is the earlier run's, nothing of the failed one"
+    );
+    assert!(
+        std::fs::read_dir(&dir)
+            .unwrap()
+            .all(|e| e.unwrap().path().is_file()),
+        "no staging directory left"
+    );
+    // export: the .glb is not there and neither is its temporary file.
+    let glb = dir.join("scene.glb");
+    let o = with_file_size_limit(&["export", "--scene", "robots-few", "--out", s(&glb)], 3000);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(snapshot(&dir), before, "no scene.glb and no temporary file");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn overwriting_an_output_keeps_its_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = temp_dir("mode");
+    let png = dir.join("private.png");
+    std::fs::write(&png, b"old").unwrap();
+    std::fs::set_permissions(&png, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let o = run(&render(&["--out", s(&png)]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mode = std::fs::metadata(&png).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o600, "{mode:o}");
+    assert_ne!(std::fs::read(&png).unwrap(), b"old");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_second_signal_exits_at_once_leaving_no_temporary_files() {
+    use std::io::{BufRead, BufReader};
+    let dir = temp_dir("sigterm-twice");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .args([
+            "bench",
+            "--scene",
+            "robots-few",
+            "--pipelines",
+            "forward,deferred",
+            "--size",
+            "32x18",
+            "--frames",
+            "0..259:1",
+            "--warmup",
+            "0",
+            "--out",
+            s(&dir),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
+        line.clear();
+    }
+    // Measuring: its staging directory exists.
+    let staging = || {
+        std::fs::read_dir(&dir)
+            .unwrap()
+            .filter(|e| {
+                let n = e.as_ref().unwrap().file_name();
+                let n = n.to_string_lossy();
+                n.starts_with(".lightgrid-run-") || n.ends_with(".tmp")
+            })
+            .count()
+    };
+    assert_eq!(staging(), 1);
+    // Two signals at once, of two kinds so the kernel cannot merge them into one: the
+    // second comes before the run could stop and write.
+    let pid = child.id();
+    let killed = Command::new("sh")
+        .args(["-c", &format!("kill -INT {pid}; kill -TERM {pid}")])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    assert_eq!(staging(), 0, "temporaries removed on the way out");
+    assert!(
+        !dir.join("results.json").exists(),
+        "aborted without writing"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn light_values_out_of_bounds_are_refused_with_the_cause() {
+    // A range whose square is no longer a normal f32: named as too small, not "not finite".
+    fails_with(
+        &render(&["--add-lights", "5", "--light-range", "1e-30"]),
+        "--light-range: 1e-30 is outside 1e-6",
+    );
+}
+
+#[test]
+fn export_refuses_what_its_import_cannot_read() {
+    let dir = temp_dir("export-limit");
+    let glb = dir.join("many.glb");
+    // 200,000 lights: a JSON part of about 90 MB, past the 64 MiB the import reads.
+    let o = lightgrid(&[
+        "export",
+        "--scene",
+        "stress",
+        "--lights",
+        "200000",
+        "--out",
+        s(&glb),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("200000 lights")
+            && err.contains("more than the 64 MiB")
+            && err.contains("own import refuses"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "nothing written"
+    );
+    // Below the limit the export is written and reads back.
+    let o = lightgrid(&[
+        "export",
+        "--scene",
+        "stress",
+        "--lights",
+        "20000",
+        "--out",
+        s(&glb),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = lightgrid(&[
+        "render",
+        "--scene",
+        s(&glb),
+        "--size",
+        "8x8",
+        "--warmup",
+        "0",
+        "--out",
+        s(&dir.join("x.png")),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn report_checks_its_input_before_writing() {
+    let dir = temp_dir("report-check");
+    let o = quick_bench(&dir, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A results.json edited so a scene name would leave the directory.
+    let mut v = json(&dir.join("results.json"));
+    v["runs"][0]["scene"] = "../../elsewhere".into();
+    std::fs::write(dir.join("results.json"), serde_json::to_vec(&v).unwrap()).unwrap();
+    let before = snapshot(&dir);
+    assert_fails_with(
+        &["report", s(&dir)],
+        "scene name \"../../elsewhere\" cannot be part of a file name",
+    );
+    assert_eq!(snapshot(&dir), before, "summary.md and the rest untouched");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

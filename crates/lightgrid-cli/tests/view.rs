@@ -440,3 +440,84 @@ fn bad_view_options_are_refused_before_a_window_opens() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Steps due at one frame run together: 10,000 of them over frames 0-4 end in a handful of
+/// frames (one step per frame would show 10,000), and a step past the bound is refused.
+#[test]
+fn steps_at_one_frame_run_together_and_script_frames_are_bounded() {
+    assert_fails_with(
+        &["view", "--script", "at 4294967295 pause"],
+        "at most 'at 10000'",
+    );
+    let x = Xvfb::start();
+    let script: Vec<String> = (0..10_000)
+        .map(|i| {
+            let action = if i % 2 == 0 { "pause" } else { "play" };
+            format!("at {} {action}", i % 5)
+        })
+        .collect();
+    let script = script.join("; ");
+    let err = x.run_ok(&[
+        "view",
+        "--scene",
+        "robots-few",
+        "--size",
+        "64x36",
+        "--script",
+        &script,
+        "--exit-after-frames",
+        "6",
+    ]);
+    let frames: u64 = err
+        .lines()
+        .find_map(|l| {
+            l.split(" frames shown")
+                .next()
+                .filter(|_| l.contains(" frames shown"))
+        })
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no frame count in:\n{err}"));
+    assert!(frames < 100, "{frames} frames for 10,000 steps:\n{err}");
+}
+
+/// The X server going away mid-session ends the viewer with "display lost" and exit 1, not
+/// a panic inside winit.
+#[test]
+fn a_lost_display_ends_the_viewer_with_a_message() {
+    let mut x = Xvfb::start();
+    let dir = temp_dir("view-display-lost");
+    let shot = dir.join("shown.png");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lightgrid"));
+    cmd.args([
+        "view",
+        "--scene",
+        "robots-few",
+        "--size",
+        "64x36",
+        "--script",
+        &format!("at 1 screenshot {}", shot.display()),
+    ])
+    .env("DISPLAY", &x.display)
+    .env_remove("WAYLAND_DISPLAY");
+    let viewer = std::thread::spawn(move || support::run_limited(cmd, Duration::from_secs(300)));
+    // Once it has shown frames (its screenshot is written), the display goes.
+    let start = std::time::Instant::now();
+    while !shot.exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(240),
+            "the viewer showed no frame"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    x.child.kill().unwrap();
+    x.child.wait().unwrap();
+    let (code, err) = viewer
+        .join()
+        .unwrap()
+        .unwrap_or_else(|err| panic!("the viewer kept running without its display:\n{err}"));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("display lost"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -2,8 +2,9 @@
 //! test or a demo can switch pipelines, resize the window, change the view and take
 //! screenshots without a person at the keyboard.
 //!
-//! Syntax: steps separated by `;`, each `at N ACTION` (N: the displayed frame, from 0) or a bare
-//! `ACTION` (frame 0). Actions:
+//! Syntax: steps separated by `;`, each `at N ACTION` (N: the displayed frame, from 0 to
+//! [`MAX_AT`]) or a bare `ACTION` (frame 0); the steps due at one frame run together in that
+//! frame, up to a screenshot or a resize (which wait for the frame to show them). Actions:
 //! `pipeline ID`, `tile N`, `msaa N`, `view shaded|lights|bounds|wasted`, `resize WxH`,
 //! `frame F` (jump the animation), `pause`, `play`, `panel on|off`, `screenshot FILE.png`,
 //! and the scene's options (the scene is opened again): `spots F` (the spot fraction, 0 to
@@ -35,6 +36,10 @@ pub struct Step {
     pub action: Action,
 }
 
+/// Latest settled frame a step may be due at: about three minutes at 60 frames per second,
+/// and more than any test or demo here waits; `at 4294967295` would never end.
+pub const MAX_AT: u32 = 10_000;
+
 fn number(word: Option<&str>, what: &str, step: &str) -> Result<u32, String> {
     let w = word.ok_or_else(|| format!("'{step}': {what} needs a number"))?;
     w.parse::<u32>()
@@ -54,6 +59,11 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
         if words.peek() == Some(&"at") {
             words.next();
             at = number(words.next(), "at", step)?;
+            if at > MAX_AT {
+                return Err(format!(
+                    "'{step}': at most 'at {MAX_AT}' (settled frames shown; a later step would keep the window open for hours)"
+                ));
+            }
         }
         let verb = words
             .next()
@@ -191,9 +201,12 @@ mod tests {
             "transparency maybe",
             "add-lights -1",
             "add-lights 99999999",
+            "at 10001 pause",
+            "at 4294967295 pause",
         ] {
             assert!(parse(bad).is_err(), "{bad} parsed");
         }
         assert_eq!(parse(" ; ;").unwrap(), vec![]);
+        assert_eq!(parse(&format!("at {MAX_AT} pause")).unwrap()[0].at, MAX_AT);
     }
 }

@@ -148,8 +148,19 @@ fn output_target(path: &Path) -> Result<std::path::PathBuf> {
 }
 
 /// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
-/// the file is either the complete new content or untouched (see [`output_target`]).
+/// the file is either the complete new content or untouched (see [`output_target`]). The
+/// temporary file is removed when the write fails (a full disk) and, through
+/// [`remove_temporaries`], when a signal ends the process; a file that is replaced keeps its
+/// permission mode.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |f| std::io::Write::write_all(f, bytes))
+}
+
+/// [`write_atomic`] with the writing done by `write` (the seam a test uses to fail part-way).
+fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> Result<()> {
     let target = output_target(path)?;
     let io = |cause| Error::Io {
         path: path.display().to_string(),
@@ -165,12 +176,91 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
             format!("{} has no file name", path.display()),
         ));
     }
-    let tmp = dir.join(sibling_name("tmp"));
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, &target).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
-    })
+    // The mode of the file being replaced (a 0600 file stays private): the rename replaces the
+    // inode, so the temporary file must carry it.
+    let mode = std::fs::metadata(&target).ok().map(|m| m.permissions());
+    let tmp = Temporary::new(dir.join(sibling_name("tmp")));
+    let mut file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(tmp.path())
+        .map_err(io)?;
+    write(&mut file).map_err(io)?;
+    // Errors a full disk reports only when the data is flushed show here, not after the rename.
+    file.sync_data().map_err(io)?;
+    drop(file);
+    if let Some(mode) = mode {
+        std::fs::set_permissions(tmp.path(), mode).map_err(io)?;
+    }
+    std::fs::rename(tmp.path(), &target).map_err(io)?;
+    tmp.keep();
+    Ok(())
+}
+
+/// Temporary files and directories alive in this process, so a signal handler can remove them
+/// ([`remove_temporaries`]) before the process exits.
+static TEMPORARIES: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// A temporary file or directory, listed while it lives and removed when dropped unless
+/// [`Temporary::keep`] says it became (by a rename) something that stays.
+pub struct Temporary {
+    path: std::path::PathBuf,
+    keep: bool,
+}
+
+impl Temporary {
+    /// List `path` (not created here) as a temporary to remove on drop or on a signal.
+    pub fn new(path: std::path::PathBuf) -> Temporary {
+        lock_temporaries().push(path.clone());
+        Temporary { path, keep: false }
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The path was renamed into place (or moved away): nothing to remove.
+    pub fn keep(mut self) {
+        self.keep = true;
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        let mut live = lock_temporaries();
+        if let Some(i) = live.iter().position(|p| *p == self.path) {
+            live.swap_remove(i);
+        }
+        if !self.keep {
+            remove_path(&self.path);
+        }
+    }
+}
+
+fn lock_temporaries() -> std::sync::MutexGuard<'static, Vec<std::path::PathBuf>> {
+    // A panic while the list was held leaves it valid (pushes and removals only).
+    TEMPORARIES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+fn remove_path(path: &Path) {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.is_dir() => drop(std::fs::remove_dir_all(path)),
+        Ok(_) => drop(std::fs::remove_file(path)),
+        Err(_) => {}
+    }
+}
+
+/// Remove every live [`Temporary`]: for a signal handler that exits the process next, since
+/// an exit runs no destructors. The list stays locked, so no new temporary is listed (and
+/// left behind) between this and the exit.
+pub fn remove_temporaries() -> impl Drop {
+    let live = lock_temporaries();
+    for p in live.iter() {
+        remove_path(p);
+    }
+    live
 }
 
 /// A temporary file name beside an output, short whatever the output's name (a name of 255
@@ -225,12 +315,12 @@ pub fn save_png(img: &RgbaImage, path: &Path) -> Result<()> {
 /// accept a new file, and the path must not be a directory or another non-regular file.
 pub fn check_writable(path: &Path) -> Result<()> {
     let target = output_target(path)?;
-    let probe = target.with_file_name(sibling_name("probe"));
-    std::fs::write(&probe, b"").map_err(|cause| Error::Io {
+    let probe = Temporary::new(target.with_file_name(sibling_name("probe")));
+    // The error names the output the user gave, not the probe's own name.
+    std::fs::write(probe.path(), b"").map_err(|cause| Error::Io {
         path: path.display().to_string(),
         cause,
     })?;
-    let _ = std::fs::remove_file(&probe);
     Ok(())
 }
 
@@ -248,5 +338,100 @@ pub fn file_identity(path: &Path) -> std::path::PathBuf {
     match (std::fs::canonicalize(dir), path.file_name()) {
         (Ok(d), Some(name)) => d.join(name),
         _ => path.to_path_buf(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Held by each test here: `remove_temporaries` removes every live temporary of the
+    /// process, those of a test writing beside it too.
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("lightgrid-image-io-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_write_failing_part_way_leaves_the_old_file_and_no_temporary() {
+        let _one = ONE_AT_A_TIME
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let dir = scratch("fail");
+        let out = dir.join("out.json");
+        std::fs::write(&out, b"old").unwrap();
+        // As a full disk fails: after part of the bytes.
+        let err = write_atomic_with(&out, |f| {
+            std::io::Write::write_all(f, b"partial")?;
+            Err(std::io::Error::from_raw_os_error(28))
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("out.json") && err.contains("No space left"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read(&out).unwrap(), b"old");
+        assert_eq!(names(&dir), ["out.json"], "no temporary file left");
+        assert!(
+            !lock_temporaries().iter().any(|p| p.starts_with(&dir)),
+            "nothing left listed"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn replacing_a_file_keeps_its_mode() {
+        let _one = ONE_AT_A_TIME
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        use std::os::unix::fs::PermissionsExt;
+        let dir = scratch("mode");
+        let out = dir.join("private.json");
+        std::fs::write(&out, b"old").unwrap();
+        for mode in [0o600, 0o640, 0o755] {
+            std::fs::set_permissions(&out, std::fs::Permissions::from_mode(mode)).unwrap();
+            write_atomic(&out, b"new").unwrap();
+            let got = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+            assert_eq!(got, mode, "{got:o} != {mode:o}");
+            assert_eq!(std::fs::read(&out).unwrap(), b"new");
+        }
+        assert_eq!(names(&dir), ["private.json"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn live_temporaries_are_removed_on_request() {
+        let _one = ONE_AT_A_TIME
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let dir = scratch("signal");
+        let file = Temporary::new(dir.join(".lightgrid-x.tmp"));
+        std::fs::write(file.path(), b"partial").unwrap();
+        let sub = Temporary::new(dir.join(".lightgrid-run-x"));
+        std::fs::create_dir_all(sub.path().join("inner")).unwrap();
+        drop(remove_temporaries());
+        assert!(names(&dir).is_empty(), "{:?}", names(&dir));
+        // A kept temporary (renamed into place) is not removed on drop.
+        let kept = Temporary::new(dir.join("kept"));
+        std::fs::write(kept.path(), b"").unwrap();
+        kept.keep();
+        drop((file, sub));
+        assert_eq!(names(&dir), ["kept"]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -487,6 +487,54 @@ fn corpus() -> Vec<Case> {
             "light 77, which does not exist",
         ),
         (
+            "light range far too small",
+            |d, _| d["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = json!(1e-30),
+            "light 0: range 1e-30 is too small",
+        ),
+        (
+            "light colour × intensity past f32",
+            |d, _| {
+                let l = &mut d["extensions"]["KHR_lights_punctual"]["lights"][0];
+                l["color"] = json!([1e30, 1e30, 1e30]);
+                l["intensity"] = json!(1e10);
+                l["range"] = json!(5.0);
+            },
+            "light 0: radiance (colour [1e30, 1e30, 1e30] × intensity",
+        ),
+        (
+            "light colour × intensity past f32, no range",
+            |d, _| {
+                let l = &mut d["extensions"]["KHR_lights_punctual"]["lights"][0];
+                l.as_object_mut().unwrap().remove("range");
+                l["color"] = json!([1e30, 1e30, 1e30]);
+                l["intensity"] = json!(1e10);
+            },
+            "gives no range lightgrid takes",
+        ),
+        (
+            "light intensity overflowing at a small range",
+            |d, _| {
+                let l = &mut d["extensions"]["KHR_lights_punctual"]["lights"][0];
+                l["intensity"] = json!(1e30);
+                l["range"] = json!(1e-5);
+            },
+            "cd gives at range",
+        ),
+        (
+            "light beyond the coordinate bound",
+            |d, _| {
+                let l = d["nodes"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .position(|n| n["extensions"]["KHR_lights_punctual"].is_object())
+                    .unwrap();
+                d["nodes"][l]["translation"] = json!([1e20, 0.0, 0.0]);
+                d["nodes"][l].as_object_mut().unwrap().remove("matrix");
+            },
+            "beyond ±1e12",
+        ),
+        (
             "negative light range",
             |d, _| d["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = json!(-3.0),
             "not a positive number",

@@ -13,7 +13,7 @@ impl<'c> App<'c> {
         self.check_patience(now)?;
         self.collect_analysis()?;
         if !self.pending(now) {
-            self.run_due_step()?;
+            self.run_due_steps()?;
         }
         self.apply_draft(now)?;
         self.follow_size(now)?;

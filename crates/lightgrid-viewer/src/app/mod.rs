@@ -133,7 +133,7 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
     std::thread::scope(|s| {
         s.spawn(move || analysis::serve(ctx, job_rx, done_tx));
         let mut app = App::new(ctx, opts, opened.scene, jobs, done, lost);
-        let ran = event_loop.run_app(&mut app);
+        let ran = run_catching_display_loss(|| event_loop.run_app(&mut app));
         // Dropping the app drops the job sender, which ends the worker.
         let App {
             fatal,
@@ -145,12 +145,50 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
         report.overflowed = figures.overflowed;
         report.truncated = figures.truncated;
         report.gpu_ms = LiveFigures::recent_mean(&figures.gpu_ms, crate::live::HISTORY);
-        ran.context("the window's event loop failed")?;
+        ran?.context("the window's event loop failed")?;
         match fatal {
             Some(e) => Err(e),
             None => Ok(report),
         }
     })
+}
+
+/// Run the event loop, turning the panic winit raises when the X server goes away (its X11
+/// backend unwraps every request's reply: `Connection(IoError(..))`) into a "display lost"
+/// error, with no panic message printed; any other panic goes on as a panic.
+fn run_catching_display_loss<T>(run: impl FnOnce() -> T) -> Result<T> {
+    fn message(payload: &(dyn std::any::Any + Send)) -> String {
+        payload
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_default()
+    }
+    // The X11 connection's errors as winit's unwraps print them (x11rb's ConnectionError).
+    fn display_gone(msg: &str) -> bool {
+        msg.contains("Connection(") || msg.contains("ConnectionError") || msg.contains("IoError")
+    }
+    let previous = Arc::new(std::panic::take_hook());
+    let chained = previous.clone();
+    std::panic::set_hook(Box::new(move |info| {
+        if !display_gone(&message(info.payload())) {
+            chained(info);
+        }
+    }));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run));
+    // Back to the hook the process had (the previous one is only shared with ours, now gone).
+    drop(std::panic::take_hook());
+    if let Ok(previous) = Arc::try_unwrap(previous) {
+        std::panic::set_hook(previous);
+    }
+    match result {
+        Ok(v) => Ok(v),
+        Err(payload) if display_gone(&message(payload.as_ref())) => Err(anyhow!(
+            "display lost: the connection to the display server failed ({})",
+            message(payload.as_ref())
+        )),
+        Err(payload) => std::panic::resume_unwind(payload),
+    }
 }
 
 /// The parts that exist while the window does.

@@ -30,25 +30,48 @@ impl<'c> App<'c> {
         })
     }
 
-    /// Run the next step when it is due: one step per frame, so each step's change is
-    /// shown (and settled) before the next one runs, and none while a screenshot waits.
-    pub(super) fn run_due_step(&mut self) -> Result<()> {
-        if !self.screenshots.is_empty() {
-            return Ok(());
+    /// Run the steps that are due, together in this frame: their changes of settings are
+    /// gathered and applied once (10,000 steps at frame 0 cost one frame and one renderer,
+    /// not 10,000 frames). A screenshot or a resize ends the batch, since it must see the
+    /// frame the steps before it make; none runs while a screenshot waits.
+    pub(super) fn run_due_steps(&mut self) -> Result<()> {
+        let mut gathered: Option<(Controls, Vec<String>)> = None;
+        while self.screenshots.is_empty() && self.requested_size.is_none() {
+            let Some(step) = self.script.get(self.next_step).cloned() else {
+                break;
+            };
+            if step.at > self.settled {
+                break;
+            }
+            self.next_step += 1;
+            let what = format!("script step at {}: {:?}", step.at, step.action);
+            let (next, _) = gathered.get_or_insert_with(|| (self.applied.clone(), Vec::new()));
+            if Self::change_controls(next, &step).with_context(|| what.clone())? {
+                if let Some((_, steps)) = &mut gathered {
+                    steps.push(what);
+                }
+                continue;
+            }
+            // The gathered changes first: this step comes after them.
+            self.apply_gathered(gathered.take())?;
+            self.run_step(&step).with_context(|| what)?;
         }
-        let Some(step) = self.script.get(self.next_step).cloned() else {
-            return Ok(());
-        };
-        if step.at > self.settled {
-            return Ok(());
-        }
-        self.next_step += 1;
-        self.run_step(&step)
-            .with_context(|| format!("script step at {}: {:?}", step.at, step.action))
+        self.apply_gathered(gathered)
     }
 
-    pub(super) fn run_step(&mut self, step: &Step) -> Result<()> {
-        let mut next = self.applied.clone();
+    /// Apply the settings several steps changed, naming them when it fails.
+    fn apply_gathered(&mut self, gathered: Option<(Controls, Vec<String>)>) -> Result<()> {
+        let Some((next, steps)) = gathered else {
+            return Ok(());
+        };
+        self.apply(next)
+            .map_err(|e| anyhow!(e))
+            .with_context(|| steps.join("; "))
+    }
+
+    /// Fold a step that changes the settings into `next`; false for a step that acts at once
+    /// (frame, pause, play, panel, resize, screenshot).
+    fn change_controls(next: &mut Controls, step: &Step) -> Result<bool> {
         match &step.action {
             Action::Pipeline(id) => next.pipeline = pipelines::find(id)?.id.to_string(),
             Action::Tile(n) => next.settings.tile_size = *n,
@@ -62,6 +85,19 @@ impl<'c> App<'c> {
                     range: None,
                 })
             }
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+
+    /// A step that acts at once (those [`Self::change_controls`] does not gather), or any
+    /// step alone.
+    pub(super) fn run_step(&mut self, step: &Step) -> Result<()> {
+        let mut next = self.applied.clone();
+        if Self::change_controls(&mut next, step)? {
+            return self.apply(next).map_err(|e| anyhow!(e));
+        }
+        match &step.action {
             Action::Resize(w, h) => {
                 let win = self.win.as_ref().context("no window")?;
                 let _ = win
@@ -69,31 +105,18 @@ impl<'c> App<'c> {
                     .request_inner_size(winit::dpi::PhysicalSize::new(*w, *h));
                 // Pending until the surface has it (X11 answers with a later event).
                 self.requested_size = Some((*w, *h));
-                return Ok(());
             }
             Action::Frame(f) => {
                 self.scene.check_frame(*f)?;
                 self.jump_to(*f);
-                return Ok(());
             }
-            Action::Pause => {
-                self.set_playing(false);
-                return Ok(());
-            }
-            Action::Play => {
-                self.set_playing(true);
-                return Ok(());
-            }
-            Action::Panel(on) => {
-                self.panel = *on;
-                return Ok(());
-            }
-            Action::Screenshot(path) => {
-                self.screenshots.push_back(path.clone());
-                return Ok(());
-            }
+            Action::Pause => self.set_playing(false),
+            Action::Play => self.set_playing(true),
+            Action::Panel(on) => self.panel = *on,
+            Action::Screenshot(path) => self.screenshots.push_back(path.clone()),
+            _ => unreachable!("settings changes are gathered above"),
         }
-        self.apply(next).map_err(|e| anyhow!(e))
+        Ok(())
     }
 
     // --- applying changes -------------------------------------------------------------------

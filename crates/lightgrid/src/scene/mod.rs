@@ -176,7 +176,114 @@ impl Spot {
     }
 }
 
+/// The bounds a light's numbers are checked against ([`Light::check_values`]), so that what
+/// the shaders compute from them stays finite in f32: the radiance (colour × intensity, what
+/// is uploaded) summed over [`MAX_LIGHTS`] lights (2^20 × 1e12 ≈ 1e18), even divided by the
+/// light pre-pass's smallest luminance (1e-8: 1e26), stays below f32's 3.4e38; the squared
+/// range the falloff divides by stays a normal f32 (1e-12 to 1e24), and so do squared
+/// distances between light positions within the coordinate bound. A tiny range is refused
+/// rather than turned into an infinite falloff or intensity.
+pub struct LightLimits {
+    /// Largest radiance component (colour × intensity).
+    pub max_radiance: f32,
+    /// Smallest and largest range, in scene units.
+    pub min_range: f32,
+    pub max_range: f32,
+    /// Largest absolute coordinate of a light's position.
+    pub max_coordinate: f32,
+}
+
+/// A number in a message: plain where that reads well, else with an exponent (f32's
+/// `Display` writes 1e30 with all its digits).
+pub fn show(v: f32) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e6).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A product computed in f64 (it may be past f32), to four significant digits: `1e40`.
+fn show_f64(v: f64) -> String {
+    let s = format!("{v:.3e}");
+    match s.split_once('e') {
+        Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
+        None => s,
+    }
+}
+
+/// [`show`] for the three parts of a vector: `[x, y, z]`.
+pub fn show3(v: Vec3) -> String {
+    format!("[{}, {}, {}]", show(v.x), show(v.y), show(v.z))
+}
+
+pub const LIGHT_LIMITS: LightLimits = LightLimits {
+    max_radiance: 1e12,
+    min_range: 1e-6,
+    max_range: 1e12,
+    max_coordinate: 1e12,
+};
+
 impl Light {
+    /// What is wrong with the light's numbers, with the values, or nothing: a range and
+    /// position within [`LIGHT_LIMITS`], finite non-negative colour and intensity whose
+    /// product (the radiance) is within them. Shared by the scene's validation
+    /// and the glTF import, which names the file and the light.
+    pub fn check_values(&self) -> std::result::Result<(), String> {
+        let lim = &LIGHT_LIMITS;
+        // The range first: an intensity derived from it (glTF candela) is only as good as it.
+        if !self.range.is_finite() || self.range <= 0.0 {
+            return Err(format!(
+                "range {} must be a positive number",
+                show(self.range)
+            ));
+        }
+        if self.range < lim.min_range {
+            return Err(format!(
+                "range {:e} is too small (at least {:e}: its square must stay a normal f32)",
+                self.range, lim.min_range
+            ));
+        }
+        if self.range > lim.max_range {
+            return Err(format!(
+                "range {:e} is too large (at most {:e})",
+                self.range, lim.max_range
+            ));
+        }
+        if !self.position.is_finite() || self.position.abs().max_element() > lim.max_coordinate {
+            return Err(format!(
+                "position {} is not finite or beyond ±{:e}",
+                show3(self.position),
+                lim.max_coordinate
+            ));
+        }
+        if !self.color.is_finite() || self.color.min_element() < 0.0 {
+            return Err(format!(
+                "colour {} must be finite and non-negative",
+                show3(self.color)
+            ));
+        }
+        if !self.intensity.is_finite() || self.intensity < 0.0 {
+            return Err(format!(
+                "intensity {} must be finite and non-negative",
+                show(self.intensity)
+            ));
+        }
+        // In f64: the f32 product itself may overflow to infinity.
+        let radiance = f64::from(self.color.max_element()) * f64::from(self.intensity);
+        if radiance > f64::from(lim.max_radiance) {
+            return Err(format!(
+                "radiance (colour {} × intensity {}) of {} exceeds {:e}",
+                show3(self.color),
+                show(self.intensity),
+                show_f64(radiance),
+                lim.max_radiance
+            ));
+        }
+        Ok(())
+    }
+
     /// A point light.
     pub fn point(position: Vec3, color: Vec3, intensity: f32, range: f32) -> Light {
         Light {
@@ -249,25 +356,11 @@ impl Light {
         [c.x, c.y, c.z, r]
     }
 
-    /// Finite position, colour and intensity, a positive finite range, and for a spot a unit
-    /// direction and cosines with -1 ≤ outer < inner ≤ 1.
+    /// Finite position, colour and intensity within [`LIGHT_LIMITS`]' bounds, a range within
+    /// them, and for a spot a unit direction and cosines with -1 ≤ outer < inner ≤ 1.
     pub fn validate(&self, index: usize) -> Result<()> {
-        let finite = self.position.is_finite()
-            && self.color.is_finite()
-            && self.intensity.is_finite()
-            && self.range.is_finite();
-        if !finite {
-            return Err(Error::invalid(
-                "light",
-                format!("light {index} has a non-finite position, colour, intensity or range"),
-            ));
-        }
-        if self.range <= 0.0 || self.intensity < 0.0 || self.color.min_element() < 0.0 {
-            return Err(Error::invalid(
-                "light",
-                format!("light {index} needs range > 0 and non-negative colour and intensity"),
-            ));
-        }
+        self.check_values()
+            .map_err(|reason| Error::invalid("light", format!("light {index}: {reason}")))?;
         if let Some(s) = self.spot {
             let unit = s.direction.is_finite() && (s.direction.length() - 1.0).abs() < 1e-3;
             let cones = s.cos_outer >= -1.0
@@ -810,5 +903,86 @@ impl Scene {
 
     pub fn materials_gpu(&self) -> Vec<GpuMaterial> {
         self.materials.iter().map(Material::to_gpu).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn error(l: &Light) -> String {
+        l.validate(3).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn light_values_are_checked_as_products_with_their_values() {
+        let ok = Light::point(Vec3::ZERO, Vec3::ONE, 10.0, 5.0);
+        ok.validate(0).unwrap();
+        // Each finite, the product past f32 (and far past the bound).
+        let e = error(&Light {
+            color: Vec3::splat(1e30),
+            intensity: 1e10,
+            ..ok
+        });
+        assert!(
+            e.contains("light 3: radiance (colour [1e30, 1e30, 1e30] × intensity 1e10) of 1e40 exceeds 1e12"),
+            "{e}"
+        );
+        // Just inside and just outside the bound.
+        let at = LIGHT_LIMITS.max_radiance;
+        Light {
+            intensity: at,
+            ..ok
+        }
+        .validate(0)
+        .unwrap();
+        assert!(error(&Light {
+            intensity: at * 1.01,
+            ..ok
+        })
+        .contains("radiance"));
+        // What the GPU gets from a light inside the bounds is finite, squares included.
+        let big = Light {
+            position: Vec3::splat(LIGHT_LIMITS.max_coordinate),
+            color: Vec3::ONE,
+            intensity: at,
+            range: LIGHT_LIMITS.max_range,
+            spot: None,
+        };
+        big.validate(0).unwrap();
+        let g = big.to_gpu();
+        assert!(g.radiance.iter().all(|c| c.is_finite()));
+        assert!((g.range * g.range).is_finite());
+        let (c, r) = big.bounding_sphere();
+        assert!(c.is_finite() && (r * r).is_finite() && (2.0 * c).length_squared().is_finite());
+        let tiny = LIGHT_LIMITS.min_range;
+        assert!((tiny * tiny).is_normal());
+    }
+
+    #[test]
+    fn a_tiny_range_is_named_as_the_cause() {
+        let ok = Light::point(Vec3::ZERO, Vec3::ONE, 10.0, 5.0);
+        let e = error(&Light { range: 1e-30, ..ok });
+        assert!(e.contains("range 1e-30 is too small"), "{e}");
+        let e = error(&Light { range: 1e30, ..ok });
+        assert!(e.contains("range 1e30 is too large"), "{e}");
+        let e = error(&Light {
+            range: f32::NAN,
+            ..ok
+        });
+        assert!(e.contains("range NaN must be a positive number"), "{e}");
+        let e = error(&Light {
+            intensity: -1.0,
+            ..ok
+        });
+        assert!(
+            e.contains("intensity -1 must be finite and non-negative"),
+            "{e}"
+        );
+        let e = error(&Light {
+            position: Vec3::new(0.0, 2e12, 0.0),
+            ..ok
+        });
+        assert!(e.contains("position [0, 2e12, 0]"), "{e}");
     }
 }

@@ -109,6 +109,16 @@ fn check_add_lights(add: &AddLights) -> Result<()> {
                 format!("{r} is not a positive number"),
             ));
         }
+        let lim = &super::LIGHT_LIMITS;
+        if r < lim.min_range || r > lim.max_range {
+            return Err(Error::invalid(
+                "--light-range",
+                format!(
+                    "{r:e} is outside {:e} to {:e} (a light's range squared must stay a normal f32)",
+                    lim.min_range, lim.max_range
+                ),
+            ));
+        }
     }
     Ok(())
 }
@@ -163,7 +173,14 @@ pub fn open(req: &SceneRequest) -> Result<Opened> {
             reason: "the file has no point or spot lights (KHR_lights_punctual); add some with --add-lights N".into(),
         });
     }
-    scene.validate()?;
+    // A file's scene that fails validation (a value from its extras, say) names the file.
+    scene.validate().map_err(|e| match req.is_file() {
+        true => Error::Gltf {
+            path: req.spec.clone(),
+            reason: e.to_string(),
+        },
+        false => e,
+    })?;
     Ok(Opened { scene, warnings })
 }
 

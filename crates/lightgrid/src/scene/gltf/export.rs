@@ -5,6 +5,7 @@
 //! the frame's camera.
 
 use super::import::{candela_from_intensity, ExactMaterial};
+use super::{MAX_FILE_BYTES, MAX_JSON_BYTES, MAX_TRIANGLES, MAX_VERTICES};
 use crate::error::{Error, Result};
 use crate::scene::{bounds_of, Material, Mesh, Scene};
 use glam::{Mat4, Quat, Vec3};
@@ -121,6 +122,56 @@ fn material_json(m: &Material) -> Value {
     v
 }
 
+/// What the import counts against its limits, counted as the export writes it: accessors
+/// read (POSITION elements, index elements) and what the instances bake.
+#[derive(Default)]
+struct Counts {
+    read_vertices: u64,
+    read_indices: u64,
+    baked_vertices: u64,
+    baked_triangles: u64,
+}
+
+impl Counts {
+    /// Refuse a file the import would refuse: the same constants, checked before anything is
+    /// written (a 1M-light scene's JSON part is far past [`MAX_JSON_BYTES`]).
+    fn check(&self, json_bytes: u64, file_bytes: u64, lights: usize) -> Result<()> {
+        let refuse = |what: String| {
+            Err(Error::invalid(
+                "export",
+                format!("{what}, which lightgrid's own import refuses; export fewer lights or less geometry"),
+            ))
+        };
+        if json_bytes > MAX_JSON_BYTES {
+            return refuse(format!(
+                "the JSON part would have {json_bytes} bytes ({lights} lights), more than the {} MiB a file may have",
+                MAX_JSON_BYTES >> 20
+            ));
+        }
+        if file_bytes > MAX_FILE_BYTES {
+            return refuse(format!(
+                "the file would have {file_bytes} bytes, more than {} MiB",
+                MAX_FILE_BYTES >> 20
+            ));
+        }
+        let (v, t) = (u64::from(MAX_VERTICES), u64::from(MAX_TRIANGLES));
+        if self.read_vertices > v || self.baked_vertices > v {
+            return refuse(format!(
+                "its meshes would have {} vertices ({} in its instances), more than {v}",
+                self.read_vertices, self.baked_vertices
+            ));
+        }
+        if self.read_indices > 3 * t || self.baked_triangles > t {
+            return refuse(format!(
+                "its meshes would have {} triangles ({} in its instances), more than {t}",
+                self.read_indices / 3,
+                self.baked_triangles
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// The GLB bytes of `scene` at `frame`, for frames of `size` (the camera's aspect ratio).
 pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     scene.validate()?;
@@ -130,6 +181,7 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     let mut meshes = Vec::new();
     let mut mesh_of: HashMap<(usize, usize, bool), usize> = HashMap::new();
     let mut nodes = Vec::new();
+    let mut counts = Counts::default();
     for (i, o) in scene.objects.iter().enumerate() {
         if scene.meshes[o.mesh].indices.is_empty() {
             continue; // glTF accessors hold at least one element
@@ -157,12 +209,17 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
                     &baked
                 };
                 meshes.push(mesh_json(&mut bin, mesh, o.material, flip));
+                counts.read_vertices += mesh.positions.len() as u64;
+                counts.read_indices += mesh.indices.len() as u64;
                 if trs {
                     mesh_of.insert(key, meshes.len() - 1);
                 }
                 meshes.len() - 1
             }
         };
+        let written = &scene.meshes[o.mesh];
+        counts.baked_vertices += written.positions.len() as u64;
+        counts.baked_triangles += written.indices.len() as u64 / 3;
         let mut node = json!({"name": format!("object {i}"), "mesh": mi});
         // The specification asks not to write the identity.
         if trs && m != Mat4::IDENTITY {
@@ -269,6 +326,7 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         data.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + data.len();
+    counts.check(json.len() as u64, total as u64, state.lights.len())?;
     let total = u32::try_from(total).map_err(|_| {
         Error::invalid(
             "export",

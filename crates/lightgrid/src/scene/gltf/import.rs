@@ -737,7 +737,22 @@ fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<
         Some(r) if r.is_finite() && r > 0.0 => r,
         Some(r) => return Err(format!("{what}: range {r} is not a positive number")),
         // Inverse-square light reaches illuminance LIGHT_CUTOFF at sqrt(I / cutoff).
-        None => (peak / LIGHT_CUTOFF).sqrt(),
+        None => {
+            // In f64: colour × intensity may overflow f32 (1e30 × 1e10).
+            let peak = f64::from(candela) * f64::from(colour.max_element());
+            let r = (peak / f64::from(LIGHT_CUTOFF)).sqrt();
+            let lim = &crate::scene::LIGHT_LIMITS;
+            if !(f64::from(lim.min_range)..=f64::from(lim.max_range)).contains(&r) {
+                return Err(format!(
+                    "{what}: colour {} × intensity {} cd = {peak:e} gives no range lightgrid takes (it has no range, and would reach {r:e}; ranges are {:e} to {:e})",
+                    crate::scene::show3(colour),
+                    crate::scene::show(candela),
+                    lim.min_range,
+                    lim.max_range
+                ));
+            }
+            r as f32
+        }
     };
     // A file lightgrid exported carries the exact numbers (the glTF ones are rounded through
     // the candela and angle conversions).
@@ -792,9 +807,19 @@ fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<
         range,
         spot,
     };
-    if !light.position.is_finite() || !light.range.is_finite() || !light.intensity.is_finite() {
-        return Err(format!("{what}: its placement or range is not finite"));
-    }
+    light.check_values().map_err(|reason| {
+        let derived = number("intensity").is_none()
+            && (reason.starts_with("radiance") || reason.starts_with("intensity"));
+        if derived {
+            format!(
+                "{what}: {reason} (the intensity {} cd gives at range {})",
+                crate::scene::show(candela),
+                crate::scene::show(range)
+            )
+        } else {
+            format!("{what}: {reason}")
+        }
+    })?;
     Ok(Some(light))
 }
 
