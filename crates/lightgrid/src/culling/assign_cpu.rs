@@ -283,10 +283,7 @@ impl AssignStrategy for CpuStrategy {
         // The slices the GPU spread over the frame's depth range (read back with the bounds:
         // the papers' CPU pipeline waits for the depth anyway).
         let dims = &match a.range {
-            Some(range) => {
-                let [lo, hi] = range.download(enc)?;
-                a.dims.clustered(a.dims.slices, lo, hi)?
-            }
+            Some(range) => range.download(enc, a.dims)?,
             None => *a.dims,
         };
         let cell_bounds: Option<Vec<[f32; 2]>> = match a.source {

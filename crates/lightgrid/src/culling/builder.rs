@@ -251,10 +251,7 @@ impl GridBuilder {
             Some(g) => g.clone(),
             None => {
                 let dims = match &self.range {
-                    Some(range) if last.sliced_on_gpu => {
-                        let [lo, hi] = range.read(device, queue)?;
-                        last.dims.clustered(last.dims.slices, lo, hi)?
-                    }
+                    Some(range) if last.sliced_on_gpu => range.read(device, queue, &last.dims)?,
                     _ => last.dims,
                 };
                 let strategy = self

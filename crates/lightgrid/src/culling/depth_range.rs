@@ -79,19 +79,18 @@ impl DepthRangePass {
         });
         let s = shader(samples);
         let layouts = [Some(scene_layout), Some(&layout)];
-        let size = std::mem::size_of::<GridParams>() as u64;
         DepthRangePass {
             reduce: compute_pipeline(device, "depth range", &s, "reduce", &layouts),
             finish: compute_pipeline(device, "depth range finish", &s, "finish", &layouts),
             layout,
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("depth range params"),
-                size,
+                size: PARAMS_BYTES,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             range: storage_buffer(device, "depth range", 8),
-            params_out: storage_buffer(device, "sliced grid params", size),
+            params_out: storage_buffer(device, "sliced grid params", PARAMS_BYTES),
         }
     }
 
@@ -135,24 +134,40 @@ impl DepthRangePass {
             pass.set_pipeline(&self.finish);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        let size = std::mem::size_of::<GridParams>() as u64;
         for target in targets {
-            encoder.copy_buffer_to_buffer(&self.params_out, 0, target, 0, size);
+            encoder.copy_buffer_to_buffer(&self.params_out, 0, target, 0, PARAMS_BYTES);
         }
     }
 
-    /// The slicing range of the last recorded frame (submits nothing itself: call after the
+    /// `dims` sliced as the last recorded frame was (submits nothing itself: call after the
     /// frame's work is submitted).
-    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<[f32; 2]> {
-        let bytes = download(device, queue, &self.range, 8)?;
-        Ok(bytemuck::pod_read_unaligned(&bytes))
+    pub fn read(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        dims: &GridDims,
+    ) -> Result<GridDims> {
+        let range = download(device, queue, &self.range, 8)?;
+        let params = download(device, queue, &self.params_out, PARAMS_BYTES)?;
+        Ok(sliced(dims, &range, &params))
     }
 
-    /// The slicing range, read back part-way through the frame (the CPU strategy's wait).
-    pub fn download(&self, enc: &mut FrameEncoder) -> Result<[f32; 2]> {
-        let bytes = enc.download(&self.range, 8)?;
-        Ok(bytemuck::pod_read_unaligned(&bytes))
+    /// `dims` sliced as this frame is, read back part-way through the frame (the CPU
+    /// strategy's wait).
+    pub fn download(&self, enc: &mut FrameEncoder, dims: &GridDims) -> Result<GridDims> {
+        let range = enc.download(&self.range, 8)?;
+        let params = enc.download(&self.params_out, PARAMS_BYTES)?;
+        Ok(sliced(dims, &range, &params))
     }
+}
+
+const PARAMS_BYTES: u64 = std::mem::size_of::<GridParams>() as u64;
+
+/// `dims` with the GPU's slicing: its range and, bit for bit, its scale and bias.
+fn sliced(dims: &GridDims, range: &[u8], params: &[u8]) -> GridDims {
+    let range: [f32; 2] = bytemuck::pod_read_unaligned(range);
+    let p: GridParams = bytemuck::pod_read_unaligned(params);
+    dims.with_slicing(range, p.slice_scale, p.slice_bias)
 }
 
 #[cfg(test)]

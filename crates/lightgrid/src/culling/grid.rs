@@ -9,7 +9,8 @@ use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::gpu_types::GridParams;
 
 /// The grid's shape: screen tiles, and for a clustered grid view-depth slices spaced
-/// exponentially between `near` and `far`. Cell index = (slice * tiles_y + ty) * tiles_x + tx.
+/// exponentially between `near` and `far` (the frame's samples' depth range, found on the GPU:
+/// `depth_range.rs`). Cell index = (slice * tiles_y + ty) * tiles_x + tx.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridDims {
     pub tile_size: u32,
@@ -19,8 +20,13 @@ pub struct GridDims {
     pub tiles_y: u32,
     /// 1 for a tiled grid.
     pub slices: u32,
+    /// The view-distance range the slices are spread over.
     pub near: f32,
     pub far: f32,
+    /// slice = floor(ln(w) * slice_scale + slice_bias): from `near` and `far`, or exactly the
+    /// GPU's values when it spread the slices ([`GridDims::with_slicing`]).
+    pub slice_scale: f32,
+    pub slice_bias: f32,
     /// Which samples the lists cover: opaque samples only, or transparent fragments too.
     pub lists: GridLists,
 }
@@ -38,6 +44,8 @@ impl GridDims {
             slices: 1,
             near: 0.0,
             far: 0.0,
+            slice_scale: 0.0,
+            slice_bias: 0.0,
             lists: GridLists::Opaque,
         })
     }
@@ -51,12 +59,29 @@ impl GridDims {
                 format!("need 0 < near < far, got {near} and {far}"),
             ));
         }
+        let s = slices as f32;
+        let span = (far / near).ln();
         Ok(GridDims {
             slices,
             near,
             far,
+            slice_scale: s / span,
+            slice_bias: -s * near.ln() / span,
             ..self
         })
+    }
+
+    /// The same grid sliced as the GPU sliced it (`depth_range.wgsl`'s `finish`): over
+    /// `[near, far]` with its own scale and bias, bit for bit, so the CPU puts every sample
+    /// in the slice the kernels put it in.
+    pub fn with_slicing(self, [near, far]: [f32; 2], slice_scale: f32, slice_bias: f32) -> Self {
+        GridDims {
+            near,
+            far,
+            slice_scale,
+            slice_bias,
+            ..self
+        }
     }
 
     /// Screen tiles (cells of one slice).
@@ -97,9 +122,7 @@ impl GridDims {
         if self.slices <= 1 {
             return (0.0, 0.0);
         }
-        let s = self.slices as f32;
-        let span = (self.far / self.near).ln();
-        (s / span, -s * self.near.ln() / span)
+        (self.slice_scale, self.slice_bias)
     }
 
     /// Slice of view distance `w` (the same formula as `grid_slice` in light_grid.wgsl).
@@ -118,8 +141,8 @@ impl GridDims {
         if self.slices <= 1 {
             return [0.0, f32::INFINITY];
         }
-        let ratio = self.far / self.near;
-        let at = |i: u32| self.near * ratio.powf(i as f32 / self.slices as f32);
+        // `slice_span` in cell_bounds.wgsl computes the same.
+        let at = |i: u32| ((i as f32 - self.slice_bias) / self.slice_scale).exp();
         [
             if k == 0 { 0.0 } else { at(k) },
             if k + 1 == self.slices {
