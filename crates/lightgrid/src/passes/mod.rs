@@ -126,6 +126,11 @@ pub fn draw_fullscreen(
 /// WGSL of a deferred compute pass's outputs (group 3).
 pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
 
+/// The MSAA edge test (`differs`) over a per-sample G-buffer: the edge-aware deferred kernel
+/// and the light volumes' edge marking both compose it, so they shade the same pixels per
+/// sample. Needs `GBUFFER_READ_WGSL` and `shader::msaa_wgsl`.
+pub const MSAA_EDGES_WGSL: &str = include_str!("msaa_edges.wgsl");
+
 /// Layout of group 3 of deferred compute passes (`compute_outputs.wgsl`).
 pub fn compute_outputs_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let storage = |binding, format| wgpu::BindGroupLayoutEntry {
