@@ -14,8 +14,9 @@ pub use crate::frame::targets::{
 };
 pub use gbuffer::{GBuffer, GBufferFormat, GBufferLayout, GBUFFER_READ_WGSL};
 pub use light_volumes::{
-    additive, classify_lights, volume_depth_format, LightVolumes, VolumeClasses, VolumeDraw,
-    VolumePipelineDesc, VOLUME_DEPTH_BYTES, VOLUME_WGSL,
+    additive, classify_lights, volume_depth_format, Fullscreen, FullscreenVolumeDesc, LightVolumes,
+    Shading, VolumeClasses, VolumeDraw, VolumePipelineDesc, COUNT_STENCIL_MASK, EDGE_STENCIL,
+    VOLUME_DEPTH_BYTES, VOLUME_WGSL,
 };
 pub use readback::{BufferReadback, DepthSamples, Readback};
 pub use tonemap::Tonemap;
