@@ -57,15 +57,23 @@ fn vs_volume_fullscreen(@builtin(vertex_index) i: u32, @location(1) light: u32) 
 }
 
 // The volume passes test against a depth-stencil copy of the scene depth (the scene depth
-// itself is sampled in the same pass); this writes the copy.
-@group(1) @binding(0) var copy_source: texture_depth_2d;
+// itself is sampled in the same pass); this writes the copy, sample by sample with MSAA
+// (reading `sample_index` makes the fragment run per sample; `DepthTexture` and the sample
+// count come from `shader::msaa_wgsl`).
+@group(1) @binding(0) var copy_source: DepthTexture;
 
 @fragment
-fn fs_copy_depth(@builtin(position) pos: vec4<f32>) -> @builtin(frag_depth) f32 {
-    return textureLoad(copy_source, vec2<u32>(pos.xy), 0);
+fn fs_copy_depth(@builtin(position) pos: vec4<f32>, @builtin(sample_index) s: u32) -> @builtin(frag_depth) f32 {
+    return textureLoad(copy_source, vec2<u32>(pos.xy), s);
 }
 
 @vertex
 fn vs_copy_depth(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    return fullscreen_position(i);
+}
+
+// Full-screen draws of a volume pass after the copy (`LightVolumes::fullscreen_pipeline`).
+@vertex
+fn vs_fullscreen_volume(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     return fullscreen_position(i);
 }

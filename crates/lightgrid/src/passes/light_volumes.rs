@@ -17,9 +17,22 @@
 //!    stencil test (z-fail marking is exact with the camera inside, but needs the back faces
 //!    unclipped by the far plane); the others fall back to classes 1 and 3.
 //!
-//! The volume passes depth-test against a Depth24PlusStencil8 copy of the scene depth, made by
-//! a full-screen pass at the start, because they also sample the scene depth to rebuild
-//! positions, and a texture cannot be a written stencil attachment and sampled in one pass.
+//! The volume passes depth-test against a depth-stencil copy of the scene depth
+//! ([`volume_depth_format`]), made by a full-screen pass at the start, because they also sample
+//! the scene depth to rebuild positions, and a texture cannot be a written stencil attachment
+//! and sampled in one pass.
+//!
+//! MSAA (tiled-deferred-tricks: "edge detection into stencil, then per-sample shading only on
+//! these edges and simple per-pixel everywhere else", Crysis 3): the copy is multisampled and
+//! written per sample; a full-screen pass sets the stencil's edge bit ([`EDGE_STENCIL`]) on the
+//! pixels whose samples show different surfaces (`passes/msaa_edges.wgsl`, the edge-aware
+//! kernel's test); then each volume class is drawn twice: [`Shading::PerPixel`] where the bit
+//! is clear (one fragment per pixel, shaded at the pixel centre, its colour written to every
+//! covered sample) and [`Shading::PerSample`] where it is set (the fragment shader reads
+//! `sample_index`, so it runs once per sample and shades the sample where it lies).
+//! `deferred_stencil`'s z-fail marks live in the low seven bits ([`COUNT_STENCIL_MASK`]), so
+//! they and the edge bit never disturb each other. Without MSAA no edge is marked and only the
+//! per-pixel pipelines exist.
 
 use crate::consts::{CONE_VOLUME_MARGIN, CONE_VOLUME_MIN_COS, CONE_VOLUME_SEGMENTS};
 use crate::scene::ViewSetup;
@@ -64,6 +77,60 @@ pub fn volume_depth_format(device: &wgpu::Device) -> wgpu::TextureFormat {
         wgpu::TextureFormat::Depth32FloatStencil8
     } else {
         wgpu::TextureFormat::Depth24PlusStencil8
+    }
+}
+
+/// The stencil bit marking an MSAA edge pixel: its samples are shaded one by one.
+pub const EDGE_STENCIL: u32 = 0x80;
+/// The stencil bits of the z-fail volume marks (`VolumeDraw::StencilMark`): below the edge bit.
+pub const COUNT_STENCIL_MASK: u32 = 0x7f;
+
+/// How the fragments of a volume (or full-screen) draw are shaded with MSAA.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shading {
+    /// Pixels whose edge bit is clear (every pixel without MSAA): one fragment per pixel.
+    PerPixel,
+    /// Pixels whose edge bit is set: the fragment entry reads `sample_index`, so it runs per
+    /// sample (MSAA only).
+    PerSample,
+}
+
+impl Shading {
+    /// The pipelines of a frame with `samples` samples per pixel.
+    pub fn of(samples: u32) -> &'static [Shading] {
+        if samples > 1 {
+            &[Shading::PerPixel, Shading::PerSample]
+        } else {
+            &[Shading::PerPixel]
+        }
+    }
+
+    fn edge_bit(self) -> u32 {
+        match self {
+            Shading::PerPixel => 0,
+            Shading::PerSample => EDGE_STENCIL,
+        }
+    }
+}
+
+/// The stencil reference a draw of `draw` with `shading` tests against (the pipelines'
+/// masks select the bits: see [`LightVolumes::pipeline`]).
+fn stencil_reference(draw: VolumeDraw, shading: Shading) -> u32 {
+    match draw {
+        VolumeDraw::StencilMark => 0,
+        // Inside the volume: the z-fail count's low bit (below).
+        VolumeDraw::StencilLight => shading.edge_bit() | 1,
+        _ => shading.edge_bit(),
+    }
+}
+
+/// Shading draws: the reference's edge bit equals the sample's.
+fn edge_test() -> wgpu::StencilFaceState {
+    wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Equal,
+        fail_op: wgpu::StencilOperation::Keep,
+        depth_fail_op: wgpu::StencilOperation::Keep,
+        pass_op: wgpu::StencilOperation::Keep,
     }
 }
 
@@ -185,6 +252,29 @@ pub struct VolumePipelineDesc<'a> {
     pub layouts: &'a [Option<&'a wgpu::BindGroupLayout>],
     pub color_targets: &'a [Option<wgpu::ColorTargetState>],
     pub draw: VolumeDraw,
+    /// Per pixel or (MSAA edge pixels) per sample; `StencilMark` writes no colour and is
+    /// drawn once, its pipeline `PerPixel`.
+    pub shading: Shading,
+}
+
+/// A full-screen draw of a volume pass (after the depth copy).
+pub struct FullscreenVolumeDesc<'a> {
+    pub label: &'a str,
+    pub module: &'a wgpu::ShaderModule,
+    pub fragment_entry: &'a str,
+    pub layouts: &'a [Option<&'a wgpu::BindGroupLayout>],
+    pub color_targets: &'a [Option<wgpu::ColorTargetState>],
+    pub kind: Fullscreen,
+}
+
+/// What a full-screen volume-pass draw does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fullscreen {
+    /// Shades the pixels (or edge samples) of `Shading`.
+    Shade(Shading),
+    /// Sets [`EDGE_STENCIL`] on every sample of the pixels its fragment does not discard; no
+    /// colour.
+    MarkEdges,
 }
 
 /// Additive blending (exit radiance, irradiance and counts accumulate over lights).
@@ -218,7 +308,23 @@ pub struct LightVolumes {
     pub depth: wgpu::TextureView,
     /// [`volume_depth_format`] on this device.
     pub depth_format: wgpu::TextureFormat,
+    /// Samples per pixel of the depth-stencil copy (the frame's).
+    pub samples: u32,
     copy_layout: wgpu::BindGroupLayout,
+}
+
+/// Colour targets kept in the pass but not written (stencil-only and copy draws).
+fn no_color(targets: &[Option<wgpu::ColorTargetState>]) -> Vec<Option<wgpu::ColorTargetState>> {
+    targets
+        .iter()
+        .map(|t| {
+            t.clone().map(|t| wgpu::ColorTargetState {
+                blend: None,
+                write_mask: wgpu::ColorWrites::empty(),
+                ..t
+            })
+        })
+        .collect()
 }
 
 fn instance_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
@@ -231,7 +337,8 @@ fn instance_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
 }
 
 impl LightVolumes {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+    /// Volumes for a `width` x `height` frame of `samples` samples per pixel.
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
         use wgpu::util::DeviceExt;
         let sphere = Mesh::sphere(ENCLOSING_SCALE, RINGS, SEGMENTS);
         let mut positions: Vec<[f32; 3]> = sphere.positions.iter().map(|p| p.to_array()).collect();
@@ -260,11 +367,12 @@ impl LightVolumes {
         });
         let sphere_count = sphere.indices.len() as u32;
         let depth_format = volume_depth_format(device);
-        let depth = super::render_texture(
+        let depth = super::multisampled_texture(
             device,
             "light volume depth-stencil",
             depth_format,
             (width, height),
+            samples,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
         .create_view(&Default::default());
@@ -276,7 +384,7 @@ impl LightVolumes {
                 ty: wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Depth,
                     view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
+                    multisampled: samples > 1,
                 },
                 count: None,
             }],
@@ -292,6 +400,7 @@ impl LightVolumes {
             cones_from: [0; 4],
             depth,
             depth_format,
+            samples,
             copy_layout,
         }
     }
@@ -324,8 +433,20 @@ impl LightVolumes {
     }
 
     /// A pipeline for one kind of volume draw (see [`VolumeDraw`]).
+    ///
+    /// Stencil (drawn with [`stencil_reference`]): shading draws pass where the edge bit is
+    /// what `shading` wants; `StencilMark` counts z-fails in the low seven bits (wrapping
+    /// within them: the write mask keeps the edge bit); `StencilLight` passes where the count's
+    /// low bit and the edge bit match the reference, and clears the count. A convex closed
+    /// volume not clipped by the far plane leaves a count of 0 or 1 (a back face behind the
+    /// surface adds one, a front face behind it takes one, and the front face lies before
+    /// the back face on every ray), so the low bit is "inside".
     pub fn pipeline(&self, device: &wgpu::Device, d: &VolumePipelineDesc) -> wgpu::RenderPipeline {
         use wgpu::{CompareFunction as C, Face, StencilFaceState, StencilOperation as Op};
+        assert!(
+            d.shading == Shading::PerPixel || self.samples > 1,
+            "per-sample volume pipelines need MSAA"
+        );
         // Reversed-Z (`crate::depth`): a front face in front of the scene surface, a back
         // face behind it.
         let (cull, compare, vertex_entry) = match d.draw {
@@ -338,6 +459,12 @@ impl LightVolumes {
             VolumeDraw::Full => (None, C::Always, "vs_volume_fullscreen"),
             VolumeDraw::StencilMark => (None, crate::depth::NEARER_OR_EQUAL, "vs_volume"),
             VolumeDraw::StencilLight => (Some(Face::Front), C::Always, "vs_volume"),
+        };
+        let both = |face: StencilFaceState, read_mask: u32, write_mask: u32| wgpu::StencilState {
+            front: face,
+            back: face,
+            read_mask,
+            write_mask,
         };
         let stencil = match d.draw {
             VolumeDraw::StencilMark => wgpu::StencilState {
@@ -353,35 +480,23 @@ impl LightVolumes {
                     depth_fail_op: Op::IncrementWrap,
                     pass_op: Op::Keep,
                 },
-                read_mask: 0xff,
-                write_mask: 0xff,
+                read_mask: COUNT_STENCIL_MASK,
+                write_mask: COUNT_STENCIL_MASK,
             },
-            VolumeDraw::StencilLight => {
-                let face = StencilFaceState {
-                    compare: C::NotEqual,
+            VolumeDraw::StencilLight => both(
+                StencilFaceState {
+                    compare: C::Equal,
                     fail_op: Op::Keep,
                     depth_fail_op: Op::Keep,
                     pass_op: Op::Zero,
-                };
-                wgpu::StencilState {
-                    front: face,
-                    back: face,
-                    read_mask: 0xff,
-                    write_mask: 0xff,
-                }
-            }
-            _ => Default::default(),
+                },
+                EDGE_STENCIL | 1,
+                COUNT_STENCIL_MASK,
+            ),
+            _ => both(edge_test(), EDGE_STENCIL, 0),
         };
-        let targets: Vec<Option<wgpu::ColorTargetState>> = if d.draw == VolumeDraw::StencilMark {
-            d.color_targets
-                .iter()
-                .map(|t| {
-                    t.clone().map(|t| wgpu::ColorTargetState {
-                        write_mask: wgpu::ColorWrites::empty(),
-                        ..t
-                    })
-                })
-                .collect()
+        let targets = if d.draw == VolumeDraw::StencilMark {
+            no_color(d.color_targets)
         } else {
             d.color_targets.to_vec()
         };
@@ -392,6 +507,7 @@ impl LightVolumes {
         });
         const POSITION: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
         const LIGHT: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![1 => Uint32];
+        let constants = self.constants();
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(d.label),
             layout: Some(&layout),
@@ -423,11 +539,14 @@ impl LightVolumes {
                 stencil,
                 bias: Default::default(),
             }),
-            multisample: Default::default(),
+            multisample: self.multisample(),
             fragment: Some(wgpu::FragmentState {
                 module: d.module,
                 entry_point: Some(d.fragment_entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
                 targets: &targets,
             }),
             multiview_mask: None,
@@ -435,8 +554,92 @@ impl LightVolumes {
         })
     }
 
-    /// The full-screen pipeline that copies the scene depth into [`Self::depth`]; the colour
-    /// targets must be the pass's (nothing is written to them).
+    /// A full-screen draw after the depth copy (no depth test): shading the pixels or edge
+    /// samples of its `Shading`, or marking the edges (see [`Fullscreen`]).
+    pub fn fullscreen_pipeline(
+        &self,
+        device: &wgpu::Device,
+        d: &FullscreenVolumeDesc,
+    ) -> wgpu::RenderPipeline {
+        use wgpu::{CompareFunction as C, StencilFaceState, StencilOperation as Op};
+        let (face, read_mask, write_mask) = match d.kind {
+            Fullscreen::Shade(_) => (edge_test(), EDGE_STENCIL, 0),
+            Fullscreen::MarkEdges => (
+                StencilFaceState {
+                    compare: C::Always,
+                    fail_op: Op::Keep,
+                    depth_fail_op: Op::Keep,
+                    pass_op: Op::Replace,
+                },
+                EDGE_STENCIL,
+                EDGE_STENCIL,
+            ),
+        };
+        let targets = match d.kind {
+            Fullscreen::Shade(_) => d.color_targets.to_vec(),
+            Fullscreen::MarkEdges => no_color(d.color_targets),
+        };
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(d.label),
+            bind_group_layouts: d.layouts,
+            immediate_size: 0,
+        });
+        let constants = self.constants();
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(d.label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: d.module,
+                entry_point: Some("vs_fullscreen_volume"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: self.depth_format,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(C::Always),
+                stencil: wgpu::StencilState {
+                    front: face,
+                    back: face,
+                    read_mask,
+                    write_mask,
+                },
+                bias: Default::default(),
+            }),
+            multisample: self.multisample(),
+            fragment: Some(wgpu::FragmentState {
+                module: d.module,
+                entry_point: Some(d.fragment_entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    fn multisample(&self) -> wgpu::MultisampleState {
+        wgpu::MultisampleState {
+            count: self.samples,
+            ..Default::default()
+        }
+    }
+
+    /// With MSAA, lighting fragments count into `pixel_counts` (`lit_out.wgsl`).
+    fn constants(&self) -> Vec<(&'static str, f64)> {
+        if self.samples > 1 {
+            vec![("MULTISAMPLED", 1.0)]
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// The full-screen pipeline that copies the scene depth into [`Self::depth`], sample by
+    /// sample with MSAA; the colour targets must be the pass's (nothing is written to them).
     pub fn copy_pipeline(
         &self,
         device: &wgpu::Device,
@@ -444,16 +647,7 @@ impl LightVolumes {
         scene_layout: &wgpu::BindGroupLayout,
         color_targets: &[Option<wgpu::ColorTargetState>],
     ) -> wgpu::RenderPipeline {
-        let targets: Vec<Option<wgpu::ColorTargetState>> = color_targets
-            .iter()
-            .map(|t| {
-                t.clone().map(|t| wgpu::ColorTargetState {
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::empty(),
-                    ..t
-                })
-            })
-            .collect();
+        let targets = no_color(color_targets);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("depth copy"),
             bind_group_layouts: &[Some(scene_layout), Some(&self.copy_layout)],
@@ -476,7 +670,7 @@ impl LightVolumes {
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
-            multisample: Default::default(),
+            multisample: self.multisample(),
             fragment: Some(wgpu::FragmentState {
                 module,
                 entry_point: Some("fs_copy_depth"),
@@ -551,9 +745,32 @@ impl LightVolumes {
         }
     }
 
-    /// Draw every light of class `Front`, `Back` or `Full` with the bound pipeline.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass, draw: VolumeDraw) {
+    /// Mark the MSAA edge pixels in the stencil with `pipeline` (a [`Fullscreen::MarkEdges`]
+    /// pipeline; its bind groups set).
+    pub fn mark_edges(&self, pass: &mut wgpu::RenderPass, pipeline: &wgpu::RenderPipeline) {
+        pass.set_pipeline(pipeline);
+        pass.set_stencil_reference(EDGE_STENCIL);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// A full-screen shading draw of the pixels or edge samples of `shading` with `pipeline`
+    /// (a [`Fullscreen::Shade`] pipeline; its bind groups set).
+    pub fn draw_fullscreen(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        pipeline: &wgpu::RenderPipeline,
+        shading: Shading,
+    ) {
+        pass.set_pipeline(pipeline);
+        pass.set_stencil_reference(shading.edge_bit());
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Draw every light of class `Front`, `Back` or `Full` with the bound pipeline, made for
+    /// `shading`.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, draw: VolumeDraw, shading: Shading) {
         self.bind(pass);
+        pass.set_stencil_reference(stencil_reference(draw, shading));
         match draw {
             VolumeDraw::Front => self.draw_instances(pass, 0, self.ranges[0].clone()),
             VolumeDraw::Back => self.draw_instances(pass, 1, self.ranges[1].clone()),
@@ -562,9 +779,17 @@ impl LightVolumes {
         }
     }
 
-    /// Draw the `k`-th light of the stencil class (mark or light, by the bound pipeline).
-    pub fn draw_stencil_light(&self, pass: &mut wgpu::RenderPass, k: u32) {
+    /// Draw the `k`-th light of the stencil class with the bound pipeline: its marks
+    /// (`StencilMark`) or its light (`StencilLight`, made for `shading`).
+    pub fn draw_stencil_light(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        k: u32,
+        draw: VolumeDraw,
+        shading: Shading,
+    ) {
         self.bind(pass);
+        pass.set_stencil_reference(stencil_reference(draw, shading));
         let i = self.ranges[3].start + k;
         self.draw_instances(pass, 3, i..i + 1);
     }

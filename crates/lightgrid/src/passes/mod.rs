@@ -14,8 +14,9 @@ pub use crate::frame::targets::{
 };
 pub use gbuffer::{GBuffer, GBufferFormat, GBufferLayout, GBUFFER_READ_WGSL};
 pub use light_volumes::{
-    additive, classify_lights, volume_depth_format, LightVolumes, VolumeClasses, VolumeDraw,
-    VolumePipelineDesc, VOLUME_DEPTH_BYTES, VOLUME_WGSL,
+    additive, classify_lights, volume_depth_format, Fullscreen, FullscreenVolumeDesc, LightVolumes,
+    Shading, VolumeClasses, VolumeDraw, VolumePipelineDesc, COUNT_STENCIL_MASK, EDGE_STENCIL,
+    VOLUME_DEPTH_BYTES, VOLUME_WGSL,
 };
 pub use readback::{BufferReadback, DepthSamples, Readback};
 pub use tonemap::Tonemap;
@@ -125,6 +126,11 @@ pub fn draw_fullscreen(
 
 /// WGSL of a deferred compute pass's outputs (group 3).
 pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
+
+/// The MSAA edge test (`differs`) over a per-sample G-buffer: the edge-aware deferred kernel
+/// and the light volumes' edge marking both compose it, so they shade the same pixels per
+/// sample. Needs `GBUFFER_READ_WGSL` and `shader::msaa_wgsl`.
+pub const MSAA_EDGES_WGSL: &str = include_str!("msaa_edges.wgsl");
 
 /// Layout of group 3 of deferred compute passes (`compute_outputs.wgsl`).
 pub fn compute_outputs_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {

@@ -12,33 +12,48 @@
 //!    inside the volume, then the volume's back faces shade only marked samples and clear the
 //!    mark. Lights reaching the far plane fall back to the plain volume draws of c.
 //!
+//! MSAA (tiled-deferred-tricks: edges marked in the stencil, their samples shaded apart): the
+//! G-buffer, depth copy and HDR target hold every sample; after a. a full-screen pass marks
+//! the edge pixels (`fs_mark_edges`, the edge-aware kernel's test), and b.–d. each run twice,
+//! per pixel where the edge bit is clear and per sample where it is set (`light_volumes.rs`).
+//!
 //! Groups: 0 scene, 1 depth-copy source (copy draw only), 2 G-buffer.
 
 use super::RenderSettings;
 use super::{lighting_attachments, FrameEncoder, FrameInputs, PipelineContext, Technique};
 use crate::error::Result;
+use crate::frame::targets::counts_in_target;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
 use crate::passes::VOLUME_DEPTH_BYTES;
 use crate::passes::{
-    additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_WGSL,
+    additive, classify_lights, Fullscreen, FullscreenVolumeDesc, LightVolumes, Shading, VolumeDraw,
+    VolumePipelineDesc, MSAA_EDGES_WGSL, VOLUME_WGSL,
 };
 use crate::passes::{GBuffer, GBufferLayout, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT};
 use crate::shader::{compose, create_module, src, ComposedShader};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    vec![shader(GBufferLayout::Full)]
+    vec![
+        shader(GBufferLayout::Full, 1),
+        shader(GBufferLayout::Full, 4),
+    ]
 }
 
 pub(super) fn shaders_mono() -> Vec<ComposedShader> {
-    vec![shader(GBufferLayout::MonoSpecular)]
+    vec![
+        shader(GBufferLayout::MonoSpecular, 1),
+        shader(GBufferLayout::MonoSpecular, 4),
+    ]
 }
 
-fn shader(layout: GBufferLayout) -> ComposedShader {
-    // Light volumes shade single-sample G-buffers only (`PipelineInfo::msaa`).
-    let single_sample = crate::shader::msaa_wgsl(1);
-    let name = match layout {
-        GBufferLayout::Full => "deferred",
-        GBufferLayout::MonoSpecular => "deferred_mono",
+/// The pipelines' shader for G-buffers of `samples` samples per pixel.
+fn shader(layout: GBufferLayout, samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    let name = match (layout, samples) {
+        (GBufferLayout::Full, 1) => "deferred",
+        (GBufferLayout::MonoSpecular, 1) => "deferred_mono",
+        (GBufferLayout::Full, _) => "deferred_msaa",
+        (GBufferLayout::MonoSpecular, _) => "deferred_mono_msaa",
     };
     compose(
         name,
@@ -49,30 +64,42 @@ fn shader(layout: GBufferLayout) -> ComposedShader {
             src::LIT_OUT,
             FULLSCREEN_WGSL,
             VOLUME_WGSL,
-            &single_sample,
+            &msaa,
             layout.read_wgsl(),
+            MSAA_EDGES_WGSL,
             include_str!("deferred.wgsl"),
         ],
     )
+}
+
+/// The pipelines of one [`Shading`]: per pixel, or per sample on MSAA edge pixels.
+struct Shaders {
+    shading: Shading,
+    base: wgpu::RenderPipeline,
+    front: wgpu::RenderPipeline,
+    back: wgpu::RenderPipeline,
+    full: wgpu::RenderPipeline,
+    /// `deferred_stencil`'s light draw (after the mark).
+    stencil_light: Option<wgpu::RenderPipeline>,
 }
 
 struct Deferred {
     gbuffer: GBuffer,
     volumes: LightVolumes,
     copy: wgpu::RenderPipeline,
-    base: wgpu::RenderPipeline,
-    front: wgpu::RenderPipeline,
-    back: wgpu::RenderPipeline,
-    full: wgpu::RenderPipeline,
-    /// (mark, light) for `deferred_stencil`.
-    stencil: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
+    /// MSAA: the edge-marking pass.
+    mark_edges: Option<wgpu::RenderPipeline>,
+    /// `deferred_stencil`'s z-fail marking.
+    stencil_mark: Option<wgpu::RenderPipeline>,
+    /// Per pixel, then (MSAA) per sample.
+    shaders: Vec<Shaders>,
 }
 
-/// HDR and count targets, both additive.
-pub(super) fn volume_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
+/// HDR and count targets, both additive (no count target with MSAA: `pixel_counts`).
+fn volume_targets(count_blend: bool, samples: u32) -> [Option<wgpu::ColorTargetState>; 2] {
     [
         Some(additive(HDR_FORMAT)),
-        count_blend.then(|| additive(COUNT_FORMAT)),
+        counts_in_target(count_blend, samples).then(|| additive(COUNT_FORMAT)),
     ]
 }
 
@@ -88,19 +115,20 @@ enum Cull {
 fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn Technique> {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
+    let samples = ctx.settings.msaa;
     let gbuffer = GBuffer::new(
         device,
         ctx.scene_layout,
         ctx.settings.gbuffer,
         layout,
         (w, h),
-        1,
+        samples,
     );
-    let volumes = LightVolumes::new(device, w, h);
-    let module = create_module(device, &shader(layout));
-    let targets = volume_targets(ctx.count_blend);
+    let volumes = LightVolumes::new(device, w, h, samples);
+    let module = create_module(device, &shader(layout, samples));
+    let targets = volume_targets(ctx.count_blend, samples);
     let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
-    let volume = |label, fragment_entry, draw| {
+    let volume = |label: &str, fragment_entry, draw, shading| {
         volumes.pipeline(
             device,
             &VolumePipelineDesc {
@@ -110,56 +138,76 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
                 layouts: &layouts,
                 color_targets: &targets,
                 draw,
+                shading,
             },
         )
     };
-    let base = {
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("deferred base"),
-            bind_group_layouts: &layouts,
-            immediate_size: 0,
-        });
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("deferred base"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
+    let fullscreen = |label: &str, fragment_entry, kind| {
+        volumes.fullscreen_pipeline(
+            device,
+            &FullscreenVolumeDesc {
+                label,
                 module: &module,
-                entry_point: Some("vs_base"),
-                compilation_options: Default::default(),
-                buffers: &[],
+                fragment_entry,
+                layouts: &layouts,
+                color_targets: &targets,
+                kind,
             },
-            primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: volumes.depth_format,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_base"),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
+        )
+    };
+    let shaders = Shading::of(samples)
+        .iter()
+        .map(|&shading| {
+            let (suffix, light, base) = match shading {
+                Shading::PerPixel => ("", "fs_light", "fs_base"),
+                Shading::PerSample => (" per sample", "fs_light_sample", "fs_base_sample"),
+            };
+            let label = |what: &str| format!("{what}{suffix}");
+            Shaders {
+                shading,
+                base: fullscreen(&label("deferred base"), base, Fullscreen::Shade(shading)),
+                front: volume(
+                    &label("light volumes (front faces)"),
+                    light,
+                    VolumeDraw::Front,
+                    shading,
+                ),
+                back: volume(
+                    &label("light volumes (back faces)"),
+                    light,
+                    VolumeDraw::Back,
+                    shading,
+                ),
+                full: volume(
+                    &label("light volumes (full screen)"),
+                    light,
+                    VolumeDraw::Full,
+                    shading,
+                ),
+                stencil_light: (cull == Cull::Stencil).then(|| {
+                    volume(
+                        &label("stencil light"),
+                        light,
+                        VolumeDraw::StencilLight,
+                        shading,
+                    )
+                }),
+            }
         })
-    };
-    let stencil = (cull == Cull::Stencil).then(|| {
-        (
-            volume("stencil mark", "fs_light", VolumeDraw::StencilMark),
-            volume("stencil light", "fs_light", VolumeDraw::StencilLight),
-        )
-    });
+        .collect();
     Box::new(Deferred {
         copy: volumes.copy_pipeline(device, &module, ctx.scene_layout, &targets),
-        base,
-        front: volume("light volumes (front faces)", "fs_light", VolumeDraw::Front),
-        back: volume("light volumes (back faces)", "fs_light", VolumeDraw::Back),
-        full: volume("light volumes (full screen)", "fs_light", VolumeDraw::Full),
-        stencil,
+        mark_edges: (samples > 1)
+            .then(|| fullscreen("msaa edge marking", "fs_mark_edges", Fullscreen::MarkEdges)),
+        stencil_mark: (cull == Cull::Stencil).then(|| {
+            volume(
+                "stencil mark",
+                "fs_stencil_only",
+                VolumeDraw::StencilMark,
+                Shading::PerPixel,
+            )
+        }),
+        shaders,
         gbuffer,
         volumes,
     })
@@ -179,13 +227,13 @@ pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
 
 impl Technique for Deferred {
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
-        let classes = classify_lights(&f.setup, f.lights, self.stencil.is_some());
+        let classes = classify_lights(&f.setup, f.lights, self.stencil_mark.is_some());
         self.volumes.upload(f.device, f.queue, &classes);
         let gbuffer_group = self.gbuffer.read_bind_group(f.device, f.targets);
         let copy_group = self.volumes.copy_bind_group(f.device, &f.targets.depth);
         let (encoder, timer) = enc.parts();
         self.gbuffer.encode(f, encoder, timer);
-        let label = if self.stencil.is_some() {
+        let label = if self.stencil_mark.is_some() {
             "deferred lighting (stencil)"
         } else {
             "deferred lighting"
@@ -201,23 +249,39 @@ impl Technique for Deferred {
         self.volumes
             .draw_depth_copy(&mut pass, f.scene_bind_group, &self.copy, &copy_group);
         pass.set_bind_group(2, &gbuffer_group, &[]);
-        pass.set_pipeline(&self.base);
-        pass.draw(0..3, 0..1);
-        for (pipeline, draw) in [
-            (&self.front, VolumeDraw::Front),
-            (&self.back, VolumeDraw::Back),
-            (&self.full, VolumeDraw::Full),
-        ] {
-            pass.set_pipeline(pipeline);
-            self.volumes.draw(&mut pass, draw);
+        if let Some(mark) = &self.mark_edges {
+            self.volumes.mark_edges(&mut pass, mark);
         }
-        if let Some((mark, light)) = &self.stencil {
-            pass.set_stencil_reference(0);
+        for s in &self.shaders {
+            self.volumes.draw_fullscreen(&mut pass, &s.base, s.shading);
+            for (pipeline, draw) in [
+                (&s.front, VolumeDraw::Front),
+                (&s.back, VolumeDraw::Back),
+                (&s.full, VolumeDraw::Full),
+            ] {
+                pass.set_pipeline(pipeline);
+                self.volumes.draw(&mut pass, draw, s.shading);
+            }
+        }
+        if let Some(mark) = &self.stencil_mark {
             for k in 0..self.volumes.stencil_count() {
                 pass.set_pipeline(mark);
-                self.volumes.draw_stencil_light(&mut pass, k);
-                pass.set_pipeline(light);
-                self.volumes.draw_stencil_light(&mut pass, k);
+                self.volumes.draw_stencil_light(
+                    &mut pass,
+                    k,
+                    VolumeDraw::StencilMark,
+                    Shading::PerPixel,
+                );
+                for s in &self.shaders {
+                    let light = s.stencil_light.as_ref().expect("stencil pipelines");
+                    pass.set_pipeline(light);
+                    self.volumes.draw_stencil_light(
+                        &mut pass,
+                        k,
+                        VolumeDraw::StencilLight,
+                        s.shading,
+                    );
+                }
             }
         }
         Ok(())

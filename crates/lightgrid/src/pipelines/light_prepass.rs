@@ -28,7 +28,7 @@ use crate::culling::{CellSource, GridBuilder};
 use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
-    additive, classify_lights, LightVolumes, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
+    additive, classify_lights, LightVolumes, Shading, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
     FULLSCREEN_WGSL, HDR_FORMAT, VOLUME_WGSL,
 };
 use crate::passes::{cleared, render_texture, texture_entry, VOLUME_DEPTH_BYTES};
@@ -39,8 +39,11 @@ use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShade
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
+    // Light volumes shade single-sample targets only (`PipelineInfo::msaa`).
+    let single_sample = crate::shader::msaa_wgsl(1);
     let mut parts = SCENE_PARTS.to_vec();
     parts.extend([
+        &single_sample,
         FULLSCREEN_WGSL,
         VOLUME_WGSL,
         ATTRIBUTES_WGSL,
@@ -155,7 +158,7 @@ fn volume_irradiance(
 ) -> Irradiance {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let volumes = Box::new(LightVolumes::new(device, w, h));
+    let volumes = Box::new(LightVolumes::new(device, w, h, 1));
     let irr_targets = [
         Some(additive(TARGET_FORMAT)),
         (!mono).then(|| additive(TARGET_FORMAT)),
@@ -177,6 +180,7 @@ fn volume_irradiance(
                 layouts: &layouts,
                 color_targets: &irr_targets,
                 draw,
+                shading: Shading::PerPixel,
             },
         )
     });
@@ -365,7 +369,7 @@ impl LightPrepass {
                 .zip([VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full])
         {
             pass.set_pipeline(pipeline);
-            volumes.draw(&mut pass, draw);
+            volumes.draw(&mut pass, draw, Shading::PerPixel);
         }
         Ok(())
     }

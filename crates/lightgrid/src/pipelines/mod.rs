@@ -82,7 +82,7 @@ pub enum Msaa {
     Refused(&'static str),
 }
 
-const LIGHT_VOLUMES_MSAA: &str = "light volumes shade per pixel; per-sample shading of the stencil-marked edge pixels is not implemented";
+const LIGHT_VOLUMES_MSAA: &str = "its irradiance volumes are drawn per pixel; per-sample irradiance on the stencil-marked edge pixels (as deferred shades them) is not implemented";
 const LIGHT_PREPASS_MSAA: &str = "its irradiance is accumulated per pixel; per-sample irradiance for edge pixels is not implemented";
 
 /// One registry row.
@@ -281,7 +281,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: deferred::shaders,
         create: deferred::create_plain,
         memory: deferred::memory,
@@ -296,7 +296,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: deferred::shaders,
         create: deferred::create_stencil,
         memory: deferred::memory,
@@ -311,7 +311,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward_mono_albedo",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: deferred::shaders_mono,
         create: deferred::create_mono,
         memory: deferred::memory_mono,

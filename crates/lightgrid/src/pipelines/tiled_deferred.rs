@@ -61,6 +61,7 @@ fn kernel_shader(samples: u32) -> ComposedShader {
             src::LIGHTING,
             &msaa,
             GBUFFER_READ_WGSL,
+            crate::passes::MSAA_EDGES_WGSL,
             src::LIGHT_GRID,
             src::TONE,
             include_str!("tiled_deferred_msaa.wgsl"),
