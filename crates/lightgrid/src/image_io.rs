@@ -189,12 +189,34 @@ fn write_atomic_with(
     // Errors a full disk reports only when the data is flushed show here, not after the rename.
     file.sync_data().map_err(io)?;
     drop(file);
+    if hard_linked(&target) {
+        // A rename would give this name a new inode and leave the file's other names with the
+        // old bytes. The whole new content exists (and fitted on the disk) in the temporary
+        // file, so the target is overwritten in place from it, keeping inode, links and mode;
+        // only this step is not atomic.
+        std::fs::copy(tmp.path(), &target).map_err(io)?;
+        return Ok(());
+    }
     if let Some(mode) = mode {
         std::fs::set_permissions(tmp.path(), mode).map_err(io)?;
     }
     std::fs::rename(tmp.path(), &target).map_err(io)?;
     tmp.keep();
     Ok(())
+}
+
+/// Does `path` name a file with more than one name (hard links)?
+fn hard_linked(path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.nlink() > 1)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        false
+    }
 }
 
 /// Temporary files and directories alive in this process, so a signal handler can remove them
@@ -411,6 +433,28 @@ mod tests {
             assert_eq!(std::fs::read(&out).unwrap(), b"new");
         }
         assert_eq!(names(&dir), ["private.json"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn replacing_a_hard_linked_file_keeps_its_links() {
+        let _one = ONE_AT_A_TIME
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        use std::os::unix::fs::MetadataExt;
+        let dir = scratch("links");
+        let (out, other) = (dir.join("a.json"), dir.join("b.json"));
+        std::fs::write(&out, b"old, and longer than the new").unwrap();
+        std::fs::hard_link(&out, &other).unwrap();
+        let inode = std::fs::metadata(&out).unwrap().ino();
+        write_atomic(&out, b"new").unwrap();
+        assert_eq!(std::fs::metadata(&out).unwrap().ino(), inode);
+        assert_eq!(
+            std::fs::read(&other).unwrap(),
+            b"new",
+            "the other name sees it"
+        );
+        assert_eq!(names(&dir), ["a.json", "b.json"], "no temporary left");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
