@@ -18,6 +18,9 @@
 // in the tile), so at most SAMPLES times the single-sample kernel's light steps where a block
 // is all edges; a workload past llvmpipe's loop guard is counted (`check_loop`), and the frame
 // refused.
+// Workgroup memory: the batch (4 KiB), the queue (1 KiB per sample above the first) and the
+// in-kernel resolve's sums (2 KiB): 13 KiB at 8x, within WebGPU's default 16 KiB; 16x needs
+// 21 KiB, which native adapters offer (the device takes the adapter's limits).
 // Counts: every shading point of the tile loops the tile's whole list, added to its pixel in
 // `pixel_counts`; the frame counters get edge pixels, samples shaded and samples with geometry,
 // as the grid kernel's.
