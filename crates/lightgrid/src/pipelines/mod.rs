@@ -228,7 +228,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
     PipelineInfo {
         id: "tiled_deferred_single",
-        description: "G-buffer, then one kernel: per tile depth bounds, cull all lights in workgroup memory, shade one sample per invocation",
+        description: "G-buffer, then one kernel: per tile depth bounds, cull all lights in workgroup memory, shade one pixel per invocation",
         paper: "tiled-shading §7",
         uses_grid: true,
         assign: false,
@@ -236,7 +236,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward",
-        msaa: Msaa::Refused("its one kernel shades one sample per invocation; edge-aware per-sample shading is implemented in tiled_deferred and clustered_deferred"),
+        msaa: Msaa::Supported,
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
         memory: tiled_deferred::memory_single,

@@ -6,7 +6,9 @@
 //! Groups: 0 scene, 1 grid, 2 G-buffer, 3 outputs.
 //!
 //! tiled_deferred_single (§7): 1. G-buffer pass; 2. one kernel, one workgroup per tile:
-//! depth bounds, frustum culling of all lights into workgroup memory, shading.
+//! depth bounds, frustum culling of all lights into workgroup memory, shading (with MSAA
+//! edge-aware, `tiled_deferred_single_msaa.wgsl`, writing the same outputs as the grid
+//! pipelines' MSAA kernel).
 //! Groups: 0 scene, 1 tile params, 2 G-buffer, 3 outputs.
 //!
 //! clustered_deferred (tiled-forward-shading §4.8): as tiled_deferred, but step 2 bounds each
@@ -64,10 +66,15 @@ fn kernel_shader(samples: u32) -> ComposedShader {
             crate::passes::MSAA_EDGES_WGSL,
             src::LIGHT_GRID,
             src::TONE,
+            MSAA_SAMPLE_OUTPUTS_WGSL,
             include_str!("tiled_deferred_msaa.wgsl"),
         ],
     )
 }
+
+/// The MSAA kernels' outputs (group 3 of `SampleOutputs`), shared by the grid and the single
+/// kernel.
+const MSAA_SAMPLE_OUTPUTS_WGSL: &str = include_str!("msaa_sample_outputs.wgsl");
 
 /// The pass writing the MSAA kernel's per-sample colours into the multisampled HDR target.
 fn expand_shader(samples: u32) -> ComposedShader {
@@ -82,12 +89,36 @@ fn expand_shader(samples: u32) -> ComposedShader {
 }
 
 pub(super) fn shaders_single() -> Vec<ComposedShader> {
-    let single_sample = crate::shader::msaa_wgsl(1);
-    let mut parts = deferred_parts(&single_sample);
-    parts.push(TILE_DEPTH_WGSL);
-    parts.push(crate::culling::TILE_FRUSTUM_WGSL);
-    parts.push(include_str!("tiled_deferred_single.wgsl"));
-    vec![compose("tiled_deferred_single", &parts)]
+    vec![single_kernel_shader(1), single_kernel_shader(4)]
+}
+
+/// The single kernel for `samples` samples per pixel: one sample per invocation, or above
+/// one the edge-aware kernel (`tiled_deferred_single_msaa.wgsl`).
+fn single_kernel_shader(samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    if samples == 1 {
+        let mut parts = deferred_parts(&msaa);
+        parts.push(TILE_DEPTH_WGSL);
+        parts.push(crate::culling::TILE_FRUSTUM_WGSL);
+        parts.push(include_str!("tiled_deferred_single.wgsl"));
+        return compose("tiled_deferred_single", &parts);
+    }
+    compose(
+        "tiled_deferred_single_msaa",
+        &[
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            src::LIGHTING,
+            &msaa,
+            GBUFFER_READ_WGSL,
+            crate::passes::MSAA_EDGES_WGSL,
+            TILE_DEPTH_WGSL,
+            crate::culling::TILE_FRUSTUM_WGSL,
+            src::TONE,
+            MSAA_SAMPLE_OUTPUTS_WGSL,
+            include_str!("tiled_deferred_single_msaa.wgsl"),
+        ],
+    )
 }
 
 enum Variant {
@@ -245,6 +276,22 @@ impl SampleOutputs {
     }
 }
 
+/// The shading kernel's group-3 layout and outputs: the targets, or with MSAA the per-sample
+/// colours.
+fn kernel_outputs(
+    device: &wgpu::Device,
+    (w, h): (u32, u32),
+    samples: u32,
+) -> (wgpu::BindGroupLayout, Outputs) {
+    if samples > 1 {
+        let (layout, outputs) = SampleOutputs::new(device, (w, h), samples);
+        (layout, Outputs::Samples(outputs))
+    } else {
+        let layout = compute_outputs_layout(device);
+        (layout.clone(), Outputs::Targets(layout))
+    }
+}
+
 struct TiledDeferred {
     gbuffer: GBuffer,
     outputs: Outputs,
@@ -277,13 +324,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         ..ctx.grid_setup()
     };
     let builder = GridBuilder::new(&setup, slices, CellSource::Depth);
-    let (outputs_layout, mut outputs) = if samples > 1 {
-        let (layout, outputs) = SampleOutputs::new(ctx.device, (w, h), samples);
-        (layout, Outputs::Samples(outputs))
-    } else {
-        let layout = compute_outputs_layout(ctx.device);
-        (layout.clone(), Outputs::Targets(layout))
-    };
+    let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let layouts = [
         Some(ctx.scene_layout),
         Some(builder.layout()),
@@ -322,15 +363,16 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
 
 pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
+    let samples = ctx.settings.msaa;
     let gbuffer = GBuffer::new(
         ctx.device,
         ctx.scene_layout,
         ctx.settings.gbuffer,
         GBufferLayout::Full,
         (w, h),
-        1,
+        samples,
     );
-    let outputs_layout = compute_outputs_layout(ctx.device);
+    let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let params_layout = ctx
         .device
         .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -360,21 +402,33 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
             resource: params.as_entire_binding(),
         }],
     });
+    let layouts = [
+        Some(ctx.scene_layout),
+        Some(&params_layout),
+        Some(&gbuffer.read_layout),
+        Some(&outputs_layout),
+    ];
+    let kernel = single_kernel_shader(samples);
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred single kernel",
-        &shaders_single()[0],
+        &kernel,
         "main",
-        &[
-            Some(ctx.scene_layout),
-            Some(&params_layout),
-            Some(&gbuffer.read_layout),
-            Some(&outputs_layout),
-        ],
+        &layouts,
     );
+    if let (Outputs::Samples(o), MsaaResolve::Kernel) = (&mut outputs, ctx.settings.msaa_resolve) {
+        o.resolving_kernel = Some(compute_pipeline_with(
+            ctx.device,
+            "tiled deferred single kernel (resolve in kernel)",
+            &kernel,
+            "main",
+            &layouts,
+            &[("RESOLVE_IN_KERNEL", 1.0)],
+        ));
+    }
     Box::new(TiledDeferred {
         gbuffer,
-        outputs: Outputs::Targets(outputs_layout),
+        outputs,
         shading,
         variant: Variant::Single {
             params,
@@ -421,7 +475,7 @@ impl Technique for TiledDeferred {
                 f.queue
                     .write_buffer(params, 0, bytemuck::bytes_of(&dims.params()));
                 // One workgroup per TILE_THREADS x TILE_THREADS block of a tile, so each
-                // invocation shades one sample (tiled_deferred_single.wgsl).
+                // invocation shades one pixel (tiled_deferred_single.wgsl).
                 let blocks = dims.tile_size.div_ceil(TILE_THREADS);
                 (
                     &*params_group,

@@ -13,46 +13,12 @@
 // in the pixel: `sample_position`), and each sample's colour is stored in
 // `sample_colors`; a fragment pass writes them into the multisampled HDR target
 // (`sample_expand.wgsl`), where the transparent pass blends and the tonemap resolves. Or,
-// with RESOLVE_IN_KERNEL, the samples are resolved here (Trick 1, below).
+// with RESOLVE_IN_KERNEL, the samples are resolved here (Trick 1; both in
+// msaa_sample_outputs.wgsl, shared with the single kernel's MSAA variant).
 // Counts go to `pixel_counts` (lighting computations) and the frame counters (edge pixels,
 // samples shaded, samples with geometry).
 
-// Per sample (pixel * SAMPLES + sample): HDR colour as two pack2x16float words.
-@group(3) @binding(0) var<storage, read_write> sample_colors: array<vec2<u32>>;
-// The in-kernel resolve's output: the display colour, sRGB-encoded (copied into the sRGB
-// display target, which cannot be a storage texture).
-@group(3) @binding(1) var resolved: texture_storage_2d<rgba8unorm, write>;
-
-// Resolve inside the kernel (tiled-deferred-tricks, Trick 1) instead of storing every
-// sample's colour: each pixel's tone-mapped samples, weighted 1/SAMPLES, are summed in
-// workgroup memory as 16-bit fixed point (two channels per u32, one atomicAdd per pair; the
-// weighted values are rounded down so a pixel's sum stays below 2^16 and never carries into
-// the next channel).
-override RESOLVE_IN_KERNEL: bool = false;
-
 const GROUP_PIXELS: u32 = SCREEN_WORKGROUP * SCREEN_WORKGROUP;
-// Per pixel of the workgroup: (R | G << 16, B).
-var<workgroup> accum: array<atomic<u32>, GROUP_PIXELS * 2u>;
-
-// Add `weight` of the tone-mapped `color` to local pixel `l`'s resolved colour.
-fn accumulate(l: u32, color: vec3<f32>, weight: f32) {
-    let q = vec3<u32>(floor(clamp(tone(color), vec3<f32>(0.0), vec3<f32>(1.0)) * weight * 65535.0));
-    atomicAdd(&accum[2u * l], q.r | (q.g << 16u));
-    atomicAdd(&accum[2u * l + 1u], q.b);
-}
-
-fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
-    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
-}
-
-// Sample `s` of pixel `p`: stored, or added to local pixel `l`'s resolved colour.
-fn output_sample(p: vec2<u32>, l: u32, s: u32, color: vec3<f32>, weight: f32) {
-    if (RESOLVE_IN_KERNEL) {
-        accumulate(l, color, weight);
-    } else {
-        store_sample(p.y * u32(frame.viewport.x) + p.x, s, color);
-    }
-}
 
 // The queued edge samples: (local pixel index << 8) | sample.
 var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
@@ -60,10 +26,6 @@ var<workgroup> queued: atomic<u32>;
 var<workgroup> group_edges: atomic<u32>;
 var<workgroup> group_first: atomic<u32>;
 var<workgroup> group_geometry: atomic<u32>;
-
-fn store_sample(pixel: u32, s: u32, color: vec3<f32>) {
-    sample_colors[pixel * SAMPLES + s] = vec2<u32>(pack2x16float(color.rg), pack2x16float(vec2<f32>(color.b, 1.0)));
-}
 
 // Sample `s` of pixel `p` at framebuffer position `xy` and depth-buffer value `depth`: shaded
 // from its cell's lights, counted into the pixel.
@@ -82,8 +44,7 @@ fn main(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
-    atomicStore(&accum[2u * li], 0u);
-    atomicStore(&accum[2u * li + 1u], 0u);
+    clear_resolve(li);
     if (li == 0u) {
         atomicStore(&queued, 0u);
         atomicStore(&group_edges, 0u);
@@ -94,7 +55,6 @@ fn main(
     let size = vec2<u32>(frame.viewport);
     let p = gid.xy;
     if (p.x < size.x && p.y < size.y) {
-        let pixel = p.y * size.x + p.x;
         let d0 = textureLoad(gb_depth, p, 0);
         let n0 = textureLoad(gb_normal, p, 0);
         var edge = false;
@@ -118,24 +78,15 @@ fn main(
             }
             atomicAdd(&group_first, 1u);
         }
-        let weight = 1.0 / f32(SAMPLES);
-        if (RESOLVE_IN_KERNEL && !edge) {
-            accumulate(li, c0, 1.0);
-        } else {
-            output_sample(p, li, 0u, c0, weight);
-        }
-        for (var s = 1u; s < SAMPLES; s = s + 1u) {
-            if (!edge) {
-                if (!RESOLVE_IN_KERNEL) {
-                    store_sample(pixel, s, c0);
-                }
-            } else if (!is_background(textureLoad(gb_depth, p, s))) {
-                queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
-            } else {
-                output_sample(p, li, s, vec3<f32>(0.0), weight);
-            }
-        }
+        output_pixel(p, li, edge, c0);
         if (edge) {
+            for (var s = 1u; s < SAMPLES; s = s + 1u) {
+                if (!is_background(textureLoad(gb_depth, p, s))) {
+                    queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
+                } else {
+                    output_sample(p, li, s, vec3<f32>(0.0), 1.0 / f32(SAMPLES));
+                }
+            }
             atomicAdd(&group_edges, 1u);
         }
         atomicAdd(&group_geometry, geometry);
@@ -154,15 +105,7 @@ fn main(
         output_sample(q, local, s, color, 1.0 / f32(SAMPLES));
     }
     check_loop(i, n);
-    if (RESOLVE_IN_KERNEL) {
-        workgroupBarrier();
-        if (p.x < size.x && p.y < size.y) {
-            let rg = atomicLoad(&accum[2u * li]);
-            let b = atomicLoad(&accum[2u * li + 1u]);
-            let c = vec3<f32>(f32(rg & 0xffffu), f32(rg >> 16u), f32(b)) / 65535.0;
-            textureStore(resolved, p, vec4<f32>(srgb_encode(c), 1.0));
-        }
-    }
+    finish_resolve(p, li, p.x < size.x && p.y < size.y);
     if (li == 0u) {
         atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
         atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n);
