@@ -417,11 +417,11 @@ fn bench_quick_preset_writes_its_report() {
             "--msaa",
             "4",
             "--pipelines",
-            "light_prepass",
+            "tiled_deferred_single",
             "--out",
             dir.to_str().unwrap(),
         ],
-        "--msaa does not apply to light_prepass (light_prepass: its irradiance volumes",
+        "--msaa does not apply to tiled_deferred_single (tiled_deferred_single: its one kernel",
     );
     assert_fails_with(
         &["bench", "--frames", "9..3", "--out", dir.to_str().unwrap()],
@@ -897,6 +897,6 @@ fn msaa_in_compare_render_and_memory() {
     assert_eq!(deferred.len(), 2, "{out}");
     assert_eq!(deferred[0].split_whitespace().nth(1), Some("44"), "{out}");
     assert_eq!(deferred[1].split_whitespace().nth(1), Some("416"), "{out}");
-    assert!(out.contains("light_prepass          refuses MSAA"), "{out}");
+    assert!(out.contains("tiled_deferred_single  refuses MSAA"), "{out}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

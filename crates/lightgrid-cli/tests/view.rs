@@ -334,7 +334,7 @@ fn a_script_step_that_cannot_run_fails_the_session() {
             "--size",
             "96x64",
             "--pipeline",
-            "light_prepass",
+            "tiled_deferred_single",
             "--script",
             "pause; at 1 msaa 4",
             "--exit-after-frames",
@@ -430,7 +430,7 @@ fn bad_view_options_are_refused_before_a_window_opens() {
     assert_fails_with(&["view", "--view", "sideways"], "--view");
     assert_fails_with(&["view", "--size", "0x10"], "--size");
     assert_fails_with(
-        &["view", "--pipeline", "light_prepass", "--msaa", "4"],
+        &["view", "--pipeline", "tiled_deferred_single", "--msaa", "4"],
         "does not apply",
     );
     assert_fails_with(&["view", "--frame", "100000"], "past the end");

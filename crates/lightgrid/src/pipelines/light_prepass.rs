@@ -2,12 +2,23 @@
 //! (deferred-shading-vs-deferred-lighting) lays it out.
 //!
 //! 1. Attributes pass: geometry → normal + specular exponent (RGBA16F) and depth.
-//! 2. Irradiance pass (HDR-range targets, additive): a depth copy, then each light's volume
-//!    (classes in `light_volumes.rs`) adds its diffuse irradiance and specular irradiance to two
-//!    RGBA16F targets; `_mono` keeps only the specular luminance, in the diffuse alpha, and has
-//!    no specular target.
-//! 3. Shading pass: geometry again (depth LessEqual against pass 1, no writes) reads the
-//!    irradiance at its pixel and applies the material colours.
+//! 2. Irradiance pass (HDR-range targets, additive): a depth-stencil copy, then each light's
+//!    volume (classes in `light_volumes.rs`) adds its diffuse irradiance and specular
+//!    irradiance to two RGBA16F targets; `_mono` keeps only the specular luminance, in the
+//!    diffuse alpha, and has no specular target.
+//! 3. Shading pass: geometry again, tested against the copy (the scene's surface test, no
+//!    writes), reads the irradiance at its pixel and applies the material colours.
+//!
+//! MSAA (tiled-deferred-tricks, as `deferred`): every target holds each sample. After the
+//! copy a full-screen pass sets the stencil's edge bit on the pixels whose samples need
+//! irradiance of their own (`attributes_differ`: geometry against sky, another exponent,
+//! plane or normal; the attributes hold no material id and need none, see
+//! `light_prepass_attributes.wgsl`); every volume class is drawn per pixel where the bit is
+//! clear (the irradiance at the pixel centre, written to every sample) and per sample where
+//! it is set. The copy is kept for pass 3, which draws the geometry twice on the same bit:
+//! per pixel elsewhere (sample 0's irradiance, which is every sample's), per sample on edge
+//! pixels (each sample's own). Material edges need no per-sample pass 3: the rasterizer
+//! gives each triangle's fragment exactly its own samples.
 //!
 //! Groups: pass 1: 0 scene. Pass 2: 0 scene, 1 depth-copy source, 2 attributes + depth.
 //! Pass 3: 0 scene, 1 irradiance.
@@ -26,12 +37,14 @@ use super::{
 use crate::consts::SCREEN_WORKGROUP;
 use crate::culling::{CellSource, GridBuilder};
 use crate::error::Result;
+use crate::frame::targets::counts_in_target;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
+use crate::passes::geometry::geometry_pipeline_on;
 use crate::passes::{
-    additive, classify_lights, LightVolumes, Shading, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
-    FULLSCREEN_WGSL, HDR_FORMAT, VOLUME_WGSL,
+    additive, classify_lights, Fullscreen, FullscreenVolumeDesc, LightVolumes, Shading, VolumeDraw,
+    VolumePipelineDesc, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT, MSAA_SURFACES_WGSL, VOLUME_WGSL,
 };
-use crate::passes::{cleared, render_texture, texture_entry, VOLUME_DEPTH_BYTES};
+use crate::passes::{cleared, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES};
 use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShader, SCENE_PARTS};
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
@@ -39,17 +52,27 @@ use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShade
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    // Light volumes shade single-sample targets only (`PipelineInfo::msaa`).
-    let single_sample = crate::shader::msaa_wgsl(1);
+    vec![shader(1), shader(4)]
+}
+
+/// The light pre-pass's shader for targets of `samples` samples per pixel.
+fn shader(samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    let name = if samples > 1 {
+        "light_prepass_msaa"
+    } else {
+        "light_prepass"
+    };
     let mut parts = SCENE_PARTS.to_vec();
     parts.extend([
-        &single_sample,
+        &msaa,
         FULLSCREEN_WGSL,
         VOLUME_WGSL,
+        MSAA_SURFACES_WGSL,
         ATTRIBUTES_WGSL,
         include_str!("light_prepass.wgsl"),
     ]);
-    vec![compose("light_prepass", &parts)]
+    compose(name, &parts)
 }
 
 /// Group 2 of the irradiance passes and the surface they read from it (both variants).
@@ -71,6 +94,7 @@ fn tiled_kernel() -> ComposedShader {
             src::LIGHTING,
             &crate::shader::msaa_wgsl(1),
             src::LIGHT_GRID,
+            MSAA_SURFACES_WGSL,
             ATTRIBUTES_WGSL,
             crate::passes::COMPUTE_OUTPUTS_WGSL,
             include_str!("tiled_light_prepass.wgsl"),
@@ -89,13 +113,25 @@ enum Mode {
     Tiled,
 }
 
+/// The volume pipelines of one [`Shading`]: per pixel, or per sample on MSAA edge pixels.
+struct VolumeShaders {
+    shading: Shading,
+    /// MSAA: the full-screen draw counting edge pixels and irradiance samples.
+    count: Option<wgpu::RenderPipeline>,
+    /// Front, back and full-screen volume classes.
+    classes: [wgpu::RenderPipeline; 3],
+}
+
 /// How the irradiance is accumulated (pass 2).
 enum Irradiance {
     /// Each light's volume rasterized, blending into the irradiance targets.
     Volumes {
         volumes: Box<LightVolumes>,
         copy: wgpu::RenderPipeline,
-        pipelines: [wgpu::RenderPipeline; 3],
+        /// MSAA: the edge-marking pass.
+        mark_edges: Option<wgpu::RenderPipeline>,
+        /// Per pixel, then (MSAA) per sample.
+        shaders: Vec<VolumeShaders>,
     },
     /// The tile grid, then one compute pass over the pixels.
     Tiled {
@@ -105,11 +141,15 @@ enum Irradiance {
     },
 }
 
+const CLASSES: [VolumeDraw; 3] = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full];
+
 struct LightPrepass {
     mono: bool,
+    samples: u32,
     attributes: wgpu::RenderPipeline,
     irradiance: Irradiance,
-    shade: wgpu::RenderPipeline,
+    /// Pass 3 per pixel, then (MSAA) per sample on the edge pixels.
+    shade: Vec<(Shading, wgpu::RenderPipeline)>,
     attr_view: wgpu::TextureView,
     diffuse_view: wgpu::TextureView,
     specular_view: Option<wgpu::TextureView>,
@@ -121,32 +161,30 @@ fn texture_layout(
     device: &wgpu::Device,
     label: &str,
     second: wgpu::TextureSampleType,
+    samples: u32,
 ) -> wgpu::BindGroupLayout {
     let first = wgpu::TextureSampleType::Float { filterable: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
-        entries: &[texture_entry(0, first), texture_entry(1, second)],
+        entries: &[
+            sampled_texture_entry(0, first, samples),
+            sampled_texture_entry(1, second, samples),
+        ],
     })
 }
 
-fn target(device: &wgpu::Device, label: &str, w: u32, h: u32) -> wgpu::TextureView {
-    target_for(
-        device,
-        label,
-        (w, h),
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-    )
-}
-
-/// A target read by a later pass and written as `written` (a render attachment or storage).
-fn target_for(
+/// A target of `samples` samples per pixel read by a later pass and written as `written` (a
+/// render attachment or storage).
+fn target(
     device: &wgpu::Device,
     label: &str,
     size: (u32, u32),
+    samples: u32,
     written: wgpu::TextureUsages,
 ) -> wgpu::TextureView {
     let usage = written | wgpu::TextureUsages::TEXTURE_BINDING;
-    render_texture(device, label, TARGET_FORMAT, size, usage).create_view(&Default::default())
+    multisampled_texture(device, label, TARGET_FORMAT, size, samples, usage)
+        .create_view(&Default::default())
 }
 
 /// Pass 2 of the light-volume variants.
@@ -158,36 +196,68 @@ fn volume_irradiance(
 ) -> Irradiance {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let volumes = Box::new(LightVolumes::new(device, w, h, 1));
+    let samples = ctx.settings.msaa;
+    let volumes = Box::new(LightVolumes::new(device, w, h, samples));
     let irr_targets = [
         Some(additive(TARGET_FORMAT)),
         (!mono).then(|| additive(TARGET_FORMAT)),
-        ctx.count_blend.then(|| additive(COUNT_FORMAT)),
+        counts_in_target(ctx.count_blend, samples).then(|| additive(COUNT_FORMAT)),
     ];
     let layouts = [Some(ctx.scene_layout), None, Some(attr_layout)];
-    let entry = if mono {
-        "fs_irradiance_mono"
-    } else {
-        "fs_irradiance"
-    };
-    let pipelines = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full].map(|draw| {
-        volumes.pipeline(
+    let fullscreen = |label: &str, fragment_entry, kind| {
+        volumes.fullscreen_pipeline(
             device,
-            &VolumePipelineDesc {
-                label: "light pre-pass irradiance",
+            &FullscreenVolumeDesc {
+                label,
                 module,
-                fragment_entry: entry,
+                fragment_entry,
                 layouts: &layouts,
                 color_targets: &irr_targets,
-                draw,
-                shading: Shading::PerPixel,
+                kind,
             },
         )
-    });
+    };
+    let shaders = Shading::of(samples)
+        .iter()
+        .map(|&shading| {
+            let (entry, count) = match (shading, mono) {
+                (Shading::PerPixel, false) => ("fs_irradiance", "fs_count"),
+                (Shading::PerPixel, true) => ("fs_irradiance_mono", "fs_count"),
+                (Shading::PerSample, false) => ("fs_irradiance_sample", "fs_count_sample"),
+                (Shading::PerSample, true) => ("fs_irradiance_mono_sample", "fs_count_sample"),
+            };
+            VolumeShaders {
+                shading,
+                count: (samples > 1).then(|| {
+                    fullscreen(
+                        "light pre-pass msaa counts",
+                        count,
+                        Fullscreen::Shade(shading),
+                    )
+                }),
+                classes: CLASSES.map(|draw| {
+                    volumes.pipeline(
+                        device,
+                        &VolumePipelineDesc {
+                            label: "light pre-pass irradiance",
+                            module,
+                            fragment_entry: entry,
+                            layouts: &layouts,
+                            color_targets: &irr_targets,
+                            draw,
+                            shading,
+                        },
+                    )
+                }),
+            }
+        })
+        .collect();
     Irradiance::Volumes {
         copy: volumes.copy_pipeline(device, module, ctx.scene_layout, &irr_targets),
+        mark_edges: (samples > 1)
+            .then(|| fullscreen("msaa edge marking", "fs_mark_edges", Fullscreen::MarkEdges)),
+        shaders,
         volumes,
-        pipelines,
     }
 }
 
@@ -221,8 +291,13 @@ fn tiled_irradiance(ctx: &PipelineContext, attr_layout: &wgpu::BindGroupLayout) 
 fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let mono = mode != Mode::Full;
     let device = ctx.device;
-    let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let module = create_module(device, &shaders()[0]);
+    let size = (ctx.dims.width, ctx.dims.height);
+    let samples = ctx.settings.msaa;
+    assert!(
+        samples == 1 || mode != Mode::Tiled,
+        "tiled_light_prepass refuses MSAA (PipelineInfo::msaa)"
+    );
+    let module = create_module(device, &shader(samples));
     let attributes = geometry_pipeline(
         device,
         &GeometryPipelineDesc {
@@ -233,18 +308,20 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             color_targets: &[Some(TARGET_FORMAT.into())],
             depth_write: true,
             depth_compare: crate::depth::SURFACE,
-            samples: 1,
+            samples,
         },
     );
     let attr_layout = texture_layout(
         device,
         "light pre-pass attributes",
         wgpu::TextureSampleType::Depth,
+        samples,
     );
     let irr_layout = texture_layout(
         device,
         "light pre-pass irradiance",
         wgpu::TextureSampleType::Float { filterable: false },
+        samples,
     );
     let irradiance = match mode {
         Mode::Tiled => tiled_irradiance(ctx, &attr_layout),
@@ -254,27 +331,51 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
         Mode::Tiled => wgpu::TextureUsages::STORAGE_BINDING,
         _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
     };
-    let shade = geometry_pipeline(
-        device,
-        &GeometryPipelineDesc {
-            label: "light pre-pass shading",
-            module: &module,
-            fragment_entry: Some(if mono { "fs_shade_mono" } else { "fs_shade" }),
-            layouts: &[Some(ctx.scene_layout), Some(&irr_layout)],
-            color_targets: &[Some(HDR_FORMAT.into())],
-            depth_write: false,
-            depth_compare: crate::depth::SURFACE,
-            samples: 1,
-        },
-    );
+    let shade = Shading::of(samples)
+        .iter()
+        .map(|&shading| {
+            let entry = match (shading, mono) {
+                (Shading::PerPixel, false) => "fs_shade",
+                (Shading::PerPixel, true) => "fs_shade_mono",
+                (Shading::PerSample, false) => "fs_shade_sample",
+                (Shading::PerSample, true) => "fs_shade_mono_sample",
+            };
+            let desc = GeometryPipelineDesc {
+                label: "light pre-pass shading",
+                module: &module,
+                fragment_entry: Some(entry),
+                layouts: &[Some(ctx.scene_layout), Some(&irr_layout)],
+                color_targets: &[Some(HDR_FORMAT.into())],
+                depth_write: false,
+                depth_compare: crate::depth::SURFACE,
+                samples,
+            };
+            let pipeline = match &irradiance {
+                Irradiance::Volumes { volumes, .. } => {
+                    geometry_pipeline_on(device, &desc, volumes.surface_test())
+                }
+                Irradiance::Tiled { .. } => geometry_pipeline(device, &desc),
+            };
+            (shading, pipeline)
+        })
+        .collect();
+    let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
     Box::new(LightPrepass {
         mono,
+        samples,
         attributes,
         irradiance,
         shade,
-        attr_view: target(device, "attributes (normal, shininess)", w, h),
-        diffuse_view: target_for(device, "diffuse irradiance", (w, h), written),
-        specular_view: (!mono).then(|| target(device, "specular irradiance", w, h)),
+        attr_view: target(
+            device,
+            "attributes (normal, shininess)",
+            size,
+            samples,
+            attachment,
+        ),
+        diffuse_view: target(device, "diffuse irradiance", size, samples, written),
+        specular_view: (!mono)
+            .then(|| target(device, "specular irradiance", size, samples, attachment)),
         attr_layout,
         irr_layout,
     })
@@ -315,7 +416,8 @@ fn bind_two(
 }
 
 impl LightPrepass {
-    /// Pass 2 with light volumes: the depth copy, then each volume class blending in.
+    /// Pass 2 with light volumes: the depth copy, (MSAA) the edge marks, then per shading the
+    /// counting draw and each volume class blending in.
     fn encode_volumes(
         &mut self,
         f: &FrameInputs,
@@ -325,6 +427,7 @@ impl LightPrepass {
         let LightPrepass {
             irradiance,
             mono,
+            samples,
             diffuse_view,
             specular_view,
             ..
@@ -332,7 +435,8 @@ impl LightPrepass {
         let Irradiance::Volumes {
             volumes,
             copy,
-            pipelines,
+            mark_edges,
+            shaders,
         } = irradiance
         else {
             unreachable!("called for the volume variants only")
@@ -353,23 +457,27 @@ impl LightPrepass {
                 specular_view
                     .as_ref()
                     .map(|v| cleared(v, wgpu::Color::TRANSPARENT)),
-                f.count_blend
+                counts_in_target(f.count_blend, *samples)
                     .then(|| cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
             ],
-            depth_stencil_attachment: Some(volumes.attachment()),
+            depth_stencil_attachment: Some(volumes.kept_attachment()),
             timestamp_writes: timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,
         });
         volumes.draw_depth_copy(&mut pass, f.scene_bind_group, &*copy, &copy_group);
         pass.set_bind_group(2, attr_group, &[]);
-        for (pipeline, draw) in
-            pipelines
-                .iter()
-                .zip([VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full])
-        {
-            pass.set_pipeline(pipeline);
-            volumes.draw(&mut pass, draw, Shading::PerPixel);
+        if let Some(mark) = mark_edges {
+            volumes.mark_edges(&mut pass, mark);
+        }
+        for s in shaders.iter() {
+            if let Some(count) = &s.count {
+                volumes.draw_fullscreen(&mut pass, count, s.shading);
+            }
+            for (pipeline, draw) in s.classes.iter().zip(CLASSES) {
+                pass.set_pipeline(pipeline);
+                volumes.draw(&mut pass, draw, s.shading);
+            }
         }
         Ok(())
     }
@@ -427,17 +535,28 @@ impl Technique for LightPrepass {
                 );
             }
         }
+        // Pass 3 tests the volume variants' kept copy (its stencil holds the edge bits), the
+        // tiled variant's the scene depth.
+        let depth = match &self.irradiance {
+            Irradiance::Volumes { volumes, .. } => volumes.loaded_attachment(),
+            Irradiance::Tiled { .. } => crate::passes::loaded_depth(&f.targets.depth),
+        };
         let (encoder, timer) = enc.parts();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light pre-pass shading"),
             color_attachments: &[Some(cleared(&f.targets.hdr, wgpu::Color::BLACK))],
-            depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
+            depth_stencil_attachment: Some(depth),
             timestamp_writes: timer.render_pass("light pre-pass shading"),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.shade);
-        draw_scene(&mut pass, f, &[&irr_group]);
+        for (shading, pipeline) in &self.shade {
+            pass.set_pipeline(pipeline);
+            if matches!(self.irradiance, Irradiance::Volumes { .. }) {
+                pass.set_stencil_reference(shading.edge_bit());
+            }
+            draw_scene(&mut pass, f, &[&irr_group]);
+        }
         Ok(())
     }
 
@@ -462,8 +581,10 @@ impl Technique for LightPrepass {
 const TARGET_BYTES: u32 = 8;
 
 /// Depth + attributes + two irradiance targets + HDR + the volumes' depth-stencil copy (the
-/// blog's layout). Per pixel: attributes pass writes depth and attributes, the copy reads
-/// depth and writes the copy, the shading pass reads the irradiance and writes HDR. Per
+/// blog's layout; each per sample with MSAA). Per pixel: attributes pass writes depth and
+/// attributes, the copy reads depth and writes the copy (kept: the shading pass tests its
+/// depth and edge bit where the other pipelines test the scene depth), the shading pass reads
+/// the irradiance and writes HDR. Per
 /// lighting computation: read depth, attributes and the light, blend into the irradiance
 /// targets.
 pub(super) fn memory_full(_: &RenderSettings) -> MemoryModel {

@@ -82,7 +82,6 @@ pub enum Msaa {
     Refused(&'static str),
 }
 
-const LIGHT_VOLUMES_MSAA: &str = "its irradiance volumes are drawn per pixel; per-sample irradiance on the stencil-marked edge pixels (as deferred shades them) is not implemented";
 const LIGHT_PREPASS_MSAA: &str = "its irradiance is accumulated per pixel; per-sample irradiance for edge pixels is not implemented";
 
 /// One registry row.
@@ -326,7 +325,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
         memory: light_prepass::memory_full,
@@ -341,7 +340,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward_mono",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,
         memory: light_prepass::memory_mono,
