@@ -283,8 +283,7 @@ pub(crate) struct RendererArgs {
     #[arg(long, value_enum)]
     pub(crate) material_draws: Option<MaterialDrawsArg>,
     /// MSAA samples per pixel: 1 (off) or a count the adapter supports for every target
-    /// (lavapipe: 4; real GPUs also 2 and 8). tiled_light_prepass and tiled_deferred_single
-    /// refuse MSAA.
+    /// (lavapipe: 4; real GPUs also 2 and 8). tiled_deferred_single refuses MSAA.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) msaa: u32,
     /// Where tiled and clustered deferred resolve MSAA: separate (per-sample colours, then

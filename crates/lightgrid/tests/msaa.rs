@@ -7,8 +7,8 @@
 //! than per-sample shading and no more than one per pixel plus the edge samples; no forward
 //! fragment lies outside its cell's bounds (an analysis render refuses such a frame); on a
 //! synthetic frame with known edges the edge pixels are found exactly, every edge sample is
-//! shaded exactly once (by the kernels, and by the light volumes' per-sample pipelines on
-//! the stencil-marked edge pixels), and an edge pixel's resolved colour is the average of its
+//! shaded exactly once (by the kernels, the light pre-pass's irradiance kernel among them, and
+//! by the light volumes' per-sample pipelines on the stencil-marked edge pixels), and an edge pixel's resolved colour is the average of its
 //! samples; the light-volume targets are counted per sample in the memory model; the
 //! pipelines that refuse MSAA say so, and so do sample counts the adapter lacks.
 
@@ -65,7 +65,10 @@ fn tolerance(id: &str) -> common::ImageTolerance {
         // no material) and compute irradiance at the same points, each sample's materials
         // applied by the second geometry pass's own coverage: measured mean 0.06-0.19, p99
         // at most 4, max 47, at most 5 pixels over 24 levels (within deferred's): the same
-        // bound, for the same reason.
+        // bound, for the same reason. tiled_light_prepass's edge-aware kernel marks the same
+        // edges and computes the same points (its irradiance summed in 32-bit registers, as
+        // tiled_deferred's colours): measured mean 0.03-0.16, p99 at most 4, max 47, at most
+        // 5 pixels over 24 levels.
         _ => common::ImageTolerance {
             max_mean: 0.5,
             max_p99: 8.0,
@@ -306,6 +309,7 @@ fn edge_pixels_are_found_and_each_edge_sample_is_shaded_once() {
         ("deferred_mono", MsaaResolve::Separate),
         ("light_prepass", MsaaResolve::Separate),
         ("light_prepass_mono", MsaaResolve::Separate),
+        ("tiled_light_prepass", MsaaResolve::Separate),
     ] {
         let settings = RenderSettings {
             msaa_resolve: resolve,
@@ -515,8 +519,9 @@ fn every_msaa_pipeline_equals_forward_with_alpha_tested_textures() {
 
 /// With MSAA every target of the light-volume pipelines holds each sample: the G-buffer (the
 /// light pre-pass's attributes and irradiance), depth, HDR and the volumes' depth-stencil copy
-/// (written per sample, the edge bit in its stencil), so their memory model is the 1x one times the sample count, the copy
-/// `VOLUME_DEPTH_BYTES` per sample.
+/// (written per sample, the edge bit in its stencil), so their memory model is the 1x one times
+/// the sample count, the copy `VOLUME_DEPTH_BYTES` per sample; `tiled_light_prepass` adds the
+/// copy and its kernel's per-sample irradiance with MSAA only.
 #[test]
 fn the_light_volume_targets_are_counted_per_sample() {
     for id in [
@@ -546,4 +551,14 @@ fn the_light_volume_targets_are_counted_per_sample() {
             "{id}"
         );
     }
+    // tiled_light_prepass adds, with MSAA, its kernel's per-sample irradiance (8 B) and the
+    // depth-stencil copy whose stencil marks the edges for the shading pass.
+    let p = lightgrid::pipelines::find("tiled_light_prepass").unwrap();
+    assert_eq!(p.msaa, Msaa::Supported);
+    let one = p.memory_model(&RenderSettings::default()).bytes_per_pixel();
+    let four = p.memory_model(&msaa(16)).bytes_per_pixel();
+    assert_eq!(
+        four,
+        SAMPLES * (one + 8 + lightgrid::passes::VOLUME_DEPTH_BYTES)
+    );
 }

@@ -27,7 +27,14 @@
 //! measured against (forward-plus §5, Fig. 3): pass 2 is the tile grid (`GridBuilder`, as
 //! every grid pipeline) and one compute pass, one invocation per pixel, that loops its tile's
 //! lights and writes the mono irradiance (`tiled_light_prepass.wgsl`). Its groups: 0 scene,
-//! 1 grid, 2 attributes + depth, 3 irradiance + count (storage).
+//! 1 grid, 2 attributes + depth, 3 irradiance + count (storage). With MSAA the kernel is
+//! edge-aware (`tiled_light_prepass_msaa.wgsl`, structured as `tiled_deferred_msaa.wgsl`:
+//! a pixel computed once at its centre, an edge pixel's samples queued and shared over the
+//! workgroup, `attributes_edge` the volume variants' test) and stores each sample's
+//! irradiance in a buffer (group 3); a render pass then copies the depth into a
+//! depth-stencil copy, writes the samples into the multisampled irradiance target
+//! (`fs_expand_irradiance`, group 1 the buffer) and marks the edges, and pass 3 runs as the
+//! volume variants' (`TiledMsaa`).
 
 use super::RenderSettings;
 use super::{
@@ -81,23 +88,39 @@ const ATTRIBUTES_WGSL: &str = include_str!("light_prepass_attributes.wgsl");
 /// The tiled variant's shaders: the light pre-pass's and the irradiance kernel.
 pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
     let mut out = shaders();
-    out.push(tiled_kernel());
+    out.extend([tiled_kernel(1), tiled_kernel(4)]);
     out
 }
 
-fn tiled_kernel() -> ComposedShader {
+/// The irradiance kernel for attributes of `samples` samples per pixel: one pixel per
+/// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`).
+fn tiled_kernel(samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    let (name, outputs, kernel) = if samples > 1 {
+        (
+            "tiled_light_prepass_msaa",
+            "",
+            include_str!("tiled_light_prepass_msaa.wgsl"),
+        )
+    } else {
+        (
+            "tiled_light_prepass",
+            crate::passes::COMPUTE_OUTPUTS_WGSL,
+            include_str!("tiled_light_prepass.wgsl"),
+        )
+    };
     compose(
-        "tiled_light_prepass",
+        name,
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
             src::LIGHTING,
-            &crate::shader::msaa_wgsl(1),
+            &msaa,
             src::LIGHT_GRID,
             MSAA_SURFACES_WGSL,
             ATTRIBUTES_WGSL,
-            crate::passes::COMPUTE_OUTPUTS_WGSL,
-            include_str!("tiled_light_prepass.wgsl"),
+            outputs,
+            kernel,
         ],
     )
 }
@@ -138,7 +161,98 @@ enum Irradiance {
         builder: Box<GridBuilder>,
         kernel: wgpu::ComputePipeline,
         outputs_layout: wgpu::BindGroupLayout,
+        /// MSAA: the kernel's per-sample output and the pass expanding it.
+        msaa: Option<Box<TiledMsaa>>,
     },
+}
+
+/// `tiled_light_prepass` with MSAA: the edge-aware kernel stores each sample's irradiance in
+/// a buffer; a render pass copies the depth into a depth-stencil copy, writes the samples
+/// into the multisampled irradiance target and marks the edge pixels (the kernel's test), so
+/// the shading pass runs as the volume variants' does.
+struct TiledMsaa {
+    /// The kernel's group 3 (the per-sample buffer, written).
+    kernel_group: wgpu::BindGroup,
+    /// The expand draw's group 1 (the same buffer, read).
+    expand_group: wgpu::BindGroup,
+    /// Only its depth-stencil copy and full-screen draws: no volume is drawn.
+    volumes: LightVolumes,
+    copy: wgpu::RenderPipeline,
+    expand: wgpu::RenderPipeline,
+    mark_edges: wgpu::RenderPipeline,
+}
+
+impl TiledMsaa {
+    fn new(
+        ctx: &PipelineContext,
+        module: &wgpu::ShaderModule,
+        attr_layout: &wgpu::BindGroupLayout,
+    ) -> (wgpu::BindGroupLayout, Self) {
+        use crate::gpu::{bind_resources, buffer_entry, STORAGE_READ, STORAGE_RW};
+        let device = ctx.device;
+        let (w, h, samples) = (ctx.dims.width, ctx.dims.height, ctx.settings.msaa);
+        let buffer = crate::gpu::storage_buffer(
+            device,
+            "msaa sample irradiance",
+            u64::from(w) * u64::from(h) * u64::from(samples) * u64::from(TARGET_BYTES),
+        );
+        let kernel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("msaa irradiance kernel output (group 3)"),
+            entries: &[buffer_entry(0, STORAGE_RW)],
+        });
+        let expand_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("msaa irradiance expand (group 1)"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ..buffer_entry(0, STORAGE_READ)
+            }],
+        });
+        let group =
+            |label, layout| bind_resources(device, label, layout, &[buffer.as_entire_binding()]);
+        let volumes = LightVolumes::new(device, w, h, samples);
+        let targets = [Some(TARGET_FORMAT.into())];
+        let fullscreen =
+            |label: &str, fragment_entry, layouts: &[Option<&wgpu::BindGroupLayout>], kind| {
+                volumes.fullscreen_pipeline(
+                    device,
+                    &FullscreenVolumeDesc {
+                        label,
+                        module,
+                        fragment_entry,
+                        layouts,
+                        color_targets: &targets,
+                        kind,
+                    },
+                )
+            };
+        // Drawn before the marks, so the per-pixel stencil test (edge bit clear) passes on
+        // every pixel; the entry reads `sample_index`, so it runs per sample.
+        let expand = fullscreen(
+            "msaa irradiance expand",
+            "fs_expand_irradiance",
+            &[
+                Some(ctx.scene_layout),
+                Some(&expand_layout),
+                Some(attr_layout),
+            ],
+            Fullscreen::Shade(Shading::PerPixel),
+        );
+        let mark_edges = fullscreen(
+            "msaa edge marking",
+            "fs_mark_edges",
+            &[Some(ctx.scene_layout), None, Some(attr_layout)],
+            Fullscreen::MarkEdges,
+        );
+        let msaa = TiledMsaa {
+            kernel_group: group("msaa irradiance kernel output", &kernel_layout),
+            expand_group: group("msaa irradiance expand", &expand_layout),
+            copy: volumes.copy_pipeline(device, module, ctx.scene_layout, &targets),
+            expand,
+            mark_edges,
+            volumes,
+        };
+        (kernel_layout, msaa)
+    }
 }
 
 const CLASSES: [VolumeDraw; 3] = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full];
@@ -261,18 +375,29 @@ fn volume_irradiance(
     }
 }
 
-/// Pass 2 of the tiled variant: the grid over the attributes pass's depth, and the kernel.
-fn tiled_irradiance(ctx: &PipelineContext, attr_layout: &wgpu::BindGroupLayout) -> Irradiance {
+/// Pass 2 of the tiled variant: the grid over the attributes pass's depth, and the kernel
+/// (with MSAA the edge-aware one, and the pass expanding its samples).
+fn tiled_irradiance(
+    ctx: &PipelineContext,
+    module: &wgpu::ShaderModule,
+    attr_layout: &wgpu::BindGroupLayout,
+) -> Irradiance {
     let setup = crate::culling::GridSetup {
         forward_opaque: false,
         ..ctx.grid_setup()
     };
     let builder = GridBuilder::new(&setup, 1, CellSource::Depth);
-    let outputs_layout = crate::passes::compute_outputs_layout(ctx.device);
+    let samples = ctx.settings.msaa;
+    let (outputs_layout, msaa) = if samples > 1 {
+        let (layout, msaa) = TiledMsaa::new(ctx, module, attr_layout);
+        (layout, Some(Box::new(msaa)))
+    } else {
+        (crate::passes::compute_outputs_layout(ctx.device), None)
+    };
     let kernel = compute_pipeline(
         ctx.device,
         "tiled light pre-pass irradiance",
-        &tiled_kernel(),
+        &tiled_kernel(samples),
         "main",
         &[
             Some(ctx.scene_layout),
@@ -285,6 +410,18 @@ fn tiled_irradiance(ctx: &PipelineContext, attr_layout: &wgpu::BindGroupLayout) 
         builder: Box::new(builder),
         kernel,
         outputs_layout,
+        msaa,
+    }
+}
+
+impl Irradiance {
+    /// The depth-stencil copy the shading pass tests (its stencil holds the MSAA edge bits):
+    /// the volume variants', or the tiled variant's with MSAA; `None`: the scene depth.
+    fn copy(&self) -> Option<&LightVolumes> {
+        match self {
+            Irradiance::Volumes { volumes, .. } => Some(volumes),
+            Irradiance::Tiled { msaa, .. } => msaa.as_ref().map(|m| &m.volumes),
+        }
     }
 }
 
@@ -293,10 +430,6 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.msaa;
-    assert!(
-        samples == 1 || mode != Mode::Tiled,
-        "tiled_light_prepass refuses MSAA (PipelineInfo::msaa)"
-    );
     let module = create_module(device, &shader(samples));
     let attributes = geometry_pipeline(
         device,
@@ -324,12 +457,15 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
         samples,
     );
     let irradiance = match mode {
-        Mode::Tiled => tiled_irradiance(ctx, &attr_layout),
+        Mode::Tiled => tiled_irradiance(ctx, &module, &attr_layout),
         _ => volume_irradiance(ctx, &module, &attr_layout, mono),
     };
-    let written = match mode {
-        Mode::Tiled => wgpu::TextureUsages::STORAGE_BINDING,
-        _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
+    // The 1x tiled kernel stores the irradiance; with MSAA (a multisampled texture cannot be
+    // a storage texture) the expand pass renders it.
+    let written = if mode == Mode::Tiled && samples == 1 {
+        wgpu::TextureUsages::STORAGE_BINDING
+    } else {
+        wgpu::TextureUsages::RENDER_ATTACHMENT
     };
     let shade = Shading::of(samples)
         .iter()
@@ -350,11 +486,9 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
                 depth_compare: crate::depth::SURFACE,
                 samples,
             };
-            let pipeline = match &irradiance {
-                Irradiance::Volumes { volumes, .. } => {
-                    geometry_pipeline_on(device, &desc, volumes.surface_test())
-                }
-                Irradiance::Tiled { .. } => geometry_pipeline(device, &desc),
+            let pipeline = match irradiance.copy() {
+                Some(copy) => geometry_pipeline_on(device, &desc, copy.surface_test()),
+                None => geometry_pipeline(device, &desc),
             };
             (shading, pipeline)
         })
@@ -513,33 +647,67 @@ impl Technique for LightPrepass {
                 builder,
                 kernel,
                 outputs_layout,
+                msaa,
             } => {
                 builder.build(f, enc)?;
-                let outputs = crate::passes::compute_outputs_to(
-                    f.device,
-                    outputs_layout,
-                    &self.diffuse_view,
-                    &f.targets.counts,
-                );
+                let outputs = match msaa {
+                    Some(_) => None,
+                    None => Some(crate::passes::compute_outputs_to(
+                        f.device,
+                        outputs_layout,
+                        &self.diffuse_view,
+                        &f.targets.counts,
+                    )),
+                };
                 let (encoder, timer) = enc.parts();
-                let mut pass = timer.begin_compute(encoder, "tiled irradiance (mono specular)");
-                pass.set_pipeline(kernel);
-                pass.set_bind_group(0, f.scene_bind_group, &[]);
-                pass.set_bind_group(1, builder.bind_group(), &[]);
-                pass.set_bind_group(2, &attr_group, &[]);
-                pass.set_bind_group(3, &outputs, &[]);
-                pass.dispatch_workgroups(
-                    f.targets.width.div_ceil(SCREEN_WORKGROUP),
-                    f.targets.height.div_ceil(SCREEN_WORKGROUP),
-                    1,
-                );
+                {
+                    let label = "tiled irradiance (mono specular)";
+                    let mut pass = timer.begin_compute(encoder, label);
+                    pass.set_pipeline(kernel);
+                    pass.set_bind_group(0, f.scene_bind_group, &[]);
+                    pass.set_bind_group(1, builder.bind_group(), &[]);
+                    pass.set_bind_group(2, &attr_group, &[]);
+                    let group3 = match (&outputs, msaa.as_deref()) {
+                        (Some(outputs), _) => outputs,
+                        (None, Some(m)) => &m.kernel_group,
+                        (None, None) => unreachable!("outputs without MSAA"),
+                    };
+                    pass.set_bind_group(3, group3, &[]);
+                    pass.dispatch_workgroups(
+                        f.targets.width.div_ceil(SCREEN_WORKGROUP),
+                        f.targets.height.div_ceil(SCREEN_WORKGROUP),
+                        1,
+                    );
+                }
+                if let Some(m) = msaa.as_deref() {
+                    let copy_group = m.volumes.copy_bind_group(f.device, &f.targets.depth);
+                    let label = "msaa irradiance expand";
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(label),
+                        color_attachments: &[Some(cleared(
+                            &self.diffuse_view,
+                            wgpu::Color::TRANSPARENT,
+                        ))],
+                        depth_stencil_attachment: Some(m.volumes.kept_attachment()),
+                        timestamp_writes: timer.render_pass(label),
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    m.volumes
+                        .draw_depth_copy(&mut pass, f.scene_bind_group, &m.copy, &copy_group);
+                    pass.set_bind_group(1, &m.expand_group, &[]);
+                    pass.set_bind_group(2, &attr_group, &[]);
+                    m.volumes
+                        .draw_fullscreen(&mut pass, &m.expand, Shading::PerPixel);
+                    m.volumes.mark_edges(&mut pass, &m.mark_edges);
+                }
             }
         }
-        // Pass 3 tests the volume variants' kept copy (its stencil holds the edge bits), the
-        // tiled variant's the scene depth.
-        let depth = match &self.irradiance {
-            Irradiance::Volumes { volumes, .. } => volumes.loaded_attachment(),
-            Irradiance::Tiled { .. } => crate::passes::loaded_depth(&f.targets.depth),
+        // Pass 3 tests the kept copy where there is one (its stencil holds the edge bits),
+        // else the scene depth.
+        let depth = match self.irradiance.copy() {
+            Some(copy) => copy.loaded_attachment(),
+            None => crate::passes::loaded_depth(&f.targets.depth),
         };
         let (encoder, timer) = enc.parts();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -552,7 +720,7 @@ impl Technique for LightPrepass {
         });
         for (shading, pipeline) in &self.shade {
             pass.set_pipeline(pipeline);
-            if matches!(self.irradiance, Irradiance::Volumes { .. }) {
+            if self.irradiance.copy().is_some() {
                 pass.set_stencil_reference(shading.edge_bit());
             }
             draw_scene(&mut pass, f, &[&irr_group]);
@@ -625,15 +793,24 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
 /// volume depth-stencil. Per pixel: the attributes pass writes depth and attributes, the
 /// cell-bounds kernel reads depth, the irradiance kernel reads depth and attributes once and
 /// writes the irradiance once, the shading pass reads it and writes HDR. Per lighting
-/// computation: an index and a light, accumulated in registers (no blending).
-pub(super) fn memory_tiled(_: &RenderSettings) -> MemoryModel {
+/// computation: an index and a light, accumulated in registers (no blending). With MSAA the
+/// kernel's per-sample irradiance buffer and the depth-stencil copy whose stencil marks the
+/// edges for the shading pass are added (each per sample, as every target).
+pub(super) fn memory_tiled(settings: &RenderSettings) -> MemoryModel {
+    let mut targets = vec![
+        ("depth", DEPTH_BYTES),
+        ("attributes (normal, exponent)", TARGET_BYTES),
+        ("irradiance (diffuse, mono specular)", TARGET_BYTES),
+        ("hdr", HDR_BYTES),
+    ];
+    if settings.msaa > 1 {
+        targets.extend([
+            ("msaa sample irradiance", TARGET_BYTES),
+            ("volume depth-stencil", VOLUME_DEPTH_BYTES),
+        ]);
+    }
     MemoryModel::new(
-        &[
-            ("depth", DEPTH_BYTES),
-            ("attributes (normal, exponent)", TARGET_BYTES),
-            ("irradiance (diffuse, mono specular)", TARGET_BYTES),
-            ("hdr", HDR_BYTES),
-        ],
+        &targets,
         Traffic {
             write_per_pixel: DEPTH_BYTES + 2 * TARGET_BYTES + HDR_BYTES,
             read_per_pixel: 2 * DEPTH_BYTES + 2 * TARGET_BYTES,

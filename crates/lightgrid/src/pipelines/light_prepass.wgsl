@@ -181,3 +181,16 @@ fn fs_shade_sample(v: VertexOut, @builtin(front_facing) front: bool, @builtin(sa
 fn fs_shade_mono_sample(v: VertexOut, @builtin(front_facing) front: bool, @builtin(sample_index) i: u32) -> @location(0) vec4<f32> {
     return shade_mono(v, front, i);
 }
+
+// --- tiled_light_prepass with MSAA: the kernel's per-sample irradiance (group 1,
+// `tiled_light_prepass_msaa.wgsl`) into the multisampled irradiance target, sample by sample.
+@group(1) @binding(0) var<storage, read> sample_irradiance: array<vec2<u32>>;
+
+@fragment
+fn fs_expand_irradiance(@builtin(position) pos: vec4<f32>, @builtin(sample_index) s: u32) -> IrradianceOut {
+    let p = vec2<u32>(pos.xy);
+    let c = sample_irradiance[(p.y * u32(frame.viewport.x) + p.x) * SAMPLES + s];
+    var out: IrradianceOut;
+    out.diffuse = vec4<f32>(unpack2x16float(c.x), unpack2x16float(c.y));
+    return out;
+}

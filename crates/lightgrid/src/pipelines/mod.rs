@@ -82,8 +82,6 @@ pub enum Msaa {
     Refused(&'static str),
 }
 
-const LIGHT_PREPASS_MSAA: &str = "its irradiance is accumulated per pixel; per-sample irradiance for edge pixels is not implemented";
-
 /// One registry row.
 pub struct PipelineInfo {
     /// The id used on the command line and in stats.
@@ -355,7 +353,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: true,
         reference: "forward_mono",
-        msaa: Msaa::Refused(LIGHT_PREPASS_MSAA),
+        msaa: Msaa::Supported,
         shaders: light_prepass::shaders_tiled,
         create: light_prepass::create_tiled,
         memory: light_prepass::memory_tiled,
