@@ -283,8 +283,7 @@ pub(crate) struct RendererArgs {
     #[arg(long, value_enum)]
     pub(crate) material_draws: Option<MaterialDrawsArg>,
     /// MSAA samples per pixel: 1 (off) or a count the adapter supports for every target
-    /// (lavapipe: 4; real GPUs also 2 and 8). light_prepass, light_prepass_mono and
-    /// tiled_light_prepass refuse MSAA.
+    /// (lavapipe: 4; real GPUs also 2 and 8); every pipeline renders with it.
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) msaa: u32,
     /// Where tiled and clustered deferred and tiled_deferred_single resolve MSAA: separate

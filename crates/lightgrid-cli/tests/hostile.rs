@@ -604,10 +604,6 @@ fn counts_and_thresholds_are_bounded_where_parsed() {
         ),
         (&["render", "--msaa", "16"], "for every target"),
         (&["bench", "--msaa", "1,8", "--out", d], "for every target"),
-        (
-            &["render", "--pipeline", "light_prepass", "--msaa", "4"],
-            "--msaa does not apply to light_prepass (light_prepass: its irradiance volumes",
-        ),
     ];
     all_refused_leaving_nothing(&dir, cases);
 }

@@ -137,7 +137,19 @@ pub(crate) fn geometry_pipeline(
     device: &wgpu::Device,
     d: &GeometryPipelineDesc,
 ) -> wgpu::RenderPipeline {
-    pipeline_with_constants(device, d, &[])
+    pipeline_with_constants(device, d, &[], None)
+}
+
+/// As [`geometry_pipeline`], testing against another depth-stencil target than the scene
+/// depth (`depth_stencil` replaces the format, depth and stencil state the description
+/// implies): the light pre-pass's shading pass on the volumes' copy, whose stencil marks the
+/// MSAA edge pixels.
+pub(crate) fn geometry_pipeline_on(
+    device: &wgpu::Device,
+    d: &GeometryPipelineDesc,
+    depth_stencil: wgpu::DepthStencilState,
+) -> wgpu::RenderPipeline {
+    pipeline_with_constants(device, d, &[], Some(depth_stencil))
 }
 
 fn specialised_pipeline(
@@ -145,13 +157,14 @@ fn specialised_pipeline(
     d: &GeometryPipelineDesc,
     shader: u32,
 ) -> wgpu::RenderPipeline {
-    pipeline_with_constants(device, d, &[("MATERIAL_SHADER", f64::from(shader))])
+    pipeline_with_constants(device, d, &[("MATERIAL_SHADER", f64::from(shader))], None)
 }
 
 fn pipeline_with_constants(
     device: &wgpu::Device,
     d: &GeometryPipelineDesc,
     constants: &[(&str, f64)],
+    depth_stencil: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
     let mut constants = constants.to_vec();
     if d.samples > 1 {
@@ -173,13 +186,13 @@ fn pipeline_with_constants(
         },
         // No culling: thin and open geometry is shaded two-sided (see geometry.wgsl).
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
+        depth_stencil: Some(depth_stencil.unwrap_or(wgpu::DepthStencilState {
             format: crate::passes::DEPTH_FORMAT,
             depth_write_enabled: Some(d.depth_write),
             depth_compare: Some(d.depth_compare),
             stencil: Default::default(),
             bias: Default::default(),
-        }),
+        })),
         multisample: wgpu::MultisampleState {
             count: d.samples,
             ..Default::default()

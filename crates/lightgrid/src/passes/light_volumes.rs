@@ -105,7 +105,8 @@ impl Shading {
         }
     }
 
-    fn edge_bit(self) -> u32 {
+    /// The stencil reference of a draw testing the edge bit.
+    pub fn edge_bit(self) -> u32 {
         match self {
             Shading::PerPixel => 0,
             Shading::PerSample => EDGE_STENCIL,
@@ -714,16 +715,64 @@ impl LightVolumes {
 
     /// Depth-stencil attachment for a volume pass: cleared, then filled by the copy draw.
     pub fn attachment(&self) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+        self.attachment_with(
+            wgpu::LoadOp::Clear(crate::depth::CLEAR),
+            wgpu::LoadOp::Clear(0),
+        )
+    }
+
+    /// As [`Self::attachment`], the copy and its edge bits kept for a later pass (the light
+    /// pre-pass's shading pass, [`Self::loaded_attachment`]).
+    pub fn kept_attachment(&self) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+        let mut a = self.attachment();
+        for store in [
+            &mut a.depth_ops.as_mut().expect("depth").store,
+            &mut a.stencil_ops.as_mut().expect("stencil").store,
+        ] {
+            *store = wgpu::StoreOp::Store;
+        }
+        a
+    }
+
+    /// The copy as a [`Self::kept_attachment`] pass left it, read-only.
+    pub fn loaded_attachment(&self) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+        self.attachment_with(wgpu::LoadOp::Load, wgpu::LoadOp::Load)
+    }
+
+    fn attachment_with(
+        &self,
+        depth: wgpu::LoadOp<f32>,
+        stencil: wgpu::LoadOp<u32>,
+    ) -> wgpu::RenderPassDepthStencilAttachment<'_> {
         wgpu::RenderPassDepthStencilAttachment {
             view: &self.depth,
             depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(crate::depth::CLEAR),
+                load: depth,
                 store: wgpu::StoreOp::Discard,
             }),
             stencil_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(0),
+                load: stencil,
                 store: wgpu::StoreOp::Discard,
             }),
+        }
+    }
+
+    /// The depth-stencil state of a geometry pass over the copy (the light pre-pass's
+    /// shading pass): the scene's surface test ([`crate::depth::SURFACE`]: the copy holds
+    /// the scene depth, bit for bit in [`volume_depth_format`]'s float format), no writes,
+    /// and the edge bit equal to the reference's (a draw's [`Shading::edge_bit`]).
+    pub fn surface_test(&self) -> wgpu::DepthStencilState {
+        wgpu::DepthStencilState {
+            format: self.depth_format,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(crate::depth::SURFACE),
+            stencil: wgpu::StencilState {
+                front: edge_test(),
+                back: edge_test(),
+                read_mask: EDGE_STENCIL,
+                write_mask: 0,
+            },
+            bias: Default::default(),
         }
     }
 

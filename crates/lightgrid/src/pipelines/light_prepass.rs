@@ -2,12 +2,23 @@
 //! (deferred-shading-vs-deferred-lighting) lays it out.
 //!
 //! 1. Attributes pass: geometry → normal + specular exponent (RGBA16F) and depth.
-//! 2. Irradiance pass (HDR-range targets, additive): a depth copy, then each light's volume
-//!    (classes in `light_volumes.rs`) adds its diffuse irradiance and specular irradiance to two
-//!    RGBA16F targets; `_mono` keeps only the specular luminance, in the diffuse alpha, and has
-//!    no specular target.
-//! 3. Shading pass: geometry again (depth LessEqual against pass 1, no writes) reads the
-//!    irradiance at its pixel and applies the material colours.
+//! 2. Irradiance pass (HDR-range targets, additive): a depth-stencil copy, then each light's
+//!    volume (classes in `light_volumes.rs`) adds its diffuse irradiance and specular
+//!    irradiance to two RGBA16F targets; `_mono` keeps only the specular luminance, in the
+//!    diffuse alpha, and has no specular target.
+//! 3. Shading pass: geometry again, tested against the copy (the scene's surface test, no
+//!    writes), reads the irradiance at its pixel and applies the material colours.
+//!
+//! MSAA (tiled-deferred-tricks, as `deferred`): every target holds each sample. After the
+//! copy a full-screen pass sets the stencil's edge bit on the pixels whose samples need
+//! irradiance of their own (`attributes_differ`: geometry against sky, another exponent,
+//! plane or normal; the attributes hold no material id and need none, see
+//! `light_prepass_attributes.wgsl`); every volume class is drawn per pixel where the bit is
+//! clear (the irradiance at the pixel centre, written to every sample) and per sample where
+//! it is set. The copy is kept for pass 3, which draws the geometry twice on the same bit:
+//! per pixel elsewhere (sample 0's irradiance, which is every sample's), per sample on edge
+//! pixels (each sample's own). Material edges need no per-sample pass 3: the rasterizer
+//! gives each triangle's fragment exactly its own samples.
 //!
 //! Groups: pass 1: 0 scene. Pass 2: 0 scene, 1 depth-copy source, 2 attributes + depth.
 //! Pass 3: 0 scene, 1 irradiance.
@@ -16,7 +27,14 @@
 //! measured against (forward-plus §5, Fig. 3): pass 2 is the tile grid (`GridBuilder`, as
 //! every grid pipeline) and one compute pass, one invocation per pixel, that loops its tile's
 //! lights and writes the mono irradiance (`tiled_light_prepass.wgsl`). Its groups: 0 scene,
-//! 1 grid, 2 attributes + depth, 3 irradiance + count (storage).
+//! 1 grid, 2 attributes + depth, 3 irradiance + count (storage). With MSAA the kernel is
+//! edge-aware (`tiled_light_prepass_msaa.wgsl`, structured as `tiled_deferred_msaa.wgsl`:
+//! a pixel computed once at its centre, an edge pixel's samples queued and shared over the
+//! workgroup, `attributes_edge` the volume variants' test) and stores each sample's
+//! irradiance in a buffer (group 3); a render pass then copies the depth into a
+//! depth-stencil copy, writes the samples into the multisampled irradiance target
+//! (`fs_expand_irradiance`, group 1 the buffer) and marks the edges, and pass 3 runs as the
+//! volume variants' (`TiledMsaa`).
 
 use super::RenderSettings;
 use super::{
@@ -26,12 +44,14 @@ use super::{
 use crate::consts::SCREEN_WORKGROUP;
 use crate::culling::{CellSource, GridBuilder};
 use crate::error::Result;
+use crate::frame::targets::counts_in_target;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
+use crate::passes::geometry::geometry_pipeline_on;
 use crate::passes::{
-    additive, classify_lights, LightVolumes, Shading, VolumeDraw, VolumePipelineDesc, COUNT_FORMAT,
-    FULLSCREEN_WGSL, HDR_FORMAT, VOLUME_WGSL,
+    additive, classify_lights, Fullscreen, FullscreenVolumeDesc, LightVolumes, Shading, VolumeDraw,
+    VolumePipelineDesc, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT, MSAA_SURFACES_WGSL, VOLUME_WGSL,
 };
-use crate::passes::{cleared, render_texture, texture_entry, VOLUME_DEPTH_BYTES};
+use crate::passes::{cleared, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES};
 use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShader, SCENE_PARTS};
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
@@ -39,17 +59,27 @@ use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShade
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    // Light volumes shade single-sample targets only (`PipelineInfo::msaa`).
-    let single_sample = crate::shader::msaa_wgsl(1);
+    vec![shader(1), shader(4)]
+}
+
+/// The light pre-pass's shader for targets of `samples` samples per pixel.
+fn shader(samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    let name = if samples > 1 {
+        "light_prepass_msaa"
+    } else {
+        "light_prepass"
+    };
     let mut parts = SCENE_PARTS.to_vec();
     parts.extend([
-        &single_sample,
+        &msaa,
         FULLSCREEN_WGSL,
         VOLUME_WGSL,
+        MSAA_SURFACES_WGSL,
         ATTRIBUTES_WGSL,
         include_str!("light_prepass.wgsl"),
     ]);
-    vec![compose("light_prepass", &parts)]
+    compose(name, &parts)
 }
 
 /// Group 2 of the irradiance passes and the surface they read from it (both variants).
@@ -58,22 +88,39 @@ const ATTRIBUTES_WGSL: &str = include_str!("light_prepass_attributes.wgsl");
 /// The tiled variant's shaders: the light pre-pass's and the irradiance kernel.
 pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
     let mut out = shaders();
-    out.push(tiled_kernel());
+    out.extend([tiled_kernel(1), tiled_kernel(4)]);
     out
 }
 
-fn tiled_kernel() -> ComposedShader {
+/// The irradiance kernel for attributes of `samples` samples per pixel: one pixel per
+/// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`).
+fn tiled_kernel(samples: u32) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    let (name, outputs, kernel) = if samples > 1 {
+        (
+            "tiled_light_prepass_msaa",
+            "",
+            include_str!("tiled_light_prepass_msaa.wgsl"),
+        )
+    } else {
+        (
+            "tiled_light_prepass",
+            crate::passes::COMPUTE_OUTPUTS_WGSL,
+            include_str!("tiled_light_prepass.wgsl"),
+        )
+    };
     compose(
-        "tiled_light_prepass",
+        name,
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
             src::LIGHTING,
-            &crate::shader::msaa_wgsl(1),
+            &msaa,
             src::LIGHT_GRID,
+            MSAA_SURFACES_WGSL,
             ATTRIBUTES_WGSL,
-            crate::passes::COMPUTE_OUTPUTS_WGSL,
-            include_str!("tiled_light_prepass.wgsl"),
+            outputs,
+            kernel,
         ],
     )
 }
@@ -89,27 +136,134 @@ enum Mode {
     Tiled,
 }
 
+/// The volume pipelines of one [`Shading`]: per pixel, or per sample on MSAA edge pixels.
+struct VolumeShaders {
+    shading: Shading,
+    /// MSAA: the full-screen draw counting edge pixels and irradiance samples.
+    count: Option<wgpu::RenderPipeline>,
+    /// Front, back and full-screen volume classes.
+    classes: [wgpu::RenderPipeline; 3],
+}
+
 /// How the irradiance is accumulated (pass 2).
 enum Irradiance {
     /// Each light's volume rasterized, blending into the irradiance targets.
     Volumes {
         volumes: Box<LightVolumes>,
         copy: wgpu::RenderPipeline,
-        pipelines: [wgpu::RenderPipeline; 3],
+        /// MSAA: the edge-marking pass.
+        mark_edges: Option<wgpu::RenderPipeline>,
+        /// Per pixel, then (MSAA) per sample.
+        shaders: Vec<VolumeShaders>,
     },
     /// The tile grid, then one compute pass over the pixels.
     Tiled {
         builder: Box<GridBuilder>,
         kernel: wgpu::ComputePipeline,
         outputs_layout: wgpu::BindGroupLayout,
+        /// MSAA: the kernel's per-sample output and the pass expanding it.
+        msaa: Option<Box<TiledMsaa>>,
     },
 }
 
+/// `tiled_light_prepass` with MSAA: the edge-aware kernel stores each sample's irradiance in
+/// a buffer; a render pass copies the depth into a depth-stencil copy, writes the samples
+/// into the multisampled irradiance target and marks the edge pixels (the kernel's test), so
+/// the shading pass runs as the volume variants' does.
+struct TiledMsaa {
+    /// The kernel's group 3 (the per-sample buffer, written).
+    kernel_group: wgpu::BindGroup,
+    /// The expand draw's group 1 (the same buffer, read).
+    expand_group: wgpu::BindGroup,
+    /// Only its depth-stencil copy and full-screen draws: no volume is drawn.
+    volumes: LightVolumes,
+    copy: wgpu::RenderPipeline,
+    expand: wgpu::RenderPipeline,
+    mark_edges: wgpu::RenderPipeline,
+}
+
+impl TiledMsaa {
+    fn new(
+        ctx: &PipelineContext,
+        module: &wgpu::ShaderModule,
+        attr_layout: &wgpu::BindGroupLayout,
+    ) -> (wgpu::BindGroupLayout, Self) {
+        use crate::gpu::{bind_resources, buffer_entry, STORAGE_READ, STORAGE_RW};
+        let device = ctx.device;
+        let (w, h, samples) = (ctx.dims.width, ctx.dims.height, ctx.settings.msaa);
+        let buffer = crate::gpu::storage_buffer(
+            device,
+            "msaa sample irradiance",
+            u64::from(w) * u64::from(h) * u64::from(samples) * u64::from(TARGET_BYTES),
+        );
+        let kernel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("msaa irradiance kernel output (group 3)"),
+            entries: &[buffer_entry(0, STORAGE_RW)],
+        });
+        let expand_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("msaa irradiance expand (group 1)"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ..buffer_entry(0, STORAGE_READ)
+            }],
+        });
+        let group =
+            |label, layout| bind_resources(device, label, layout, &[buffer.as_entire_binding()]);
+        let volumes = LightVolumes::new(device, w, h, samples);
+        let targets = [Some(TARGET_FORMAT.into())];
+        let fullscreen =
+            |label: &str, fragment_entry, layouts: &[Option<&wgpu::BindGroupLayout>], kind| {
+                volumes.fullscreen_pipeline(
+                    device,
+                    &FullscreenVolumeDesc {
+                        label,
+                        module,
+                        fragment_entry,
+                        layouts,
+                        color_targets: &targets,
+                        kind,
+                    },
+                )
+            };
+        // Drawn before the marks, so the per-pixel stencil test (edge bit clear) passes on
+        // every pixel; the entry reads `sample_index`, so it runs per sample.
+        let expand = fullscreen(
+            "msaa irradiance expand",
+            "fs_expand_irradiance",
+            &[
+                Some(ctx.scene_layout),
+                Some(&expand_layout),
+                Some(attr_layout),
+            ],
+            Fullscreen::Shade(Shading::PerPixel),
+        );
+        let mark_edges = fullscreen(
+            "msaa edge marking",
+            "fs_mark_edges",
+            &[Some(ctx.scene_layout), None, Some(attr_layout)],
+            Fullscreen::MarkEdges,
+        );
+        let msaa = TiledMsaa {
+            kernel_group: group("msaa irradiance kernel output", &kernel_layout),
+            expand_group: group("msaa irradiance expand", &expand_layout),
+            copy: volumes.copy_pipeline(device, module, ctx.scene_layout, &targets),
+            expand,
+            mark_edges,
+            volumes,
+        };
+        (kernel_layout, msaa)
+    }
+}
+
+const CLASSES: [VolumeDraw; 3] = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full];
+
 struct LightPrepass {
     mono: bool,
+    samples: u32,
     attributes: wgpu::RenderPipeline,
     irradiance: Irradiance,
-    shade: wgpu::RenderPipeline,
+    /// Pass 3 per pixel, then (MSAA) per sample on the edge pixels.
+    shade: Vec<(Shading, wgpu::RenderPipeline)>,
     attr_view: wgpu::TextureView,
     diffuse_view: wgpu::TextureView,
     specular_view: Option<wgpu::TextureView>,
@@ -121,32 +275,30 @@ fn texture_layout(
     device: &wgpu::Device,
     label: &str,
     second: wgpu::TextureSampleType,
+    samples: u32,
 ) -> wgpu::BindGroupLayout {
     let first = wgpu::TextureSampleType::Float { filterable: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
-        entries: &[texture_entry(0, first), texture_entry(1, second)],
+        entries: &[
+            sampled_texture_entry(0, first, samples),
+            sampled_texture_entry(1, second, samples),
+        ],
     })
 }
 
-fn target(device: &wgpu::Device, label: &str, w: u32, h: u32) -> wgpu::TextureView {
-    target_for(
-        device,
-        label,
-        (w, h),
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-    )
-}
-
-/// A target read by a later pass and written as `written` (a render attachment or storage).
-fn target_for(
+/// A target of `samples` samples per pixel read by a later pass and written as `written` (a
+/// render attachment or storage).
+fn target(
     device: &wgpu::Device,
     label: &str,
     size: (u32, u32),
+    samples: u32,
     written: wgpu::TextureUsages,
 ) -> wgpu::TextureView {
     let usage = written | wgpu::TextureUsages::TEXTURE_BINDING;
-    render_texture(device, label, TARGET_FORMAT, size, usage).create_view(&Default::default())
+    multisampled_texture(device, label, TARGET_FORMAT, size, samples, usage)
+        .create_view(&Default::default())
 }
 
 /// Pass 2 of the light-volume variants.
@@ -158,51 +310,94 @@ fn volume_irradiance(
 ) -> Irradiance {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let volumes = Box::new(LightVolumes::new(device, w, h, 1));
+    let samples = ctx.settings.msaa;
+    let volumes = Box::new(LightVolumes::new(device, w, h, samples));
     let irr_targets = [
         Some(additive(TARGET_FORMAT)),
         (!mono).then(|| additive(TARGET_FORMAT)),
-        ctx.count_blend.then(|| additive(COUNT_FORMAT)),
+        counts_in_target(ctx.count_blend, samples).then(|| additive(COUNT_FORMAT)),
     ];
     let layouts = [Some(ctx.scene_layout), None, Some(attr_layout)];
-    let entry = if mono {
-        "fs_irradiance_mono"
-    } else {
-        "fs_irradiance"
-    };
-    let pipelines = [VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full].map(|draw| {
-        volumes.pipeline(
+    let fullscreen = |label: &str, fragment_entry, kind| {
+        volumes.fullscreen_pipeline(
             device,
-            &VolumePipelineDesc {
-                label: "light pre-pass irradiance",
+            &FullscreenVolumeDesc {
+                label,
                 module,
-                fragment_entry: entry,
+                fragment_entry,
                 layouts: &layouts,
                 color_targets: &irr_targets,
-                draw,
-                shading: Shading::PerPixel,
+                kind,
             },
         )
-    });
+    };
+    let shaders = Shading::of(samples)
+        .iter()
+        .map(|&shading| {
+            let (entry, count) = match (shading, mono) {
+                (Shading::PerPixel, false) => ("fs_irradiance", "fs_count"),
+                (Shading::PerPixel, true) => ("fs_irradiance_mono", "fs_count"),
+                (Shading::PerSample, false) => ("fs_irradiance_sample", "fs_count_sample"),
+                (Shading::PerSample, true) => ("fs_irradiance_mono_sample", "fs_count_sample"),
+            };
+            VolumeShaders {
+                shading,
+                count: (samples > 1).then(|| {
+                    fullscreen(
+                        "light pre-pass msaa counts",
+                        count,
+                        Fullscreen::Shade(shading),
+                    )
+                }),
+                classes: CLASSES.map(|draw| {
+                    volumes.pipeline(
+                        device,
+                        &VolumePipelineDesc {
+                            label: "light pre-pass irradiance",
+                            module,
+                            fragment_entry: entry,
+                            layouts: &layouts,
+                            color_targets: &irr_targets,
+                            draw,
+                            shading,
+                        },
+                    )
+                }),
+            }
+        })
+        .collect();
     Irradiance::Volumes {
         copy: volumes.copy_pipeline(device, module, ctx.scene_layout, &irr_targets),
+        mark_edges: (samples > 1)
+            .then(|| fullscreen("msaa edge marking", "fs_mark_edges", Fullscreen::MarkEdges)),
+        shaders,
         volumes,
-        pipelines,
     }
 }
 
-/// Pass 2 of the tiled variant: the grid over the attributes pass's depth, and the kernel.
-fn tiled_irradiance(ctx: &PipelineContext, attr_layout: &wgpu::BindGroupLayout) -> Irradiance {
+/// Pass 2 of the tiled variant: the grid over the attributes pass's depth, and the kernel
+/// (with MSAA the edge-aware one, and the pass expanding its samples).
+fn tiled_irradiance(
+    ctx: &PipelineContext,
+    module: &wgpu::ShaderModule,
+    attr_layout: &wgpu::BindGroupLayout,
+) -> Irradiance {
     let setup = crate::culling::GridSetup {
         forward_opaque: false,
         ..ctx.grid_setup()
     };
     let builder = GridBuilder::new(&setup, 1, CellSource::Depth);
-    let outputs_layout = crate::passes::compute_outputs_layout(ctx.device);
+    let samples = ctx.settings.msaa;
+    let (outputs_layout, msaa) = if samples > 1 {
+        let (layout, msaa) = TiledMsaa::new(ctx, module, attr_layout);
+        (layout, Some(Box::new(msaa)))
+    } else {
+        (crate::passes::compute_outputs_layout(ctx.device), None)
+    };
     let kernel = compute_pipeline(
         ctx.device,
         "tiled light pre-pass irradiance",
-        &tiled_kernel(),
+        &tiled_kernel(samples),
         "main",
         &[
             Some(ctx.scene_layout),
@@ -215,14 +410,27 @@ fn tiled_irradiance(ctx: &PipelineContext, attr_layout: &wgpu::BindGroupLayout) 
         builder: Box::new(builder),
         kernel,
         outputs_layout,
+        msaa,
+    }
+}
+
+impl Irradiance {
+    /// The depth-stencil copy the shading pass tests (its stencil holds the MSAA edge bits):
+    /// the volume variants', or the tiled variant's with MSAA; `None`: the scene depth.
+    fn copy(&self) -> Option<&LightVolumes> {
+        match self {
+            Irradiance::Volumes { volumes, .. } => Some(volumes),
+            Irradiance::Tiled { msaa, .. } => msaa.as_ref().map(|m| &m.volumes),
+        }
     }
 }
 
 fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let mono = mode != Mode::Full;
     let device = ctx.device;
-    let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let module = create_module(device, &shaders()[0]);
+    let size = (ctx.dims.width, ctx.dims.height);
+    let samples = ctx.settings.msaa;
+    let module = create_module(device, &shader(samples));
     let attributes = geometry_pipeline(
         device,
         &GeometryPipelineDesc {
@@ -233,48 +441,75 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             color_targets: &[Some(TARGET_FORMAT.into())],
             depth_write: true,
             depth_compare: crate::depth::SURFACE,
-            samples: 1,
+            samples,
         },
     );
     let attr_layout = texture_layout(
         device,
         "light pre-pass attributes",
         wgpu::TextureSampleType::Depth,
+        samples,
     );
     let irr_layout = texture_layout(
         device,
         "light pre-pass irradiance",
         wgpu::TextureSampleType::Float { filterable: false },
+        samples,
     );
     let irradiance = match mode {
-        Mode::Tiled => tiled_irradiance(ctx, &attr_layout),
+        Mode::Tiled => tiled_irradiance(ctx, &module, &attr_layout),
         _ => volume_irradiance(ctx, &module, &attr_layout, mono),
     };
-    let written = match mode {
-        Mode::Tiled => wgpu::TextureUsages::STORAGE_BINDING,
-        _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
+    // The 1x tiled kernel stores the irradiance; with MSAA (a multisampled texture cannot be
+    // a storage texture) the expand pass renders it.
+    let written = if mode == Mode::Tiled && samples == 1 {
+        wgpu::TextureUsages::STORAGE_BINDING
+    } else {
+        wgpu::TextureUsages::RENDER_ATTACHMENT
     };
-    let shade = geometry_pipeline(
-        device,
-        &GeometryPipelineDesc {
-            label: "light pre-pass shading",
-            module: &module,
-            fragment_entry: Some(if mono { "fs_shade_mono" } else { "fs_shade" }),
-            layouts: &[Some(ctx.scene_layout), Some(&irr_layout)],
-            color_targets: &[Some(HDR_FORMAT.into())],
-            depth_write: false,
-            depth_compare: crate::depth::SURFACE,
-            samples: 1,
-        },
-    );
+    let shade = Shading::of(samples)
+        .iter()
+        .map(|&shading| {
+            let entry = match (shading, mono) {
+                (Shading::PerPixel, false) => "fs_shade",
+                (Shading::PerPixel, true) => "fs_shade_mono",
+                (Shading::PerSample, false) => "fs_shade_sample",
+                (Shading::PerSample, true) => "fs_shade_mono_sample",
+            };
+            let desc = GeometryPipelineDesc {
+                label: "light pre-pass shading",
+                module: &module,
+                fragment_entry: Some(entry),
+                layouts: &[Some(ctx.scene_layout), Some(&irr_layout)],
+                color_targets: &[Some(HDR_FORMAT.into())],
+                depth_write: false,
+                depth_compare: crate::depth::SURFACE,
+                samples,
+            };
+            let pipeline = match irradiance.copy() {
+                Some(copy) => geometry_pipeline_on(device, &desc, copy.surface_test()),
+                None => geometry_pipeline(device, &desc),
+            };
+            (shading, pipeline)
+        })
+        .collect();
+    let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
     Box::new(LightPrepass {
         mono,
+        samples,
         attributes,
         irradiance,
         shade,
-        attr_view: target(device, "attributes (normal, shininess)", w, h),
-        diffuse_view: target_for(device, "diffuse irradiance", (w, h), written),
-        specular_view: (!mono).then(|| target(device, "specular irradiance", w, h)),
+        attr_view: target(
+            device,
+            "attributes (normal, shininess)",
+            size,
+            samples,
+            attachment,
+        ),
+        diffuse_view: target(device, "diffuse irradiance", size, samples, written),
+        specular_view: (!mono)
+            .then(|| target(device, "specular irradiance", size, samples, attachment)),
         attr_layout,
         irr_layout,
     })
@@ -315,7 +550,8 @@ fn bind_two(
 }
 
 impl LightPrepass {
-    /// Pass 2 with light volumes: the depth copy, then each volume class blending in.
+    /// Pass 2 with light volumes: the depth copy, (MSAA) the edge marks, then per shading the
+    /// counting draw and each volume class blending in.
     fn encode_volumes(
         &mut self,
         f: &FrameInputs,
@@ -325,6 +561,7 @@ impl LightPrepass {
         let LightPrepass {
             irradiance,
             mono,
+            samples,
             diffuse_view,
             specular_view,
             ..
@@ -332,7 +569,8 @@ impl LightPrepass {
         let Irradiance::Volumes {
             volumes,
             copy,
-            pipelines,
+            mark_edges,
+            shaders,
         } = irradiance
         else {
             unreachable!("called for the volume variants only")
@@ -353,23 +591,27 @@ impl LightPrepass {
                 specular_view
                     .as_ref()
                     .map(|v| cleared(v, wgpu::Color::TRANSPARENT)),
-                f.count_blend
+                counts_in_target(f.count_blend, *samples)
                     .then(|| cleared(&f.targets.counts, wgpu::Color::TRANSPARENT)),
             ],
-            depth_stencil_attachment: Some(volumes.attachment()),
+            depth_stencil_attachment: Some(volumes.kept_attachment()),
             timestamp_writes: timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,
         });
         volumes.draw_depth_copy(&mut pass, f.scene_bind_group, &*copy, &copy_group);
         pass.set_bind_group(2, attr_group, &[]);
-        for (pipeline, draw) in
-            pipelines
-                .iter()
-                .zip([VolumeDraw::Front, VolumeDraw::Back, VolumeDraw::Full])
-        {
-            pass.set_pipeline(pipeline);
-            volumes.draw(&mut pass, draw, Shading::PerPixel);
+        if let Some(mark) = mark_edges {
+            volumes.mark_edges(&mut pass, mark);
+        }
+        for s in shaders.iter() {
+            if let Some(count) = &s.count {
+                volumes.draw_fullscreen(&mut pass, count, s.shading);
+            }
+            for (pipeline, draw) in s.classes.iter().zip(CLASSES) {
+                pass.set_pipeline(pipeline);
+                volumes.draw(&mut pass, draw, s.shading);
+            }
         }
         Ok(())
     }
@@ -405,39 +647,84 @@ impl Technique for LightPrepass {
                 builder,
                 kernel,
                 outputs_layout,
+                msaa,
             } => {
                 builder.build(f, enc)?;
-                let outputs = crate::passes::compute_outputs_to(
-                    f.device,
-                    outputs_layout,
-                    &self.diffuse_view,
-                    &f.targets.counts,
-                );
+                let outputs = match msaa {
+                    Some(_) => None,
+                    None => Some(crate::passes::compute_outputs_to(
+                        f.device,
+                        outputs_layout,
+                        &self.diffuse_view,
+                        &f.targets.counts,
+                    )),
+                };
                 let (encoder, timer) = enc.parts();
-                let mut pass = timer.begin_compute(encoder, "tiled irradiance (mono specular)");
-                pass.set_pipeline(kernel);
-                pass.set_bind_group(0, f.scene_bind_group, &[]);
-                pass.set_bind_group(1, builder.bind_group(), &[]);
-                pass.set_bind_group(2, &attr_group, &[]);
-                pass.set_bind_group(3, &outputs, &[]);
-                pass.dispatch_workgroups(
-                    f.targets.width.div_ceil(SCREEN_WORKGROUP),
-                    f.targets.height.div_ceil(SCREEN_WORKGROUP),
-                    1,
-                );
+                {
+                    let label = "tiled irradiance (mono specular)";
+                    let mut pass = timer.begin_compute(encoder, label);
+                    pass.set_pipeline(kernel);
+                    pass.set_bind_group(0, f.scene_bind_group, &[]);
+                    pass.set_bind_group(1, builder.bind_group(), &[]);
+                    pass.set_bind_group(2, &attr_group, &[]);
+                    let group3 = match (&outputs, msaa.as_deref()) {
+                        (Some(outputs), _) => outputs,
+                        (None, Some(m)) => &m.kernel_group,
+                        (None, None) => unreachable!("outputs without MSAA"),
+                    };
+                    pass.set_bind_group(3, group3, &[]);
+                    pass.dispatch_workgroups(
+                        f.targets.width.div_ceil(SCREEN_WORKGROUP),
+                        f.targets.height.div_ceil(SCREEN_WORKGROUP),
+                        1,
+                    );
+                }
+                if let Some(m) = msaa.as_deref() {
+                    let copy_group = m.volumes.copy_bind_group(f.device, &f.targets.depth);
+                    let label = "msaa irradiance expand";
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(label),
+                        color_attachments: &[Some(cleared(
+                            &self.diffuse_view,
+                            wgpu::Color::TRANSPARENT,
+                        ))],
+                        depth_stencil_attachment: Some(m.volumes.kept_attachment()),
+                        timestamp_writes: timer.render_pass(label),
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    m.volumes
+                        .draw_depth_copy(&mut pass, f.scene_bind_group, &m.copy, &copy_group);
+                    pass.set_bind_group(1, &m.expand_group, &[]);
+                    pass.set_bind_group(2, &attr_group, &[]);
+                    m.volumes
+                        .draw_fullscreen(&mut pass, &m.expand, Shading::PerPixel);
+                    m.volumes.mark_edges(&mut pass, &m.mark_edges);
+                }
             }
         }
+        // Pass 3 tests the kept copy where there is one (its stencil holds the edge bits),
+        // else the scene depth.
+        let depth = match self.irradiance.copy() {
+            Some(copy) => copy.loaded_attachment(),
+            None => crate::passes::loaded_depth(&f.targets.depth),
+        };
         let (encoder, timer) = enc.parts();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("light pre-pass shading"),
             color_attachments: &[Some(cleared(&f.targets.hdr, wgpu::Color::BLACK))],
-            depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
+            depth_stencil_attachment: Some(depth),
             timestamp_writes: timer.render_pass("light pre-pass shading"),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.shade);
-        draw_scene(&mut pass, f, &[&irr_group]);
+        for (shading, pipeline) in &self.shade {
+            pass.set_pipeline(pipeline);
+            if self.irradiance.copy().is_some() {
+                pass.set_stencil_reference(shading.edge_bit());
+            }
+            draw_scene(&mut pass, f, &[&irr_group]);
+        }
         Ok(())
     }
 
@@ -462,8 +749,10 @@ impl Technique for LightPrepass {
 const TARGET_BYTES: u32 = 8;
 
 /// Depth + attributes + two irradiance targets + HDR + the volumes' depth-stencil copy (the
-/// blog's layout). Per pixel: attributes pass writes depth and attributes, the copy reads
-/// depth and writes the copy, the shading pass reads the irradiance and writes HDR. Per
+/// blog's layout; each per sample with MSAA). Per pixel: attributes pass writes depth and
+/// attributes, the copy reads depth and writes the copy (kept: the shading pass tests its
+/// depth and edge bit where the other pipelines test the scene depth), the shading pass reads
+/// the irradiance and writes HDR. Per
 /// lighting computation: read depth, attributes and the light, blend into the irradiance
 /// targets.
 pub(super) fn memory_full(_: &RenderSettings) -> MemoryModel {
@@ -504,15 +793,24 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
 /// volume depth-stencil. Per pixel: the attributes pass writes depth and attributes, the
 /// cell-bounds kernel reads depth, the irradiance kernel reads depth and attributes once and
 /// writes the irradiance once, the shading pass reads it and writes HDR. Per lighting
-/// computation: an index and a light, accumulated in registers (no blending).
-pub(super) fn memory_tiled(_: &RenderSettings) -> MemoryModel {
+/// computation: an index and a light, accumulated in registers (no blending). With MSAA the
+/// kernel's per-sample irradiance buffer and the depth-stencil copy whose stencil marks the
+/// edges for the shading pass are added (each per sample, as every target).
+pub(super) fn memory_tiled(settings: &RenderSettings) -> MemoryModel {
+    let mut targets = vec![
+        ("depth", DEPTH_BYTES),
+        ("attributes (normal, exponent)", TARGET_BYTES),
+        ("irradiance (diffuse, mono specular)", TARGET_BYTES),
+        ("hdr", HDR_BYTES),
+    ];
+    if settings.msaa > 1 {
+        targets.extend([
+            ("msaa sample irradiance", TARGET_BYTES),
+            ("volume depth-stencil", VOLUME_DEPTH_BYTES),
+        ]);
+    }
     MemoryModel::new(
-        &[
-            ("depth", DEPTH_BYTES),
-            ("attributes (normal, exponent)", TARGET_BYTES),
-            ("irradiance (diffuse, mono specular)", TARGET_BYTES),
-            ("hdr", HDR_BYTES),
-        ],
+        &targets,
         Traffic {
             write_per_pixel: DEPTH_BYTES + 2 * TARGET_BYTES + HDR_BYTES,
             read_per_pixel: 2 * DEPTH_BYTES + 2 * TARGET_BYTES,

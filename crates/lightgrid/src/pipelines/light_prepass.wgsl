@@ -1,5 +1,18 @@
 // light_prepass / light_prepass_mono (deferred lighting): attributes, irradiance per light
 // volume, then a second geometry pass that applies the materials.
+//
+// With MSAA (tiled-deferred-tricks, as `deferred.wgsl`; `light_prepass.rs`): every target
+// holds each sample; `fs_mark_edges` sets the stencil's edge bit on the pixels whose samples
+// need irradiance of their own (`attributes_differ`); the irradiance of every other pixel is
+// computed once, at its centre, and written to all its samples (`fs_irradiance*`), that of
+// an edge pixel sample by sample where each lies (`fs_irradiance*_sample`, which read
+// `sample_index` and so run per sample). The shading pass tests the same edge bit: per pixel
+// elsewhere (every sample holds the pixel's irradiance: sample 0's is read), per sample on
+// edge pixels (each sample reads its own). Lighting computations count into `pixel_counts`,
+// each pixel once (by the fragment covering sample 0, as in `deferred.wgsl`); the full-screen
+// `fs_count*` draws count edge pixels, irradiance samples computed and samples with geometry.
+// Entries with side effects force the early depth and stencil tests, so the per-sample
+// pipelines count only the samples the edge bit lets through.
 
 // --- 1. attributes: normal and specular exponent (depth goes to the depth target)
 @fragment
@@ -16,65 +29,168 @@ struct IrradianceOut {
     @location(2) count: f32,
 }
 
-// The light terms at the sample under a volume fragment; false for sky.
-fn irradiance_terms(v: VolumeOut, out_terms: ptr<function, LightTerms>) -> bool {
-    let p = vec2<u32>(v.clip.xy);
-    let depth = textureLoad(attr_depth, p, 0);
-    if (is_background(depth)) {
-        return false;
-    }
-    let s = attributes_surface(p, depth);
-    *out_terms = light_terms(s, view_dir_to(s.position), lights[v.light]);
-    return true;
+// Does the fragment with coverage `mask` count for its pixel (the one covering sample 0)?
+fn counts_for_pixel(mask: u32) -> bool {
+    return (mask & 1u) != 0u;
 }
 
-@fragment
-fn fs_irradiance(v: VolumeOut) -> IrradianceOut {
-    var t: LightTerms;
-    if (!irradiance_terms(v, &t)) {
-        discard;
+// The lighting computation of a volume fragment at pixel `p`, counted `n` times.
+fn irradiance_out(p: vec2<u32>, s: Surface, light: u32, n: u32) -> IrradianceOut {
+    if (MULTISAMPLED) {
+        count_pixel(p, n);
     }
+    let t = light_terms(s, view_dir_to(s.position), lights[light]);
     var out: IrradianceOut;
     out.diffuse = vec4<f32>(t.diffuse, 0.0);
     out.specular = vec4<f32>(t.specular, 0.0);
-    out.count = 1.0;
+    out.count = f32(n);
     return out;
 }
 
 // The common compromise: specular irradiance kept as its luminance, in the diffuse alpha.
-struct MonoIrradianceOut {
-    @location(0) diffuse: vec4<f32>,
-    @location(2) count: f32,
+fn mono(out: IrradianceOut) -> IrradianceOut {
+    var m = out;
+    m.diffuse.a = luminance(out.specular.rgb);
+    m.specular = vec4<f32>(0.0);
+    return m;
 }
 
-@fragment
-fn fs_irradiance_mono(v: VolumeOut) -> MonoIrradianceOut {
-    var t: LightTerms;
-    if (!irradiance_terms(v, &t)) {
+// One fragment per pixel (no edge; every pixel without MSAA), at the pixel centre.
+fn irradiance_pixel(v: VolumeOut, mask: u32) -> IrradianceOut {
+    let p = vec2<u32>(v.clip.xy);
+    if (is_background(textureLoad(attr_depth, p, 0))) {
         discard;
     }
-    var out: MonoIrradianceOut;
-    out.diffuse = vec4<f32>(t.diffuse, luminance(t.specular));
-    out.count = 1.0;
+    return irradiance_out(p, attributes_pixel_surface(p), v.light, select(0u, 1u, counts_for_pixel(mask)));
+}
+
+// One fragment per sample of an edge pixel: the sample's own surface where it lies.
+fn irradiance_sample(v: VolumeOut, i: u32) -> IrradianceOut {
+    let p = vec2<u32>(v.clip.xy);
+    let depth = textureLoad(attr_depth, p, i);
+    if (is_background(depth)) {
+        discard;
+    }
+    return irradiance_out(p, attributes_sample_surface(p, i, depth), v.light, 1u);
+}
+
+@fragment @early_depth_test(force)
+fn fs_irradiance(v: VolumeOut, @builtin(sample_mask) mask: u32) -> IrradianceOut {
+    return irradiance_pixel(v, mask);
+}
+
+@fragment @early_depth_test(force)
+fn fs_irradiance_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> IrradianceOut {
+    return irradiance_sample(v, i);
+}
+
+@fragment @early_depth_test(force)
+fn fs_irradiance_mono(v: VolumeOut, @builtin(sample_mask) mask: u32) -> IrradianceOut {
+    return mono(irradiance_pixel(v, mask));
+}
+
+@fragment @early_depth_test(force)
+fn fs_irradiance_mono_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> IrradianceOut {
+    return mono(irradiance_sample(v, i));
+}
+
+// MSAA: keep the pixels whose samples need irradiance of their own, whose stencil the
+// pipeline marks. No side effects: the stencil is written after the shader (late tests), so
+// a discarded pixel stays unmarked.
+@fragment
+fn fs_mark_edges(@builtin(position) pos: vec4<f32>) -> IrradianceOut {
+    if (!attributes_edge(vec2<u32>(pos.xy))) {
+        discard;
+    }
+    var out: IrradianceOut;
+    return out;
+}
+
+// MSAA, per pixel that is no edge: one irradiance sample computed (counted by the fragment
+// covering sample 0), and its covered samples with geometry. Adds nothing to the targets.
+@fragment @early_depth_test(force)
+fn fs_count(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -> IrradianceOut {
+    let p = vec2<u32>(pos.xy);
+    if (!is_background(textureLoad(attr_depth, p, 0))) {
+        var geometry = 0u;
+        for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            let covered = ((mask >> s) & 1u) != 0u;
+            geometry += select(0u, 1u, covered && !is_background(textureLoad(attr_depth, p, s)));
+        }
+        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], geometry);
+        if (counts_for_pixel(mask)) {
+            atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
+        }
+    }
+    var out: IrradianceOut;
+    return out;
+}
+
+// MSAA, per sample of an edge pixel: the edge pixel once (at sample 0), the sample as
+// computed and with geometry. Adds nothing to the targets.
+@fragment @early_depth_test(force)
+fn fs_count_sample(@builtin(position) pos: vec4<f32>, @builtin(sample_index) i: u32) -> IrradianceOut {
+    let p = vec2<u32>(pos.xy);
+    if (i == 0u) {
+        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], 1u);
+    }
+    if (!is_background(textureLoad(attr_depth, p, i))) {
+        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
+        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], 1u);
+    }
+    var out: IrradianceOut;
     return out;
 }
 
 // --- 3. shading: group 1 = the irradiance targets
-@group(1) @binding(0) var irr_diffuse: texture_2d<f32>;
-@group(1) @binding(1) var irr_specular: texture_2d<f32>;
+@group(1) @binding(0) var irr_diffuse: SampleTexture;
+@group(1) @binding(1) var irr_specular: SampleTexture;
 
-@fragment
-fn fs_shade(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+fn shade(v: VertexOut, front: bool, i: u32) -> vec4<f32> {
     let s = surface_from_vertex(v, front);
     let p = vec2<u32>(v.clip.xy);
-    let d = textureLoad(irr_diffuse, p, 0).rgb;
-    let sp = textureLoad(irr_specular, p, 0).rgb;
+    let d = textureLoad(irr_diffuse, p, i).rgb;
+    let sp = textureLoad(irr_specular, p, i).rgb;
     return vec4<f32>(surface_base(s) + d * s.diffuse + sp * s.specular, 1.0);
+}
+
+fn shade_mono(v: VertexOut, front: bool, i: u32) -> vec4<f32> {
+    let s = surface_from_vertex(v, front);
+    let d = textureLoad(irr_diffuse, vec2<u32>(v.clip.xy), i);
+    return vec4<f32>(surface_base(s) + d.rgb * s.diffuse + mono_specular(d.rgb, d.a) * s.specular, 1.0);
+}
+
+// Per pixel (no edge; every pixel without MSAA): each sample holds the pixel's irradiance.
+@fragment
+fn fs_shade(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    return shade(v, front, 0u);
 }
 
 @fragment
 fn fs_shade_mono(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    let s = surface_from_vertex(v, front);
-    let d = textureLoad(irr_diffuse, vec2<u32>(v.clip.xy), 0);
-    return vec4<f32>(surface_base(s) + d.rgb * s.diffuse + mono_specular(d.rgb, d.a) * s.specular, 1.0);
+    return shade_mono(v, front, 0u);
+}
+
+// Per sample of an edge pixel: the sample's own irradiance.
+@fragment
+fn fs_shade_sample(v: VertexOut, @builtin(front_facing) front: bool, @builtin(sample_index) i: u32) -> @location(0) vec4<f32> {
+    return shade(v, front, i);
+}
+
+@fragment
+fn fs_shade_mono_sample(v: VertexOut, @builtin(front_facing) front: bool, @builtin(sample_index) i: u32) -> @location(0) vec4<f32> {
+    return shade_mono(v, front, i);
+}
+
+// --- tiled_light_prepass with MSAA: the kernel's per-sample irradiance (group 1,
+// `tiled_light_prepass_msaa.wgsl`) into the multisampled irradiance target, sample by sample.
+@group(1) @binding(0) var<storage, read> sample_irradiance: array<vec2<u32>>;
+
+@fragment
+fn fs_expand_irradiance(@builtin(position) pos: vec4<f32>, @builtin(sample_index) s: u32) -> IrradianceOut {
+    let p = vec2<u32>(pos.xy);
+    let c = sample_irradiance[(p.y * u32(frame.viewport.x) + p.x) * SAMPLES + s];
+    var out: IrradianceOut;
+    out.diffuse = vec4<f32>(unpack2x16float(c.x), unpack2x16float(c.y));
+    return out;
 }

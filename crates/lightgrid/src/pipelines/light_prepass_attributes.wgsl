@@ -1,16 +1,72 @@
-// The light pre-pass's attributes (pass 1's normal + specular exponent and depth) as read by
-// its irradiance passes (group 2): the light volumes' fragments (`light_prepass.wgsl`) and
-// the tiled compute kernel (`tiled_light_prepass.wgsl`).
+// The light pre-pass's attributes (pass 1's normal + specular exponent and depth, each sample
+// with MSAA: `shader::msaa_wgsl`'s texture types) as read by its irradiance passes (group 2):
+// the light volumes' fragments (`light_prepass.wgsl`) and the tiled compute kernel
+// (`tiled_light_prepass.wgsl`).
 
-@group(2) @binding(0) var attr_normal_shininess: texture_2d<f32>;
-@group(2) @binding(1) var attr_depth: texture_depth_2d;
+@group(2) @binding(0) var attr_normal_shininess: SampleTexture;
+@group(2) @binding(1) var attr_depth: DepthTexture;
 
-// The surface the irradiance is computed at: pixel `p` at depth-buffer value `depth` (< 1).
-fn attributes_surface(p: vec2<u32>, depth: f32) -> Surface {
-    let a = textureLoad(attr_normal_shininess, p, 0);
-    var s: Surface;
-    s.position = position_from_depth(p, depth);
-    s.normal = normalize(a.xyz);
-    s.shininess = a.w;
-    return s;
+// The surface the irradiance is computed at: sample `s` of pixel `p`'s normal and exponent,
+// at camera-relative `position`.
+fn attributes_surface_at(p: vec2<u32>, s: u32, position: vec3<f32>) -> Surface {
+    let a = textureLoad(attr_normal_shininess, p, s);
+    var surface: Surface;
+    surface.position = position;
+    surface.normal = normalize(a.xyz);
+    surface.shininess = a.w;
+    return surface;
+}
+
+// Pixel `p`'s depth at its centre, where forward shades it: for a pixel that is no edge (one
+// surface over it) the samples' mean, as the standard patterns' positions average to the
+// centre and depth is affine over a triangle (the deferred pipelines do the same).
+fn attributes_centre_depth(p: vec2<u32>) -> f32 {
+    var sum = 0.0;
+    for (var s = 0u; s < SAMPLES; s = s + 1u) {
+        sum += textureLoad(attr_depth, p, s);
+    }
+    return sum / f32(SAMPLES);
+}
+
+// Pixel `p` shaded once (no edge; every pixel without MSAA): sample 0's normal and exponent
+// at the pixel centre.
+fn attributes_pixel_surface(p: vec2<u32>) -> Surface {
+    let position = position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), attributes_centre_depth(p));
+    return attributes_surface_at(p, 0u, position);
+}
+
+// Sample `s` of an edge pixel `p`, with depth-buffer value `depth`, where it lies.
+fn attributes_sample_surface(p: vec2<u32>, s: u32, depth: f32) -> Surface {
+    return attributes_surface_at(p, s, position_from_screen(vec2<f32>(p) + sample_position(s), depth));
+}
+
+// The MSAA edge test over the attributes (`msaa_surfaces.wgsl`): do samples 0 (depth `d0`,
+// attributes `a0`) and `s` of pixel `p` need irradiance of their own? Geometry against sky,
+// another specular exponent, or another plane or normal. The attributes hold no material
+// id, and need none: the irradiance is a function of position, normal and exponent alone;
+// the materials' colours are applied by the shading pass, whose fragments cover exactly
+// their own triangle's samples, so two materials meeting in one plane with one exponent
+// read one irradiance correctly (the G-buffer's test marks such pixels only because it
+// shades the material there too).
+fn attributes_differ(p: vec2<u32>, s: u32, d0: f32, a0: vec4<f32>) -> bool {
+    let d = textureLoad(attr_depth, p, s);
+    if (is_background(d) != is_background(d0)) {
+        return true;
+    }
+    if (is_background(d0)) {
+        return false;
+    }
+    let a = textureLoad(attr_normal_shininess, p, s);
+    return surfaces_differ(p, s, d0, a0.xyz, d, a.xyz, a.w != a0.w);
+}
+
+// Is pixel `p` an MSAA edge (some sample differs from sample 0)? Never without MSAA.
+fn attributes_edge(p: vec2<u32>) -> bool {
+    let d0 = textureLoad(attr_depth, p, 0);
+    let a0 = textureLoad(attr_normal_shininess, p, 0);
+    var edge = false;
+    for (var s = 1u; s < SAMPLES; s = s + 1u) {
+        edge = edge || attributes_differ(p, s, d0, a0);
+    }
+    return edge;
 }

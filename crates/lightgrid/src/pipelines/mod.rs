@@ -82,9 +82,6 @@ pub enum Msaa {
     Refused(&'static str),
 }
 
-const LIGHT_VOLUMES_MSAA: &str = "its irradiance volumes are drawn per pixel; per-sample irradiance on the stencil-marked edge pixels (as deferred shades them) is not implemented";
-const LIGHT_PREPASS_MSAA: &str = "its irradiance is accumulated per pixel; per-sample irradiance for edge pixels is not implemented";
-
 /// One registry row.
 pub struct PipelineInfo {
     /// The id used on the command line and in stats.
@@ -326,7 +323,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
         memory: light_prepass::memory_full,
@@ -341,7 +338,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: false,
         reference: "forward_mono",
-        msaa: Msaa::Refused(LIGHT_VOLUMES_MSAA),
+        msaa: Msaa::Supported,
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,
         memory: light_prepass::memory_mono,
@@ -356,7 +353,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         clustered: false,
         depth_bounds: true,
         reference: "forward_mono",
-        msaa: Msaa::Refused(LIGHT_PREPASS_MSAA),
+        msaa: Msaa::Supported,
         shaders: light_prepass::shaders_tiled,
         create: light_prepass::create_tiled,
         memory: light_prepass::memory_tiled,

@@ -19,7 +19,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         write_output(p, vec4<f32>(0.0), 0u);
         return;
     }
-    let s = attributes_surface(p, depth);
+    let s = attributes_pixel_surface(p);
     let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
     write_output(p, grid_irradiance_mono(s, view_dir_to(s.position), cell), grid_cell_count(cell));
 }

@@ -1,0 +1,105 @@
+// tiled_light_prepass with MSAA: the irradiance kernel made edge-aware, as the deferred one is
+// (`tiled_deferred_msaa.wgsl`: tiled-shading §2.1, tiled-deferred-tricks' edge detection and
+// Lauritzen's redistribution of the edge samples over the workgroup).
+//
+// Each invocation owns a pixel of the per-sample attributes. It finds whether the pixel is an
+// edge (`attributes_edge`: the light volumes' test, so the stencil marks of the expand pass
+// that follows are the pixels this kernel shaded per sample) and accumulates its tile's
+// lights once: at the pixel centre (the samples' mean depth) for a pixel that is no edge,
+// that value stored for every sample; at sample 0's own place for an edge pixel, whose other
+// samples with geometry are queued in workgroup memory and taken in turn by every invocation
+// of the workgroup after a barrier. Each sample's mono irradiance (diffuse rgb, specular
+// luminance) goes to `sample_irradiance` as two pack2x16float words; a fragment pass writes
+// it into the multisampled irradiance target (`fs_expand_irradiance`) for the shading pass.
+// Counts go to `pixel_counts` and the frame counters (edge pixels, samples computed, samples
+// with geometry).
+
+// Per sample (pixel * SAMPLES + sample): the irradiance as two pack2x16float words.
+@group(3) @binding(0) var<storage, read_write> sample_irradiance: array<vec2<u32>>;
+
+const GROUP_PIXELS: u32 = SCREEN_WORKGROUP * SCREEN_WORKGROUP;
+
+// The queued edge samples: (local pixel index << 8) | sample.
+var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
+var<workgroup> queued: atomic<u32>;
+var<workgroup> group_edges: atomic<u32>;
+var<workgroup> group_first: atomic<u32>;
+var<workgroup> group_geometry: atomic<u32>;
+
+fn store_irradiance(p: vec2<u32>, s: u32, value: vec4<f32>) {
+    let i = (p.y * u32(frame.viewport.x) + p.x) * SAMPLES + s;
+    sample_irradiance[i] = vec2<u32>(pack2x16float(value.rg), pack2x16float(value.ba));
+}
+
+// The tile's lights on `surface` at depth-buffer value `depth`, counted into pixel `p`.
+fn irradiance_at(p: vec2<u32>, surface: Surface, depth: f32) -> vec4<f32> {
+    let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
+    count_pixel(p, grid_cell_count(cell));
+    return grid_irradiance_mono(surface, view_dir_to(surface.position), cell);
+}
+
+@compute @workgroup_size(SCREEN_WORKGROUP, SCREEN_WORKGROUP)
+fn main(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    if (li == 0u) {
+        atomicStore(&queued, 0u);
+        atomicStore(&group_edges, 0u);
+        atomicStore(&group_first, 0u);
+        atomicStore(&group_geometry, 0u);
+    }
+    workgroupBarrier();
+    let size = vec2<u32>(frame.viewport);
+    let p = gid.xy;
+    if (p.x < size.x && p.y < size.y) {
+        let d0 = textureLoad(attr_depth, p, 0);
+        var geometry = 0u;
+        for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            geometry += select(1u, 0u, is_background(textureLoad(attr_depth, p, s)));
+        }
+        let edge = attributes_edge(p);
+        var v0 = vec4<f32>(0.0);
+        if (!is_background(d0)) {
+            if (edge) {
+                v0 = irradiance_at(p, attributes_sample_surface(p, 0u, d0), d0);
+            } else {
+                v0 = irradiance_at(p, attributes_pixel_surface(p), attributes_centre_depth(p));
+            }
+            atomicAdd(&group_first, 1u);
+        }
+        store_irradiance(p, 0u, v0);
+        for (var s = 1u; s < SAMPLES; s = s + 1u) {
+            if (!edge) {
+                store_irradiance(p, s, v0);
+            } else if (!is_background(textureLoad(attr_depth, p, s))) {
+                queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
+            } else {
+                store_irradiance(p, s, vec4<f32>(0.0));
+            }
+        }
+        if (edge) {
+            atomicAdd(&group_edges, 1u);
+        }
+        atomicAdd(&group_geometry, geometry);
+    }
+    // Every invocation takes queued edge samples in turn.
+    let n = workgroupUniformLoad(&queued);
+    let origin = wg.xy * SCREEN_WORKGROUP;
+    var i = li;
+    for (; i < n; i = i + GROUP_PIXELS) {
+        let item = queue[i];
+        let local = item >> 8u;
+        let s = item & 0xffu;
+        let q = origin + vec2<u32>(local % SCREEN_WORKGROUP, local / SCREEN_WORKGROUP);
+        let depth = textureLoad(attr_depth, q, s);
+        store_irradiance(q, s, irradiance_at(q, attributes_sample_surface(q, s, depth), depth));
+    }
+    check_loop(i, n);
+    if (li == 0u) {
+        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
+        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n);
+        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], atomicLoad(&group_geometry));
+    }
+}
