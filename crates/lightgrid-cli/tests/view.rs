@@ -430,10 +430,6 @@ fn bad_view_options_are_refused_before_a_window_opens() {
     }
     assert_fails_with(&["view", "--view", "sideways"], "--view");
     assert_fails_with(&["view", "--size", "0x10"], "--size");
-    assert_fails_with(
-        &["view", "--pipeline", "tiled_deferred", "--msaa", "8"],
-        "for every target",
-    );
     assert_fails_with(&["view", "--frame", "100000"], "past the end");
     assert!(
         std::fs::read_dir(&dir).unwrap().next().is_none(),
