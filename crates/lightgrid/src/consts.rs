@@ -36,6 +36,10 @@ pub const TILE_LIGHT_BATCH: u32 = 1024;
 /// round-off can never drop a light that reaches a sample.
 pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 
+/// The largest finite binary16 value: what a shader clamps to before `pack2x16float`, whose
+/// result for a value beyond binary16's range WGSL leaves indeterminate.
+pub const HALF_MAX: f32 = 65504.0;
+
 /// The narrowest slicing range a clustered grid takes (`hi / lo`, `culling/depth_range.rs`):
 /// a frame whose samples all lie at one view distance (a wall facing the camera) still gets
 /// slices of a finite scale.
@@ -241,6 +245,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
     ("SLICING_MIN_RATIO", WgslConst::F32(SLICING_MIN_RATIO)),
+    ("HALF_MAX", WgslConst::F32(HALF_MAX)),
     ("CONE_SLACK", WgslConst::F32(CONE_SLACK)),
     ("CONE_VOLUME_MIN_COS", WgslConst::F32(CONE_VOLUME_MIN_COS)),
     ("CONE_VOLUME_SEGMENTS", WgslConst::U32(CONE_VOLUME_SEGMENTS)),

@@ -237,10 +237,16 @@ impl TiledMsaa {
             ],
             Fullscreen::Shade(Shading::PerPixel),
         );
+        // The edges the kernel shaded per sample, read from what it stored
+        // (`fs_mark_irradiance_edges`), not decided again.
         let mark_edges = fullscreen(
             "msaa edge marking",
-            "fs_mark_edges",
-            &[Some(ctx.scene_layout), None, Some(attr_layout)],
+            "fs_mark_irradiance_edges",
+            &[
+                Some(ctx.scene_layout),
+                Some(&expand_layout),
+                Some(attr_layout),
+            ],
             Fullscreen::MarkEdges,
         );
         let msaa = TiledMsaa {

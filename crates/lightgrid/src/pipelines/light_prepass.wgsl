@@ -186,6 +186,28 @@ fn fs_shade_mono_sample(v: VertexOut, @builtin(front_facing) front: bool, @built
 // `tiled_light_prepass_msaa.wgsl`) into the multisampled irradiance target, sample by sample.
 @group(1) @binding(0) var<storage, read> sample_irradiance: array<vec2<u32>>;
 
+// Mark the pixels whose samples the kernel gave irradiance of their own, read from what it
+// stored rather than decided again: the kernel's compute evaluation of the edge test and a
+// fragment shader's can round differently on one device (measured on an NVIDIA H200: pixels
+// the kernel shaded per sample were left unmarked and shaded from sample 0, up to 95 levels
+// off `forward_mono` on 2CylinderEngine at 4x; lavapipe agreed with itself). A pixel whose
+// samples hold one value shades alike per pixel and per sample. No side effects (see
+// `fs_mark_edges`).
+@fragment
+fn fs_mark_irradiance_edges(@builtin(position) pos: vec4<f32>) -> IrradianceOut {
+    let first = (u32(pos.y) * u32(frame.viewport.x) + u32(pos.x)) * SAMPLES;
+    let c0 = sample_irradiance[first];
+    var differ = false;
+    for (var s = 1u; s < SAMPLES; s = s + 1u) {
+        differ = differ || any(sample_irradiance[first + s] != c0);
+    }
+    if (!differ) {
+        discard;
+    }
+    var out: IrradianceOut;
+    return out;
+}
+
 @fragment
 fn fs_expand_irradiance(@builtin(position) pos: vec4<f32>, @builtin(sample_index) s: u32) -> IrradianceOut {
     let p = vec2<u32>(pos.xy);

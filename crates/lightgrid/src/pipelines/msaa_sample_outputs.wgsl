@@ -40,7 +40,9 @@ fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
 }
 
 fn store_sample(pixel: u32, s: u32, color: vec3<f32>) {
-    sample_colors[pixel * SAMPLES + s] = vec2<u32>(pack2x16float(color.rg), pack2x16float(vec2<f32>(color.b, 1.0)));
+    // Clamped: pack2x16float of a value beyond binary16's range is indeterminate (WGSL).
+    let c = min(color, vec3<f32>(HALF_MAX));
+    sample_colors[pixel * SAMPLES + s] = vec2<u32>(pack2x16float(c.rg), pack2x16float(vec2<f32>(c.b, 1.0)));
 }
 
 // Sample `s` of pixel `p`: stored, or added to local pixel `l`'s resolved colour.

@@ -26,9 +26,13 @@ var<workgroup> group_edges: atomic<u32>;
 var<workgroup> group_first: atomic<u32>;
 var<workgroup> group_geometry: atomic<u32>;
 
+// pack2x16float of a value beyond binary16's range is indeterminate (WGSL): clamped to the
+// largest half (HALF_MAX), a highlight's irradiance saturates the tone curve as the RGBA16F
+// targets' conversion does.
 fn store_irradiance(p: vec2<u32>, s: u32, value: vec4<f32>) {
     let i = (p.y * u32(frame.viewport.x) + p.x) * SAMPLES + s;
-    sample_irradiance[i] = vec2<u32>(pack2x16float(value.rg), pack2x16float(value.ba));
+    let v = min(value, vec4<f32>(HALF_MAX));
+    sample_irradiance[i] = vec2<u32>(pack2x16float(v.rg), pack2x16float(v.ba));
 }
 
 // The tile's lights on `surface` at depth-buffer value `depth`, counted into pixel `p`.
