@@ -1177,7 +1177,13 @@ fn moved(s: &Scene, d: glam::Vec3) -> Scene {
 #[test]
 fn real_camera_planes_render_like_forward() {
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
-    for (near, far) in [(1e-6, 100.0), (1e-4, 1e4), (0.05, 1e6), (1e-6, 1e6)] {
+    for (near, far) in [
+        (1e-6, 100.0),
+        (1e-4, 1e4),
+        (0.05, 1e6),
+        (1e-6, 1e6),
+        (1.0, 1e3),
+    ] {
         check(&with_planes(&s, near, far), 200, (128, 72), settings(16));
     }
 }
