@@ -128,6 +128,15 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     assert!(submitted
         .iter()
         .all(|s| s.io.submits == 1 && s.io.readback_bytes == 0));
+    // Clusters: the slicing range and the sliced parameters come back with the bounds, in
+    // the same one wait.
+    let (submitted, _) = play(&mut r, &scene, "clustered_forward", &frames[..2]);
+    let slices = u64::from(RenderSettings::default().slices);
+    for s in &submitted {
+        assert_eq!(s.io.submits, 2, "one part-way submission");
+        let params = std::mem::size_of::<lightgrid::gpu_types::GridParams>() as u64;
+        assert_eq!(s.io.readback_bytes, cells * slices * 8 + 8 + params);
+    }
 }
 
 #[test]

@@ -280,18 +280,24 @@ pub(super) fn create_strategy(_: &StrategyContext) -> Box<dyn AssignStrategy> {
 
 impl AssignStrategy for CpuStrategy {
     fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
-        // The slices the GPU spread over the frame's depth range (read back with the bounds:
-        // the papers' CPU pipeline waits for the depth anyway).
+        // The cell bounds and, for clusters, the slices the GPU spread over the frame's depth
+        // range, read back in one wait (the papers' CPU pipeline waits for the depth anyway).
+        let depth = a.source == CellSource::Depth;
+        let mut parts = Vec::new();
+        if depth {
+            parts.push((a.bounds.buffer(), (a.dims.cell_count() * 8) as u64));
+        }
+        if let Some(range) = a.range {
+            parts.extend(range.readback());
+        }
+        let bytes = enc.download_all(&parts)?;
+        let cell_bounds: Option<Vec<[f32; 2]>> =
+            depth.then(|| bytemuck::pod_collect_to_vec(&bytes[0]));
         let dims = &match a.range {
-            Some(range) => range.download(enc, a.dims)?,
-            None => *a.dims,
-        };
-        let cell_bounds: Option<Vec<[f32; 2]>> = match a.source {
-            CellSource::NearFar => None,
-            CellSource::Depth => {
-                let bytes = enc.download(a.bounds.buffer(), (a.dims.cell_count() * 8) as u64)?;
-                Some(bytemuck::pod_collect_to_vec(&bytes))
+            Some(_) => {
+                super::depth_range::sliced(a.dims, &bytes[parts.len() - 2], &bytes[parts.len() - 1])
             }
+            None => *a.dims,
         };
         let start = Instant::now();
         let range = match &cell_bounds {

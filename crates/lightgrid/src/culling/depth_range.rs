@@ -152,19 +152,18 @@ impl DepthRangePass {
         Ok(sliced(dims, &range, &params))
     }
 
-    /// `dims` sliced as this frame is, read back part-way through the frame (the CPU
-    /// strategy's wait).
-    pub fn download(&self, enc: &mut FrameEncoder, dims: &GridDims) -> Result<GridDims> {
-        let range = enc.download(&self.range, 8)?;
-        let params = enc.download(&self.params_out, PARAMS_BYTES)?;
-        Ok(sliced(dims, &range, &params))
+    /// What to read back part-way through the frame for [`sliced`] (the slicing range, the
+    /// sliced parameters): the CPU strategy reads them with the cell bounds, in one wait.
+    pub fn readback(&self) -> [(&wgpu::Buffer, u64); 2] {
+        [(&self.range, 8), (&self.params_out, PARAMS_BYTES)]
     }
 }
 
 const PARAMS_BYTES: u64 = std::mem::size_of::<GridParams>() as u64;
 
-/// `dims` with the GPU's slicing: its range and, bit for bit, its scale and bias.
-fn sliced(dims: &GridDims, range: &[u8], params: &[u8]) -> GridDims {
+/// `dims` with the GPU's slicing, from the bytes of [`DepthRangePass::readback`]: its range
+/// and, bit for bit, its scale and bias.
+pub fn sliced(dims: &GridDims, range: &[u8], params: &[u8]) -> GridDims {
     let range: [f32; 2] = bytemuck::pod_read_unaligned(range);
     let p: GridParams = bytemuck::pod_read_unaligned(params);
     dims.with_slicing(range, p.slice_scale, p.slice_bias)

@@ -110,23 +110,44 @@ impl<'a> FrameEncoder<'a> {
     /// them (the `cpu` strategy's cell bounds). Counted as a submission, a blocking readback
     /// and CPU wait.
     pub fn download(&mut self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
-        if bytes == 0 {
-            return Ok(Vec::new());
+        Ok(self.download_all(&[(buffer, bytes)])?.remove(0))
+    }
+
+    /// [`Self::download`] of several buffers (the first `bytes` of each, multiples of 4) in
+    /// one submission and one wait.
+    pub fn download_all(&mut self, parts: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>> {
+        let total: u64 = parts.iter().map(|&(_, bytes)| bytes).sum();
+        if total == 0 {
+            return Ok(vec![Vec::new(); parts.len()]);
         }
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("download"),
-            size: bytes,
+            size: total,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        self.encoder
-            .copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        let mut offset = 0;
+        for &(buffer, bytes) in parts {
+            if bytes > 0 {
+                self.encoder
+                    .copy_buffer_to_buffer(buffer, 0, &staging, offset, bytes);
+            }
+            offset += bytes;
+        }
         self.submit_recorded("submitting a frame part")?;
         let start = Instant::now();
-        let out = read_buffer(self.device, &staging)?;
+        let all = read_buffer(self.device, &staging)?;
         self.io.cpu_wait_ms += start.elapsed().as_secs_f64() * 1e3;
-        self.io.readback_bytes += bytes;
-        Ok(out)
+        self.io.readback_bytes += total;
+        let mut rest = all.as_slice();
+        Ok(parts
+            .iter()
+            .map(|&(_, bytes)| {
+                let (part, tail) = rest.split_at(bytes as usize);
+                rest = tail;
+                part.to_vec()
+            })
+            .collect())
     }
 
     /// Submit the frame (no wait). Returns what the frame cost and its submission.
