@@ -96,10 +96,11 @@ pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
 /// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`).
 fn tiled_kernel(samples: u32) -> ComposedShader {
     let msaa = crate::shader::msaa_wgsl(samples);
-    let (name, outputs, kernel) = if samples > 1 {
+    // The kernel and what it shares: the storage outputs at 1x, the edge queue above.
+    let (name, shared, kernel) = if samples > 1 {
         (
             "tiled_light_prepass_msaa",
-            "",
+            super::tiled_deferred::MSAA_EDGE_QUEUE_WGSL,
             include_str!("tiled_light_prepass_msaa.wgsl"),
         )
     } else {
@@ -119,7 +120,7 @@ fn tiled_kernel(samples: u32) -> ComposedShader {
             src::LIGHT_GRID,
             MSAA_SURFACES_WGSL,
             ATTRIBUTES_WGSL,
-            outputs,
+            shared,
             kernel,
         ],
     )

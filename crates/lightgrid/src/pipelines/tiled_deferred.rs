@@ -66,6 +66,7 @@ fn kernel_shader(samples: u32) -> ComposedShader {
             crate::passes::MSAA_EDGES_WGSL,
             src::LIGHT_GRID,
             src::TONE,
+            MSAA_EDGE_QUEUE_WGSL,
             MSAA_SAMPLE_OUTPUTS_WGSL,
             include_str!("tiled_deferred_msaa.wgsl"),
         ],
@@ -75,6 +76,8 @@ fn kernel_shader(samples: u32) -> ComposedShader {
 /// The MSAA kernels' outputs (group 3 of `SampleOutputs`), shared by the grid and the single
 /// kernel.
 const MSAA_SAMPLE_OUTPUTS_WGSL: &str = include_str!("msaa_sample_outputs.wgsl");
+/// The edge-aware kernels' queue of edge samples and counts (also the tiled light pre-pass's).
+pub(super) const MSAA_EDGE_QUEUE_WGSL: &str = include_str!("msaa_edge_queue.wgsl");
 
 /// The pass writing the MSAA kernel's per-sample colours into the multisampled HDR target.
 fn expand_shader(samples: u32) -> ComposedShader {
@@ -115,6 +118,7 @@ fn single_kernel_shader(samples: u32) -> ComposedShader {
             TILE_DEPTH_WGSL,
             crate::culling::TILE_FRUSTUM_WGSL,
             src::TONE,
+            MSAA_EDGE_QUEUE_WGSL,
             MSAA_SAMPLE_OUTPUTS_WGSL,
             include_str!("tiled_deferred_single_msaa.wgsl"),
         ],

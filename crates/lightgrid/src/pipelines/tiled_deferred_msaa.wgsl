@@ -18,14 +18,17 @@
 // Counts go to `pixel_counts` (lighting computations) and the frame counters (edge pixels,
 // samples shaded, samples with geometry).
 
-const GROUP_PIXELS: u32 = SCREEN_WORKGROUP * SCREEN_WORKGROUP;
+// The queue of edge samples and the counts: msaa_edge_queue.wgsl.
+const GROUP_WIDTH: u32 = SCREEN_WORKGROUP;
 
-// The queued edge samples: (local pixel index << 8) | sample.
-var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
-var<workgroup> queued: atomic<u32>;
-var<workgroup> group_edges: atomic<u32>;
-var<workgroup> group_first: atomic<u32>;
-var<workgroup> group_geometry: atomic<u32>;
+fn msaa_depth(p: vec2<u32>, s: u32) -> f32 {
+    return textureLoad(gb_depth, p, s);
+}
+
+// An edge pixel's sample without geometry: black.
+fn background_sample(p: vec2<u32>, l: u32, s: u32) {
+    output_sample(p, l, s, vec3<f32>(0.0), 1.0 / f32(SAMPLES));
+}
 
 // Sample `s` of pixel `p` at framebuffer position `xy` and depth-buffer value `depth`: shaded
 // from its cell's lights, counted into the pixel.
@@ -45,12 +48,7 @@ fn main(
     @builtin(local_invocation_index) li: u32,
 ) {
     clear_resolve(li);
-    if (li == 0u) {
-        atomicStore(&queued, 0u);
-        atomicStore(&group_edges, 0u);
-        atomicStore(&group_first, 0u);
-        atomicStore(&group_geometry, 0u);
-    }
+    clear_edge_queue(li);
     workgroupBarrier();
     let size = vec2<u32>(frame.viewport);
     let p = gid.xy;
@@ -76,20 +74,9 @@ fn main(
                 // samples' mean depth is the centre's, where forward shades the pixel.
                 c0 = shade_at(p, 0u, vec2<f32>(p) + vec2<f32>(0.5), depth_sum / f32(SAMPLES));
             }
-            atomicAdd(&group_first, 1u);
         }
         output_pixel(p, li, edge, c0);
-        if (edge) {
-            for (var s = 1u; s < SAMPLES; s = s + 1u) {
-                if (!is_background(textureLoad(gb_depth, p, s))) {
-                    queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
-                } else {
-                    output_sample(p, li, s, vec3<f32>(0.0), 1.0 / f32(SAMPLES));
-                }
-            }
-            atomicAdd(&group_edges, 1u);
-        }
-        atomicAdd(&group_geometry, geometry);
+        enqueue_pixel(p, li, edge, !is_background(d0), geometry);
     }
     // Every invocation takes queued edge samples in turn.
     let n = workgroupUniformLoad(&queued);
@@ -97,18 +84,13 @@ fn main(
     var i = li;
     for (; i < n; i = i + GROUP_PIXELS) {
         let item = queue[i];
-        let local = item >> 8u;
-        let s = item & 0xffu;
-        let q = origin + vec2<u32>(local % SCREEN_WORKGROUP, local / SCREEN_WORKGROUP);
+        let q = queued_pixel(origin, item);
+        let s = queued_sample(item);
         let xy = vec2<f32>(q) + sample_position(s);
         let color = shade_at(q, s, xy, textureLoad(gb_depth, q, s));
-        output_sample(q, local, s, color, 1.0 / f32(SAMPLES));
+        output_sample(q, queued_local(item), s, color, 1.0 / f32(SAMPLES));
     }
     check_loop(i, n);
     finish_resolve(p, li, p.x < size.x && p.y < size.y);
-    if (li == 0u) {
-        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
-        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n);
-        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], atomicLoad(&group_geometry));
-    }
+    report_edge_counts(li, n);
 }

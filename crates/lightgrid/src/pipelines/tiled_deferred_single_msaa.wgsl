@@ -27,44 +27,37 @@
 
 @group(1) @binding(0) var<uniform> tile: GridParams;
 
-const GROUP_PIXELS: u32 = TILE_THREADS * TILE_THREADS;
+// The queue of edge samples and the counts: msaa_edge_queue.wgsl.
+const GROUP_WIDTH: u32 = TILE_THREADS;
+
+fn msaa_depth(p: vec2<u32>, s: u32) -> f32 {
+    return textureLoad(gb_depth, p, s);
+}
+
+// An edge pixel's sample without geometry: black.
+fn background_sample(p: vec2<u32>, l: u32, s: u32) {
+    output_sample(p, l, s, vec3<f32>(0.0), 1.0 / f32(SAMPLES));
+}
 
 var<workgroup> batch: array<u32, TILE_LIGHT_BATCH>;
 var<workgroup> batch_count: atomic<u32>;
-// The queued edge samples: (local pixel index << 8) | sample.
-var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
-var<workgroup> queued: atomic<u32>;
-var<workgroup> group_edges: atomic<u32>;
-var<workgroup> group_first: atomic<u32>;
-var<workgroup> group_geometry: atomic<u32>;
 
 // Sample `s` of pixel `p` at framebuffer position `xy` and depth-buffer value `depth`.
 fn surface_at(p: vec2<u32>, s: u32, xy: vec2<f32>, depth: f32) -> Surface {
     return apply_material(raw_surface_from_gbuffer(p, s, position_from_screen(xy, depth)));
 }
 
-// Queued sample `item`'s pixel, in the block at `origin`.
-fn queued_pixel(origin: vec2<u32>, item: u32) -> vec2<u32> {
-    let l = item >> 8u;
-    return origin + vec2<u32>(l % TILE_THREADS, l / TILE_THREADS);
-}
-
 // Queued sample `item`'s surface, in the block at `origin`.
 fn queued_surface(origin: vec2<u32>, item: u32) -> Surface {
     let q = queued_pixel(origin, item);
-    let s = item & 0xffu;
+    let s = queued_sample(item);
     return surface_at(q, s, vec2<f32>(q) + sample_position(s), textureLoad(gb_depth, q, s));
 }
 
 @compute @workgroup_size(TILE_THREADS, TILE_THREADS)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     clear_resolve(li);
-    if (li == 0u) {
-        atomicStore(&queued, 0u);
-        atomicStore(&group_edges, 0u);
-        atomicStore(&group_first, 0u);
-        atomicStore(&group_geometry, 0u);
-    }
+    clear_edge_queue(li);
     // Workgroup (tile, block): blocks per tile edge, the block's first pixel and this
     // invocation's pixel.
     let blocks = (tile.tile_size + TILE_THREADS - 1u) / TILE_THREADS;
@@ -107,19 +100,8 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
             }
             view0 = view_dir_to(s0.position);
             first = true;
-            atomicAdd(&group_first, 1u);
         }
-        if (edge) {
-            for (var s = 1u; s < SAMPLES; s = s + 1u) {
-                if (!is_background(textureLoad(gb_depth, p, s))) {
-                    queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
-                } else {
-                    output_sample(p, li, s, vec3<f32>(0.0), 1.0 / f32(SAMPLES));
-                }
-            }
-            atomicAdd(&group_edges, 1u);
-        }
-        atomicAdd(&group_geometry, geometry);
+        enqueue_pixel(p, li, edge, first, geometry);
     }
     let n_queued = workgroupUniformLoad(&queued);
 
@@ -186,15 +168,11 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         let item = queue[t];
         let q = queued_pixel(origin, item);
         let color = surface_base(queued_surface(origin, item)) + taken_acc[k];
-        output_sample(q, item >> 8u, item & 0xffu, color, 1.0 / f32(SAMPLES));
+        output_sample(q, queued_local(item), queued_sample(item), color, 1.0 / f32(SAMPLES));
         count_pixel(q, count);
         k = k + 1u;
     }
     check_loop(t, n_queued);
     finish_resolve(p, li, inside);
-    if (li == 0u) {
-        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
-        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n_queued);
-        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], atomicLoad(&group_geometry));
-    }
+    report_edge_counts(li, n_queued);
 }

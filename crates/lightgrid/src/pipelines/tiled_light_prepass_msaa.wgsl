@@ -17,14 +17,17 @@
 // Per sample (pixel * SAMPLES + sample): the irradiance as two pack2x16float words.
 @group(3) @binding(0) var<storage, read_write> sample_irradiance: array<vec2<u32>>;
 
-const GROUP_PIXELS: u32 = SCREEN_WORKGROUP * SCREEN_WORKGROUP;
+// The queue of edge samples and the counts: msaa_edge_queue.wgsl.
+const GROUP_WIDTH: u32 = SCREEN_WORKGROUP;
 
-// The queued edge samples: (local pixel index << 8) | sample.
-var<workgroup> queue: array<u32, GROUP_PIXELS * (SAMPLES - 1u)>;
-var<workgroup> queued: atomic<u32>;
-var<workgroup> group_edges: atomic<u32>;
-var<workgroup> group_first: atomic<u32>;
-var<workgroup> group_geometry: atomic<u32>;
+fn msaa_depth(p: vec2<u32>, s: u32) -> f32 {
+    return textureLoad(attr_depth, p, s);
+}
+
+// An edge pixel's sample without geometry: no irradiance.
+fn background_sample(p: vec2<u32>, l: u32, s: u32) {
+    store_irradiance(p, s, vec4<f32>(0.0));
+}
 
 // pack2x16float of a value beyond binary16's range is indeterminate (WGSL): clamped to the
 // largest half (HALF_MAX), a highlight's irradiance saturates the tone curve as the RGBA16F
@@ -48,12 +51,7 @@ fn main(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
-    if (li == 0u) {
-        atomicStore(&queued, 0u);
-        atomicStore(&group_edges, 0u);
-        atomicStore(&group_first, 0u);
-        atomicStore(&group_geometry, 0u);
-    }
+    clear_edge_queue(li);
     workgroupBarrier();
     let size = vec2<u32>(frame.viewport);
     let p = gid.xy;
@@ -71,22 +69,14 @@ fn main(
             } else {
                 v0 = irradiance_at(p, attributes_pixel_surface(p), attributes_centre_depth(p));
             }
-            atomicAdd(&group_first, 1u);
         }
         store_irradiance(p, 0u, v0);
-        for (var s = 1u; s < SAMPLES; s = s + 1u) {
-            if (!edge) {
+        if (!edge) {
+            for (var s = 1u; s < SAMPLES; s = s + 1u) {
                 store_irradiance(p, s, v0);
-            } else if (!is_background(textureLoad(attr_depth, p, s))) {
-                queue[atomicAdd(&queued, 1u)] = (li << 8u) | s;
-            } else {
-                store_irradiance(p, s, vec4<f32>(0.0));
             }
         }
-        if (edge) {
-            atomicAdd(&group_edges, 1u);
-        }
-        atomicAdd(&group_geometry, geometry);
+        enqueue_pixel(p, li, edge, !is_background(d0), geometry);
     }
     // Every invocation takes queued edge samples in turn.
     let n = workgroupUniformLoad(&queued);
@@ -94,16 +84,11 @@ fn main(
     var i = li;
     for (; i < n; i = i + GROUP_PIXELS) {
         let item = queue[i];
-        let local = item >> 8u;
-        let s = item & 0xffu;
-        let q = origin + vec2<u32>(local % SCREEN_WORKGROUP, local / SCREEN_WORKGROUP);
+        let q = queued_pixel(origin, item);
+        let s = queued_sample(item);
         let depth = textureLoad(attr_depth, q, s);
         store_irradiance(q, s, irradiance_at(q, attributes_sample_surface(q, s, depth), depth));
     }
     check_loop(i, n);
-    if (li == 0u) {
-        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], atomicLoad(&group_edges));
-        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], atomicLoad(&group_first) + n);
-        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], atomicLoad(&group_geometry));
-    }
+    report_edge_counts(li, n);
 }
