@@ -40,6 +40,40 @@ fn volume_position(p: vec3<f32>, l: u32) -> vec3<f32> {
     return light.position + axis * h + (u * p.x + w * p.y) * rho;
 }
 
+// With MSAA a pixel that two primitives of one draw share (a volume mesh's inner edges; the
+// full-screen triangle, which lavapipe cuts along the screen's diagonal) runs one fragment
+// for each, over the samples each covers: only the one covering sample 0 counts for it.
+fn counts_for_pixel(mask: u32) -> bool {
+    return (mask & 1u) != 0u;
+}
+
+// The MSAA counts of a pixel that is no edge (one point computed for it), from the fragment
+// with coverage `mask`, its samples' depths in `depth`: the point (once per pixel) and the
+// covered samples with geometry, as the edge-aware kernels count them.
+fn count_pixel_once(depth: DepthTexture, p: vec2<u32>, mask: u32) {
+    var geometry = 0u;
+    for (var s = 0u; s < SAMPLES; s = s + 1u) {
+        let covered = ((mask >> s) & 1u) != 0u;
+        geometry += select(0u, 1u, covered && !is_background(textureLoad(depth, p, s)));
+    }
+    atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], geometry);
+    if (counts_for_pixel(mask)) {
+        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
+    }
+}
+
+// The MSAA counts of sample `i` of an edge pixel: the edge pixel (at its sample 0) and, where
+// the sample holds geometry (`depth`), the point computed for it.
+fn count_edge_sample(depth: DepthTexture, p: vec2<u32>, i: u32) {
+    if (i == 0u) {
+        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], 1u);
+    }
+    if (!is_background(textureLoad(depth, p, i))) {
+        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
+        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], 1u);
+    }
+}
+
 @vertex
 fn vs_volume(v: VolumeIn) -> VolumeOut {
     var out: VolumeOut;

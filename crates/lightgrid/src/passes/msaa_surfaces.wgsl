@@ -4,6 +4,17 @@
 // specular exponent in w: `light_prepass_attributes.wgsl`). Needs `shader::msaa_wgsl`'s
 // `sample_position`.
 
+// Pixel `p`'s depth at its centre, where forward shades it, read from `depth`: for a pixel
+// that is no edge (one surface over it) the samples' mean, as the standard patterns' positions
+// average to the centre and depth is affine over a triangle.
+fn centre_depth(depth: DepthTexture, p: vec2<u32>) -> f32 {
+    var sum = 0.0;
+    for (var s = 0u; s < SAMPLES; s = s + 1u) {
+        sum += textureLoad(depth, p, s);
+    }
+    return sum / f32(SAMPLES);
+}
+
 // Do sample 0 (depth `d0`, normal `n0`) and sample `s` (depth `d`, normal `n`) of pixel `p`
 // show different surfaces, given whether what each reader stores besides the normal differs
 // (`kinds_differ`)? A normal more than ~8 degrees off, or a sample off sample 0's tangent

@@ -16,23 +16,9 @@
 // covering sample 0 counts, so a pixel shaded once is counted once. The shading entries
 // force the early depth and stencil tests (`shader::EARLY_DEPTH_TEST`): with their counting
 // side effects the tests would otherwise run after them, and the per-sample pipelines would
-// shade, and count, every sample before the edge bit rejected it.
-
-// Does the fragment with coverage `mask` count for its pixel (the one covering sample 0)?
-fn counts_for_pixel(mask: u32) -> bool {
-    return (mask & 1u) != 0u;
-}
-
-// Pixel `p`'s depth at its centre, where forward shades it: for a pixel that is no edge
-// (one surface over it) the samples' mean, as the standard patterns' positions average to
-// the centre and depth is affine over a triangle (`tiled_deferred_msaa.wgsl` does the same).
-fn centre_depth(p: vec2<u32>) -> f32 {
-    var sum = 0.0;
-    for (var s = 0u; s < SAMPLES; s = s + 1u) {
-        sum += textureLoad(gb_depth, p, s);
-    }
-    return sum / f32(SAMPLES);
-}
+// shade, and count, every sample before the edge bit rejected it. `counts_for_pixel` and the
+// counting are light_volume.wgsl's, shared with the light pre-pass; `centre_depth` is
+// msaa_surfaces.wgsl's.
 
 // One fragment per pixel (no edge; every pixel without MSAA): sample 0's attributes at the
 // pixel centre.
@@ -42,7 +28,7 @@ fn fs_light(v: VolumeOut, @builtin(sample_mask) mask: u32) -> LitOut {
     if (is_background(textureLoad(gb_depth, p, 0))) {
         discard;
     }
-    let position = position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), centre_depth(p));
+    let position = position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), centre_depth(gb_depth, p));
     let s = apply_material(raw_surface_from_gbuffer(p, 0u, position));
     let n = select(0u, 1u, counts_for_pixel(mask));
     return lit(v.clip, shade_light(s, view_dir_to(s.position), lights[v.light]), n);
@@ -71,15 +57,7 @@ fn fs_base(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -
     if (!is_background(textureLoad(gb_depth, p, 0))) {
         color = textureLoad(gb_base, p, 0).rgb;
         if (MULTISAMPLED) {
-            var geometry = 0u;
-            for (var s = 0u; s < SAMPLES; s = s + 1u) {
-                let covered = ((mask >> s) & 1u) != 0u;
-                geometry += select(0u, 1u, covered && !is_background(textureLoad(gb_depth, p, s)));
-            }
-            atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], geometry);
-            if (counts_for_pixel(mask)) {
-                atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
-            }
+            count_pixel_once(gb_depth, p, mask);
         }
     }
     return lit(pos, color, 0u);
@@ -91,13 +69,9 @@ fn fs_base(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -
 fn fs_base_sample(@builtin(position) pos: vec4<f32>, @builtin(sample_index) i: u32) -> LitOut {
     let p = vec2<u32>(pos.xy);
     var color = vec3<f32>(0.0);
-    if (i == 0u) {
-        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], 1u);
-    }
+    count_edge_sample(gb_depth, p, i);
     if (!is_background(textureLoad(gb_depth, p, i))) {
         color = textureLoad(gb_base, p, i).rgb;
-        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
-        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], 1u);
     }
     return lit(pos, color, 0u);
 }

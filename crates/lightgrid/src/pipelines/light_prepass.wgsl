@@ -29,10 +29,6 @@ struct IrradianceOut {
     @location(2) count: f32,
 }
 
-// Does the fragment with coverage `mask` count for its pixel (the one covering sample 0)?
-fn counts_for_pixel(mask: u32) -> bool {
-    return (mask & 1u) != 0u;
-}
 
 // The lighting computation of a volume fragment at pixel `p`, counted `n` times.
 fn irradiance_out(p: vec2<u32>, s: Surface, light: u32, n: u32) -> IrradianceOut {
@@ -112,15 +108,7 @@ fn fs_mark_edges(@builtin(position) pos: vec4<f32>) -> IrradianceOut {
 fn fs_count(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -> IrradianceOut {
     let p = vec2<u32>(pos.xy);
     if (!is_background(textureLoad(attr_depth, p, 0))) {
-        var geometry = 0u;
-        for (var s = 0u; s < SAMPLES; s = s + 1u) {
-            let covered = ((mask >> s) & 1u) != 0u;
-            geometry += select(0u, 1u, covered && !is_background(textureLoad(attr_depth, p, s)));
-        }
-        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], geometry);
-        if (counts_for_pixel(mask)) {
-            atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
-        }
+        count_pixel_once(attr_depth, p, mask);
     }
     var out: IrradianceOut;
     return out;
@@ -130,14 +118,7 @@ fn fs_count(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) 
 // computed and with geometry. Adds nothing to the targets.
 @fragment @early_depth_test(force)
 fn fs_count_sample(@builtin(position) pos: vec4<f32>, @builtin(sample_index) i: u32) -> IrradianceOut {
-    let p = vec2<u32>(pos.xy);
-    if (i == 0u) {
-        atomicAdd(&frame_counters[COUNTER_EDGE_PIXELS], 1u);
-    }
-    if (!is_background(textureLoad(attr_depth, p, i))) {
-        atomicAdd(&frame_counters[COUNTER_SHADED_SAMPLES], 1u);
-        atomicAdd(&frame_counters[COUNTER_GEOMETRY_SAMPLES], 1u);
-    }
+    count_edge_sample(attr_depth, vec2<u32>(pos.xy), i);
     var out: IrradianceOut;
     return out;
 }

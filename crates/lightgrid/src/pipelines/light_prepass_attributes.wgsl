@@ -17,21 +17,11 @@ fn attributes_surface_at(p: vec2<u32>, s: u32, position: vec3<f32>) -> Surface {
     return surface;
 }
 
-// Pixel `p`'s depth at its centre, where forward shades it: for a pixel that is no edge (one
-// surface over it) the samples' mean, as the standard patterns' positions average to the
-// centre and depth is affine over a triangle (the deferred pipelines do the same).
-fn attributes_centre_depth(p: vec2<u32>) -> f32 {
-    var sum = 0.0;
-    for (var s = 0u; s < SAMPLES; s = s + 1u) {
-        sum += textureLoad(attr_depth, p, s);
-    }
-    return sum / f32(SAMPLES);
-}
 
 // Pixel `p` shaded once (no edge; every pixel without MSAA): sample 0's normal and exponent
 // at the pixel centre.
 fn attributes_pixel_surface(p: vec2<u32>) -> Surface {
-    let position = position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), attributes_centre_depth(p));
+    let position = position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), centre_depth(attr_depth, p));
     return attributes_surface_at(p, 0u, position);
 }
 

@@ -67,7 +67,7 @@ fn main(
             if (edge) {
                 v0 = irradiance_at(p, attributes_sample_surface(p, 0u, d0), d0);
             } else {
-                v0 = irradiance_at(p, attributes_pixel_surface(p), attributes_centre_depth(p));
+                v0 = irradiance_at(p, attributes_pixel_surface(p), centre_depth(attr_depth, p));
             }
         }
         store_irradiance(p, 0u, v0);
