@@ -67,8 +67,6 @@ struct LastFrame {
     cell_bounds: Option<Vec<[f32; 2]>>,
     /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
     near_far: [f32; 2],
-    /// The slices were spread on the GPU (`dims` holds near..far until read back).
-    sliced_on_gpu: bool,
 }
 
 pub struct GridBuilder {
@@ -219,7 +217,6 @@ impl GridBuilder {
             cpu_grid: run.cpu_grid,
             cell_bounds: run.cell_bounds,
             near_far: [f.setup.near, f.setup.far],
-            sliced_on_gpu: self.range.is_some(),
         });
         Ok(())
     }
@@ -251,8 +248,9 @@ impl GridBuilder {
             Some(g) => g.clone(),
             None => {
                 let dims = match &self.range {
-                    Some(range) if last.sliced_on_gpu => range.read(device, queue, &last.dims)?,
-                    _ => last.dims,
+                    // The GPU spread the slices: `last.dims` holds near..far.
+                    Some(range) => range.read(device, queue, &last.dims)?,
+                    None => last.dims,
                 };
                 let strategy = self
                     .strategies

@@ -29,16 +29,38 @@ use crate::passes::{
 };
 use crate::shader::{compose, compute_pipeline, compute_pipeline_with, src, ComposedShader};
 
-/// Shared modules of a single-sample deferred compute shader (no vertex stage).
-fn deferred_parts(single_sample: &str) -> Vec<&str> {
-    vec![
+/// A deferred shading kernel (`name`) for `samples` samples per pixel, over the G-buffer and
+/// `reads` (the grid, or the single kernel's culling): `single` at one sample per pixel
+/// (one sample per invocation, storage-texture outputs), else the edge-aware `edge_aware`
+/// (the edge test, the edge queue, the per-sample outputs).
+fn deferred_kernel(
+    samples: u32,
+    name: &str,
+    reads: &[&str],
+    single: &str,
+    edge_aware: &str,
+) -> ComposedShader {
+    let msaa = crate::shader::msaa_wgsl(samples);
+    let mut parts = vec![
         src::TYPES,
         src::SCENE_BINDINGS,
         src::LIGHTING,
-        single_sample,
+        &msaa,
         GBUFFER_READ_WGSL,
-        COMPUTE_OUTPUTS_WGSL,
-    ]
+    ];
+    parts.extend(reads);
+    if samples == 1 {
+        parts.extend([COMPUTE_OUTPUTS_WGSL, single]);
+        return compose(name, &parts);
+    }
+    parts.extend([
+        crate::passes::MSAA_EDGES_WGSL,
+        src::TONE,
+        MSAA_EDGE_QUEUE_WGSL,
+        MSAA_SAMPLE_OUTPUTS_WGSL,
+        edge_aware,
+    ]);
+    compose(&format!("{name}_msaa"), &parts)
 }
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
@@ -48,28 +70,12 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 /// The grid pipelines' shading kernel for `samples` samples per pixel: one sample per
 /// invocation, or above one the edge-aware kernel (`tiled_deferred_msaa.wgsl`).
 fn kernel_shader(samples: u32) -> ComposedShader {
-    let msaa = crate::shader::msaa_wgsl(samples);
-    if samples == 1 {
-        let mut parts = deferred_parts(&msaa);
-        parts.push(src::LIGHT_GRID);
-        parts.push(include_str!("tiled_deferred.wgsl"));
-        return compose("tiled_deferred", &parts);
-    }
-    compose(
-        "tiled_deferred_msaa",
-        &[
-            src::TYPES,
-            src::SCENE_BINDINGS,
-            src::LIGHTING,
-            &msaa,
-            GBUFFER_READ_WGSL,
-            crate::passes::MSAA_EDGES_WGSL,
-            src::LIGHT_GRID,
-            src::TONE,
-            MSAA_EDGE_QUEUE_WGSL,
-            MSAA_SAMPLE_OUTPUTS_WGSL,
-            include_str!("tiled_deferred_msaa.wgsl"),
-        ],
+    deferred_kernel(
+        samples,
+        "tiled_deferred",
+        &[src::LIGHT_GRID],
+        include_str!("tiled_deferred.wgsl"),
+        include_str!("tiled_deferred_msaa.wgsl"),
     )
 }
 
@@ -98,30 +104,12 @@ pub(super) fn shaders_single() -> Vec<ComposedShader> {
 /// The single kernel for `samples` samples per pixel: one sample per invocation, or above
 /// one the edge-aware kernel (`tiled_deferred_single_msaa.wgsl`).
 fn single_kernel_shader(samples: u32) -> ComposedShader {
-    let msaa = crate::shader::msaa_wgsl(samples);
-    if samples == 1 {
-        let mut parts = deferred_parts(&msaa);
-        parts.push(TILE_DEPTH_WGSL);
-        parts.push(crate::culling::TILE_FRUSTUM_WGSL);
-        parts.push(include_str!("tiled_deferred_single.wgsl"));
-        return compose("tiled_deferred_single", &parts);
-    }
-    compose(
-        "tiled_deferred_single_msaa",
-        &[
-            src::TYPES,
-            src::SCENE_BINDINGS,
-            src::LIGHTING,
-            &msaa,
-            GBUFFER_READ_WGSL,
-            crate::passes::MSAA_EDGES_WGSL,
-            TILE_DEPTH_WGSL,
-            crate::culling::TILE_FRUSTUM_WGSL,
-            src::TONE,
-            MSAA_EDGE_QUEUE_WGSL,
-            MSAA_SAMPLE_OUTPUTS_WGSL,
-            include_str!("tiled_deferred_single_msaa.wgsl"),
-        ],
+    deferred_kernel(
+        samples,
+        "tiled_deferred_single",
+        &[TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL],
+        include_str!("tiled_deferred_single.wgsl"),
+        include_str!("tiled_deferred_single_msaa.wgsl"),
     )
 }
 
