@@ -131,31 +131,20 @@ fn bad_advise_options_are_refused() {
 
 #[test]
 fn an_interrupted_advice_exits_1_and_says_so() {
-    use std::io::{BufRead, BufReader};
     let dir = temp_dir("advise-interrupted");
     let json = dir.join("advice.json");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lightgrid"))
-        .args([
-            "advise",
-            "--scene",
-            "robots-few",
-            "--size",
-            "64x36",
-            "--budget",
-            "60",
-            "--json",
-            json.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Once it measures (its first progress line), one SIGTERM: stop, not abort.
-    let mut err = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
-        line.clear();
-    }
+    // Once it measures, one SIGTERM: stop, not abort.
+    let (mut child, mut err) = support::start_measuring(&[
+        "advise",
+        "--scene",
+        "robots-few",
+        "--size",
+        "64x36",
+        "--budget",
+        "60",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
     let killed = std::process::Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()

@@ -420,36 +420,30 @@ fn two_runs_into_one_directory_do_not_mix() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A bench long enough to interrupt: every frame of robots-few, two pipelines, into `dir`.
+fn slow_bench(dir: &std::path::Path) -> Vec<&str> {
+    vec![
+        "bench",
+        "--scene",
+        "robots-few",
+        "--pipelines",
+        "forward,deferred",
+        "--size",
+        "32x18",
+        "--frames",
+        "0..259:1",
+        "--warmup",
+        "0",
+        "--out",
+        s(dir),
+    ]
+}
+
 #[test]
 fn sigterm_stops_a_bench_and_keeps_its_results() {
-    use std::io::{BufRead, BufReader};
     let dir = temp_dir("sigterm");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
-        .args([
-            "bench",
-            "--scene",
-            "robots-few",
-            "--pipelines",
-            "forward,deferred",
-            "--size",
-            "32x18",
-            "--frames",
-            "0..259:1",
-            "--warmup",
-            "0",
-            "--out",
-            s(&dir),
-        ])
-        .stderr(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    // Wait until it measures (the first progress line), then SIGTERM.
-    let mut err = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
-        line.clear();
-    }
+    // Wait until it measures, then SIGTERM.
+    let (mut child, mut err) = support::start_measuring(&slow_bench(&dir));
     std::thread::sleep(std::time::Duration::from_millis(1500));
     let killed = Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
@@ -1103,33 +1097,8 @@ fn overwriting_an_output_keeps_its_mode() {
 
 #[test]
 fn a_second_signal_exits_at_once_leaving_no_temporary_files() {
-    use std::io::{BufRead, BufReader};
     let dir = temp_dir("sigterm-twice");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
-        .args([
-            "bench",
-            "--scene",
-            "robots-few",
-            "--pipelines",
-            "forward,deferred",
-            "--size",
-            "32x18",
-            "--frames",
-            "0..259:1",
-            "--warmup",
-            "0",
-            "--out",
-            s(&dir),
-        ])
-        .stderr(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut err = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
-        line.clear();
-    }
+    let (mut child, _err) = support::start_measuring(&slow_bench(&dir));
     // Measuring: its staging directory exists.
     let staging = || {
         std::fs::read_dir(&dir)

@@ -5,6 +5,30 @@ use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+/// `lightgrid args`, started with stderr piped (stdout discarded), handed back once it
+/// measures (its first progress line), with the rest of its stderr to read: the moment the
+/// signal tests interrupt it.
+pub fn start_measuring(
+    args: &[&str],
+) -> (
+    std::process::Child,
+    std::io::BufReader<std::process::ChildStderr>,
+) {
+    use std::io::BufRead;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgrid"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while err.read_line(&mut line).unwrap() > 0 && !line.contains("% ") {
+        line.clear();
+    }
+    (child, err)
+}
+
 pub fn lightgrid(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lightgrid"))
         .args(args)
