@@ -90,6 +90,8 @@ pub const COUNTER_WRITE_OVERFLOW: u32 = 4;
 pub const COUNTER_PAIRS_NEEDED: u32 = 5;
 /// Of those, pairs that did not fit the pair buffer (sized from earlier frames).
 pub const COUNTER_PAIRS_OUT_OF_ROOM: u32 = 6;
+/// Lights a `LightCuller` refused (not finite, range not positive: `cull_lights.wgsl`).
+pub const COUNTER_INVALID_LIGHTS: u32 = 7;
 /// Three slots: the spill pass's indirect dispatch arguments (x, y, z).
 pub const COUNTER_SPILL_ARGS: u32 = 8;
 /// Three slots: the scatter emit pass's indirect dispatch arguments (x, y, z).
@@ -275,6 +277,10 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     (
         "COUNTER_PAIRS_OUT_OF_ROOM",
         WgslConst::U32(COUNTER_PAIRS_OUT_OF_ROOM),
+    ),
+    (
+        "COUNTER_INVALID_LIGHTS",
+        WgslConst::U32(COUNTER_INVALID_LIGHTS),
     ),
     ("COUNTER_SPILL_ARGS", WgslConst::U32(COUNTER_SPILL_ARGS)),
     ("COUNTER_ITEM_ARGS", WgslConst::U32(COUNTER_ITEM_ARGS)),

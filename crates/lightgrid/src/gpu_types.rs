@@ -79,7 +79,9 @@ pub struct FrameUniforms {
     /// 1: spot lights are culled by their cone as well as their bounding sphere
     /// (`SpotCull::Cone`); 0: by the sphere only.
     pub spot_cull: u32,
-    pub _pad0: u32,
+    /// 1: standard depth (0 at the near plane, cleared to 1), as a caller of
+    /// `culling::LightCuller` may have; 0: lightgrid's reversed-Z (`depth.rs`).
+    pub standard_depth: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }

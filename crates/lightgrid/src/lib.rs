@@ -25,7 +25,13 @@ pub mod shader;
 pub mod stats;
 
 pub use analysis::FrameOutput;
+/// The light grid for any wgpu renderer (`culling/culler.rs`; README, "Embedding").
+pub use culling::{
+    CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
+    LightCuller,
+};
 pub use error::{Error, Result};
+pub use frame::{DepthBounds, SpotCull};
 pub use frame::{FinishedFrame, RenderSettings, SubmittedFrame};
 pub use renderer::{max_frame_edge, validate_size, Renderer, MAX_FRAMES_IN_FLIGHT};
 pub use stats::{FrameStats, TimingSource};

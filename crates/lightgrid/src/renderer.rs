@@ -116,6 +116,8 @@ pub struct Renderer<'c> {
     ctx: &'c GpuContext,
     targets: Targets,
     scene_layout: wgpu::BindGroupLayout,
+    /// Group 0 of the culling kernels (`culling::cull_layout`), a subset of the scene's.
+    cull_layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     lights: GrowBuffer,
     light_bounds: GrowBuffer,
@@ -123,6 +125,8 @@ pub struct Renderer<'c> {
     vertices: GrowBuffer,
     indices: GrowBuffer,
     scene_bind_group: wgpu::BindGroup,
+    /// The culling kernels' group 0 over the same buffers.
+    cull_bind_group: wgpu::BindGroup,
     /// The scene's base-colour textures (uploaded with its static geometry).
     textures: BaseTextures,
     scene: Option<SceneUpload>,
@@ -187,6 +191,7 @@ impl<'c> Renderer<'c> {
         let created = scoped(device, "creating render targets", || {
             let targets = Targets::new(device, width, height, settings.msaa);
             let scene_layout = scene_layout(device);
+            let cull_layout = crate::culling::cull_layout(device);
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
                 size: std::mem::size_of::<FrameUniforms>() as u64,
@@ -201,9 +206,9 @@ impl<'c> Renderer<'c> {
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
             let counters = FrameCounters::new(device, MAX_PASSES);
             let textures = BaseTextures::new(device, &ctx.queue, &[]);
-            let scene_bind_group = Self::bind_scene(
+            let (scene_bind_group, cull_bind_group) = Self::bind_scene(
                 device,
-                &scene_layout,
+                [&scene_layout, &cull_layout],
                 &uniforms,
                 [&lights, &light_bounds, &materials],
                 [counters.buffer(), &targets.pixel_counts],
@@ -216,6 +221,7 @@ impl<'c> Renderer<'c> {
                 timer: PassTimer::new(ctx, MAX_PASSES),
                 counters,
                 scene_layout,
+                cull_layout,
                 uniforms,
                 lights,
                 light_bounds,
@@ -223,6 +229,7 @@ impl<'c> Renderer<'c> {
                 vertices,
                 indices,
                 scene_bind_group,
+                cull_bind_group,
                 textures,
                 scene: None,
                 techniques: HashMap::new(),
@@ -247,15 +254,21 @@ impl<'c> Renderer<'c> {
         })
     }
 
+    /// Group 0 of the scene and of the culling kernels, over the same buffers.
     fn bind_scene(
         device: &wgpu::Device,
-        layout: &wgpu::BindGroupLayout,
+        [layout, cull_layout]: [&wgpu::BindGroupLayout; 2],
         uniforms: &wgpu::Buffer,
         [lights, light_bounds, materials]: [&GrowBuffer; 3],
         [counters, pixel_counts]: [&wgpu::Buffer; 2],
         textures: &BaseTextures,
-    ) -> wgpu::BindGroup {
-        crate::gpu::bind_resources(
+    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        let cull = crate::culling::bind_cull_group(
+            device,
+            cull_layout,
+            [uniforms, &lights.buffer, counters, &light_bounds.buffer],
+        );
+        let scene = crate::gpu::bind_resources(
             device,
             "scene (group 0)",
             layout,
@@ -269,7 +282,8 @@ impl<'c> Renderer<'c> {
                 wgpu::BindingResource::TextureView(&textures.view),
                 wgpu::BindingResource::Sampler(&textures.sampler),
             ],
-        )
+        );
+        (scene, cull)
     }
 
     pub fn size(&self) -> (u32, u32) {
@@ -302,6 +316,7 @@ impl<'c> Renderer<'c> {
             let ctx = PipelineContext {
                 device,
                 scene_layout: &self.scene_layout,
+                cull_layout: &self.cull_layout,
                 dims: self.dims,
                 settings: self.settings,
                 count_blend: self.ctx.count_blend,
@@ -468,7 +483,7 @@ impl<'c> Renderer<'c> {
             near: state.camera.near,
             far: state.camera.far,
             spot_cull: u32::from(self.settings.spot_cull == SpotCull::Cone),
-            _pad0: 0,
+            standard_depth: 0,
             _pad1: 0,
             _pad2: 0,
         };
@@ -479,9 +494,9 @@ impl<'c> Renderer<'c> {
 
     /// Group 0 again, after a buffer it binds was replaced.
     fn rebind_scene(&mut self) {
-        self.scene_bind_group = Self::bind_scene(
+        (self.scene_bind_group, self.cull_bind_group) = Self::bind_scene(
             &self.ctx.device,
-            &self.scene_layout,
+            [&self.scene_layout, &self.cull_layout],
             &self.uniforms,
             [&self.lights, &self.light_bounds, &self.materials],
             [self.counters.buffer(), &self.targets.pixel_counts],
@@ -505,6 +520,7 @@ impl<'c> Renderer<'c> {
             device,
             queue,
             scene_bind_group: &self.scene_bind_group,
+            cull_bind_group: &self.cull_bind_group,
             counters: self.counters.buffer(),
             vertices: &self.vertices.buffer,
             indices: &self.indices.buffer,

@@ -107,7 +107,7 @@ fn gpu_structs_match_wgsl() {
             near,
             far,
             spot_cull,
-            _pad0,
+            standard_depth,
             _pad1,
             _pad2
         ]

@@ -16,17 +16,20 @@ use super::depth_range::DepthRangePass;
 use super::gpu_assign::read_grid;
 use super::registry::find_strategy;
 pub use super::strategy::CellSource;
-use super::strategy::{AssignFrame, AssignStrategy, StrategyContext};
+use super::strategy::{AssignFrame, AssignStrategy, CullFrame, StrategyContext};
 use super::{GridBuffers, GridDims, GridLists, LightGrid};
 use crate::error::{Error, Result};
-use crate::frame::{Assign, FrameEncoder, FrameInputs};
+use crate::frame::{Assign, FrameEncoder};
 use crate::gpu::CounterValues;
 
 /// What a [`GridBuilder`] is created from.
 pub struct GridSetup<'a> {
     pub device: &'a wgpu::Device,
-    /// Group 0 layout, shared by all pipelines.
-    pub scene_layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the culling kernels (`strategy::cull_layout`).
+    pub cull_layout: &'a wgpu::BindGroupLayout,
+    /// The renderer's group 0: an MSAA forward grid's fragment bounds draw its geometry with
+    /// it. `None` for a caller's depth buffer.
+    pub scene_layout: Option<&'a wgpu::BindGroupLayout>,
     /// The frame's tile grid (one slice).
     pub tiles: GridDims,
     /// `--assign` (`auto` resolved per frame).
@@ -45,6 +48,9 @@ pub struct GridSetup<'a> {
     pub depth_bounds: crate::frame::DepthBounds,
     /// How the cell-bounds kernel reduces depths (`--depth-reduction`).
     pub depth_reduction: crate::frame::DepthReduction,
+    /// Index entries the lists start with (`GridBuffers::INITIAL_INDEX_CAPACITY`); they grow
+    /// from the frame counters.
+    pub index_capacity: u64,
 }
 
 /// A built grid and what went into it (analysis).
@@ -76,7 +82,8 @@ pub struct GridBuilder {
     assign: Assign,
     lists: GridLists,
     software_adapter: bool,
-    scene_layout: wgpu::BindGroupLayout,
+    index_capacity: u64,
+    cull_layout: wgpu::BindGroupLayout,
     bounds: CellBoundsPass,
     /// Step 0, for a clustered grid over the depth buffer.
     range: Option<DepthRangePass>,
@@ -90,7 +97,7 @@ impl GridBuilder {
     /// `slices` 1 builds a tiled grid, more a clustered one (slices spread each frame over
     /// the samples' depth range, or between the camera's near and far planes without depth).
     pub fn new(ctx: &GridSetup, slices: u32, source: CellSource) -> Self {
-        let (device, scene_layout) = (ctx.device, ctx.scene_layout);
+        let (device, cull_layout) = (ctx.device, ctx.cull_layout);
         GridBuilder {
             tiles: ctx.tiles,
             slices,
@@ -98,21 +105,28 @@ impl GridBuilder {
             assign: ctx.assign,
             lists: ctx.lists,
             software_adapter: ctx.software_adapter,
-            scene_layout: scene_layout.clone(),
+            index_capacity: ctx.index_capacity,
+            cull_layout: cull_layout.clone(),
             bounds: CellBoundsPass::new(
                 device,
-                scene_layout,
+                cull_layout,
+                ctx.scene_layout,
                 ctx.samples,
                 ctx.forward_opaque,
                 ctx.depth_bounds,
                 ctx.depth_reduction,
             ),
             range: (slices > 1 && source == CellSource::Depth)
-                .then(|| DepthRangePass::new(device, scene_layout, ctx.samples)),
-            buffers: GridBuffers::new(device),
+                .then(|| DepthRangePass::new(device, cull_layout, ctx.samples)),
+            buffers: GridBuffers::new(device, ctx.index_capacity),
             strategies: Vec::new(),
             last: None,
         }
+    }
+
+    /// The screen size changed (`LightCuller`: a caller's viewport).
+    pub(crate) fn set_tiles(&mut self, tiles: GridDims) {
+        self.tiles = tiles;
     }
 
     /// Group 1 of the shading pass (`culling/light_grid.wgsl`).
@@ -122,6 +136,22 @@ impl GridBuilder {
 
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         self.buffers.bind_group()
+    }
+
+    /// Create `assign`'s strategy now (`auto`: both it may resolve to), so a device that
+    /// cannot run it fails here rather than at the first frame.
+    pub(crate) fn prepare(&mut self, device: &wgpu::Device) -> Result<()> {
+        let wanted = match self.assign {
+            Assign::Auto => vec![
+                Assign::Auto.resolve(0, self.software_adapter),
+                Assign::Auto.resolve(usize::MAX, self.software_adapter),
+            ],
+            a => vec![a],
+        };
+        for a in wanted {
+            self.strategy(device, a)?;
+        }
+        Ok(())
     }
 
     fn strategy(
@@ -140,7 +170,8 @@ impl GridBuilder {
                 })?;
                 let ctx = StrategyContext {
                     device,
-                    scene_layout: &self.scene_layout,
+                    cull_layout: &self.cull_layout,
+                    index_capacity: self.index_capacity,
                 };
                 let created = crate::gpu::scoped(
                     device,
@@ -154,9 +185,9 @@ impl GridBuilder {
         Ok(self.strategies[i].1.as_mut())
     }
 
-    /// Record this frame's grid. With `CellSource::Depth`, `f.targets.depth` must hold the
-    /// frame's depth in what `enc` has recorded so far.
-    pub fn build(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
+    /// Record this frame's grid. With `CellSource::Depth`, `f.depth` must hold the frame's
+    /// depth in what `enc` has recorded so far.
+    pub fn build(&mut self, f: &CullFrame, enc: &mut FrameEncoder) -> Result<()> {
         let dims = if self.slices > 1 {
             self.tiles
                 .clustered(self.slices, f.setup.near, f.setup.far)?
@@ -165,7 +196,7 @@ impl GridBuilder {
         };
         // Cells spanning near..far already cover every transparent fragment.
         let dims = dims.with_lists(match self.source {
-            CellSource::Depth if f.has_transparency() => self.lists,
+            CellSource::Depth if f.transparency => self.lists,
             _ => GridLists::Opaque,
         });
         if let Some(range) = &self.range {
@@ -183,7 +214,7 @@ impl GridBuilder {
                     .fill(f.device, f.queue, &dims, [f.setup.near, f.setup.far])
             }
         }
-        let assign = self.assign.resolve(f.lights.len(), self.software_adapter);
+        let assign = self.assign.resolve(f.light_count, self.software_adapter);
         let source = self.source;
         // Disjoint borrows: the strategy list, the grid buffers and the bounds.
         self.strategy(f.device, assign)?;

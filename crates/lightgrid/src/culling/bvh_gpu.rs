@@ -8,9 +8,10 @@ use super::gpu_assign::{bvh_shader, CellKernels};
 use super::radix_sort::RadixSort;
 use super::scan::ScanPass;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
+use super::CullFrame;
 use crate::consts::ASSIGN_THREADS;
 use crate::error::Result;
-use crate::frame::{FrameEncoder, FrameInputs};
+use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
 use crate::gpu::{
     bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, UniformSlots,
@@ -47,14 +48,14 @@ pub struct GpuBvhBuild {
 }
 
 impl GpuBvhBuild {
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> Self {
+    pub fn new(device: &wgpu::Device, cull_layout: &wgpu::BindGroupLayout) -> Self {
         let layout = buffer_layout(
             device,
             "bvh build (group 1)",
             &[UNIFORM, STORAGE_RW, STORAGE_RW, STORAGE_RW, STORAGE_RW],
         );
         let s = shader();
-        let layouts = [Some(scene_layout), Some(&layout)];
+        let layouts = [Some(cull_layout), Some(&layout)];
         let pipeline = |entry: &str| {
             compute_pipeline(device, &format!("bvh build {entry}"), &s, entry, &layouts)
         };
@@ -73,9 +74,9 @@ impl GpuBvhBuild {
 
     /// Record the build for the frame's lights. The hierarchy is ready for the passes
     /// recorded after it; [`GpuBvhBuild::buffers`] binds it.
-    pub fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder, scan: &ScanPass) {
+    pub fn encode(&mut self, f: &CullFrame, enc: &mut FrameEncoder, scan: &ScanPass) {
         let device = f.device;
-        let n = f.lights.len() as u32;
+        let n = f.light_count as u32;
         if n == 0 {
             return;
         }
@@ -126,7 +127,7 @@ impl GpuBvhBuild {
                    items: u32| {
             let mut pass = timer.begin_compute(encoder, label);
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(0, f.bind_group, &[]);
             pass.set_bind_group(1, group, &[]);
             let (x, y) = groups_1d(items.div_ceil(ASSIGN_THREADS));
             pass.dispatch_workgroups(x, y, 1);
@@ -189,7 +190,7 @@ pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> 
     let layout = BvhBuffers::new(ctx.device).layout;
     Box::new(GpuBvhStrategy {
         kernels: CellKernels::new(ctx, "bvh", &bvh_shader(), &[&layout]),
-        build: GpuBvhBuild::new(ctx.device, ctx.scene_layout),
+        build: GpuBvhBuild::new(ctx.device, ctx.cull_layout),
         layout,
     })
 }

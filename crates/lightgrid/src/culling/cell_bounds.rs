@@ -11,10 +11,11 @@
 //! `--depth-bounds` (`DepthBounds`) then opens one side of each occupied cell's bounds, or
 //! both sides of every cell, to the cell's slice: twin [`open_bounds`].
 
+use super::CullFrame;
 use super::{GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
-use crate::frame::{DepthBounds, DepthReduction, FrameEncoder, FrameInputs};
+use crate::frame::{DepthBounds, DepthReduction, FrameEncoder};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
@@ -193,9 +194,12 @@ pub struct CellBoundsPass {
 impl CellBoundsPass {
     /// The kernel over a depth target of `samples` samples per pixel.
     /// `forward_opaque`: a forward pass shades the opaque fragments from these bounds' grid.
+    /// `scene_layout`: the renderer's group 0, with which an MSAA grid's fragment bounds draw
+    /// its geometry (none for a caller's depth buffer: [`super::LightCuller`]).
     pub fn new(
         device: &wgpu::Device,
-        scene_layout: &wgpu::BindGroupLayout,
+        cull_layout: &wgpu::BindGroupLayout,
+        scene_layout: Option<&wgpu::BindGroupLayout>,
         samples: u32,
         forward_opaque: bool,
         depth_bounds: DepthBounds,
@@ -213,7 +217,7 @@ impl CellBoundsPass {
             ],
         });
         let s = shader(samples, depth_bounds, reduction);
-        let layouts = [Some(scene_layout), Some(&layout)];
+        let layouts = [Some(cull_layout), Some(&layout)];
         let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -223,7 +227,7 @@ impl CellBoundsPass {
             mapped_at_creation: false,
         });
         CellBoundsPass {
-            fragments: (samples > 1).then(|| {
+            fragments: scene_layout.filter(|_| samples > 1).map(|scene_layout| {
                 super::fragment_bounds::FragmentBounds::new(
                     device,
                     scene_layout,
@@ -269,18 +273,17 @@ impl CellBoundsPass {
 
     /// Record the kernel over the frame's depth target (`f.targets.depth`, as recorded in
     /// `enc` so far).
-    pub fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder, dims: &GridDims) {
-        let (device, queue, scene, depth) =
-            (f.device, f.queue, f.scene_bind_group, &f.targets.depth);
+    pub fn encode(&mut self, f: &CullFrame, enc: &mut FrameEncoder, dims: &GridDims) {
+        let (device, queue, cull, depth) = (f.device, f.queue, f.bind_group, f.depth());
         self.ensure(device, dims);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
-        if let Some(fragments) = &mut self.fragments {
-            fragments.encode(f, enc, dims, &self.params);
-        }
-        let fragment_bounds = self
-            .fragments
-            .as_ref()
-            .map_or(&self.no_fragments, |b| b.buffer());
+        let fragment_bounds = match (&mut self.fragments, f.scene) {
+            (Some(fragments), Some(scene)) => {
+                fragments.encode(scene, enc, dims, &self.params);
+                fragments.buffer()
+            }
+            _ => &self.no_fragments,
+        };
         let (encoder, timer) = enc.parts();
         let group = bind_resources(
             device,
@@ -298,7 +301,7 @@ impl CellBoundsPass {
         encoder.clear_buffer(&self.occupancy, 0, None);
         let mut pass = timer.begin_compute(encoder, "assign: cell bounds");
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, scene, &[]);
+        pass.set_bind_group(0, cull, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.dispatch_workgroups(dims.tiles_x, dims.tiles_y, 1);
         pass.set_pipeline(&self.args);

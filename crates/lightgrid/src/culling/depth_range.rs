@@ -11,10 +11,11 @@
 //! Steps (`depth_range.wgsl`): 1. `reduce`, 2. `finish`. CPU twins: [`depth_range_cpu`] and
 //! [`slicing_range`].
 
+use super::CullFrame;
 use super::GridDims;
 use crate::consts::SLICING_MIN_RATIO;
 use crate::error::Result;
-use crate::frame::{FrameEncoder, FrameInputs};
+use crate::frame::FrameEncoder;
 use crate::gpu::{bind_resources, download, storage_buffer};
 use crate::gpu_types::GridParams;
 use crate::scene::ViewSetup;
@@ -67,7 +68,7 @@ pub struct DepthRangePass {
 
 impl DepthRangePass {
     /// The passes over a depth target of `samples` samples per pixel.
-    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout, samples: u32) -> Self {
+    pub fn new(device: &wgpu::Device, cull_layout: &wgpu::BindGroupLayout, samples: u32) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth range (group 1)"),
             entries: &[
@@ -78,7 +79,7 @@ impl DepthRangePass {
             ],
         });
         let s = shader(samples);
-        let layouts = [Some(scene_layout), Some(&layout)];
+        let layouts = [Some(cull_layout), Some(&layout)];
         DepthRangePass {
             reduce: compute_pipeline(device, "depth range", &s, "reduce", &layouts),
             finish: compute_pipeline(device, "depth range finish", &s, "finish", &layouts),
@@ -100,7 +101,7 @@ impl DepthRangePass {
     /// before the frame's commands, so the copies win).
     pub fn encode(
         &self,
-        f: &FrameInputs,
+        f: &CullFrame,
         enc: &mut FrameEncoder,
         dims: &GridDims,
         targets: &[&wgpu::Buffer],
@@ -117,7 +118,7 @@ impl DepthRangePass {
             "depth range",
             &self.layout,
             &[
-                wgpu::BindingResource::TextureView(&f.targets.depth),
+                wgpu::BindingResource::TextureView(f.depth()),
                 self.params.as_entire_binding(),
                 self.range.as_entire_binding(),
                 self.params_out.as_entire_binding(),
@@ -126,7 +127,7 @@ impl DepthRangePass {
         let (encoder, timer) = enc.parts();
         {
             let mut pass = timer.begin_compute(encoder, "assign: depth range");
-            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(0, f.bind_group, &[]);
             pass.set_bind_group(1, &group, &[]);
             pass.set_pipeline(&self.reduce);
             let t = crate::consts::TILE_THREADS;

@@ -175,7 +175,7 @@ impl CellKernels {
     ) -> Self {
         let device = ctx.device;
         let common = AssignCommon::new(device);
-        let mut layouts = vec![Some(ctx.scene_layout), Some(&common.layout)];
+        let mut layouts = vec![Some(ctx.cull_layout), Some(&common.layout)];
         layouts.extend(extra.iter().map(|l| Some(*l)));
         let pipeline = |entry: &str| {
             compute_pipeline(device, &format!("{name} {entry}"), shader, entry, &layouts)
@@ -185,7 +185,7 @@ impl CellKernels {
             spill_args: pipeline("spill_args_main"),
             spill: pipeline("spill_main"),
             name,
-            capacity: ListCapacity::new(name, u64::from(GridBuffers::INITIAL_INDEX_CAPACITY)),
+            capacity: ListCapacity::new(name, ctx.index_capacity),
             common,
         }
     }
@@ -224,7 +224,7 @@ impl CellKernels {
                     label: &str,
                     run: &dyn Fn(&mut wgpu::ComputePass)| {
             let mut pass = timer.begin_compute(encoder, label);
-            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(0, f.bind_group, &[]);
             pass.set_bind_group(1, &group, &[]);
             for (i, g) in extra.iter().enumerate() {
                 pass.set_bind_group(2 + i as u32, *g, &[]);

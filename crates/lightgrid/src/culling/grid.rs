@@ -311,7 +311,8 @@ impl GridBuffers {
         })
     }
 
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// Buffers whose index list starts at `index_capacity` entries.
+    pub fn new(device: &wgpu::Device, index_capacity: u64) -> Self {
         let layout = Self::layout(device);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("grid params"),
@@ -320,11 +321,7 @@ impl GridBuffers {
             mapped_at_creation: false,
         });
         let cells = storage_buffer(device, "grid cells", 1 << 14);
-        let indices = storage_buffer(
-            device,
-            "grid indices",
-            u64::from(Self::INITIAL_INDEX_CAPACITY) * 4,
-        );
+        let indices = storage_buffer(device, "grid indices", index_capacity.max(1) * 4);
         let bounds = storage_buffer(device, "grid cell bounds", 1 << 14);
         let bind_group = Self::bind(device, &layout, [&params, &cells, &indices, &bounds]);
         GridBuffers {

@@ -8,6 +8,7 @@ mod builder;
 mod bvh;
 mod bvh_gpu;
 mod cell_bounds;
+mod culler;
 mod depth_range;
 mod fragment_bounds;
 mod gather;
@@ -29,6 +30,10 @@ pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, Lig
 pub use cell_bounds::{
     cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
 };
+pub use culler::{
+    CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
+    LightCuller,
+};
 pub use depth_range::{depth_range_cpu, slicing_range, DepthRangePass};
 pub use gather::{assign_gather_cpu, gather_margins};
 pub use gpu_assign::check_index_capacity;
@@ -39,7 +44,7 @@ pub use oracle::{
 };
 pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
 pub use spot_ray::{ray_test_count, RayTestCount};
-pub use strategy::AssignStrategy;
+pub use strategy::{bind_cull_group, cull_layout, AssignStrategy, CullFrame};
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
@@ -66,5 +71,7 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
         gpu_assign::bvh_shader(),
         bvh_gpu::shader(),
         scatter::shader(),
+        culler::prep_shader(),
+        culler::embed_shader(),
     ]
 }

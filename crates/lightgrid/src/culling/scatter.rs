@@ -11,7 +11,6 @@
 use super::gpu_assign::{copy_dispatch_args, indirect_args_buffer, AssignCommon};
 use super::radix_sort::RadixSort;
 use super::strategy::{AssignFrame, AssignStrategy, ListCapacity, StrategyContext, StrategyRun};
-use super::GridBuffers;
 use crate::consts::{ASSIGN_THREADS, COUNTER_ITEM_ARGS};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -61,7 +60,7 @@ pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> 
     let common = AssignCommon::new(device);
     let layout = buffer_layout(device, "scatter (group 2)", &[STORAGE_RW; 6]);
     let s = shader();
-    let layouts = [Some(ctx.scene_layout), Some(&common.layout), Some(&layout)];
+    let layouts = [Some(ctx.cull_layout), Some(&common.layout), Some(&layout)];
     let pipeline =
         |entry: &str| compute_pipeline(device, &format!("scatter {entry}"), &s, entry, &layouts);
     Box::new(ScatterStrategy {
@@ -78,7 +77,7 @@ pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> 
         item_total: storage_buffer(device, "scatter item total", 16),
         light_rects: storage_buffer(device, "scatter light rects", 1 << 14),
         item_args: indirect_args_buffer(device, "scatter emit arguments"),
-        pairs: ListCapacity::new("scatter", u64::from(GridBuffers::INITIAL_INDEX_CAPACITY)),
+        pairs: ListCapacity::new("scatter", ctx.index_capacity),
         sort: RadixSort::new(device),
     })
 }
@@ -133,7 +132,7 @@ impl AssignStrategy for ScatterStrategy {
             ..
         } = a;
         let device = f.device;
-        let lights = f.lights.len() as u64;
+        let lights = f.light_count as u64;
         grow_storage(
             device,
             &mut self.light_items,
@@ -158,7 +157,7 @@ impl AssignStrategy for ScatterStrategy {
         grid.ensure(device, f.queue, dims, dims.cell_count(), slots as usize);
         let common = self.common.bind(device, grid, bounds, dims);
         let own = self.bind(device);
-        let groups = [f.scene_bind_group, &common, &own];
+        let groups = [f.bind_group, &common, &own];
         let (encoder, timer) = enc.parts();
         // 1. Tile rectangles and items per light; 2. their offsets; 3. dispatch arguments.
         {

@@ -27,6 +27,8 @@ pub struct FrameInputs<'a> {
     pub device: &'a wgpu::Device,
     pub queue: &'a wgpu::Queue,
     pub scene_bind_group: &'a wgpu::BindGroup,
+    /// Group 0 of the culling kernels over the same buffers (`culling::cull_layout`).
+    pub cull_bind_group: &'a wgpu::BindGroup,
     /// The frame counters bound in group 0 (`consts::COUNTER_*`); indirect dispatch arguments
     /// that kernels write there are copied out of it.
     pub counters: &'a wgpu::Buffer,
@@ -69,9 +71,16 @@ pub struct FrameIo {
 pub struct FrameEncoder<'a> {
     device: &'a wgpu::Device,
     queue: &'a wgpu::Queue,
-    encoder: wgpu::CommandEncoder,
+    encoder: Recording<'a>,
     pub timer: &'a mut PassTimer,
     io: FrameIo,
+}
+
+/// The encoder a frame records into: the renderer's own, or a caller's
+/// (`culling::LightCuller`), which is never submitted here.
+enum Recording<'a> {
+    Owned(wgpu::CommandEncoder),
+    Borrowed(&'a mut wgpu::CommandEncoder),
 }
 
 impl<'a> FrameEncoder<'a> {
@@ -80,7 +89,7 @@ impl<'a> FrameEncoder<'a> {
         queue: &'a wgpu::Queue,
         timer: &'a mut PassTimer,
     ) -> Self {
-        let encoder = device.create_command_encoder(&Default::default());
+        let encoder = Recording::Owned(device.create_command_encoder(&Default::default()));
         FrameEncoder {
             device,
             queue,
@@ -90,14 +99,41 @@ impl<'a> FrameEncoder<'a> {
         }
     }
 
+    /// Record into a caller's encoder: the caller submits it; a part-way submission
+    /// ([`Self::download`]) is refused.
+    pub(crate) fn borrowed(
+        device: &'a wgpu::Device,
+        queue: &'a wgpu::Queue,
+        encoder: &'a mut wgpu::CommandEncoder,
+        timer: &'a mut PassTimer,
+    ) -> Self {
+        FrameEncoder {
+            device,
+            queue,
+            encoder: Recording::Borrowed(encoder),
+            timer,
+            io: FrameIo::default(),
+        }
+    }
+
     /// The encoder and the pass timer, to begin a pass.
     pub fn parts(&mut self) -> (&mut wgpu::CommandEncoder, &mut PassTimer) {
-        (&mut self.encoder, self.timer)
+        let encoder = match &mut self.encoder {
+            Recording::Owned(e) => e,
+            Recording::Borrowed(e) => &mut **e,
+        };
+        (encoder, self.timer)
     }
 
     fn submit_recorded(&mut self, stage: &str) -> Result<wgpu::SubmissionIndex> {
+        let Recording::Owned(encoder) = &mut self.encoder else {
+            return Err(crate::error::Error::Gpu {
+                stage: stage.into(),
+                message: "a caller's command encoder cannot be submitted part-way".into(),
+            });
+        };
         let done = std::mem::replace(
-            &mut self.encoder,
+            encoder,
             self.device.create_command_encoder(&Default::default()),
         );
         let index = scoped(self.device, stage, || self.queue.submit([done.finish()]))?;
@@ -129,7 +165,8 @@ impl<'a> FrameEncoder<'a> {
         let mut offset = 0;
         for &(buffer, bytes) in parts {
             if bytes > 0 {
-                self.encoder
+                self.parts()
+                    .0
                     .copy_buffer_to_buffer(buffer, 0, &staging, offset, bytes);
             }
             offset += bytes;

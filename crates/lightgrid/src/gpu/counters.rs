@@ -8,8 +8,9 @@
 use super::{wait_idle, PassTimer};
 use crate::consts::{
     COUNTER_EDGE_PIXELS, COUNTER_GEOMETRY_SAMPLES, COUNTER_INDEX_NEEDED, COUNTER_INDEX_OUT_OF_ROOM,
-    COUNTER_OFF_BOUNDS_FRAGMENTS, COUNTER_PAIRS_NEEDED, COUNTER_PAIRS_OUT_OF_ROOM,
-    COUNTER_SHADED_SAMPLES, COUNTER_SLOTS, COUNTER_TRUNCATED_LOOPS, COUNTER_WRITE_OVERFLOW,
+    COUNTER_INVALID_LIGHTS, COUNTER_OFF_BOUNDS_FRAGMENTS, COUNTER_PAIRS_NEEDED,
+    COUNTER_PAIRS_OUT_OF_ROOM, COUNTER_SHADED_SAMPLES, COUNTER_SLOTS, COUNTER_TRUNCATED_LOOPS,
+    COUNTER_WRITE_OVERFLOW,
 };
 use crate::error::{Error, Result};
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -57,6 +58,10 @@ impl CounterValues {
     /// MSAA forward fragments outside their cell's bounds (the frame is wrong when non-zero).
     pub fn fragments_off_bounds(&self) -> u32 {
         self.get(COUNTER_OFF_BOUNDS_FRAGMENTS)
+    }
+    /// Lights a `LightCuller` refused (not finite, range not positive).
+    pub fn invalid_lights(&self) -> u32 {
+        self.get(COUNTER_INVALID_LIGHTS)
     }
     /// Count and write passes disagreed (a bug, never silent).
     pub fn write_overflow(&self) -> u32 {
@@ -173,6 +178,20 @@ impl FrameCounters {
         slot.state.store(PENDING, Ordering::Release);
         let state = slot.state.clone();
         slot.buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+            state.store(if r.is_ok() { READY } else { FAILED }, Ordering::Release);
+        });
+    }
+
+    /// Map the slot recorded this frame once `encoder` is submitted (by its owner, who may
+    /// submit it after this returns: `culling::LightCuller`).
+    pub fn map_on_submit(&mut self, encoder: &wgpu::CommandEncoder) {
+        let Some(i) = self.recording.take() else {
+            return;
+        };
+        let slot = &self.slots[i];
+        slot.state.store(PENDING, Ordering::Release);
+        let state = slot.state.clone();
+        encoder.map_buffer_on_submit(&slot.buffer, wgpu::MapMode::Read, .., move |r| {
             state.store(if r.is_ok() { READY } else { FAILED }, Ordering::Release);
         });
     }

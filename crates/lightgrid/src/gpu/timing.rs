@@ -76,6 +76,17 @@ impl PassTimer {
         }
     }
 
+    /// A timer that measures nothing (a `LightCuller` recording into a caller's encoder).
+    pub fn disabled() -> Self {
+        Self {
+            queries: None,
+            labels: Vec::new(),
+            submission: 0,
+            capacity: 0,
+            period_ns: 1.0,
+        }
+    }
+
     /// Bytes of the timestamps of `passes` passes.
     pub fn bytes_for(passes: u32) -> u64 {
         u64::from(passes) * 16

@@ -656,7 +656,7 @@ impl Technique for LightPrepass {
                 outputs_layout,
                 msaa,
             } => {
-                builder.build(f, enc)?;
+                builder.build(&crate::culling::CullFrame::of(f), enc)?;
                 let outputs = match msaa {
                     Some(_) => None,
                     None => Some(crate::passes::compute_outputs_to(

@@ -24,6 +24,8 @@ pub struct PipelineContext<'a> {
     pub device: &'a wgpu::Device,
     /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
     pub scene_layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the culling kernels (`culling::cull_layout`).
+    pub cull_layout: &'a wgpu::BindGroupLayout,
     pub dims: GridDims,
     pub settings: RenderSettings,
     /// The adapter can blend into the R32Float count target.
@@ -37,7 +39,8 @@ impl PipelineContext<'_> {
     pub fn grid_setup(&self) -> GridSetup<'_> {
         GridSetup {
             device: self.device,
-            scene_layout: self.scene_layout,
+            cull_layout: self.cull_layout,
+            scene_layout: Some(self.scene_layout),
             tiles: self.dims,
             assign: self.settings.assign,
             software_adapter: self.software_adapter,
@@ -46,6 +49,7 @@ impl PipelineContext<'_> {
             forward_opaque: true,
             depth_bounds: self.settings.depth_bounds,
             depth_reduction: self.settings.depth_reduction,
+            index_capacity: u64::from(crate::culling::GridBuffers::INITIAL_INDEX_CAPACITY),
         }
     }
 }

@@ -453,7 +453,7 @@ impl Technique for TiledDeferred {
         let shading = resolving.unwrap_or(&self.shading);
         let (group1, label, groups) = match &mut self.variant {
             Variant::Multi { builder, label } => {
-                builder.build(f, enc)?;
+                builder.build(&crate::culling::CullFrame::of(f), enc)?;
                 let groups = (
                     dims.width.div_ceil(SCREEN_WORKGROUP),
                     dims.height.div_ceil(SCREEN_WORKGROUP),

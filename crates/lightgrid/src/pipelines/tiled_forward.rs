@@ -125,7 +125,7 @@ impl Technique for TiledForward {
             });
             depth_only.draw(&mut pass, f);
         }
-        self.builder.build(f, enc)?;
+        self.builder.build(&crate::culling::CullFrame::of(f), enc)?;
         let (encoder, timer) = enc.parts();
         let mut pass =
             begin_lighting_pass(encoder, timer, f, self.label, self.depth_only.is_none());

@@ -132,7 +132,8 @@ impl TransparentPass {
             TransparentLights::All => None,
             TransparentLights::Grid(b) => Some(b.bind_group()),
             TransparentLights::Own => {
-                self.own_grid.build(f, enc)?;
+                self.own_grid
+                    .build(&crate::culling::CullFrame::of(f), enc)?;
                 Some(self.own_grid.bind_group())
             }
         };

@@ -41,8 +41,12 @@ fn view_dir_to(position: vec3<f32>) -> vec3<f32> {
 }
 
 // Does a depth-buffer value hold no geometry? Reversed-Z (depth.rs): 1 at the near plane,
-// 0 at the far plane and for the cleared background.
+// 0 at the far plane and for the cleared background. A LightCuller's caller may use standard
+// depth instead (`frame.standard_depth`: 0 at the near plane, 1 at the far and the clear).
 fn is_background(depth: f32) -> bool {
+    if (frame.standard_depth != 0u) {
+        return depth >= 1.0;
+    }
     return depth <= 0.0;
 }
 
@@ -66,7 +70,8 @@ fn position_from_screen(xy: vec2<f32>, depth: f32) -> vec3<f32> {
 // View distance (-z in view space) of a depth-buffer value: the inverse of the reversed-Z
 // projection's depth = A / w - B, whose coefficients are the projection's z row
 // (proj[3][2] = A, proj[2][2] = B; depth.rs computes them in f64). The background (0) maps
-// to the far plane.
+// to the far plane. The same inverse holds for a standard-depth perspective projection
+// (A < 0 there).
 fn view_distance_from_depth(depth: f32) -> f32 {
     return frame.proj[3][2] / (depth + frame.proj[2][2]);
 }

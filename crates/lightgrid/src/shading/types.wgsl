@@ -40,7 +40,8 @@ struct FrameUniforms {
     near: f32,
     far: f32,
     spot_cull: u32,
-    _pad0: u32,
+    standard_depth: u32,     // 1: depth 0 at the near plane, 1 (the clear) at the far; 0: reversed-Z
+
     _pad1: u32,
     _pad2: u32,
 }

@@ -1,0 +1,937 @@
+//! [`LightCuller`]: lightgrid's light grid for any wgpu renderer (tiled-shading §6.2: the grid
+//! is three arrays any shading pass can read; forward-plus §3: culling is a compute stage
+//! between the caller's depth pre-pass and the caller's shading).
+//!
+//! The caller keeps its device, queue, encoder, depth buffer, lights and shaders. Per frame
+//! [`LightCuller::encode`] records into the caller's encoder, after its depth pre-pass:
+//! 1. `cull_lights.wgsl`: the caller's lights ([`CullLight`], world space) into a
+//!    camera-relative copy and their bounding spheres;
+//! 2. the same stages lightgrid's own renderer runs ([`GridBuilder`]): for clusters the
+//!    depth range their slices are spread over, the cell bounds, the strategy;
+//! 3. a copy of the culler's counters into a staging slot mapped when the caller submits.
+//!
+//! The caller's shading pass binds [`LightCuller::bind_group`] and includes
+//! [`LightCuller::wgsl`], which answers "which cell is this sample in", "how many lights",
+//! "the i-th light's index"; the light loop and the BRDF are the caller's. No submission, no
+//! wait: overflow, truncated shader loops and refused lights come back a frame or two later
+//! from [`LightCuller::poll`], and the lists grow from them.
+
+use super::builder::{GridBuilder, GridSetup};
+use super::grid::GridDims;
+use super::strategy::{bind_cull_group, cull_layout, CellSource, CullFrame};
+use crate::consts::POINT_LIGHT_COS;
+use crate::frame::{Assign, DepthBounds, DepthReduction, FrameEncoder, GridLists, SpotCull};
+use crate::gpu::{
+    buffer_entry, groups_1d, grow_storage, storage_buffer, FrameCounters, FrameTag, PassTimer,
+    STORAGE_READ, STORAGE_RW, UNIFORM,
+};
+use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::scene::ViewSetup;
+use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use glam::{DMat3, DVec3, Mat4};
+
+/// One light as [`LightCuller`] reads it from the caller's buffer: 48 bytes, `#[repr(C)]`,
+/// the layout of a WGSL `struct { position: vec3<f32>, range: f32, payload: vec4<f32>,
+/// direction: vec3<f32>, cos_outer: f32 }` in a `storage` array.
+///
+/// - `position` (world space) and `range` (> 0): the light reaches nothing farther.
+/// - `payload`: the caller's (colour, intensity, ...); the culler never reads it.
+/// - `direction` (unit) and `cos_outer` (−1..=1): a spot light's axis and the cosine of its
+///   outer half-angle; a point light has `cos_outer` = [`CullLight::POINT`] (−2) and any
+///   direction.
+///
+/// A light that is not finite or has no positive range is culled from every cell and counted
+/// in [`CullReport::invalid_lights`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CullLight {
+    pub position: [f32; 3],
+    pub range: f32,
+    pub payload: [f32; 4],
+    pub direction: [f32; 3],
+    pub cos_outer: f32,
+}
+
+const _: () = assert!(std::mem::size_of::<CullLight>() == std::mem::size_of::<GpuLight>());
+
+impl CullLight {
+    /// `cos_outer` of a point light.
+    pub const POINT: f32 = POINT_LIGHT_COS;
+
+    /// A point light at `position` reaching `range`, with the caller's `payload`.
+    pub fn point(position: [f32; 3], range: f32, payload: [f32; 4]) -> Self {
+        CullLight {
+            position,
+            range,
+            payload,
+            direction: [0.0, 0.0, 0.0],
+            cos_outer: Self::POINT,
+        }
+    }
+
+    /// A spot light: unit `direction`, outer half-angle cosine `cos_outer`.
+    pub fn spot(
+        position: [f32; 3],
+        range: f32,
+        direction: [f32; 3],
+        cos_outer: f32,
+        payload: [f32; 4],
+    ) -> Self {
+        CullLight {
+            position,
+            range,
+            payload,
+            direction,
+            cos_outer,
+        }
+    }
+}
+
+/// The cells of the grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CullGrid {
+    /// Screen tiles of `tile_size` × `tile_size` pixels, each bounded by its samples' depth
+    /// range (tiled shading).
+    Tiles { tile_size: u32 },
+    /// Tiles cut into `slices` depth slices, spread exponentially over the frame's samples'
+    /// depth range (clustered shading).
+    Clusters { tile_size: u32, slices: u32 },
+}
+
+/// How lights are assigned to cells (all on the GPU).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CullStrategy {
+    /// One workgroup per occupied cell tests every light (forward-plus §4).
+    Gather,
+    /// One thread per light emits (cell, light) pairs, radix-sorted by cell.
+    Scatter,
+    /// A light BVH built on the GPU each frame, walked per occupied cell
+    /// (tiled-forward-shading §4.4).
+    BvhGpu,
+    /// `Gather` up to 8192 lights, `BvhGpu` above.
+    #[default]
+    Auto,
+}
+
+impl CullStrategy {
+    fn assign(self) -> Assign {
+        match self {
+            CullStrategy::Gather => Assign::Gather,
+            CullStrategy::Scatter => Assign::Scatter,
+            CullStrategy::BvhGpu => Assign::BvhGpu,
+            CullStrategy::Auto => Assign::Auto,
+        }
+    }
+}
+
+/// What a [`LightCuller`] builds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CullConfig {
+    pub grid: CullGrid,
+    pub strategy: CullStrategy,
+    /// Which side of each cell's depth range culls lights ([`DepthBounds::Both`]: a light
+    /// must reach between the cell's nearest and farthest sample).
+    pub depth_bounds: DepthBounds,
+    /// Samples per pixel of the caller's depth texture (1, or its MSAA count). With MSAA the
+    /// bounds cover every sample.
+    pub samples: u32,
+    /// The most lights one frame may have; more is an error of [`LightCuller::encode`].
+    pub max_lights: u32,
+    /// Index entries the lists start with; they grow from the frames' reports.
+    pub index_capacity: u32,
+    /// Spot lights culled by their cone as well as their bounding sphere.
+    pub spot_cull: SpotCull,
+}
+
+impl Default for CullConfig {
+    /// 16-pixel tiles, `Auto`, both depth bounds, no MSAA, up to 65,536 lights.
+    fn default() -> Self {
+        CullConfig {
+            grid: CullGrid::Tiles { tile_size: 16 },
+            strategy: CullStrategy::Auto,
+            depth_bounds: DepthBounds::Both,
+            samples: 1,
+            max_lights: 1 << 16,
+            index_capacity: super::GridBuffers::INITIAL_INDEX_CAPACITY,
+            spot_cull: SpotCull::Cone,
+        }
+    }
+}
+
+/// One frame's inputs to [`LightCuller::encode`].
+pub struct CullInputs<'a> {
+    /// The caller's depth buffer after its depth pre-pass, recorded earlier in the same
+    /// encoder (a view of a 2D depth texture with `TEXTURE_BINDING` usage and
+    /// [`CullConfig::samples`] samples; its depth aspect is read).
+    pub depth: &'a wgpu::TextureView,
+    /// The caller's lights: [`CullLight`]s from byte 0, with `STORAGE` usage.
+    pub lights: &'a wgpu::Buffer,
+    pub light_count: u32,
+    /// World to view space (right-handed, the camera looking down −z): a rotation and a
+    /// translation, column-major (`glam::Mat4::to_cols_array_2d`).
+    pub view: [[f32; 4]; 4],
+    /// View to clip space: a symmetric perspective projection with depth 0..1, standard
+    /// (0 at `near`, cleared to 1) or reversed (1 at `near`, cleared to 0; infinite allowed).
+    pub proj: [[f32; 4]; 4],
+    /// The projection's planes (view distances); `far` bounds the slices of an infinite one.
+    pub near: f32,
+    pub far: f32,
+    /// Pixels of the depth buffer the grid covers, from its top-left corner.
+    pub viewport: [u32; 2],
+}
+
+/// Which input a [`CullError`] is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CullInput {
+    Config,
+    Depth,
+    Lights,
+    LightCount,
+    Viewport,
+    View,
+    Projection,
+    Planes,
+    /// The device could not do what the frame needs (a list too large to bind).
+    Device,
+}
+
+/// A refused configuration or frame: the input, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CullError {
+    pub input: CullInput,
+    pub message: String,
+}
+
+impl std::fmt::Display for CullError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}: {}", self.input, self.message)
+    }
+}
+
+impl std::error::Error for CullError {}
+
+fn refuse<T>(input: CullInput, message: impl Into<String>) -> Result<T, CullError> {
+    Err(CullError {
+        input,
+        message: message.into(),
+    })
+}
+
+impl From<crate::error::Error> for CullError {
+    fn from(e: crate::error::Error) -> Self {
+        CullError {
+            input: CullInput::Device,
+            message: e.to_string(),
+        }
+    }
+}
+
+/// What the GPU said about one encoded frame (from [`LightCuller::poll`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CullReport {
+    /// The number [`LightCuller::encode`] returned for the frame.
+    pub frame: u64,
+    /// Index entries the frame's lists needed.
+    pub index_entries: u32,
+    /// Some list did not fit: the frame's grid lacks lights. The lists have grown since.
+    pub overflowed: bool,
+    /// Kernel loops the shader compiler cut short: the frame's grid is wrong.
+    pub truncated_loops: u32,
+    /// Lights refused (not finite, range not positive): in no cell.
+    pub invalid_lights: u32,
+}
+
+impl CullReport {
+    /// Every light reached every cell it should: no overflow, no truncated loop, no refused
+    /// light.
+    pub fn is_complete(&self) -> bool {
+        !self.overflowed && self.truncated_loops == 0 && self.invalid_lights == 0
+    }
+}
+
+/// Storage buffers the culling kernels' pipeline layouts bind in one stage at most (scatter's
+/// three groups; `tests/culler.rs` creates every strategy on a device with exactly this).
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = 15;
+
+/// The caller-facing WGSL: the grid's bindings (declared at group `GROUP`) and the accessors,
+/// the cell addressing shared with lightgrid's own shaders (`grid_cell.wgsl`) renamed into
+/// the `light_grid` prefix so nothing collides with the caller's names.
+const EMBED_WGSL: &str = include_str!("embed.wgsl");
+
+/// `grid_cell.wgsl` with its names prefixed (`grid` → `light_grid`, `GridParams` →
+/// `LightGridParams`, `GRID_LISTS_SEPARATE` → `LIGHT_GRID_LISTS_SEPARATE`).
+fn prefixed_grid_cell() -> String {
+    let mut out = String::new();
+    let text = src::GRID_CELL;
+    let mut ident = String::new();
+    let flush = |ident: &mut String, out: &mut String| {
+        let renamed = match ident.as_str() {
+            "grid" => "light_grid".to_string(),
+            "GridParams" => "LightGridParams".to_string(),
+            "GRID_LISTS_SEPARATE" => "LIGHT_GRID_LISTS_SEPARATE".to_string(),
+            s if s.starts_with("grid_") => format!("light_{s}"),
+            s => s.to_string(),
+        };
+        out.push_str(&renamed);
+        ident.clear();
+    };
+    let mut comment = false;
+    for c in text.chars() {
+        if comment {
+            out.push(c);
+            comment = c != '\n';
+            continue;
+        }
+        if c.is_ascii_alphanumeric() || c == '_' {
+            ident.push(c);
+            continue;
+        }
+        flush(&mut ident, &mut out);
+        if c == '/' && out.ends_with('/') {
+            comment = true;
+        }
+        out.push(c);
+    }
+    flush(&mut ident, &mut out);
+    out
+}
+
+/// Culls a caller's lights into lightgrid's light grid, in the caller's encoder.
+///
+/// ```no_run
+/// # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, depth: &wgpu::TextureView,
+/// #          lights: &wgpu::Buffer, view: glam::Mat4, proj: glam::Mat4)
+/// #          -> Result<(), lightgrid::CullError> {
+/// use lightgrid::{CullConfig, CullGrid, CullInputs, LightCuller};
+/// let mut culler = LightCuller::new(device, queue, CullConfig {
+///     grid: CullGrid::Clusters { tile_size: 16, slices: 24 },
+///     ..CullConfig::default()
+/// })?;
+/// // The caller's shader: `LightCuller::wgsl(1)` declares the grid at group 1.
+/// let grid_wgsl = LightCuller::wgsl(1);
+/// let mut encoder = device.create_command_encoder(&Default::default());
+/// // ... the caller's depth pre-pass into `depth` ...
+/// culler.encode(&mut encoder, &CullInputs {
+///     depth,
+///     lights,
+///     light_count: 300,
+///     view: view.to_cols_array_2d(),
+///     proj: proj.to_cols_array_2d(),
+///     near: 0.1,
+///     far: 100.0,
+///     viewport: [1280, 720],
+/// })?;
+/// // ... the caller's shading pass with `culler.bind_group()` at group 1 ...
+/// queue.submit([encoder.finish()]);
+/// for report in culler.poll()? {
+///     assert!(report.is_complete(), "frame {} lacks lights", report.frame);
+/// }
+/// # Ok(()) }
+/// ```
+pub struct LightCuller {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    config: CullConfig,
+    core: GridBuilder,
+    layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    /// The camera-relative copy of the caller's lights and their bounding spheres.
+    lights: wgpu::Buffer,
+    bounds: wgpu::Buffer,
+    counters: FrameCounters,
+    group: wgpu::BindGroup,
+    prep: wgpu::ComputePipeline,
+    prep_layout: wgpu::BindGroupLayout,
+    timer: PassTimer,
+    frames: u64,
+}
+
+pub(crate) fn prep_shader() -> ComposedShader {
+    compose(
+        "cull lights",
+        &[src::TYPES, include_str!("cull_lights.wgsl")],
+    )
+}
+
+/// The caller-facing module at group 0, for the validation test.
+pub(crate) fn embed_shader() -> ComposedShader {
+    compose("light grid (embedded)", &[&LightCuller::wgsl(0)])
+}
+
+impl LightCuller {
+    /// A culler on the caller's device and queue (clones of the handles). Refuses a
+    /// configuration outside lightgrid's limits.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: CullConfig,
+    ) -> Result<Self, CullError> {
+        let config_error = |e: crate::error::Error| CullError {
+            input: CullInput::Config,
+            message: e.to_string(),
+        };
+        let (tile_size, slices) = match config.grid {
+            CullGrid::Tiles { tile_size } => (tile_size, 1),
+            CullGrid::Clusters { tile_size, slices } => {
+                if slices < 2 {
+                    return refuse(
+                        CullInput::Config,
+                        format!(
+                            "clusters need at least 2 slices, not {slices} (use CullGrid::Tiles)"
+                        ),
+                    );
+                }
+                (tile_size, slices)
+            }
+        };
+        crate::frame::validate_tile_size(tile_size).map_err(config_error)?;
+        crate::frame::validate_slices(slices).map_err(config_error)?;
+        crate::frame::validate_msaa(config.samples).map_err(config_error)?;
+        if config.max_lights == 0 {
+            return refuse(CullInput::Config, "max_lights must be at least 1");
+        }
+        let max_bytes = u64::from(config.max_lights) * std::mem::size_of::<GpuLight>() as u64;
+        let limits = device.limits();
+        if max_bytes
+            > limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size)
+        {
+            return refuse(
+                CullInput::Config,
+                format!(
+                    "max_lights {} needs {max_bytes} bytes of lights, more than this device binds",
+                    config.max_lights
+                ),
+            );
+        }
+        if config.index_capacity == 0 {
+            return refuse(CullInput::Config, "index_capacity must be at least 1");
+        }
+        let layout = cull_layout(device);
+        let tiles = GridDims::new(tile_size, tile_size, tile_size).map_err(config_error)?;
+        let need = STORAGE_BUFFERS_PER_STAGE;
+        let have = device.limits().max_storage_buffers_per_shader_stage;
+        if have < need {
+            return refuse(
+                CullInput::Device,
+                format!(
+                    "the culling kernels bind {need} storage buffers per stage; this device allows {have} (request LightCuller::required_limits)"
+                ),
+            );
+        }
+        let mut core = crate::gpu::scoped(device, "creating the light culler", || {
+            GridBuilder::new(
+                &GridSetup {
+                    device,
+                    cull_layout: &layout,
+                    scene_layout: None,
+                    tiles,
+                    assign: config.strategy.assign(),
+                    // `Auto` stays on the GPU (`cpu` needs the lights on the CPU).
+                    software_adapter: false,
+                    lists: GridLists::Opaque,
+                    samples: config.samples,
+                    forward_opaque: false,
+                    depth_bounds: config.depth_bounds,
+                    depth_reduction: DepthReduction::Atomics,
+                    index_capacity: u64::from(config.index_capacity),
+                },
+                slices,
+                CellSource::Depth,
+            )
+        })?;
+        core.prepare(device)?;
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("culler uniforms"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let lights = storage_buffer(device, "culler lights", 48 * 64);
+        let bounds = storage_buffer(device, "culler light bounds", 16 * 64);
+        let counters = FrameCounters::new(device, 0);
+        let group = bind_cull_group(
+            device,
+            &layout,
+            [&uniforms, &lights, counters.buffer(), &bounds],
+        );
+        let prep_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cull lights"),
+            entries: &[
+                buffer_entry(0, UNIFORM),
+                buffer_entry(1, STORAGE_READ),
+                buffer_entry(2, STORAGE_RW),
+                buffer_entry(3, STORAGE_RW),
+                buffer_entry(4, STORAGE_RW),
+            ],
+        });
+        let prep = compute_pipeline(
+            device,
+            "cull lights",
+            &prep_shader(),
+            "main",
+            &[Some(&prep_layout)],
+        );
+        Ok(LightCuller {
+            device: device.clone(),
+            queue: queue.clone(),
+            config,
+            core,
+            layout,
+            uniforms,
+            lights,
+            bounds,
+            counters,
+            group,
+            prep,
+            prep_layout,
+            timer: PassTimer::disabled(),
+            frames: 0,
+        })
+    }
+
+    /// The limits a device needs for the culler: the defaults, with the storage buffers per
+    /// stage the kernels bind and the adapter's largest storage bindings (long light lists),
+    /// for `wgpu::DeviceDescriptor::required_limits`.
+    pub fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+        let a = adapter.limits();
+        wgpu::Limits {
+            max_storage_buffers_per_shader_stage: STORAGE_BUFFERS_PER_STAGE
+                .max(wgpu::Limits::default().max_storage_buffers_per_shader_stage),
+            max_storage_buffer_binding_size: a.max_storage_buffer_binding_size,
+            max_buffer_size: a.max_buffer_size,
+            ..wgpu::Limits::default()
+        }
+    }
+
+    /// The caller's shading pass's WGSL for the grid at bind group `group`: the bindings, and
+    ///
+    /// - `light_grid_cell(pixel: vec2<f32>, view_distance: f32) -> u32`: the cell of the sample
+    ///   at framebuffer position `pixel` (`@builtin(position).xy`) and view distance
+    ///   `view_distance` (−z in view space);
+    /// - `light_grid_count(cell: u32) -> u32`: how many lights the cell lists;
+    /// - `light_grid_light(cell: u32, i: u32) -> u32`: the index, in the caller's light
+    ///   buffer, of the cell's `i`-th light.
+    ///
+    /// Every name it declares starts with `light_grid` or `LightGrid`.
+    pub fn wgsl(group: u32) -> String {
+        format!(
+            "{}\nconst LIGHT_GRID_LISTS_SEPARATE: u32 = {}u;\n\n{}",
+            EMBED_WGSL.replace("LIGHT_GRID_GROUP", &group.to_string()),
+            crate::consts::GRID_LISTS_SEPARATE,
+            prefixed_grid_cell()
+        )
+    }
+
+    /// The layout of [`Self::bind_group`], for the caller's pipeline layout (visible to
+    /// fragment and compute stages).
+    pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.core.layout()
+    }
+
+    /// The grid the last encoded frame builds. Take it again after every
+    /// [`Self::encode`]: it is replaced when the lists grow.
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        self.core.bind_group()
+    }
+
+    /// The configuration the culler was made with.
+    pub fn config(&self) -> &CullConfig {
+        &self.config
+    }
+
+    /// Record one frame's culling into `encoder` after the caller's depth pre-pass. The
+    /// caller submits the encoder (one `encode` per submission). Returns the frame's number,
+    /// which its [`CullReport`] carries.
+    pub fn encode(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &CullInputs,
+    ) -> Result<u64, CullError> {
+        let camera = self.check(inputs)?;
+        let (width, height) = (inputs.viewport[0], inputs.viewport[1]);
+        let tile_size = match self.config.grid {
+            CullGrid::Tiles { tile_size } | CullGrid::Clusters { tile_size, .. } => tile_size,
+        };
+        self.core.set_tiles(
+            GridDims::new(width, height, tile_size).map_err(|e| CullError {
+                input: CullInput::Viewport,
+                message: e.to_string(),
+            })?,
+        );
+        let n = inputs.light_count;
+        let grown_lights = grow_storage(
+            &self.device,
+            &mut self.lights,
+            "culler lights",
+            u64::from(n.max(1)) * 48,
+        );
+        let grown_bounds = grow_storage(
+            &self.device,
+            &mut self.bounds,
+            "culler light bounds",
+            u64::from(n.max(1)) * 16,
+        );
+        if grown_lights || grown_bounds {
+            self.group = bind_cull_group(
+                &self.device,
+                &self.layout,
+                [
+                    &self.uniforms,
+                    &self.lights,
+                    self.counters.buffer(),
+                    &self.bounds,
+                ],
+            );
+        }
+        let uniforms = camera.uniforms(inputs, self.config.spot_cull);
+        self.queue
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let depth_view = inputs
+            .depth
+            .texture()
+            .create_view(&wgpu::TextureViewDescriptor {
+                label: Some("culler depth"),
+                aspect: wgpu::TextureAspect::DepthOnly,
+                base_mip_level: 0,
+                mip_level_count: Some(1),
+                ..Default::default()
+            });
+        let prep_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cull lights"),
+            layout: &self.prep_layout,
+            entries: &[
+                entry(0, &self.uniforms),
+                entry(1, inputs.lights),
+                entry(2, &self.lights),
+                entry(3, &self.bounds),
+                entry(4, self.counters.buffer()),
+            ],
+        });
+        self.timer.reset();
+        self.frames += 1;
+        let frame = self.frames;
+        let setup = camera.setup(inputs, self.config.spot_cull);
+        let result = crate::gpu::scoped(&self.device, "recording the light culler", || {
+            self.counters.clear(encoder);
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("cull: lights"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.prep);
+                pass.set_bind_group(0, &prep_group, &[]);
+                let (x, y) = groups_1d(n.div_ceil(crate::consts::ASSIGN_THREADS));
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            let f = CullFrame {
+                device: &self.device,
+                queue: &self.queue,
+                bind_group: &self.group,
+                counters: self.counters.buffer(),
+                depth: Some(&depth_view),
+                setup,
+                light_count: n as usize,
+                lights: &[],
+                transparency: false,
+                scene: None,
+            };
+            let mut enc =
+                FrameEncoder::borrowed(&self.device, &self.queue, encoder, &mut self.timer);
+            self.core.build(&f, &mut enc)
+        });
+        result??;
+        let tag = FrameTag {
+            serial: frame,
+            pipeline: "LightCuller",
+            pass_labels: Vec::new(),
+        };
+        self.counters
+            .encode_copy(&self.device, encoder, &self.timer, tag);
+        self.counters.map_on_submit(encoder);
+        Ok(frame)
+    }
+
+    /// The reports of the frames the GPU has finished since the last call, oldest first,
+    /// without waiting (the caller's event loop polls the device, or this does). The lists
+    /// grow from them.
+    pub fn poll(&mut self) -> Result<Vec<CullReport>, CullError> {
+        let readbacks = self.counters.poll(&self.device)?;
+        self.reports(readbacks)
+    }
+
+    /// [`Self::poll`] after waiting for every submitted frame (tests, tools).
+    pub fn wait(&mut self) -> Result<Vec<CullReport>, CullError> {
+        let readbacks = self.counters.wait(&self.device)?;
+        self.reports(readbacks)
+    }
+
+    fn reports(
+        &mut self,
+        readbacks: Vec<crate::gpu::FrameReadback>,
+    ) -> Result<Vec<CullReport>, CullError> {
+        let mut out = Vec::with_capacity(readbacks.len());
+        for r in readbacks {
+            self.core.observe(&self.device, &r.values)?;
+            out.push(CullReport {
+                frame: r.tag.serial,
+                index_entries: r.values.index_needed().max(r.values.pairs_needed()),
+                overflowed: r.values.overflowed(),
+                truncated_loops: r.values.truncated_loops(),
+                invalid_lights: r.values.invalid_lights(),
+            });
+        }
+        Ok(out)
+    }
+
+    /// Refuse inputs the kernels cannot honour, each error naming its input.
+    fn check(&self, i: &CullInputs) -> Result<Camera, CullError> {
+        use CullInput as I;
+        let texture = i.depth.texture();
+        let format = texture.format();
+        if !format.is_depth_stencil_format() || !format.has_depth_aspect() {
+            return refuse(I::Depth, format!("{format:?} is not a depth format"));
+        }
+        if texture.dimension() != wgpu::TextureDimension::D2 || texture.depth_or_array_layers() != 1
+        {
+            return refuse(I::Depth, "the depth texture must be 2D with one layer");
+        }
+        if texture.sample_count() != self.config.samples {
+            return refuse(
+                I::Depth,
+                format!(
+                    "the depth texture has {} samples per pixel; the culler was configured for {}",
+                    texture.sample_count(),
+                    self.config.samples
+                ),
+            );
+        }
+        if !texture
+            .usage()
+            .contains(wgpu::TextureUsages::TEXTURE_BINDING)
+        {
+            return refuse(I::Depth, "the depth texture lacks TEXTURE_BINDING usage");
+        }
+        let [w, h] = i.viewport;
+        if w == 0 || h == 0 {
+            return refuse(I::Viewport, format!("{w}x{h} has no pixels"));
+        }
+        if w > texture.width() || h > texture.height() {
+            return refuse(
+                I::Viewport,
+                format!(
+                    "{w}x{h} is larger than the depth texture ({}x{})",
+                    texture.width(),
+                    texture.height()
+                ),
+            );
+        }
+        if i.light_count > self.config.max_lights {
+            return refuse(
+                I::LightCount,
+                format!(
+                    "{} lights, more than the configured max_lights {}",
+                    i.light_count, self.config.max_lights
+                ),
+            );
+        }
+        let needed = u64::from(i.light_count) * std::mem::size_of::<CullLight>() as u64;
+        if i.lights.size() < needed {
+            return refuse(
+                I::Lights,
+                format!(
+                    "{} lights need {needed} bytes; the buffer has {}",
+                    i.light_count,
+                    i.lights.size()
+                ),
+            );
+        }
+        if !i.lights.usage().contains(wgpu::BufferUsages::STORAGE) {
+            return refuse(I::Lights, "the light buffer lacks STORAGE usage");
+        }
+        Camera::new(i)
+    }
+}
+
+fn entry(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: b.as_entire_binding(),
+    }
+}
+
+/// The camera a frame's matrices describe, checked.
+struct Camera {
+    rotation: Mat4,
+    eye: glam::Vec3,
+    standard_depth: bool,
+}
+
+impl Camera {
+    fn new(i: &CullInputs) -> Result<Camera, CullError> {
+        use CullInput as I;
+        let finite = |m: &[[f32; 4]; 4]| m.iter().flatten().all(|x| x.is_finite());
+        if !finite(&i.view) {
+            return refuse(I::View, "the view matrix is not finite");
+        }
+        if !finite(&i.proj) {
+            return refuse(I::Projection, "the projection is not finite");
+        }
+        // The view: a rotation and a translation (computed in f64, so a camera far from the
+        // origin keeps its eye).
+        let v = glam::DMat4::from_cols_array_2d(&i.view.map(|c| c.map(f64::from)));
+        let r = DMat3::from_mat4(v);
+        let rtr = r.transpose() * r;
+        let off = (rtr - DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        if off > 1e-3 || r.determinant() < 0.0 {
+            return refuse(
+                I::View,
+                "the view matrix must be a rotation and a translation (no scale, shear or mirror)",
+            );
+        }
+        if v.row(3) != glam::DVec4::new(0.0, 0.0, 0.0, 1.0) {
+            return refuse(I::View, "the view matrix's last row must be (0, 0, 0, 1)");
+        }
+        let eye: DVec3 = -(r.transpose() * v.w_axis.truncate());
+        // The projection: symmetric perspective, w = -z.
+        let p = &i.proj;
+        let zero = |x: f32| x == 0.0;
+        let perspective = p[2][3] == -1.0
+            && zero(p[3][3])
+            && zero(p[0][3])
+            && zero(p[1][3])
+            && p[0][0] > 0.0
+            && p[1][1] > 0.0;
+        if !perspective {
+            return refuse(
+                I::Projection,
+                "a perspective projection with w = -z (right-handed, looking down -z) is needed",
+            );
+        }
+        if !(zero(p[2][0])
+            && zero(p[2][1])
+            && zero(p[1][0])
+            && zero(p[0][1])
+            && zero(p[3][0])
+            && zero(p[3][1]))
+        {
+            return refuse(
+                I::Projection,
+                "an off-centre or skewed projection (jitter, VR) is not supported: tiles assume a symmetric frustum",
+            );
+        }
+        let (near, far) = (i.near, i.far);
+        if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
+            return refuse(
+                I::Planes,
+                format!("near {near} and far {far} must be finite with 0 < near < far"),
+            );
+        }
+        crate::depth::check_planes(near, far).map_err(|e| CullError {
+            input: I::Planes,
+            message: e.to_string(),
+        })?;
+        // depth = A / w - B (A = proj[3][2], B = proj[2][2]): reversed when A > 0.
+        let (a, b) = (f64::from(p[3][2]), f64::from(p[2][2]));
+        if a == 0.0 {
+            return refuse(
+                I::Projection,
+                "the projection's depth does not vary with distance",
+            );
+        }
+        let standard_depth = a < 0.0;
+        let w_at = |d: f64| a / (d + b);
+        let (near_depth, far_depth) = if standard_depth {
+            (0.0, 1.0)
+        } else {
+            (1.0, 0.0)
+        };
+        let proj_near = w_at(near_depth);
+        let agrees = |x: f64, y: f32| (x - f64::from(y)).abs() <= 1e-3 * f64::from(y);
+        if !agrees(proj_near, near) {
+            return refuse(
+                I::Planes,
+                format!("near {near} is not the projection's near plane ({proj_near})"),
+            );
+        }
+        let proj_far = w_at(far_depth);
+        if proj_far.is_finite() && proj_far > 0.0 && !agrees(proj_far, far) {
+            return refuse(
+                I::Planes,
+                format!("far {far} is not the projection's far plane ({proj_far})"),
+            );
+        }
+        if standard_depth && !(proj_far.is_finite() && proj_far > 0.0) {
+            return refuse(
+                I::Projection,
+                "a standard-depth projection needs a finite far plane",
+            );
+        }
+        Ok(Camera {
+            rotation: Mat4::from_mat3(r.as_mat3()),
+            eye: eye.as_vec3(),
+            standard_depth,
+        })
+    }
+
+    fn uniforms(&self, i: &CullInputs, spot_cull: SpotCull) -> FrameUniforms {
+        let proj = Mat4::from_cols_array_2d(&i.proj);
+        FrameUniforms {
+            view: self.rotation.to_cols_array_2d(),
+            proj: i.proj,
+            view_proj: (proj * self.rotation).to_cols_array_2d(),
+            inv_view: self.rotation.transpose().to_cols_array_2d(),
+            eye: self.eye.to_array(),
+            light_count: i.light_count,
+            viewport: [i.viewport[0] as f32, i.viewport[1] as f32],
+            near: i.near,
+            far: i.far,
+            spot_cull: u32::from(spot_cull == SpotCull::Cone),
+            standard_depth: u32::from(self.standard_depth),
+            _pad1: 0,
+            _pad2: 0,
+        }
+    }
+
+    fn setup(&self, i: &CullInputs, spot_cull: SpotCull) -> ViewSetup {
+        ViewSetup {
+            view: self.rotation,
+            eye: self.eye,
+            p00: i.proj[0][0],
+            p11: i.proj[1][1],
+            near: i.near,
+            far: i.far,
+            width: i.viewport[0],
+            height: i.viewport[1],
+            spot_cull,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_embedded_module_declares_only_prefixed_names() {
+        let module = naga::front::wgsl::parse_str(&LightCuller::wgsl(2)).expect("parses");
+        for (_, g) in module.global_variables.iter() {
+            let name = g.name.as_deref().unwrap_or("");
+            assert!(name.starts_with("light_grid"), "{name}");
+            assert_eq!(g.binding.as_ref().map(|b| b.group), Some(2));
+        }
+        for (_, f) in module.functions.iter() {
+            let name = f.name.as_deref().unwrap_or("");
+            assert!(name.starts_with("light_grid"), "{name}");
+        }
+        for (_, t) in module.types.iter() {
+            if let Some(name) = &t.name {
+                assert!(name.starts_with("LightGrid"), "{name}");
+            }
+        }
+    }
+}

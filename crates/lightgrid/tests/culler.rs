@@ -1,0 +1,1002 @@
+//! `LightCuller` through its public API only, as another wgpu renderer uses it: its own
+//! device, its own depth buffer (written by its own shader, every sample its own depth), its
+//! own lights. Every strategy × tiles/clusters × depth-bounds mode, and MSAA depth, is checked
+//! on the GPU against a brute-force oracle in the test's own WGSL: every light that reaches a
+//! sample must be listed in the sample's cell (found with the caller-facing accessor). Then
+//! the lists' growth from the culler's reports, and each kind of bad use refused with the
+//! input it names.
+
+use glam::{Mat4, Vec3};
+use lightgrid::{
+    CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullStrategy, DepthBounds,
+    LightCuller,
+};
+use wgpu::util::DeviceExt;
+
+const W: u32 = 203;
+const H: u32 = 141;
+const NEAR: f32 = 0.1;
+const FAR: f32 = 100.0;
+
+/// The caller's device: the first Vulkan adapter (lavapipe on CI), never a silent pass.
+fn device() -> (wgpu::Device, wgpu::Queue) {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))
+        .expect("LightCuller tests need a GPU adapter (CI installs mesa-vulkan-drivers)");
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        assert_eq!(adapter.get_info().backend, wgpu::Backend::Vulkan);
+    }
+    pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        // Exactly what the culler asks for: every strategy must be created within it.
+        required_limits: LightCuller::required_limits(&adapter),
+        ..Default::default()
+    }))
+    .expect("a device with the culler's limits")
+}
+
+/// A small deterministic generator (the test's own).
+struct Rng(u64);
+impl Rng {
+    fn f(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f()
+    }
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
+            if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+struct Camera {
+    eye: Vec3,
+    view: Mat4,
+    proj: Mat4,
+    /// depth = a / w - b.
+    a: f32,
+    b: f32,
+    standard: bool,
+}
+
+fn camera(eye: Vec3, standard: bool) -> Camera {
+    // Right-handed, looking down -z: rows s, u, -f and the translation.
+    let f = Vec3::new(-0.3, -0.2, -1.0).normalize();
+    let s = f.cross(Vec3::Y).normalize();
+    let u = s.cross(f);
+    let rotation = Mat4::from_cols(
+        glam::Vec4::new(s.x, u.x, -f.x, 0.0),
+        glam::Vec4::new(s.y, u.y, -f.y, 0.0),
+        glam::Vec4::new(s.z, u.z, -f.z, 0.0),
+        glam::Vec4::W,
+    );
+    let view = rotation * Mat4::from_translation(-eye);
+    // clip.z = b z + a, clip.w = -z: depth = a / w - b; standard 0 at near, reversed 1.
+    let (n, fa) = (f64::from(NEAR), f64::from(FAR));
+    let (a, b) = if standard {
+        (n * fa / (n - fa), fa / (n - fa))
+    } else {
+        (n * fa / (fa - n), n / (fa - n))
+    };
+    let h = 1.0 / 0.5f32.tan();
+    let proj = Mat4::from_cols(
+        glam::Vec4::new(h * H as f32 / W as f32, 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, h, 0.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, b as f32, -1.0),
+        glam::Vec4::new(0.0, 0.0, a as f32, 0.0),
+    );
+    let p = proj.to_cols_array_2d();
+    Camera {
+        eye,
+        view,
+        proj,
+        a: p[3][2],
+        b: p[2][2],
+        standard,
+    }
+}
+
+/// Lights around the view: in front, behind the camera, crossing the near plane, containing
+/// the camera, just outside the screen edges; a quarter of them spots.
+fn lights(cam: &Camera, n: usize, seed: u64) -> Vec<CullLight> {
+    let mut rng = Rng(seed);
+    let inv = cam.view.inverse();
+    (0..n)
+        .map(|i| {
+            let kind = i % 5;
+            let view_pos = match kind {
+                // In front, anywhere in the view.
+                0 | 1 => {
+                    let w = rng.range(0.5, 60.0);
+                    Vec3::new(rng.range(-0.9, 0.9) * w, rng.range(-0.6, 0.6) * w, -w)
+                }
+                // Behind the camera.
+                2 => Vec3::new(
+                    rng.range(-3.0, 3.0),
+                    rng.range(-3.0, 3.0),
+                    rng.range(0.0, 4.0),
+                ),
+                // At (or just beyond) the screen edges.
+                3 => {
+                    let w = rng.range(1.0, 30.0);
+                    let side = if rng.f() < 0.5 { -1.0 } else { 1.0 };
+                    Vec3::new(
+                        side * rng.range(0.75, 1.1) * w,
+                        rng.range(-0.7, 0.7) * w,
+                        -w,
+                    )
+                }
+                // Near the eye: crossing the near plane or holding the camera.
+                _ => Vec3::new(
+                    rng.range(-0.5, 0.5),
+                    rng.range(-0.5, 0.5),
+                    rng.range(-0.6, 0.4),
+                ),
+            };
+            let p = inv.transform_point3(view_pos).to_array();
+            let range = if kind == 4 {
+                rng.range(0.2, 1.5)
+            } else {
+                rng.range(0.4, 6.0)
+            };
+            let payload = [rng.f(), rng.f(), rng.f(), 1.0];
+            if i % 4 == 3 {
+                let d = rng.unit().to_array();
+                CullLight::spot(p, range, d, rng.range(-0.4, 0.95), payload)
+            } else {
+                CullLight::point(p, range, payload)
+            }
+        })
+        .collect()
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Check {
+    /// Camera-relative (world minus eye) from view space: the view's inverse rotation.
+    inv_rotation: [[f32; 4]; 4],
+    eye: [f32; 3],
+    light_count: u32,
+    a: f32,
+    b: f32,
+    p00: f32,
+    p11: f32,
+    viewport: [f32; 2],
+    near: f32,
+    far: f32,
+    standard: u32,
+    pad: [u32; 3],
+}
+
+const DEPTH_WGSL: &str = r#"
+struct Check { inv_rotation: mat4x4<f32>, eye: vec3<f32>, light_count: u32, a: f32, b: f32,
+    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, pad0: u32, pad1: u32, pad2: u32 }
+@group(0) @binding(0) var<uniform> c: Check;
+
+@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.5, 1.0);
+}
+
+fn hash(p: vec2<f32>) -> f32 {
+    return fract(sin(dot(p, vec2<f32>(12.9898, 78.233))) * 43758.547);
+}
+
+// Every sample its own view distance: smooth slopes, steps every 9 px, noise per sample, and
+// a disc of sky.
+@fragment fn fs(@builtin(position) pos: vec4<f32>, @builtin(sample_index) s: u32) -> @builtin(frag_depth) f32 {
+    let uv = pos.xy / c.viewport;
+    if (length(uv - vec2<f32>(0.7, 0.3)) < 0.12) {
+        discard;
+    }
+    let t = clamp(0.15 + 0.5 * uv.y + 0.25 * hash(floor(pos.xy / 9.0)) + 0.08 * hash(pos.xy + f32(s)), 0.0, 1.0);
+    let w = c.near * 1.5 * pow(c.far / (c.near * 1.5), t * 0.8);
+    return c.a / w - c.b;
+}
+"#;
+
+const CHECK_WGSL: &str = r#"
+struct Check { inv_rotation: mat4x4<f32>, eye: vec3<f32>, light_count: u32, a: f32, b: f32,
+    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, pad0: u32, pad1: u32, pad2: u32 }
+struct MyLight { position: vec3<f32>, range: f32, payload: vec4<f32>, direction: vec3<f32>, cos_outer: f32 }
+@group(0) @binding(0) var<uniform> c: Check;
+@group(0) @binding(1) var<storage, read> my_lights: array<MyLight>;
+@group(0) @binding(2) var depth_tex: DEPTH_TYPE;
+// [0] misses, [1] lights reaching samples, [2] entries of the samples' lists, [3] samples,
+// [4..6] the first miss: pixel x, y, light.
+@group(0) @binding(3) var<storage, read_write> result: array<atomic<u32>, 8>;
+
+// Reaches with a margin (rounding in this shader's own reconstruction is not a miss).
+fn reaches(l: MyLight, p: vec3<f32>) -> bool {
+    let d = p - l.position;
+    let dist = length(d);
+    if (dist >= l.range * 0.999) {
+        return false;
+    }
+    if (l.cos_outer < -1.5) {
+        return true;
+    }
+    return dot(d, l.direction) > (l.cos_outer + 1e-3) * dist;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= u32(c.viewport.x) || gid.y >= u32(c.viewport.y)) {
+        return;
+    }
+    for (var s = 0u; s < SAMPLES; s++) {
+        let d = textureLoad(depth_tex, gid.xy, LOAD_SAMPLE);
+        let sky = select(d <= 0.0, d >= 1.0, c.standard != 0u);
+        if (sky) {
+            continue;
+        }
+        let w = c.a / (d + c.b);
+        let xy = vec2<f32>(gid.xy) + 0.5;
+        let ndc = vec2<f32>(xy.x / c.viewport.x * 2.0 - 1.0, 1.0 - xy.y / c.viewport.y * 2.0);
+        let v = vec3<f32>(ndc.x * w / c.p00, ndc.y * w / c.p11, -w);
+        // Camera-relative point; the lights are moved by the eye (world minus eye).
+        let p = (c.inv_rotation * vec4<f32>(v, 0.0)).xyz;
+        let cell = light_grid_cell(xy, w);
+        let n = light_grid_count(cell);
+        atomicAdd(&result[2], n);
+        atomicAdd(&result[3], 1u);
+        for (var l = 0u; l < c.light_count; l++) {
+            var light = my_lights[l];
+            light.position = light.position - c.eye;
+            if (!reaches(light, p)) {
+                continue;
+            }
+            atomicAdd(&result[1], 1u);
+            var found = false;
+            for (var i = 0u; i < n; i++) {
+                found = found || light_grid_light(cell, i) == l;
+            }
+            if (!found) {
+                if (atomicAdd(&result[0], 1u) == 0u) {
+                    atomicStore(&result[4], gid.x);
+                    atomicStore(&result[5], gid.y);
+                    atomicStore(&result[6], l);
+                }
+            }
+        }
+    }
+}
+"#;
+
+/// The caller's resources for one camera: its depth texture (written by its own pass), its
+/// lights, and its oracle pipeline.
+struct Caller {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    samples: u32,
+    depth: wgpu::Texture,
+    depth_view: wgpu::TextureView,
+    depth_pipeline: wgpu::RenderPipeline,
+    check: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    light_count: u32,
+    cam: Camera,
+}
+
+impl Caller {
+    fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        samples: u32,
+        cam: Camera,
+        lights: &[CullLight],
+    ) -> Self {
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("caller depth"),
+            size: wgpu::Extent3d {
+                width: W,
+                height: H,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let depth_view = depth.create_view(&Default::default());
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("caller depth"),
+            source: wgpu::ShaderSource::Wgsl(DEPTH_WGSL.into()),
+        });
+        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("caller depth"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState {
+                count: samples,
+                ..Default::default()
+            },
+            multiview_mask: None,
+            cache: None,
+        });
+        let rot = Mat4::from_mat3(glam::Mat3::from_mat4(cam.view));
+        let p = cam.proj.to_cols_array_2d();
+        let check = Check {
+            inv_rotation: rot.transpose().to_cols_array_2d(),
+            eye: cam.eye.to_array(),
+            light_count: lights.len() as u32,
+            a: cam.a,
+            b: cam.b,
+            p00: p[0][0],
+            p11: p[1][1],
+            viewport: [W as f32, H as f32],
+            near: NEAR,
+            far: FAR,
+            standard: u32::from(cam.standard),
+            pad: [0; 3],
+        };
+        let check = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("check"),
+            contents: bytemuck::bytes_of(&check),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("caller lights"),
+            contents: bytemuck::cast_slice(lights),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        Caller {
+            device: device.clone(),
+            queue: queue.clone(),
+            samples,
+            depth,
+            depth_view,
+            depth_pipeline,
+            check,
+            lights: light_buffer,
+            light_count: lights.len() as u32,
+            cam,
+        }
+    }
+
+    fn inputs(&self) -> CullInputs<'_> {
+        CullInputs {
+            depth: &self.depth_view,
+            lights: &self.lights,
+            light_count: self.light_count,
+            view: self.cam.view.to_cols_array_2d(),
+            proj: self.cam.proj.to_cols_array_2d(),
+            near: NEAR,
+            far: FAR,
+            viewport: [W, H],
+        }
+    }
+
+    /// Depth pre-pass, culling, and the oracle over every sample; returns the oracle's
+    /// counts `[misses, reaching, listed, samples, x, y, light]` and the culler's report.
+    fn frame(&self, culler: &mut LightCuller) -> ([u32; 7], lightgrid::CullReport) {
+        let device = &self.device;
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &self.depth_pipeline.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.check.as_entire_binding(),
+                }],
+            });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("caller depth pre-pass"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(if self.cam.standard { 1.0 } else { 0.0 }),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        let frame = culler
+            .encode(&mut encoder, &self.inputs())
+            .expect("culling");
+        let result = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("oracle result"),
+            size: 32,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("oracle readback"),
+            size: 32,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        {
+            let (ty, sample) = if self.samples > 1 {
+                ("texture_depth_multisampled_2d", "i32(s)")
+            } else {
+                ("texture_depth_2d", "0")
+            };
+            let src = format!(
+                "const SAMPLES: u32 = {}u;\n{}\n{}",
+                self.samples,
+                LightCuller::wgsl(1),
+                CHECK_WGSL
+                    .replace("DEPTH_TYPE", ty)
+                    .replace("LOAD_SAMPLE", sample)
+            );
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("oracle"),
+                source: wgpu::ShaderSource::Wgsl(src.into()),
+            });
+            let own = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("oracle"),
+                entries: &[
+                    buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                    buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Depth,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: self.samples > 1,
+                        },
+                        count: None,
+                    },
+                    buffer_entry(3, wgpu::BufferBindingType::Storage { read_only: false }),
+                ],
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("oracle"),
+                bind_group_layouts: &[Some(&own), Some(culler.bind_group_layout())],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("oracle"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("oracle"),
+                layout: &own,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: self.check.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: self.lights.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&self.depth.create_view(
+                            &wgpu::TextureViewDescriptor {
+                                aspect: wgpu::TextureAspect::DepthOnly,
+                                ..Default::default()
+                            },
+                        )),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: result.as_entire_binding(),
+                    },
+                ],
+            });
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.set_bind_group(1, culler.bind_group(), &[]);
+            pass.dispatch_workgroups(W.div_ceil(8), H.div_ceil(8), 1);
+        }
+        encoder.copy_buffer_to_buffer(&result, 0, &readback, 0, 32);
+        self.queue.submit([encoder.finish()]);
+        readback.map_async(wgpu::MapMode::Read, .., |r| r.expect("map"));
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+        let values: Vec<u32> =
+            bytemuck::cast_slice(&readback.get_mapped_range(..).expect("mapped")).to_vec();
+        let reports = culler.wait().expect("reports");
+        let report = *reports
+            .iter()
+            .find(|r| r.frame == frame)
+            .expect("the frame's report");
+        (values[..7].try_into().unwrap(), report)
+    }
+}
+
+fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Cull one frame with `config` and check it against the oracle; a frame whose lists did not
+/// fit is culled again (the lists grew from its report).
+fn check(caller: &Caller, config: CullConfig, what: &str) {
+    let mut culler = LightCuller::new(&caller.device, &caller.queue, config).expect("culler");
+    let (mut r, mut report) = caller.frame(&mut culler);
+    if report.overflowed {
+        (r, report) = caller.frame(&mut culler);
+    }
+    assert!(report.is_complete(), "{what}: {report:?}");
+    assert!(
+        r[3] > W * H / 2,
+        "{what}: only {} samples have geometry",
+        r[3]
+    );
+    assert!(
+        r[1] > 5_000,
+        "{what}: only {} light-sample pairs: the scene tests nothing",
+        r[1]
+    );
+    assert_eq!(
+        r[0], 0,
+        "{what}: {} lights reaching samples are missing from their cells (first: pixel ({}, {}), light {})",
+        r[0], r[4], r[5], r[6]
+    );
+    // Culling culls: the lists hold far fewer than every light per sample.
+    let per_sample = f64::from(r[2]) / f64::from(r[3]);
+    let reaching = f64::from(r[1]) / f64::from(r[3]);
+    println!("{what}: {per_sample:.1} listed, {reaching:.1} reaching per sample");
+    assert!(
+        per_sample < f64::from(caller.light_count) * 0.6,
+        "{what}: {per_sample:.1} lights listed per sample of {}",
+        caller.light_count
+    );
+}
+
+const STRATEGIES: [CullStrategy; 3] = [
+    CullStrategy::Gather,
+    CullStrategy::Scatter,
+    CullStrategy::BvhGpu,
+];
+const GRIDS: [CullGrid; 2] = [
+    CullGrid::Tiles { tile_size: 16 },
+    CullGrid::Clusters {
+        tile_size: 32,
+        slices: 16,
+    },
+];
+
+#[test]
+fn every_strategy_grid_and_depth_bounds_mode_lists_every_reaching_light() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 7);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in STRATEGIES {
+        for grid in GRIDS {
+            for depth_bounds in [
+                DepthBounds::Both,
+                DepthBounds::Min,
+                DepthBounds::Max,
+                DepthBounds::None,
+            ] {
+                let config = CullConfig {
+                    grid,
+                    strategy,
+                    depth_bounds,
+                    ..CullConfig::default()
+                };
+                check(
+                    &caller,
+                    config,
+                    &format!("{strategy:?} {grid:?} {depth_bounds:?}"),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn msaa_depth_standard_depth_and_a_camera_far_from_the_origin() {
+    let (device, queue) = device();
+    // Reversed-Z, every sample its own depth.
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights_near = lights(&cam, 300, 11);
+    let msaa = Caller::new(&device, &queue, 4, cam, &lights_near);
+    for strategy in STRATEGIES {
+        for grid in GRIDS {
+            let config = CullConfig {
+                grid,
+                strategy,
+                samples: 4,
+                ..CullConfig::default()
+            };
+            check(&msaa, config, &format!("MSAA 4 {strategy:?} {grid:?}"));
+        }
+    }
+    // Standard depth (0 at near, cleared to 1), 20 km from the origin.
+    let cam = camera(Vec3::new(20_000.0, 35.0, -12_000.0), true);
+    let far_lights = lights(&cam, 300, 13);
+    let far = Caller::new(&device, &queue, 1, cam, &far_lights);
+    for grid in GRIDS {
+        let config = CullConfig {
+            grid,
+            strategy: CullStrategy::Gather,
+            ..CullConfig::default()
+        };
+        check(
+            &far,
+            config,
+            &format!("standard depth far from the origin {grid:?}"),
+        );
+    }
+}
+
+#[test]
+fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let mut lights = lights(&cam, 300, 17);
+    for strategy in STRATEGIES {
+        let config = CullConfig {
+            strategy,
+            index_capacity: 1,
+            ..CullConfig::default()
+        };
+        let caller = Caller::new(&device, &queue, 1, camera(cam.eye, false), &lights);
+        let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+        let (_, first) = caller.frame(&mut culler);
+        assert!(
+            first.overflowed,
+            "{strategy:?}: one index entry cannot hold the grid: {first:?}"
+        );
+        assert!(!first.is_complete());
+        let (r, second) = caller.frame(&mut culler);
+        assert!(
+            second.is_complete(),
+            "{strategy:?}: the lists did not grow: {second:?}"
+        );
+        assert_eq!(r[0], 0, "{strategy:?}: misses after growing");
+    }
+    // A NaN position and a zero range: refused, counted, and in no list.
+    lights[5].position[1] = f32::NAN;
+    lights[9].range = 0.0;
+    let caller = Caller::new(&device, &queue, 1, camera(cam.eye, false), &lights);
+    let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
+    let (_, report) = caller.frame(&mut culler);
+    assert_eq!(report.invalid_lights, 2, "{report:?}");
+    assert!(!report.is_complete());
+}
+
+fn refused(culler: &mut LightCuller, device: &wgpu::Device, inputs: &CullInputs) -> CullError {
+    let mut encoder = device.create_command_encoder(&Default::default());
+    culler
+        .encode(&mut encoder, inputs)
+        .expect_err("bad input must be refused")
+}
+
+#[test]
+fn bad_use_is_a_typed_error_naming_the_input() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 40, 19);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    let mut culler = LightCuller::new(
+        &device,
+        &queue,
+        CullConfig {
+            max_lights: 40,
+            ..CullConfig::default()
+        },
+    )
+    .expect("culler");
+    let good = caller.inputs();
+    let expect = |culler: &mut LightCuller, inputs: &CullInputs, input: CullInput, words: &str| {
+        let e = refused(culler, &device, inputs);
+        assert_eq!(e.input, input, "{e}");
+        assert!(e.to_string().contains(words), "{e} (expected '{words}')");
+    };
+    // Depth: a colour texture, an MSAA texture for a 1-sample culler, no TEXTURE_BINDING.
+    let texture = |format, samples, usage| {
+        device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width: W,
+                    height: H,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+    };
+    use wgpu::TextureUsages as U;
+    let colour = texture(wgpu::TextureFormat::Rgba8Unorm, 1, U::TEXTURE_BINDING);
+    expect(
+        &mut culler,
+        &CullInputs {
+            depth: &colour,
+            ..caller.inputs()
+        },
+        CullInput::Depth,
+        "not a depth format",
+    );
+    let msaa = texture(
+        wgpu::TextureFormat::Depth32Float,
+        4,
+        U::TEXTURE_BINDING | U::RENDER_ATTACHMENT,
+    );
+    expect(
+        &mut culler,
+        &CullInputs {
+            depth: &msaa,
+            ..caller.inputs()
+        },
+        CullInput::Depth,
+        "4 samples",
+    );
+    let unbound = texture(wgpu::TextureFormat::Depth32Float, 1, U::RENDER_ATTACHMENT);
+    expect(
+        &mut culler,
+        &CullInputs {
+            depth: &unbound,
+            ..caller.inputs()
+        },
+        CullInput::Depth,
+        "TEXTURE_BINDING",
+    );
+    // Lights: a buffer smaller than the count says, more lights than configured, no STORAGE.
+    let small = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: 48 * 10,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    expect(
+        &mut culler,
+        &CullInputs {
+            lights: &small,
+            ..caller.inputs()
+        },
+        CullInput::Lights,
+        "1920 bytes",
+    );
+    expect(
+        &mut culler,
+        &CullInputs {
+            light_count: 41,
+            ..caller.inputs()
+        },
+        CullInput::LightCount,
+        "max_lights 40",
+    );
+    let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: 48 * 40,
+        usage: wgpu::BufferUsages::UNIFORM,
+        mapped_at_creation: false,
+    });
+    expect(
+        &mut culler,
+        &CullInputs {
+            lights: &uniform,
+            ..caller.inputs()
+        },
+        CullInput::Lights,
+        "STORAGE",
+    );
+    // Viewport: empty, larger than the depth texture.
+    expect(
+        &mut culler,
+        &CullInputs {
+            viewport: [0, H],
+            ..caller.inputs()
+        },
+        CullInput::Viewport,
+        "no pixels",
+    );
+    expect(
+        &mut culler,
+        &CullInputs {
+            viewport: [W + 1, H],
+            ..caller.inputs()
+        },
+        CullInput::Viewport,
+        "larger than the depth texture",
+    );
+    // Matrices: NaN, a scaled view, an orthographic or off-centre projection.
+    let mut nan_view = good.view;
+    nan_view[3][0] = f32::NAN;
+    expect(
+        &mut culler,
+        &CullInputs {
+            view: nan_view,
+            ..caller.inputs()
+        },
+        CullInput::View,
+        "not finite",
+    );
+    let mut nan_proj = good.proj;
+    nan_proj[0][0] = f32::NAN;
+    expect(
+        &mut culler,
+        &CullInputs {
+            proj: nan_proj,
+            ..caller.inputs()
+        },
+        CullInput::Projection,
+        "not finite",
+    );
+    let scaled = (Mat4::from_scale(Vec3::splat(2.0)) * caller.cam.view).to_cols_array_2d();
+    expect(
+        &mut culler,
+        &CullInputs {
+            view: scaled,
+            ..caller.inputs()
+        },
+        CullInput::View,
+        "rotation and a translation",
+    );
+    let ortho = Mat4::from_cols(
+        glam::Vec4::X,
+        glam::Vec4::Y,
+        glam::Vec4::new(0.0, 0.0, -0.01, 0.0),
+        glam::Vec4::new(0.0, 0.0, 0.0, 1.0),
+    )
+    .to_cols_array_2d();
+    expect(
+        &mut culler,
+        &CullInputs {
+            proj: ortho,
+            ..caller.inputs()
+        },
+        CullInput::Projection,
+        "perspective",
+    );
+    let mut jittered = good.proj;
+    jittered[2][0] = 0.01;
+    expect(
+        &mut culler,
+        &CullInputs {
+            proj: jittered,
+            ..caller.inputs()
+        },
+        CullInput::Projection,
+        "off-centre",
+    );
+    // Planes: near ≥ far, NaN, and planes the projection does not have.
+    expect(
+        &mut culler,
+        &CullInputs {
+            near: FAR,
+            far: NEAR,
+            ..caller.inputs()
+        },
+        CullInput::Planes,
+        "0 < near < far",
+    );
+    expect(
+        &mut culler,
+        &CullInputs {
+            near: f32::NAN,
+            ..caller.inputs()
+        },
+        CullInput::Planes,
+        "0 < near < far",
+    );
+    expect(
+        &mut culler,
+        &CullInputs {
+            near: 0.5,
+            ..caller.inputs()
+        },
+        CullInput::Planes,
+        "not the projection's near plane",
+    );
+    expect(
+        &mut culler,
+        &CullInputs {
+            far: 50.0,
+            ..caller.inputs()
+        },
+        CullInput::Planes,
+        "not the projection's far plane",
+    );
+    // Configurations: tile sizes, slices, sample counts and capacities out of range.
+    for config in [
+        CullConfig {
+            grid: CullGrid::Tiles { tile_size: 0 },
+            ..CullConfig::default()
+        },
+        CullConfig {
+            grid: CullGrid::Tiles { tile_size: 1 << 20 },
+            ..CullConfig::default()
+        },
+        CullConfig {
+            grid: CullGrid::Clusters {
+                tile_size: 16,
+                slices: 1,
+            },
+            ..CullConfig::default()
+        },
+        CullConfig {
+            grid: CullGrid::Clusters {
+                tile_size: 16,
+                slices: 100_000,
+            },
+            ..CullConfig::default()
+        },
+        CullConfig {
+            samples: 3,
+            ..CullConfig::default()
+        },
+        CullConfig {
+            max_lights: 0,
+            ..CullConfig::default()
+        },
+        CullConfig {
+            max_lights: u32::MAX,
+            ..CullConfig::default()
+        },
+        CullConfig {
+            index_capacity: 0,
+            ..CullConfig::default()
+        },
+    ] {
+        let e = LightCuller::new(&device, &queue, config)
+            .err()
+            .unwrap_or_else(|| panic!("{config:?} accepted"));
+        assert_eq!(e.input, CullInput::Config, "{e}");
+    }
+    // After all that, the good inputs still cull.
+    let mut encoder = device.create_command_encoder(&Default::default());
+    culler.encode(&mut encoder, &good).expect("good inputs");
+}
