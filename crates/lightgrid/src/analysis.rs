@@ -2,7 +2,7 @@
 //! tests), never the real-time path. The frame's image, depth and lighting counts are copied
 //! out in the frame's own submission ([`AnalysisReadbacks`]); after the wait the ideal count
 //! is computed on the CPU, the grid the pipeline shaded with is downloaded
-//! (`GridBuilder::download`) and everything lands in [`FrameStats`].
+//! (`LightCuller::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
     assign_cpu, cell_bounds_cpu_samples, ideal_fragment_counts, ideal_pixel_counts, BuiltGrid,

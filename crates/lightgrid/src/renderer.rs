@@ -582,7 +582,7 @@ impl<'c> Renderer<'c> {
         if let Some(builder) = self
             .techniques
             .get_mut(r.tag.pipeline)
-            .and_then(|t| t.grid_builder())
+            .and_then(|t| t.culler())
         {
             builder.observe(&self.ctx.device, &r.values)?;
         }
@@ -743,11 +743,7 @@ impl<'c> Renderer<'c> {
                 }
                 continue;
             }
-            let grid = match self
-                .techniques
-                .get_mut(info.id)
-                .and_then(|t| t.grid_builder())
-            {
+            let grid = match self.techniques.get_mut(info.id).and_then(|t| t.culler()) {
                 Some(b) => Some(b.download(&self.ctx.device, &self.ctx.queue, &readback.values)?),
                 None => None,
             };

@@ -329,10 +329,18 @@ fn prefixed_grid_cell() -> String {
 /// # Ok(()) }
 /// ```
 pub struct LightCuller {
+    /// The stages every grid is built by (lightgrid's renderer's and a caller's).
+    core: GridBuilder,
+    /// A caller's culler: what turns its inputs into the culling kernels' group 0. `None` in
+    /// lightgrid's renderer, whose frames bring their own ([`CullFrame::of`]).
+    caller: Option<Box<Caller>>,
+}
+
+/// What a caller's [`LightCuller`] keeps besides the grid's stages.
+struct Caller {
     device: wgpu::Device,
     queue: wgpu::Queue,
     config: CullConfig,
-    core: GridBuilder,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     /// The camera-relative copy of the caller's lights and their bounding spheres.
@@ -474,21 +482,66 @@ impl LightCuller {
             &[Some(&prep_layout)],
         );
         Ok(LightCuller {
-            device: device.clone(),
-            queue: queue.clone(),
-            config,
             core,
-            layout,
-            uniforms,
-            lights,
-            bounds,
-            counters,
-            group,
-            prep,
-            prep_layout,
-            timer: PassTimer::disabled(),
-            frames: 0,
+            caller: Some(Box::new(Caller {
+                device: device.clone(),
+                queue: queue.clone(),
+                config,
+                layout,
+                uniforms,
+                lights,
+                bounds,
+                counters,
+                group,
+                prep,
+                prep_layout,
+                timer: PassTimer::disabled(),
+                frames: 0,
+            })),
         })
+    }
+
+    /// lightgrid's renderer's culler: its frames bring the culling kernels' group 0 and the
+    /// depth ([`CullFrame::of`]), and `setup` says the rest (`--assign` may be `cpu`).
+    pub(crate) fn for_renderer(setup: &GridSetup, slices: u32, source: CellSource) -> Self {
+        LightCuller {
+            core: GridBuilder::new(setup, slices, source),
+            caller: None,
+        }
+    }
+
+    /// Record a renderer frame's grid (`GridBuilder::build`).
+    pub(crate) fn build(&mut self, f: &CullFrame, enc: &mut FrameEncoder) -> crate::Result<()> {
+        self.core.build(f, enc)
+    }
+
+    /// A renderer frame's counters: the lists grow from them.
+    pub(crate) fn observe(
+        &mut self,
+        device: &wgpu::Device,
+        values: &crate::gpu::CounterValues,
+    ) -> crate::Result<()> {
+        self.core.observe(device, values)
+    }
+
+    /// The last renderer frame's grid (analysis; waits).
+    pub(crate) fn download(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        values: &crate::gpu::CounterValues,
+    ) -> crate::Result<super::BuiltGrid> {
+        self.core.download(device, queue, values)
+    }
+
+    fn caller(&mut self) -> Result<&mut Caller, CullError> {
+        match self.caller.as_deref_mut() {
+            Some(c) => Ok(c),
+            None => refuse(
+                CullInput::Config,
+                "lightgrid's renderer's culler takes its frames from the renderer",
+            ),
+        }
     }
 
     /// The limits a device needs for the culler: the defaults, with the storage buffers per
@@ -527,7 +580,7 @@ impl LightCuller {
     /// The layout of [`Self::bind_group`], for the caller's pipeline layout (visible to
     /// fragment and compute stages).
     pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
-        &self.core.layout()
+        self.core.layout()
     }
 
     /// The grid the last encoded frame builds. Take it again after every
@@ -536,9 +589,9 @@ impl LightCuller {
         self.core.bind_group()
     }
 
-    /// The configuration the culler was made with.
-    pub fn config(&self) -> &CullConfig {
-        &self.config
+    /// The configuration the culler was made with (`None`: lightgrid's renderer's).
+    pub fn config(&self) -> Option<&CullConfig> {
+        self.caller.as_ref().map(|c| &c.config)
     }
 
     /// Record one frame's culling into `encoder` after the caller's depth pre-pass. The
@@ -549,12 +602,19 @@ impl LightCuller {
         encoder: &mut wgpu::CommandEncoder,
         inputs: &CullInputs,
     ) -> Result<u64, CullError> {
-        let camera = self.check(inputs)?;
+        let core = &mut self.core;
+        let Some(c) = self.caller.as_deref_mut() else {
+            return refuse(
+                CullInput::Config,
+                "lightgrid's renderer's culler takes its frames from the renderer",
+            );
+        };
+        let camera = c.check(inputs)?;
         let (width, height) = (inputs.viewport[0], inputs.viewport[1]);
-        let tile_size = match self.config.grid {
+        let tile_size = match c.config.grid {
             CullGrid::Tiles { tile_size } | CullGrid::Clusters { tile_size, .. } => tile_size,
         };
-        self.core.set_tiles(
+        core.set_tiles(
             GridDims::new(width, height, tile_size).map_err(|e| CullError {
                 input: CullInput::Viewport,
                 message: e.to_string(),
@@ -562,32 +622,27 @@ impl LightCuller {
         );
         let n = inputs.light_count;
         let grown_lights = grow_storage(
-            &self.device,
-            &mut self.lights,
+            &c.device,
+            &mut c.lights,
             "culler lights",
             u64::from(n.max(1)) * 48,
         );
         let grown_bounds = grow_storage(
-            &self.device,
-            &mut self.bounds,
+            &c.device,
+            &mut c.bounds,
             "culler light bounds",
             u64::from(n.max(1)) * 16,
         );
         if grown_lights || grown_bounds {
-            self.group = bind_cull_group(
-                &self.device,
-                &self.layout,
-                [
-                    &self.uniforms,
-                    &self.lights,
-                    self.counters.buffer(),
-                    &self.bounds,
-                ],
+            c.group = bind_cull_group(
+                &c.device,
+                &c.layout,
+                [&c.uniforms, &c.lights, c.counters.buffer(), &c.bounds],
             );
         }
-        let uniforms = camera.uniforms(inputs, self.config.spot_cull);
-        self.queue
-            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let uniforms = camera.uniforms(inputs, c.config.spot_cull);
+        c.queue
+            .write_buffer(&c.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let depth_view = inputs
             .depth
             .texture()
@@ -598,38 +653,38 @@ impl LightCuller {
                 mip_level_count: Some(1),
                 ..Default::default()
             });
-        let prep_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let prep_group = c.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("cull lights"),
-            layout: &self.prep_layout,
+            layout: &c.prep_layout,
             entries: &[
-                entry(0, &self.uniforms),
+                entry(0, &c.uniforms),
                 entry(1, inputs.lights),
-                entry(2, &self.lights),
-                entry(3, &self.bounds),
-                entry(4, self.counters.buffer()),
+                entry(2, &c.lights),
+                entry(3, &c.bounds),
+                entry(4, c.counters.buffer()),
             ],
         });
-        self.timer.reset();
-        self.frames += 1;
-        let frame = self.frames;
-        let setup = camera.setup(inputs, self.config.spot_cull);
-        let result = crate::gpu::scoped(&self.device, "recording the light culler", || {
-            self.counters.clear(encoder);
+        c.timer.reset();
+        c.frames += 1;
+        let frame = c.frames;
+        let setup = camera.setup(inputs, c.config.spot_cull);
+        let result = crate::gpu::scoped(&c.device, "recording the light culler", || {
+            c.counters.clear(encoder);
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("cull: lights"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.prep);
+                pass.set_pipeline(&c.prep);
                 pass.set_bind_group(0, &prep_group, &[]);
                 let (x, y) = groups_1d(n.div_ceil(crate::consts::ASSIGN_THREADS));
                 pass.dispatch_workgroups(x, y, 1);
             }
             let f = CullFrame {
-                device: &self.device,
-                queue: &self.queue,
-                bind_group: &self.group,
-                counters: self.counters.buffer(),
+                device: &c.device,
+                queue: &c.queue,
+                bind_group: &c.group,
+                counters: c.counters.buffer(),
                 depth: Some(&depth_view),
                 setup,
                 light_count: n as usize,
@@ -637,9 +692,8 @@ impl LightCuller {
                 transparency: false,
                 scene: None,
             };
-            let mut enc =
-                FrameEncoder::borrowed(&self.device, &self.queue, encoder, &mut self.timer);
-            self.core.build(&f, &mut enc)
+            let mut enc = FrameEncoder::borrowed(&c.device, &c.queue, encoder, &mut c.timer);
+            core.build(&f, &mut enc)
         });
         result??;
         let tag = FrameTag {
@@ -647,9 +701,8 @@ impl LightCuller {
             pipeline: "LightCuller",
             pass_labels: Vec::new(),
         };
-        self.counters
-            .encode_copy(&self.device, encoder, &self.timer, tag);
-        self.counters.map_on_submit(encoder);
+        c.counters.encode_copy(&c.device, encoder, &c.timer, tag);
+        c.counters.map_on_submit(encoder);
         Ok(frame)
     }
 
@@ -657,13 +710,15 @@ impl LightCuller {
     /// without waiting (the caller's event loop polls the device, or this does). The lists
     /// grow from them.
     pub fn poll(&mut self) -> Result<Vec<CullReport>, CullError> {
-        let readbacks = self.counters.poll(&self.device)?;
+        let c = self.caller()?;
+        let readbacks = c.counters.poll(&c.device)?;
         self.reports(readbacks)
     }
 
     /// [`Self::poll`] after waiting for every submitted frame (tests, tools).
     pub fn wait(&mut self) -> Result<Vec<CullReport>, CullError> {
-        let readbacks = self.counters.wait(&self.device)?;
+        let c = self.caller()?;
+        let readbacks = c.counters.wait(&c.device)?;
         self.reports(readbacks)
     }
 
@@ -671,9 +726,10 @@ impl LightCuller {
         &mut self,
         readbacks: Vec<crate::gpu::FrameReadback>,
     ) -> Result<Vec<CullReport>, CullError> {
+        let device = self.caller()?.device.clone();
         let mut out = Vec::with_capacity(readbacks.len());
         for r in readbacks {
-            self.core.observe(&self.device, &r.values)?;
+            self.core.observe(&device, &r.values)?;
             out.push(CullReport {
                 frame: r.tag.serial,
                 index_entries: r.values.index_needed().max(r.values.pairs_needed()),
@@ -684,7 +740,9 @@ impl LightCuller {
         }
         Ok(out)
     }
+}
 
+impl Caller {
     /// Refuse inputs the kernels cannot honour, each error naming its input.
     fn check(&self, i: &CullInputs) -> Result<Camera, CullError> {
         use CullInput as I;

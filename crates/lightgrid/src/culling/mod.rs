@@ -1,6 +1,6 @@
 //! Light assignment: the light grid contract (tiled-shading §6.2), the cell bounds every
 //! strategy reads, the strategies (CPU; GPU gather, scatter and BVH) with their CPU twins,
-//! [`GridBuilder`] which runs the one `--assign` names, and the brute-force oracle that proves
+//! [`LightCuller`] (over `builder.rs`'s `GridBuilder`) which runs the one `--assign` names, for lightgrid's renderer and for any other wgpu renderer, and the brute-force oracle that proves
 //! nothing is ever missed.
 
 mod assign_cpu;
@@ -25,7 +25,8 @@ mod strategy;
 pub use crate::frame::{Assign, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
 pub use assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
-pub use builder::{BuiltGrid, CellSource, GridBuilder, GridSetup};
+pub use builder::BuiltGrid;
+pub(crate) use builder::{CellSource, GridSetup};
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
 pub use cell_bounds::{
     cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,

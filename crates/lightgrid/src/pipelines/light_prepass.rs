@@ -24,7 +24,7 @@
 //! Pass 3: 0 scene, 1 irradiance.
 //!
 //! `tiled_light_prepass` is compute-based deferred lighting [And11], the baseline Forward+ is
-//! measured against (forward-plus §5, Fig. 3): pass 2 is the tile grid (`GridBuilder`, as
+//! measured against (forward-plus §5, Fig. 3): pass 2 is the tile grid (`LightCuller`, as
 //! every grid pipeline) and one compute pass, one invocation per pixel, that loops its tile's
 //! lights and writes the mono irradiance (`tiled_light_prepass.wgsl`). Its groups: 0 scene,
 //! 1 grid, 2 attributes + depth, 3 irradiance + count (storage). With MSAA the kernel is
@@ -42,7 +42,7 @@ use super::{
     PipelineContext, Technique, TransparentLights,
 };
 use crate::consts::SCREEN_WORKGROUP;
-use crate::culling::{CellSource, GridBuilder};
+use crate::culling::{CellSource, LightCuller};
 use crate::error::Result;
 use crate::frame::targets::counts_in_target;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
@@ -159,7 +159,7 @@ enum Irradiance {
     },
     /// The tile grid, then one compute pass over the pixels.
     Tiled {
-        builder: Box<GridBuilder>,
+        builder: Box<LightCuller>,
         kernel: wgpu::ComputePipeline,
         outputs_layout: wgpu::BindGroupLayout,
         /// MSAA: the kernel's per-sample output and the pass expanding it.
@@ -393,7 +393,7 @@ fn tiled_irradiance(
         forward_opaque: false,
         ..ctx.grid_setup()
     };
-    let builder = GridBuilder::new(&setup, 1, CellSource::Depth);
+    let builder = LightCuller::for_renderer(&setup, 1, CellSource::Depth);
     let samples = ctx.settings.msaa;
     let (outputs_layout, msaa) = if samples > 1 {
         let (layout, msaa) = TiledMsaa::new(ctx, module, attr_layout);
@@ -408,7 +408,7 @@ fn tiled_irradiance(
         "main",
         &[
             Some(ctx.scene_layout),
-            Some(builder.layout()),
+            Some(builder.bind_group_layout()),
             Some(attr_layout),
             Some(&outputs_layout),
         ],
@@ -735,7 +735,7 @@ impl Technique for LightPrepass {
         Ok(())
     }
 
-    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+    fn culler(&mut self) -> Option<&mut LightCuller> {
         match &mut self.irradiance {
             Irradiance::Tiled { builder, .. } => Some(builder),
             Irradiance::Volumes { .. } => None,

@@ -8,7 +8,7 @@ mod tiled_deferred;
 mod tiled_forward;
 mod transparent;
 
-use crate::culling::{GridBuilder, GridDims, GridSetup};
+use crate::culling::{GridDims, GridSetup, LightCuller};
 use crate::error::Error;
 use crate::error::Result;
 use crate::memory::MemoryModel;
@@ -35,7 +35,7 @@ pub struct PipelineContext<'a> {
 }
 
 impl PipelineContext<'_> {
-    /// What a grid pipeline's [`GridBuilder`] is created from.
+    /// What a grid pipeline's [`LightCuller`] is created from.
     pub fn grid_setup(&self) -> GridSetup<'_> {
         GridSetup {
             device: self.device,
@@ -62,7 +62,7 @@ pub trait Technique {
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()>;
     /// The grid builder of a grid pipeline with an `--assign` strategy: analysis downloads
     /// its grid, and the frame counters size its lists.
-    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+    fn culler(&mut self) -> Option<&mut LightCuller> {
         None
     }
     /// Where the frame's transparent fragments find their lights (after `encode`): a grid
@@ -95,7 +95,7 @@ pub struct PipelineInfo {
     pub paper: &'static str,
     /// Reads a light grid. `forward` never does: it is the reference.
     pub uses_grid: bool,
-    /// Builds its grid with the strategy `--assign` names (a `GridBuilder`).
+    /// Builds its grid with the strategy `--assign` names (a `LightCuller`).
     pub assign: bool,
     /// Its grid is clustered: `--slices` view-depth slices per tile.
     pub clustered: bool,

@@ -1,7 +1,7 @@
 //! `tiled_deferred`, `tiled_deferred_single` and `clustered_deferred`.
 //!
 //! tiled_deferred (tiled-shading §2, §6): 1. G-buffer pass; 2. per-tile depth bounds and the
-//! tile grid (`GridBuilder`, the strategy `--assign` names); 3. compute pass, one invocation
+//! tile grid (`LightCuller`, the strategy `--assign` names); 3. compute pass, one invocation
 //! per sample: read the G-buffer once, loop the tile's lights in registers.
 //! Groups: 0 scene, 1 grid, 2 G-buffer, 3 outputs.
 //!
@@ -19,7 +19,7 @@ use super::RenderSettings;
 use super::{FrameEncoder, FrameInputs, PipelineContext, Technique, TransparentLights};
 use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
-use crate::culling::{CellSource, GridBuilder, GridDims};
+use crate::culling::{CellSource, GridDims, LightCuller};
 use crate::error::Result;
 use crate::frame::MsaaResolve;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
@@ -116,7 +116,7 @@ fn single_kernel_shader(samples: u32) -> ComposedShader {
 enum Variant {
     /// Multi-pass: grid + shading kernel.
     Multi {
-        builder: Box<GridBuilder>,
+        builder: Box<LightCuller>,
         label: &'static str,
     },
     /// Single kernel; group 1 holds the tile size.
@@ -315,11 +315,11 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         forward_opaque: false,
         ..ctx.grid_setup()
     };
-    let builder = GridBuilder::new(&setup, slices, CellSource::Depth);
+    let builder = LightCuller::for_renderer(&setup, slices, CellSource::Depth);
     let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let layouts = [
         Some(ctx.scene_layout),
-        Some(builder.layout()),
+        Some(builder.bind_group_layout()),
         Some(&gbuffer.read_layout),
         Some(&outputs_layout),
     ];
@@ -499,7 +499,7 @@ impl Technique for TiledDeferred {
         matches!(&self.outputs, Outputs::Samples(s) if s.resolved_last)
     }
 
-    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+    fn culler(&mut self) -> Option<&mut LightCuller> {
         match &mut self.variant {
             Variant::Multi { builder, .. } => Some(builder),
             Variant::Single { .. } => None,

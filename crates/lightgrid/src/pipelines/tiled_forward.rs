@@ -1,5 +1,5 @@
 //! `tiled_forward`, `tiled_forward_prez` and `clustered_forward`: forward shading reading a
-//! light grid built by a [`GridBuilder`] (the strategy `--assign` names).
+//! light grid built by a [`LightCuller`] (the strategy `--assign` names).
 //!
 //! tiled_forward (tiled-shading §3): 1. grid with every tile spanning near..far; 2. lighting
 //! pass (depth test Less, writes depth).
@@ -15,7 +15,7 @@ use super::{
     FrameInputs, MaterialPipelines,
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, TransparentLights};
-use crate::culling::{CellSource, GridBuilder};
+use crate::culling::{CellSource, LightCuller};
 use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
@@ -28,7 +28,7 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 }
 
 struct TiledForward {
-    builder: GridBuilder,
+    builder: LightCuller,
     /// The depth pre-pass (pre-Z and clustered).
     depth_only: Option<DepthPipelines>,
     shading: MaterialPipelines,
@@ -45,7 +45,7 @@ enum Kind {
 fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     let module = create_module(ctx.device, &shaders()[0]);
     let prepass = kind != Kind::Plain;
-    let builder = GridBuilder::new(
+    let builder = LightCuller::for_renderer(
         &ctx.grid_setup(),
         if kind == Kind::Clustered {
             ctx.settings.slices
@@ -64,7 +64,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             label: "tiled forward shading",
             module: &module,
             fragment_entry: Some("fs_main"),
-            layouts: &[Some(ctx.scene_layout), Some(builder.layout())],
+            layouts: &[Some(ctx.scene_layout), Some(builder.bind_group_layout())],
             color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
             depth_write: !prepass,
             depth_compare: crate::depth::SURFACE,
@@ -134,7 +134,7 @@ impl Technique for TiledForward {
         Ok(())
     }
 
-    fn grid_builder(&mut self) -> Option<&mut GridBuilder> {
+    fn culler(&mut self) -> Option<&mut LightCuller> {
         Some(&mut self.builder)
     }
 

@@ -11,7 +11,7 @@
 //! depth (a GPU strategy: the frame stays one submission without readback).
 
 use super::{FrameEncoder, FrameInputs, GeometryPipelineDesc, PipelineContext};
-use crate::culling::{CellSource, GridBuffers, GridBuilder, GridLists};
+use crate::culling::{CellSource, GridBuffers, GridLists, LightCuller};
 use crate::error::Result;
 use crate::frame::targets::counts_in_target;
 use crate::frame::Assign;
@@ -31,7 +31,7 @@ pub enum TransparentLights<'a> {
     /// Every light (`forward`).
     All,
     /// The technique's own grid, built this frame with transparent lists.
-    Grid(&'a GridBuilder),
+    Grid(&'a LightCuller),
     /// No grid of its own: the pass builds one.
     Own,
 }
@@ -40,7 +40,7 @@ pub enum TransparentLights<'a> {
 pub struct TransparentPass {
     all_lights: MaterialPipelines,
     grid: MaterialPipelines,
-    own_grid: GridBuilder,
+    own_grid: LightCuller,
 }
 
 /// Colour blending over the opaque image (alpha kept), counts added.
@@ -71,7 +71,7 @@ impl TransparentPass {
         let module = create_module(ctx.device, &shader());
         // A GPU strategy (gather), so the frame still makes one submission and no readback,
         // over the opaque depth; one list per tile covering near..max.
-        let own_grid = GridBuilder::new(
+        let own_grid = LightCuller::for_renderer(
             &crate::culling::GridSetup {
                 assign: Assign::Gather,
                 lists: GridLists::Shared,
