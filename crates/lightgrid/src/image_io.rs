@@ -148,7 +148,7 @@ fn output_target(path: &Path) -> Result<std::path::PathBuf> {
 }
 
 /// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
-/// the file is either the complete new content or untouched (see [`output_target`]). The
+/// the file is either the complete new content or untouched (see `output_target`). The
 /// temporary file is removed when the write fails (a full disk) and, through
 /// [`remove_temporaries`], when a signal ends the process; a file that is replaced keeps its
 /// permission mode.

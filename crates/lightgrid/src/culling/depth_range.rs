@@ -153,7 +153,7 @@ impl DepthRangePass {
         Ok(sliced(dims, &range, &params))
     }
 
-    /// What to read back part-way through the frame for [`sliced`] (the slicing range, the
+    /// What to read back part-way through the frame for `sliced` (the slicing range, the
     /// sliced parameters): the CPU strategy reads them with the cell bounds, in one wait.
     pub fn readback(&self) -> [(&wgpu::Buffer, u64); 2] {
         [(&self.range, 8), (&self.params_out, PARAMS_BYTES)]

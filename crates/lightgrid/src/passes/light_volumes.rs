@@ -435,7 +435,7 @@ impl LightVolumes {
 
     /// A pipeline for one kind of volume draw (see [`VolumeDraw`]).
     ///
-    /// Stencil (drawn with [`stencil_reference`]): shading draws pass where the edge bit is
+    /// Stencil (drawn with `stencil_reference`): shading draws pass where the edge bit is
     /// what `shading` wants; `StencilMark` counts z-fails in the low seven bits (wrapping
     /// within them: the write mask keeps the edge bit); `StencilLight` passes where the count's
     /// low bit and the edge bit match the reference, and clears the count. A convex closed

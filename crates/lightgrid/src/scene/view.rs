@@ -29,7 +29,7 @@ pub struct ViewSetup {
     pub view: Mat4,
     /// The camera's world position: camera-relative space's origin.
     pub eye: Vec3,
-    /// proj[0][0] and proj[1][1]: x_ndc = p00 * x / w, y_ndc = p11 * y / w.
+    /// `proj[0][0]` and `proj[1][1]`: x_ndc = p00 * x / w, y_ndc = p11 * y / w.
     pub p00: f32,
     pub p11: f32,
     pub near: f32,
