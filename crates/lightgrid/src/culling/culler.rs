@@ -45,10 +45,15 @@ use glam::{DMat3, DVec3, Mat4};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CullLight {
+    /// World position.
     pub position: [f32; 3],
+    /// Greater than zero: the light reaches nothing farther.
     pub range: f32,
+    /// The caller's: never read by the culler.
     pub payload: [f32; 4],
+    /// A spot's unit axis (ignored for a point light).
     pub direction: [f32; 3],
+    /// A spot's outer half-angle cosine (−1..=1), or [`CullLight::POINT`].
     pub cos_outer: f32,
 }
 
@@ -90,12 +95,20 @@ impl CullLight {
 /// The cells of the grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CullGrid {
-    /// Screen tiles of `tile_size` × `tile_size` pixels, each bounded by its samples' depth
-    /// range (tiled shading).
-    Tiles { tile_size: u32 },
-    /// Tiles cut into `slices` depth slices, spread exponentially over the frame's samples'
-    /// depth range (clustered shading).
-    Clusters { tile_size: u32, slices: u32 },
+    /// Screen tiles of `tile_size` × `tile_size` pixels (4 to 64), each bounded by its
+    /// samples' depth range (tiled shading).
+    Tiles {
+        /// Tile edge in pixels.
+        tile_size: u32,
+    },
+    /// Tiles cut into `slices` depth slices (2 to 256), spread exponentially over the frame's
+    /// samples' depth range (clustered shading).
+    Clusters {
+        /// Tile edge in pixels.
+        tile_size: u32,
+        /// Depth slices per tile.
+        slices: u32,
+    },
 }
 
 /// How lights are assigned to cells (all on the GPU).
@@ -127,7 +140,9 @@ impl CullStrategy {
 /// What a [`LightCuller`] builds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CullConfig {
+    /// Tiles or clusters.
     pub grid: CullGrid,
+    /// How lights are assigned to cells.
     pub strategy: CullStrategy,
     /// Which side of each cell's depth range culls lights ([`DepthBounds::Both`]: a light
     /// must reach between the cell's nearest and farthest sample).
@@ -159,6 +174,7 @@ impl Default for CullConfig {
 }
 
 /// One frame's inputs to [`LightCuller::encode`].
+#[derive(Clone, Copy)]
 pub struct CullInputs<'a> {
     /// The caller's depth buffer after its depth pre-pass, recorded earlier in the same
     /// encoder (a view of a 2D depth texture with `TEXTURE_BINDING` usage and
@@ -166,6 +182,7 @@ pub struct CullInputs<'a> {
     pub depth: &'a wgpu::TextureView,
     /// The caller's lights: [`CullLight`]s from byte 0, with `STORAGE` usage.
     pub lights: &'a wgpu::Buffer,
+    /// Lights in the buffer this frame (at most [`CullConfig::max_lights`]).
     pub light_count: u32,
     /// World to view space (right-handed, the camera looking down −z): a rotation and a
     /// translation, column-major (`glam::Mat4::to_cols_array_2d`).
@@ -173,8 +190,9 @@ pub struct CullInputs<'a> {
     /// View to clip space: a symmetric perspective projection with depth 0..1, standard
     /// (0 at `near`, cleared to 1) or reversed (1 at `near`, cleared to 0; infinite allowed).
     pub proj: [[f32; 4]; 4],
-    /// The projection's planes (view distances); `far` bounds the slices of an infinite one.
+    /// The projection's near plane (a view distance).
     pub near: f32,
+    /// The projection's far plane; for an infinite projection, where the slices end.
     pub far: f32,
     /// Pixels of the depth buffer the grid covers, from its top-left corner.
     pub viewport: [u32; 2],
@@ -183,13 +201,22 @@ pub struct CullInputs<'a> {
 /// Which input a [`CullError`] is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CullInput {
+    /// [`CullConfig`].
     Config,
+    /// [`CullInputs::depth`]: format, dimension, sample count, usage.
     Depth,
+    /// [`CullInputs::lights`]: size, usage.
     Lights,
+    /// [`CullInputs::light_count`] beyond [`CullConfig::max_lights`].
     LightCount,
+    /// [`CullInputs::viewport`]: empty, or larger than the depth texture.
     Viewport,
+    /// [`CullInputs::view`]: not finite, or not a rotation and a translation.
     View,
+    /// [`CullInputs::proj`]: not finite, not a symmetric perspective projection.
     Projection,
+    /// [`CullInputs::near`] / [`CullInputs::far`]: not 0 < near < far, or not the
+    /// projection's.
     Planes,
     /// The device could not do what the frame needs (a list too large to bind).
     Device,
@@ -198,7 +225,9 @@ pub enum CullInput {
 /// A refused configuration or frame: the input, and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CullError {
+    /// The input at fault.
     pub input: CullInput,
+    /// Why, with the values involved.
     pub message: String,
 }
 
@@ -251,7 +280,7 @@ impl CullReport {
 
 /// Storage buffers the culling kernels' pipeline layouts bind in one stage at most (scatter's
 /// three groups; `tests/culler.rs` creates every strategy on a device with exactly this).
-pub const STORAGE_BUFFERS_PER_STAGE: u32 = 15;
+pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 15;
 
 /// The caller-facing WGSL: the grid's bindings (declared at group `GROUP`) and the accessors,
 /// the cell addressing shared with lightgrid's own shaders (`grid_cell.wgsl`) renamed into
@@ -544,7 +573,7 @@ impl LightCuller {
         }
     }
 
-    /// The limits a device needs for the culler: the defaults, with the storage buffers per
+    /// The limits a device needs for the culler: the defaults, with the 15 storage buffers per
     /// stage the kernels bind and the adapter's largest storage bindings (long light lists),
     /// for `wgpu::DeviceDescriptor::required_limits`.
     pub fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {

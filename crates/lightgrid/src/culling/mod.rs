@@ -45,7 +45,8 @@ pub use oracle::{
 };
 pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
 pub use spot_ray::{ray_test_count, RayTestCount};
-pub use strategy::{bind_cull_group, cull_layout, AssignStrategy, CullFrame};
+pub use strategy::AssignStrategy;
+pub(crate) use strategy::{bind_cull_group, cull_layout, CullFrame};
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
