@@ -607,19 +607,24 @@ struct Variant {
 }
 
 fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
-    /// The entries of a setting to measure: all where it applies, else the first.
-    fn used<T: Copy>(all: &[T], applies: bool) -> &[T] {
-        if applies {
-            all
-        } else {
-            &all[..1]
-        }
-    }
-    /// Every variant once per value, in order (the product, last dimension fastest).
-    fn times<T: Copy>(out: Vec<Variant>, values: &[T], set: fn(&mut Variant, T)) -> Vec<Variant> {
+    // Does the option `flag` apply to the pipeline in variant `v`? The library's table of
+    // settings decides, as it does for the CLI's refusals.
+    let applies = |flag: &str, v: &Variant| {
+        let axis = pipelines::find_axis(flag).expect("a flag of the table");
+        (axis.applies)(info, &v.settings())
+    };
+    /// Every variant once per value of a setting where it applies, else at its first value
+    /// (the product, last dimension fastest).
+    fn times<T: Copy>(
+        out: Vec<Variant>,
+        values: &[T],
+        applies: impl Fn(&Variant) -> bool,
+        set: fn(&mut Variant, T),
+    ) -> Vec<Variant> {
         out.iter()
             .flat_map(|v| {
-                values.iter().map(move |&x| {
+                let used = if applies(v) { values } else { &values[..1] };
+                used.iter().map(move |&x| {
                     let mut v = *v;
                     set(&mut v, x);
                     v
@@ -636,41 +641,79 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant
         depth_bounds: config.depth_bounds[0],
         depth_reduction: config.depth_reductions[0],
     }];
-    out = times(out, used(&config.spot_culls, info.uses_grid), |v, x| {
-        v.spot_cull = x
-    });
-    // Only pipelines with an `--assign` grid build transparent lists.
-    out = times(out, used(&config.lists, info.assign), |v, x| v.lists = x);
     out = times(
         out,
-        used(&config.material_draws, info.forward_shading),
+        &config.spot_culls,
+        |v| applies("spot-cull", v),
+        |v, x| v.spot_cull = x,
+    );
+    out = times(
+        out,
+        &config.lists,
+        |v| applies("lists", v),
+        |v, x| v.lists = x,
+    );
+    out = times(
+        out,
+        &config.material_draws,
+        |v| applies("material-draws", v),
         |v, x| v.material_draws = x,
     );
     // A pipeline refusing MSAA is measured without it only.
-    let msaa: Vec<u32> = (config.msaa.iter().copied())
-        .filter(|&m| m == 1 || info.msaa == pipelines::Msaa::Supported)
-        .collect();
-    out = times(out, &msaa, |v, x| v.msaa = x);
-    // Only the deferred kernels resolve, and only with MSAA.
-    let resolves: Vec<Option<MsaaResolve>> =
-        config.msaa_resolve.iter().copied().map(Some).collect();
+    let msaa: Vec<u32> = config.msaa.clone();
     out = out
         .into_iter()
-        .flat_map(|v| match v.msaa > 1 && !info.forward_shading {
-            true => times(vec![v], &resolves, |v, x| v.msaa_resolve = x),
+        .flat_map(|v| {
+            msaa.iter()
+                .filter(|&&m| m == 1 || applies("msaa", &v))
+                .map(move |&m| Variant { msaa: m, ..v })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    // Only the deferred kernels resolve, and only with MSAA: others keep `None`.
+    out = out
+        .into_iter()
+        .flat_map(|v| match applies("msaa-resolve", &v) {
+            true => config
+                .msaa_resolve
+                .iter()
+                .map(|&x| Variant {
+                    msaa_resolve: Some(x),
+                    ..v
+                })
+                .collect(),
             false => vec![v],
         })
         .collect();
     out = times(
         out,
-        used(&config.depth_bounds, info.depth_bounds),
+        &config.depth_bounds,
+        |v| applies("depth-bounds", v),
         |v, x| v.depth_bounds = x,
     );
     times(
         out,
-        used(&config.depth_reductions, info.depth_bounds),
+        &config.depth_reductions,
+        |v| applies("depth-reduction", v),
         |v, x| v.depth_reduction = x,
     )
+}
+
+impl Variant {
+    /// The settings the variant differs in (the others at their defaults), for the table's
+    /// applies-to rules.
+    fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            spot_cull: self.spot_cull,
+            lists: self.lists,
+            material_draws: self.material_draws,
+            msaa: self.msaa,
+            msaa_resolve: self.msaa_resolve.unwrap_or_default(),
+            depth_bounds: self.depth_bounds,
+            depth_reduction: self.depth_reduction,
+            ..RenderSettings::default()
+        }
+    }
 }
 
 /// The suffix of a scene measured without its transparent objects (`opaque_variants`).

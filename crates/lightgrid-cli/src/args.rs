@@ -5,42 +5,11 @@ use crate::files::Files;
 use anyhow::{Context, Result};
 use clap::Args;
 use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::{Axis, SettingValue, AXES};
 use lightgrid::scene::catalog::SceneParams;
 use lightgrid::scene::{AddLights, SceneRequest};
 use lightgrid::RenderSettings;
 use std::path::Path;
-
-/// `--assign` values.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub(crate) enum AssignArg {
-    /// On a software adapter (lavapipe) cpu at every light count (measured fastest there from
-    /// 1k to 1M lights); on a hardware GPU gather up to 8192 lights, bvh-gpu above.
-    Auto,
-    /// On the CPU: projected sphere rectangles, per-cell depth test; grid uploaded.
-    Cpu,
-    /// GPU: one workgroup per cell tests every light.
-    Gather,
-    /// GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell.
-    Scatter,
-    /// Light hierarchy built on the CPU each frame, walked per cell on the GPU.
-    Bvh,
-    /// Light hierarchy built on the GPU each frame (Morton codes, radix sort), walked as bvh.
-    BvhGpu,
-}
-
-impl From<AssignArg> for lightgrid::pipelines::Assign {
-    fn from(a: AssignArg) -> Self {
-        use lightgrid::pipelines::Assign;
-        match a {
-            AssignArg::Auto => Assign::Auto,
-            AssignArg::Cpu => Assign::Cpu,
-            AssignArg::Gather => Assign::Gather,
-            AssignArg::Scatter => Assign::Scatter,
-            AssignArg::Bvh => Assign::Bvh,
-            AssignArg::BvhGpu => Assign::BvhGpu,
-        }
-    }
-}
 
 /// Frame size as WIDTHxHEIGHT.
 #[derive(Clone, Copy, Debug)]
@@ -105,62 +74,6 @@ pub(crate) fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
-/// `--spot-cull` values.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub(crate) enum SpotCullArg {
-    /// The tightest sphere around each spot's cone.
-    Sphere,
-    /// The sphere, then the cone against each cell's bounding sphere (never misses a lit
-    /// sample, and tighter).
-    Cone,
-}
-
-impl From<SpotCullArg> for lightgrid::pipelines::SpotCull {
-    fn from(a: SpotCullArg) -> Self {
-        match a {
-            SpotCullArg::Sphere => Self::Sphere,
-            SpotCullArg::Cone => Self::Cone,
-        }
-    }
-}
-
-/// `--lists`: the light lists of frames with transparent geometry.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum ListsArg {
-    /// An opaque list pruned by the tile's depth bounds and a transparent list over
-    /// near..opaque max (tiled-forward-shading §4.5).
-    Separate,
-    /// One list over near..opaque max for both.
-    Shared,
-}
-
-impl From<ListsArg> for lightgrid::culling::GridLists {
-    fn from(a: ListsArg) -> Self {
-        match a {
-            ListsArg::Separate => Self::Separate,
-            ListsArg::Shared => Self::Shared,
-        }
-    }
-}
-
-/// `--material-draws`: how forward pipelines draw the material shaders.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum MaterialDrawsArg {
-    /// A pipeline per material shader, switched between runs of geometry.
-    PerMaterial,
-    /// One pipeline branching on the material, as deferred shading does.
-    Uber,
-}
-
-impl From<MaterialDrawsArg> for lightgrid::frame::MaterialDraws {
-    fn from(a: MaterialDrawsArg) -> Self {
-        match a {
-            MaterialDrawsArg::PerMaterial => Self::PerMaterial,
-            MaterialDrawsArg::Uber => Self::Uber,
-        }
-    }
-}
-
 /// `--transparency on|off`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum OnOff {
@@ -182,179 +95,134 @@ pub(crate) fn parse_non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Which of the options that only some pipelines read were given on the command line.
-#[derive(Clone, Copy, Default)]
-pub(crate) struct Given {
-    pub(crate) slices: bool,
-    pub(crate) gbuffer: bool,
-    pub(crate) assign: bool,
-    pub(crate) spot_cull: bool,
-    pub(crate) lists: bool,
-    pub(crate) material_draws: bool,
-    /// `--msaa` above 1.
-    pub(crate) msaa: bool,
-    pub(crate) msaa_resolve: bool,
-    pub(crate) depth_bounds: bool,
-    pub(crate) depth_reduction: bool,
+/// A clap value parser for any setting the library names ([`SettingValue`]): the one adapter
+/// between the library's enums and the command line (their names and one line of help each).
+pub(crate) fn setting<T: SettingValue + Send + Sync>(
+) -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values = T::VALUES
+        .iter()
+        .map(|v| PossibleValue::new(v.name()).help(v.help()));
+    PossibleValuesParser::new(values).map(|name| T::parse(&name).expect("a possible value"))
 }
 
 /// One rule for every command: an option given explicitly that applies to none of the chosen
-/// pipelines is refused rather than silently ignored.
+/// pipelines (with `settings`) is refused rather than silently ignored; which pipelines an
+/// option applies to is the library's table ([`AXES`]).
 pub(crate) fn check_applies(
-    given: Given,
+    given: &[&'static Axis],
     chosen: &[&'static lightgrid::pipelines::PipelineInfo],
+    settings: &RenderSettings,
 ) -> Result<()> {
-    use lightgrid::pipelines::{PipelineInfo, PIPELINES};
-    type Applies = fn(&PipelineInfo) -> bool;
-    let rules: [(&str, bool, Applies); 10] = [
-        ("--slices", given.slices, |p| p.clustered),
-        ("--gbuffer", given.gbuffer, |p| p.uses_gbuffer()),
-        ("--assign", given.assign, |p| p.assign),
-        ("--spot-cull", given.spot_cull, |p| p.uses_grid),
-        ("--lists", given.lists, |p| p.assign),
-        ("--material-draws", given.material_draws, |p| {
-            p.forward_shading
-        }),
-        ("--msaa", given.msaa, |p| {
-            p.msaa == lightgrid::pipelines::Msaa::Supported
-        }),
-        ("--msaa-resolve", given.msaa_resolve, |p| {
-            p.msaa == lightgrid::pipelines::Msaa::Supported && !p.forward_shading
-        }),
-        ("--depth-bounds", given.depth_bounds, |p| p.depth_bounds),
-        ("--depth-reduction", given.depth_reduction, |p| {
-            p.depth_bounds
-        }),
-    ];
-    for (flag, given, applies) in rules {
-        if given && !chosen.iter().any(|p| applies(p)) {
-            let takers: Vec<&str> = PIPELINES
-                .iter()
-                .filter(|p| applies(p))
-                .map(|p| p.id)
-                .collect();
-            // A pipeline that refuses MSAA says why.
-            let why: Vec<String> = chosen
-                .iter()
-                .filter_map(|p| match p.msaa {
-                    lightgrid::pipelines::Msaa::Refused(why) if flag == "--msaa" => {
-                        Some(format!(" ({}: {why})", p.id))
-                    }
-                    _ => None,
-                })
-                .collect();
-            let chosen: Vec<&str> = chosen.iter().map(|p| p.id).collect();
-            anyhow::bail!(
-                "{flag} does not apply to {}{}; it applies to: {}",
-                chosen.join(", "),
-                why.concat(),
-                takers.join(", ")
-            );
-        }
-    }
-    Ok(())
+    lightgrid::pipelines::check_axes_apply(given, chosen, settings).map_err(anyhow::Error::msg)
 }
 
-/// The renderer's settings as options (`render`, `compare`, `play`).
+/// The options of the library's table of settings ([`AXES`]), one value each, made from the
+/// table: a setting added there is an option here, with its values and help, and refused
+/// where it does not apply.
+#[derive(Clone, Default)]
+pub(crate) struct AxisArgs {
+    /// The options given, with their value.
+    pub(crate) given: Vec<(&'static Axis, String)>,
+}
+
+impl AxisArgs {
+    /// The table's options, for `augment_args`: one value each (`list`: a comma list).
+    pub(crate) fn options(cmd: clap::Command, list: bool) -> clap::Command {
+        use clap::builder::PossibleValue;
+        AXES.iter().fold(cmd, |cmd, axis| {
+            let default = (axis.get)(&RenderSettings::default());
+            let mut arg = clap::Arg::new(axis.column)
+                .long(axis.flag)
+                .value_name(axis.column.to_uppercase())
+                .allow_hyphen_values(true)
+                .help(format!("{} [default: {default}]", capitalized(axis.help)));
+            let values = (axis.values)();
+            arg = if values.is_empty() {
+                // A number: the table's `set` checks it.
+                arg.value_parser(move |v: &str| -> Result<String, String> {
+                    (axis.set)(&mut RenderSettings::default(), v)?;
+                    Ok(v.to_string())
+                })
+            } else {
+                arg.value_parser(clap::builder::PossibleValuesParser::new(
+                    values
+                        .iter()
+                        .map(|v| PossibleValue::new(v.name).help(v.help)),
+                ))
+            };
+            if list {
+                arg = arg.value_delimiter(',').action(clap::ArgAction::Append);
+            }
+            cmd.arg(arg)
+        })
+    }
+
+    /// The given options' values, from `matches`.
+    pub(crate) fn given_in(matches: &clap::ArgMatches) -> Vec<(&'static Axis, Vec<String>)> {
+        AXES.iter()
+            .filter_map(|axis| {
+                let values = matches.get_many::<String>(axis.column)?;
+                Some((axis, values.cloned().collect()))
+            })
+            .collect()
+    }
+
+    /// The options given.
+    pub(crate) fn axes(&self) -> Vec<&'static Axis> {
+        self.given.iter().map(|(a, _)| *a).collect()
+    }
+
+    /// `settings` with the given options set.
+    pub(crate) fn apply(&self, settings: &mut RenderSettings) -> Result<()> {
+        for (axis, value) in &self.given {
+            (axis.set)(settings, value).map_err(|e| anyhow::anyhow!("{}: {e}", axis.option()))?;
+        }
+        Ok(())
+    }
+}
+
+fn capitalized(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
+}
+
+impl clap::FromArgMatches for AxisArgs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let given = AxisArgs::given_in(matches)
+            .into_iter()
+            .map(|(axis, mut values)| (axis, values.pop().unwrap_or_default()))
+            .collect();
+        Ok(AxisArgs { given })
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+impl clap::Args for AxisArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        AxisArgs::options(cmd, false)
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+/// The renderer's settings as options (`render`, `compare`, `play`, `view`): `--tile`, and
+/// every setting of the library's table ([`AXES`]).
 #[derive(Args, Clone)]
 pub(crate) struct RendererArgs {
     /// Screen tile edge in pixels for grid pipelines (4 to 64).
     #[arg(long, allow_hyphen_values = true, default_value_t = lightgrid::consts::DEFAULT_TILE_SIZE)]
     pub(crate) tile: u32,
-    /// View-depth slices of clustered pipelines (exponential spacing, 1 to 256) [default: 32].
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) slices: Option<u32>,
-    /// Who builds the light grid of grid pipelines (not tiled_deferred_single, which culls
-    /// inside its kernel) [default: auto].
-    #[arg(long, value_enum)]
-    pub(crate) assign: Option<AssignArg>,
-    /// G-buffer channel precision in bits for deferred pipelines [default: 16].
-    #[arg(long, value_parser = parse_gbuffer)]
-    pub(crate) gbuffer: Option<GBufferFormat>,
-    /// What grid pipelines cull spot lights by [default: cone].
-    #[arg(long, value_enum)]
-    pub(crate) spot_cull: Option<SpotCullArg>,
-    /// The light lists of grid pipelines with an --assign grid, for frames with transparent
-    /// objects [default: separate].
-    #[arg(long, value_enum)]
-    pub(crate) lists: Option<ListsArg>,
-    /// How forward-shading pipelines draw the material shaders: a pipeline per shader, or
-    /// one branching übershader [default: per-material].
-    #[arg(long, value_enum)]
-    pub(crate) material_draws: Option<MaterialDrawsArg>,
-    /// MSAA samples per pixel: 1 (off) or a count the adapter supports for every target
-    /// (lavapipe: 4; real GPUs also 2 and 8); every pipeline renders with it.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
-    pub(crate) msaa: u32,
-    /// Where tiled and clustered deferred and tiled_deferred_single resolve MSAA: separate
-    /// (per-sample colours, then the tonemap) or kernel (inside the shading kernel,
-    /// tiled-deferred-tricks Trick 1; frames with transparent objects resolve separately)
-    /// [default: separate].
-    #[arg(long, value_enum)]
-    pub(crate) msaa_resolve: Option<MsaaResolveArg>,
-    /// Which cell depth bounds grids built from the depth buffer cull lights by: both, min
-    /// (far side open), max (near side open) or none (every cell spans its slice)
-    /// (tiled-forward-shading §4.4) [default: both].
-    #[arg(long, value_enum)]
-    pub(crate) depth_bounds: Option<DepthBoundsArg>,
-    /// How the cell-bounds kernel of grids built from depth reduces a tile's samples:
-    /// atomics (every sample into workgroup memory) or subgroup (registers, then one subgroup
-    /// min/max; tiled grids, adapters with subgroups; tiled-shading §8) [default: atomics].
-    #[arg(long, value_enum)]
-    pub(crate) depth_reduction: Option<DepthReductionArg>,
-}
-
-/// `--depth-reduction` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum DepthReductionArg {
-    Atomics,
-    Subgroup,
-}
-
-impl From<DepthReductionArg> for lightgrid::frame::DepthReduction {
-    fn from(a: DepthReductionArg) -> Self {
-        match a {
-            DepthReductionArg::Atomics => lightgrid::frame::DepthReduction::Atomics,
-            DepthReductionArg::Subgroup => lightgrid::frame::DepthReduction::Subgroup,
-        }
-    }
-}
-
-/// `--depth-bounds` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum DepthBoundsArg {
-    Both,
-    Min,
-    Max,
-    None,
-}
-
-impl From<DepthBoundsArg> for lightgrid::frame::DepthBounds {
-    fn from(a: DepthBoundsArg) -> Self {
-        use lightgrid::frame::DepthBounds as D;
-        match a {
-            DepthBoundsArg::Both => D::Both,
-            DepthBoundsArg::Min => D::Min,
-            DepthBoundsArg::Max => D::Max,
-            DepthBoundsArg::None => D::None,
-        }
-    }
-}
-
-/// `--msaa-resolve` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum MsaaResolveArg {
-    Separate,
-    Kernel,
-}
-
-impl From<MsaaResolveArg> for lightgrid::frame::MsaaResolve {
-    fn from(a: MsaaResolveArg) -> Self {
-        match a {
-            MsaaResolveArg::Separate => lightgrid::frame::MsaaResolve::Separate,
-            MsaaResolveArg::Kernel => lightgrid::frame::MsaaResolve::Kernel,
-        }
-    }
+    #[command(flatten)]
+    pub(crate) axes: AxisArgs,
 }
 
 /// `--msaa-resolve` only means something with MSAA.
@@ -370,40 +238,20 @@ pub(crate) fn check_msaa_resolve(resolve_given: bool, msaa: &[u32]) -> Result<()
 impl RendererArgs {
     /// The renderer settings, validated (the message gives each option's range).
     pub(crate) fn settings(&self) -> Result<RenderSettings> {
-        let settings = RenderSettings {
+        let mut settings = RenderSettings {
             tile_size: self.tile,
-            gbuffer: self.gbuffer.unwrap_or_default(),
-            slices: self.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
-            assign: self.assign.unwrap_or(AssignArg::Auto).into(),
-            spot_cull: self.spot_cull.map(Into::into).unwrap_or_default(),
-            lists: self
-                .lists
-                .map_or(RenderSettings::default().lists, Into::into),
-            material_draws: self.material_draws.map(Into::into).unwrap_or_default(),
-            msaa: self.msaa,
-            msaa_resolve: self.msaa_resolve.map(Into::into).unwrap_or_default(),
-            depth_bounds: self.depth_bounds.map(Into::into).unwrap_or_default(),
-            depth_reduction: self.depth_reduction.map(Into::into).unwrap_or_default(),
+            ..RenderSettings::default()
         };
-        check_msaa_resolve(self.msaa_resolve.is_some(), &[self.msaa])?;
+        self.axes.apply(&mut settings)?;
+        let resolve_given = self.axes.axes().iter().any(|a| a.flag == "msaa-resolve");
+        check_msaa_resolve(resolve_given, &[settings.msaa])?;
         settings.validate()?;
         Ok(settings)
     }
 
-    /// Which options were given, for [`check_applies`].
-    pub(crate) fn given(&self) -> Given {
-        Given {
-            slices: self.slices.is_some(),
-            gbuffer: self.gbuffer.is_some(),
-            assign: self.assign.is_some(),
-            spot_cull: self.spot_cull.is_some(),
-            lists: self.lists.is_some(),
-            material_draws: self.material_draws.is_some(),
-            msaa: self.msaa > 1,
-            msaa_resolve: self.msaa_resolve.is_some(),
-            depth_bounds: self.depth_bounds.is_some(),
-            depth_reduction: self.depth_reduction.is_some(),
-        }
+    /// The options given that only some pipelines read, for [`check_applies`].
+    pub(crate) fn given(&self) -> Vec<&'static Axis> {
+        self.axes.axes()
     }
 }
 

@@ -2,14 +2,15 @@
 
 use crate::args::{
     check_applies, format_duration, parse_fraction, parse_gbuffer, parse_size, progress_bar,
-    run_outcome, stop_on_ctrl_c, AssignArg, Given, ListsArg, MaterialDrawsArg, OnOff, Size,
-    SpotCullArg, MAX_COUNT,
+    run_outcome, setting, stop_on_ctrl_c, OnOff, Size, MAX_COUNT,
 };
 use anyhow::Result;
 use clap::Args;
+use lightgrid::frame::{DepthBounds, DepthReduction, GridLists, MaterialDraws, MsaaResolve};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::PIPELINES;
+use lightgrid::pipelines::{find_axis, Assign, Axis, SpotCull};
 use lightgrid_bench::{check_out_dir, BenchConfig, FrameRange, OutDir};
 use std::path::PathBuf;
 
@@ -80,8 +81,8 @@ pub(crate) struct BenchArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) slices: Option<u32>,
     /// Who builds the light grid of grid pipelines [default: auto].
-    #[arg(long, value_enum)]
-    pub(crate) assign: Option<AssignArg>,
+    #[arg(long, value_parser = setting::<Assign>())]
+    pub(crate) assign: Option<Assign>,
     /// MSAA sample counts to measure: 1, 4 or a list (1,4); the adapter's supported counts
     /// only (lavapipe: 1 and 4). Pipelines that refuse MSAA are measured at 1 only
     /// [default: 1].
@@ -89,16 +90,16 @@ pub(crate) struct BenchArgs {
     pub(crate) msaa: Vec<u32>,
     /// Which cell depth bounds grids built from depth cull by: both, min, max, none or a
     /// list (both,min,max,none) [default: both; the depth-bounds preset: all four].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub(crate) depth_bounds: Vec<crate::args::DepthBoundsArg>,
+    #[arg(long, value_parser = setting::<DepthBounds>(), value_delimiter = ',')]
+    pub(crate) depth_bounds: Vec<DepthBounds>,
     /// How the cell-bounds kernel reduces depths: atomics, subgroup or atomics,subgroup to
     /// measure both (subgroup: adapters with subgroups) [default: atomics].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub(crate) depth_reduction: Vec<crate::args::DepthReductionArg>,
+    #[arg(long, value_parser = setting::<DepthReduction>(), value_delimiter = ',')]
+    pub(crate) depth_reduction: Vec<DepthReduction>,
     /// Where tiled and clustered deferred resolve MSAA: separate, kernel, or separate,kernel
     /// to measure both [default: separate; the msaa preset: both].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub(crate) msaa_resolve: Vec<crate::args::MsaaResolveArg>,
+    #[arg(long, value_parser = setting::<MsaaResolve>(), value_delimiter = ',')]
+    pub(crate) msaa_resolve: Vec<MsaaResolve>,
     /// Scatter N point lights over every scene's bounds (catalog scenes and glTF files).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) add_lights: Option<u32>,
@@ -127,8 +128,8 @@ pub(crate) struct BenchArgs {
     pub(crate) headlights: bool,
     /// What grid pipelines cull spot lights by: sphere, cone, or sphere,cone to measure both
     /// [default: cone].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub(crate) spot_cull: Vec<SpotCullArg>,
+    #[arg(long, value_parser = setting::<SpotCull>(), value_delimiter = ',')]
+    pub(crate) spot_cull: Vec<SpotCull>,
     /// The scenes' transparent objects (robots and random scenes): on, off, or on,off to
     /// also measure each scene with glass without it (as `<scene>-opaque`) [default: on].
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -138,12 +139,12 @@ pub(crate) struct BenchArgs {
     pub(crate) material_shaders: Option<OnOff>,
     /// The light lists of grid pipelines for frames with transparent objects: separate,
     /// shared, or separate,shared to measure both [default: separate].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub(crate) lists: Vec<ListsArg>,
+    #[arg(long, value_parser = setting::<GridLists>(), value_delimiter = ',')]
+    pub(crate) lists: Vec<GridLists>,
     /// How forward-shading pipelines draw the material shaders: per-material, uber, or
     /// per-material,uber to measure both [default: per-material].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub(crate) material_draws: Vec<MaterialDrawsArg>,
+    #[arg(long, value_parser = setting::<MaterialDraws>(), value_delimiter = ',')]
+    pub(crate) material_draws: Vec<MaterialDraws>,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
@@ -394,7 +395,7 @@ pub(crate) fn bench_config(
             .or(d.tile)
             .unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
         slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
-        assign: a.assign.unwrap_or(AssignArg::Auto).into(),
+        assign: a.assign.unwrap_or_default(),
         gbuffers: if a.gbuffer.is_empty() {
             gbuffers
         } else {
@@ -416,7 +417,7 @@ pub(crate) fn bench_config(
         spot_culls: if a.spot_cull.is_empty() {
             d.spot_culls.clone()
         } else {
-            a.spot_cull.iter().map(|&c| c.into()).collect()
+            a.spot_cull.clone()
         },
         transparency: if a.transparency.is_empty() {
             d.transparency
@@ -429,12 +430,12 @@ pub(crate) fn bench_config(
         lists: if a.lists.is_empty() {
             d.lists.clone()
         } else {
-            a.lists.iter().map(|&l| l.into()).collect()
+            a.lists.clone()
         },
         material_draws: if a.material_draws.is_empty() {
             vec![Default::default()]
         } else {
-            a.material_draws.iter().map(|&m| m.into()).collect()
+            a.material_draws.clone()
         },
         msaa: if a.msaa.is_empty() {
             d.msaa.clone()
@@ -444,18 +445,18 @@ pub(crate) fn bench_config(
         msaa_resolve: if a.msaa_resolve.is_empty() {
             d.msaa_resolve.clone()
         } else {
-            a.msaa_resolve.iter().map(|&m| m.into()).collect()
+            a.msaa_resolve.clone()
         },
         add_lights: crate::args::added_lights(a.add_lights, a.light_range)?,
         depth_bounds: if a.depth_bounds.is_empty() {
             d.depth_bounds.clone()
         } else {
-            a.depth_bounds.iter().map(|&b| b.into()).collect()
+            a.depth_bounds.clone()
         },
         depth_reductions: if a.depth_reduction.is_empty() {
             vec![Default::default()]
         } else {
-            a.depth_reduction.iter().map(|&r| r.into()).collect()
+            a.depth_reduction.clone()
         },
     };
     crate::args::check_msaa_resolve(!a.msaa_resolve.is_empty(), &config.msaa)?;
@@ -465,19 +466,29 @@ pub(crate) fn bench_config(
         .iter()
         .map(|p| lightgrid::pipelines::find(p))
         .collect::<Result<_, _>>()?;
-    let given = Given {
-        slices: a.slices.is_some(),
-        gbuffer: !a.gbuffer.is_empty(),
-        assign: a.assign.is_some(),
-        spot_cull: !a.spot_cull.is_empty(),
-        lists: !a.lists.is_empty(),
-        material_draws: !a.material_draws.is_empty(),
-        msaa: a.msaa.iter().any(|&n| n > 1),
-        msaa_resolve: !a.msaa_resolve.is_empty(),
-        depth_bounds: !a.depth_bounds.is_empty(),
-        depth_reduction: !a.depth_reduction.is_empty(),
+    // The options given (by their flags in the library's table of settings).
+    let given: Vec<&'static Axis> = [
+        ("slices", a.slices.is_some()),
+        ("gbuffer", !a.gbuffer.is_empty()),
+        ("assign", a.assign.is_some()),
+        ("spot-cull", !a.spot_cull.is_empty()),
+        ("lists", !a.lists.is_empty()),
+        ("material-draws", !a.material_draws.is_empty()),
+        ("msaa", !a.msaa.is_empty()),
+        ("msaa-resolve", !a.msaa_resolve.is_empty()),
+        ("depth-bounds", !a.depth_bounds.is_empty()),
+        ("depth-reduction", !a.depth_reduction.is_empty()),
+    ]
+    .into_iter()
+    .filter(|&(_, given)| given)
+    .map(|(flag, _)| find_axis(flag).expect("a flag of the table"))
+    .collect();
+    // The MSAA-dependent options apply at the largest sample count measured.
+    let settings = lightgrid::RenderSettings {
+        msaa: config.msaa.iter().copied().max().unwrap_or(1),
+        ..Default::default()
     };
-    check_applies(given, &chosen)?;
+    check_applies(&given, &chosen, &settings)?;
     Ok(config)
 }
 

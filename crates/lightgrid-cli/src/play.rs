@@ -82,8 +82,8 @@ struct PlayJson<'a> {
 
 pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
-    check_applies(a.renderer.given(), &[info])?;
     let settings = a.renderer.settings()?;
+    check_applies(&a.renderer.given(), &[info], &settings)?;
     let mut files = Files::default();
     files.output("--json", a.json.as_deref(), Kind::Data)?;
     a.scene.claim(&mut files)?;

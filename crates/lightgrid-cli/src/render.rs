@@ -42,8 +42,8 @@ pub(crate) struct RenderArgs {
 
 pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
-    check_applies(a.scene.renderer.given(), &[info])?;
     let settings = a.scene.renderer.settings()?;
+    check_applies(&a.scene.renderer.given(), &[info], &settings)?;
     let mut files = Files::default();
     files.output("--out", a.out.as_deref(), Kind::Png)?;
     files.output("--stats", a.stats.as_deref(), Kind::Data)?;

@@ -2,11 +2,12 @@
 
 use crate::args::{
     check_applies, format_duration, parse_non_negative, parse_size, progress_bar, run_outcome,
-    stop_on_ctrl_c, AssignArg, Given, Size, MAX_COUNT,
+    setting, stop_on_ctrl_c, Size, MAX_COUNT,
 };
 use anyhow::Result;
 use clap::Args;
 use lightgrid::gpu::GpuContext;
+use lightgrid::pipelines::{find_axis, Assign};
 use lightgrid_bench::{check_out_dir, OutDir};
 use std::path::PathBuf;
 
@@ -22,11 +23,11 @@ pub(crate) struct ScalingArgs {
     /// Strategies to measure.
     #[arg(
         long,
-        value_enum,
+        value_parser = setting::<Assign>(),
         value_delimiter = ',',
         default_value = "cpu,gather,scatter,bvh,bvh-gpu"
     )]
-    pub(crate) assign: Vec<AssignArg>,
+    pub(crate) assign: Vec<Assign>,
     /// Grid pipeline to render with.
     #[arg(long, default_value = "clustered_deferred")]
     pub(crate) pipeline: String,
@@ -70,16 +71,17 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     // below, after the options (which a user fixes first) and before anything is rendered.
     check_out_dir(&a.out, true)?;
     let info = lightgrid::pipelines::find(&a.pipeline)?;
-    let given = Given {
-        slices: a.slices.is_some(),
-        ..Given::default()
-    };
-    check_applies(given, &[info])?;
+    let given: Vec<_> = a
+        .slices
+        .iter()
+        .filter_map(|_| find_axis("slices"))
+        .collect();
+    check_applies(&given, &[info], &Default::default())?;
     let config = lightgrid_bench::ScalingConfig {
         scene: a.scene.clone(),
         pipeline: a.pipeline.clone(),
         lights: a.lights.clone(),
-        strategies: a.assign.iter().map(|&s| s.into()).collect(),
+        strategies: a.assign.clone(),
         size: (a.size.0, a.size.1),
         tile_size: a.tile,
         slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),

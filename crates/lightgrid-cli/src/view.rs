@@ -77,8 +77,8 @@ fn checked_script(text: &str, files: &mut Files) -> Result<Vec<Step>> {
 
 pub(crate) fn view(adapter: Option<&str>, a: &ViewArgs) -> Result<()> {
     let info = pipelines::find(&a.pipeline)?;
-    check_applies(a.renderer.given(), &[info])?;
     let settings = a.renderer.settings()?;
+    check_applies(&a.renderer.given(), &[info], &settings)?;
     let mut files = Files::default();
     files.output("--screenshot", a.screenshot.as_deref(), Kind::Png)?;
     let script = match &a.script {

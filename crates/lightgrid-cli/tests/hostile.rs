@@ -1208,3 +1208,75 @@ fn report_checks_its_input_before_writing() {
     assert_eq!(snapshot(&dir), before, "summary.md and the rest untouched");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Driven by the library's table of settings (`lightgrid::pipelines::AXES`): every option is
+/// accepted (and renders) with a pipeline it applies to, refused with one it does not apply
+/// to (naming who it applies to), and listed in `--help` with its values. An option added to
+/// the table is checked here without a line of this test changing.
+#[test]
+fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_where_it_does() {
+    use lightgrid::pipelines::{RenderSettings, AXES, PIPELINES};
+    let help = String::from_utf8_lossy(&lightgrid(&["render", "--help"]).stdout).into_owned();
+    let dir = temp_dir("axes");
+    for axis in AXES {
+        assert!(
+            help.contains(&axis.option()),
+            "render --help lacks {}",
+            axis.option()
+        );
+        for v in (axis.values)() {
+            assert!(
+                help.contains(v.name),
+                "render --help lacks {} {}",
+                axis.option(),
+                v.name
+            );
+        }
+        // A value other than the default where there is one (the default for numbers: 4
+        // samples for --msaa, 8 slices); --msaa-resolve applies only with MSAA.
+        let value = match (axis.values)().get(1) {
+            Some(v) => v.name.to_string(),
+            None if axis.flag == "msaa" => "4".into(),
+            None => "8".into(),
+        };
+        let mut settings = RenderSettings::default();
+        (axis.set)(&mut settings, &value).unwrap();
+        let msaa = if axis.flag == "msaa-resolve" {
+            "4"
+        } else {
+            "1"
+        };
+        settings.msaa = msaa.parse().unwrap();
+        let taker = PIPELINES.iter().find(|p| (axis.applies)(p, &settings));
+        let other = PIPELINES.iter().find(|p| !(axis.applies)(p, &settings));
+        let taker = taker.unwrap_or_else(|| panic!("{} applies to no pipeline", axis.flag));
+        let out = dir.join(format!("{}.png", axis.flag));
+        let mut args = render(&["--pipeline", taker.id, "--msaa", msaa]);
+        if axis.flag != "msaa" {
+            args.extend([axis.option(), value.clone()]);
+        } else {
+            let i = args.iter().position(|a| a == "--msaa").unwrap();
+            args[i + 1] = value.clone();
+        }
+        args.extend(["--out".into(), s(&out).into()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = lightgrid(&args);
+        assert!(o.status.success(), "{args:?} refused: {}", stderr(&o));
+        assert!(out.exists(), "{args:?} wrote no image");
+        // Every pipeline takes MSAA: nothing to refuse.
+        if let Some(other) = other {
+            let needle = format!("{} does not apply to {}", axis.option(), other.id);
+            let mut args = render(&["--pipeline", other.id, "--msaa", msaa]);
+            args.extend([axis.option(), value.clone()]);
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            assert_fails_with(&args, &needle);
+            let o = lightgrid(&args);
+            assert!(
+                stderr(&o).contains(taker.id),
+                "{args:?}: the refusal names no taker"
+            );
+        } else {
+            assert_eq!(axis.flag, "msaa", "only --msaa applies to every pipeline");
+        }
+    }
+}

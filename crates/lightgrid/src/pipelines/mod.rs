@@ -1,6 +1,7 @@
 //! The pipeline registry: one module per pipeline id, one row in [`PIPELINES`]. The CLI, the
 //! default job and the tests iterate this table; adding a pipeline touches nothing else.
 
+mod axes;
 mod deferred;
 mod forward;
 mod light_prepass;
@@ -17,6 +18,7 @@ use crate::shader::ComposedShader;
 pub use crate::culling::Assign;
 use crate::frame::GBufferFormat;
 pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings, SpotCull};
+pub use axes::{check_axes_apply, find_axis, Axis, AxisValue, SettingValue, AXES};
 pub use transparent::{TransparentLights, TransparentPass};
 
 /// What a pipeline needs to create its GPU objects.
@@ -110,6 +112,9 @@ pub struct PipelineInfo {
     pub reference: &'static str,
     /// With MSAA: supported, or refused and why.
     pub msaa: Msaa,
+    /// Its MSAA shading kernel can resolve the samples itself (`--msaa-resolve kernel`,
+    /// tiled-deferred-tricks Trick 1): tiled and clustered deferred and the single kernel.
+    pub kernel_resolve: bool,
     /// Every composed shader the pipeline creates (validated by the tests without a GPU).
     pub shaders: fn() -> Vec<ComposedShader>,
     pub create: fn(&PipelineContext) -> Box<dyn Technique>,
@@ -148,6 +153,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: forward::shaders,
         create: forward::create,
         memory: forward::memory,
@@ -163,6 +169,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward_mono",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: forward::shaders,
         create: forward::create_mono,
         memory: forward::memory,
@@ -178,6 +185,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward_mono_albedo",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: forward::shaders,
         create: forward::create_mono_albedo,
         memory: forward::memory,
@@ -193,6 +201,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_plain,
         memory: tiled_forward::memory_plain,
@@ -208,6 +217,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_prez,
         memory: tiled_forward::memory_prez,
@@ -223,6 +233,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: true,
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_multi,
         memory: tiled_deferred::memory_multi,
@@ -238,6 +249,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: true,
         shaders: tiled_deferred::shaders_single,
         create: tiled_deferred::create_single,
         memory: tiled_deferred::memory_single,
@@ -253,6 +265,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: tiled_forward::shaders,
         create: tiled_forward::create_clustered,
         memory: tiled_forward::memory_clustered,
@@ -268,6 +281,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: true,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: true,
         shaders: tiled_deferred::shaders,
         create: tiled_deferred::create_clustered,
         memory: tiled_deferred::memory_clustered,
@@ -283,6 +297,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: deferred::shaders,
         create: deferred::create_plain,
         memory: deferred::memory,
@@ -298,6 +313,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: deferred::shaders,
         create: deferred::create_stencil,
         memory: deferred::memory,
@@ -313,6 +329,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward_mono_albedo",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: deferred::shaders_mono,
         create: deferred::create_mono,
         memory: deferred::memory_mono,
@@ -328,6 +345,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: light_prepass::shaders,
         create: light_prepass::create_full,
         memory: light_prepass::memory_full,
@@ -343,6 +361,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: false,
         reference: "forward_mono",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: light_prepass::shaders,
         create: light_prepass::create_mono,
         memory: light_prepass::memory_mono,
@@ -358,6 +377,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         depth_bounds: true,
         reference: "forward_mono",
         msaa: Msaa::Supported,
+        kernel_resolve: false,
         shaders: light_prepass::shaders_tiled,
         create: light_prepass::create_tiled,
         memory: light_prepass::memory_tiled,

@@ -1,0 +1,464 @@
+//! The render settings that only some pipelines read, one row each ([`AXES`]): the option,
+//! its values, which pipelines it applies to (from their capabilities in [`PIPELINES`]), and
+//! how to read and set it on a [`RenderSettings`]. Every place that asks "does this option
+//! apply" asks the row: the CLI's refusal of an option given for pipelines that ignore it and
+//! its `--help`, and the benchmark's product of variants (a setting that changes nothing for
+//! a pipeline is measured once).
+//!
+//! [`PIPELINES`]: super::PIPELINES
+
+use super::PipelineInfo;
+use crate::frame::{
+    Assign, DepthBounds, DepthReduction, GBufferFormat, GridLists, MaterialDraws, MsaaResolve,
+    RenderSettings, SpotCull,
+};
+
+/// A setting's values by name (the option's values, the results' columns).
+pub trait SettingValue: Copy + PartialEq + Sized + 'static {
+    /// Every value the option accepts, the default first.
+    const VALUES: &'static [Self];
+    fn name(self) -> &'static str;
+    /// One line for `--help`.
+    fn help(self) -> &'static str;
+
+    /// The value called `name`, or the accepted names.
+    fn parse(name: &str) -> Result<Self, String> {
+        Self::VALUES
+            .iter()
+            .copied()
+            .find(|v| v.name() == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::VALUES.iter().map(|v| v.name()).collect();
+                format!("'{name}' is not one of {}", names.join(", "))
+            })
+    }
+}
+
+impl SettingValue for Assign {
+    const VALUES: &'static [Self] = &[
+        Assign::Auto,
+        Assign::Cpu,
+        Assign::Gather,
+        Assign::Scatter,
+        Assign::Bvh,
+        Assign::BvhGpu,
+    ];
+    fn name(self) -> &'static str {
+        Assign::name(self)
+    }
+    fn help(self) -> &'static str {
+        self.description()
+    }
+}
+
+impl SettingValue for SpotCull {
+    const VALUES: &'static [Self] = &[SpotCull::Cone, SpotCull::Sphere];
+    fn name(self) -> &'static str {
+        match self {
+            SpotCull::Sphere => "sphere",
+            SpotCull::Cone => "cone",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            SpotCull::Sphere => "the tightest sphere around each spot's cone",
+            SpotCull::Cone => "the sphere, then the cone against each cell's bounding sphere (never misses a lit sample, and tighter)",
+        }
+    }
+}
+
+impl SettingValue for GridLists {
+    // `Opaque` is what a frame without transparent objects builds, not an option.
+    const VALUES: &'static [Self] = &[GridLists::Separate, GridLists::Shared];
+    fn name(self) -> &'static str {
+        GridLists::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            GridLists::Separate => "an opaque list pruned by the cell's depth bounds and a transparent list over near..opaque max (tiled-forward-shading §4.5)",
+            GridLists::Shared => "one list over near..opaque max for both",
+            GridLists::Opaque => "opaque lists only (frames without transparent objects)",
+        }
+    }
+}
+
+impl SettingValue for MaterialDraws {
+    const VALUES: &'static [Self] = &[MaterialDraws::PerMaterial, MaterialDraws::Uber];
+    fn name(self) -> &'static str {
+        MaterialDraws::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            MaterialDraws::PerMaterial => {
+                "a pipeline per material shader, switched between runs of geometry"
+            }
+            MaterialDraws::Uber => {
+                "one pipeline branching on the material, as deferred shading does"
+            }
+        }
+    }
+}
+
+impl SettingValue for MsaaResolve {
+    const VALUES: &'static [Self] = &[MsaaResolve::Separate, MsaaResolve::Kernel];
+    fn name(self) -> &'static str {
+        MsaaResolve::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            MsaaResolve::Separate => "per-sample colours, then the tonemap",
+            MsaaResolve::Kernel => "inside the shading kernel (tiled-deferred-tricks Trick 1; frames with transparent objects resolve separately)",
+        }
+    }
+}
+
+impl SettingValue for DepthBounds {
+    const VALUES: &'static [Self] = &DepthBounds::ALL;
+    fn name(self) -> &'static str {
+        DepthBounds::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            DepthBounds::Both => "the cell's samples' [min, max]",
+            DepthBounds::Min => "far side open: [min, slice far]",
+            DepthBounds::Max => "near side open: [slice near, max]",
+            DepthBounds::None => "every cell spans its slice",
+        }
+    }
+}
+
+impl SettingValue for DepthReduction {
+    const VALUES: &'static [Self] = &DepthReduction::ALL;
+    fn name(self) -> &'static str {
+        DepthReduction::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            DepthReduction::Atomics => "every sample into workgroup memory with atomics",
+            DepthReduction::Subgroup => {
+                "registers, then one subgroup min/max (adapters with subgroups; tiled-shading §8)"
+            }
+        }
+    }
+}
+
+impl SettingValue for GBufferFormat {
+    const VALUES: &'static [Self] = &[GBufferFormat::F16, GBufferFormat::F32];
+    fn name(self) -> &'static str {
+        match self {
+            GBufferFormat::F16 => "16",
+            GBufferFormat::F32 => "32",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            GBufferFormat::F16 => "16-bit float channels",
+            GBufferFormat::F32 => "32-bit float channels",
+        }
+    }
+}
+
+/// A named value of an axis, for `--help`.
+#[derive(Clone, Copy, Debug)]
+pub struct AxisValue {
+    pub name: &'static str,
+    pub help: &'static str,
+}
+
+/// One setting that only some pipelines read.
+pub struct Axis {
+    /// The option, without its dashes (`spot-cull`).
+    pub flag: &'static str,
+    /// The results column and key (`spot_cull`).
+    pub column: &'static str,
+    /// What the option sets (`--help`), and which pipelines read it.
+    pub help: &'static str,
+    /// Every value by name, the default first; empty for a number ([`Axis::set`] checks it).
+    pub values: fn() -> Vec<AxisValue>,
+    /// Does `pipeline`, rendering with `settings`, read this setting?
+    pub applies: fn(&PipelineInfo, &RenderSettings) -> bool,
+    /// The setting's value in `settings`, by name.
+    pub get: fn(&RenderSettings) -> String,
+    /// Set the value called `value` (an error names the accepted values).
+    pub set: fn(&mut RenderSettings, &str) -> Result<(), String>,
+}
+
+impl Axis {
+    /// `--flag`.
+    pub fn option(&self) -> String {
+        format!("--{}", self.flag)
+    }
+
+    /// The pipelines this applies to with `settings`, by id.
+    pub fn takers(&self, settings: &RenderSettings) -> Vec<&'static str> {
+        super::PIPELINES
+            .iter()
+            .filter(|p| (self.applies)(p, settings))
+            .map(|p| p.id)
+            .collect()
+    }
+}
+
+fn values<T: SettingValue>() -> Vec<AxisValue> {
+    T::VALUES
+        .iter()
+        .map(|v| AxisValue {
+            name: v.name(),
+            help: v.help(),
+        })
+        .collect()
+}
+
+fn number(value: &str) -> Result<u32, String> {
+    value
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{value}' is not a whole number"))
+}
+
+/// The tiled grids whose cell bounds the depth buffer gives: the cell-bounds kernel reduces
+/// a tiled grid's samples in subgroups; a clustered grid's samples go to different slices,
+/// so its cells reduce with atomics either way (`cell_bounds.wgsl`: `SUBGROUP_REDUCTION &&
+/// grid.slices == 1u`).
+fn reduces_tile_depth(p: &PipelineInfo) -> bool {
+    p.depth_bounds && !p.clustered
+}
+
+/// The table: every setting only some pipelines read.
+pub const AXES: &[Axis] = &[
+    Axis {
+        flag: "slices",
+        column: "slices",
+        help: "view-depth slices of clustered pipelines (exponential spacing, 1 to 256)",
+        values: Vec::new,
+        applies: |p, _| p.clustered,
+        get: |s| s.slices.to_string(),
+        set: |s, v| {
+            s.slices = number(v)?;
+            crate::frame::validate_slices(s.slices).map_err(|e| e.to_string())
+        },
+    },
+    Axis {
+        flag: "gbuffer",
+        column: "gbuffer",
+        help: "G-buffer channel precision in bits of deferred pipelines",
+        values: values::<GBufferFormat>,
+        applies: |p, _| p.uses_gbuffer(),
+        get: |s| s.gbuffer.name().to_string(),
+        set: |s, v| {
+            s.gbuffer = GBufferFormat::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "assign",
+        column: "assign",
+        help: "who builds the light grid of grid pipelines (not tiled_deferred_single, which culls inside its kernel)",
+        values: values::<Assign>,
+        applies: |p, _| p.assign,
+        get: |s| s.assign.name().to_string(),
+        set: |s, v| {
+            s.assign = Assign::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "spot-cull",
+        column: "spot_cull",
+        help: "what grid pipelines cull spot lights by",
+        values: values::<SpotCull>,
+        applies: |p, _| p.uses_grid,
+        get: |s| s.spot_cull.name().to_string(),
+        set: |s, v| {
+            s.spot_cull = SpotCull::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "lists",
+        column: "lists",
+        help: "the light lists of grid pipelines with an --assign grid, for frames with transparent objects",
+        values: values::<GridLists>,
+        applies: |p, _| p.assign,
+        get: |s| SettingValue::name(s.lists).to_string(),
+        set: |s, v| {
+            s.lists = GridLists::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "material-draws",
+        column: "material_draws",
+        help: "how forward-shading pipelines draw the material shaders",
+        values: values::<MaterialDraws>,
+        applies: |p, _| p.forward_shading,
+        get: |s| s.material_draws.name().to_string(),
+        set: |s, v| {
+            s.material_draws = MaterialDraws::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "msaa",
+        column: "msaa",
+        help: "MSAA samples per pixel: 1 (off) or a count the adapter supports for every target (lavapipe: 4; real GPUs also 2 and 8)",
+        values: Vec::new,
+        applies: |p, _| p.msaa == super::Msaa::Supported,
+        get: |s| s.msaa.to_string(),
+        set: |s, v| {
+            s.msaa = number(v)?;
+            crate::frame::validate_msaa(s.msaa).map_err(|e| e.to_string())
+        },
+    },
+    Axis {
+        flag: "msaa-resolve",
+        column: "msaa_resolve",
+        help: "where tiled and clustered deferred and tiled_deferred_single resolve MSAA (with --msaa above 1)",
+        values: values::<MsaaResolve>,
+        applies: |p, s| p.kernel_resolve && s.msaa > 1,
+        get: |s| s.msaa_resolve.name().to_string(),
+        set: |s, v| {
+            s.msaa_resolve = MsaaResolve::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "depth-bounds",
+        column: "depth_bounds",
+        help: "which cell depth bounds grids built from the depth buffer cull lights by (tiled-forward-shading §4.4)",
+        values: values::<DepthBounds>,
+        applies: |p, _| p.depth_bounds,
+        get: |s| s.depth_bounds.name().to_string(),
+        set: |s, v| {
+            s.depth_bounds = DepthBounds::parse(v)?;
+            Ok(())
+        },
+    },
+    Axis {
+        flag: "depth-reduction",
+        column: "depth_reduction",
+        help: "how the cell-bounds kernel of tiled grids built from depth reduces a tile's samples (clustered grids always use atomics)",
+        values: values::<DepthReduction>,
+        applies: |p, _| reduces_tile_depth(p),
+        get: |s| s.depth_reduction.name().to_string(),
+        set: |s, v| {
+            s.depth_reduction = DepthReduction::parse(v)?;
+            Ok(())
+        },
+    },
+];
+
+/// The row of `--flag` (without dashes).
+pub fn find_axis(flag: &str) -> Option<&'static Axis> {
+    AXES.iter().find(|a| a.flag == flag)
+}
+
+/// The first option given (by flag) that applies to none of `chosen` with `settings`, as an
+/// error naming who it applies to.
+pub fn check_axes_apply(
+    given: &[&'static Axis],
+    chosen: &[&'static PipelineInfo],
+    settings: &RenderSettings,
+) -> Result<(), String> {
+    for axis in given {
+        if chosen.iter().any(|p| (axis.applies)(p, settings)) {
+            continue;
+        }
+        let ids: Vec<&str> = chosen.iter().map(|p| p.id).collect();
+        let takers = axis.takers(settings);
+        let takers = if takers.is_empty() {
+            // Only `--msaa-resolve` depends on another setting.
+            let with_msaa = RenderSettings {
+                msaa: 4,
+                ..*settings
+            };
+            format!(
+                "none at --msaa {} (with MSAA: {})",
+                settings.msaa,
+                axis.takers(&with_msaa).join(", ")
+            )
+        } else {
+            takers.join(", ")
+        };
+        return Err(format!(
+            "{} does not apply to {}; it applies to: {takers}",
+            axis.option(),
+            ids.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipelines::PIPELINES;
+
+    /// Every named value round-trips; the default settings hold each axis's first value.
+    #[test]
+    fn every_value_sets_and_reads_back() {
+        for axis in AXES {
+            let all = (axis.values)();
+            for v in &all {
+                let mut s = RenderSettings::default();
+                (axis.set)(&mut s, v.name).unwrap();
+                assert_eq!((axis.get)(&s), v.name, "{}", axis.flag);
+            }
+            if let Some(first) = all.first() {
+                assert_eq!(
+                    (axis.get)(&RenderSettings::default()),
+                    first.name,
+                    "{}",
+                    axis.flag
+                );
+            }
+            let mut s = RenderSettings::default();
+            assert!(
+                (axis.set)(&mut s, "no-such-value").is_err(),
+                "{}",
+                axis.flag
+            );
+        }
+    }
+
+    #[test]
+    fn flags_and_columns_are_unique() {
+        for (i, a) in AXES.iter().enumerate() {
+            for b in &AXES[i + 1..] {
+                assert_ne!(a.flag, b.flag);
+                assert_ne!(a.column, b.column);
+            }
+        }
+    }
+
+    /// The two rules the old hand-written checks had wrong: the subgroup depth reduction is
+    /// a tiled grid's, and only the deferred kernels resolve MSAA.
+    #[test]
+    fn depth_reduction_and_msaa_resolve_apply_exactly_where_read() {
+        let find = |id| PIPELINES.iter().find(|p| p.id == id).unwrap();
+        let reduction = find_axis("depth-reduction").unwrap();
+        let s = RenderSettings::default();
+        assert!((reduction.applies)(find("tiled_deferred"), &s));
+        assert!((reduction.applies)(find("tiled_forward_prez"), &s));
+        assert!(!(reduction.applies)(find("clustered_forward"), &s));
+        assert!(!(reduction.applies)(find("clustered_deferred"), &s));
+        let resolve = find_axis("msaa-resolve").unwrap();
+        let msaa = RenderSettings { msaa: 4, ..s };
+        let takers = resolve.takers(&msaa);
+        assert_eq!(
+            takers,
+            [
+                "tiled_deferred",
+                "tiled_deferred_single",
+                "clustered_deferred"
+            ]
+        );
+        assert!(resolve.takers(&s).is_empty(), "no resolve without MSAA");
+        let e = check_axes_apply(&[reduction], &[find("clustered_forward")], &s).unwrap_err();
+        assert!(
+            e.contains("--depth-reduction does not apply to clustered_forward"),
+            "{e}"
+        );
+        assert!(e.contains("tiled_deferred"), "{e}");
+    }
+}
