@@ -134,7 +134,6 @@ impl AxisArgs {
             let default = (axis.get)(&RenderSettings::default());
             let mut arg = clap::Arg::new(axis.column)
                 .long(axis.flag)
-                .value_name(axis.column.to_uppercase())
                 .allow_hyphen_values(true)
                 .help(format!("{} [default: {default}]", capitalized(axis.help)));
             let values = (axis.values)();
