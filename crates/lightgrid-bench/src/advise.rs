@@ -549,33 +549,43 @@ mod tests {
 
     #[test]
     fn ranking_puts_the_fastest_correct_frames_first() {
-        let mut wrong = measured("tiled_forward", Some(16), 1.0, 10);
+        let mut wrong = measured(lightgrid::pipelines::ids::TILED_FORWARD, Some(16), 1.0, 10);
         wrong.outcome = Outcome::Measured {
             frame_ms: 1.0,
             gpu_ms: None,
             wrong_frames: 2,
         };
-        let mut skipped = measured("forward", None, 0.5, 1);
+        let mut skipped = measured(lightgrid::pipelines::ids::FORWARD, None, 0.5, 1);
         skipped.outcome = Outcome::Skipped {
             reason: "slow".into(),
         };
         let r = rank(vec![
             skipped,
-            measured("deferred", None, 30.0, 50),
+            measured(lightgrid::pipelines::ids::DEFERRED, None, 30.0, 50),
             wrong,
-            measured("tiled_deferred", Some(16), 20.0, 40),
-            measured("clustered_forward", Some(16), 20.0, 30),
+            measured(
+                lightgrid::pipelines::ids::TILED_DEFERRED,
+                Some(16),
+                20.0,
+                40,
+            ),
+            measured(
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                Some(16),
+                20.0,
+                30,
+            ),
         ]);
         let order: Vec<&str> = r.iter().map(|m| m.candidate.pipeline).collect();
         // Equal times: less memory first; wrong frames and skipped ones after the measured.
         assert_eq!(
             order,
             vec![
-                "clustered_forward",
-                "tiled_deferred",
-                "deferred",
-                "forward",
-                "tiled_forward"
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                lightgrid::pipelines::ids::TILED_DEFERRED,
+                lightgrid::pipelines::ids::DEFERRED,
+                lightgrid::pipelines::ids::FORWARD,
+                lightgrid::pipelines::ids::TILED_FORWARD
             ]
         );
     }
@@ -583,27 +593,42 @@ mod tests {
     #[test]
     fn refinement_tries_tiles_then_strategies_of_the_top_grid_pipelines() {
         let done = vec![
-            measured("tiled_deferred", Some(16), 10.0, 1),
-            measured("clustered_forward", Some(16), 12.0, 1),
-            measured("deferred", None, 11.0, 1),
-            measured("tiled_forward", Some(16), 13.0, 1),
-            measured("tiled_forward_prez", Some(16), 14.0, 1),
+            measured(lightgrid::pipelines::ids::TILED_DEFERRED, Some(16), 10.0, 1),
+            measured(
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                Some(16),
+                12.0,
+                1,
+            ),
+            measured(lightgrid::pipelines::ids::DEFERRED, None, 11.0, 1),
+            measured(lightgrid::pipelines::ids::TILED_FORWARD, Some(16), 13.0, 1),
+            measured(
+                lightgrid::pipelines::ids::TILED_FORWARD_PREZ,
+                Some(16),
+                14.0,
+                1,
+            ),
         ];
         let r = refine(&done);
         let pipelines: std::collections::BTreeSet<&str> = r.iter().map(|c| c.pipeline).collect();
         // The top three grid pipelines; `deferred` has no grid to refine.
         assert_eq!(
             pipelines,
-            ["clustered_forward", "tiled_deferred", "tiled_forward"].into()
+            [
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                lightgrid::pipelines::ids::TILED_DEFERRED,
+                lightgrid::pipelines::ids::TILED_FORWARD
+            ]
+            .into()
         );
         assert!(r.iter().all(|c| !done.iter().any(|d| d.candidate == *c)));
         assert!(r.contains(&Candidate {
-            pipeline: "tiled_deferred",
+            pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
             tile: Some(32),
             assign: Some("cpu")
         }));
         assert!(r.contains(&Candidate {
-            pipeline: "tiled_deferred",
+            pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
             tile: Some(16),
             assign: Some("gather")
         }));
@@ -613,12 +638,25 @@ mod tests {
     #[test]
     fn the_recommendation_gives_its_reasons_against_the_runner_up() {
         let r = rank(vec![
-            measured("forward", None, 400.0, 10 << 20),
-            measured("tiled_deferred", Some(16), 20.0, 40 << 20),
-            measured("clustered_forward", Some(32), 10.0, 20 << 20),
+            measured(lightgrid::pipelines::ids::FORWARD, None, 400.0, 10 << 20),
+            measured(
+                lightgrid::pipelines::ids::TILED_DEFERRED,
+                Some(16),
+                20.0,
+                40 << 20,
+            ),
+            measured(
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                Some(32),
+                10.0,
+                20 << 20,
+            ),
         ]);
         let rec = recommend(&r).unwrap();
-        assert_eq!(rec.candidate.pipeline, "clustered_forward");
+        assert_eq!(
+            rec.candidate.pipeline,
+            lightgrid::pipelines::ids::CLUSTERED_FORWARD
+        );
         assert_eq!(
             rec.options,
             "--pipeline clustered_forward --tile 32 --assign cpu"
@@ -636,12 +674,17 @@ mod tests {
         assert!(text.contains("50% efficient"), "{text}");
         // A tie is called a tie.
         let r = rank(vec![
-            measured("tiled_deferred", Some(16), 10.2, 1),
-            measured("clustered_forward", Some(16), 10.0, 1),
+            measured(lightgrid::pipelines::ids::TILED_DEFERRED, Some(16), 10.2, 1),
+            measured(
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                Some(16),
+                10.0,
+                1,
+            ),
         ]);
         assert!(recommend(&r).unwrap().reasons[1].contains("a tie"));
         // Nothing measured: no recommendation.
-        let mut s = measured("forward", None, 1.0, 1);
+        let mut s = measured(lightgrid::pipelines::ids::FORWARD, None, 1.0, 1);
         s.outcome = Outcome::Failed { reason: "x".into() };
         assert!(recommend(&[s]).is_none());
     }

@@ -500,16 +500,20 @@ mod tests {
             y_label: "ms".into(),
             bars: vec![
                 (
-                    "tiled_deferred".into(),
+                    lightgrid::pipelines::ids::TILED_DEFERRED.into(),
                     vec![("gbuffer".into(), 1.0), ("shade".into(), 2.0)],
                 ),
                 (
-                    "deferred".into(),
+                    lightgrid::pipelines::ids::DEFERRED.into(),
                     vec![("gbuffer".into(), 1.0), ("lights".into(), 4.0)],
                 ),
             ],
         };
-        assert!(bars.svg().contains("tiled_deferred") && bars.svg().contains("lights"));
+        assert!(
+            bars.svg()
+                .contains(lightgrid::pipelines::ids::TILED_DEFERRED)
+                && bars.svg().contains("lights")
+        );
         assert_eq!(bars.png().dimensions(), SIZE);
         let empty = StackedBars {
             bars: vec![],

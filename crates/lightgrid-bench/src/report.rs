@@ -6,6 +6,7 @@ use crate::invalid;
 use crate::plot::{LineChart, Series, StackedBars};
 use lightgrid::error::{Error, Result};
 use lightgrid::image_io::{save_png, write_atomic};
+use lightgrid::pipelines::ids;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -76,8 +77,8 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
                 .find(|p| p.label == label)
                 .map_or("-".into(), |p| format!("{:.2}", p.ms))
         };
-        let bounds = pass_ms("assign: cell bounds");
-        let fragments = pass_ms("assign: fragment bounds");
+        let bounds = pass_ms(lightgrid::culling::labels::CELL_BOUNDS);
+        let fragments = pass_ms(lightgrid::culling::labels::FRAGMENT_BOUNDS);
         let shading: Vec<_> = r.frames.iter().filter_map(|f| f.msaa_shading).collect();
         let (edges, shaded) = if shading.is_empty() {
             ("-".to_string(), "-".to_string())
@@ -915,7 +916,7 @@ fn fig3_counts(s: &mut String, results: &BenchResults, scene: &str) {
         .runs
         .iter()
         .filter(|r| r.scene == scene && r.msaa == 1 && r.gbuffer_bits.unwrap_or(16) == 16)
-        .filter(|r| r.pipeline != "tiled_forward")
+        .filter(|r| r.pipeline != ids::TILED_FORWARD)
         .filter_map(|r| {
             let n = r.frames.len().max(1) as f64;
             let area: Option<Vec<u64>> =

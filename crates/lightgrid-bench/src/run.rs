@@ -1251,7 +1251,7 @@ impl PreparedBench {
         let heatmap_pipeline = config
             .pipelines
             .iter()
-            .find(|p| p.as_str() == "tiled_deferred")
+            .find(|p| p.as_str() == lightgrid::pipelines::ids::TILED_DEFERRED)
             .or_else(|| {
                 config
                     .pipelines

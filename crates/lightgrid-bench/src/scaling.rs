@@ -14,6 +14,7 @@ use crate::report::csv_bytes;
 use lightgrid::error::{Error, Result};
 use lightgrid::gpu::GpuContext;
 use lightgrid::image_io::write_atomic;
+use lightgrid::pipelines::ids;
 use lightgrid::pipelines::{self, Assign, RenderSettings};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::Renderer;
@@ -46,7 +47,7 @@ impl Default for ScalingConfig {
     fn default() -> Self {
         ScalingConfig {
             scene: "stress".into(),
-            pipeline: "clustered_deferred".into(),
+            pipeline: ids::CLUSTERED_DEFERRED.into(),
             lights: vec![1_000, 4_000, 16_000, 64_000, 256_000, 1_000_000],
             strategies: vec![
                 Assign::Cpu,

@@ -9,6 +9,7 @@ use clap::Args;
 use lightgrid::frame::{DepthBounds, DepthReduction, GridLists, MaterialDraws, MsaaResolve};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
+use lightgrid::pipelines::ids;
 use lightgrid::pipelines::PIPELINES;
 use lightgrid::pipelines::{find_axis, Assign, Axis, SpotCull};
 use lightgrid_bench::{check_out_dir, BenchConfig, FrameRange, OutDir};
@@ -244,7 +245,7 @@ fn study(
         repeat: if hardware { 3 } else { 1 },
         pipelines: PIPELINES
             .iter()
-            .filter(|p| studied(p) || p.id == "forward" || p.id == "deferred")
+            .filter(|p| studied(p) || p.id == ids::FORWARD || p.id == ids::DEFERRED)
             .map(|p| p.id.to_string())
             .collect(),
         ..everything()
@@ -287,10 +288,10 @@ pub(crate) fn bench_config(
         Some(Preset::Msaa) => BenchDefaults {
             scenes: vec!["random-fps"],
             pipelines: [
-                "tiled_forward_prez",
-                "clustered_forward",
-                "tiled_deferred",
-                "clustered_deferred",
+                ids::TILED_FORWARD_PREZ,
+                ids::CLUSTERED_FORWARD,
+                ids::TILED_DEFERRED,
+                ids::CLUSTERED_DEFERRED,
             ]
             .map(String::from)
             .to_vec(),
@@ -322,11 +323,11 @@ pub(crate) fn bench_config(
             scenes: vec!["scattered"],
             size: Some(if hardware { (1280, 720) } else { (640, 360) }),
             pipelines: [
-                "tiled_forward_prez",
-                "tiled_light_prepass",
-                "tiled_deferred",
-                "deferred",
-                "light_prepass",
+                ids::TILED_FORWARD_PREZ,
+                ids::TILED_LIGHT_PREPASS,
+                ids::TILED_DEFERRED,
+                ids::DEFERRED,
+                ids::LIGHT_PREPASS,
             ]
             .map(String::from)
             .to_vec(),
@@ -336,7 +337,7 @@ pub(crate) fn bench_config(
             ..study(hardware, |_| false)
         },
         Some(Preset::LightRange) => BenchDefaults {
-            pipelines: ["forward", "tiled_forward_prez", "tiled_deferred"]
+            pipelines: [ids::FORWARD, ids::TILED_FORWARD_PREZ, ids::TILED_DEFERRED]
                 .map(String::from)
                 .to_vec(),
             frames: "0..259:65",
@@ -345,9 +346,13 @@ pub(crate) fn bench_config(
             ..study(hardware, |_| false)
         },
         Some(Preset::DepthBounds) => BenchDefaults {
-            pipelines: ["tiled_forward", "tiled_forward_prez", "clustered_forward"]
-                .map(String::from)
-                .to_vec(),
+            pipelines: [
+                ids::TILED_FORWARD,
+                ids::TILED_FORWARD_PREZ,
+                ids::CLUSTERED_FORWARD,
+            ]
+            .map(String::from)
+            .to_vec(),
             depth_bounds: lightgrid::frame::DepthBounds::ALL.to_vec(),
             // tiled-forward-shading measures 32x32 tiles.
             tile: Some(32),
@@ -356,7 +361,7 @@ pub(crate) fn bench_config(
         Some(Preset::Clustered) => BenchDefaults {
             scenes: vec!["random-top", "random-fps"],
             frames: "0..119:10",
-            pipelines: ["tiled_forward_prez", "clustered_forward"]
+            pipelines: [ids::TILED_FORWARD_PREZ, ids::CLUSTERED_FORWARD]
                 .map(String::from)
                 .to_vec(),
             transparency: false,

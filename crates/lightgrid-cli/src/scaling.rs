@@ -7,6 +7,7 @@ use crate::args::{
 use anyhow::Result;
 use clap::Args;
 use lightgrid::gpu::GpuContext;
+use lightgrid::pipelines::ids;
 use lightgrid::pipelines::{find_axis, Assign};
 use lightgrid_bench::{check_out_dir, OutDir};
 use std::path::PathBuf;
@@ -29,7 +30,7 @@ pub(crate) struct ScalingArgs {
     )]
     pub(crate) assign: Vec<Assign>,
     /// Grid pipeline to render with.
-    #[arg(long, default_value = "clustered_deferred")]
+    #[arg(long, default_value = ids::CLUSTERED_DEFERRED)]
     pub(crate) pipeline: String,
     /// Scene with a variable light count.
     #[arg(long, default_value = "stress")]

@@ -8,12 +8,13 @@ use anyhow::{Context, Result};
 use clap::Args;
 use lightgrid::debug_view::DebugView;
 use lightgrid::pipelines;
+use lightgrid::pipelines::ids;
 use lightgrid_viewer::script::{self, Action, Step};
 use std::path::PathBuf;
 
 /// The pipeline the viewer opens with: tiled deferred shading (tiled-shading §2), the
 /// fastest on lavapipe at the catalog scenes' sizes (README, results).
-const DEFAULT_PIPELINE: &str = "tiled_deferred";
+const DEFAULT_PIPELINE: &str = ids::TILED_DEFERRED;
 
 #[derive(Args)]
 pub(crate) struct ViewArgs {

@@ -340,7 +340,7 @@ fn bad_tile_and_gbuffer_values_are_rejected() {
     );
     assert_fails_with(
         &["render", "--scene", "robots-few", "--gbuffer", "24"],
-        "16 or 32",
+        "possible values: 16, 32",
     );
 }
 

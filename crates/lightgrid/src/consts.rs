@@ -335,3 +335,14 @@ pub fn wgsl_prelude() -> String {
     }
     out
 }
+
+/// The timed passes' labels that code outside the pass reads (the frame's assignment span,
+/// the benchmark's cell-bounds figures and claims): constants, so a renamed pass cannot
+/// silently un-measure them.
+pub mod pass_labels {
+    /// Every light-assignment pass's label starts with this (`FinishedFrame::assign_gpu_ms`).
+    pub const ASSIGN_PREFIX: &str = "assign:";
+    pub const CELL_BOUNDS: &str = "assign: cell bounds";
+    pub const FRAGMENT_BOUNDS: &str = "assign: fragment bounds";
+    pub const DEPTH_RANGE: &str = "assign: depth range";
+}

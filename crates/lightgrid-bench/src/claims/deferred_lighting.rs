@@ -4,12 +4,13 @@
 //! models at the measured lights per pixel.
 
 use super::*;
+use lightgrid::pipelines::ids;
 
 /// 8. Deferred lighting is no real win over deferred shading.
 pub(super) fn lighting_marginal(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find(r, scene, "light_prepass", None).and_then(avg_ms),
-        find(r, scene, "deferred", None).and_then(avg_ms),
+        find(r, scene, ids::LIGHT_PREPASS, None).and_then(avg_ms),
+        find(r, scene, ids::DEFERRED, None).and_then(avg_ms),
     ) {
         (Some(l), Some(d)) => (
             format!("avg ms: light_prepass {l:.1}, deferred {d:.1}"),
@@ -43,12 +44,12 @@ pub fn less_memory(
 /// Claim 18: the mono-specular pipelines' render targets, as the runs recorded them.
 pub(super) fn mono_memory(r: &BenchResults, scene: &str) -> (String, Verdict) {
     let bytes = |p| Some(find(r, scene, p, None)?.summary.as_ref()?.bytes_per_pixel);
-    match (bytes("light_prepass_mono"), bytes("deferred_mono")) {
+    match (bytes(ids::LIGHT_PREPASS_MONO), bytes(ids::DEFERRED_MONO)) {
         (Some(l), Some(d)) => less_memory(
             l,
             d,
-            find(r, scene, "light_prepass_mono", None).and_then(avg_ms),
-            find(r, scene, "deferred_mono", None).and_then(avg_ms),
+            find(r, scene, ids::LIGHT_PREPASS_MONO, None).and_then(avg_ms),
+            find(r, scene, ids::DEFERRED_MONO, None).and_then(avg_ms),
         ),
         _ => not_measured("light_prepass_mono and deferred_mono"),
     }
@@ -78,7 +79,7 @@ pub fn writes_more(
 
 /// Claim 15: lights per pixel from deferred's counts, writes from the traffic model.
 pub(super) fn write_break_even(r: &BenchResults, scene: &str) -> (String, Verdict) {
-    let pair = ["light_prepass", "deferred"];
+    let pair = [ids::LIGHT_PREPASS, ids::DEFERRED];
     match (
         lights_per_pixel(r, scene),
         modelled(r, scene, pair[0], Side::Writes),
@@ -95,7 +96,7 @@ pub(super) fn write_break_even(r: &BenchResults, scene: &str) -> (String, Verdic
 /// (each volume fragment that runs the light function is a lit pixel; the transparent pass
 /// is outside the blog's model).
 pub(super) fn lights_per_pixel(r: &BenchResults, scene: &str) -> Option<f64> {
-    let x = find(r, scene, "deferred", None)?;
+    let x = find(r, scene, ids::DEFERRED, None)?;
     let pixels = f64::from(x.width) * f64::from(x.height);
     let opaque: Option<Vec<f64>> = x
         .frames
@@ -183,7 +184,7 @@ pub(super) fn mono_reads(r: &BenchResults, scene: &str) -> (String, Verdict) {
 /// Claims 16 and 17: lights per pixel from deferred's counts, bytes from the traffic models of
 /// the two mono-specular pipelines.
 pub(super) fn mono_break_even(r: &BenchResults, scene: &str, side: Side) -> (String, Verdict) {
-    let pair = ["light_prepass_mono", "deferred_mono"];
+    let pair = [ids::LIGHT_PREPASS_MONO, ids::DEFERRED_MONO];
     match (
         lights_per_pixel(r, scene),
         modelled(r, scene, pair[0], side),

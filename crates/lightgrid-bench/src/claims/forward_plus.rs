@@ -2,13 +2,14 @@
 //! against its own baseline, compute-based deferred lighting [And11], stage by stage (Fig. 3).
 
 use super::*;
+use lightgrid::pipelines::ids;
 
 /// 6. Forward+ vs deferred, measured; Table 1 evaluated literally as information.
 pub(super) fn forward_plus_vs_deferred(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find(r, scene, "tiled_forward_prez", None),
-        find(r, scene, "deferred", None),
-        find(r, scene, "light_prepass", None),
+        find(r, scene, ids::TILED_FORWARD_PREZ, None),
+        find(r, scene, ids::DEFERRED, None),
+        find(r, scene, ids::LIGHT_PREPASS, None),
     ) {
         (Some(fp), Some(d), lp) => {
             let model: Vec<_> = fp
@@ -43,8 +44,8 @@ pub(super) fn forward_plus_vs_deferred(r: &BenchResults, scene: &str) -> (String
 /// 6b. The same against the paper's own baseline, compute-based deferred lighting.
 pub(super) fn forward_plus_by_stages(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find(r, scene, "tiled_forward_prez", None),
-        find(r, scene, "tiled_light_prepass", None),
+        find(r, scene, ids::TILED_FORWARD_PREZ, None),
+        find(r, scene, ids::TILED_LIGHT_PREPASS, None),
     ) {
         (Some(fp), Some(cd)) => match (stages(fp), stages(cd)) {
             (Ok(a), Ok(b)) => forward_plus_stages(&a, &b),
@@ -81,7 +82,11 @@ pub fn stages(x: &RunRecord) -> std::result::Result<[f64; 3], String> {
 pub fn fig3_stage(label: &str) -> std::result::Result<Option<usize>, ()> {
     Ok(Some(match label {
         "depth pre-pass" | "light pre-pass attributes" => 0,
-        l if l.starts_with("assign") || l.contains("irradiance") => 1,
+        l if l.starts_with(lightgrid::culling::labels::ASSIGN_PREFIX)
+            || l.contains("irradiance") =>
+        {
+            1
+        }
         l if l.contains("shading") => 2,
         "transparent" | "tonemap" => return Ok(None),
         _ => return Err(()),

@@ -4,6 +4,7 @@
 //! `evaluate_claims` adds the families that compare runs across scenes or settings.
 
 use super::{BenchResults, RunRecord};
+use lightgrid::pipelines::ids;
 
 mod deferred_lighting;
 mod forward_plus;
@@ -118,7 +119,7 @@ fn cell_bounds_ms(x: &RunRecord) -> Option<f64> {
         .as_ref()?
         .passes
         .iter()
-        .find(|p| p.label == "assign: cell bounds")
+        .find(|p| p.label == lightgrid::culling::labels::CELL_BOUNDS)
         .map(|p| p.ms)
 }
 
@@ -159,7 +160,7 @@ fn culled<'a>(r: &'a BenchResults, scene: &str) -> Vec<&'a RunRecord> {
         .iter()
         .filter(|x| {
             x.scene == scene
-                && !x.pipeline.starts_with("forward")
+                && !x.pipeline.starts_with(ids::FORWARD)
                 && x.gbuffer_bits.unwrap_or(16) == 16
                 && x.msaa == 1
         })
@@ -306,7 +307,7 @@ mod tests {
 
     #[test]
     fn subgroup_reduction_claim_on_both_sides() {
-        let (e, v) = subgroup_faster("tiled_deferred", 6.0, 1.0);
+        let (e, v) = subgroup_faster(ids::TILED_DEFERRED, 6.0, 1.0);
         assert_eq!(v, Verdict::Held);
         assert!(e.contains("(6.00x)"), "{e}");
         assert_eq!(subgroup_faster("p", 8.4, 12.7).1, Verdict::NotHeld);
@@ -365,25 +366,25 @@ mod tests {
         assert_eq!(one_side_enough("p", 10.0, 10.9, 14.0).1, Verdict::Held);
         assert_eq!(one_side_enough("p", 10.0, 14.0, 10.5).1, Verdict::Held);
         assert_eq!(one_side_enough("p", 10.0, 11.5, 12.0).1, Verdict::NotHeld);
-        let (evidence, _) = one_side_enough("tiled_forward_prez", 10.0, 11.0, 12.0);
+        let (evidence, _) = one_side_enough(ids::TILED_FORWARD_PREZ, 10.0, 11.0, 12.0);
         assert!(evidence.contains("1.10x both"), "{evidence}");
     }
 
     #[test]
     fn fastest_worst_case_on_both_sides() {
         let held = fastest_worst(&rows(&[
-            ("tiled_deferred", 20.0),
-            ("deferred", 35.0),
-            ("tiled_forward", 21.0),
+            (ids::TILED_DEFERRED, 20.0),
+            (ids::DEFERRED, 35.0),
+            (ids::TILED_FORWARD, 21.0),
         ]));
         assert_eq!(held.unwrap().1, Verdict::Held);
         let not = fastest_worst(&rows(&[
-            ("tiled_deferred", 22.0),
-            ("deferred", 35.0),
-            ("tiled_forward", 21.0),
+            (ids::TILED_DEFERRED, 22.0),
+            (ids::DEFERRED, 35.0),
+            (ids::TILED_FORWARD, 21.0),
         ]));
         assert_eq!(not.unwrap().1, Verdict::NotHeld);
-        assert!(fastest_worst(&rows(&[("deferred", 3.0)])).is_none());
+        assert!(fastest_worst(&rows(&[(ids::DEFERRED, 3.0)])).is_none());
     }
 
     #[test]
@@ -414,8 +415,11 @@ mod tests {
 
     #[test]
     fn few_lights_competitive_on_both_sides() {
-        assert_eq!(competitive("tiled_forward", 12.0, 10.0).1, Verdict::Held);
-        assert_eq!(competitive("tiled_forward", 13.0, 10.0).1, Verdict::NotHeld);
+        assert_eq!(competitive(ids::TILED_FORWARD, 12.0, 10.0).1, Verdict::Held);
+        assert_eq!(
+            competitive(ids::TILED_FORWARD, 13.0, 10.0).1,
+            Verdict::NotHeld
+        );
     }
 
     #[test]

@@ -3,12 +3,13 @@
 //! light ranges (Fig. 4.2(a)).
 
 use super::*;
+use lightgrid::pipelines::ids;
 
 /// 7. Tiled deferred vs tiled forward in the plain case.
 pub(super) fn plain_case(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find(r, scene, "tiled_deferred", None).and_then(avg_ms),
-        find(r, scene, "tiled_forward_prez", None).and_then(avg_ms),
+        find(r, scene, ids::TILED_DEFERRED, None).and_then(avg_ms),
+        find(r, scene, ids::TILED_FORWARD_PREZ, None).and_then(avg_ms),
     ) {
         (Some(td), Some(tf)) => (
             format!("avg ms: tiled_deferred {td:.1}, tiled_forward_prez {tf:.1}"),
@@ -21,8 +22,8 @@ pub(super) fn plain_case(r: &BenchResults, scene: &str) -> (String, Verdict) {
 /// 9. MSAA: hardware MSAA in forward against per-sample deferred shading.
 pub(super) fn msaa_forward_faster(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find_msaa(r, scene, "tiled_deferred", None, 4).and_then(avg_ms),
-        find_msaa(r, scene, "tiled_forward_prez", None, 4).and_then(avg_ms),
+        find_msaa(r, scene, ids::TILED_DEFERRED, None, 4).and_then(avg_ms),
+        find_msaa(r, scene, ids::TILED_FORWARD_PREZ, None, 4).and_then(avg_ms),
     ) {
         (Some(td), Some(tf)) => {
             let ratio = td / tf.max(1e-9);
@@ -43,7 +44,7 @@ pub(super) fn z_reduction_scales(r: &BenchResults, scene: &str) -> (String, Verd
     let mut reduction: Vec<(u32, f64)> = r
         .runs
         .iter()
-        .filter(|x| x.scene == scene && x.pipeline == "tiled_forward_prez")
+        .filter(|x| x.scene == scene && x.pipeline == ids::TILED_FORWARD_PREZ)
         .filter_map(|x| Some((x.msaa, cell_bounds_ms(x)?)))
         .collect();
     reduction.sort_by_key(|&(n, _)| n);
@@ -92,7 +93,7 @@ pub(super) fn range_claims(r: &BenchResults) -> Vec<Claim> {
         let mut listed = Vec::new();
         let mut speedups = Vec::new();
         for (f, scene) in &scenes {
-            let tiled = find(r, scene, "tiled_deferred", None);
+            let tiled = find(r, scene, ids::TILED_DEFERRED, None);
             let share = tiled.and_then(|t| {
                 Some(t.summary.as_ref()?.lights_per_tile_avg? / f64::from(t.lights?.max(1)))
             });
@@ -100,7 +101,7 @@ pub(super) fn range_claims(r: &BenchResults) -> Vec<Claim> {
                 listed.push((*f, s));
             }
             let ms = |p| find(r, scene, p, None).and_then(avg_ms);
-            if let (Some(fw), Some(t)) = (ms("forward"), ms("tiled_deferred")) {
+            if let (Some(fw), Some(t)) = (ms(ids::FORWARD), ms(ids::TILED_DEFERRED)) {
                 speedups.push((*f, fw / t.max(1e-9)));
             }
         }
@@ -191,13 +192,13 @@ pub(super) fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
         claim(
             "A depth pre-pass alone makes tiled forward shading faster (22.4 → 15.6 ms)",
             match (
-                find(r, scene, "tiled_forward", None).and_then(avg_ms),
-                ms("tiled_forward_prez", DepthBounds::None),
+                find(r, scene, ids::TILED_FORWARD, None).and_then(avg_ms),
+                ms(ids::TILED_FORWARD_PREZ, DepthBounds::None),
             ) {
                 (Some(no_prez), Some(prez)) => faster(
                     "tiled_forward_prez [bounds none]",
                     prez,
-                    "tiled_forward",
+                    ids::TILED_FORWARD,
                     no_prez,
                 ),
                 _ => not_measured("tiled_forward and tiled_forward_prez --depth-bounds none"),
@@ -206,8 +207,8 @@ pub(super) fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
         claim(
             "Depth bounds after the pre-pass make it faster again (15.6 → 10.9 ms)",
             match (
-                ms("tiled_forward_prez", DepthBounds::None),
-                ms("tiled_forward_prez", DepthBounds::Both),
+                ms(ids::TILED_FORWARD_PREZ, DepthBounds::None),
+                ms(ids::TILED_FORWARD_PREZ, DepthBounds::Both),
             ) {
                 (Some(none), Some(both)) => faster(
                     "tiled_forward_prez [bounds both]",
@@ -218,9 +219,9 @@ pub(super) fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
                 _ => not_measured("tiled_forward_prez --depth-bounds none,both"),
             },
         );
-        for p in ["tiled_forward_prez", "clustered_forward"] {
+        for p in [ids::TILED_FORWARD_PREZ, ids::CLUSTERED_FORWARD] {
             claim(
-                if p == "clustered_forward" {
+                if p == ids::CLUSTERED_FORWARD {
                     "With clusters too, one side of the depth bounds (min or max only) is enough: within 10% of both (§4.8)"
                 } else {
                     "One side of the depth bounds (min or max only) is enough: within 10% of both"
@@ -260,7 +261,7 @@ pub(super) fn view_dependence(r: &BenchResults) -> Vec<Claim> {
     let (top, fps) = ("random-top", "random-fps");
     let ms = |scene: &str, p: &str| find(r, scene, p, None).and_then(avg_ms);
     let count = |scene: &str, p: &str| find(r, scene, p, None).and_then(avg_count);
-    let (tiled, clustered) = ("tiled_forward_prez", "clustered_forward");
+    let (tiled, clustered) = (ids::TILED_FORWARD_PREZ, ids::CLUSTERED_FORWARD);
     let mut out = Vec::new();
     let source = "tiled-forward-shading Fig. 4.6";
     let mut claim =
@@ -270,7 +271,7 @@ pub(super) fn view_dependence(r: &BenchResults) -> Vec<Claim> {
             top,
             "In the top-down view tiled forward outperforms clustered forward (6.6 vs 9.3 ms)",
             match (ms(top, tiled), ms(top, clustered)) {
-                (Some(t), Some(c)) => faster("tiled_forward_prez", t, "clustered_forward", c),
+                (Some(t), Some(c)) => faster(ids::TILED_FORWARD_PREZ, t, ids::CLUSTERED_FORWARD, c),
                 _ => not_measured("tiled_forward_prez and clustered_forward"),
             },
         );
@@ -280,7 +281,7 @@ pub(super) fn view_dependence(r: &BenchResults) -> Vec<Claim> {
             fps,
             "In the first-person view tiled forward becomes slower than clustered forward (9.4 vs 9.1 ms)",
             match (ms(fps, tiled), ms(fps, clustered)) {
-                (Some(t), Some(c)) => faster("clustered_forward", c, "tiled_forward_prez", t),
+                (Some(t), Some(c)) => faster(ids::CLUSTERED_FORWARD, c, ids::TILED_FORWARD_PREZ, t),
                 _ => not_measured("tiled_forward_prez and clustered_forward"),
             },
         );

@@ -3,12 +3,13 @@
 //! subgroup depth reduction of §8.
 
 use super::*;
+use lightgrid::pipelines::ids;
 
 /// 1. Variability.
 pub(super) fn variability(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find(r, scene, "tiled_deferred", None),
-        find(r, scene, "deferred", None),
+        find(r, scene, ids::TILED_DEFERRED, None),
+        find(r, scene, ids::DEFERRED, None),
     ) {
         (Some(t), Some(d)) if t.frames.len() > 1 => {
             let spread = |x: &RunRecord| {
@@ -29,11 +30,11 @@ pub(super) fn variability(r: &BenchResults, scene: &str) -> (String, Verdict) {
 
 /// 2. Deferred-Stencil culls best.
 pub(super) fn stencil_fewest(r: &BenchResults, scene: &str) -> (String, Verdict) {
-    match find(r, scene, "deferred_stencil", None).and_then(avg_count) {
+    match find(r, scene, ids::DEFERRED_STENCIL, None).and_then(avg_count) {
         Some(st) => {
             let others: Vec<(String, f64)> = culled(r, scene)
                 .into_iter()
-                .filter(|x| x.pipeline != "deferred_stencil")
+                .filter(|x| x.pipeline != ids::DEFERRED_STENCIL)
                 .filter_map(|x| avg_count(x).map(|c| (run_name(x), c)))
                 .collect();
             let best = others.iter().min_by(|a, b| a.1.total_cmp(&b.1));
@@ -52,8 +53,8 @@ pub(super) fn stencil_fewest(r: &BenchResults, scene: &str) -> (String, Verdict)
 /// 3. Tiled forward worst, pre-Z + depth range improve it substantially.
 pub(super) fn tiled_forward_worst(r: &BenchResults, scene: &str) -> (String, Verdict) {
     match (
-        find(r, scene, "tiled_forward", None).and_then(avg_count),
-        find(r, scene, "tiled_forward_prez", None).and_then(avg_count),
+        find(r, scene, ids::TILED_FORWARD, None).and_then(avg_count),
+        find(r, scene, ids::TILED_FORWARD_PREZ, None).and_then(avg_count),
     ) {
         (Some(tf), Some(pz)) => {
             let worst = culled(r, scene)
@@ -107,8 +108,8 @@ pub(super) fn gbuffer_size(r: &BenchResults, scene: &str) -> (String, Verdict) {
     let ratio = |p: &str| {
         Some(avg_ms(find(r, scene, p, Some(32))?)? / avg_ms(find(r, scene, p, Some(16))?)?)
     };
-    match (ratio("deferred"), ratio("tiled_deferred")) {
-        (Some(d), Some(t)) if find(r, scene, "deferred", Some(32)).is_some_and(|x| x.gbuffer_bits == Some(32)) => (
+    match (ratio(ids::DEFERRED), ratio(ids::TILED_DEFERRED)) {
+        (Some(d), Some(t)) if find(r, scene, ids::DEFERRED, Some(32)).is_some_and(|x| x.gbuffer_bits == Some(32)) => (
             format!("32-bit / 16-bit G-buffer frame time: deferred {d:.2}x, tiled_deferred {t:.2}x (held: deferred at least 5% slower and more affected)"),
             verdict(d >= 1.05 && d > t),
         ),
@@ -185,10 +186,10 @@ pub(super) fn fastest_worst_case(r: &BenchResults, scene: &str) -> (String, Verd
 
 /// The verdict on (pipeline, worst frame ms) rows.
 pub fn fastest_worst(worst: &[(String, f64)]) -> Option<(String, Verdict)> {
-    let td = worst.iter().find(|(p, _)| p == "tiled_deferred")?.1;
+    let td = worst.iter().find(|(p, _)| p == ids::TILED_DEFERRED)?.1;
     let (other, best) = worst
         .iter()
-        .filter(|(p, _)| p != "tiled_deferred")
+        .filter(|(p, _)| p != ids::TILED_DEFERRED)
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
     Some((
         format!(
@@ -206,13 +207,13 @@ pub(super) fn few_lights_competitive(r: &BenchResults, scene: &str) -> (String, 
             Verdict::NotMeasured,
         );
     }
-    let forward = ["tiled_forward", "tiled_forward_prez"]
+    let forward = [ids::TILED_FORWARD, ids::TILED_FORWARD_PREZ]
         .iter()
         .filter_map(|p| Some((p.to_string(), avg_ms(find(r, scene, p, None)?)?)))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     match (
         forward,
-        find(r, scene, "tiled_deferred", None).and_then(avg_ms),
+        find(r, scene, ids::TILED_DEFERRED, None).and_then(avg_ms),
     ) {
         (Some((p, f)), Some(d)) => competitive(&p, f, d),
         _ => not_measured("tiled_forward or tiled_forward_prez, and tiled_deferred"),
@@ -273,8 +274,10 @@ pub(super) fn prez_per_computation(r: &BenchResults, scene: &str) -> (String, Ve
             .collect()
     };
     match (
-        series("tiled_forward_prez").as_deref().and_then(fit_cost),
-        series("tiled_deferred").as_deref().and_then(fit_cost),
+        series(ids::TILED_FORWARD_PREZ)
+            .as_deref()
+            .and_then(fit_cost),
+        series(ids::TILED_DEFERRED).as_deref().and_then(fit_cost),
     ) {
         (Some(p), Some(d)) => four_times(p, d),
         _ => not_measured(
@@ -294,9 +297,9 @@ pub fn stencil_competitive(ratio16: f64, ratio32: f64) -> (String, Verdict) {
 /// Claim 14.
 pub(super) fn stencil_gbuffer(r: &BenchResults, scene: &str) -> (String, Verdict) {
     let ratio = |bits| {
-        let s = find(r, scene, "deferred_stencil", Some(bits))
+        let s = find(r, scene, ids::DEFERRED_STENCIL, Some(bits))
             .filter(|x| x.gbuffer_bits == Some(bits))?;
-        let t = find(r, scene, "tiled_deferred", Some(bits))
+        let t = find(r, scene, ids::TILED_DEFERRED, Some(bits))
             .filter(|x| x.gbuffer_bits == Some(bits))?;
         Some(avg_ms(s)? / avg_ms(t)?.max(1e-9))
     };

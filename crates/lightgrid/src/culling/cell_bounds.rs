@@ -299,7 +299,7 @@ impl CellBoundsPass {
             ],
         );
         encoder.clear_buffer(&self.occupancy, 0, None);
-        let mut pass = timer.begin_compute(encoder, "assign: cell bounds");
+        let mut pass = timer.begin_compute(encoder, super::labels::CELL_BOUNDS);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, cull, &[]);
         pass.set_bind_group(1, &group, &[]);

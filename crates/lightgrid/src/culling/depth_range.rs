@@ -126,7 +126,7 @@ impl DepthRangePass {
         );
         let (encoder, timer) = enc.parts();
         {
-            let mut pass = timer.begin_compute(encoder, "assign: depth range");
+            let mut pass = timer.begin_compute(encoder, super::labels::DEPTH_RANGE);
             pass.set_bind_group(0, f.bind_group, &[]);
             pass.set_bind_group(1, &group, &[]);
             pass.set_pipeline(&self.reduce);

@@ -112,7 +112,7 @@ impl FragmentBounds {
         if !self.forward_opaque && !f.has_transparency() {
             return;
         }
-        let label = "assign: fragment bounds";
+        let label = super::labels::FRAGMENT_BOUNDS;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],

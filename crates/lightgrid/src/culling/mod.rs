@@ -48,6 +48,8 @@ pub use spot_ray::{ray_test_count, RayTestCount};
 pub use strategy::AssignStrategy;
 pub(crate) use strategy::{bind_cull_group, cull_layout, CullFrame};
 
+pub use crate::consts::pass_labels as labels;
+
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
 /// `tile_frustum` / `light_in_tile` (needs the scene bindings).

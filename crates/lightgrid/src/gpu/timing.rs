@@ -225,7 +225,10 @@ pub fn frame_timings(labels: &[TimedPass], ticks: &[u64], period_ns: f64) -> Fra
     FrameTimings {
         passes,
         gpu_ms: spans(&|_| true),
-        assign_ms: spans(&|p| p.label.starts_with("assign:")),
+        assign_ms: spans(&|p| {
+            p.label
+                .starts_with(crate::consts::pass_labels::ASSIGN_PREFIX)
+        }),
     }
 }
 

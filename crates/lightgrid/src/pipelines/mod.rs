@@ -88,6 +88,26 @@ pub enum Msaa {
     Refused(&'static str),
 }
 
+/// Every pipeline's id, as a constant: code that names a pipeline uses these, so a renamed
+/// or removed pipeline is a compile error there, not a silently unmatched string.
+pub mod ids {
+    pub const FORWARD: &str = "forward";
+    pub const FORWARD_MONO: &str = "forward_mono";
+    pub const FORWARD_MONO_ALBEDO: &str = "forward_mono_albedo";
+    pub const TILED_FORWARD: &str = "tiled_forward";
+    pub const TILED_FORWARD_PREZ: &str = "tiled_forward_prez";
+    pub const TILED_DEFERRED: &str = "tiled_deferred";
+    pub const TILED_DEFERRED_SINGLE: &str = "tiled_deferred_single";
+    pub const CLUSTERED_FORWARD: &str = "clustered_forward";
+    pub const CLUSTERED_DEFERRED: &str = "clustered_deferred";
+    pub const DEFERRED: &str = "deferred";
+    pub const DEFERRED_STENCIL: &str = "deferred_stencil";
+    pub const DEFERRED_MONO: &str = "deferred_mono";
+    pub const LIGHT_PREPASS: &str = "light_prepass";
+    pub const LIGHT_PREPASS_MONO: &str = "light_prepass_mono";
+    pub const TILED_LIGHT_PREPASS: &str = "tiled_light_prepass";
+}
+
 /// One registry row.
 pub struct PipelineInfo {
     /// The id used on the command line and in stats.
@@ -143,7 +163,7 @@ impl PipelineInfo {
 /// The registry, reference first.
 pub const PIPELINES: &[PipelineInfo] = &[
     PipelineInfo {
-        id: "forward",
+        id: ids::FORWARD,
         description: "every light evaluated for every fragment; the reference image",
         paper: "all (brute force)",
         uses_grid: false,
@@ -151,7 +171,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         depth_bounds: false,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: forward::shaders,
@@ -159,7 +179,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: forward::memory,
     },
     PipelineInfo {
-        id: "forward_mono",
+        id: ids::FORWARD_MONO,
         description: "forward with the light pre-pass's monochrome specular; the reference for light_prepass_mono",
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
@@ -167,7 +187,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         depth_bounds: false,
-        reference: "forward_mono",
+        reference: ids::FORWARD_MONO,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: forward::shaders,
@@ -175,7 +195,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: forward::memory,
     },
     PipelineInfo {
-        id: "forward_mono_albedo",
+        id: ids::FORWARD_MONO_ALBEDO,
         description: "forward with a one-value (luminance) specular albedo; the reference for deferred_mono",
         paper: "deferred-shading-vs-deferred-lighting (the fair counterpart)",
         uses_grid: false,
@@ -183,7 +203,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         depth_bounds: false,
-        reference: "forward_mono_albedo",
+        reference: ids::FORWARD_MONO_ALBEDO,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: forward::shaders,
@@ -191,7 +211,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: forward::memory,
     },
     PipelineInfo {
-        id: "tiled_forward",
+        id: ids::TILED_FORWARD,
         description: "tile grid without depth bounds (every tile spans near..far), read by forward shading",
         paper: "tiled-shading §3",
         uses_grid: true,
@@ -199,7 +219,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         depth_bounds: false,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: tiled_forward::shaders,
@@ -207,7 +227,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: tiled_forward::memory_plain,
     },
     PipelineInfo {
-        id: "tiled_forward_prez",
+        id: ids::TILED_FORWARD_PREZ,
         description: "depth pre-pass, per-tile depth bounds, tile grid, forward shading with early-Z",
         paper: "tiled-shading §6.3, forward-plus, tiled-forward-shading §4.4",
         uses_grid: true,
@@ -215,7 +235,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: false,
         depth_bounds: true,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: tiled_forward::shaders,
@@ -223,7 +243,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: tiled_forward::memory_prez,
     },
     PipelineInfo {
-        id: "tiled_deferred",
+        id: ids::TILED_DEFERRED,
         description: "G-buffer, per-tile depth bounds, tile grid, one compute pass shading each sample",
         paper: "tiled-shading §2, §6, §8",
         uses_grid: true,
@@ -231,7 +251,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: true,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: true,
         shaders: tiled_deferred::shaders,
@@ -239,7 +259,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: tiled_deferred::memory_multi,
     },
     PipelineInfo {
-        id: "tiled_deferred_single",
+        id: ids::TILED_DEFERRED_SINGLE,
         description: "G-buffer, then one kernel: per tile depth bounds, cull all lights in workgroup memory, shade one pixel per invocation",
         paper: "tiled-shading §7",
         uses_grid: true,
@@ -247,7 +267,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: false,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: true,
         shaders: tiled_deferred::shaders_single,
@@ -255,7 +275,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: tiled_deferred::memory_single,
     },
     PipelineInfo {
-        id: "clustered_forward",
+        id: ids::CLUSTERED_FORWARD,
         description: "depth pre-pass, per-cluster sample bounds, grid of (tile, view-depth slice) clusters holding samples, forward shading",
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
@@ -263,7 +283,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: true,
         clustered: true,
         depth_bounds: true,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: tiled_forward::shaders,
@@ -271,7 +291,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: tiled_forward::memory_clustered,
     },
     PipelineInfo {
-        id: "clustered_deferred",
+        id: ids::CLUSTERED_DEFERRED,
         description: "G-buffer, per-cluster sample bounds, cluster grid, one compute pass shading each sample from its cluster",
         paper: "tiled-forward-shading §4.8",
         uses_grid: true,
@@ -279,7 +299,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: true,
         depth_bounds: true,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: true,
         shaders: tiled_deferred::shaders,
@@ -287,7 +307,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: tiled_deferred::memory_clustered,
     },
     PipelineInfo {
-        id: "deferred",
+        id: ids::DEFERRED,
         description: "G-buffer, then each light's volume rasterized with additive blending",
         paper: "tiled-shading §1.1, §8 (Deferred)",
         uses_grid: false,
@@ -295,7 +315,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: false,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: deferred::shaders,
@@ -303,7 +323,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: deferred::memory,
     },
     PipelineInfo {
-        id: "deferred_stencil",
+        id: ids::DEFERRED_STENCIL,
         description: "as deferred, with a two-sided stencil pass per light so only samples inside its volume are shaded",
         paper: "tiled-shading §8 (Deferred-Stencil)",
         uses_grid: false,
@@ -311,7 +331,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: false,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: deferred::shaders,
@@ -319,7 +339,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: deferred::memory,
     },
     PipelineInfo {
-        id: "deferred_mono",
+        id: ids::DEFERRED_MONO,
         description: "as deferred, with the specular albedo as one value in the diffuse target's alpha (three G-buffer targets): mono-specular deferred shading",
         paper: "deferred-shading-vs-deferred-lighting (the fair counterpart of light_prepass_mono)",
         uses_grid: false,
@@ -327,7 +347,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: false,
-        reference: "forward_mono_albedo",
+        reference: ids::FORWARD_MONO_ALBEDO,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: deferred::shaders_mono,
@@ -335,7 +355,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: deferred::memory_mono,
     },
     PipelineInfo {
-        id: "light_prepass",
+        id: ids::LIGHT_PREPASS,
         description: "deferred lighting: normal+exponent, diffuse and specular irradiance per light volume, second geometry pass",
         paper: "deferred-shading-vs-deferred-lighting",
         uses_grid: false,
@@ -343,7 +363,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: false,
-        reference: "forward",
+        reference: ids::FORWARD,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: light_prepass::shaders,
@@ -351,7 +371,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: light_prepass::memory_full,
     },
     PipelineInfo {
-        id: "light_prepass_mono",
+        id: ids::LIGHT_PREPASS_MONO,
         description: "light pre-pass with monochrome specular irradiance in the diffuse target's alpha",
         paper: "deferred-shading-vs-deferred-lighting (the compromise)",
         uses_grid: false,
@@ -359,7 +379,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: false,
-        reference: "forward_mono",
+        reference: ids::FORWARD_MONO,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: light_prepass::shaders,
@@ -367,7 +387,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         memory: light_prepass::memory_mono,
     },
     PipelineInfo {
-        id: "tiled_light_prepass",
+        id: ids::TILED_LIGHT_PREPASS,
         description: "compute-based deferred lighting: attributes pre-pass, one compute pass per tile accumulating its lights into one irradiance target (mono specular), a second geometry pass applying the materials",
         paper: "forward-plus §5 (its baseline [And11]), deferred-shading-vs-deferred-lighting",
         uses_grid: true,
@@ -375,7 +395,7 @@ pub const PIPELINES: &[PipelineInfo] = &[
         forward_shading: false,
         clustered: false,
         depth_bounds: true,
-        reference: "forward_mono",
+        reference: ids::FORWARD_MONO,
         msaa: Msaa::Supported,
         kernel_resolve: false,
         shaders: light_prepass::shaders_tiled,
