@@ -4,7 +4,6 @@
 use crate::files::Files;
 use anyhow::{Context, Result};
 use clap::Args;
-use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{Axis, SettingValue, AXES};
 use lightgrid::scene::catalog::SceneParams;
 use lightgrid::scene::{AddLights, SceneRequest};
@@ -371,14 +370,6 @@ pub(crate) struct SceneArgs {
 pub(crate) fn parse_view(s: &str) -> Result<lightgrid::debug_view::DebugView, String> {
     lightgrid::debug_view::DebugView::parse(s)
         .ok_or_else(|| format!("'{s}': one of shaded, lights, bounds, wasted"))
-}
-
-pub(crate) fn parse_gbuffer(s: &str) -> Result<GBufferFormat, String> {
-    match s {
-        "16" => Ok(GBufferFormat::F16),
-        "32" => Ok(GBufferFormat::F32),
-        _ => Err(format!("'{s}': the G-buffer is 16 or 32 bits per channel")),
-    }
 }
 
 pub(crate) fn timing_label(t: lightgrid::TimingSource) -> &'static str {

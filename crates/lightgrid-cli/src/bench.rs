@@ -1,8 +1,8 @@
 //! `lightgrid bench` and `lightgrid report`: the papers' evaluations and their report.
 
 use crate::args::{
-    check_applies, format_duration, parse_fraction, parse_gbuffer, parse_size, progress_bar,
-    run_outcome, setting, stop_on_ctrl_c, OnOff, Size, MAX_COUNT,
+    check_applies, format_duration, parse_fraction, parse_size, progress_bar, run_outcome, setting,
+    stop_on_ctrl_c, OnOff, Size, MAX_COUNT,
 };
 use anyhow::Result;
 use clap::Args;
@@ -108,7 +108,7 @@ pub(crate) struct BenchArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_positive)]
     pub(crate) light_range: Option<f64>,
     /// G-buffer precisions to measure: 16, 32 or 16,32.
-    #[arg(long, value_delimiter = ',', value_parser = parse_gbuffer)]
+    #[arg(long, value_delimiter = ',', value_parser = setting::<GBufferFormat>())]
     pub(crate) gbuffer: Vec<GBufferFormat>,
     /// Measurements per frame, 1 to 1000; the median is kept and the spread recorded.
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=MAX_COUNT))]

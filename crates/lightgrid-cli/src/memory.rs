@@ -1,6 +1,6 @@
 //! `lightgrid memory`: render targets and the traffic model of every pipeline.
 
-use crate::args::{parse_gbuffer, parse_size, Size};
+use crate::args::{parse_size, setting, Size};
 use anyhow::Result;
 use clap::Args;
 use lightgrid::passes::GBufferFormat;
@@ -13,7 +13,7 @@ pub(crate) struct MemoryArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = parse_size, default_value = "1920x1080")]
     pub(crate) size: Size,
     /// G-buffer channel precision in bits for deferred pipelines.
-    #[arg(long, default_value = "16", value_parser = parse_gbuffer)]
+    #[arg(long, default_value = "16", value_parser = setting::<GBufferFormat>())]
     pub(crate) gbuffer: GBufferFormat,
     /// MSAA samples per pixel, or a list (1,2,4,8): one table per count (tiled-forward-shading
     /// Fig. 4.4). A model: any count lightgrid knows (1, 2, 4, 8, 16), whether or not this

@@ -596,11 +596,7 @@ fn check(caller: &Caller, config: CullConfig, what: &str) {
     );
 }
 
-const STRATEGIES: [CullStrategy; 3] = [
-    CullStrategy::Gather,
-    CullStrategy::Scatter,
-    CullStrategy::BvhGpu,
-];
+const STRATEGIES: [CullStrategy; 3] = CullStrategy::ALL;
 const GRIDS: [CullGrid; 2] = [
     CullGrid::Tiles { tile_size: 16 },
     CullGrid::Clusters {

@@ -16,23 +16,23 @@ use lightgrid::scene::{LightAnchor, Rng, Scene, SceneLight};
 use lightgrid::{RenderSettings, Renderer};
 use std::time::Instant;
 
-const STRATEGIES: [Assign; 5] = [
-    Assign::Cpu,
-    Assign::Gather,
-    Assign::Scatter,
-    Assign::Bvh,
-    Assign::BvhGpu,
-];
+/// Every strategy of the registry.
+fn strategies() -> Vec<Assign> {
+    lightgrid::culling::STRATEGIES
+        .iter()
+        .map(|s| s.assign)
+        .collect()
+}
 
-/// Every pipeline whose grid `--assign` builds; `tiled_forward` assigns against `[near, far]`,
-/// the others against the depth bounds of their pre-pass or G-buffer.
-const GRID_PIPELINES: [&str; 5] = [
-    "tiled_forward",
-    "tiled_forward_prez",
-    "tiled_deferred",
-    "clustered_forward",
-    "clustered_deferred",
-];
+/// Every pipeline whose grid `--assign` builds, from the registry; `tiled_forward` assigns
+/// against `[near, far]`, the others against the depth bounds of their pre-pass or G-buffer.
+fn grid_pipelines() -> Vec<&'static str> {
+    lightgrid::pipelines::PIPELINES
+        .iter()
+        .filter(|p| p.assign)
+        .map(|p| p.id)
+        .collect()
+}
 
 const TILES: [u32; 9] = [4, 5, 7, 8, 13, 16, 31, 32, 64];
 
@@ -49,13 +49,13 @@ struct Config {
 /// What the scenes of a run measured, for the bounds at the end.
 #[derive(Default)]
 struct Totals {
-    scenes: [usize; STRATEGIES.len()],
+    scenes: Vec<usize>,
     coverage: common::Coverage,
     hits: u64,
     at_slice_boundary: u64,
     disagreements: usize,
     /// Seconds spent rendering (and downloading), per strategy, and checking on the CPU.
-    render_s: [f64; STRATEGIES.len()],
+    render_s: Vec<f64>,
     check_s: f64,
 }
 
@@ -95,7 +95,10 @@ fn run(
     for (ci, config) in configs.iter().enumerate() {
         let start = Instant::now();
         let (w, h) = config.size;
-        let mut renderers: Vec<Renderer> = STRATEGIES
+        let strategies = strategies();
+        totals.scenes.resize(strategies.len(), 0);
+        totals.render_s.resize(strategies.len(), 0.0);
+        let mut renderers: Vec<Renderer> = strategies
             .iter()
             .map(|&assign| {
                 let settings = RenderSettings {
@@ -122,7 +125,7 @@ fn run(
             scene.validate().unwrap();
             let lights = scene.frame(frame).lights;
             let mut oracle: Option<common::FrameOracle> = None;
-            for (si, (assign, r)) in STRATEGIES.iter().zip(&mut renderers).enumerate() {
+            for (si, (assign, r)) in strategies.iter().zip(&mut renderers).enumerate() {
                 let what = format!(
                     "scene {k} of config {ci} ({} f{frame}, {} --assign {} {w}x{h} tile {} \
                      slices {})",
@@ -170,10 +173,14 @@ fn run(
             config.slices,
             config.pipeline,
             config.scenes,
-            STRATEGIES.len(),
+            strategies.len(),
             start.elapsed().as_secs_f64(),
             totals.render_s.iter().sum::<f64>(),
-            totals.render_s.map(|t| (t * 10.0).round() / 10.0),
+            totals
+                .render_s
+                .iter()
+                .map(|t| (t * 10.0).round() / 10.0)
+                .collect::<Vec<_>>(),
             totals.check_s,
         );
     }
@@ -191,7 +198,7 @@ fn gpu_strategies_contain_the_oracle_in_small_randomized_scenes() {
             size: (64 + 2 * rng.below(68) + 1, 48 + 2 * rng.below(51) + 1),
             tile: TILES[i % TILES.len()],
             slices: [2, 8, 16, 32, 64][i % 5],
-            pipeline: GRID_PIPELINES[i % GRID_PIPELINES.len()],
+            pipeline: grid_pipelines()[i % grid_pipelines().len()],
             scenes: 5,
             lights: 240,
         })

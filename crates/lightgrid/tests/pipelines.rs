@@ -618,21 +618,19 @@ fn check_assign(
     out.grid
 }
 
-const GRID_PIPELINES: [&str; 6] = [
-    "tiled_forward",
-    "tiled_forward_prez",
-    "tiled_deferred",
-    "clustered_forward",
-    "clustered_deferred",
-    "tiled_light_prepass",
-];
-const STRATEGIES: [Assign; 5] = [
-    Assign::Cpu,
-    Assign::Gather,
-    Assign::Scatter,
-    Assign::Bvh,
-    Assign::BvhGpu,
-];
+/// Every pipeline whose grid `--assign` builds, from the registry.
+fn grid_pipelines() -> Vec<&'static str> {
+    lightgrid::pipelines::PIPELINES
+        .iter()
+        .filter(|p| p.assign)
+        .map(|p| p.id)
+        .collect()
+}
+
+/// Every strategy of the registry.
+fn strategies() -> impl Iterator<Item = Assign> {
+    lightgrid::culling::STRATEGIES.iter().map(|s| s.assign)
+}
 
 fn check_strategies(
     scene: &Scene,
@@ -656,7 +654,7 @@ fn check_strategies(
                 .image
         });
     }
-    for assign in STRATEGIES {
+    for assign in strategies() {
         let settings = RenderSettings {
             tile_size: tile,
             slices,
@@ -674,7 +672,7 @@ fn check_strategies(
 #[test]
 fn every_strategy_matches_its_twin_on_every_grid_pipeline() {
     let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
-    check_strategies(&s, 200, (160, 90), 16, 32, &GRID_PIPELINES);
+    check_strategies(&s, 200, (160, 90), 16, 32, &grid_pipelines());
 }
 
 #[test]
@@ -815,7 +813,7 @@ fn strategies_agree_with_each_other_and_pipelines_without_a_grid_ignore_them() {
     let ctx = common::gpu();
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
     let mut lists = Vec::new();
-    for assign in STRATEGIES {
+    for assign in strategies() {
         let settings = RenderSettings {
             assign,
             ..Default::default()
@@ -894,7 +892,7 @@ fn strategies_on_randomized_edge_case_lights() {
             .collect();
         scene.lights = lights;
         scene.validate().unwrap();
-        check_strategies(&scene, frame, (w, h), tile, slices, &GRID_PIPELINES);
+        check_strategies(&scene, frame, (w, h), tile, slices, &grid_pipelines());
     }
 }
 

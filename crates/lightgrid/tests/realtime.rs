@@ -15,7 +15,13 @@ use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::shader::{compose, compute_pipeline, src};
 use lightgrid::{Error, RenderSettings, Renderer};
 
-const GPU_STRATEGIES: [Assign; 4] = [Assign::Gather, Assign::Scatter, Assign::Bvh, Assign::BvhGpu];
+/// The registry's strategies that record into the frame's one submission.
+fn gpu_strategies() -> impl Iterator<Item = Assign> {
+    lightgrid::culling::STRATEGIES
+        .iter()
+        .filter(|s| !s.reads_back)
+        .map(|s| s.assign)
+}
 
 fn stress(lights: u32) -> lightgrid::scene::Scene {
     catalog::build(
@@ -68,7 +74,7 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
         lightgrid::MAX_FRAMES_IN_FLIGHT + 1,
     ));
     let mut checked = 0;
-    for assign in GPU_STRATEGIES {
+    for assign in gpu_strategies() {
         let settings = RenderSettings {
             assign,
             ..Default::default()
@@ -164,7 +170,7 @@ fn static_geometry_is_uploaded_once() {
 fn a_frame_whose_lists_did_not_fit_is_reported_and_later_frames_fit() {
     let ctx = common::gpu();
     let scene = stress(20_000);
-    for assign in GPU_STRATEGIES {
+    for assign in gpu_strategies() {
         let settings = RenderSettings {
             assign,
             ..Default::default()

@@ -127,6 +127,13 @@ pub enum CullStrategy {
 }
 
 impl CullStrategy {
+    /// The strategies `Auto` chooses between and the one it does not, each by name.
+    pub const ALL: [CullStrategy; 3] = [
+        CullStrategy::Gather,
+        CullStrategy::Scatter,
+        CullStrategy::BvhGpu,
+    ];
+
     fn assign(self) -> Assign {
         match self {
             CullStrategy::Gather => Assign::Gather,

@@ -9,6 +9,9 @@ use crate::frame::Assign;
 /// One registry row.
 pub struct StrategyInfo {
     pub assign: Assign,
+    /// The frame waits for the GPU part-way (the cell bounds read back: the papers' CPU
+    /// pipeline); the others record into the frame's one submission.
+    pub reads_back: bool,
     pub create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
 }
 
@@ -16,22 +19,27 @@ pub struct StrategyInfo {
 pub const STRATEGIES: &[StrategyInfo] = &[
     StrategyInfo {
         assign: Assign::Cpu,
+        reads_back: true,
         create: super::assign_cpu::create_strategy,
     },
     StrategyInfo {
         assign: Assign::Gather,
+        reads_back: false,
         create: super::gather::create_strategy,
     },
     StrategyInfo {
         assign: Assign::Scatter,
+        reads_back: false,
         create: super::scatter::create_strategy,
     },
     StrategyInfo {
         assign: Assign::Bvh,
+        reads_back: false,
         create: super::bvh::create_strategy,
     },
     StrategyInfo {
         assign: Assign::BvhGpu,
+        reads_back: false,
         create: super::bvh_gpu::create_strategy,
     },
 ];
