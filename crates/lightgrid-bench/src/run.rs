@@ -3,13 +3,12 @@
 use crate::invalid;
 use crate::outdir::{Outcome, STOPPED_BY_SIGNAL};
 use image::RgbaImage;
-use lightgrid::culling::GridLists;
 use lightgrid::error::Result;
-use lightgrid::frame::{DepthBounds, DepthReduction, MaterialDraws, MsaaResolve};
+use lightgrid::frame::MsaaResolve;
 use lightgrid::gpu::{GpuContext, PassTiming};
 use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
-use lightgrid::pipelines::{self, RenderSettings, SpotCull};
+use lightgrid::pipelines::{self, Axis, RenderSettings, SettingValue, AXES};
 use lightgrid::realtime::{play, PlayPlan, PlayedFrame};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{gltf, source, AddLights, SceneRequest};
@@ -78,11 +77,11 @@ pub struct BenchConfig {
     /// None: each scene's own size.
     pub size: Option<(u32, u32)>,
     pub tile_size: u32,
-    /// View-depth slices of clustered pipelines.
-    pub slices: u32,
-    /// Who builds the grids of pipelines that can use GPU gather (the others use the CPU).
-    pub assign: lightgrid::pipelines::Assign,
-    pub gbuffers: Vec<GBufferFormat>,
+    /// The values each setting of the library's table (`lightgrid::pipelines::AXES`) is
+    /// measured at; a setting not listed is measured at its default. Every pipeline is
+    /// measured once per combination of the values of the settings that apply to it.
+    #[serde(default)]
+    pub settings: Vec<AxisValues>,
     /// Measurements per frame (the spread is kept).
     pub repeat: u32,
     /// Discarded renders of the first frame before each pipeline's series.
@@ -106,10 +105,6 @@ pub struct BenchConfig {
     /// Headlights on the robots of the scenes that have them (`--headlights`).
     #[serde(default)]
     pub headlights: bool,
-    /// What grid pipelines cull spots by (`--spot-cull`): every grid pipeline is measured
-    /// once per entry (pipelines without a grid once).
-    #[serde(default = "default_spot_culls")]
-    pub spot_culls: Vec<SpotCull>,
     /// The scenes' transparent objects (`--transparency on|off`).
     #[serde(default = "default_on")]
     pub transparency: bool,
@@ -121,92 +116,78 @@ pub struct BenchConfig {
     /// The materials' own shaders (`--material-shaders on|off`).
     #[serde(default = "default_on")]
     pub material_shaders: bool,
-    /// The lists grid pipelines build for frames with transparent geometry (`--lists`):
-    /// every pipeline with an `--assign` grid is measured once per entry.
-    #[serde(default = "default_lists")]
-    pub lists: Vec<GridLists>,
-    /// How forward-shading pipelines draw the material shaders (`--material-draws`): each of
-    /// them is measured once per entry.
-    #[serde(default = "default_material_draws")]
-    pub material_draws: Vec<MaterialDraws>,
-    /// MSAA sample counts (`--msaa`): every pipeline that renders with MSAA is measured once
-    /// per entry (the others only at 1).
-    #[serde(default = "default_msaa")]
-    pub msaa: Vec<u32>,
-    /// Where tiled and clustered deferred resolve MSAA (`--msaa-resolve`): each is measured
-    /// once per entry at every sample count above 1.
-    #[serde(default = "default_msaa_resolve")]
-    pub msaa_resolve: Vec<MsaaResolve>,
     /// Lights scattered over every scene's bounds (`--add-lights`).
     #[serde(default)]
     pub add_lights: Option<AddLights>,
-    /// Which cell depth bounds grids built from depth cull by (`--depth-bounds`): every
-    /// pipeline with such a grid is measured once per entry.
-    #[serde(default = "default_depth_bounds")]
-    pub depth_bounds: Vec<DepthBounds>,
-    /// How the cell-bounds kernel reduces depths (`--depth-reduction`): every pipeline with a
-    /// grid built from depth is measured once per entry.
-    #[serde(default = "default_depth_reductions")]
-    pub depth_reductions: Vec<DepthReduction>,
 }
 
-fn default_depth_reductions() -> Vec<DepthReduction> {
-    vec![DepthReduction::default()]
-}
-
-fn default_depth_bounds() -> Vec<DepthBounds> {
-    vec![DepthBounds::default()]
-}
-
-fn default_msaa_resolve() -> Vec<MsaaResolve> {
-    vec![MsaaResolve::default()]
-}
-
-fn one() -> u32 {
-    1
-}
-
-fn default_msaa() -> Vec<u32> {
-    vec![1]
-}
-
-fn default_material_draws() -> Vec<MaterialDraws> {
-    vec![MaterialDraws::default()]
-}
-
-fn default_spot_culls() -> Vec<SpotCull> {
-    vec![SpotCull::default()]
+/// The values one setting of the library's table is measured at (`--spot-cull sphere,cone`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisValues {
+    /// The option without its dashes (`spot-cull`), a row of `lightgrid::pipelines::AXES`.
+    pub flag: String,
+    /// Value names, as the option takes them.
+    pub values: Vec<String>,
 }
 
 fn default_on() -> bool {
     true
 }
 
-fn default_lists() -> Vec<GridLists> {
-    vec![RenderSettings::default().lists]
-}
-
 impl BenchConfig {
+    /// The values `axis` is measured at: those listed, else its default.
+    pub fn values(&self, axis: &Axis) -> Vec<String> {
+        match self.settings.iter().find(|a| a.flag == axis.flag) {
+            Some(a) => a.values.clone(),
+            None => vec![(axis.get)(&RenderSettings::default())],
+        }
+    }
+
+    /// Is `axis` measured at more than one value?
+    pub fn varies(&self, axis: &Axis) -> bool {
+        self.values(axis).len() > 1
+    }
+
+    /// The values of the setting `T` is the type of.
+    pub fn values_of<T: SettingValue>(&self) -> Vec<T> {
+        let axis = pipelines::find_axis(T::FLAG).expect("every setting type has a row");
+        (self.values(axis).iter())
+            .map(|v| T::parse(v).expect("validated"))
+            .collect()
+    }
+
+    /// The MSAA sample counts measured.
+    pub fn msaa_counts(&self) -> Vec<u32> {
+        let axis = pipelines::find_axis("msaa").expect("the msaa row");
+        (self.values(axis).iter())
+            .map(|v| v.parse().expect("validated"))
+            .collect()
+    }
+
+    /// Set `flag`'s values (replacing any listed).
+    pub fn set(&mut self, flag: &str, values: Vec<String>) {
+        self.settings.retain(|a| a.flag != flag);
+        self.settings.push(AxisValues {
+            flag: flag.into(),
+            values,
+        });
+    }
+
     pub fn validate(&self) -> Result<()> {
         check_range_scales(&self.range_scales)?;
-        if self.scenes.is_empty()
-            || self.pipelines.is_empty()
-            || self.gbuffers.is_empty()
-            || self.spot_culls.is_empty()
-            || self.lists.is_empty()
-            || self.material_draws.is_empty()
-            || self.msaa.is_empty()
-            || self.msaa_resolve.is_empty()
-            || self.depth_bounds.is_empty()
-            || self.depth_reductions.is_empty()
-        {
-            return Err(invalid(
-                "bench",
-                "needs at least one scene, pipeline, G-buffer setting, spot culling, list setting and sample count",
-            ));
+        if self.scenes.is_empty() || self.pipelines.is_empty() {
+            return Err(invalid("bench", "needs at least one scene and pipeline"));
         }
-        for &n in &self.msaa {
-            lightgrid::frame::validate_msaa(n)?;
+        for a in &self.settings {
+            let axis = pipelines::find_axis(&a.flag)
+                .ok_or_else(|| invalid("bench", format!("no setting --{}", a.flag)))?;
+            if a.values.is_empty() {
+                return Err(invalid("bench", format!("--{} needs a value", a.flag)));
+            }
+            for v in &a.values {
+                (axis.set)(&mut RenderSettings::default(), v)
+                    .map_err(|e| invalid("bench", format!("--{}: {e}", a.flag)))?;
+            }
         }
         for p in &self.pipelines {
             pipelines::find(p)?;
@@ -250,7 +231,6 @@ impl BenchConfig {
         }
         lightgrid::RenderSettings {
             tile_size: self.tile_size,
-            slices: self.slices,
             ..Default::default()
         }
         .validate()?;
@@ -420,30 +400,12 @@ pub enum TimesFrom {
 pub struct RunRecord {
     pub scene: String,
     pub pipeline: String,
-    /// None for pipelines without a G-buffer (measured once).
-    pub gbuffer_bits: Option<u32>,
-    /// What spots were culled by, when the run measured more than one way (grid pipelines).
+    /// The settings the pipeline rendered with.
+    pub settings: RenderSettings,
+    /// The settings the run measured at more than one value that the pipeline reads (their
+    /// flags): what tells this series from its siblings.
     #[serde(default)]
-    pub spot_cull: Option<SpotCull>,
-    /// The transparent lists, when the run measured more than one setting (`--lists`).
-    #[serde(default)]
-    pub lists: Option<GridLists>,
-    /// How material shaders were drawn, when the run measured more than one way.
-    #[serde(default)]
-    pub material_draws: Option<MaterialDraws>,
-    /// MSAA samples per pixel.
-    #[serde(default = "one")]
-    pub msaa: u32,
-    /// Where the MSAA deferred kernel resolved (deferred grid pipelines above one sample).
-    #[serde(default)]
-    pub msaa_resolve: Option<MsaaResolve>,
-    /// The cell depth bounds culled by, when the run measured more than one
-    /// (`--depth-bounds`; pipelines whose grid is bounded by depth).
-    #[serde(default)]
-    pub depth_bounds: Option<DepthBounds>,
-    /// The depth reduction, when the run measured more than one (`--depth-reduction`).
-    #[serde(default)]
-    pub depth_reduction: Option<DepthReduction>,
+    pub varied: Vec<String>,
     pub width: u32,
     pub height: u32,
     pub tile_size: u32,
@@ -570,150 +532,55 @@ fn median(v: &[f64]) -> usize {
     idx[idx.len() / 2]
 }
 
-/// One series of the plan: a scene, a G-buffer setting and a pipeline over its frames.
+/// One series of the plan: a scene and a pipeline with one combination of the settings
+/// that apply to it, over its frames.
 struct Series {
     scene: usize,
-    gbuffer: GBufferFormat,
     info: &'static pipelines::PipelineInfo,
-    /// False for pipelines without a G-buffer (measured once, under the first setting).
-    uses_gbuffer: bool,
-    /// What spots are culled by; recorded when more than one is measured.
-    spot_cull: SpotCull,
-    /// The transparent lists; recorded when more than one is measured.
-    lists: GridLists,
-    /// How material shaders are drawn; recorded when more than one is measured.
-    material_draws: MaterialDraws,
-    /// MSAA samples per pixel.
-    msaa: u32,
-    /// Where the MSAA deferred kernel resolves (recorded above one sample).
-    msaa_resolve: Option<MsaaResolve>,
-    /// Which depth bounds the grid culls by; recorded when more than one is measured.
-    depth_bounds: DepthBounds,
-    depth_reduction: DepthReduction,
+    settings: RenderSettings,
     frames: Vec<u32>,
 }
 
-/// The settings one pipeline is measured under: every combination of the entries that
-/// apply to it (a setting that changes nothing for it is measured once, at its first entry).
-#[derive(Clone, Copy)]
-struct Variant {
-    spot_cull: SpotCull,
-    lists: GridLists,
-    material_draws: MaterialDraws,
-    msaa: u32,
-    msaa_resolve: Option<MsaaResolve>,
-    depth_bounds: DepthBounds,
-    depth_reduction: DepthReduction,
-}
-
-fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<Variant> {
-    // Does the option `flag` apply to the pipeline in variant `v`? The library's table of
-    // settings decides, as it does for the CLI's refusals.
-    let applies = |flag: &str, v: &Variant| {
-        let axis = pipelines::find_axis(flag).expect("a flag of the table");
-        (axis.applies)(info, &v.settings())
-    };
-    /// Every variant once per value of a setting where it applies, else at its first value
-    /// (the product, last dimension fastest).
-    fn times<T: Copy>(
-        out: Vec<Variant>,
-        values: &[T],
-        applies: impl Fn(&Variant) -> bool,
-        set: fn(&mut Variant, T),
-    ) -> Vec<Variant> {
-        out.iter()
-            .flat_map(|v| {
-                let used = if applies(v) { values } else { &values[..1] };
-                used.iter().map(move |&x| {
-                    let mut v = *v;
-                    set(&mut v, x);
-                    v
-                })
-            })
-            .collect()
-    }
-    let mut out = vec![Variant {
-        spot_cull: config.spot_culls[0],
-        lists: config.lists[0],
-        material_draws: config.material_draws[0],
-        msaa: 1,
-        msaa_resolve: None,
-        depth_bounds: config.depth_bounds[0],
-        depth_reduction: config.depth_reductions[0],
+/// The settings one pipeline is measured under: every combination of the values of the
+/// settings that apply to it (the library's table decides which, as it does for the CLI's
+/// refusals); a setting that changes nothing for it stays at its default. The product runs
+/// in the table's order, last setting fastest.
+fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<RenderSettings> {
+    let mut out = vec![RenderSettings {
+        tile_size: config.tile_size,
+        ..RenderSettings::default()
     }];
-    out = times(
-        out,
-        &config.spot_culls,
-        |v| applies("spot-cull", v),
-        |v, x| v.spot_cull = x,
-    );
-    out = times(
-        out,
-        &config.lists,
-        |v| applies("lists", v),
-        |v, x| v.lists = x,
-    );
-    out = times(
-        out,
-        &config.material_draws,
-        |v| applies("material-draws", v),
-        |v, x| v.material_draws = x,
-    );
-    // A pipeline refusing MSAA is measured without it only.
-    let msaa: Vec<u32> = config.msaa.clone();
-    out = out
-        .into_iter()
-        .flat_map(|v| {
-            msaa.iter()
-                .filter(|&&m| m == 1 || applies("msaa", &v))
-                .map(move |&m| Variant { msaa: m, ..v })
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    // Only the deferred kernels resolve, and only with MSAA: others keep `None`.
-    out = out
-        .into_iter()
-        .flat_map(|v| match applies("msaa-resolve", &v) {
-            true => config
-                .msaa_resolve
-                .iter()
-                .map(|&x| Variant {
-                    msaa_resolve: Some(x),
-                    ..v
-                })
-                .collect(),
-            false => vec![v],
-        })
-        .collect();
-    out = times(
-        out,
-        &config.depth_bounds,
-        |v| applies("depth-bounds", v),
-        |v, x| v.depth_bounds = x,
-    );
-    times(
-        out,
-        &config.depth_reductions,
-        |v| applies("depth-reduction", v),
-        |v, x| v.depth_reduction = x,
-    )
+    for axis in AXES {
+        let values = config.values(axis);
+        out = out
+            .into_iter()
+            .flat_map(|s| match (axis.applies)(info, &s) {
+                true => values
+                    .iter()
+                    .map(|v| {
+                        let mut s = s;
+                        (axis.set)(&mut s, v).expect("validated");
+                        s
+                    })
+                    .collect(),
+                false => vec![s],
+            })
+            .collect();
+    }
+    out
 }
 
-impl Variant {
-    /// The settings the variant differs in (the others at their defaults), for the table's
-    /// applies-to rules.
-    fn settings(&self) -> RenderSettings {
-        RenderSettings {
-            spot_cull: self.spot_cull,
-            lists: self.lists,
-            material_draws: self.material_draws,
-            msaa: self.msaa,
-            msaa_resolve: self.msaa_resolve.unwrap_or_default(),
-            depth_bounds: self.depth_bounds,
-            depth_reduction: self.depth_reduction,
-            ..RenderSettings::default()
-        }
-    }
+/// What tells `settings` from its siblings: the flags of the settings measured at more than
+/// one value that `info` reads.
+fn varied(
+    config: &BenchConfig,
+    info: &pipelines::PipelineInfo,
+    settings: &RenderSettings,
+) -> Vec<String> {
+    AXES.iter()
+        .filter(|a| config.varies(a) && (a.applies)(info, settings))
+        .map(|a| a.flag.to_string())
+        .collect()
 }
 
 /// The suffix of a scene measured without its transparent objects (`opaque_variants`).
@@ -857,29 +724,15 @@ fn plan(config: &BenchConfig, scenes: &[lightgrid::scene::Scene]) -> Result<Vec<
                 ),
             ));
         }
-        for (gi, g) in config.gbuffers.iter().enumerate() {
-            for id in &config.pipelines {
-                let info = pipelines::find(id)?;
-                let g_used = info.uses_gbuffer();
-                if !g_used && gi > 0 {
-                    continue;
-                }
-                for v in variants(config, info) {
-                    plan.push(Series {
-                        scene: si,
-                        gbuffer: *g,
-                        info,
-                        uses_gbuffer: g_used,
-                        spot_cull: v.spot_cull,
-                        lists: v.lists,
-                        material_draws: v.material_draws,
-                        msaa: v.msaa,
-                        msaa_resolve: v.msaa_resolve,
-                        depth_bounds: v.depth_bounds,
-                        depth_reduction: v.depth_reduction,
-                        frames: frames.clone(),
-                    });
-                }
+        for id in &config.pipelines {
+            let info = pipelines::find(id)?;
+            for settings in variants(config, info) {
+                plan.push(Series {
+                    scene: si,
+                    info,
+                    settings,
+                    frames: frames.clone(),
+                });
             }
         }
     }
@@ -921,28 +774,8 @@ impl<'a> Measuring<'a> {
         });
     }
 
-    fn settings(&self, series: &Series) -> RenderSettings {
-        RenderSettings {
-            tile_size: self.config.tile_size,
-            gbuffer: series.gbuffer,
-            slices: self.config.slices,
-            assign: if series.info.assign {
-                self.config.assign
-            } else {
-                lightgrid::pipelines::Assign::default()
-            },
-            spot_cull: series.spot_cull,
-            lists: series.lists,
-            material_draws: series.material_draws,
-            msaa: series.msaa,
-            msaa_resolve: series.msaa_resolve.unwrap_or_default(),
-            depth_bounds: series.depth_bounds,
-            depth_reduction: series.depth_reduction,
-        }
-    }
-
     fn renderer(&mut self, series: &Series, size: (u32, u32)) -> Result<&mut Renderer<'a>> {
-        let settings = self.settings(series);
+        let settings = series.settings;
         let si = series.scene;
         if !self.renderers.iter().any(|r| r.0 == si && r.1 == settings) {
             self.renderers.retain(|r| r.0 == si);
@@ -970,35 +803,9 @@ impl<'a> Measuring<'a> {
     ) -> Result<SeriesEnd> {
         let info = series.info;
         let frames = &series.frames;
-        let g = if series.uses_gbuffer {
-            format!(" g{}", series.gbuffer.bits())
-        } else {
-            String::new()
-        };
-        // The settings the record names (those measured in more than one way).
-        let mut cull = match record.spot_cull {
-            Some(c) => format!(" {c:?}").to_lowercase(),
-            None => String::new(),
-        };
-        if let Some(l) = record.lists {
-            cull += &format!(" {} lists", l.name());
-        }
-        if let Some(d) = record.material_draws {
-            cull += &format!(" {} draws", d.name());
-        }
-        if series.msaa > 1 {
-            cull += &format!(" {}x msaa", series.msaa);
-        }
-        if let Some(r) = series.msaa_resolve {
-            cull += &format!(" {} resolve", r.name());
-        }
-        if let Some(b) = record.depth_bounds {
-            cull += &format!(" bounds {}", b.name());
-        }
-        if let Some(d) = record.depth_reduction {
-            cull += &format!(" {} reduction", d.name());
-        }
-        let label = |what: &str| format!("{} {}{g}{cull} {what}", scene.name, info.id);
+        // The settings the record names (those measured at more than one value).
+        let named = record.describe();
+        let label = |what: &str| format!("{} {}{named} {what}", scene.name, info.id);
         for _ in 0..self.config.warmup {
             self.tick(label("warm-up"));
             self.renderer(series, (record.width, record.height))?
@@ -1070,7 +877,7 @@ impl<'a> Measuring<'a> {
             warmup: crate::PLAY_QUEUE_FILL,
         };
         let (base, total, stop) = (self.done, self.total, self.stop);
-        let settings = self.settings(series);
+        let settings = series.settings;
         let progress = &mut *self.progress;
         let renderer = &mut self
             .renderers
@@ -1125,18 +932,79 @@ impl FrameRecord {
 }
 
 impl RunRecord {
+    /// The value of the setting `T` is the type of, when the run measured more than one and
+    /// the pipeline reads it.
+    pub fn varied<T: SettingValue>(&self) -> Option<T> {
+        self.varied
+            .iter()
+            .any(|f| f == T::FLAG)
+            .then(|| pipelines::value_of::<T>(&self.settings))
+    }
+
+    /// Does the pipeline read the setting `flag` (with the run's settings)?
+    pub fn reads(&self, flag: &str) -> bool {
+        let axis = pipelines::find_axis(flag).expect("a row of the table");
+        pipelines::find(&self.pipeline).is_ok_and(|p| (axis.applies)(p, &self.settings))
+    }
+
+    /// The G-buffer's bits per channel, for pipelines with one.
+    pub fn gbuffer_bits(&self) -> Option<u32> {
+        self.reads(GBufferFormat::FLAG)
+            .then_some(self.settings.gbuffer.bits())
+    }
+
+    /// MSAA samples per pixel.
+    pub fn msaa(&self) -> u32 {
+        self.settings.msaa
+    }
+
+    /// Where the MSAA deferred kernel resolved (the deferred kernels above one sample).
+    pub fn msaa_resolve(&self) -> Option<MsaaResolve> {
+        self.reads(MsaaResolve::FLAG)
+            .then_some(self.settings.msaa_resolve)
+    }
+
+    /// What spots were culled by, when the run measured more than one way.
+    pub fn spot_cull(&self) -> Option<lightgrid::pipelines::SpotCull> {
+        self.varied()
+    }
+
+    /// The transparent lists, when the run measured more than one setting.
+    pub fn lists(&self) -> Option<lightgrid::culling::GridLists> {
+        self.varied()
+    }
+
+    /// How material shaders were drawn, when the run measured more than one way.
+    pub fn material_draws(&self) -> Option<lightgrid::frame::MaterialDraws> {
+        self.varied()
+    }
+
+    /// The cell depth bounds culled by, when the run measured more than one.
+    pub fn depth_bounds(&self) -> Option<lightgrid::frame::DepthBounds> {
+        self.varied()
+    }
+
+    /// The depth reduction, when the run measured more than one.
+    pub fn depth_reduction(&self) -> Option<lightgrid::frame::DepthReduction> {
+        self.varied()
+    }
+
+    /// " flag value" for each setting the run measured at more than one value (the series'
+    /// name in progress lines and errors).
+    pub fn describe(&self) -> String {
+        self.varied
+            .iter()
+            .filter_map(|f| pipelines::find_axis(f))
+            .map(|a| format!(" {} {}", a.flag, (a.get)(&self.settings)))
+            .collect()
+    }
+
     fn new(scene: &lightgrid::scene::Scene, series: &Series, size: (u32, u32), tile: u32) -> Self {
         RunRecord {
             scene: scene.name.clone(),
             pipeline: series.info.id.to_string(),
-            gbuffer_bits: series.uses_gbuffer.then_some(series.gbuffer.bits()),
-            spot_cull: None,
-            lists: None,
-            material_draws: None,
-            msaa: series.msaa,
-            msaa_resolve: series.msaa_resolve,
-            depth_bounds: None,
-            depth_reduction: None,
+            settings: series.settings,
+            varied: Vec::new(),
             lights: None,
             width: size.0,
             height: size.1,
@@ -1273,22 +1141,9 @@ impl PreparedBench {
             let scene = &scenes[series.scene];
             let size = config.size.unwrap_or(scene.default_size);
             let mut record = RunRecord::new(scene, series, size, config.tile_size);
-            if config.spot_culls.len() > 1 && series.info.uses_grid {
-                record.spot_cull = Some(series.spot_cull);
-            }
-            if config.lists.len() > 1 && series.info.assign {
-                record.lists = Some(series.lists);
-            }
-            if config.material_draws.len() > 1 && series.info.forward_shading {
-                record.material_draws = Some(series.material_draws);
-            }
-            if config.depth_bounds.len() > 1 && series.info.depth_bounds {
-                record.depth_bounds = Some(series.depth_bounds);
-            }
-            if config.depth_reductions.len() > 1 && series.info.depth_bounds {
-                record.depth_reduction = Some(series.depth_reduction);
-            }
+            record.varied = varied(config, series.info, &series.settings);
             let mut bytes = (0, 0);
+            let named = record.describe();
             let end = m.series(scene, series, &mut record, &mut bytes, &mut results);
             record.complete = matches!(end, Ok(SeriesEnd::Complete));
             record.summary = RunSummary::from_frames(&record.frames, bytes.0, bytes.1);
@@ -1304,13 +1159,7 @@ impl PreparedBench {
                 Err(e) => {
                     results.outcome = Outcome::Failed(format!(
                         "{} / {}{}: {e}",
-                        scene.name,
-                        series.info.id,
-                        if series.uses_gbuffer {
-                            format!(" (G-buffer {} bits)", series.gbuffer.bits())
-                        } else {
-                            String::new()
-                        }
+                        scene.name, series.info.id, named
                     ));
                     break;
                 }
@@ -1324,11 +1173,15 @@ impl PreparedBench {
                 .unwrap_or_else(|| config.pipelines[0].clone());
             for scene in scenes {
                 let size = config.size.unwrap_or(scene.default_size);
-                let settings = RenderSettings {
+                // The first value of every setting (the thumbnails show the scene).
+                let mut settings = RenderSettings {
                     tile_size: config.tile_size,
-                    slices: config.slices,
                     ..Default::default()
                 };
+                for axis in AXES {
+                    (axis.set)(&mut settings, &config.values(axis)[0]).expect("validated");
+                }
+                let settings = RenderSettings { ..settings };
                 let strip = Renderer::new(ctx, size.0, size.1, settings)
                     .and_then(|mut r| thumbnails(&mut r, scene, &pipeline));
                 match strip {

@@ -5,9 +5,8 @@
 #[path = "../../lightgrid/tests/common/mod.rs"]
 mod common;
 
-use lightgrid::passes::GBufferFormat;
 use lightgrid_bench::{
-    evaluate_claims, run, write_report, BenchConfig, FrameRange, TimesFrom, Verdict,
+    evaluate_claims, run, write_report, AxisValues, BenchConfig, FrameRange, TimesFrom, Verdict,
 };
 use serde_json::Value;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -29,29 +28,23 @@ fn config() -> BenchConfig {
         frames: FrameRange::parse("0..259:129").unwrap(),
         size: Some((96, 54)),
         tile_size: 16,
-        slices: 32,
-        assign: Default::default(),
-        gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
+        settings: vec![AxisValues {
+            flag: "gbuffer".into(),
+            values: vec!["16".into(), "32".into()],
+        }],
         repeat: 2,
         warmup: 1,
         seed: 1,
         lights: None,
         heatmap_frame: None,
         spot_fraction: 0.0,
-        msaa: vec![1],
-        msaa_resolve: vec![Default::default()],
         add_lights: None,
-        depth_bounds: vec![Default::default()],
-        depth_reductions: vec![Default::default()],
         heatmap_max: None,
         range_scales: vec![],
         headlights: false,
-        spot_culls: vec![Default::default()],
         transparency: true,
         opaque_variants: false,
         material_shaders: true,
-        lists: vec![lightgrid::culling::GridLists::Separate],
-        material_draws: vec![Default::default()],
     }
 }
 
@@ -119,7 +112,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
     // results.json: the documented layout.
     let json: Value =
         serde_json::from_slice(&std::fs::read(dir.join("results.json")).unwrap()).unwrap();
-    assert_eq!(json["schema_version"], 3);
+    assert_eq!(json["schema_version"], 4);
     assert!(json["adapter"].is_string() && json["command"].is_string());
     assert_eq!(json["outcome"]["status"], "complete");
     assert_eq!(json["config"]["repeat"], 2);
@@ -276,7 +269,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
 fn stopped_at(at: u32) -> lightgrid_bench::BenchResults {
     let ctx = common::gpu();
     let mut cfg = config();
-    cfg.gbuffers = vec![GBufferFormat::F16];
+    cfg.set("gbuffer", vec!["16".into()]);
     cfg.repeat = 1;
     let stop = AtomicBool::new(false);
     let mut calls = 0;
@@ -414,17 +407,19 @@ fn spot_culls_are_measured_side_by_side() {
     let cfg = BenchConfig {
         pipelines: vec!["forward".into(), "clustered_deferred".into()],
         frames: FrameRange::parse("0..259:200").unwrap(),
-        gbuffers: vec![GBufferFormat::F16],
         repeat: 1,
         spot_fraction: 1.0,
-        spot_culls: vec![SpotCull::Sphere, SpotCull::Cone],
+        settings: vec![AxisValues {
+            flag: "spot-cull".into(),
+            values: vec!["sphere".into(), "cone".into()],
+        }],
         ..config()
     };
     let results = run(&ctx, &cfg, &AtomicBool::new(false), &mut |_| {}).unwrap();
     let runs: Vec<(&str, Option<SpotCull>)> = results
         .runs
         .iter()
-        .map(|r| (r.pipeline.as_str(), r.spot_cull))
+        .map(|r| (r.pipeline.as_str(), r.spot_cull()))
         .collect();
     assert_eq!(
         runs,

@@ -134,7 +134,13 @@ impl AxisArgs {
             let mut arg = clap::Arg::new(axis.column)
                 .long(axis.flag)
                 .allow_hyphen_values(true)
-                .help(format!("{} [default: {default}]", capitalized(axis.help)));
+                .help(match list {
+                    false => format!("{} [default: {default}]", capitalized(axis.help)),
+                    true => format!(
+                        "{}: a value, or a comma list to measure each [default: {default}, unless the preset sets it]",
+                        capitalized(axis.help)
+                    ),
+                });
             let values = (axis.values)();
             arg = if values.is_empty() {
                 // A number: the table's `set` checks it.
@@ -185,6 +191,37 @@ fn capitalized(s: &str) -> String {
     c.next()
         .map(|f| f.to_uppercase().chain(c).collect())
         .unwrap_or_default()
+}
+
+/// The options of the library's table of settings as comma lists of values to measure
+/// (`bench`): made from the table as [`AxisArgs`] is.
+#[derive(Clone, Default)]
+pub(crate) struct AxisListArgs {
+    /// The options given, with their values.
+    pub(crate) given: Vec<(&'static Axis, Vec<String>)>,
+}
+
+impl clap::FromArgMatches for AxisListArgs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        Ok(AxisListArgs {
+            given: AxisArgs::given_in(matches),
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+impl clap::Args for AxisListArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        AxisArgs::options(cmd, true)
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 impl clap::FromArgMatches for AxisArgs {

@@ -1,18 +1,18 @@
 //! `lightgrid bench` and `lightgrid report`: the papers' evaluations and their report.
 
 use crate::args::{
-    check_applies, format_duration, parse_fraction, parse_size, progress_bar, run_outcome, setting,
-    stop_on_ctrl_c, OnOff, Size, MAX_COUNT,
+    check_applies, format_duration, parse_fraction, parse_size, progress_bar, run_outcome,
+    stop_on_ctrl_c, AxisListArgs, OnOff, Size, MAX_COUNT,
 };
 use anyhow::Result;
 use clap::Args;
-use lightgrid::frame::{DepthBounds, DepthReduction, GridLists, MaterialDraws, MsaaResolve};
+use lightgrid::frame::{DepthBounds, GridLists, MsaaResolve};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
 use lightgrid::pipelines::PIPELINES;
-use lightgrid::pipelines::{find_axis, Assign, Axis, SpotCull};
-use lightgrid_bench::{check_out_dir, BenchConfig, FrameRange, OutDir};
+use lightgrid::pipelines::{Axis, SettingValue, SpotCull};
+use lightgrid_bench::{check_out_dir, AxisValues, BenchConfig, FrameRange, OutDir};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -78,38 +78,15 @@ pub(crate) struct BenchArgs {
     /// Screen tile edge in pixels.
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) tile: Option<u32>,
-    /// View-depth slices of clustered pipelines (1 to 256) [default: 32].
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) slices: Option<u32>,
-    /// Who builds the light grid of grid pipelines [default: auto].
-    #[arg(long, value_parser = setting::<Assign>())]
-    pub(crate) assign: Option<Assign>,
-    /// MSAA sample counts to measure: 1, 4 or a list (1,4); the adapter's supported counts
-    /// only (lavapipe: 1 and 4). Pipelines that refuse MSAA are measured at 1 only
-    /// [default: 1].
-    #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
-    pub(crate) msaa: Vec<u32>,
-    /// Which cell depth bounds grids built from depth cull by: both, min, max, none or a
-    /// list (both,min,max,none) [default: both; the depth-bounds preset: all four].
-    #[arg(long, value_parser = setting::<DepthBounds>(), value_delimiter = ',')]
-    pub(crate) depth_bounds: Vec<DepthBounds>,
-    /// How the cell-bounds kernel reduces depths: atomics, subgroup or atomics,subgroup to
-    /// measure both (subgroup: adapters with subgroups) [default: atomics].
-    #[arg(long, value_parser = setting::<DepthReduction>(), value_delimiter = ',')]
-    pub(crate) depth_reduction: Vec<DepthReduction>,
-    /// Where tiled and clustered deferred resolve MSAA: separate, kernel, or separate,kernel
-    /// to measure both [default: separate; the msaa preset: both].
-    #[arg(long, value_parser = setting::<MsaaResolve>(), value_delimiter = ',')]
-    pub(crate) msaa_resolve: Vec<MsaaResolve>,
+    /// Every setting of the library's table, each a value or a comma list to measure.
+    #[command(flatten)]
+    pub(crate) axes: AxisListArgs,
     /// Scatter N point lights over every scene's bounds (catalog scenes and glTF files).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) add_lights: Option<u32>,
     /// Range of the lights --add-lights scatters (default: about 8 reach each point).
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::parse_positive)]
     pub(crate) light_range: Option<f64>,
-    /// G-buffer precisions to measure: 16, 32 or 16,32.
-    #[arg(long, value_delimiter = ',', value_parser = setting::<GBufferFormat>())]
-    pub(crate) gbuffer: Vec<GBufferFormat>,
     /// Measurements per frame, 1 to 1000; the median is kept and the spread recorded.
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..=MAX_COUNT))]
     pub(crate) repeat: Option<u32>,
@@ -127,10 +104,6 @@ pub(crate) struct BenchArgs {
     /// Give every robot two headlights (spot lights), in the scenes that have robots.
     #[arg(long)]
     pub(crate) headlights: bool,
-    /// What grid pipelines cull spot lights by: sphere, cone, or sphere,cone to measure both
-    /// [default: cone].
-    #[arg(long, value_parser = setting::<SpotCull>(), value_delimiter = ',')]
-    pub(crate) spot_cull: Vec<SpotCull>,
     /// The scenes' transparent objects (robots and random scenes): on, off, or on,off to
     /// also measure each scene with glass without it (as `<scene>-opaque`) [default: on].
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -138,14 +111,6 @@ pub(crate) struct BenchArgs {
     /// The materials' own shaders (car paint, rim); off renders every material standard.
     #[arg(long, value_enum)]
     pub(crate) material_shaders: Option<OnOff>,
-    /// The light lists of grid pipelines for frames with transparent objects: separate,
-    /// shared, or separate,shared to measure both [default: separate].
-    #[arg(long, value_parser = setting::<GridLists>(), value_delimiter = ',')]
-    pub(crate) lists: Vec<GridLists>,
-    /// How forward-shading pipelines draw the material shaders: per-material, uber, or
-    /// per-material,uber to measure both [default: per-material].
-    #[arg(long, value_parser = setting::<MaterialDraws>(), value_delimiter = ',')]
-    pub(crate) material_draws: Vec<MaterialDraws>,
     /// Frame of the lights-per-tile heatmap (default: the middle measured frame).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) heatmap_frame: Option<u32>,
@@ -187,19 +152,16 @@ pub(crate) struct BenchDefaults {
     pub(crate) scenes: Vec<&'static str>,
     pub(crate) frames: &'static str,
     pub(crate) size: Option<(u32, u32)>,
-    pub(crate) gbuffers: Vec<GBufferFormat>,
     pub(crate) repeat: u32,
     pub(crate) pipelines: Vec<String>,
     pub(crate) spot_fraction: f32,
-    pub(crate) spot_culls: Vec<lightgrid::pipelines::SpotCull>,
-    pub(crate) lists: Vec<lightgrid::culling::GridLists>,
-    pub(crate) msaa: Vec<u32>,
-    pub(crate) msaa_resolve: Vec<lightgrid::frame::MsaaResolve>,
+    /// The values settings of the library's table are measured at (unless their options
+    /// say): `--flag` without dashes and the values.
+    pub(crate) settings: Vec<(&'static str, Vec<String>)>,
     /// The scenes' transparent objects (unless `--transparency` says).
     pub(crate) transparency: bool,
     /// The paper's tile edge (unless `--tile` says; None: the renderer's default).
     pub(crate) tile: Option<u32>,
-    pub(crate) depth_bounds: Vec<lightgrid::frame::DepthBounds>,
     /// Light-range factors to measure each scene with (empty: the scene's own ranges).
     pub(crate) range_scales: Vec<f32>,
     /// The lights-per-tile heatmap's fixed scale (None: each frame's own maximum).
@@ -215,17 +177,12 @@ fn everything() -> BenchDefaults {
         scenes: vec!["robots-many"],
         frames: "0..259:5",
         size: None,
-        gbuffers: vec![GBufferFormat::F16],
         repeat: 1,
         pipelines: PIPELINES.iter().map(|p| p.id.to_string()).collect(),
         spot_fraction: 0.0,
-        spot_culls: vec![Default::default()],
-        lists: default_lists(),
-        msaa: vec![1],
-        msaa_resolve: vec![Default::default()],
+        settings: Vec::new(),
         transparency: true,
         tile: None,
-        depth_bounds: vec![Default::default()],
         range_scales: Vec::new(),
         heatmap_max: None,
         opaque_variants: false,
@@ -252,8 +209,12 @@ fn study(
     }
 }
 
-fn default_lists() -> Vec<lightgrid::culling::GridLists> {
-    vec![lightgrid::pipelines::RenderSettings::default().lists]
+/// A preset's values of the setting `T` is the type of.
+fn measure<T: SettingValue>(values: &[T]) -> (&'static str, Vec<String>) {
+    (
+        T::FLAG,
+        values.iter().map(|v| v.name().to_string()).collect(),
+    )
 }
 
 /// `supported`: the MSAA sample counts the adapter offers (the msaa preset measures them all).
@@ -272,17 +233,11 @@ pub(crate) fn bench_config(
         },
         Some(Preset::Spots) => BenchDefaults {
             spot_fraction: 1.0,
-            spot_culls: vec![
-                lightgrid::pipelines::SpotCull::Sphere,
-                lightgrid::pipelines::SpotCull::Cone,
-            ],
+            settings: vec![measure(&[SpotCull::Sphere, SpotCull::Cone])],
             ..study(hardware, |p| p.uses_grid)
         },
         Some(Preset::Transparency) => BenchDefaults {
-            lists: vec![
-                lightgrid::culling::GridLists::Separate,
-                lightgrid::culling::GridLists::Shared,
-            ],
+            settings: vec![measure(&[GridLists::Separate, GridLists::Shared])],
             ..study(hardware, |p| p.assign)
         },
         Some(Preset::Msaa) => BenchDefaults {
@@ -295,10 +250,9 @@ pub(crate) fn bench_config(
             ]
             .map(String::from)
             .to_vec(),
-            msaa: supported.to_vec(),
-            msaa_resolve: vec![
-                lightgrid::frame::MsaaResolve::Separate,
-                lightgrid::frame::MsaaResolve::Kernel,
+            settings: vec![
+                ("msaa", supported.iter().map(u32::to_string).collect()),
+                measure(&[MsaaResolve::Separate, MsaaResolve::Kernel]),
             ],
             // Fig. 4.4 measures the scene with and without its translucent blocks.
             opaque_variants: true,
@@ -307,7 +261,7 @@ pub(crate) fn bench_config(
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
             size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
-            gbuffers: vec![GBufferFormat::F16, GBufferFormat::F32],
+            settings: vec![measure(&[GBufferFormat::F16, GBufferFormat::F32])],
             repeat: if hardware { 3 } else { 1 },
             // The references of the mono-specular pipelines only exist to test their images.
             pipelines: PIPELINES
@@ -353,7 +307,7 @@ pub(crate) fn bench_config(
             ]
             .map(String::from)
             .to_vec(),
-            depth_bounds: lightgrid::frame::DepthBounds::ALL.to_vec(),
+            settings: vec![measure(&DepthBounds::ALL)],
             // tiled-forward-shading measures 32x32 tiles.
             tile: Some(32),
             ..study(hardware, |_| false)
@@ -369,14 +323,22 @@ pub(crate) fn bench_config(
             ..study(hardware, |_| false)
         },
     };
-    let (scenes, frames, size, gbuffers, repeat, pipelines) = (
-        d.scenes,
-        d.frames,
-        d.size,
-        d.gbuffers,
-        d.repeat,
-        d.pipelines,
-    );
+    let (scenes, frames, size, repeat, pipelines) =
+        (d.scenes, d.frames, d.size, d.repeat, d.pipelines);
+    // The preset's settings, then the options given.
+    let mut settings: Vec<AxisValues> = (d.settings.iter())
+        .map(|(flag, values)| AxisValues {
+            flag: flag.to_string(),
+            values: values.clone(),
+        })
+        .collect();
+    for (axis, values) in &a.axes.given {
+        settings.retain(|s| s.flag != axis.flag);
+        settings.push(AxisValues {
+            flag: axis.flag.to_string(),
+            values: values.clone(),
+        });
+    }
     let pipelines = match a.pipelines.as_deref() {
         None => pipelines,
         Some("all") => all,
@@ -399,13 +361,7 @@ pub(crate) fn bench_config(
             .tile
             .or(d.tile)
             .unwrap_or(lightgrid::consts::DEFAULT_TILE_SIZE),
-        slices: a.slices.unwrap_or(lightgrid::consts::DEFAULT_SLICES),
-        assign: a.assign.unwrap_or_default(),
-        gbuffers: if a.gbuffer.is_empty() {
-            gbuffers
-        } else {
-            a.gbuffer.clone()
-        },
+        settings,
         repeat: a.repeat.unwrap_or(repeat),
         warmup: a.warmup.unwrap_or(1),
         seed: a.seed,
@@ -419,11 +375,6 @@ pub(crate) fn bench_config(
         heatmap_max: a.heatmap_max.or(d.heatmap_max),
         spot_fraction: a.spot_fraction.map_or(d.spot_fraction, |f| f as f32),
         headlights: a.headlights,
-        spot_culls: if a.spot_cull.is_empty() {
-            d.spot_culls.clone()
-        } else {
-            a.spot_cull.clone()
-        },
         transparency: if a.transparency.is_empty() {
             d.transparency
         } else {
@@ -432,65 +383,24 @@ pub(crate) fn bench_config(
         opaque_variants: d.opaque_variants && a.transparency.is_empty()
             || a.transparency.iter().any(|t| !t.on()) && a.transparency.iter().any(|t| t.on()),
         material_shaders: a.material_shaders.is_none_or(OnOff::on),
-        lists: if a.lists.is_empty() {
-            d.lists.clone()
-        } else {
-            a.lists.clone()
-        },
-        material_draws: if a.material_draws.is_empty() {
-            vec![Default::default()]
-        } else {
-            a.material_draws.clone()
-        },
-        msaa: if a.msaa.is_empty() {
-            d.msaa.clone()
-        } else {
-            a.msaa.clone()
-        },
-        msaa_resolve: if a.msaa_resolve.is_empty() {
-            d.msaa_resolve.clone()
-        } else {
-            a.msaa_resolve.clone()
-        },
         add_lights: crate::args::added_lights(a.add_lights, a.light_range)?,
-        depth_bounds: if a.depth_bounds.is_empty() {
-            d.depth_bounds.clone()
-        } else {
-            a.depth_bounds.clone()
-        },
-        depth_reductions: if a.depth_reduction.is_empty() {
-            vec![Default::default()]
-        } else {
-            a.depth_reduction.clone()
-        },
     };
-    crate::args::check_msaa_resolve(!a.msaa_resolve.is_empty(), &config.msaa)?;
+    let resolve_given = a
+        .axes
+        .given
+        .iter()
+        .any(|(axis, _)| axis.flag == MsaaResolve::FLAG);
+    crate::args::check_msaa_resolve(resolve_given, &config.msaa_counts())?;
     config.validate()?;
     let chosen: Vec<_> = config
         .pipelines
         .iter()
         .map(|p| lightgrid::pipelines::find(p))
         .collect::<Result<_, _>>()?;
-    // The options given (by their flags in the library's table of settings).
-    let given: Vec<&'static Axis> = [
-        ("slices", a.slices.is_some()),
-        ("gbuffer", !a.gbuffer.is_empty()),
-        ("assign", a.assign.is_some()),
-        ("spot-cull", !a.spot_cull.is_empty()),
-        ("lists", !a.lists.is_empty()),
-        ("material-draws", !a.material_draws.is_empty()),
-        ("msaa", !a.msaa.is_empty()),
-        ("msaa-resolve", !a.msaa_resolve.is_empty()),
-        ("depth-bounds", !a.depth_bounds.is_empty()),
-        ("depth-reduction", !a.depth_reduction.is_empty()),
-    ]
-    .into_iter()
-    .filter(|&(_, given)| given)
-    .map(|(flag, _)| find_axis(flag).expect("a flag of the table"))
-    .collect();
+    let given: Vec<&'static Axis> = a.axes.given.iter().map(|(axis, _)| *axis).collect();
     // The MSAA-dependent options apply at the largest sample count measured.
     let settings = lightgrid::RenderSettings {
-        msaa: config.msaa.iter().copied().max().unwrap_or(1),
+        msaa: config.msaa_counts().into_iter().max().unwrap_or(1),
         ..Default::default()
     };
     check_applies(&given, &chosen, &settings)?;
@@ -507,8 +417,8 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         !ctx.is_software(),
         &lightgrid::frame::msaa_counts(&ctx, GBufferFormat::F16),
     )?;
-    for &n in &config.msaa {
-        for &g in &config.gbuffers {
+    for n in config.msaa_counts() {
+        for g in config.values_of::<GBufferFormat>() {
             lightgrid::frame::check_msaa(&ctx, n, g)?;
         }
     }

@@ -255,7 +255,7 @@ pub(super) fn budget(
 ) -> Option<(u32, u32)> {
     use lightgrid::frame::GBufferFormat;
     let x = find(r, scene, pipeline, None)?;
-    let gbuffer = match x.gbuffer_bits {
+    let gbuffer = match x.gbuffer_bits() {
         Some(32) => GBufferFormat::F32,
         _ => GBufferFormat::F16,
     };

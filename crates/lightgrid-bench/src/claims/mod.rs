@@ -107,10 +107,28 @@ fn find_run<'a>(
     r.runs.iter().find(|x| {
         x.scene == scene
             && x.pipeline == pipeline
-            && x.msaa == samples
-            && (x.gbuffer_bits.is_none() || x.gbuffer_bits == bits.or(Some(16)))
-            && x.depth_bounds.unwrap_or_default() == bounds
+            && x.msaa() == samples
+            && (x.gbuffer_bits().is_none() || x.gbuffer_bits() == bits.or(Some(16)))
+            && x.depth_bounds().unwrap_or_default() == bounds
     })
+}
+
+/// Are `a` and `b` the same series but for the setting `T` is the type of (the scene, the
+/// pipeline, the frame size and every other setting of the library's table equal)? How a
+/// claim pairs runs that differ in one setting.
+pub(crate) fn differs_only_in<T: lightgrid::pipelines::SettingValue>(
+    a: &RunRecord,
+    b: &RunRecord,
+) -> bool {
+    a.scene == b.scene
+        && a.pipeline == b.pipeline
+        && (a.width, a.height, a.tile_size) == (b.width, b.height, b.tile_size)
+        && lightgrid::pipelines::AXES
+            .iter()
+            .filter(|axis| axis.flag != T::FLAG)
+            .all(|axis| (axis.get)(&a.settings) == (axis.get)(&b.settings))
+        && lightgrid::pipelines::value_of::<T>(&a.settings)
+            != lightgrid::pipelines::value_of::<T>(&b.settings)
 }
 
 /// The average GPU time of the cell-bounds pass (the Z-reduction) of a run.
@@ -161,8 +179,8 @@ fn culled<'a>(r: &'a BenchResults, scene: &str) -> Vec<&'a RunRecord> {
         .filter(|x| {
             x.scene == scene
                 && !x.pipeline.starts_with(ids::FORWARD)
-                && x.gbuffer_bits.unwrap_or(16) == 16
-                && x.msaa == 1
+                && x.gbuffer_bits().unwrap_or(16) == 16
+                && x.msaa() == 1
         })
         .collect()
 }

@@ -45,7 +45,7 @@ pub(super) fn z_reduction_scales(r: &BenchResults, scene: &str) -> (String, Verd
         .runs
         .iter()
         .filter(|x| x.scene == scene && x.pipeline == ids::TILED_FORWARD_PREZ)
-        .filter_map(|x| Some((x.msaa, cell_bounds_ms(x)?)))
+        .filter_map(|x| Some((x.msaa(), cell_bounds_ms(x)?)))
         .collect();
     reduction.sort_by_key(|&(n, _)| n);
     match (reduction.first(), reduction.last()) {
@@ -180,7 +180,7 @@ pub(super) fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
     let mut scenes: Vec<&str> = r
         .runs
         .iter()
-        .filter(|x| x.depth_bounds.is_some())
+        .filter(|x| x.depth_bounds().is_some())
         .map(|x| x.scene.as_str())
         .collect();
     scenes.dedup();

@@ -109,7 +109,7 @@ pub(super) fn gbuffer_size(r: &BenchResults, scene: &str) -> (String, Verdict) {
         Some(avg_ms(find(r, scene, p, Some(32))?)? / avg_ms(find(r, scene, p, Some(16))?)?)
     };
     match (ratio(ids::DEFERRED), ratio(ids::TILED_DEFERRED)) {
-        (Some(d), Some(t)) if find(r, scene, ids::DEFERRED, Some(32)).is_some_and(|x| x.gbuffer_bits == Some(32)) => (
+        (Some(d), Some(t)) if find(r, scene, ids::DEFERRED, Some(32)).is_some_and(|x| x.gbuffer_bits() == Some(32)) => (
             format!("32-bit / 16-bit G-buffer frame time: deferred {d:.2}x, tiled_deferred {t:.2}x (held: deferred at least 5% slower and more affected)"),
             verdict(d >= 1.05 && d > t),
         ),
@@ -126,20 +126,12 @@ pub(super) fn reduction_claims(r: &BenchResults) -> Vec<Claim> {
     for x in r
         .runs
         .iter()
-        .filter(|x| x.depth_reduction == Some(DepthReduction::Atomics))
+        .filter(|x| x.depth_reduction() == Some(DepthReduction::Atomics))
     {
         // The same series in every other setting.
         let Some(y) = r.runs.iter().find(|y| {
-            y.depth_reduction == Some(DepthReduction::Subgroup)
-                && y.scene == x.scene
-                && y.pipeline == x.pipeline
-                && y.msaa == x.msaa
-                && y.msaa_resolve == x.msaa_resolve
-                && y.gbuffer_bits == x.gbuffer_bits
-                && y.depth_bounds == x.depth_bounds
-                && y.spot_cull == x.spot_cull
-                && y.lists == x.lists
-                && y.material_draws == x.material_draws
+            y.depth_reduction() == Some(DepthReduction::Subgroup)
+                && super::differs_only_in::<DepthReduction>(x, y)
         }) else {
             continue;
         };
@@ -298,9 +290,9 @@ pub fn stencil_competitive(ratio16: f64, ratio32: f64) -> (String, Verdict) {
 pub(super) fn stencil_gbuffer(r: &BenchResults, scene: &str) -> (String, Verdict) {
     let ratio = |bits| {
         let s = find(r, scene, ids::DEFERRED_STENCIL, Some(bits))
-            .filter(|x| x.gbuffer_bits == Some(bits))?;
+            .filter(|x| x.gbuffer_bits() == Some(bits))?;
         let t = find(r, scene, ids::TILED_DEFERRED, Some(bits))
-            .filter(|x| x.gbuffer_bits == Some(bits))?;
+            .filter(|x| x.gbuffer_bits() == Some(bits))?;
         Some(avg_ms(s)? / avg_ms(t)?.max(1e-9))
     };
     match (ratio(16), ratio(32)) {

@@ -2,7 +2,7 @@
 //! `--assign`): plain values, below everything that reads them.
 
 /// Settings every pipeline of a renderer shares.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct RenderSettings {
     /// Screen tile edge in pixels (`--tile`).
     pub tile_size: u32,

@@ -15,6 +15,8 @@ use crate::frame::{
 
 /// A setting's values by name (the option's values, the results' columns).
 pub trait SettingValue: Copy + PartialEq + Sized + 'static {
+    /// The option (its row in [`AXES`], without dashes).
+    const FLAG: &'static str;
     /// Every value the option accepts, the default first.
     const VALUES: &'static [Self];
     fn name(self) -> &'static str;
@@ -35,6 +37,7 @@ pub trait SettingValue: Copy + PartialEq + Sized + 'static {
 }
 
 impl SettingValue for Assign {
+    const FLAG: &'static str = "assign";
     const VALUES: &'static [Self] = &[
         Assign::Auto,
         Assign::Cpu,
@@ -52,6 +55,7 @@ impl SettingValue for Assign {
 }
 
 impl SettingValue for SpotCull {
+    const FLAG: &'static str = "spot-cull";
     const VALUES: &'static [Self] = &[SpotCull::Cone, SpotCull::Sphere];
     fn name(self) -> &'static str {
         match self {
@@ -68,6 +72,7 @@ impl SettingValue for SpotCull {
 }
 
 impl SettingValue for GridLists {
+    const FLAG: &'static str = "lists";
     // `Opaque` is what a frame without transparent objects builds, not an option.
     const VALUES: &'static [Self] = &[GridLists::Separate, GridLists::Shared];
     fn name(self) -> &'static str {
@@ -83,6 +88,7 @@ impl SettingValue for GridLists {
 }
 
 impl SettingValue for MaterialDraws {
+    const FLAG: &'static str = "material-draws";
     const VALUES: &'static [Self] = &[MaterialDraws::PerMaterial, MaterialDraws::Uber];
     fn name(self) -> &'static str {
         MaterialDraws::name(self)
@@ -100,6 +106,7 @@ impl SettingValue for MaterialDraws {
 }
 
 impl SettingValue for MsaaResolve {
+    const FLAG: &'static str = "msaa-resolve";
     const VALUES: &'static [Self] = &[MsaaResolve::Separate, MsaaResolve::Kernel];
     fn name(self) -> &'static str {
         MsaaResolve::name(self)
@@ -113,6 +120,7 @@ impl SettingValue for MsaaResolve {
 }
 
 impl SettingValue for DepthBounds {
+    const FLAG: &'static str = "depth-bounds";
     const VALUES: &'static [Self] = &DepthBounds::ALL;
     fn name(self) -> &'static str {
         DepthBounds::name(self)
@@ -128,6 +136,7 @@ impl SettingValue for DepthBounds {
 }
 
 impl SettingValue for DepthReduction {
+    const FLAG: &'static str = "depth-reduction";
     const VALUES: &'static [Self] = &DepthReduction::ALL;
     fn name(self) -> &'static str {
         DepthReduction::name(self)
@@ -143,6 +152,7 @@ impl SettingValue for DepthReduction {
 }
 
 impl SettingValue for GBufferFormat {
+    const FLAG: &'static str = "gbuffer";
     const VALUES: &'static [Self] = &[GBufferFormat::F16, GBufferFormat::F32];
     fn name(self) -> &'static str {
         match self {
@@ -348,6 +358,12 @@ pub const AXES: &[Axis] = &[
     },
 ];
 
+/// The value of the setting `T` is the type of, in `settings`.
+pub fn value_of<T: SettingValue>(settings: &RenderSettings) -> T {
+    let axis = find_axis(T::FLAG).expect("every setting type has a row");
+    T::parse(&(axis.get)(settings)).expect("the row reads its own values")
+}
+
 /// The row of `--flag` (without dashes).
 pub fn find_axis(flag: &str) -> Option<&'static Axis> {
     AXES.iter().find(|a| a.flag == flag)
@@ -419,6 +435,25 @@ mod tests {
                 axis.flag
             );
         }
+    }
+
+    /// Each value type names its own row, whose values are the type's.
+    #[test]
+    fn every_value_type_names_its_row() {
+        fn check<T: SettingValue>() {
+            let axis = find_axis(T::FLAG).unwrap();
+            let names: Vec<&str> = (axis.values)().iter().map(|v| v.name).collect();
+            let own: Vec<&str> = T::VALUES.iter().map(|v| v.name()).collect();
+            assert_eq!(names, own, "{}", T::FLAG);
+        }
+        check::<Assign>();
+        check::<SpotCull>();
+        check::<GridLists>();
+        check::<MaterialDraws>();
+        check::<MsaaResolve>();
+        check::<DepthBounds>();
+        check::<DepthReduction>();
+        check::<GBufferFormat>();
     }
 
     #[test]

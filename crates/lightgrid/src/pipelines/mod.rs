@@ -18,7 +18,7 @@ use crate::shader::ComposedShader;
 pub use crate::culling::Assign;
 use crate::frame::GBufferFormat;
 pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings, SpotCull};
-pub use axes::{check_axes_apply, find_axis, Axis, AxisValue, SettingValue, AXES};
+pub use axes::{check_axes_apply, find_axis, value_of, Axis, AxisValue, SettingValue, AXES};
 pub use transparent::{TransparentLights, TransparentPass};
 
 /// What a pipeline needs to create its GPU objects.
