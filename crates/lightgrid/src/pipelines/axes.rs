@@ -223,7 +223,7 @@ fn number(value: &str) -> Result<u32, String> {
     value
         .trim()
         .parse()
-        .map_err(|_| format!("'{value}' is not a whole number"))
+        .map_err(|_| format!("'{value}' is not a whole number from 0 to {}", u32::MAX))
 }
 
 /// The tiled grids whose cell bounds the depth buffer gives: the cell-bounds kernel reduces
