@@ -10,29 +10,14 @@
 mod common;
 
 use lightgrid::culling::ViewSetup;
-use lightgrid::pipelines::Assign;
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{LightAnchor, Rng, Scene, SceneLight};
 use lightgrid::{RenderSettings, Renderer};
 use std::time::Instant;
 
-/// Every strategy of the registry.
-fn strategies() -> Vec<Assign> {
-    lightgrid::culling::STRATEGIES
-        .iter()
-        .map(|s| s.assign)
-        .collect()
-}
-
-/// Every pipeline whose grid `--assign` builds, from the registry; `tiled_forward` assigns
-/// against `[near, far]`, the others against the depth bounds of their pre-pass or G-buffer.
-fn grid_pipelines() -> Vec<&'static str> {
-    lightgrid::pipelines::PIPELINES
-        .iter()
-        .filter(|p| p.assign)
-        .map(|p| p.id)
-        .collect()
-}
+// The strategies and grid pipelines come from the registries (`common::strategies`,
+// `common::grid_pipelines`); `tiled_forward` assigns against `[near, far]`, the others
+// against the depth bounds of their pre-pass or G-buffer.
 
 const TILES: [u32; 9] = [4, 5, 7, 8, 13, 16, 31, 32, 64];
 
@@ -95,7 +80,7 @@ fn run(
     for (ci, config) in configs.iter().enumerate() {
         let start = Instant::now();
         let (w, h) = config.size;
-        let strategies = strategies();
+        let strategies = common::strategies();
         totals.scenes.resize(strategies.len(), 0);
         totals.render_s.resize(strategies.len(), 0.0);
         let mut renderers: Vec<Renderer> = strategies
@@ -198,7 +183,7 @@ fn gpu_strategies_contain_the_oracle_in_small_randomized_scenes() {
             size: (64 + 2 * rng.below(68) + 1, 48 + 2 * rng.below(51) + 1),
             tile: TILES[i % TILES.len()],
             slices: [2, 8, 16, 32, 64][i % 5],
-            pipeline: grid_pipelines()[i % grid_pipelines().len()],
+            pipeline: common::grid_pipelines()[i % common::grid_pipelines().len()],
             scenes: 5,
             lights: 240,
         })

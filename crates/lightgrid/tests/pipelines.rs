@@ -618,20 +618,6 @@ fn check_assign(
     out.grid
 }
 
-/// Every pipeline whose grid `--assign` builds, from the registry.
-fn grid_pipelines() -> Vec<&'static str> {
-    lightgrid::pipelines::PIPELINES
-        .iter()
-        .filter(|p| p.assign)
-        .map(|p| p.id)
-        .collect()
-}
-
-/// Every strategy of the registry.
-fn strategies() -> impl Iterator<Item = Assign> {
-    lightgrid::culling::STRATEGIES.iter().map(|s| s.assign)
-}
-
 fn check_strategies(
     scene: &Scene,
     frame: u32,
@@ -654,7 +640,7 @@ fn check_strategies(
                 .image
         });
     }
-    for assign in strategies() {
+    for assign in common::strategies() {
         let settings = RenderSettings {
             tile_size: tile,
             slices,
@@ -672,7 +658,7 @@ fn check_strategies(
 #[test]
 fn every_strategy_matches_its_twin_on_every_grid_pipeline() {
     let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
-    check_strategies(&s, 200, (160, 90), 16, 32, &grid_pipelines());
+    check_strategies(&s, 200, (160, 90), 16, 32, &common::grid_pipelines());
 }
 
 #[test]
@@ -813,7 +799,7 @@ fn strategies_agree_with_each_other_and_pipelines_without_a_grid_ignore_them() {
     let ctx = common::gpu();
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
     let mut lists = Vec::new();
-    for assign in strategies() {
+    for assign in common::strategies() {
         let settings = RenderSettings {
             assign,
             ..Default::default()
@@ -892,7 +878,14 @@ fn strategies_on_randomized_edge_case_lights() {
             .collect();
         scene.lights = lights;
         scene.validate().unwrap();
-        check_strategies(&scene, frame, (w, h), tile, slices, &grid_pipelines());
+        check_strategies(
+            &scene,
+            frame,
+            (w, h),
+            tile,
+            slices,
+            &common::grid_pipelines(),
+        );
     }
 }
 

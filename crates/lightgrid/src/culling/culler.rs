@@ -294,11 +294,20 @@ pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 15;
 /// the `light_grid` prefix so nothing collides with the caller's names.
 const EMBED_WGSL: &str = include_str!("embed.wgsl");
 
-/// `grid_cell.wgsl` with its names prefixed (`grid` → `light_grid`, `GridParams` →
+/// lightgrid's `GridParams` struct (`shading/types.wgsl`), the one definition of the grid's
+/// uniform layout.
+fn grid_params_struct() -> &'static str {
+    let start = src::TYPES
+        .find("struct GridParams {")
+        .expect("types.wgsl defines GridParams");
+    let end = start + src::TYPES[start..].find('}').expect("its closing brace") + 1;
+    &src::TYPES[start..end]
+}
+
+/// WGSL `text` with its names prefixed (`grid` → `light_grid`, `GridParams` →
 /// `LightGridParams`, `GRID_LISTS_SEPARATE` → `LIGHT_GRID_LISTS_SEPARATE`).
-fn prefixed_grid_cell() -> String {
+fn prefixed(text: &str) -> String {
     let mut out = String::new();
-    let text = src::GRID_CELL;
     let mut ident = String::new();
     let flush = |ident: &mut String, out: &mut String| {
         let renamed = match ident.as_str() {
@@ -606,10 +615,11 @@ impl LightCuller {
     /// Every name it declares starts with `light_grid` or `LightGrid`.
     pub fn wgsl(group: u32) -> String {
         format!(
-            "{}\nconst LIGHT_GRID_LISTS_SEPARATE: u32 = {}u;\n\n{}",
+            "{}\n{}\nconst LIGHT_GRID_LISTS_SEPARATE: u32 = {}u;\n\n{}",
+            prefixed(grid_params_struct()),
             EMBED_WGSL.replace("LIGHT_GRID_GROUP", &group.to_string()),
             crate::consts::GRID_LISTS_SEPARATE,
-            prefixed_grid_cell()
+            prefixed(src::GRID_CELL)
         )
     }
 

@@ -9,16 +9,7 @@
 //         ...
 //     }
 
-struct LightGridParams {
-    tile_size: u32,
-    tiles_x: u32,
-    tiles_y: u32,
-    slices: u32,
-    slice_scale: f32,
-    slice_bias: f32,
-    lists: u32,
-    layer_cells: u32,
-}
+// LightGridParams: lightgrid's GridParams (shading/types.wgsl), renamed.
 
 @group(LIGHT_GRID_GROUP) @binding(0) var<uniform> light_grid: LightGridParams;
 @group(LIGHT_GRID_GROUP) @binding(1) var<storage, read> light_grid_cells: array<vec2<u32>>;  // (offset, count)

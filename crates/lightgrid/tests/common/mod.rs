@@ -14,6 +14,23 @@ use lightgrid::pipelines::Assign;
 use lightgrid::scene::{Camera, Light, Rng, Spot};
 use std::path::PathBuf;
 
+/// Every pipeline whose grid `--assign` builds, from the registry.
+pub fn grid_pipelines() -> Vec<&'static str> {
+    lightgrid::pipelines::PIPELINES
+        .iter()
+        .filter(|p| p.assign)
+        .map(|p| p.id)
+        .collect()
+}
+
+/// Every strategy of the registry.
+pub fn strategies() -> Vec<Assign> {
+    lightgrid::culling::STRATEGIES
+        .iter()
+        .map(|s| s.assign)
+        .collect()
+}
+
 /// A GPU context, or a failing test. A missing adapter is never a pass: install
 /// `mesa-vulkan-drivers` for Mesa's software Vulkan adapter (what CI does).
 pub fn gpu() -> GpuContext {
