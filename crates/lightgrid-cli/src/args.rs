@@ -137,7 +137,7 @@ impl AxisArgs {
                 .help(match list {
                     false => format!("{} [default: {default}]", capitalized(axis.help)),
                     true => format!(
-                        "{}: a value, or a comma list to measure each [default: {default}, unless the preset sets it]",
+                        "{}: a value, or a comma list to measure each (a preset may set it) [default: {default}]",
                         capitalized(axis.help)
                     ),
                 });
