@@ -195,8 +195,7 @@ pub fn msaa_defs(samples: u32) -> Vec<Def> {
     ]
 }
 
-/// The key of a stage whose only variant is the frame's sample count: every MSAA count the
-/// renderer can request.
+/// Every MSAA count the renderer can request (`consts::MSAA_COUNTS`), for the keys' `all()`.
 pub fn every_sample_count() -> impl Iterator<Item = u32> {
     crate::consts::MSAA_COUNTS.into_iter()
 }
