@@ -1,10 +1,13 @@
-//! Every composed shader the registry and shared passes can produce validates with naga
-//! (no GPU needed), and every shader starts with the constants prelude.
+//! Every composed shader the library can create validates with naga (no GPU needed): every
+//! value of every shader key (`shader::ShaderKey::all`), with and without the adapter-dependent
+//! early depth test; every shader starts with the constants prelude.
 
-use lightgrid::consts::WGSL_CONSTS;
+use lightgrid::consts::{MSAA_COUNTS, WGSL_CONSTS};
+use lightgrid::frame::{DepthBounds, DepthReduction};
+use lightgrid::passes::GBufferLayout;
 use lightgrid::pipelines::all_shaders;
 use lightgrid::pipelines::PIPELINES;
-use lightgrid::shader::validate;
+use lightgrid::shader::{overrides, validate, validate_for, ComposedShader};
 
 #[test]
 fn every_composed_shader_validates() {
@@ -13,12 +16,112 @@ fn every_composed_shader_validates() {
         shaders.len() > PIPELINES.len(),
         "pipelines plus shared passes"
     );
-    let failures: Vec<String> = shaders.iter().filter_map(|s| validate(s).err()).collect();
+    let failures: Vec<String> = shaders
+        .iter()
+        .flat_map(|s| [validate_for(s, true).err(), validate_for(s, false).err()])
+        .flatten()
+        .collect();
     assert!(
         failures.is_empty(),
         "shader validation failed:\n{}",
         failures.join("\n")
     );
+}
+
+/// The shaders of one keyed stage (labelled `"<stage> <key>"`).
+fn stage<'a>(shaders: &'a [ComposedShader], stage: &str) -> Vec<&'a ComposedShader> {
+    let prefix = format!("{stage} ");
+    shaders
+        .iter()
+        .filter(|s| s.name.starts_with(&prefix))
+        .collect()
+}
+
+/// Each keyed stage is composed for every value its key can take: every MSAA count the
+/// renderer can request, every depth-bounds × reduction, every G-buffer layout, each once.
+#[test]
+fn every_key_value_is_composed_once() {
+    let shaders = all_shaders();
+    let mut names = std::collections::HashSet::new();
+    for s in &shaders {
+        assert!(names.insert(&s.name), "{} composed twice", s.name);
+    }
+    let msaa = MSAA_COUNTS.len();
+    let expected = [
+        (
+            "cell_bounds",
+            msaa * DepthBounds::ALL.len() * DepthReduction::ALL.len(),
+        ),
+        ("depth_range", msaa),
+        ("tonemap", msaa),
+        ("depth_samples", msaa),
+        ("deferred", GBufferLayout::ALL.len() * msaa),
+        ("light_prepass", msaa),
+        ("tiled_light_prepass", msaa),
+        // The grid pipelines' kernel and the single kernel.
+        ("tiled_deferred", 2 * msaa),
+        // Only above one sample per pixel.
+        ("sample_expand", msaa - 1),
+    ];
+    for (name, count) in expected {
+        let found = stage(&shaders, name);
+        assert_eq!(found.len(), count, "{name}: {found:#?}");
+        for samples in MSAA_COUNTS
+            .iter()
+            .filter(|&&n| name != "sample_expand" || n > 1)
+        {
+            let decl = format!("const SAMPLES: u32 = {samples}u;");
+            assert!(
+                found.iter().any(|s| s.source.contains(&decl)),
+                "{name} at {samples} samples"
+            );
+        }
+    }
+}
+
+/// `--depth-reduction subgroup` is the only cell-bounds variant with subgroup operations: the
+/// others are created on adapters without subgroups, which must not see them even unreached.
+#[test]
+fn only_the_subgroup_reduction_needs_subgroups() {
+    let shaders = all_shaders();
+    let cell_bounds = stage(&shaders, "cell_bounds");
+    let no_subgroups = naga::valid::Capabilities::all()
+        - naga::valid::Capabilities::SUBGROUP
+        - naga::valid::Capabilities::SUBGROUP_BARRIER;
+    for s in cell_bounds {
+        let module = validate(s).unwrap();
+        let without =
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), no_subgroups)
+                .validate(&module);
+        assert_eq!(
+            without.is_ok(),
+            !s.name.contains("Subgroup"),
+            "{}: {without:?}",
+            s.name
+        );
+    }
+}
+
+/// The only `override`s are the pipeline specialisations named in `shader::overrides`, which
+/// the pipelines set through the same names; each is declared by some shader.
+#[test]
+fn overrides_are_the_named_ones() {
+    let mut declared = std::collections::HashSet::new();
+    for s in all_shaders() {
+        let module = validate(&s).unwrap();
+        for (_, o) in module.overrides.iter() {
+            let name = o.name.clone().unwrap_or_default();
+            assert!(
+                overrides::ALL.contains(&name.as_str()),
+                "{}: override {name} is not in shader::overrides",
+                s.name
+            );
+            declared.insert(name);
+        }
+    }
+    for name in overrides::ALL {
+        assert!(declared.contains(name), "no shader declares {name}");
+    }
 }
 
 #[test]

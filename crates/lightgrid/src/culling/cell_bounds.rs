@@ -17,55 +17,60 @@ use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::{DepthBounds, DepthReduction, FrameEncoder};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compute_pipeline, every_sample_count, msaa_defs, src, Def, ShaderKey};
 
-pub(crate) fn shader(
-    samples: u32,
-    depth_bounds: DepthBounds,
-    reduction: DepthReduction,
-) -> ComposedShader {
-    compose(
-        "cell_bounds",
-        &[
+/// The cell-bounds kernel's variants: the depth target's samples, `--depth-bounds`
+/// (`DEPTH_BOUNDS`) and `--depth-reduction` (`SUBGROUP_REDUCTION`: tiled-shading §8's
+/// warp-level reduction, each invocation's samples in registers, one subgroup min/max, one
+/// atomic per subgroup; the subgroup code is compiled in only then, as it is only composed for
+/// an adapter with subgroups: the device feature; WGSL's `enable subgroups;` is left out,
+/// which naga rejects).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct CellBoundsKey {
+    pub samples: u32,
+    pub depth_bounds: DepthBounds,
+    pub reduction: DepthReduction,
+}
+
+impl ShaderKey for CellBoundsKey {
+    const STAGE: &'static str = "cell_bounds";
+
+    fn all() -> Vec<Self> {
+        let mut out = Vec::new();
+        for samples in every_sample_count() {
+            for depth_bounds in DepthBounds::ALL {
+                for reduction in DepthReduction::ALL {
+                    out.push(CellBoundsKey {
+                        samples,
+                        depth_bounds,
+                        reduction,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    fn defs(self) -> Vec<Def> {
+        let mut defs = msaa_defs(self.samples);
+        defs.push(Def::U32("DEPTH_BOUNDS", self.depth_bounds.id()));
+        defs.push(Def::Bool(
+            "SUBGROUP_REDUCTION",
+            self.reduction == DepthReduction::Subgroup,
+        ));
+        defs
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![
             src::TYPES,
             src::SCENE_BINDINGS,
             src::GRID_CELL,
-            &crate::shader::msaa_wgsl(samples),
-            &format!("const DEPTH_BOUNDS: u32 = {}u;\n", depth_bounds.id()),
-            match reduction {
-                DepthReduction::Atomics => ATOMIC_REDUCTION_WGSL,
-                DepthReduction::Subgroup => SUBGROUP_REDUCTION_WGSL,
-            },
+            src::MSAA,
             include_str!("cell_bounds.wgsl"),
-        ],
-    )
-}
-
-/// `--depth-reduction atomics`: every sample goes into workgroup memory with atomics
-/// (`include_depth`); the register path is never taken, its reduction never called.
-const ATOMIC_REDUCTION_WGSL: &str = "
-const SUBGROUP_REDUCTION: bool = false;
-fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {}
-";
-
-/// `--depth-reduction subgroup` (tiled-shading §8's warp-level reduction): each invocation's
-/// samples in registers, one subgroup min/max, one atomic per subgroup. Only composed for an
-/// adapter with subgroups (the device feature; WGSL's `enable subgroups;` is left out, which
-/// naga rejects).
-const SUBGROUP_REDUCTION_WGSL: &str = "
-const SUBGROUP_REDUCTION: bool = true;
-fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {
-    let l = subgroupMin(lo);
-    let h = subgroupMax(hi);
-    let t = subgroupMax(tile_max);
-    // One lane per subgroup writes (naga has no subgroupElect): the first active one.
-    if (li == subgroupBroadcastFirst(li)) {
-        atomicMin(&slice_lo[0], l);
-        atomicMax(&slice_hi[0], h);
-        atomicMax(&tile_hi, t);
+        ]
     }
 }
-";
 
 /// `--depth-bounds` applied to the opaque cells' `bounds` (as the kernel's `open_bounds`
 /// does): `Min` opens an occupied cell's far side to its slice's far end, `Max` its near
@@ -216,7 +221,12 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(5, crate::gpu::STORAGE_READ),
             ],
         });
-        let s = shader(samples, depth_bounds, reduction);
+        let s = CellBoundsKey {
+            samples,
+            depth_bounds,
+            reduction,
+        }
+        .shader();
         let layouts = [Some(cull_layout), Some(&layout)];
         let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);

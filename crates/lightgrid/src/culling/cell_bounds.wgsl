@@ -19,6 +19,21 @@
 // (`fragment_bounds.wgsl`: (0xffffffff - min bits, max bits), zero = none); unused without.
 @group(1) @binding(5) var<storage, read> fragment_bounds: array<u32>;
 
+#if SUBGROUP_REDUCTION
+// `--depth-reduction subgroup`: the invocations' register bounds, one subgroup min/max, and
+// one lane per subgroup writes (naga has no subgroupElect): the first active one.
+fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {
+    let l = subgroupMin(lo);
+    let h = subgroupMax(hi);
+    let t = subgroupMax(tile_max);
+    if (li == subgroupBroadcastFirst(li)) {
+        atomicMin(&slice_lo[0], l);
+        atomicMax(&slice_hi[0], h);
+        atomicMax(&tile_hi, t);
+    }
+}
+#endif
+
 // Cell `cell`'s fragment bounds (min > max when none).
 fn fragment_range(cell: u32) -> vec2<f32> {
     if (SAMPLES == 1u) {
@@ -102,9 +117,11 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         check_loop(x, grid.tile_size);
     }
     check_loop(y, grid.tile_size);
+#if SUBGROUP_REDUCTION
     if (registers) {
         subgroup_reduce(lo, hi, t_hi, li);
     }
+#endif
     workgroupBarrier();
     let tile = wg.y * grid.tiles_x + wg.x;
     let tiles = grid.tiles_x * grid.tiles_y;
@@ -133,7 +150,7 @@ fn write_bounds(cell: u32, b: vec2<f32>) {
     }
 }
 
-// `--depth-bounds` (DEPTH_BOUNDS, composed in by cell_bounds.rs): one side of an occupied
+// `--depth-bounds` (DEPTH_BOUNDS, from the kernel's key `CellBoundsKey`): one side of an occupied
 // cell's bounds opened to its slice's end, or (none) every cell given its whole slice.
 // Twin: `open_bounds` in cell_bounds.rs.
 fn open_bounds(k: u32, b: vec2<f32>) -> vec2<f32> {

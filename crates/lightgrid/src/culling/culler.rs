@@ -406,9 +406,18 @@ pub(crate) fn prep_shader() -> ComposedShader {
     )
 }
 
-/// The caller-facing module at group 0, for the validation test.
-pub(crate) fn embed_shader() -> ComposedShader {
-    compose("light grid (embedded)", &[&LightCuller::wgsl(0)])
+/// The caller-facing module at every group a default wgpu device has, for the validation
+/// test. Not a [`crate::shader::ShaderKey`]: the group is the caller's, and its WGSL is
+/// pasted into the caller's shader rather than composed here.
+pub(crate) fn embed_shaders() -> Vec<ComposedShader> {
+    (0..wgpu::Limits::default().max_bind_groups)
+        .map(|group| {
+            compose(
+                &format!("light grid (embedded at group {group})"),
+                &[&LightCuller::wgsl(group)],
+            )
+        })
+        .collect()
 }
 
 impl LightCuller {

@@ -19,18 +19,35 @@ use crate::frame::FrameEncoder;
 use crate::gpu::{bind_resources, download, storage_buffer};
 use crate::gpu_types::GridParams;
 use crate::scene::ViewSetup;
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compute_pipeline, every_sample_count, msaa_defs, src, Def, ShaderKey};
 
-pub(crate) fn shader(samples: u32) -> ComposedShader {
-    compose(
-        "depth_range",
-        &[
+/// The depth-range kernel of a depth target of `samples` samples per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct DepthRangeKey {
+    pub samples: u32,
+}
+
+impl ShaderKey for DepthRangeKey {
+    const STAGE: &'static str = "depth_range";
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .map(|samples| Self { samples })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![
             src::TYPES,
             src::SCENE_BINDINGS,
-            &crate::shader::msaa_wgsl(samples),
+            src::MSAA,
             include_str!("depth_range.wgsl"),
-        ],
-    )
+        ]
+    }
 }
 
 /// The view-distance `[min, max]` of every sample that holds geometry (`planes[s]`: sample
@@ -78,7 +95,7 @@ impl DepthRangePass {
                 crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),
             ],
         });
-        let s = shader(samples);
+        let s = DepthRangeKey { samples }.shader();
         let layouts = [Some(cull_layout), Some(&layout)];
         DepthRangePass {
             reduce: compute_pipeline(device, "depth range", &s, "reduce", &layouts),

@@ -55,19 +55,12 @@ pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
 /// `tile_frustum` / `light_in_tile` (needs the scene bindings).
 pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
 
-/// Every assignment shader, for the validation test.
+/// Every assignment shader, for the validation test: every value of the keyed stages.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
-    use crate::frame::{DepthBounds, DepthReduction};
-    vec![
-        cell_bounds::shader(1, DepthBounds::Both, DepthReduction::Atomics),
-        cell_bounds::shader(4, DepthBounds::Both, DepthReduction::Atomics),
-        cell_bounds::shader(1, DepthBounds::Min, DepthReduction::Atomics),
-        cell_bounds::shader(1, DepthBounds::Max, DepthReduction::Atomics),
-        cell_bounds::shader(4, DepthBounds::None, DepthReduction::Atomics),
-        cell_bounds::shader(1, DepthBounds::Both, DepthReduction::Subgroup),
-        cell_bounds::shader(4, DepthBounds::Both, DepthReduction::Subgroup),
-        depth_range::shader(1),
-        depth_range::shader(4),
+    use crate::shader::ShaderKey;
+    let mut out = cell_bounds::CellBoundsKey::all_shaders();
+    out.extend(depth_range::DepthRangeKey::all_shaders());
+    out.extend([
         fragment_bounds::shader(),
         scan::shader(),
         radix_sort::shader(),
@@ -76,6 +69,7 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
         bvh_gpu::shader(),
         scatter::shader(),
         culler::prep_shader(),
-        culler::embed_shader(),
-    ]
+    ]);
+    out.extend(culler::embed_shaders());
+    out
 }

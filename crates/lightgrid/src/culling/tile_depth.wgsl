@@ -1,5 +1,5 @@
 // Per-tile depth min/max over a depth texture, every sample of it (`DepthTexture` and SAMPLES
-// from `shader::msaa_wgsl`: with MSAA the bounds hold every sample, tiled-shading §2.1), for a
+// from `shader/msaa.wgsl`: with MSAA the bounds hold every sample, tiled-shading §2.1), for a
 // workgroup of TILE_THREADS x TILE_THREADS invocations striding over one tile (any tile size).
 // The background (`is_background`: no geometry) is ignored; a tile without samples returns
 // min > max. Positive floats order like their bit patterns, so workgroup u32 atomics do the

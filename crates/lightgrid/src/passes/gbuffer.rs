@@ -53,6 +53,9 @@ pub enum GBufferLayout {
 }
 
 impl GBufferLayout {
+    /// Every layout (the deferred shaders' keys).
+    pub const ALL: [GBufferLayout; 2] = [GBufferLayout::Full, GBufferLayout::MonoSpecular];
+
     /// Colour targets written per pixel.
     pub fn targets(self) -> u32 {
         (0..TARGET_NAMES.len()).filter(|&l| self.has(l)).count() as u32

@@ -1,5 +1,5 @@
 // Reading the G-buffer (group 2) in deferred passes, fragment or compute. The texture types
-// come from the frame's sample count (`shader::msaa_wgsl`): with MSAA every target holds
+// come from the frame's sample count (`shader/msaa.wgsl`): with MSAA every target holds
 // each sample, `textureLoad(t, p, s)` reading sample `s`.
 
 @group(2) @binding(0) var gb_normal: SampleTexture;

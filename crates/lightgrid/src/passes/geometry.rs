@@ -4,6 +4,7 @@
 
 use crate::frame::FrameInputs;
 use crate::gpu::PassTimer;
+use crate::shader::overrides;
 
 /// A render pipeline drawing the scene geometry with the shared vertex stage.
 #[derive(Clone, Copy)]
@@ -157,7 +158,12 @@ fn specialised_pipeline(
     d: &GeometryPipelineDesc,
     shader: u32,
 ) -> wgpu::RenderPipeline {
-    pipeline_with_constants(device, d, &[("MATERIAL_SHADER", f64::from(shader))], None)
+    pipeline_with_constants(
+        device,
+        d,
+        &[(overrides::MATERIAL_SHADER, f64::from(shader))],
+        None,
+    )
 }
 
 fn pipeline_with_constants(
@@ -168,7 +174,7 @@ fn pipeline_with_constants(
 ) -> wgpu::RenderPipeline {
     let mut constants = constants.to_vec();
     if d.samples > 1 {
-        constants.push(("MULTISAMPLED", 1.0));
+        constants.push((overrides::MULTISAMPLED, 1.0));
     }
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(d.label),

@@ -93,7 +93,7 @@ fn vs_volume_fullscreen(@builtin(vertex_index) i: u32, @location(1) light: u32) 
 // The volume passes test against a depth-stencil copy of the scene depth (the scene depth
 // itself is sampled in the same pass); this writes the copy, sample by sample with MSAA
 // (reading `sample_index` makes the fragment run per sample; `DepthTexture` and the sample
-// count come from `shader::msaa_wgsl`).
+// count come from `shader/msaa.wgsl`).
 @group(1) @binding(0) var copy_source: DepthTexture;
 
 @fragment

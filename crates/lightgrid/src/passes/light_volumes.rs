@@ -633,7 +633,7 @@ impl LightVolumes {
     /// With MSAA, lighting fragments count into `pixel_counts` (`lit_out.wgsl`).
     fn constants(&self) -> Vec<(&'static str, f64)> {
         if self.samples > 1 {
-            vec![("MULTISAMPLED", 1.0)]
+            vec![(crate::shader::overrides::MULTISAMPLED, 1.0)]
         } else {
             Vec::new()
         }

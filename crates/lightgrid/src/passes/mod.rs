@@ -27,7 +27,11 @@ use std::num::NonZeroU64;
 
 /// Every shader of the shared passes, for validation.
 pub fn shaders() -> Vec<ComposedShader> {
-    vec![tonemap::shader(1), tonemap::shader(4), gbuffer::shader()]
+    use crate::shader::ShaderKey;
+    let mut out = tonemap::TonemapKey::all_shaders();
+    out.extend(readback::DepthSamplesKey::all_shaders());
+    out.push(gbuffer::shader());
+    out
 }
 
 /// `fullscreen_position(vertex_index)`: a screen-covering triangle.
@@ -129,7 +133,7 @@ pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
 
 /// The MSAA edge test (`differs`) over a per-sample G-buffer: the edge-aware deferred kernel
 /// and the light volumes' edge marking both compose it, so they shade the same pixels per
-/// sample. Needs `GBUFFER_READ_WGSL` and `shader::msaa_wgsl`.
+/// sample. Needs `GBUFFER_READ_WGSL` and `shader::src::MSAA` with `shader::msaa_defs`.
 pub const MSAA_EDGES_WGSL: &str = concat!(
     include_str!("msaa_surfaces.wgsl"),
     include_str!("msaa_edges.wgsl")
@@ -137,7 +141,7 @@ pub const MSAA_EDGES_WGSL: &str = concat!(
 
 /// The edge test's core (`surfaces_differ`: normals and planes of two samples with geometry),
 /// for readers of other per-sample attributes than the G-buffer (the light pre-pass). Needs
-/// `shader::msaa_wgsl`.
+/// `shader::src::MSAA` with `shader::msaa_defs`.
 pub const MSAA_SURFACES_WGSL: &str = include_str!("msaa_surfaces.wgsl");
 
 /// Layout of group 3 of deferred compute passes (`compute_outputs.wgsl`).
@@ -287,7 +291,7 @@ pub fn texture_entry(
     sampled_texture_entry(binding, sample_type, 1)
 }
 
-/// As [`texture_entry`], multisampled when `samples` > 1 (`shader::msaa_wgsl`'s types).
+/// As [`texture_entry`], multisampled when `samples` > 1 (`shader::src::MSAA`'s types).
 pub fn sampled_texture_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,

@@ -2,7 +2,7 @@
 // by the edge-aware deferred kernel (`tiled_deferred_msaa.wgsl`) and the light volumes' edge
 // marking (`deferred.wgsl`, `fs_mark_edges`), so both shade the same pixels per sample. Needs
 // the G-buffer reader (`gb_depth`, `gb_normal`), `msaa_surfaces.wgsl` (composed before it by
-// `MSAA_EDGES_WGSL`) and `shader::msaa_wgsl`'s `sample_position`.
+// `MSAA_EDGES_WGSL`) and `shader/msaa.wgsl`'s `sample_position`.
 
 // Do samples 0 and `s` of pixel `p` show different surfaces? Geometry against sky, another
 // material, or what `surfaces_differ` tells from normals and planes.

@@ -1,7 +1,7 @@
 // The MSAA edge test's core (tiled-deferred-tricks: edge detection), for samples of one pixel
 // that both hold geometry: `msaa_edges.wgsl`'s `differs` over the G-buffer (material id in
 // the normal's w), and the light pre-pass's `attributes_differ` over its attributes (the
-// specular exponent in w: `light_prepass_attributes.wgsl`). Needs `shader::msaa_wgsl`'s
+// specular exponent in w: `light_prepass_attributes.wgsl`). Needs `shader/msaa.wgsl`'s
 // `sample_position`.
 
 // Pixel `p`'s depth at its centre, where forward shades it, read from `depth`: for a pixel

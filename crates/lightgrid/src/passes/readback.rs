@@ -2,6 +2,7 @@
 
 use crate::error::Result;
 use crate::gpu::read_buffer;
+use crate::shader::{every_sample_count, msaa_defs, Def, ShaderKey};
 
 /// A MAP_READ buffer sized for one texture, with rows padded to the copy alignment.
 pub struct Readback {
@@ -106,6 +107,30 @@ impl BufferReadback {
     }
 }
 
+/// The copy of every sample of a depth target of `samples` samples per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct DepthSamplesKey {
+    pub samples: u32,
+}
+
+impl ShaderKey for DepthSamplesKey {
+    const STAGE: &'static str = "depth_samples";
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .map(|samples| Self { samples })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![crate::shader::src::MSAA, include_str!("depth_samples.wgsl")]
+    }
+}
+
 /// Analysis of an MSAA frame: every sample of the depth target, one plane per sample
 /// (`depth_samples.wgsl`), read back.
 pub struct DepthSamples {
@@ -119,13 +144,7 @@ pub struct DepthSamples {
 
 impl DepthSamples {
     pub fn new(device: &wgpu::Device, (width, height): (u32, u32), samples: u32) -> Self {
-        let shader = crate::shader::compose(
-            "depth_samples",
-            &[
-                &crate::shader::msaa_wgsl(samples),
-                include_str!("depth_samples.wgsl"),
-            ],
-        );
+        let shader = DepthSamplesKey { samples }.shader();
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth samples"),
             entries: &[

@@ -3,18 +3,35 @@
 
 use super::LDR_FORMAT;
 use crate::gpu::PassTimer;
-use crate::shader::{compose, ComposedShader};
+use crate::shader::{every_sample_count, msaa_defs, src, Def, ShaderKey};
 
-pub(crate) fn shader(samples: u32) -> ComposedShader {
-    compose(
-        "tonemap",
-        &[
+/// The tonemap of an HDR target of `samples` samples per pixel (above one, it resolves).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct TonemapKey {
+    pub samples: u32,
+}
+
+impl ShaderKey for TonemapKey {
+    const STAGE: &'static str = "tonemap";
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .map(|samples| Self { samples })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![
             super::FULLSCREEN_WGSL,
-            &crate::shader::msaa_wgsl(samples),
-            crate::shader::src::TONE,
+            src::MSAA,
+            src::TONE,
             include_str!("tonemap.wgsl"),
-        ],
-    )
+        ]
+    }
 }
 
 pub struct Tonemap {
@@ -37,7 +54,7 @@ impl Tonemap {
             device,
             &super::FullscreenDesc {
                 label: "tonemap",
-                shader: &shader(samples),
+                shader: &TonemapKey { samples }.shader(),
                 fragment_entry: "fs_tonemap",
                 layout: &layout,
                 target: LDR_FORMAT,

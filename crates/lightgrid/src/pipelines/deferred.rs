@@ -30,46 +30,62 @@ use crate::passes::{
     VolumePipelineDesc, MSAA_EDGES_WGSL, VOLUME_WGSL,
 };
 use crate::passes::{GBuffer, GBufferLayout, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT};
-use crate::shader::{compose, create_module, src, ComposedShader};
+use crate::shader::{
+    create_module, every_sample_count, msaa_defs, src, ComposedShader, Def, ShaderKey,
+};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    vec![
-        shader(GBufferLayout::Full, 1),
-        shader(GBufferLayout::Full, 4),
-    ]
+    layout_shaders(GBufferLayout::Full)
 }
 
 pub(super) fn shaders_mono() -> Vec<ComposedShader> {
-    vec![
-        shader(GBufferLayout::MonoSpecular, 1),
-        shader(GBufferLayout::MonoSpecular, 4),
-    ]
+    layout_shaders(GBufferLayout::MonoSpecular)
 }
 
-/// The pipelines' shader for G-buffers of `samples` samples per pixel.
-fn shader(layout: GBufferLayout, samples: u32) -> ComposedShader {
-    let msaa = crate::shader::msaa_wgsl(samples);
-    let name = match (layout, samples) {
-        (GBufferLayout::Full, 1) => "deferred",
-        (GBufferLayout::MonoSpecular, 1) => "deferred_mono",
-        (GBufferLayout::Full, _) => "deferred_msaa",
-        (GBufferLayout::MonoSpecular, _) => "deferred_mono_msaa",
-    };
-    compose(
-        name,
-        &[
+/// Every value of [`DeferredKey`] with G-buffer `layout`.
+fn layout_shaders(layout: GBufferLayout) -> Vec<ComposedShader> {
+    DeferredKey::all()
+        .into_iter()
+        .filter(|k| k.layout == layout)
+        .map(DeferredKey::shader)
+        .collect()
+}
+
+/// The pipelines' shader: the G-buffer's layout and samples per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct DeferredKey {
+    pub layout: GBufferLayout,
+    pub samples: u32,
+}
+
+impl ShaderKey for DeferredKey {
+    const STAGE: &'static str = "deferred";
+
+    fn all() -> Vec<Self> {
+        GBufferLayout::ALL
+            .into_iter()
+            .flat_map(|layout| every_sample_count().map(move |samples| Self { layout, samples }))
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![
             src::TYPES,
             src::SCENE_BINDINGS,
             src::LIGHTING,
             src::LIT_OUT,
             FULLSCREEN_WGSL,
             VOLUME_WGSL,
-            &msaa,
-            layout.read_wgsl(),
+            src::MSAA,
+            self.layout.read_wgsl(),
             MSAA_EDGES_WGSL,
             include_str!("deferred.wgsl"),
-        ],
-    )
+        ]
+    }
 }
 
 /// The pipelines of one [`Shading`]: per pixel, or per sample on MSAA edge pixels.
@@ -125,7 +141,7 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
         samples,
     );
     let volumes = LightVolumes::new(device, w, h, samples);
-    let module = create_module(device, &shader(layout, samples));
+    let module = create_module(device, &DeferredKey { layout, samples }.shader());
     let targets = volume_targets(ctx.count_blend, samples);
     let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
     let volume = |label: &str, fragment_entry, draw, shading| {

@@ -52,34 +52,50 @@ use crate::passes::{
     VolumePipelineDesc, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT, MSAA_SURFACES_WGSL, VOLUME_WGSL,
 };
 use crate::passes::{cleared, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES};
-use crate::shader::{compose, compute_pipeline, create_module, src, ComposedShader, SCENE_PARTS};
+use crate::shader::{
+    compute_pipeline, create_module, every_sample_count, msaa_defs, src, ComposedShader, Def,
+    ShaderKey, SCENE_PARTS,
+};
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
 /// rounded up to what every adapter renders and blends.
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    vec![shader(1), shader(4)]
+    LightPrepassKey::all_shaders()
 }
 
 /// The light pre-pass's shader for targets of `samples` samples per pixel.
-fn shader(samples: u32) -> ComposedShader {
-    let msaa = crate::shader::msaa_wgsl(samples);
-    let name = if samples > 1 {
-        "light_prepass_msaa"
-    } else {
-        "light_prepass"
-    };
-    let mut parts = SCENE_PARTS.to_vec();
-    parts.extend([
-        &msaa,
-        FULLSCREEN_WGSL,
-        VOLUME_WGSL,
-        MSAA_SURFACES_WGSL,
-        ATTRIBUTES_WGSL,
-        include_str!("light_prepass.wgsl"),
-    ]);
-    compose(name, &parts)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct LightPrepassKey {
+    pub samples: u32,
+}
+
+impl ShaderKey for LightPrepassKey {
+    const STAGE: &'static str = "light_prepass";
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .map(|samples| Self { samples })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        let mut parts = SCENE_PARTS.to_vec();
+        parts.extend([
+            src::MSAA,
+            FULLSCREEN_WGSL,
+            VOLUME_WGSL,
+            MSAA_SURFACES_WGSL,
+            ATTRIBUTES_WGSL,
+            include_str!("light_prepass.wgsl"),
+        ]);
+        parts
+    }
 }
 
 /// Group 2 of the irradiance passes and the surface they read from it (both variants).
@@ -88,42 +104,55 @@ const ATTRIBUTES_WGSL: &str = include_str!("light_prepass_attributes.wgsl");
 /// The tiled variant's shaders: the light pre-pass's and the irradiance kernel.
 pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
     let mut out = shaders();
-    out.extend([tiled_kernel(1), tiled_kernel(4)]);
+    out.extend(TiledKernelKey::all_shaders());
     out
 }
 
 /// The irradiance kernel for attributes of `samples` samples per pixel: one pixel per
 /// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`).
-fn tiled_kernel(samples: u32) -> ComposedShader {
-    let msaa = crate::shader::msaa_wgsl(samples);
-    // The kernel and what it shares: the storage outputs at 1x, the edge queue above.
-    let (name, shared, kernel) = if samples > 1 {
-        (
-            "tiled_light_prepass_msaa",
-            super::tiled_deferred::MSAA_EDGE_QUEUE_WGSL,
-            include_str!("tiled_light_prepass_msaa.wgsl"),
-        )
-    } else {
-        (
-            "tiled_light_prepass",
-            crate::passes::COMPUTE_OUTPUTS_WGSL,
-            include_str!("tiled_light_prepass.wgsl"),
-        )
-    };
-    compose(
-        name,
-        &[
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct TiledKernelKey {
+    pub samples: u32,
+}
+
+impl ShaderKey for TiledKernelKey {
+    const STAGE: &'static str = "tiled_light_prepass";
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .map(|samples| Self { samples })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        // The kernel and what it shares: the storage outputs at 1x, the edge queue above.
+        let (shared, kernel) = if self.samples > 1 {
+            (
+                super::tiled_deferred::MSAA_EDGE_QUEUE_WGSL,
+                include_str!("tiled_light_prepass_msaa.wgsl"),
+            )
+        } else {
+            (
+                crate::passes::COMPUTE_OUTPUTS_WGSL,
+                include_str!("tiled_light_prepass.wgsl"),
+            )
+        };
+        vec![
             src::TYPES,
             src::SCENE_BINDINGS,
             src::LIGHTING,
-            &msaa,
+            src::MSAA,
             src::LIGHT_GRID,
             MSAA_SURFACES_WGSL,
             ATTRIBUTES_WGSL,
             shared,
             kernel,
-        ],
-    )
+        ]
+    }
 }
 
 /// Which light pre-pass.
@@ -404,7 +433,7 @@ fn tiled_irradiance(
     let kernel = compute_pipeline(
         ctx.device,
         "tiled light pre-pass irradiance",
-        &tiled_kernel(samples),
+        &TiledKernelKey { samples }.shader(),
         "main",
         &[
             Some(ctx.scene_layout),
@@ -437,7 +466,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.msaa;
-    let module = create_module(device, &shader(samples));
+    let module = create_module(device, &LightPrepassKey { samples }.shader());
     let attributes = geometry_pipeline(
         device,
         &GeometryPipelineDesc {

@@ -1,5 +1,5 @@
 // The light pre-pass's attributes (pass 1's normal + specular exponent and depth, each sample
-// with MSAA: `shader::msaa_wgsl`'s texture types) as read by its irradiance passes (group 2):
+// with MSAA: `shader/msaa.wgsl`'s texture types) as read by its irradiance passes (group 2):
 // the light volumes' fragments (`light_prepass.wgsl`) and the tiled compute kernel
 // (`tiled_light_prepass.wgsl`).
 

@@ -404,14 +404,20 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
 ];
 
-/// Every shader the library can create, for the validation test: the registry's pipelines
-/// plus the shared passes.
+/// Every shader the library can create, for the validation test: the shared passes, the
+/// culling stages and the registry's pipelines, every value of each keyed stage
+/// (`shader::ShaderKey::all`), once each (pipelines sharing a stage list it each).
 pub fn all_shaders() -> Vec<ComposedShader> {
     let mut out = crate::passes::shaders();
     out.extend(crate::culling::shaders());
     out.push(transparent::shader());
     for p in PIPELINES {
-        out.extend((p.shaders)());
+        for s in (p.shaders)() {
+            match out.iter().find(|o| o.name == s.name) {
+                Some(o) => assert_eq!(o.source, s.source, "two shaders named {}", s.name),
+                None => out.push(s),
+            }
+        }
     }
     out
 }

@@ -27,56 +27,96 @@ use crate::passes::{
     compute_outputs, compute_outputs_layout, GBuffer, GBufferLayout, COMPUTE_OUTPUTS_WGSL,
     GBUFFER_READ_WGSL,
 };
-use crate::shader::{compose, compute_pipeline, compute_pipeline_with, src, ComposedShader};
+use crate::shader::{
+    compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, src,
+    ComposedShader, Def, ShaderKey,
+};
 
-/// A deferred shading kernel (`name`) for `samples` samples per pixel, over the G-buffer and
-/// `reads` (the grid, or the single kernel's culling): `single` at one sample per pixel
-/// (one sample per invocation, storage-texture outputs), else the edge-aware `edge_aware`
-/// (the edge test, the edge queue, the per-sample outputs).
-fn deferred_kernel(
-    samples: u32,
-    name: &str,
-    reads: &[&str],
-    single: &str,
-    edge_aware: &str,
-) -> ComposedShader {
-    let msaa = crate::shader::msaa_wgsl(samples);
-    let mut parts = vec![
-        src::TYPES,
-        src::SCENE_BINDINGS,
-        src::LIGHTING,
-        &msaa,
-        GBUFFER_READ_WGSL,
-    ];
-    parts.extend(reads);
-    if samples == 1 {
-        parts.extend([COMPUTE_OUTPUTS_WGSL, single]);
-        return compose(name, &parts);
+/// Which deferred shading kernel: the grid pipelines' (`tiled_deferred`, `clustered_deferred`:
+/// the light grid read in group 1) or the single kernel's (its own tile culling inside).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kernel {
+    Grid,
+    Single,
+}
+
+/// A deferred shading kernel over the G-buffer for `samples` samples per pixel: at one, one
+/// sample per invocation with storage-texture outputs (`tiled_deferred.wgsl`,
+/// `tiled_deferred_single.wgsl`); above, the edge-aware kernel (the edge test, the edge queue,
+/// the per-sample outputs: `tiled_deferred_msaa.wgsl`, `tiled_deferred_single_msaa.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct KernelKey {
+    pub kernel: Kernel,
+    pub samples: u32,
+}
+
+impl ShaderKey for KernelKey {
+    const STAGE: &'static str = "tiled_deferred";
+
+    fn all() -> Vec<Self> {
+        [Kernel::Grid, Kernel::Single]
+            .into_iter()
+            .flat_map(|kernel| every_sample_count().map(move |samples| Self { kernel, samples }))
+            .collect()
     }
-    parts.extend([
-        crate::passes::MSAA_EDGES_WGSL,
-        src::TONE,
-        MSAA_EDGE_QUEUE_WGSL,
-        MSAA_SAMPLE_OUTPUTS_WGSL,
-        edge_aware,
-    ]);
-    compose(&format!("{name}_msaa"), &parts)
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        let mut parts = vec![
+            src::TYPES,
+            src::SCENE_BINDINGS,
+            src::LIGHTING,
+            src::MSAA,
+            GBUFFER_READ_WGSL,
+        ];
+        match self.kernel {
+            Kernel::Grid => parts.push(src::LIGHT_GRID),
+            Kernel::Single => parts.extend([TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL]),
+        }
+        if self.samples == 1 {
+            parts.push(COMPUTE_OUTPUTS_WGSL);
+            parts.push(match self.kernel {
+                Kernel::Grid => include_str!("tiled_deferred.wgsl"),
+                Kernel::Single => include_str!("tiled_deferred_single.wgsl"),
+            });
+        } else {
+            parts.extend([
+                crate::passes::MSAA_EDGES_WGSL,
+                src::TONE,
+                MSAA_EDGE_QUEUE_WGSL,
+                MSAA_SAMPLE_OUTPUTS_WGSL,
+                match self.kernel {
+                    Kernel::Grid => include_str!("tiled_deferred_msaa.wgsl"),
+                    Kernel::Single => include_str!("tiled_deferred_single_msaa.wgsl"),
+                },
+            ]);
+        }
+        parts
+    }
+}
+
+/// Every value of [`KernelKey`] of `kernel`.
+fn kernel_shaders(kernel: Kernel) -> Vec<ComposedShader> {
+    KernelKey::all()
+        .into_iter()
+        .filter(|k| k.kernel == kernel)
+        .map(KernelKey::shader)
+        .collect()
 }
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    vec![kernel_shader(1), kernel_shader(4), expand_shader(4)]
+    let mut out = kernel_shaders(Kernel::Grid);
+    out.extend(ExpandKey::all_shaders());
+    out
 }
 
-/// The grid pipelines' shading kernel for `samples` samples per pixel: one sample per
-/// invocation, or above one the edge-aware kernel (`tiled_deferred_msaa.wgsl`).
-fn kernel_shader(samples: u32) -> ComposedShader {
-    deferred_kernel(
-        samples,
-        "tiled_deferred",
-        &[src::LIGHT_GRID],
-        include_str!("tiled_deferred.wgsl"),
-        include_str!("tiled_deferred_msaa.wgsl"),
-    )
+pub(super) fn shaders_single() -> Vec<ComposedShader> {
+    let mut out = kernel_shaders(Kernel::Single);
+    out.extend(ExpandKey::all_shaders());
+    out
 }
 
 /// The MSAA kernels' outputs (group 3 of `SampleOutputs`), shared by the grid and the single
@@ -85,32 +125,34 @@ const MSAA_SAMPLE_OUTPUTS_WGSL: &str = include_str!("msaa_sample_outputs.wgsl");
 /// The edge-aware kernels' queue of edge samples and counts (also the tiled light pre-pass's).
 pub(super) const MSAA_EDGE_QUEUE_WGSL: &str = include_str!("msaa_edge_queue.wgsl");
 
-/// The pass writing the MSAA kernel's per-sample colours into the multisampled HDR target.
-fn expand_shader(samples: u32) -> ComposedShader {
-    compose(
-        "sample_expand",
-        &[
+/// The pass writing the MSAA kernel's per-sample colours into the multisampled HDR target:
+/// only above one sample per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct ExpandKey {
+    pub samples: u32,
+}
+
+impl ShaderKey for ExpandKey {
+    const STAGE: &'static str = "sample_expand";
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .filter(|&samples| samples > 1)
+            .map(|samples| Self { samples })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![
             crate::passes::FULLSCREEN_WGSL,
-            &crate::shader::msaa_wgsl(samples),
+            src::MSAA,
             include_str!("sample_expand.wgsl"),
-        ],
-    )
-}
-
-pub(super) fn shaders_single() -> Vec<ComposedShader> {
-    vec![single_kernel_shader(1), single_kernel_shader(4)]
-}
-
-/// The single kernel for `samples` samples per pixel: one sample per invocation, or above
-/// one the edge-aware kernel (`tiled_deferred_single_msaa.wgsl`).
-fn single_kernel_shader(samples: u32) -> ComposedShader {
-    deferred_kernel(
-        samples,
-        "tiled_deferred_single",
-        &[TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL],
-        include_str!("tiled_deferred_single.wgsl"),
-        include_str!("tiled_deferred_single_msaa.wgsl"),
-    )
+        ]
+    }
 }
 
 enum Variant {
@@ -216,12 +258,12 @@ impl SampleOutputs {
             device,
             &crate::passes::FullscreenDesc {
                 label: "sample expand",
-                shader: &expand_shader(samples),
+                shader: &ExpandKey { samples }.shader(),
                 fragment_entry: "fs_expand",
                 layout: &expand_layout,
                 target: crate::passes::HDR_FORMAT,
                 samples,
-                constants: &[("WIDTH", f64::from(w))],
+                constants: &[(overrides::WIDTH, f64::from(w))],
             },
         );
         (
@@ -323,7 +365,11 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         Some(&gbuffer.read_layout),
         Some(&outputs_layout),
     ];
-    let kernel = kernel_shader(samples);
+    let kernel = KernelKey {
+        kernel: Kernel::Grid,
+        samples,
+    }
+    .shader();
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred shading",
@@ -338,7 +384,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
             &kernel,
             "main",
             &layouts,
-            &[("RESOLVE_IN_KERNEL", 1.0)],
+            &[(overrides::RESOLVE_IN_KERNEL, 1.0)],
         ));
     }
     Box::new(TiledDeferred {
@@ -400,7 +446,11 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
         Some(&gbuffer.read_layout),
         Some(&outputs_layout),
     ];
-    let kernel = single_kernel_shader(samples);
+    let kernel = KernelKey {
+        kernel: Kernel::Single,
+        samples,
+    }
+    .shader();
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred single kernel",
@@ -415,7 +465,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
             &kernel,
             "main",
             &layouts,
-            &[("RESOLVE_IN_KERNEL", 1.0)],
+            &[(overrides::RESOLVE_IN_KERNEL, 1.0)],
         ));
     }
     Box::new(TiledDeferred {
