@@ -895,3 +895,45 @@ fn msaa_in_compare_render_and_memory() {
     assert_eq!(single, 2, "{out}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A missing dim light darkens a small region by a few levels: below the mean and the 99th
+/// percentile bounds, caught by `--max-over` (and not by a level it stays under).
+#[test]
+fn diff_max_over_catches_a_small_dark_region() {
+    let dir = temp_dir("diff-over");
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    let img = |dark: bool| {
+        image::RgbaImage::from_fn(100, 100, |x, y| {
+            let inside = dark && (x as i32 - 30).pow(2) + (y as i32 - 40).pow(2) < 16;
+            image::Rgba(if inside {
+                [70, 70, 70, 255]
+            } else {
+                [80, 80, 80, 255]
+            })
+        })
+    };
+    img(false).save(&a).unwrap();
+    img(true).save(&b).unwrap();
+    let (sa, sb) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let o = lightgrid(&["diff", sa, sb, "--max-mean", "0.5", "--max-p99", "4"]);
+    assert!(o.status.success(), "mean and p99 pass: {}", stderr(&o));
+    let o = lightgrid(&["diff", sa, sb, "--max-over", "4:10", "--json"]);
+    assert!(
+        !o.status.success(),
+        "45 pixels 10 levels darker must fail 4:10"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["pixels_over"]["count"], 45, "{v}");
+    assert!(stderr(&o).contains("45 pixels differ by more than 4 levels (at most 10 allowed)"));
+    let o = lightgrid(&["diff", sa, sb, "--max-over", "10:0"]);
+    assert!(
+        o.status.success(),
+        "no pixel differs by more than 10: {}",
+        stderr(&o)
+    );
+    for bad in ["4", "4:", ":3", "256:1", "255:1", "-1:2", "4:-2", "nan:1"] {
+        let o = lightgrid(&["diff", sa, sb, "--max-over", bad]);
+        assert!(!o.status.success(), "--max-over {bad} accepted");
+        assert!(!stderr(&o).contains("panicked"), "{bad}: {}", stderr(&o));
+    }
+}

@@ -16,9 +16,24 @@ pub struct DiffSummary {
     pub max: f64,
 }
 
-/// Compare two images of the same size; returns the summary and a visual diff image
-/// (difference ×8, in red, over a dimmed copy of `a`).
-pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
+/// Per difference level (0-255), how many pixels differ by exactly that much (the largest
+/// colour channel's difference): the bounds on how many pixels may differ by more than a
+/// level (`lightgrid diff --max-over`, the image tests) read it.
+pub fn difference_histogram(a: &RgbaImage, b: &RgbaImage) -> Result<[u64; 256]> {
+    check_same_size(a, b)?;
+    let mut histogram = [0u64; 256];
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        histogram[usize::from(pixel_difference(pa, pb))] += 1;
+    }
+    Ok(histogram)
+}
+
+/// The largest absolute difference of two pixels' colour channels.
+fn pixel_difference(a: &image::Rgba<u8>, b: &image::Rgba<u8>) -> u8 {
+    (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0)
+}
+
+fn check_same_size(a: &RgbaImage, b: &RgbaImage) -> Result<()> {
     if a.dimensions() != b.dimensions() {
         return Err(Error::invalid(
             "images",
@@ -31,11 +46,18 @@ pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// Compare two images of the same size; returns the summary and a visual diff image
+/// (difference ×8, in red, over a dimmed copy of `a`).
+pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
+    check_same_size(a, b)?;
     let mut histogram = [0u64; 256];
     let mut sum = 0u64;
     let mut vis = RgbaImage::new(a.width(), a.height());
     for ((pa, pb), pv) in a.pixels().zip(b.pixels()).zip(vis.pixels_mut()) {
-        let d = (0..3).map(|c| pa[c].abs_diff(pb[c])).max().unwrap_or(0);
+        let d = pixel_difference(pa, pb);
         histogram[d as usize] += 1;
         sum += u64::from(d);
         let luma = ((u32::from(pa[0]) + u32::from(pa[1]) + u32::from(pa[2])) / 12) as u8;

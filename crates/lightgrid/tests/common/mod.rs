@@ -67,8 +67,16 @@ pub fn golden_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
 }
 
+/// `LIGHTGRID_BLESS=1` rewrites the goldens instead of comparing with them: refused under
+/// `CI=true`, where it would turn every image check into a pass.
 pub fn blessing() -> bool {
-    std::env::var("LIGHTGRID_BLESS").is_ok_and(|v| v == "1")
+    let bless = std::env::var("LIGHTGRID_BLESS").is_ok_and(|v| v == "1");
+    let ci = std::env::var("CI").is_ok_and(|v| v == "true");
+    assert!(
+        !(bless && ci),
+        "LIGHTGRID_BLESS=1 is refused under CI=true: goldens are re-blessed by hand, never by CI"
+    );
+    bless
 }
 
 /// An image comparison's bounds, in 8-bit sRGB levels; a pixel's difference is its largest
@@ -142,13 +150,7 @@ impl ImageComparison {
 /// Per-pixel differences (largest absolute channel difference, alpha ignored) of two images of
 /// the same size, as a histogram over the 256 levels.
 pub fn difference_histogram(a: &image::RgbaImage, b: &image::RgbaImage) -> [u64; 256] {
-    assert_eq!(a.dimensions(), b.dimensions(), "image sizes differ");
-    let mut histogram = [0u64; 256];
-    for (pa, pb) in a.pixels().zip(b.pixels()) {
-        let d = (0..3).map(|c| pa[c].abs_diff(pb[c])).max().unwrap_or(0);
-        histogram[d as usize] += 1;
-    }
-    histogram
+    lightgrid::image_io::difference_histogram(a, b).expect("image sizes differ")
 }
 
 /// How many pixels differ by more than `level`.
