@@ -9,7 +9,7 @@ use lightgrid::error::{Error, Result};
 use lightgrid::frame::MaterialDraws;
 use lightgrid::image_io::{save_png, write_atomic};
 use lightgrid::passes::GBufferFormat;
-use lightgrid::pipelines::{ids, SpotCull};
+use lightgrid::pipelines::{ids, SettingValue, SpotCull};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -33,26 +33,14 @@ pub(crate) fn run_name(r: &RunRecord) -> String {
 /// than one.
 fn pipeline_label(r: &RunRecord) -> String {
     let mut label = r.pipeline.clone();
-    if let Some(c) = r.spot_cull() {
-        label += &format!(" [{}]", spot_cull_name(c));
-    }
-    if let Some(l) = r.lists() {
-        label += &format!(" [{} lists]", l.name());
-    }
-    if let Some(d) = r.material_draws() {
-        label += &format!(" [{} draws]", d.name());
-    }
-    if r.msaa() > 1 {
-        label += &format!(" [{}x msaa]", r.msaa());
-    }
-    if let Some(m) = r.msaa_resolve() {
-        label += &format!(" [{} resolve]", m.name());
-    }
-    if let Some(b) = r.depth_bounds() {
-        label += &format!(" [bounds {}]", b.name());
-    }
-    if let Some(d) = r.depth_reduction() {
-        label += &format!(" [{} reduction]", d.name());
+    // Each setting that names the run, in the table's order, as its row says (the G-buffer
+    // is named by `run_name`); MSAA and where it resolves whenever MSAA is on.
+    for axis in lightgrid::pipelines::AXES {
+        let names = r.varied.iter().any(|f| f == axis.flag)
+            || (axis.flag == "msaa-resolve" && r.msaa_resolve().is_some());
+        if names && axis.flag != GBufferFormat::FLAG {
+            label += &format!(" [{}]", (axis.label)(&(axis.get)(&r.settings)));
+        }
     }
     label
 }

@@ -402,8 +402,8 @@ pub struct RunRecord {
     pub pipeline: String,
     /// The settings the pipeline rendered with.
     pub settings: RenderSettings,
-    /// The settings the run measured at more than one value that the pipeline reads (their
-    /// flags): what tells this series from its siblings.
+    /// The settings the pipeline reads that the run measured at more than one value or away
+    /// from their default (their flags): what names this series among its siblings.
     #[serde(default)]
     pub varied: Vec<String>,
     pub width: u32,
@@ -570,15 +570,17 @@ fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<RenderS
     out
 }
 
-/// What tells `settings` from its siblings: the flags of the settings measured at more than
-/// one value that `info` reads.
+/// What names `settings` among its siblings: the flags of the settings `info` reads that
+/// the run measured at more than one value or at a value other than the default.
 fn varied(
     config: &BenchConfig,
     info: &pipelines::PipelineInfo,
     settings: &RenderSettings,
 ) -> Vec<String> {
+    let default = RenderSettings::default();
     AXES.iter()
-        .filter(|a| config.varies(a) && (a.applies)(info, settings))
+        .filter(|a| (a.applies)(info, settings))
+        .filter(|a| config.varies(a) || (a.get)(settings) != (a.get)(&default))
         .map(|a| a.flag.to_string())
         .collect()
 }
@@ -932,8 +934,8 @@ impl FrameRecord {
 }
 
 impl RunRecord {
-    /// The value of the setting `T` is the type of, when the run measured more than one and
-    /// the pipeline reads it.
+    /// The value of the setting `T` is the type of, when it names the run (measured at more
+    /// than one value or away from its default, and read by the pipeline).
     pub fn varied<T: SettingValue>(&self) -> Option<T> {
         self.varied
             .iter()

@@ -191,6 +191,8 @@ pub struct Axis {
     pub get: fn(&RenderSettings) -> String,
     /// Set the value called `value` (an error names the accepted values).
     pub set: fn(&mut RenderSettings, &str) -> Result<(), String>,
+    /// How a series measured at `value` is named in reports (`[bounds min]`).
+    pub label: fn(&str) -> String,
 }
 
 impl Axis {
@@ -247,6 +249,7 @@ pub const AXES: &[Axis] = &[
             s.slices = number(v)?;
             crate::frame::validate_slices(s.slices).map_err(|e| e.to_string())
         },
+        label: |v| format!("{v} slices"),
     },
     Axis {
         flag: "gbuffer",
@@ -259,6 +262,7 @@ pub const AXES: &[Axis] = &[
             s.gbuffer = GBufferFormat::parse(v)?;
             Ok(())
         },
+        label: |v| format!("g{v}"),
     },
     Axis {
         flag: "assign",
@@ -271,6 +275,7 @@ pub const AXES: &[Axis] = &[
             s.assign = Assign::parse(v)?;
             Ok(())
         },
+        label: |v| v.to_string(),
     },
     Axis {
         flag: "spot-cull",
@@ -283,6 +288,7 @@ pub const AXES: &[Axis] = &[
             s.spot_cull = SpotCull::parse(v)?;
             Ok(())
         },
+        label: |v| v.to_string(),
     },
     Axis {
         flag: "lists",
@@ -295,6 +301,7 @@ pub const AXES: &[Axis] = &[
             s.lists = GridLists::parse(v)?;
             Ok(())
         },
+        label: |v| format!("{v} lists"),
     },
     Axis {
         flag: "material-draws",
@@ -307,6 +314,7 @@ pub const AXES: &[Axis] = &[
             s.material_draws = MaterialDraws::parse(v)?;
             Ok(())
         },
+        label: |v| format!("{v} draws"),
     },
     Axis {
         flag: "msaa",
@@ -319,6 +327,7 @@ pub const AXES: &[Axis] = &[
             s.msaa = number(v)?;
             crate::frame::validate_msaa(s.msaa).map_err(|e| e.to_string())
         },
+        label: |v| format!("{v}x msaa"),
     },
     Axis {
         flag: "msaa-resolve",
@@ -331,6 +340,7 @@ pub const AXES: &[Axis] = &[
             s.msaa_resolve = MsaaResolve::parse(v)?;
             Ok(())
         },
+        label: |v| format!("{v} resolve"),
     },
     Axis {
         flag: "depth-bounds",
@@ -343,6 +353,7 @@ pub const AXES: &[Axis] = &[
             s.depth_bounds = DepthBounds::parse(v)?;
             Ok(())
         },
+        label: |v| format!("bounds {v}"),
     },
     Axis {
         flag: "depth-reduction",
@@ -355,6 +366,7 @@ pub const AXES: &[Axis] = &[
             s.depth_reduction = DepthReduction::parse(v)?;
             Ok(())
         },
+        label: |v| format!("{v} reduction"),
     },
 ];
 
