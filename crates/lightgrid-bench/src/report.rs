@@ -68,7 +68,7 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
     for r in runs {
         let m = r.summary.as_ref().expect("filtered");
         let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-            format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
+            format!("{:.2}", x.mean / m.ideal_lighting_computations.mean.max(1.0))
         });
         let pass_ms = |label: &str| {
             m.passes
@@ -105,7 +105,7 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
             s,
             "| {pipeline} | {} | {:.2} | {ratio} | {:.1} | {bounds} | {fragments} | {edges} | {shaded} |",
             r.msaa,
-            m.gpu_ms.avg,
+            m.gpu_ms.mean,
             m.target_bytes as f64 / (1024.0 * 1024.0),
         );
     }
@@ -543,7 +543,7 @@ fn msaa_charts(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -
         y_label: "ms (log scale)".into(),
         log_x: false,
         log_y: true,
-        series: series(&|r| r.summary.as_ref().map_or(0.0, |m| m.gpu_ms.avg)),
+        series: series(&|r| r.summary.as_ref().map_or(0.0, |m| m.gpu_ms.mean)),
     };
     write_chart(dir, "msaa_time", time.svg(), time.png(), written)?;
     let memory = LineChart {
@@ -636,9 +636,9 @@ fn summary(results: &BenchResults) -> String {
             let Some(m) = &r.summary else { continue };
             let lc = m
                 .lighting_computations
-                .map_or("n/a".into(), |x| format!("{:.0}", x.avg));
+                .map_or("n/a".into(), |x| format!("{:.0}", x.mean));
             let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-                format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
+                format!("{:.2}", x.mean / m.ideal_lighting_computations.mean.max(1.0))
             });
             let eff = m
                 .efficiency
@@ -657,7 +657,7 @@ fn summary(results: &BenchResults) -> String {
                     (false, super::run::TimesFrom::Analysis) => " (incomplete; analysis times)",
                 },
                 r.gbuffer_bits.map_or("-".into(), |b| format!("{b}-bit")),
-                m.gpu_ms.avg,
+                m.gpu_ms.mean,
                 m.gpu_ms.min,
                 m.gpu_ms.max,
                 fps(r),
@@ -674,7 +674,7 @@ fn summary(results: &BenchResults) -> String {
             .iter()
             .find(|r| &r.scene == scene)
             .and_then(|r| r.summary.as_ref())
-            .map(|m| m.ideal_lighting_computations.avg);
+            .map(|m| m.ideal_lighting_computations.mean);
         if let Some(i) = ideal {
             let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
         }

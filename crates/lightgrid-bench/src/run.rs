@@ -13,7 +13,7 @@ use lightgrid::pipelines::{self, RenderSettings, SpotCull};
 use lightgrid::realtime::{play, PlayPlan, PlayedFrame};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{gltf, source, AddLights, SceneRequest};
-use lightgrid::stats::TimingSource;
+use lightgrid::stats::{Distribution, TimingSource};
 use lightgrid::Renderer;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -320,34 +320,12 @@ pub struct FrameRecord {
     pub msaa_shading: Option<lightgrid::frame::MsaaShading>,
 }
 
-/// min / avg / max of a series.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Stat {
-    pub min: f64,
-    pub avg: f64,
-    pub max: f64,
-}
-
-impl Stat {
-    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Stat> {
-        let v: Vec<f64> = values.into_iter().collect();
-        if v.is_empty() {
-            return None;
-        }
-        Some(Stat {
-            min: v.iter().copied().fold(f64::INFINITY, f64::min),
-            avg: v.iter().sum::<f64>() / v.len() as f64,
-            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        })
-    }
-}
-
 /// Summaries of a run's per-frame series.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSummary {
-    pub gpu_ms: Stat,
-    pub lighting_computations: Option<Stat>,
-    pub ideal_lighting_computations: Stat,
+    pub gpu_ms: Distribution,
+    pub lighting_computations: Option<Distribution>,
+    pub ideal_lighting_computations: Distribution,
     /// Σ ideal ÷ Σ actual over the frames.
     pub efficiency: Option<f64>,
     pub lights_per_tile_avg: Option<f64>,
@@ -383,11 +361,11 @@ impl RunSummary {
             .filter_map(|f| f.lights_per_tile_avg)
             .collect();
         Some(RunSummary {
-            gpu_ms: Stat::of(frames.iter().map(|f| f.gpu_ms))?,
+            gpu_ms: Distribution::of(frames.iter().map(|f| f.gpu_ms))?,
             lighting_computations: counts
                 .as_ref()
-                .and_then(|c| Stat::of(c.iter().map(|&n| n as f64))),
-            ideal_lighting_computations: Stat::of(
+                .and_then(|c| Distribution::of(c.iter().map(|&n| n as f64))),
+            ideal_lighting_computations: Distribution::of(
                 frames.iter().map(|f| f.ideal_lighting_computations as f64),
             )?,
             efficiency: counts
@@ -562,12 +540,6 @@ pub struct Progress {
     pub done: u64,
     pub total: u64,
     pub label: String,
-}
-
-fn median(v: &[f64]) -> usize {
-    let mut idx: Vec<usize> = (0..v.len()).collect();
-    idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
-    idx[idx.len() / 2]
 }
 
 /// One series of the plan: a scene, a G-buffer setting and a pipeline over its frames.
@@ -855,7 +827,7 @@ struct Measuring<'a> {
     /// measured).
     heatmap_pipeline: Option<String>,
     /// Renderers by (scene, settings); pipelines without a grid builder ignore `assign`.
-    renderers: Vec<(usize, RenderSettings, Renderer<'a>)>,
+    renderers: Vec<(usize, RenderSettings, Renderer)>,
 }
 
 /// How a series ended when it did not fail.
@@ -898,7 +870,7 @@ impl<'a> Measuring<'a> {
         }
     }
 
-    fn renderer(&mut self, series: &Series, size: (u32, u32)) -> Result<&mut Renderer<'a>> {
+    fn renderer(&mut self, series: &Series, size: (u32, u32)) -> Result<&mut Renderer> {
         let settings = self.settings(series);
         let si = series.scene;
         if !self.renderers.iter().any(|r| r.0 == si && r.1 == settings) {
@@ -1127,12 +1099,12 @@ impl RunRecord {
                 .iter()
                 .map(|p| p.gpu_ms.unwrap_or(p.frame_ms))
                 .collect();
-            let m = median(&times);
+            let m = Distribution::median_index(&times).expect("not empty");
             rec.gpu_ms = times[m];
             rec.gpu_ms_repeats = times.clone();
             rec.passes = of_frame[m].passes.clone();
             let periods: Vec<f64> = of_frame.iter().map(|p| p.frame_ms).collect();
-            rec.frame_ms = periods[median(&periods)];
+            rec.frame_ms = periods[Distribution::median_index(&periods).expect("not empty")];
         }
         let measured = played.len().min(per_pass);
         if measured > 0 {

@@ -208,7 +208,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
         let check = |stat: &Value, v: &[f64]| {
             let avg = v.iter().sum::<f64>() / v.len() as f64;
             assert!(
-                (num(stat, "avg") - avg).abs() <= 1e-9 * avg.max(1.0),
+                (num(stat, "mean") - avg).abs() <= 1e-9 * avg.max(1.0),
                 "{stat} vs {v:?}"
             );
             assert_eq!(
