@@ -1,5 +1,7 @@
 //! The pipeline registry: one module per pipeline id, one row in [`PIPELINES`]. The CLI, the
-//! default job and the tests iterate this table; adding a pipeline touches nothing else.
+//! benchmark, the viewer, the default job and the image and MSAA tests iterate this table;
+//! the `--assign` checks list grid pipelines by hand (`GRID_PIPELINES` in `tests/pipelines.rs`
+//! and `tests/gpu_culling.rs`), so a new grid pipeline is added there too.
 
 mod deferred;
 mod forward;
