@@ -68,7 +68,10 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
     for r in runs {
         let m = r.summary.as_ref().expect("filtered");
         let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-            format!("{:.2}", x.mean / m.ideal_lighting_computations.mean.max(1.0))
+            format!(
+                "{:.2}",
+                x.mean / m.ideal_lighting_computations.mean.max(1.0)
+            )
         });
         let pass_ms = |label: &str| {
             m.passes
@@ -638,7 +641,10 @@ fn summary(results: &BenchResults) -> String {
                 .lighting_computations
                 .map_or("n/a".into(), |x| format!("{:.0}", x.mean));
             let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-                format!("{:.2}", x.mean / m.ideal_lighting_computations.mean.max(1.0))
+                format!(
+                    "{:.2}",
+                    x.mean / m.ideal_lighting_computations.mean.max(1.0)
+                )
             });
             let eff = m
                 .efficiency

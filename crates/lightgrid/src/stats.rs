@@ -218,7 +218,10 @@ mod tests {
         assert_eq!((d.median, d.p95), (3.0, 4.0));
         assert_eq!(Distribution::median_index(&[4.0, 1.0, 3.0, 2.0]), Some(2));
         let one = Distribution::of([7.0]).unwrap();
-        assert_eq!((one.min, one.mean, one.median, one.p95, one.max), (7.0, 7.0, 7.0, 7.0, 7.0));
+        assert_eq!(
+            (one.min, one.mean, one.median, one.p95, one.max),
+            (7.0, 7.0, 7.0, 7.0, 7.0)
+        );
         let odd: Vec<f64> = (1..=21).map(f64::from).rev().collect();
         let d = Distribution::of(odd.iter().copied()).unwrap();
         assert_eq!((d.median, d.p95), (11.0, 20.0));

@@ -305,8 +305,8 @@ impl App {
         };
         let fly_speed = FlyCamera::from_camera(&scene.camera_path.at(opts.frame)).speed;
         let adapter = ctx.adapter_label();
-        let msaa_counts =
-            [GBufferFormat::F16, GBufferFormat::F32].map(|g| lightgrid::frame::msaa_counts(&ctx, g));
+        let msaa_counts = [GBufferFormat::F16, GBufferFormat::F32]
+            .map(|g| lightgrid::frame::msaa_counts(&ctx, g));
         App {
             ctx,
             win: None,
