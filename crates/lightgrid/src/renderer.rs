@@ -688,7 +688,7 @@ impl Renderer {
 
     /// Real-time frames submitted whose GPU work may not be done yet (at most
     /// [`MAX_FRAMES_IN_FLIGHT`]).
-    pub fn frames_in_flight(&self) -> usize {
+    pub(crate) fn frames_in_flight(&self) -> usize {
         self.in_flight.len()
     }
 

@@ -381,7 +381,7 @@ pub fn all_shaders() -> Vec<ComposedShader> {
 /// The reference pipeline's id.
 pub const REFERENCE: &str = "forward";
 
-pub fn pipeline_names() -> String {
+fn pipeline_names() -> String {
     PIPELINES
         .iter()
         .map(|p| p.id)
