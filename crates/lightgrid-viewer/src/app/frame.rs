@@ -116,7 +116,7 @@ impl App {
     }
 
     /// The image the window shows now: the debug view's (once one came back) or the frame.
-    pub(super) fn source<'a>(win: &'a Win, view: DebugView) -> &'a wgpu::TextureView {
+    pub(super) fn source(win: &Win, view: DebugView) -> &wgpu::TextureView {
         match (&win.debug_texture, view) {
             (Some(t), v) if v != DebugView::Shaded => t,
             _ => win.renderer.display_view(),
