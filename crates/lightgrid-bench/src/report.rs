@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 pub const REPORT_FILES: &[&str] = &["results.json", "results.csv", "summary.md"];
 
 /// Version of the results.json layout (documented in README).
-pub const SCHEMA_VERSION: u32 = 3;
+pub const SCHEMA_VERSION: u32 = 4;
 
 /// A run as the summary names it: the pipeline, the variant settings it was measured under
 /// and its G-buffer precision.
@@ -81,7 +81,11 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
         };
         let bounds = pass_ms("assign: cell bounds");
         let fragments = pass_ms("assign: fragment bounds");
-        let shading: Vec<_> = r.frames.iter().filter_map(|f| f.msaa_shading).collect();
+        let shading: Vec<_> = r
+            .frames
+            .iter()
+            .filter_map(|f| f.stats.msaa_shading)
+            .collect();
         let (edges, shaded) = if shading.is_empty() {
             ("-".to_string(), "-".to_string())
         } else {
@@ -292,25 +296,26 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 height: r.height,
                 tile_size: r.tile_size,
                 timing: r.timing.label(),
-                frame: f.frame,
-                gpu_ms: f.gpu_ms,
+                frame: f.stats.frame,
+                gpu_ms: f.stats.gpu_ms,
                 gpu_ms_min: repeats().fold(f64::INFINITY, f64::min),
                 gpu_ms_max: repeats().fold(f64::NEG_INFINITY, f64::max),
                 frame_ms: f.frame_ms,
                 analysis_gpu_ms: f.analysis_gpu_ms,
-                lighting_computations: f.lighting_computations,
-                ideal_lighting_computations: f.ideal_lighting_computations,
-                transparent_fragments: f.transparent_fragments,
-                ideal_transparent_computations: f.ideal_transparent_computations,
-                lights_per_tile_avg: f.lights_per_tile_avg,
-                lights_per_tile_max: f.lights_per_tile_max,
-                tile_area_computations: f.tile_area_computations,
-                grid_bytes: f.grid_bytes,
-                modelled_write_bytes: f.modelled_write_bytes,
-                modelled_read_bytes: f.modelled_read_bytes,
-                edge_pixels: f.msaa_shading.map(|m| m.edge_pixels),
-                shaded_samples: f.msaa_shading.map(|m| m.shaded_samples),
+                lighting_computations: f.stats.lighting_computations,
+                ideal_lighting_computations: f.stats.ideal_lighting_computations,
+                transparent_fragments: f.stats.transparent_fragments,
+                ideal_transparent_computations: f.stats.ideal_transparent_computations,
+                lights_per_tile_avg: f.stats.lights_per_tile_avg,
+                lights_per_tile_max: f.stats.lights_per_tile_max,
+                tile_area_computations: f.stats.tile_area_computations,
+                grid_bytes: f.stats.memory.grid_bytes,
+                modelled_write_bytes: f.stats.memory.modelled_write_bytes,
+                modelled_read_bytes: f.stats.memory.modelled_read_bytes,
+                edge_pixels: f.stats.msaa_shading.map(|m| m.edge_pixels),
+                shaded_samples: f.stats.msaa_shading.map(|m| m.shaded_samples),
                 passes: f
+                    .stats
                     .passes
                     .iter()
                     .map(|p| format!("{}={:.4}", p.label, p.ms))
@@ -383,7 +388,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                         points: r
                             .frames
                             .iter()
-                            .map(|f| (f.frame as f64, f.gpu_ms))
+                            .map(|f| (f.stats.frame as f64, f.stats.gpu_ms))
                             .collect(),
                         emphasis: false,
                     })
@@ -430,13 +435,22 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
             .collect();
         let mut series: Vec<Series> = runs
             .iter()
-            .filter(|r| r.frames.iter().all(|f| f.lighting_computations.is_some()))
+            .filter(|r| {
+                r.frames
+                    .iter()
+                    .all(|f| f.stats.lighting_computations.is_some())
+            })
             .map(|r| Series {
                 name: pipeline_label(r),
                 points: r
                     .frames
                     .iter()
-                    .map(|f| (f.frame as f64, f.lighting_computations.unwrap_or(0) as f64))
+                    .map(|f| {
+                        (
+                            f.stats.frame as f64,
+                            f.stats.lighting_computations.unwrap_or(0) as f64,
+                        )
+                    })
                     .collect(),
                 emphasis: false,
             })
@@ -447,7 +461,12 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 points: r
                     .frames
                     .iter()
-                    .map(|f| (f.frame as f64, f.ideal_lighting_computations as f64))
+                    .map(|f| {
+                        (
+                            f.stats.frame as f64,
+                            f.stats.ideal_lighting_computations as f64,
+                        )
+                    })
                     .collect(),
                 emphasis: true,
             });
@@ -696,12 +715,12 @@ fn summary(results: &BenchResults) -> String {
             let fragments: f64 = r
                 .frames
                 .iter()
-                .map(|f| f.transparent_fragments as f64)
+                .map(|f| f.stats.transparent_fragments as f64)
                 .sum();
             let ideal: f64 = r
                 .frames
                 .iter()
-                .map(|f| f.ideal_transparent_computations as f64)
+                .map(|f| f.stats.ideal_transparent_computations as f64)
                 .sum();
             if fragments > 0.0 {
                 let pixels = f64::from(r.width) * f64::from(r.height);
@@ -716,7 +735,7 @@ fn summary(results: &BenchResults) -> String {
                     let counts: Option<Vec<u64>> = r
                         .frames
                         .iter()
-                        .map(|f| f.transparent_lighting_computations)
+                        .map(|f| f.stats.transparent_lighting_computations)
                         .collect();
                     if let Some(c) = counts.filter(|c| !c.is_empty()) {
                         let avg = c.iter().sum::<u64>() as f64 / c.len() as f64;
@@ -746,8 +765,8 @@ fn summary(results: &BenchResults) -> String {
                 (v.len() == r.frames.len()).then(|| v.iter().sum::<u64>() as f64 / n)
             };
             let traffic = match (
-                avg(&|f| f.modelled_write_bytes),
-                avg(&|f| f.modelled_read_bytes),
+                avg(&|f| f.stats.memory.modelled_write_bytes),
+                avg(&|f| f.stats.memory.modelled_read_bytes),
             ) {
                 (Some(wb), Some(rb)) => format!("{:.1} / {:.1}", mib(wb), mib(rb)),
                 _ => "n/a".into(),
@@ -755,7 +774,7 @@ fn summary(results: &BenchResults) -> String {
             let t1: Vec<_> = r
                 .frames
                 .iter()
-                .filter_map(|f| f.forward_plus_table1)
+                .filter_map(|f| f.stats.memory.forward_plus_table1)
                 .collect();
             let table1 = if t1.is_empty() {
                 "-".into()
@@ -924,16 +943,19 @@ fn fig3_counts(s: &mut String, results: &BenchResults, scene: &str) {
         .filter(|r| r.pipeline != "tiled_forward")
         .filter_map(|r| {
             let n = r.frames.len().max(1) as f64;
-            let area: Option<Vec<u64>> =
-                r.frames.iter().map(|f| f.tile_area_computations).collect();
+            let area: Option<Vec<u64>> = r
+                .frames
+                .iter()
+                .map(|f| f.stats.tile_area_computations)
+                .collect();
             let area = area.filter(|a| !a.is_empty())?.iter().sum::<u64>() as f64 / n;
             // Ours, opaque samples only (the figure has no transparency).
             let opaque: Option<f64> = r
                 .frames
                 .iter()
                 .map(|f| {
-                    let all = f.lighting_computations? as f64;
-                    Some(all - f.transparent_lighting_computations.unwrap_or(0) as f64)
+                    let all = f.stats.lighting_computations? as f64;
+                    Some(all - f.stats.transparent_lighting_computations.unwrap_or(0) as f64)
                 })
                 .sum::<Option<f64>>()
                 .map(|t| t / n);

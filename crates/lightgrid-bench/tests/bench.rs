@@ -119,7 +119,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
     // results.json: the documented layout.
     let json: Value =
         serde_json::from_slice(&std::fs::read(dir.join("results.json")).unwrap()).unwrap();
-    assert_eq!(json["schema_version"], 3);
+    assert_eq!(json["schema_version"], 4);
     assert!(json["adapter"].is_string() && json["command"].is_string());
     assert_eq!(json["outcome"]["status"], "complete");
     assert_eq!(json["config"]["repeat"], 2);
@@ -436,10 +436,13 @@ fn spot_culls_are_measured_side_by_side() {
     );
     let (sphere, cone) = (&results.runs[1], &results.runs[2]);
     for (a, b) in sphere.frames.iter().zip(&cone.frames) {
-        assert_eq!(a.ideal_lighting_computations, b.ideal_lighting_computations);
+        assert_eq!(
+            a.stats.ideal_lighting_computations,
+            b.stats.ideal_lighting_computations
+        );
         let (a, b) = (
-            a.lighting_computations.unwrap(),
-            b.lighting_computations.unwrap(),
+            a.stats.lighting_computations.unwrap(),
+            b.stats.lighting_computations.unwrap(),
         );
         assert!(b < a, "cone {b} not below sphere {a}");
     }

@@ -151,21 +151,11 @@ fn one() -> u32 {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Distribution {
     pub min: f64,
-    /// The arithmetic mean (`avg` in results files written before this summary had a
-    /// median; read under either name).
-    #[serde(alias = "avg")]
+    /// The arithmetic mean.
     pub mean: f64,
-    /// NaN when read from a results file written before it was recorded.
-    #[serde(default = "unknown")]
     pub median: f64,
-    /// NaN when read from a results file written before it was recorded.
-    #[serde(default = "unknown")]
     pub p95: f64,
     pub max: f64,
-}
-
-fn unknown() -> f64 {
-    f64::NAN
 }
 
 impl Distribution {
@@ -226,12 +216,5 @@ mod tests {
         let d = Distribution::of(odd.iter().copied()).unwrap();
         assert_eq!((d.median, d.p95), (11.0, 20.0));
         assert_eq!(odd[Distribution::median_index(&odd).unwrap()], 11.0);
-    }
-
-    #[test]
-    fn reads_the_old_min_avg_max_shape() {
-        let d: Distribution = serde_json::from_str(r#"{"min": 1, "avg": 2, "max": 3}"#).unwrap();
-        assert_eq!((d.min, d.mean, d.max), (1.0, 2.0, 3.0));
-        assert!(d.median.is_nan() && d.p95.is_nan());
     }
 }
