@@ -60,7 +60,10 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
     for r in runs {
         let m = r.summary.as_ref().expect("filtered");
         let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-            format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
+            format!(
+                "{:.2}",
+                x.mean / m.ideal_lighting_computations.mean.max(1.0)
+            )
         });
         let pass_ms = |label: &str| {
             m.passes
@@ -70,7 +73,11 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
         };
         let bounds = pass_ms(lightgrid::culling::labels::CELL_BOUNDS);
         let fragments = pass_ms(lightgrid::culling::labels::FRAGMENT_BOUNDS);
-        let shading: Vec<_> = r.frames.iter().filter_map(|f| f.msaa_shading).collect();
+        let shading: Vec<_> = r
+            .frames
+            .iter()
+            .filter_map(|f| f.stats.msaa_shading)
+            .collect();
         let (edges, shaded) = if shading.is_empty() {
             ("-".to_string(), "-".to_string())
         } else {
@@ -97,7 +104,7 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
             s,
             "| {pipeline} | {} | {:.2} | {ratio} | {:.1} | {bounds} | {fragments} | {edges} | {shaded} |",
             r.msaa(),
-            m.gpu_ms.avg,
+            m.gpu_ms.mean,
             m.target_bytes as f64 / (1024.0 * 1024.0),
         );
     }
@@ -230,25 +237,26 @@ fn csv(results: &BenchResults) -> Result<Vec<u8>> {
                 r.height.to_string(),
                 r.tile_size.to_string(),
                 r.timing.label().to_string(),
-                f.frame.to_string(),
-                format!("{:.4}", f.gpu_ms),
+                f.stats.frame.to_string(),
+                format!("{:.4}", f.stats.gpu_ms),
                 format!("{:.4}", repeats().fold(f64::INFINITY, f64::min)),
                 format!("{:.4}", repeats().fold(f64::NEG_INFINITY, f64::max)),
                 format!("{:.4}", f.frame_ms),
                 format!("{:.4}", f.analysis_gpu_ms),
-                opt(f.lighting_computations),
-                f.ideal_lighting_computations.to_string(),
-                f.transparent_fragments.to_string(),
-                f.ideal_transparent_computations.to_string(),
-                opt(f.lights_per_tile_avg.map(|v| format!("{v:.3}"))),
-                opt(f.lights_per_tile_max),
-                opt(f.tile_area_computations),
-                opt(f.grid_bytes),
-                opt(f.modelled_write_bytes),
-                opt(f.modelled_read_bytes),
-                opt(f.msaa_shading.map(|m| m.edge_pixels)),
-                opt(f.msaa_shading.map(|m| m.shaded_samples)),
-                f.passes
+                opt(f.stats.lighting_computations),
+                f.stats.ideal_lighting_computations.to_string(),
+                f.stats.transparent_fragments.to_string(),
+                f.stats.ideal_transparent_computations.to_string(),
+                opt(f.stats.lights_per_tile_avg.map(|v| format!("{v:.3}"))),
+                opt(f.stats.lights_per_tile_max),
+                opt(f.stats.tile_area_computations),
+                opt(f.stats.memory.grid_bytes),
+                opt(f.stats.memory.modelled_write_bytes),
+                opt(f.stats.memory.modelled_read_bytes),
+                opt(f.stats.msaa_shading.map(|m| m.edge_pixels)),
+                opt(f.stats.msaa_shading.map(|m| m.shaded_samples)),
+                f.stats
+                    .passes
                     .iter()
                     .map(|p| format!("{}={:.4}", p.label, p.ms))
                     .collect::<Vec<_>>()
@@ -323,7 +331,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                         points: r
                             .frames
                             .iter()
-                            .map(|f| (f.frame as f64, f.gpu_ms))
+                            .map(|f| (f.stats.frame as f64, f.stats.gpu_ms))
                             .collect(),
                         emphasis: false,
                     })
@@ -370,13 +378,22 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
             .collect();
         let mut series: Vec<Series> = runs
             .iter()
-            .filter(|r| r.frames.iter().all(|f| f.lighting_computations.is_some()))
+            .filter(|r| {
+                r.frames
+                    .iter()
+                    .all(|f| f.stats.lighting_computations.is_some())
+            })
             .map(|r| Series {
                 name: pipeline_label(r),
                 points: r
                     .frames
                     .iter()
-                    .map(|f| (f.frame as f64, f.lighting_computations.unwrap_or(0) as f64))
+                    .map(|f| {
+                        (
+                            f.stats.frame as f64,
+                            f.stats.lighting_computations.unwrap_or(0) as f64,
+                        )
+                    })
                     .collect(),
                 emphasis: false,
             })
@@ -387,7 +404,12 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 points: r
                     .frames
                     .iter()
-                    .map(|f| (f.frame as f64, f.ideal_lighting_computations as f64))
+                    .map(|f| {
+                        (
+                            f.stats.frame as f64,
+                            f.stats.ideal_lighting_computations as f64,
+                        )
+                    })
                     .collect(),
                 emphasis: true,
             });
@@ -486,7 +508,7 @@ fn msaa_charts(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -
         y_label: "ms (log scale)".into(),
         log_x: false,
         log_y: true,
-        series: series(&|r| r.summary.as_ref().map_or(0.0, |m| m.gpu_ms.avg)),
+        series: series(&|r| r.summary.as_ref().map_or(0.0, |m| m.gpu_ms.mean)),
     };
     write_chart(dir, "msaa_time", time.svg(), time.png(), written)?;
     let memory = LineChart {
@@ -581,9 +603,12 @@ fn summary(results: &BenchResults) -> String {
             let Some(m) = &r.summary else { continue };
             let lc = m
                 .lighting_computations
-                .map_or("n/a".into(), |x| format!("{:.0}", x.avg));
+                .map_or("n/a".into(), |x| format!("{:.0}", x.mean));
             let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-                format!("{:.2}", x.avg / m.ideal_lighting_computations.avg.max(1.0))
+                format!(
+                    "{:.2}",
+                    x.mean / m.ideal_lighting_computations.mean.max(1.0)
+                )
             });
             let eff = m
                 .efficiency
@@ -602,7 +627,7 @@ fn summary(results: &BenchResults) -> String {
                     (false, super::run::TimesFrom::Analysis) => " (incomplete; analysis times)",
                 },
                 r.gbuffer_bits().map_or("-".into(), |b| format!("{b}-bit")),
-                m.gpu_ms.avg,
+                m.gpu_ms.mean,
                 m.gpu_ms.min,
                 m.gpu_ms.max,
                 fps(r),
@@ -619,7 +644,7 @@ fn summary(results: &BenchResults) -> String {
             .iter()
             .find(|r| &r.scene == scene)
             .and_then(|r| r.summary.as_ref())
-            .map(|m| m.ideal_lighting_computations.avg);
+            .map(|m| m.ideal_lighting_computations.mean);
         if let Some(i) = ideal {
             let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
         }
@@ -635,12 +660,12 @@ fn summary(results: &BenchResults) -> String {
             let fragments: f64 = r
                 .frames
                 .iter()
-                .map(|f| f.transparent_fragments as f64)
+                .map(|f| f.stats.transparent_fragments as f64)
                 .sum();
             let ideal: f64 = r
                 .frames
                 .iter()
-                .map(|f| f.ideal_transparent_computations as f64)
+                .map(|f| f.stats.ideal_transparent_computations as f64)
                 .sum();
             if fragments > 0.0 {
                 let pixels = f64::from(r.width) * f64::from(r.height);
@@ -655,7 +680,7 @@ fn summary(results: &BenchResults) -> String {
                     let counts: Option<Vec<u64>> = r
                         .frames
                         .iter()
-                        .map(|f| f.transparent_lighting_computations)
+                        .map(|f| f.stats.transparent_lighting_computations)
                         .collect();
                     if let Some(c) = counts.filter(|c| !c.is_empty()) {
                         let avg = c.iter().sum::<u64>() as f64 / c.len() as f64;
@@ -685,8 +710,8 @@ fn summary(results: &BenchResults) -> String {
                 (v.len() == r.frames.len()).then(|| v.iter().sum::<u64>() as f64 / n)
             };
             let traffic = match (
-                avg(&|f| f.modelled_write_bytes),
-                avg(&|f| f.modelled_read_bytes),
+                avg(&|f| f.stats.memory.modelled_write_bytes),
+                avg(&|f| f.stats.memory.modelled_read_bytes),
             ) {
                 (Some(wb), Some(rb)) => format!("{:.1} / {:.1}", mib(wb), mib(rb)),
                 _ => "n/a".into(),
@@ -694,7 +719,7 @@ fn summary(results: &BenchResults) -> String {
             let t1: Vec<_> = r
                 .frames
                 .iter()
-                .filter_map(|f| f.forward_plus_table1)
+                .filter_map(|f| f.stats.memory.forward_plus_table1)
                 .collect();
             let table1 = if t1.is_empty() {
                 "-".into()
@@ -863,16 +888,19 @@ fn fig3_counts(s: &mut String, results: &BenchResults, scene: &str) {
         .filter(|r| r.pipeline != ids::TILED_FORWARD)
         .filter_map(|r| {
             let n = r.frames.len().max(1) as f64;
-            let area: Option<Vec<u64>> =
-                r.frames.iter().map(|f| f.tile_area_computations).collect();
+            let area: Option<Vec<u64>> = r
+                .frames
+                .iter()
+                .map(|f| f.stats.tile_area_computations)
+                .collect();
             let area = area.filter(|a| !a.is_empty())?.iter().sum::<u64>() as f64 / n;
             // Ours, opaque samples only (the figure has no transparency).
             let opaque: Option<f64> = r
                 .frames
                 .iter()
                 .map(|f| {
-                    let all = f.lighting_computations? as f64;
-                    Some(all - f.transparent_lighting_computations.unwrap_or(0) as f64)
+                    let all = f.stats.lighting_computations? as f64;
+                    Some(all - f.stats.transparent_lighting_computations.unwrap_or(0) as f64)
                 })
                 .sum::<Option<f64>>()
                 .map(|t| t / n);

@@ -6,13 +6,12 @@ use image::RgbaImage;
 use lightgrid::error::Result;
 use lightgrid::frame::MsaaResolve;
 use lightgrid::gpu::{GpuContext, PassTiming};
-use lightgrid::memory::ForwardPlusTable1;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{self, Axis, RenderSettings, SettingValue, AXES};
 use lightgrid::realtime::{play, PlayPlan, PlayedFrame};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{gltf, source, AddLights, SceneRequest};
-use lightgrid::stats::TimingSource;
+use lightgrid::stats::{Distribution, TimingSource};
 use lightgrid::Renderer;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -261,11 +260,12 @@ impl BenchConfig {
 /// of the same frame ([`SOURCES`] in results.json says so).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
-    pub frame: u32,
-    /// GPU time on the real-time path (timestamp span of each submission, summed; wall frame
-    /// time without
-    /// timestamps), median over the repeats.
-    pub gpu_ms: f64,
+    /// The analysis render's statistics, flattened into the record, with `gpu_ms`, `passes`
+    /// and `timing` the real-time path's once it has measured the frame: `gpu_ms` its
+    /// timestamp span (each submission's, summed; the wall frame time without timestamps),
+    /// median over the repeats, `passes` the median repeat's.
+    #[serde(flatten)]
+    pub stats: lightgrid::FrameStats,
     pub gpu_ms_repeats: Vec<f64>,
     /// Wall time from this frame's start to the next one's on the real-time path (median).
     #[serde(default)]
@@ -273,61 +273,14 @@ pub struct FrameRecord {
     /// GPU time of the analysis render of the frame (for comparison; not what a game sees).
     #[serde(default)]
     pub analysis_gpu_ms: f64,
-    /// Per-pass times of the median repeat.
-    pub passes: Vec<PassTiming>,
-    pub lighting_computations: Option<u64>,
-    pub ideal_lighting_computations: u64,
-    /// Transparent fragments in front of the opaque depth (the transparent overdraw), and
-    /// their part of the ideal count.
-    #[serde(default)]
-    pub transparent_fragments: u64,
-    #[serde(default)]
-    pub ideal_transparent_computations: u64,
-    /// The transparent pass's lighting computations.
-    #[serde(default)]
-    pub transparent_lighting_computations: Option<u64>,
-    pub lights_per_tile_avg: Option<f64>,
-    pub lights_per_tile_max: Option<u32>,
-    /// tiled-shading Fig. 3's count (tile area × list length, tiled grids).
-    #[serde(default)]
-    pub tile_area_computations: Option<u64>,
-    pub grid_bytes: Option<u64>,
-    pub modelled_write_bytes: Option<u64>,
-    pub modelled_read_bytes: Option<u64>,
-    pub forward_plus_table1: Option<ForwardPlusTable1>,
-    /// MSAA deferred kernels: edge pixels, samples shaded, samples with geometry.
-    #[serde(default)]
-    pub msaa_shading: Option<lightgrid::frame::MsaaShading>,
-}
-
-/// min / avg / max of a series.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Stat {
-    pub min: f64,
-    pub avg: f64,
-    pub max: f64,
-}
-
-impl Stat {
-    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Stat> {
-        let v: Vec<f64> = values.into_iter().collect();
-        if v.is_empty() {
-            return None;
-        }
-        Some(Stat {
-            min: v.iter().copied().fold(f64::INFINITY, f64::min),
-            avg: v.iter().sum::<f64>() / v.len() as f64,
-            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        })
-    }
 }
 
 /// Summaries of a run's per-frame series.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSummary {
-    pub gpu_ms: Stat,
-    pub lighting_computations: Option<Stat>,
-    pub ideal_lighting_computations: Stat,
+    pub gpu_ms: Distribution,
+    pub lighting_computations: Option<Distribution>,
+    pub ideal_lighting_computations: Distribution,
     /// Σ ideal ÷ Σ actual over the frames.
     pub efficiency: Option<f64>,
     pub lights_per_tile_avg: Option<f64>,
@@ -344,11 +297,17 @@ impl RunSummary {
         bytes_per_pixel: u32,
         target_bytes: u64,
     ) -> Option<Self> {
-        let counts: Option<Vec<u64>> = frames.iter().map(|f| f.lighting_computations).collect();
-        let ideal: u64 = frames.iter().map(|f| f.ideal_lighting_computations).sum();
+        let counts: Option<Vec<u64>> = frames
+            .iter()
+            .map(|f| f.stats.lighting_computations)
+            .collect();
+        let ideal: u64 = frames
+            .iter()
+            .map(|f| f.stats.ideal_lighting_computations)
+            .sum();
         let mut passes: Vec<PassTiming> = Vec::new();
         for f in frames {
-            for p in &f.passes {
+            for p in &f.stats.passes {
                 match passes.iter_mut().find(|q| q.label == p.label) {
                     Some(q) => q.ms += p.ms,
                     None => passes.push(p.clone()),
@@ -360,15 +319,17 @@ impl RunSummary {
         }
         let per_tile: Vec<f64> = frames
             .iter()
-            .filter_map(|f| f.lights_per_tile_avg)
+            .filter_map(|f| f.stats.lights_per_tile_avg)
             .collect();
         Some(RunSummary {
-            gpu_ms: Stat::of(frames.iter().map(|f| f.gpu_ms))?,
+            gpu_ms: Distribution::of(frames.iter().map(|f| f.stats.gpu_ms))?,
             lighting_computations: counts
                 .as_ref()
-                .and_then(|c| Stat::of(c.iter().map(|&n| n as f64))),
-            ideal_lighting_computations: Stat::of(
-                frames.iter().map(|f| f.ideal_lighting_computations as f64),
+                .and_then(|c| Distribution::of(c.iter().map(|&n| n as f64))),
+            ideal_lighting_computations: Distribution::of(
+                frames
+                    .iter()
+                    .map(|f| f.stats.ideal_lighting_computations as f64),
             )?,
             efficiency: counts
                 .map(|c| c.iter().sum::<u64>())
@@ -376,7 +337,10 @@ impl RunSummary {
                 .map(|n| ideal as f64 / n as f64),
             lights_per_tile_avg: (!per_tile.is_empty())
                 .then(|| per_tile.iter().sum::<f64>() / per_tile.len() as f64),
-            lights_per_tile_max: frames.iter().filter_map(|f| f.lights_per_tile_max).max(),
+            lights_per_tile_max: frames
+                .iter()
+                .filter_map(|f| f.stats.lights_per_tile_max)
+                .max(),
             passes,
             bytes_per_pixel,
             target_bytes,
@@ -514,8 +478,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("analysis_gpu_ms", "analysis render of the same frame (readbacks recorded in the frame)"),
     ("lighting_computations", "analysis render: the GPU's count target"),
     ("ideal_lighting_computations", "analysis render: depth read back, every visible sample against the lights reaching it"),
-    ("lights_per_tile_avg, lights_per_tile_max, grid_bytes", "analysis render: the grid downloaded"),
-    ("modelled_write_bytes, modelled_read_bytes, forward_plus_table1", "analysis render: the memory model applied to its counts"),
+    ("lights_per_tile_avg, lights_per_tile_max, memory.grid_bytes", "analysis render: the grid downloaded"),
+    ("memory.modelled_write_bytes, memory.modelled_read_bytes, memory.forward_plus_table1", "analysis render: the memory model applied to its counts"),
+    ("the frame's other fields (lightgrid::FrameStats)", "analysis render of the frame"),
 ];
 
 /// Progress of a run, for a progress bar.
@@ -524,12 +489,6 @@ pub struct Progress {
     pub done: u64,
     pub total: u64,
     pub label: String,
-}
-
-fn median(v: &[f64]) -> usize {
-    let mut idx: Vec<usize> = (0..v.len()).collect();
-    idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
-    idx[idx.len() / 2]
 }
 
 /// One series of the plan: a scene and a pipeline with one combination of the settings
@@ -753,7 +712,7 @@ struct Measuring<'a> {
     /// measured).
     heatmap_pipeline: Option<String>,
     /// Renderers by (scene, settings); pipelines without a grid builder ignore `assign`.
-    renderers: Vec<(usize, RenderSettings, Renderer<'a>)>,
+    renderers: Vec<(usize, RenderSettings, Renderer)>,
 }
 
 /// How a series ended when it did not fail.
@@ -776,7 +735,7 @@ impl<'a> Measuring<'a> {
         });
     }
 
-    fn renderer(&mut self, series: &Series, size: (u32, u32)) -> Result<&mut Renderer<'a>> {
+    fn renderer(&mut self, series: &Series, size: (u32, u32)) -> Result<&mut Renderer> {
         let settings = series.settings;
         let si = series.scene;
         if !self.renderers.iter().any(|r| r.0 == si && r.1 == settings) {
@@ -910,25 +869,10 @@ impl FrameRecord {
     /// analysis render.
     fn from_analysis(frame: u32, s: &lightgrid::FrameStats) -> FrameRecord {
         FrameRecord {
-            frame,
-            gpu_ms: s.gpu_ms,
+            stats: lightgrid::FrameStats { frame, ..s.clone() },
             gpu_ms_repeats: Vec::new(),
             frame_ms: 0.0,
             analysis_gpu_ms: s.gpu_ms,
-            passes: s.passes.clone(),
-            lighting_computations: s.lighting_computations,
-            ideal_lighting_computations: s.ideal_lighting_computations,
-            transparent_fragments: s.transparent_fragments,
-            ideal_transparent_computations: s.ideal_transparent_computations,
-            transparent_lighting_computations: s.transparent_lighting_computations,
-            lights_per_tile_avg: s.lights_per_tile_avg,
-            lights_per_tile_max: s.lights_per_tile_max,
-            tile_area_computations: s.tile_area_computations,
-            grid_bytes: s.memory.grid_bytes,
-            modelled_write_bytes: s.memory.modelled_write_bytes,
-            modelled_read_bytes: s.memory.modelled_read_bytes,
-            forward_plus_table1: s.memory.forward_plus_table1,
-            msaa_shading: s.msaa_shading,
         }
     }
 }
@@ -1040,12 +984,13 @@ impl RunRecord {
                 .iter()
                 .map(|p| p.gpu_ms.unwrap_or(p.frame_ms))
                 .collect();
-            let m = median(&times);
-            rec.gpu_ms = times[m];
+            let m = Distribution::median_index(&times).expect("not empty");
+            rec.stats.gpu_ms = times[m];
+            rec.stats.timing = self.timing;
             rec.gpu_ms_repeats = times.clone();
-            rec.passes = of_frame[m].passes.clone();
+            rec.stats.passes = of_frame[m].passes.clone();
             let periods: Vec<f64> = of_frame.iter().map(|p| p.frame_ms).collect();
-            rec.frame_ms = periods[median(&periods)];
+            rec.frame_ms = periods[Distribution::median_index(&periods).expect("not empty")];
         }
         let measured = played.len().min(per_pass);
         if measured > 0 {

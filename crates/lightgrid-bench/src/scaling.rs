@@ -17,7 +17,7 @@ use lightgrid::image_io::write_atomic;
 use lightgrid::pipelines::ids;
 use lightgrid::pipelines::{self, Assign, RenderSettings};
 use lightgrid::scene::catalog::{self, SceneParams};
-use lightgrid::Renderer;
+use lightgrid::{Distribution, Renderer};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -168,12 +168,6 @@ impl ScalingConfig {
     }
 }
 
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[s.len() / 2]
-}
-
 impl ScalingPoint {
     fn new(lights: u32, assign: String) -> Self {
         ScalingPoint {
@@ -202,7 +196,7 @@ impl ScalingPoint {
         let Some(last) = outs.last() else { return };
         let times: Vec<f64> = outs.iter().filter_map(|o| o.stats.assign_ms).collect();
         let s = &last.stats;
-        self.assign_ms = (!times.is_empty()).then(|| median(&times));
+        self.assign_ms = Distribution::of(times.iter().copied()).map(|d| d.median);
         self.assign_ms_runs = times;
         self.assign_gpu_ms = s.assign_gpu_ms;
         self.assign_cpu_ms = s.assign_cpu_ms;

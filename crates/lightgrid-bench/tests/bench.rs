@@ -201,7 +201,7 @@ fn a_run_writes_every_file_with_consistent_summaries() {
         let check = |stat: &Value, v: &[f64]| {
             let avg = v.iter().sum::<f64>() / v.len() as f64;
             assert!(
-                (num(stat, "avg") - avg).abs() <= 1e-9 * avg.max(1.0),
+                (num(stat, "mean") - avg).abs() <= 1e-9 * avg.max(1.0),
                 "{stat} vs {v:?}"
             );
             assert_eq!(
@@ -431,10 +431,13 @@ fn spot_culls_are_measured_side_by_side() {
     );
     let (sphere, cone) = (&results.runs[1], &results.runs[2]);
     for (a, b) in sphere.frames.iter().zip(&cone.frames) {
-        assert_eq!(a.ideal_lighting_computations, b.ideal_lighting_computations);
+        assert_eq!(
+            a.stats.ideal_lighting_computations,
+            b.stats.ideal_lighting_computations
+        );
         let (a, b) = (
-            a.lighting_computations.unwrap(),
-            b.lighting_computations.unwrap(),
+            a.stats.lighting_computations.unwrap(),
+            b.stats.lighting_computations.unwrap(),
         );
         assert!(b < a, "cone {b} not below sphere {a}");
     }

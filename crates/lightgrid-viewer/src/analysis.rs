@@ -44,7 +44,7 @@ pub struct Analysed {
 
 /// The worker's side: render each job that arrives until the sender is dropped.
 pub fn serve(ctx: &GpuContext, jobs: Receiver<Job>, done: Sender<Done>) {
-    let mut renderer: Option<Renderer<'_>> = None;
+    let mut renderer: Option<Renderer> = None;
     let mut scene: Option<(Arc<Scene>, Scene)> = None;
     for job in jobs {
         let start = std::time::Instant::now();
@@ -74,9 +74,9 @@ pub fn serve(ctx: &GpuContext, jobs: Receiver<Job>, done: Sender<Done>) {
     }
 }
 
-fn run<'c>(
-    ctx: &'c GpuContext,
-    renderer: &mut Option<Renderer<'c>>,
+fn run(
+    ctx: &GpuContext,
+    renderer: &mut Option<Renderer>,
     cached: &mut Option<(Arc<Scene>, Scene)>,
     job: &Job,
 ) -> Result<(FrameStats, Option<DebugImage>), String> {

@@ -10,7 +10,6 @@ use crate::culling::{
 };
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
-use crate::gpu::GpuContext;
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
 use crate::passes::{BufferReadback, DepthSamples, Readback, Targets};
 use crate::pipelines::PipelineInfo;
@@ -183,7 +182,11 @@ impl FrameOutput {
 
 /// What [`analyze`] works from: a finished, waited-for analysis frame.
 pub(crate) struct AnalysisInput<'r> {
-    pub ctx: &'r GpuContext,
+    pub device: &'r wgpu::Device,
+    /// `GpuContext::count_blend`: forward pipelines count lighting where it is true.
+    pub count_blend: bool,
+    /// `GpuContext::adapter_label`.
+    pub adapter: &'r str,
     pub size: (u32, u32),
     pub dims: GridDims,
     pub settings: RenderSettings,
@@ -206,8 +209,7 @@ pub(crate) struct AnalysisInput<'r> {
 
 /// Read the frame's copies back and compute its statistics.
 pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
-    let ctx = a.ctx;
-    let device = &ctx.device;
+    let device = a.device;
     let (width, height) = a.size;
     let (dims, settings) = (a.dims, a.settings);
     let lights = &a.up_state.lights;
@@ -218,7 +220,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     let samples = depth_samples.len() as u64;
     let sum = |counts: &[u32]| counts.iter().map(|&c| u64::from(c)).sum::<u64>();
     // Counted by the count target where it can blend, always with MSAA (`pixel_counts`).
-    let countable = ctx.count_blend || samples > 1;
+    let countable = a.count_blend || samples > 1;
     let counts = if countable {
         Some(a.readbacks.counts.read(device)?)
     } else {
@@ -312,7 +314,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         stats: FrameStats {
             scene: a.scene.name.clone(),
             pipeline: a.info.id.to_string(),
-            adapter: ctx.adapter_label(),
+            adapter: a.adapter.to_string(),
             width,
             height,
             frame: a.up_state.frame,

@@ -8,6 +8,7 @@ use crate::frame::FinishedFrame;
 use crate::gpu::PassTiming;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
+use crate::stats::Distribution;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -47,41 +48,15 @@ pub struct PlayRun {
     pub interrupted: bool,
 }
 
-/// mean / median / 95th percentile / max of a series.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Distribution {
-    pub mean: f64,
-    pub median: f64,
-    pub p95: f64,
-    pub max: f64,
-}
-
-impl Distribution {
-    pub fn of(values: &[f64]) -> Option<Distribution> {
-        if values.is_empty() {
-            return None;
-        }
-        let mut v = values.to_vec();
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-        Some(Distribution {
-            mean: v.iter().sum::<f64>() / v.len() as f64,
-            median: at(0.5),
-            p95: at(0.95),
-            max: v[v.len() - 1],
-        })
-    }
-}
-
 impl PlayRun {
     pub fn frame_ms(&self) -> Option<Distribution> {
-        Distribution::of(&self.frames.iter().map(|f| f.frame_ms).collect::<Vec<_>>())
+        Distribution::of(self.frames.iter().map(|f| f.frame_ms))
     }
 
     /// None when any frame lacks a GPU time (no timestamps).
     pub fn gpu_ms(&self) -> Option<Distribution> {
         let v: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
-        Distribution::of(&v?)
+        Distribution::of(v?)
     }
 
     /// Frames per second: frames over the sum of their periods (with the queue full when the

@@ -112,8 +112,18 @@ struct Uploaded {
 }
 
 /// Renders frames at one size on one device.
-pub struct Renderer<'c> {
-    ctx: &'c GpuContext,
+///
+/// It owns clones of the context's device and queue (cheap handles) and the adapter facts it
+/// reads, so it borrows nothing: a [`GpuContext`] may be dropped or moved while it lives.
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    /// R32Float blends (`GpuContext::count_blend`): forward pipelines count lighting.
+    count_blend: bool,
+    /// The adapter is a software rasterizer (`GpuContext::is_software`).
+    software_adapter: bool,
+    /// `GpuContext::adapter_label`, for the statistics.
+    adapter_label: String,
     targets: Targets,
     scene_layout: wgpu::BindGroupLayout,
     /// Group 0 of the culling kernels (`culling::cull_layout`), a subset of the scene's.
@@ -167,9 +177,9 @@ pub fn validate_size(ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-impl<'c> Renderer<'c> {
+impl Renderer {
     pub fn new(
-        ctx: &'c GpuContext,
+        ctx: &GpuContext,
         width: u32,
         height: u32,
         settings: RenderSettings,
@@ -215,7 +225,11 @@ impl<'c> Renderer<'c> {
                 &textures,
             );
             Renderer {
-                ctx,
+                device: device.clone(),
+                queue: ctx.queue.clone(),
+                count_blend: ctx.count_blend,
+                software_adapter: ctx.is_software(),
+                adapter_label: ctx.adapter_label(),
                 targets,
                 tonemap: Tonemap::new(device, settings.msaa),
                 timer: PassTimer::new(ctx, MAX_PASSES),
@@ -312,15 +326,15 @@ impl<'c> Renderer<'c> {
             ));
         }
         if !self.techniques.contains_key(info.id) {
-            let device = &self.ctx.device;
+            let device = &self.device;
             let ctx = PipelineContext {
                 device,
                 scene_layout: &self.scene_layout,
                 cull_layout: &self.cull_layout,
                 dims: self.dims,
                 settings: self.settings,
-                count_blend: self.ctx.count_blend,
-                software_adapter: self.ctx.is_software(),
+                count_blend: self.count_blend,
+                software_adapter: self.software_adapter,
             };
             let t = scoped(device, &format!("creating pipeline {}", info.id), || {
                 (info.create)(&ctx)
@@ -389,8 +403,8 @@ impl<'c> Renderer<'c> {
     /// every frame after them. Returns the bytes written and what was written after the
     /// static geometry.
     fn upload_geometry(&mut self, scene: &Scene, state: &FrameState) -> Result<(u64, Geometry)> {
-        let ctx = self.ctx;
-        let (device, queue) = (&ctx.device, &ctx.queue);
+        // Cheap handle clones: `rebind_scene` borrows `self` mutably while they are in use.
+        let (device, queue) = (&self.device.clone(), &self.queue.clone());
         let mut upload_bytes = 0u64;
         let fingerprint = scene.static_fingerprint();
         // The per-frame geometry, when the static upload below has already baked it.
@@ -453,8 +467,8 @@ impl<'c> Renderer<'c> {
 
     /// The frame's lights and uniforms. Returns the bytes written.
     fn upload_frame_data(&mut self, state: &FrameState) -> u64 {
-        let ctx = self.ctx;
-        let device = &ctx.device;
+        // Cheap handle clones: `rebind_scene` borrows `self` mutably while they are in use.
+        let (device, queue) = (&self.device.clone(), &self.queue.clone());
         // Lights and geometry are drawn and shaded camera-relative (`ViewSetup::relative`).
         let eye = state.camera.eye;
         let relative: Vec<_> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
@@ -466,8 +480,8 @@ impl<'c> Renderer<'c> {
         if self.light_bounds.reserve(device, bb.len() as u64) || grew_lights {
             self.rebind_scene();
         }
-        self.lights.write(&ctx.queue, 0, lb);
-        self.light_bounds.write(&ctx.queue, 0, bb);
+        self.lights.write(queue, 0, lb);
+        self.light_bounds.write(queue, 0, bb);
         let (width, height) = self.size();
         let view = state.camera.rotation();
         let proj = state.camera.proj(width as f32 / height as f32);
@@ -487,15 +501,14 @@ impl<'c> Renderer<'c> {
             _pad1: 0,
             _pad2: 0,
         };
-        ctx.queue
-            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
         (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64
     }
 
     /// Group 0 again, after a buffer it binds was replaced.
     fn rebind_scene(&mut self) {
         (self.scene_bind_group, self.cull_bind_group) = Self::bind_scene(
-            &self.ctx.device,
+            &self.device,
             [&self.scene_layout, &self.cull_layout],
             &self.uniforms,
             [&self.lights, &self.light_bounds, &self.materials],
@@ -512,8 +525,8 @@ impl<'c> Renderer<'c> {
         up: &Uploaded,
         analysis: bool,
     ) -> Result<(u64, FrameIo, wgpu::SubmissionIndex)> {
-        let device = &self.ctx.device;
-        let queue = &self.ctx.queue;
+        let device = &self.device;
+        let queue = &self.queue;
         let technique = self.techniques.get_mut(info.id).expect("prepared");
         self.timer.reset();
         let inputs = FrameInputs {
@@ -529,7 +542,7 @@ impl<'c> Renderer<'c> {
             targets: &self.targets,
             setup: up.setup,
             lights: &up.state.lights,
-            count_blend: self.ctx.count_blend,
+            count_blend: self.count_blend,
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
         self.counters.clear(enc.parts().0);
@@ -584,10 +597,10 @@ impl<'c> Renderer<'c> {
             .get_mut(r.tag.pipeline)
             .and_then(|t| t.culler())
         {
-            builder.observe(&self.ctx.device, &r.values)?;
+            builder.observe(&self.device, &r.values)?;
         }
         if let Some(t) = &mut self.transparent {
-            t.observe(&self.ctx.device, &r.values)?;
+            t.observe(&self.device, &r.values)?;
         }
         let write_overflow = r.values.write_overflow();
         if write_overflow > 0 {
@@ -618,7 +631,7 @@ impl<'c> Renderer<'c> {
 
     /// Collect the frames the GPU has finished, without waiting.
     fn collect(&mut self, wait: bool) -> Result<()> {
-        let device = &self.ctx.device;
+        let device = &self.device;
         let done = if wait {
             self.counters.wait(device)?
         } else {
@@ -647,8 +660,7 @@ impl<'c> Renderer<'c> {
         if self.in_flight.len() >= MAX_FRAMES_IN_FLIGHT {
             let oldest = self.in_flight.pop_front().expect("non-empty");
             let start = Instant::now();
-            self.ctx
-                .device
+            self.device
                 .poll(wgpu::PollType::Wait {
                     submission_index: Some(oldest),
                     timeout: None,
@@ -676,7 +688,7 @@ impl<'c> Renderer<'c> {
 
     /// Real-time frames submitted whose GPU work may not be done yet (at most
     /// [`MAX_FRAMES_IN_FLIGHT`]).
-    pub fn frames_in_flight(&self) -> usize {
+    pub(crate) fn frames_in_flight(&self) -> usize {
         self.in_flight.len()
     }
 
@@ -708,7 +720,7 @@ impl<'c> Renderer<'c> {
         loop {
             let start = Instant::now();
             let (serial, io, _) = self.encode_frame(info, &up, true)?;
-            let done = self.counters.wait(&self.ctx.device)?;
+            let done = self.counters.wait(&self.device)?;
             let wall_ms = start.elapsed().as_secs_f64() * 1e3;
             let readback = done
                 .into_iter()
@@ -744,11 +756,13 @@ impl<'c> Renderer<'c> {
                 continue;
             }
             let grid = match self.techniques.get_mut(info.id).and_then(|t| t.culler()) {
-                Some(b) => Some(b.download(&self.ctx.device, &self.ctx.queue, &readback.values)?),
+                Some(b) => Some(b.download(&self.device, &self.queue, &readback.values)?),
                 None => None,
             };
             return analysis::analyze(analysis::AnalysisInput {
-                ctx: self.ctx,
+                device: &self.device,
+                count_blend: self.count_blend,
+                adapter: &self.adapter_label,
                 size: self.size(),
                 dims: self.dims,
                 settings: self.settings,

@@ -1,4 +1,5 @@
-//! Per-frame statistics written by `lightgrid render --stats`.
+//! Per-frame statistics written by `lightgrid render --stats`, and [`Distribution`]: the one
+//! summary of a series of values (frame times, counts) every command and the benchmark use.
 
 use crate::gpu::PassTiming;
 use crate::memory::FrameMemory;
@@ -140,4 +141,80 @@ pub struct FrameStats {
 
 fn one() -> u32 {
     1
+}
+
+/// The summary of a series: min / mean / median / 95th percentile / max.
+///
+/// The median and the percentile are order statistics (a value of the series: the one at
+/// rank `round((n - 1) q)` in ascending order, so the median of an even count is the upper of
+/// the middle two); [`Distribution::median_index`] finds which value that is.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Distribution {
+    pub min: f64,
+    /// The arithmetic mean.
+    pub mean: f64,
+    pub median: f64,
+    pub p95: f64,
+    pub max: f64,
+}
+
+impl Distribution {
+    /// The summary of `values`; None when there are none.
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Distribution> {
+        let v: Vec<f64> = values.into_iter().collect();
+        let order = Self::ascending(&v);
+        let last = *order.last()?;
+        let at = |q: f64| v[order[Self::rank(v.len(), q)]];
+        Some(Distribution {
+            min: v[order[0]],
+            mean: v.iter().sum::<f64>() / v.len() as f64,
+            median: at(0.5),
+            p95: at(0.95),
+            max: v[last],
+        })
+    }
+
+    /// The index in `values` of the value [`Distribution::of`] reports as the median (the
+    /// first of equal values); None when there are none.
+    pub fn median_index(values: &[f64]) -> Option<usize> {
+        let order = Self::ascending(values);
+        order.get(Self::rank(values.len(), 0.5)).copied()
+    }
+
+    /// Indices of `values` in ascending order (a stable sort: equal values keep their order).
+    fn ascending(values: &[f64]) -> Vec<usize> {
+        let mut order: Vec<usize> = (0..values.len()).collect();
+        order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+        order
+    }
+
+    /// The rank of the `q` quantile among `n` sorted values.
+    fn rank(n: usize, q: f64) -> usize {
+        (n.saturating_sub(1) as f64 * q).round() as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Distribution;
+
+    #[test]
+    fn distribution_of_a_series() {
+        assert_eq!(Distribution::of(std::iter::empty()), None);
+        assert_eq!(Distribution::median_index(&[]), None);
+        let d = Distribution::of([4.0, 1.0, 3.0, 2.0]).unwrap();
+        assert_eq!((d.min, d.mean, d.max), (1.0, 2.5, 4.0));
+        // The upper of the middle two, as the benchmark has always picked its median frame.
+        assert_eq!((d.median, d.p95), (3.0, 4.0));
+        assert_eq!(Distribution::median_index(&[4.0, 1.0, 3.0, 2.0]), Some(2));
+        let one = Distribution::of([7.0]).unwrap();
+        assert_eq!(
+            (one.min, one.mean, one.median, one.p95, one.max),
+            (7.0, 7.0, 7.0, 7.0, 7.0)
+        );
+        let odd: Vec<f64> = (1..=21).map(f64::from).rev().collect();
+        let d = Distribution::of(odd.iter().copied()).unwrap();
+        assert_eq!((d.median, d.p95), (11.0, 20.0));
+        assert_eq!(odd[Distribution::median_index(&odd).unwrap()], 11.0);
+    }
 }

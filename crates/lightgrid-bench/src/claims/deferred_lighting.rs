@@ -102,8 +102,8 @@ pub(super) fn lights_per_pixel(r: &BenchResults, scene: &str) -> Option<f64> {
         .frames
         .iter()
         .map(|f| {
-            let n = f.lighting_computations?;
-            Some(n.saturating_sub(f.transparent_lighting_computations.unwrap_or(0)) as f64)
+            let n = f.stats.lighting_computations?;
+            Some(n.saturating_sub(f.stats.transparent_lighting_computations.unwrap_or(0)) as f64)
         })
         .collect();
     let opaque = opaque.filter(|o| !o.is_empty())?;
@@ -125,8 +125,8 @@ pub(super) fn modelled(r: &BenchResults, scene: &str, pipeline: &str, side: Side
         .frames
         .iter()
         .map(|f| match side {
-            Side::Writes => f.modelled_write_bytes,
-            Side::Reads => f.modelled_read_bytes,
+            Side::Writes => f.stats.memory.modelled_write_bytes,
+            Side::Reads => f.stats.memory.modelled_read_bytes,
         })
         .collect();
     let bytes = bytes.filter(|b| !b.is_empty())?;

@@ -15,7 +15,7 @@ pub(super) fn forward_plus_vs_deferred(r: &BenchResults, scene: &str) -> (String
             let model: Vec<_> = fp
                 .frames
                 .iter()
-                .filter_map(|f| f.forward_plus_table1)
+                .filter_map(|f| f.stats.memory.forward_plus_table1)
                 .collect();
             let m = model.iter().map(|t| t.m).sum::<f64>() / model.len().max(1) as f64;
             let wins = model

@@ -142,11 +142,11 @@ fn cell_bounds_ms(x: &RunRecord) -> Option<f64> {
 }
 
 fn avg_ms(x: &RunRecord) -> Option<f64> {
-    x.summary.as_ref().map(|s| s.gpu_ms.avg)
+    x.summary.as_ref().map(|s| s.gpu_ms.mean)
 }
 
 fn avg_count(x: &RunRecord) -> Option<f64> {
-    x.summary.as_ref()?.lighting_computations.map(|s| s.avg)
+    x.summary.as_ref()?.lighting_computations.map(|s| s.mean)
 }
 
 /// Pearson correlation of two series (None when either is constant or too short).

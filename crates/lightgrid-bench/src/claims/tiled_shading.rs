@@ -75,11 +75,11 @@ pub(super) fn time_follows_computations(r: &BenchResults, scene: &str) -> (Strin
     let mut corr: Vec<(String, f64)> = culled(r, scene)
         .into_iter()
         .filter_map(|x| {
-            let t: Vec<f64> = x.frames.iter().map(|f| f.gpu_ms).collect();
+            let t: Vec<f64> = x.frames.iter().map(|f| f.stats.gpu_ms).collect();
             let c: Option<Vec<f64>> = x
                 .frames
                 .iter()
-                .map(|f| f.lighting_computations.map(|n| n as f64))
+                .map(|f| f.stats.lighting_computations.map(|n| n as f64))
                 .collect();
             correlation(&t, &c?).map(|k| (run_name(x), k))
         })
@@ -262,7 +262,7 @@ pub(super) fn prez_per_computation(r: &BenchResults, scene: &str) -> (String, Ve
         find(r, scene, p, None)?
             .frames
             .iter()
-            .map(|f| Some((f.lighting_computations? as f64, f.gpu_ms)))
+            .map(|f| Some((f.stats.lighting_computations? as f64, f.stats.gpu_ms)))
             .collect()
     };
     match (

@@ -4,7 +4,7 @@
 
 use super::*;
 
-impl<'c> App<'c> {
+impl App {
     /// A scripted run that has waited too long (for a settled view or a screenshot) ends
     /// with what it waited for, rather than hanging.
     pub(super) fn check_patience(&mut self, now: Instant) -> Result<()> {
@@ -102,7 +102,7 @@ impl<'c> App<'c> {
     /// and write it. A shaded frame is first waited for and checked: an overflowed frame is
     /// retried on the next one, a frame with loops cut short is refused.
     pub(super) fn screenshot(&mut self, path: &Path) -> Result<Shot> {
-        let ctx = self.ctx;
+        let ctx = self.ctx.clone();
         let view = self.applied.view;
         let win = self.win.as_mut().context("no window")?;
         let debug = view != DebugView::Shaded && win.debug_texture.is_some();

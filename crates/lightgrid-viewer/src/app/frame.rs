@@ -4,7 +4,7 @@
 
 use super::*;
 
-impl<'c> App<'c> {
+impl App {
     pub(super) fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         if let Some(reason) = self.lost.lock().ok().and_then(|mut l| l.take()) {
             bail!("the GPU device was lost ({reason}); restart the viewer");
@@ -76,11 +76,11 @@ impl<'c> App<'c> {
 
     /// Render and present one frame; false when nothing was shown.
     pub(super) fn render(&mut self) -> Result<bool> {
-        let ctx = self.ctx;
+        let ctx = self.ctx.clone();
         let pipeline = self.applied.pipeline.clone();
         let win = self.win.as_mut().context("no window")?;
         // The surface first: a frame is rendered only when it can be shown.
-        let texture = match win.surface.acquire(ctx)? {
+        let texture = match win.surface.acquire(&ctx)? {
             Acquired::Frame(t) => t,
             Acquired::Skip => {
                 self.idle_until = Some(Instant::now() + SKIP_PAUSE);
@@ -116,7 +116,7 @@ impl<'c> App<'c> {
     }
 
     /// The image the window shows now: the debug view's (once one came back) or the frame.
-    pub(super) fn source<'a>(win: &'a Win, view: DebugView) -> &'a wgpu::TextureView {
+    pub(super) fn source(win: &Win, view: DebugView) -> &wgpu::TextureView {
         match (&win.debug_texture, view) {
             (Some(t), v) if v != DebugView::Shaded => t,
             _ => win.renderer.display_view(),
@@ -124,7 +124,7 @@ impl<'c> App<'c> {
     }
 
     pub(super) fn present(&mut self, texture: wgpu::SurfaceTexture) -> Result<bool> {
-        let ctx = self.ctx;
+        let ctx = self.ctx.clone();
         let win = self.win.as_mut().context("no window")?;
         let target = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());

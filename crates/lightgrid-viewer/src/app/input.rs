@@ -3,7 +3,7 @@
 
 use super::*;
 
-impl<'c> App<'c> {
+impl App {
     pub(super) fn key(
         &mut self,
         event_loop: &ActiveEventLoop,

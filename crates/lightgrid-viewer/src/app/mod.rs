@@ -129,9 +129,11 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
     });
     let (jobs, job_rx) = mpsc::channel();
     let (done_tx, done) = mpsc::channel();
-    let ctx = &ctx;
+    // Shared with the analysis worker; renderers own clones of its device and queue.
+    let ctx = Arc::new(ctx);
+    let worker_ctx = ctx.clone();
     std::thread::scope(|s| {
-        s.spawn(move || analysis::serve(ctx, job_rx, done_tx));
+        s.spawn(move || analysis::serve(&worker_ctx, job_rx, done_tx));
         let mut app = App::new(ctx, opts, opened.scene, jobs, done, lost);
         let ran = run_catching_display_loss(|| event_loop.run_app(&mut app));
         // Dropping the app drops the job sender, which ends the worker.
@@ -192,12 +194,12 @@ fn run_catching_display_loss<T>(run: impl FnOnce() -> T) -> Result<T> {
 }
 
 /// The parts that exist while the window does.
-struct Win<'c> {
+struct Win {
     window: Arc<Window>,
     surface: WindowSurface,
     blit: Blit,
     egui: EguiLayer,
-    renderer: Renderer<'c>,
+    renderer: Renderer,
     /// The debug view's image of the newest analysis result, on the GPU.
     debug_texture: Option<wgpu::TextureView>,
     size_changed_at: Option<Instant>,
@@ -228,9 +230,9 @@ enum Shot {
     Retry,
 }
 
-struct App<'c> {
-    ctx: &'c GpuContext,
-    win: Option<Win<'c>>,
+struct App {
+    ctx: Arc<GpuContext>,
+    win: Option<Win>,
     /// Size the window opens at.
     initial_size: (u32, u32),
     applied: Controls,
@@ -286,15 +288,15 @@ struct App<'c> {
     msaa_counts: [Vec<u32>; 2],
 }
 
-impl<'c> App<'c> {
+impl App {
     fn new(
-        ctx: &'c GpuContext,
+        ctx: Arc<GpuContext>,
         opts: ViewOptions,
         scene: Scene,
         jobs: Sender<Job>,
         done: Receiver<Done>,
         lost: Arc<Mutex<Option<String>>>,
-    ) -> App<'c> {
+    ) -> App {
         let controls = Controls {
             pipeline: opts.pipeline.clone(),
             settings: opts.settings,
@@ -302,6 +304,9 @@ impl<'c> App<'c> {
             view: opts.view,
         };
         let fly_speed = FlyCamera::from_camera(&scene.camera_path.at(opts.frame)).speed;
+        let adapter = ctx.adapter_label();
+        let msaa_counts = [GBufferFormat::F16, GBufferFormat::F32]
+            .map(|g| lightgrid::frame::msaa_counts(&ctx, g));
         App {
             ctx,
             win: None,
@@ -344,11 +349,10 @@ impl<'c> App<'c> {
             lost,
             fatal: None,
             report: ViewReport {
-                adapter: ctx.adapter_label(),
+                adapter,
                 ..Default::default()
             },
-            msaa_counts: [GBufferFormat::F16, GBufferFormat::F32]
-                .map(|g| lightgrid::frame::msaa_counts(ctx, g)),
+            msaa_counts,
         }
     }
 
@@ -359,7 +363,7 @@ impl<'c> App<'c> {
         event_loop.exit();
     }
 
-    fn open_window(&mut self, event_loop: &ActiveEventLoop) -> Result<Win<'c>> {
+    fn open_window(&mut self, event_loop: &ActiveEventLoop) -> Result<Win> {
         let (w, h) = self.initial_size;
         let attributes = Window::default_attributes()
             .with_title(self.title())
@@ -369,11 +373,11 @@ impl<'c> App<'c> {
                 .create_window(attributes)
                 .context("creating the window")?,
         );
-        let surface = WindowSurface::new(self.ctx, window.clone())?;
+        let surface = WindowSurface::new(&self.ctx, window.clone())?;
         let device = &self.ctx.device;
         let blit = Blit::new(device, surface.format());
-        let size = render_size(self.ctx, surface.size());
-        let renderer = Renderer::new(self.ctx, size.0, size.1, self.applied.settings)?;
+        let size = render_size(&self.ctx, surface.size());
+        let renderer = Renderer::new(&self.ctx, size.0, size.1, self.applied.settings)?;
         let egui_ctx = egui::Context::default();
         let state = egui_winit::State::new(
             egui_ctx.clone(),
@@ -405,7 +409,7 @@ impl<'c> App<'c> {
 
     /// Put `renderer` in the window's place: its frames are numbered anew, so nothing of the
     /// old one's reports may be read as its own.
-    fn replace_renderer(&mut self, renderer: Renderer<'c>) {
+    fn replace_renderer(&mut self, renderer: Renderer) {
         if let Some(win) = &mut self.win {
             win.renderer = renderer;
             win.debug_texture = None;
@@ -444,7 +448,7 @@ fn render_size(ctx: &GpuContext, (w, h): (u32, u32)) -> (u32, u32) {
     (w.clamp(1, limit), h.clamp(1, limit))
 }
 
-impl ApplicationHandler for App<'_> {
+impl ApplicationHandler for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.win.is_some() {
             return;
@@ -467,7 +471,7 @@ impl ApplicationHandler for App<'_> {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(_) => {
                 win.size_changed_at = Some(Instant::now());
-                win.surface.resize(self.ctx);
+                win.surface.resize(&self.ctx);
                 win.window.request_redraw();
             }
             WindowEvent::RedrawRequested => {

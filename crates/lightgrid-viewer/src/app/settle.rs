@@ -5,14 +5,14 @@
 
 use super::*;
 
-impl<'c> App<'c> {
+impl App {
     /// Something the next frames will change by themselves: scripts and screenshots wait.
     pub(super) fn pending(&self, now: Instant) -> bool {
         let Some(win) = &self.win else { return true };
         let size_settling = win
             .size_changed_at
             .is_some_and(|t| now.duration_since(t) < SETTLE);
-        let wrong_size = win.renderer.size() != render_size(self.ctx, win.surface.size());
+        let wrong_size = win.renderer.size() != render_size(&self.ctx, win.surface.size());
         let debug_stale = self.applied.view != DebugView::Shaded
             && self.analysis.failed_generation != Some(self.generation)
             && !self.analysis_current(true);
@@ -143,7 +143,7 @@ impl<'c> App<'c> {
             Rebuild::Scene | Rebuild::Renderer => {
                 let win = self.win.as_ref().ok_or("no window")?;
                 let (w, h) = win.renderer.size();
-                Some(Renderer::new(self.ctx, w, h, next.settings).map_err(|e| e.to_string())?)
+                Some(Renderer::new(&self.ctx, w, h, next.settings).map_err(|e| e.to_string())?)
             }
             _ => None,
         };
@@ -162,7 +162,7 @@ impl<'c> App<'c> {
     }
 
     /// Put what `apply` or `recover` made in place and make `next` the applied state.
-    fn install(&mut self, next: Controls, scene: Option<Scene>, renderer: Option<Renderer<'c>>) {
+    fn install(&mut self, next: Controls, scene: Option<Scene>, renderer: Option<Renderer>) {
         if let Some(scene) = scene {
             self.set_scene(scene);
         }
@@ -216,7 +216,7 @@ impl<'c> App<'c> {
         // failed one stays.
         let win = self.win.as_ref().context("no window")?;
         let (w, h) = win.renderer.size();
-        let renderer = Renderer::new(self.ctx, w, h, good.settings)?;
+        let renderer = Renderer::new(&self.ctx, w, h, good.settings)?;
         let scene = match self.applied.request != good.request {
             true => Some(lightgrid::scene::open(&good.request)?.scene),
             false => None,
@@ -230,14 +230,14 @@ impl<'c> App<'c> {
         let Some(win) = &mut self.win else {
             return Ok(());
         };
-        let wanted = render_size(self.ctx, win.surface.size());
+        let wanted = render_size(&self.ctx, win.surface.size());
         let settling = win
             .size_changed_at
             .is_some_and(|t| now.duration_since(t) < SETTLE);
         if wanted == win.renderer.size() || settling {
             return Ok(());
         }
-        let renderer = Renderer::new(self.ctx, wanted.0, wanted.1, self.applied.settings)?;
+        let renderer = Renderer::new(&self.ctx, wanted.0, wanted.1, self.applied.settings)?;
         self.replace_renderer(renderer);
         Ok(())
     }

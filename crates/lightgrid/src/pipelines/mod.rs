@@ -1,5 +1,6 @@
-//! The pipeline registry: one module per pipeline id, one row in [`PIPELINES`]. The CLI, the
-//! default job and the tests iterate this table; adding a pipeline touches nothing else.
+//! The pipeline registry: one module per pipeline id, one row in [`PIPELINES`] and its id in
+//! [`ids`]. The CLI, the benchmark, the viewer, the default job and the tests iterate this
+//! table (the `--assign` checks filtered by capability: `tests/common`'s `grid_pipelines()`).
 
 mod axes;
 mod deferred;
@@ -425,7 +426,7 @@ pub fn all_shaders() -> Vec<ComposedShader> {
 /// The reference pipeline's id.
 pub const REFERENCE: &str = "forward";
 
-pub fn pipeline_names() -> String {
+fn pipeline_names() -> String {
     PIPELINES
         .iter()
         .map(|p| p.id)

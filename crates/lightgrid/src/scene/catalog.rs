@@ -185,7 +185,7 @@ pub const SCENES: &[SceneInfo] = &[
 ];
 
 /// Comma-separated scene names, for error messages and help.
-pub fn scene_names() -> String {
+fn scene_names() -> String {
     scenes_where(|_| true)
 }
 

@@ -20,10 +20,6 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    pub fn vertex_count(&self) -> usize {
-        self.positions.len()
-    }
-
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }

@@ -459,13 +459,7 @@ pub enum LightAnchor {
 }
 
 /// Where a light on [`LightAnchor::Circle`] is at `frame`, starting at `start`.
-pub fn circle_position(
-    start: Vec3,
-    radius: f32,
-    frames_per_turn: f32,
-    phase: f32,
-    frame: u32,
-) -> Vec3 {
+fn circle_position(start: Vec3, radius: f32, frames_per_turn: f32, phase: f32, frame: u32) -> Vec3 {
     let turn = std::f32::consts::TAU * frame as f32 / frames_per_turn.max(1.0);
     let at = |a: f32| Vec3::new(a.cos(), 0.0, a.sin()) * radius;
     // The offset first, so frame 0 is exactly the start.

@@ -5,8 +5,9 @@
 //! ([`MAX_VERTICES`], [`MAX_TRIANGLES`], [`MAX_FILE_BYTES`]), the node graph is walked without
 //! recursion and refused if it is not a forest, and any problem is an [`Error::Gltf`] naming
 //! the file and the problem. What the renderer cannot show (points and lines, directional
-//! lights, orthographic cameras, textures, extensions it does not know) is skipped with a
-//! warning, unless the file marks the extension required.
+//! lights, orthographic cameras, extensions it does not know) is skipped with a warning,
+//! unless the file marks the extension required. Of a material's textures only the base
+//! colour's (`baseColorTexture`, PNG or JPEG) is loaded; the others are not read.
 //!
 //! Mapping rules (documented in README "glTF scenes"): metallic-roughness materials by
 //! `import::map_material`'s rule; KHR_lights_punctual point and spot lights keep their range,
