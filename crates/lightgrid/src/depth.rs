@@ -63,15 +63,15 @@ pub const MIN_NEAR_FAR_RATIO: f32 = 1e-30;
 /// Can the depth buffer hold a camera with these planes? `0 < near < far`, both finite, and
 /// `near / far` at least [`MIN_NEAR_FAR_RATIO`]: otherwise the frame is refused, never
 /// rendered with depths that lost the surfaces.
-pub fn check_planes(near: f32, far: f32) -> crate::Result<()> {
+pub fn check_planes(near: f32, far: f32) -> crate::error::Result<()> {
     if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
-        return Err(crate::Error::invalid(
+        return Err(crate::error::Error::invalid(
             "camera",
             format!("needs finite planes with 0 < near < far; near {near}, far {far}"),
         ));
     }
     if near / far < MIN_NEAR_FAR_RATIO {
-        return Err(crate::Error::invalid(
+        return Err(crate::error::Error::invalid(
             "camera",
             format!(
                 "near {near} / far {far} is below {MIN_NEAR_FAR_RATIO:e}: the depth buffer \

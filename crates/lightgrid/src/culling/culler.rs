@@ -565,7 +565,11 @@ impl LightCuller {
     }
 
     /// Record a renderer frame's grid (`GridBuilder::build`).
-    pub(crate) fn build(&mut self, f: &CullFrame, enc: &mut FrameEncoder) -> crate::Result<()> {
+    pub(crate) fn build(
+        &mut self,
+        f: &CullFrame,
+        enc: &mut FrameEncoder,
+    ) -> crate::error::Result<()> {
         self.core.build(f, enc)
     }
 
@@ -574,7 +578,7 @@ impl LightCuller {
         &mut self,
         device: &wgpu::Device,
         values: &crate::gpu::CounterValues,
-    ) -> crate::Result<()> {
+    ) -> crate::error::Result<()> {
         self.core.observe(device, values)
     }
 
@@ -584,7 +588,7 @@ impl LightCuller {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         values: &crate::gpu::CounterValues,
-    ) -> crate::Result<super::BuiltGrid> {
+    ) -> crate::error::Result<super::BuiltGrid> {
         self.core.download(device, queue, values)
     }
 
