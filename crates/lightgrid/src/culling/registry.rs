@@ -48,3 +48,21 @@ pub const STRATEGIES: &[StrategyInfo] = &[
 pub fn find_strategy(assign: Assign) -> Option<&'static StrategyInfo> {
     STRATEGIES.iter().find(|s| s.assign == assign)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The registry is the list of strategies: every `--assign` value but `auto` has exactly
+    /// one row (a variant without one would be refused at its first frame, and left out of
+    /// every test that iterates the registry).
+    #[test]
+    fn every_strategy_value_has_one_row() {
+        for a in Assign::ALL {
+            let rows = STRATEGIES.iter().filter(|s| s.assign == a).count();
+            let expected = usize::from(a != Assign::Auto);
+            assert_eq!(rows, expected, "{}", a.name());
+        }
+        assert_eq!(STRATEGIES.len(), Assign::ALL.len() - 1);
+    }
+}
