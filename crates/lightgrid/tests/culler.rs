@@ -814,6 +814,23 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         CullInput::LightCount,
         "max_lights 40",
     );
+    // Even no lights need a buffer of one light (a storage binding holds one element).
+    let tiny = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: 16,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    expect(
+        &mut culler,
+        &CullInputs {
+            lights: &tiny,
+            light_count: 0,
+            ..caller.inputs()
+        },
+        CullInput::Lights,
+        "48 bytes",
+    );
     let uniform = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: 48 * 40,
@@ -992,7 +1009,45 @@ fn bad_use_is_a_typed_error_naming_the_input() {
             .unwrap_or_else(|| panic!("{config:?} accepted"));
         assert_eq!(e.input, CullInput::Config, "{e}");
     }
-    // After all that, the good inputs still cull.
-    let mut encoder = device.create_command_encoder(&Default::default());
-    culler.encode(&mut encoder, &good).expect("good inputs");
+    // After all that, the good inputs still cull, with lights and without, every strategy.
+    for strategy in STRATEGIES {
+        let mut culler = LightCuller::new(
+            &device,
+            &queue,
+            CullConfig {
+                strategy,
+                max_lights: 40,
+                ..CullConfig::default()
+            },
+        )
+        .expect("culler");
+        // With its 40 lights, through the caller's own depth pre-pass and oracle.
+        let (r, report) = caller.frame(&mut culler);
+        assert!(
+            report.is_complete() && report.index_entries > 0,
+            "{strategy:?}: {report:?}"
+        );
+        assert_eq!(r[0], 0, "{strategy:?}: misses");
+        // No lights: an empty grid, reported complete.
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let inputs = CullInputs {
+            light_count: 0,
+            ..caller.inputs()
+        };
+        let frame = culler.encode(&mut encoder, &inputs).expect("no lights");
+        queue.submit([encoder.finish()]);
+        let reports = culler.wait().expect("reports");
+        let report = reports
+            .iter()
+            .find(|r| r.frame == frame)
+            .expect("its report");
+        assert!(
+            report.is_complete(),
+            "{strategy:?} without lights: {report:?}"
+        );
+        assert_eq!(
+            report.index_entries, 0,
+            "{strategy:?} without lights: {report:?}"
+        );
+    }
 }

@@ -853,7 +853,8 @@ impl Caller {
                 ),
             );
         }
-        let needed = u64::from(i.light_count) * std::mem::size_of::<CullLight>() as u64;
+        // A storage binding holds at least one element, even for a frame without lights.
+        let needed = u64::from(i.light_count.max(1)) * std::mem::size_of::<CullLight>() as u64;
         if i.lights.size() < needed {
             return refuse(
                 I::Lights,
