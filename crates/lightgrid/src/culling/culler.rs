@@ -943,12 +943,8 @@ impl Camera {
             );
         }
         let (near, far) = (i.near, i.far);
-        if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
-            return refuse(
-                I::Planes,
-                format!("near {near} and far {far} must be finite with 0 < near < far"),
-            );
-        }
+        // The renderer's own check of a camera's planes (finite, 0 < near < far, a ratio the
+        // depth buffer holds).
         crate::depth::check_planes(near, far).map_err(|e| CullError {
             input: I::Planes,
             message: e.to_string(),
