@@ -19,28 +19,17 @@ use crate::frame::FrameEncoder;
 use crate::gpu::{bind_resources, download, storage_buffer};
 use crate::gpu_types::GridParams;
 use crate::scene::ViewSetup;
-use crate::shader::{compute_pipeline, every_sample_count, msaa_defs, src, Def, ShaderKey};
+use crate::shader::{compute_pipeline, src, SampleStage, SamplesKey, ShaderKey};
 
 /// The depth-range kernel of a depth target of `samples` samples per pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct DepthRangeKey {
-    pub samples: u32,
-}
+pub(crate) type DepthRangeKey = SamplesKey<DepthRangeStage>;
 
-impl ShaderKey for DepthRangeKey {
+pub(crate) enum DepthRangeStage {}
+
+impl SampleStage for DepthRangeStage {
     const STAGE: &'static str = "depth_range";
 
-    fn all() -> Vec<Self> {
-        every_sample_count()
-            .map(|samples| Self { samples })
-            .collect()
-    }
-
-    fn defs(self) -> Vec<Def> {
-        msaa_defs(self.samples)
-    }
-
-    fn parts(self) -> Vec<&'static str> {
+    fn parts(_samples: u32) -> Vec<&'static str> {
         vec![
             src::TYPES,
             src::SCENE_BINDINGS,
@@ -95,7 +84,7 @@ impl DepthRangePass {
                 crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),
             ],
         });
-        let s = DepthRangeKey { samples }.shader();
+        let s = DepthRangeKey::new(samples).shader();
         let layouts = [Some(cull_layout), Some(&layout)];
         DepthRangePass {
             reduce: compute_pipeline(device, "depth range", &s, "reduce", &layouts),

@@ -2,7 +2,7 @@
 
 use crate::error::Result;
 use crate::gpu::read_buffer;
-use crate::shader::{every_sample_count, msaa_defs, Def, ShaderKey};
+use crate::shader::{SampleStage, SamplesKey, ShaderKey};
 
 /// A MAP_READ buffer sized for one texture, with rows padded to the copy alignment.
 pub struct Readback {
@@ -108,25 +108,14 @@ impl BufferReadback {
 }
 
 /// The copy of every sample of a depth target of `samples` samples per pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct DepthSamplesKey {
-    pub samples: u32,
-}
+pub(crate) type DepthSamplesKey = SamplesKey<DepthSamplesStage>;
 
-impl ShaderKey for DepthSamplesKey {
+pub(crate) enum DepthSamplesStage {}
+
+impl SampleStage for DepthSamplesStage {
     const STAGE: &'static str = "depth_samples";
 
-    fn all() -> Vec<Self> {
-        every_sample_count()
-            .map(|samples| Self { samples })
-            .collect()
-    }
-
-    fn defs(self) -> Vec<Def> {
-        msaa_defs(self.samples)
-    }
-
-    fn parts(self) -> Vec<&'static str> {
+    fn parts(_samples: u32) -> Vec<&'static str> {
         vec![crate::shader::src::MSAA, include_str!("depth_samples.wgsl")]
     }
 }
@@ -144,7 +133,7 @@ pub struct DepthSamples {
 
 impl DepthSamples {
     pub fn new(device: &wgpu::Device, (width, height): (u32, u32), samples: u32) -> Self {
-        let shader = DepthSamplesKey { samples }.shader();
+        let shader = DepthSamplesKey::new(samples).shader();
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth samples"),
             entries: &[

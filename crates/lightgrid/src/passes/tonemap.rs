@@ -3,28 +3,17 @@
 
 use super::LDR_FORMAT;
 use crate::gpu::PassTimer;
-use crate::shader::{every_sample_count, msaa_defs, src, Def, ShaderKey};
+use crate::shader::{src, SampleStage, SamplesKey, ShaderKey};
 
 /// The tonemap of an HDR target of `samples` samples per pixel (above one, it resolves).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct TonemapKey {
-    pub samples: u32,
-}
+pub(crate) type TonemapKey = SamplesKey<TonemapStage>;
 
-impl ShaderKey for TonemapKey {
+pub(crate) enum TonemapStage {}
+
+impl SampleStage for TonemapStage {
     const STAGE: &'static str = "tonemap";
 
-    fn all() -> Vec<Self> {
-        every_sample_count()
-            .map(|samples| Self { samples })
-            .collect()
-    }
-
-    fn defs(self) -> Vec<Def> {
-        msaa_defs(self.samples)
-    }
-
-    fn parts(self) -> Vec<&'static str> {
+    fn parts(_samples: u32) -> Vec<&'static str> {
         vec![
             super::FULLSCREEN_WGSL,
             src::MSAA,
@@ -54,7 +43,7 @@ impl Tonemap {
             device,
             &super::FullscreenDesc {
                 label: "tonemap",
-                shader: &TonemapKey { samples }.shader(),
+                shader: &TonemapKey::new(samples).shader(),
                 fragment_entry: "fs_tonemap",
                 layout: &layout,
                 target: LDR_FORMAT,

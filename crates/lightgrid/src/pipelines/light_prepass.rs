@@ -53,8 +53,8 @@ use crate::passes::{
 };
 use crate::passes::{cleared, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES};
 use crate::shader::{
-    compute_pipeline, create_module, every_sample_count, msaa_defs, src, ComposedShader, Def,
-    ShaderKey, SCENE_PARTS,
+    compute_pipeline, create_module, src, ComposedShader, SampleStage, SamplesKey, ShaderKey,
+    SCENE_PARTS,
 };
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
@@ -66,25 +66,14 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 }
 
 /// The light pre-pass's shader for targets of `samples` samples per pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct LightPrepassKey {
-    pub samples: u32,
-}
+pub(super) type LightPrepassKey = SamplesKey<LightPrepassStage>;
 
-impl ShaderKey for LightPrepassKey {
+pub(super) enum LightPrepassStage {}
+
+impl SampleStage for LightPrepassStage {
     const STAGE: &'static str = "light_prepass";
 
-    fn all() -> Vec<Self> {
-        every_sample_count()
-            .map(|samples| Self { samples })
-            .collect()
-    }
-
-    fn defs(self) -> Vec<Def> {
-        msaa_defs(self.samples)
-    }
-
-    fn parts(self) -> Vec<&'static str> {
+    fn parts(_samples: u32) -> Vec<&'static str> {
         let mut parts = SCENE_PARTS.to_vec();
         parts.extend([
             src::MSAA,
@@ -110,27 +99,16 @@ pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
 
 /// The irradiance kernel for attributes of `samples` samples per pixel: one pixel per
 /// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct TiledKernelKey {
-    pub samples: u32,
-}
+pub(super) type TiledKernelKey = SamplesKey<TiledKernelStage>;
 
-impl ShaderKey for TiledKernelKey {
+pub(super) enum TiledKernelStage {}
+
+impl SampleStage for TiledKernelStage {
     const STAGE: &'static str = "tiled_light_prepass";
 
-    fn all() -> Vec<Self> {
-        every_sample_count()
-            .map(|samples| Self { samples })
-            .collect()
-    }
-
-    fn defs(self) -> Vec<Def> {
-        msaa_defs(self.samples)
-    }
-
-    fn parts(self) -> Vec<&'static str> {
+    fn parts(samples: u32) -> Vec<&'static str> {
         // The kernel and what it shares: the storage outputs at 1x, the edge queue above.
-        let (shared, kernel) = if self.samples > 1 {
+        let (shared, kernel) = if samples > 1 {
             (
                 super::tiled_deferred::MSAA_EDGE_QUEUE_WGSL,
                 include_str!("tiled_light_prepass_msaa.wgsl"),
@@ -433,7 +411,7 @@ fn tiled_irradiance(
     let kernel = compute_pipeline(
         ctx.device,
         "tiled light pre-pass irradiance",
-        &TiledKernelKey { samples }.shader(),
+        &TiledKernelKey::new(samples).shader(),
         "main",
         &[
             Some(ctx.scene_layout),
@@ -466,7 +444,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.msaa;
-    let module = create_module(device, &LightPrepassKey { samples }.shader());
+    let module = create_module(device, &LightPrepassKey::new(samples).shader());
     let attributes = geometry_pipeline(
         device,
         &GeometryPipelineDesc {

@@ -29,7 +29,7 @@ use crate::passes::{
 };
 use crate::shader::{
     compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, src,
-    ComposedShader, Def, ShaderKey,
+    ComposedShader, Def, SampleStage, SamplesKey, ShaderKey,
 };
 
 /// Which deferred shading kernel: the grid pipelines' (`tiled_deferred`, `clustered_deferred`:
@@ -127,26 +127,19 @@ pub(super) const MSAA_EDGE_QUEUE_WGSL: &str = include_str!("msaa_edge_queue.wgsl
 
 /// The pass writing the MSAA kernel's per-sample colours into the multisampled HDR target:
 /// only above one sample per pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct ExpandKey {
-    pub samples: u32,
-}
+pub(super) type ExpandKey = SamplesKey<ExpandStage>;
 
-impl ShaderKey for ExpandKey {
+pub(super) enum ExpandStage {}
+
+impl SampleStage for ExpandStage {
     const STAGE: &'static str = "sample_expand";
 
-    fn all() -> Vec<Self> {
-        every_sample_count()
-            .filter(|&samples| samples > 1)
-            .map(|samples| Self { samples })
-            .collect()
+    // Only above one sample per pixel (a 1x target needs no expansion).
+    fn requested(samples: u32) -> bool {
+        samples > 1
     }
 
-    fn defs(self) -> Vec<Def> {
-        msaa_defs(self.samples)
-    }
-
-    fn parts(self) -> Vec<&'static str> {
+    fn parts(_samples: u32) -> Vec<&'static str> {
         vec![
             crate::passes::FULLSCREEN_WGSL,
             src::MSAA,
@@ -258,7 +251,7 @@ impl SampleOutputs {
             device,
             &crate::passes::FullscreenDesc {
                 label: "sample expand",
-                shader: &ExpandKey { samples }.shader(),
+                shader: &ExpandKey::new(samples).shader(),
                 fragment_entry: "fs_expand",
                 layout: &expand_layout,
                 target: crate::passes::HDR_FORMAT,

@@ -105,6 +105,71 @@ pub trait ShaderKey: Copy + std::fmt::Debug + 'static {
     }
 }
 
+/// A stage whose only variant is the sample count of the targets it reads or writes: its
+/// key is [`SamplesKey`], which defines the MSAA values ([`msaa_defs`]).
+pub trait SampleStage: 'static {
+    /// The stage's name (the shader's label).
+    const STAGE: &'static str;
+
+    /// The WGSL parts after the prelude and the defs, for `samples` samples per pixel.
+    fn parts(samples: u32) -> Vec<&'static str>;
+
+    /// Does the renderer ask for the stage at `samples` samples per pixel? Every count unless
+    /// the stage says otherwise.
+    fn requested(samples: u32) -> bool {
+        let _ = samples;
+        true
+    }
+}
+
+/// The key of a [`SampleStage`]: the sample count.
+pub struct SamplesKey<S> {
+    pub samples: u32,
+    stage: std::marker::PhantomData<fn() -> S>,
+}
+
+impl<S> SamplesKey<S> {
+    pub fn new(samples: u32) -> Self {
+        SamplesKey {
+            samples,
+            stage: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<S> Clone for SamplesKey<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S> Copy for SamplesKey<S> {}
+
+impl<S> std::fmt::Debug for SamplesKey<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{{ samples: {} }}", self.samples)
+    }
+}
+
+impl<S: SampleStage> ShaderKey for SamplesKey<S> {
+    const STAGE: &'static str = S::STAGE;
+
+    fn all() -> Vec<Self> {
+        every_sample_count()
+            .filter(|&n| S::requested(n))
+            .map(Self::new)
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        S::parts(self.samples)
+    }
+}
+
 /// Prelude + the given parts, in order (a shader without variants).
 pub fn compose(name: &str, parts: &[&str]) -> ComposedShader {
     compose_defs(name, &[], parts)
