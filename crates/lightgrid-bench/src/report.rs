@@ -6,7 +6,7 @@ use crate::invalid;
 use crate::plot::{LineChart, Series, StackedBars};
 use lightgrid::culling::GridLists;
 use lightgrid::error::{Error, Result};
-use lightgrid::frame::MaterialDraws;
+use lightgrid::frame::{MaterialDraws, MsaaResolve};
 use lightgrid::image_io::{save_png, write_atomic};
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::{ids, SettingValue, SpotCull};
@@ -37,7 +37,7 @@ fn pipeline_label(r: &RunRecord) -> String {
     // is named by `run_name`); MSAA and where it resolves whenever MSAA is on.
     for axis in lightgrid::pipelines::AXES {
         let names = r.varied.iter().any(|f| f == axis.flag)
-            || (axis.flag == "msaa-resolve" && r.msaa_resolve().is_some());
+            || (axis.flag == MsaaResolve::FLAG && r.msaa_resolve().is_some());
         if names && axis.flag != GBufferFormat::FLAG {
             label += &format!(" [{}]", (axis.label)(&(axis.get)(&r.settings)));
         }

@@ -910,31 +910,6 @@ impl RunRecord {
             .then_some(self.settings.msaa_resolve)
     }
 
-    /// What spots were culled by, when the run measured more than one way.
-    pub fn spot_cull(&self) -> Option<lightgrid::pipelines::SpotCull> {
-        self.varied()
-    }
-
-    /// The transparent lists, when the run measured more than one setting.
-    pub fn lists(&self) -> Option<lightgrid::culling::GridLists> {
-        self.varied()
-    }
-
-    /// How material shaders were drawn, when the run measured more than one way.
-    pub fn material_draws(&self) -> Option<lightgrid::frame::MaterialDraws> {
-        self.varied()
-    }
-
-    /// The cell depth bounds culled by, when the run measured more than one.
-    pub fn depth_bounds(&self) -> Option<lightgrid::frame::DepthBounds> {
-        self.varied()
-    }
-
-    /// The depth reduction, when the run measured more than one.
-    pub fn depth_reduction(&self) -> Option<lightgrid::frame::DepthReduction> {
-        self.varied()
-    }
-
     /// " flag value" for each setting the run measured at more than one value (the series'
     /// name in progress lines and errors).
     pub fn describe(&self) -> String {

@@ -419,7 +419,7 @@ fn spot_culls_are_measured_side_by_side() {
     let runs: Vec<(&str, Option<SpotCull>)> = results
         .runs
         .iter()
-        .map(|r| (r.pipeline.as_str(), r.spot_cull()))
+        .map(|r| (r.pipeline.as_str(), r.varied::<SpotCull>()))
         .collect();
     assert_eq!(
         runs,

@@ -278,7 +278,8 @@ impl RendererArgs {
             ..RenderSettings::default()
         };
         self.axes.apply(&mut settings)?;
-        let resolve_given = self.axes.axes().iter().any(|a| a.flag == "msaa-resolve");
+        let resolve_given =
+            (self.axes.axes().iter()).any(|a| a.flag == lightgrid::frame::MsaaResolve::FLAG);
         check_msaa_resolve(resolve_given, &[settings.msaa])?;
         settings.validate()?;
         Ok(settings)

@@ -109,7 +109,7 @@ fn find_run<'a>(
             && x.pipeline == pipeline
             && x.msaa() == samples
             && (x.gbuffer_bits().is_none() || x.gbuffer_bits() == bits.or(Some(16)))
-            && x.depth_bounds().unwrap_or_default() == bounds
+            && x.varied::<DepthBounds>().unwrap_or_default() == bounds
     })
 }
 

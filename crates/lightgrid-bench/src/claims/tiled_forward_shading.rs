@@ -180,7 +180,7 @@ pub(super) fn depth_bound_claims(r: &BenchResults) -> Vec<Claim> {
     let mut scenes: Vec<&str> = r
         .runs
         .iter()
-        .filter(|x| x.depth_bounds().is_some())
+        .filter(|x| x.varied::<lightgrid::frame::DepthBounds>().is_some())
         .map(|x| x.scene.as_str())
         .collect();
     scenes.dedup();

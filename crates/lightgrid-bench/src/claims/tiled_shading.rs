@@ -126,11 +126,11 @@ pub(super) fn reduction_claims(r: &BenchResults) -> Vec<Claim> {
     for x in r
         .runs
         .iter()
-        .filter(|x| x.depth_reduction() == Some(DepthReduction::Atomics))
+        .filter(|x| x.varied() == Some(DepthReduction::Atomics))
     {
         // The same series in every other setting.
         let Some(y) = r.runs.iter().find(|y| {
-            y.depth_reduction() == Some(DepthReduction::Subgroup)
+            y.varied() == Some(DepthReduction::Subgroup)
                 && super::differs_only_in::<DepthReduction>(x, y)
         }) else {
             continue;
