@@ -465,7 +465,8 @@ fn try_measure(
     let mut renderer = Renderer::new(ctx, plan.size.0, plan.size.1, settings)?;
     // The warm-up frame (shader compilation included) bounds what one frame costs.
     let t = Instant::now();
-    renderer.render_frame(plan.scene, frames[frames.len() / 2], c.pipeline)?;
+    renderer.use_scene(plan.scene)?;
+    renderer.render_frame(&plan.scene.frame(frames[frames.len() / 2]), c.pipeline)?;
     renderer.finish()?;
     let first = t.elapsed();
     // The frames to play, their queue fill, and the analysis frame.

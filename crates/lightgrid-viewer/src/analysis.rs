@@ -4,12 +4,13 @@
 //! count rasterized on the CPU), which takes longer than a frame.
 //!
 //! The worker keeps its own [`Renderer`] on the shared device (rebuilt when the size or the
-//! settings change) and its own copy of the scene (copied once per opened scene), and answers
-//! one [`Job`] at a time; the window sends the next only when the last has come back.
+//! settings change), given the window's own scene (`Arc`-shared, never copied) and the
+//! frame's state, and answers one [`Job`] at a time; the window sends the next only when the
+//! last has come back.
 
 use lightgrid::debug_view::{self, DebugImage, DebugView};
 use lightgrid::gpu::GpuContext;
-use lightgrid::scene::{CameraPath, Scene};
+use lightgrid::scene::{FrameState, Scene};
 use lightgrid::{FrameStats, RenderSettings, Renderer};
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::Arc;
@@ -19,10 +20,11 @@ pub struct Job {
     /// The window's state generation this job was taken at (a result whose generation is
     /// older than the window's describes a view no longer shown).
     pub generation: u64,
-    /// The scene as opened (shared, never changed); the camera below replaces its path.
+    /// The scene as opened (shared with the window, never changed).
     pub scene: Arc<Scene>,
-    pub camera: CameraPath,
-    pub frame: u32,
+    /// The frame the window showed: its camera (the fly camera's, if flying), lights and
+    /// object transforms.
+    pub state: FrameState,
     pub pipeline: &'static str,
     pub settings: RenderSettings,
     pub size: (u32, u32),
@@ -45,13 +47,12 @@ pub struct Analysed {
 /// The worker's side: render each job that arrives until the sender is dropped.
 pub fn serve(ctx: &GpuContext, jobs: Receiver<Job>, done: Sender<Done>) {
     let mut renderer: Option<Renderer> = None;
-    let mut scene: Option<(Arc<Scene>, Scene)> = None;
     for job in jobs {
         let start = std::time::Instant::now();
         // A panic in an analysis frame is this job's error, not the window's: the renderer
         // that panicked is dropped and the next job makes a new one.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            run(ctx, &mut renderer, &mut scene, &job)
+            run(ctx, &mut renderer, &job)
         }))
         .unwrap_or_else(|_| {
             renderer = None;
@@ -77,7 +78,6 @@ pub fn serve(ctx: &GpuContext, jobs: Receiver<Job>, done: Sender<Done>) {
 fn run(
     ctx: &GpuContext,
     renderer: &mut Option<Renderer>,
-    cached: &mut Option<(Arc<Scene>, Scene)>,
     job: &Job,
 ) -> Result<(FrameStats, Option<DebugImage>), String> {
     let keep = renderer
@@ -89,17 +89,12 @@ fn run(
             Renderer::new(ctx, job.size.0, job.size.1, job.settings).map_err(|e| e.to_string())?,
         );
     }
-    if !cached
-        .as_ref()
-        .is_some_and(|(a, _)| Arc::ptr_eq(a, &job.scene))
-    {
-        *cached = Some((job.scene.clone(), (*job.scene).clone()));
-    }
-    let scene = &mut cached.as_mut().expect("set above").1;
-    scene.camera_path = job.camera.clone();
     let r = renderer.as_mut().expect("set above");
+    if !r.scene().is_some_and(|s| Arc::ptr_eq(s, &job.scene)) {
+        r.set_scene(job.scene.clone()).map_err(|e| e.to_string())?;
+    }
     let out = r
-        .render(scene, job.frame, job.pipeline)
+        .render_state(&job.state, job.pipeline)
         .map_err(|e| e.to_string())?;
     let image = debug_view::draw(job.view, &out);
     Ok((out.stats, image))

@@ -3,7 +3,7 @@
 //! is, so leaving the camera path does not jump.
 
 use glam::Vec3;
-use lightgrid::scene::{Camera, CameraPath};
+use lightgrid::scene::Camera;
 
 /// Radians per pixel of mouse drag.
 pub const TURN_PER_PIXEL: f32 = 0.004;
@@ -77,17 +77,6 @@ impl FlyCamera {
         self.pitch = (self.pitch - dy * TURN_PER_PIXEL).clamp(-PITCH_LIMIT, PITCH_LIMIT);
     }
 
-    /// The scene's camera path replaced by this camera held still over the whole animation
-    /// (the same frame count, so the objects and lights still play).
-    pub fn hold(&self, path: &CameraPath) -> CameraPath {
-        let target = self.eye + self.forward();
-        let last = path.frame_count() - 1;
-        CameraPath {
-            keys: vec![(0, self.eye, target), (last, self.eye, target)],
-            ..path.clone()
-        }
-    }
-
     /// The camera to render with, keeping `lens`' field of view and planes.
     pub fn camera(&self, lens: &Camera) -> Camera {
         Camera {
@@ -129,22 +118,6 @@ mod tests {
             assert_eq!(again.eye, c.eye);
             assert!(((again.target - again.eye).normalize() - want).length() < 1e-4);
             assert_eq!((again.fov_y, again.near, again.far), (1.0, 0.1, 100.0));
-        }
-    }
-
-    #[test]
-    fn holds_the_camera_over_the_whole_animation() {
-        let mut path = CameraPath::fixed(Vec3::ZERO, Vec3::NEG_Z, 60.0, 0.1, 50.0);
-        path.keys.push((259, Vec3::X, Vec3::Z));
-        let mut fly = FlyCamera::from_camera(&path.at(100));
-        fly.turn(40.0, 10.0);
-        let held = fly.hold(&path);
-        assert_eq!(held.frame_count(), 260);
-        for f in [0, 100, 259, 400] {
-            let c = held.at(f);
-            assert!((c.eye - fly.eye).length() < 1e-5);
-            assert!(((c.target - c.eye).normalize() - fly.forward()).length() < 1e-4);
-            assert_eq!((c.fov_y, c.near, c.far), (path.fov_y, 0.1, 50.0));
         }
     }
 

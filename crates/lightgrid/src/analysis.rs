@@ -13,7 +13,7 @@ use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
 use crate::passes::{BufferReadback, DepthSamples, Readback, Targets};
 use crate::pipelines::PipelineInfo;
-use crate::scene::{rasterize, FrameState, Scene};
+use crate::scene::{rasterize, FrameState};
 use crate::stats::{FrameStats, TimingSource};
 use glam::Vec3;
 use image::RgbaImage;
@@ -191,7 +191,7 @@ pub(crate) struct AnalysisInput<'r> {
     pub dims: GridDims,
     pub settings: RenderSettings,
     pub readbacks: &'r AnalysisReadbacks,
-    pub scene: &'r Scene,
+    pub scene_name: &'r str,
     pub info: &'static PipelineInfo,
     pub up_state: &'r FrameState,
     /// The frame's transparent triangles (world space), drawn after the opaque image.
@@ -312,7 +312,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     Ok(FrameOutput {
         image,
         stats: FrameStats {
-            scene: a.scene.name.clone(),
+            scene: a.scene_name.to_string(),
             pipeline: a.info.id.to_string(),
             adapter: a.adapter.to_string(),
             width,

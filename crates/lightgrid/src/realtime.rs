@@ -123,6 +123,11 @@ pub fn play(
     }
     // Frames of an earlier use of the renderer are not this run's.
     renderer.finish()?;
+    for &frame in plan.frames {
+        plan.scene.check_frame(frame)?;
+    }
+    // The scene once; each frame is then its state (as a game's frame would be).
+    renderer.use_scene(plan.scene)?;
     for &frame in plan.frames.iter().cycle().take(plan.warmup as usize) {
         if stop.load(Ordering::Relaxed) {
             return Ok(PlayRun {
@@ -130,7 +135,7 @@ pub fn play(
                 ..Default::default()
             });
         }
-        renderer.render_frame(plan.scene, frame, plan.pipeline)?;
+        renderer.render_frame(&plan.scene.frame(frame), plan.pipeline)?;
         renderer.poll_finished()?;
     }
     let total = plan.frames.len() as u64 * u64::from(plan.passes);
@@ -149,7 +154,7 @@ pub fn play(
                 prev.frame_ms = (now - last_start).as_secs_f64() * 1e3;
             }
             last_start = now;
-            let s = renderer.render_frame(plan.scene, frame, plan.pipeline)?;
+            let s = renderer.render_frame(&plan.scene.frame(frame), plan.pipeline)?;
             first_serial.get_or_insert(s.serial);
             run.frames.push(PlayedFrame {
                 frame,

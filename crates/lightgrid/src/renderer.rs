@@ -1,15 +1,19 @@
 //! The renderer: owns the targets and scene buffers and renders frames of a scene with a
-//! registry pipeline, in three steps:
-//! 1. **upload** ([`Renderer::upload`]): lights and uniforms every frame, the static geometry
-//!    and materials once per scene, the moving objects every frame; everything is validated
-//!    here, once;
+//! registry pipeline. The scene's static part (meshes, materials, textures, the geometry
+//! that never moves) is given once ([`Renderer::set_scene`], an `Arc` the caller may share);
+//! each frame is then a small description, a [`FrameState`] (camera, lights, object
+//! transforms), rendered in three steps:
+//! 1. **upload** (`upload`): lights and uniforms every frame, the moving objects every frame
+//!    after the static geometry (uploaded by `set_scene`); the frame is validated here, once;
 //! 2. **encode** (`encode_frame`): the pipeline's passes, the tonemap and the copy of the
 //!    frame counters, recorded into one [`FrameEncoder`] and submitted once, without waiting
 //!    (only the `cpu` strategy with depth bounds reads the cell bounds back part-way);
-//! 3. **analyze** (`analysis.rs`, only when asked: [`Renderer::render`]): image, depth and
-//!    counts read back, the ideal count, the grid downloaded, [`FrameStats`] filled.
+//! 3. **analyze** (`analysis.rs`, only when asked: [`Renderer::render_state`]): image, depth
+//!    and counts read back, the ideal count, the grid downloaded, [`FrameStats`] filled.
 //!
-//! [`Renderer::render_frame`] is the real-time path (steps 1-2): frames stay in flight, their
+//! [`Renderer::render`] is the convenience form of step 3 for one frame of a `&Scene` (it sets
+//! the scene when its contents differ from the one held). [`Renderer::render_frame`] is the
+//! real-time path (steps 1-2): frames stay in flight, their
 //! counters and timestamps come back asynchronously ([`Renderer::poll_finished`]), list sizes
 //! follow them a frame later, and a frame they show to be wrong is reported in its
 //! [`FinishedFrame`].
@@ -28,6 +32,7 @@ use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
 use crate::scene::{Draw, FrameState, Geometry, Light, Scene, SpotCull};
 use std::collections::{HashMap, VecDeque};
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use crate::analysis::FrameOutput;
@@ -88,7 +93,10 @@ impl GrowBuffer {
 /// What the GPU holds of the current scene: the static geometry (uploaded once) and where the
 /// moving geometry follows it.
 struct SceneUpload {
-    fingerprint: u64,
+    scene: Arc<Scene>,
+    /// `Scene::content_fingerprint`, computed when [`Renderer::render`] first compares a scene
+    /// with this one (never on the frame path).
+    fingerprint: OnceLock<u64>,
     static_vertices: u32,
     static_indices: u32,
     /// The static geometry's runs of one material shader each.
@@ -96,8 +104,8 @@ struct SceneUpload {
 }
 
 /// What one frame uploaded.
-struct Uploaded {
-    state: FrameState,
+struct Uploaded<'s> {
+    state: &'s FrameState,
     setup: ViewSetup,
     index_count: u32,
     /// Runs of one material shader: the opaque geometry's, the transparent objects'.
@@ -140,6 +148,8 @@ pub struct Renderer {
     /// The scene's base-colour textures (uploaded with its static geometry).
     textures: BaseTextures,
     scene: Option<SceneUpload>,
+    /// Bytes `set_scene` wrote, counted in the next frame's `upload_bytes`.
+    static_upload_bytes: u64,
     tonemap: Tonemap,
     timer: PassTimer,
     counters: FrameCounters,
@@ -246,6 +256,7 @@ impl Renderer {
                 cull_bind_group,
                 textures,
                 scene: None,
+                static_upload_bytes: 0,
                 techniques: HashMap::new(),
                 transparent: None,
                 settings,
@@ -350,12 +361,87 @@ impl Renderer {
         Ok(())
     }
 
-    /// Step 1: validate `frame` of `scene` and upload what the frame needs.
-    fn upload(&mut self, scene: &Scene, frame: u32) -> Result<Uploaded> {
-        let state = Self::validated_frame(scene, frame)?;
-        let (mut upload_bytes, frame_geometry) = self.upload_geometry(scene, &state)?;
-        upload_bytes += self.upload_frame_data(&state);
-        let upload = self.scene.as_ref().expect("geometry uploaded");
+    /// The scene whose static part the GPU holds ([`Renderer::set_scene`]), if any.
+    pub fn scene(&self) -> Option<&Arc<Scene>> {
+        self.scene.as_ref().map(|u| &u.scene)
+    }
+
+    /// Take `scene` as the one whose frames follow: its materials, textures and static
+    /// opaque geometry are uploaded now, once; each frame then uploads only its
+    /// [`FrameState`] (lights, uniforms, moving and transparent objects). The renderer keeps
+    /// the `Arc`, so a viewer and its analysis worker can share one scene without copies.
+    pub fn set_scene(&mut self, scene: Arc<Scene>) -> Result<()> {
+        self.scene = None;
+        scoped(&self.device.clone(), "uploading the scene", || {
+            self.upload_static(scene)
+        })?
+    }
+
+    /// [`Renderer::set_scene`] with a copy of `scene`, unless the scene held has the same
+    /// contents. The comparison hashes the scene's meshes, objects, materials and textures
+    /// (`Scene::content_fingerprint`): a call per frame costs that hash every frame, so a
+    /// caller rendering many frames calls this (or `set_scene`) once and then renders
+    /// [`FrameState`]s.
+    pub fn use_scene(&mut self, scene: &Scene) -> Result<()> {
+        let held = self
+            .scene
+            .as_ref()
+            .map(|u| *u.fingerprint.get_or_init(|| u.scene.content_fingerprint()));
+        if held != Some(scene.content_fingerprint()) {
+            self.set_scene(Arc::new(scene.clone()))?;
+        }
+        Ok(())
+    }
+
+    /// The static geometry, materials and textures of `scene`, in buffers with room for what
+    /// every frame writes after them (`Scene::frame_geometry_len`).
+    fn upload_static(&mut self, scene: Arc<Scene>) -> Result<()> {
+        // Cheap handle clones: `rebind_scene` borrows `self` mutably while they are in use.
+        let (device, queue) = (&self.device.clone(), &self.queue.clone());
+        let geometry = scene.static_geometry();
+        let materials = scene.materials_gpu();
+        let vb: &[u8] = bytemuck::cast_slice(&geometry.vertices);
+        let ib: &[u8] = bytemuck::cast_slice(&geometry.indices);
+        let mb: &[u8] = bytemuck::cast_slice(&materials);
+        let (moving_vertices, moving_indices) = scene.frame_geometry_len();
+        let vertex_bytes = std::mem::size_of::<crate::gpu_types::GpuVertex>();
+        self.vertices
+            .reserve(device, (vb.len() + moving_vertices * vertex_bytes) as u64);
+        self.indices
+            .reserve(device, (ib.len() + moving_indices * 4) as u64);
+        // A new scene gets its own textures (a white texel without any), and the bind group
+        // the new view.
+        self.textures = BaseTextures::new(device, queue, &scene.textures);
+        self.materials.reserve(device, mb.len() as u64);
+        self.rebind_scene();
+        self.vertices.write(queue, 0, vb);
+        self.indices.write(queue, 0, ib);
+        self.materials.write(queue, 0, mb);
+        self.static_upload_bytes = self.textures.bytes + (vb.len() + ib.len() + mb.len()) as u64;
+        self.scene = Some(SceneUpload {
+            scene,
+            fingerprint: OnceLock::new(),
+            static_vertices: geometry.vertices.len() as u32,
+            static_indices: geometry.indices.len() as u32,
+            static_draws: geometry.draws,
+        });
+        Ok(())
+    }
+
+    /// Step 1: validate `state` against the scene held and upload what the frame needs.
+    fn upload<'s>(&mut self, state: &'s FrameState) -> Result<Uploaded<'s>> {
+        let upload = self.scene.as_ref().ok_or_else(|| {
+            Error::invalid(
+                "scene",
+                "no scene to render: give one with Renderer::set_scene first",
+            )
+        })?;
+        Self::validate_state(&upload.scene, state)?;
+        // What `set_scene` wrote is this frame's too (once).
+        let mut upload_bytes = std::mem::take(&mut self.static_upload_bytes);
+        let (bytes, frame_geometry) = self.upload_geometry(state)?;
+        upload_bytes += bytes + self.upload_frame_data(state);
+        let upload = self.scene.as_ref().expect("checked above");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
         let (moving_opaque, moving_transparent) = frame_geometry.split_draws();
         let mut opaque = upload.static_draws.clone();
@@ -379,11 +465,10 @@ impl Renderer {
         })
     }
 
-    /// The animation at `frame`, with its lights checked (count, NaN, ranges).
-    fn validated_frame(scene: &Scene, frame: u32) -> Result<FrameState> {
-        scene.check_frame(frame)?;
-        let state = scene.frame(frame);
-        crate::depth::check_planes(state.camera.near, state.camera.far)?;
+    /// A frame of `scene` as the caller describes it: the camera, the lights (count, NaN,
+    /// ranges) and one finite transform per object.
+    fn validate_state(scene: &Scene, state: &FrameState) -> Result<()> {
+        state.camera.validate()?;
         if state.lights.len() > MAX_LIGHTS as usize {
             return Err(Error::invalid(
                 "lights",
@@ -396,68 +481,48 @@ impl Renderer {
         for (i, l) in state.lights.iter().enumerate() {
             l.validate(i)?;
         }
-        Ok(state)
+        if state.transforms.len() != scene.objects.len() {
+            return Err(Error::invalid(
+                "frame",
+                format!(
+                    "{} object transforms for the {} objects of {}",
+                    state.transforms.len(),
+                    scene.objects.len(),
+                    scene.name
+                ),
+            ));
+        }
+        if let Some(i) = state.transforms.iter().position(|m| !m.is_finite()) {
+            return Err(Error::invalid(
+                "frame",
+                format!("object {i}'s transform is not finite"),
+            ));
+        }
+        Ok(())
     }
 
-    /// The static geometry and materials once per scene (by fingerprint), the moving objects
-    /// every frame after them. Returns the bytes written and what was written after the
-    /// static geometry.
-    fn upload_geometry(&mut self, scene: &Scene, state: &FrameState) -> Result<(u64, Geometry)> {
-        // Cheap handle clones: `rebind_scene` borrows `self` mutably while they are in use.
-        let (device, queue) = (&self.device.clone(), &self.queue.clone());
-        let mut upload_bytes = 0u64;
-        let fingerprint = scene.static_fingerprint();
-        // The per-frame geometry, when the static upload below has already baked it.
-        let mut baked = None;
-        if self.scene.as_ref().map(|s| s.fingerprint) != Some(fingerprint) {
-            let geometry = scene.static_geometry();
-            let materials = scene.materials_gpu();
-            let vb: &[u8] = bytemuck::cast_slice(&geometry.vertices);
-            let ib: &[u8] = bytemuck::cast_slice(&geometry.indices);
-            let mb: &[u8] = bytemuck::cast_slice(&materials);
-            // Room for the moving objects too, so the buffers rarely grow later.
-            let moving = scene.frame_geometry(state, geometry.vertices.len() as u32);
-            self.vertices.reserve(
-                device,
-                (vb.len() + std::mem::size_of_val(moving.vertices.as_slice())) as u64,
-            );
-            self.indices.reserve(
-                device,
-                (ib.len() + std::mem::size_of_val(moving.indices.as_slice())) as u64,
-            );
-            // The textures are part of the fingerprint: a new scene gets its own (a white
-            // texel without any), and the bind group the new view.
-            self.textures = BaseTextures::new(device, queue, &scene.textures);
-            upload_bytes += self.textures.bytes;
-            self.materials.reserve(device, mb.len() as u64);
-            self.rebind_scene();
-            self.vertices.write(queue, 0, vb);
-            self.indices.write(queue, 0, ib);
-            self.materials.write(queue, 0, mb);
-            upload_bytes += (vb.len() + ib.len() + mb.len()) as u64;
-            self.scene = Some(SceneUpload {
-                fingerprint,
-                static_vertices: geometry.vertices.len() as u32,
-                static_indices: geometry.indices.len() as u32,
-                static_draws: geometry.draws,
-            });
-            baked = Some(moving);
-        }
-        let upload = self.scene.as_ref().expect("uploaded above");
+    /// The moving objects, written after the static geometry. Returns the bytes written and
+    /// what was written.
+    fn upload_geometry(&mut self, state: &FrameState) -> Result<(u64, Geometry)> {
+        let queue = &self.queue.clone();
+        let upload = self.scene.as_ref().expect("checked by upload");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
-        let moving = baked.unwrap_or_else(|| scene.frame_geometry(state, static_vertices));
+        let moving = upload.scene.frame_geometry(state, static_vertices);
         let vb: &[u8] = bytemuck::cast_slice(&moving.vertices);
         let ib: &[u8] = bytemuck::cast_slice(&moving.indices);
         let (v_off, i_off) = (
             u64::from(static_vertices) * std::mem::size_of::<crate::gpu_types::GpuVertex>() as u64,
             u64::from(static_indices) * 4,
         );
-        if self.vertices.reserve(device, v_off + vb.len() as u64)
-            || self.indices.reserve(device, i_off + ib.len() as u64)
+        let mut upload_bytes = 0;
+        if self.vertices.buffer.size() < v_off + vb.len() as u64
+            || self.indices.buffer.size() < i_off + ib.len() as u64
         {
-            // A grown buffer lost the static part: upload everything again.
-            self.scene = None;
-            return self.upload_geometry(scene, state);
+            // `upload_static` made room for every frame; should a frame still not fit,
+            // growing loses the static part: upload it again.
+            let scene = upload.scene.clone();
+            self.upload_static(scene)?;
+            upload_bytes += std::mem::take(&mut self.static_upload_bytes);
         }
         self.vertices.write(queue, v_off, vb);
         self.indices.write(queue, i_off, ib);
@@ -644,14 +709,14 @@ impl Renderer {
         Ok(())
     }
 
-    /// Real time: render `frame` of `scene` with `pipeline_id` and return once it is
-    /// submitted, without waiting for it (nor for anything of this frame). Frames finished
-    /// meanwhile are collected for [`Renderer::poll_finished`]; with more than
-    /// [`MAX_FRAMES_IN_FLIGHT`] in flight this waits for the oldest first.
+    /// Real time: render `state`, a frame of the scene held ([`Renderer::set_scene`]), with
+    /// `pipeline_id` and return once it is submitted, without waiting for it (nor for
+    /// anything of this frame). Frames finished meanwhile are collected for
+    /// [`Renderer::poll_finished`]; with more than [`MAX_FRAMES_IN_FLIGHT`] in flight this
+    /// waits for the oldest first.
     pub fn render_frame(
         &mut self,
-        scene: &Scene,
-        frame: u32,
+        state: &FrameState,
         pipeline_id: &str,
     ) -> Result<SubmittedFrame> {
         let info = pipelines::find(pipeline_id)?;
@@ -672,7 +737,7 @@ impl Renderer {
             throttle_ms = start.elapsed().as_secs_f64() * 1e3;
         }
         self.collect(false)?;
-        let up = self.upload(scene, frame)?;
+        let up = self.upload(state)?;
         let (serial, io, index) = self.encode_frame(info, &up, false)?;
         self.in_flight.push_back(index);
         while self.in_flight.len() > MAX_FRAMES_IN_FLIGHT {
@@ -705,18 +770,28 @@ impl Renderer {
         Ok(std::mem::take(&mut self.finished))
     }
 
-    /// Analysis: render `frame` of `scene` with `pipeline_id`, wait for it, read back image,
-    /// depth and counts, download the grid and compute the ideal count ([`FrameOutput`]).
-    /// A frame whose lists did not fit is rerun after growing them (`assign_reruns`); a frame
-    /// with truncated shader loops is an error ([`Error::TruncatedLoops`]).
+    /// Analysis of one frame of `scene`: [`Renderer::use_scene`] (which hashes the scene to
+    /// see whether it is the one held), then [`Renderer::render_state`] of
+    /// `scene.frame(frame)`.
     pub fn render(&mut self, scene: &Scene, frame: u32, pipeline_id: &str) -> Result<FrameOutput> {
+        scene.check_frame(frame)?;
+        self.use_scene(scene)?;
+        self.render_state(&scene.frame(frame), pipeline_id)
+    }
+
+    /// Analysis: render `state`, a frame of the scene held ([`Renderer::set_scene`]), with
+    /// `pipeline_id`, wait for it, read back image, depth and counts, download the grid and
+    /// compute the ideal count ([`FrameOutput`]). A frame whose lists did not fit is rerun
+    /// after growing them (`assign_reruns`); a frame with truncated shader loops is an error
+    /// ([`Error::TruncatedLoops`]).
+    pub fn render_state(&mut self, state: &FrameState, pipeline_id: &str) -> Result<FrameOutput> {
         let info = pipelines::find(pipeline_id)?;
         self.prepare_technique(info)?;
         // Earlier real-time frames first, so this frame's counters are its own.
         self.finish()?;
         let mut reruns = 0u32;
         // A rerun records the same uploaded frame again with the grown lists.
-        let up = self.upload(scene, frame)?;
+        let up = self.upload(state)?;
         loop {
             let start = Instant::now();
             let (serial, io, _) = self.encode_frame(info, &up, true)?;
@@ -767,9 +842,9 @@ impl Renderer {
                 dims: self.dims,
                 settings: self.settings,
                 readbacks: &self.readbacks,
-                scene,
+                scene_name: &self.scene.as_ref().expect("uploaded").scene.name,
                 info,
-                up_state: &up.state,
+                up_state: up.state,
                 transparent: up.frame_geometry.transparent_triangles(up.static_vertices),
                 setup: up.setup,
                 triangles: up.index_count / 3,

@@ -46,8 +46,9 @@ fn play(
 ) {
     let mut submitted = Vec::new();
     let mut finished = Vec::new();
+    r.use_scene(scene).unwrap();
     for &f in frames {
-        submitted.push(r.render_frame(scene, f, pipeline).unwrap());
+        submitted.push(r.render_frame(&scene.frame(f), pipeline).unwrap());
         finished.extend(r.poll_finished().unwrap());
     }
     finished.extend(r.finish().unwrap());

@@ -200,9 +200,8 @@ impl App {
         let win = self.win.as_ref().context("no window")?;
         let job = Job {
             generation: self.generation,
-            scene: self.base.clone(),
-            camera: self.scene.camera_path.clone(),
-            frame: self.frame,
+            scene: self.scene.clone(),
+            state: self.frame_state(),
             pipeline: pipelines::find(&self.applied.pipeline)?.id,
             settings: self.applied.settings,
             size: win.renderer.size(),

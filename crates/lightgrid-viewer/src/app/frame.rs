@@ -3,6 +3,7 @@
 //! panel, present.
 
 use super::*;
+use lightgrid::scene::FrameState;
 
 impl App {
     pub(super) fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -58,15 +59,21 @@ impl App {
         if self.playing && !std::mem::take(&mut self.hold_frame) {
             self.frame = (self.frame + 1) % self.scene.frame_count();
         }
-        self.scene.camera_path = match &self.fly {
-            Some(f) => f.hold(&self.base.camera_path),
-            None => self.base.camera_path.clone(),
-        };
+    }
+
+    /// What the window shows now: the scene at the current frame, seen by the fly camera
+    /// when there is one (the path's lens kept).
+    pub(super) fn frame_state(&self) -> FrameState {
+        let mut state = self.scene.frame(self.frame);
+        if let Some(fly) = &self.fly {
+            state.camera = fly.camera(&state.camera);
+        }
+        state
     }
 
     /// The fly camera, starting where the path's camera is now.
     pub(super) fn fly_camera(&mut self) -> &mut FlyCamera {
-        let camera = self.base.camera_path.at(self.frame);
+        let camera = self.scene.camera_path.at(self.frame);
         let speed = self.fly_speed;
         self.fly.get_or_insert_with(|| FlyCamera {
             speed,
@@ -78,6 +85,7 @@ impl App {
     pub(super) fn render(&mut self) -> Result<bool> {
         let ctx = self.ctx.clone();
         let pipeline = self.applied.pipeline.clone();
+        let state = self.frame_state();
         let win = self.win.as_mut().context("no window")?;
         // The surface first: a frame is rendered only when it can be shown.
         let texture = match win.surface.acquire(&ctx)? {
@@ -87,10 +95,12 @@ impl App {
                 return Ok(false);
             }
         };
-        match win
-            .renderer
-            .render_frame(&self.scene, self.frame, &pipeline)
-        {
+        let held = (win.renderer.scene()).is_some_and(|s| Arc::ptr_eq(s, &self.scene));
+        let rendered = match held {
+            true => Ok(()),
+            false => win.renderer.set_scene(self.scene.clone()),
+        };
+        match rendered.and_then(|()| win.renderer.render_frame(&state, &pipeline)) {
             Ok(s) => {
                 self.submitted = Some(s.serial);
                 self.last_good = self.applied.clone();

@@ -240,10 +240,9 @@ struct App {
     /// The last state that rendered; a failing change goes back to it.
     last_good: Controls,
     draft_edited: Option<Instant>,
-    /// The scene as opened (shared with the analysis thread), and the copy rendered, whose
-    /// camera path the fly camera replaces.
-    base: Arc<Scene>,
-    scene: Scene,
+    /// The scene as opened: one copy, shared with the window's renderer and the analysis
+    /// thread's (`Renderer::set_scene`); each frame is its state, with the fly camera's view.
+    scene: Arc<Scene>,
     frame: u32,
     playing: bool,
     /// The frame was just chosen (a jump or a step): show it before the animation moves on.
@@ -315,8 +314,7 @@ impl App {
             draft: controls.clone(),
             last_good: controls,
             draft_edited: None,
-            base: Arc::new(scene.clone()),
-            scene,
+            scene: Arc::new(scene),
             frame: opts.frame,
             playing: !opts.paused,
             hold_frame: true,
@@ -423,8 +421,7 @@ impl App {
     /// A newly opened scene in place of the old one (the animation frame kept if it has it).
     fn set_scene(&mut self, scene: Scene) {
         self.frame = self.frame.min(scene.frame_count() - 1);
-        self.base = Arc::new(scene.clone());
-        self.scene = scene;
+        self.scene = Arc::new(scene);
         self.generation += 1;
     }
 

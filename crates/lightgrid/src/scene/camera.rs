@@ -17,6 +17,34 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// Refuse a camera no view can be built from: non-finite values, the eye on its target,
+    /// `up` along the view direction, a field of view outside (0, π), or planes that
+    /// `depth::check_planes` refuses.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        let bad = |why: String| Err(crate::error::Error::invalid("camera", why));
+        let vectors = [self.eye, self.target, self.up];
+        if !(vectors.iter().all(|v| v.is_finite()) && self.fov_y.is_finite()) {
+            return bad(format!(
+                "needs finite values; eye {}, target {}, up {}, fov_y {}",
+                self.eye, self.target, self.up, self.fov_y
+            ));
+        }
+        let forward = self.target - self.eye;
+        if forward.length_squared() == 0.0 || forward.cross(self.up).length_squared() == 0.0 {
+            return bad(format!(
+                "eye {} to target {} with up {} gives no view direction",
+                self.eye, self.target, self.up
+            ));
+        }
+        if !(self.fov_y > 0.0 && self.fov_y < std::f32::consts::PI) {
+            return bad(format!(
+                "field of view {} rad is not between 0 and π",
+                self.fov_y
+            ));
+        }
+        crate::depth::check_planes(self.near, self.far)
+    }
+
     /// World space to view space (for files: the glTF export's camera node).
     pub fn view(&self) -> Mat4 {
         self.rotation() * Mat4::from_translation(-self.eye)
@@ -123,6 +151,95 @@ impl CameraPath {
             fov_y: self.fov_y,
             near: self.near,
             far: self.far,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_camera_no_view_can_be_built_from_is_refused_with_the_reason() {
+        let good = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y: 1.0,
+            near: 0.05,
+            far: 1e6,
+        };
+        good.validate().unwrap();
+        let cases = [
+            (
+                Camera {
+                    eye: Vec3::NAN,
+                    ..good
+                },
+                "needs finite values",
+            ),
+            (
+                Camera {
+                    up: Vec3::new(0.0, f32::INFINITY, 0.0),
+                    ..good
+                },
+                "needs finite values",
+            ),
+            (
+                Camera {
+                    fov_y: f32::NAN,
+                    ..good
+                },
+                "needs finite values",
+            ),
+            (
+                Camera {
+                    target: good.eye,
+                    ..good
+                },
+                "no view direction",
+            ),
+            (
+                Camera {
+                    up: good.target - good.eye,
+                    ..good
+                },
+                "no view direction",
+            ),
+            (
+                Camera {
+                    up: Vec3::ZERO,
+                    ..good
+                },
+                "no view direction",
+            ),
+            (Camera { fov_y: 0.0, ..good }, "not between 0 and"),
+            (
+                Camera {
+                    fov_y: -1.0,
+                    ..good
+                },
+                "not between 0 and",
+            ),
+            (
+                Camera {
+                    fov_y: std::f32::consts::PI,
+                    ..good
+                },
+                "not between 0 and",
+            ),
+            (Camera { near: 0.0, ..good }, "0 < near < far"),
+            (
+                Camera {
+                    far: f32::INFINITY,
+                    ..good
+                },
+                "0 < near < far",
+            ),
+        ];
+        for (camera, want) in cases {
+            let e = camera.validate().unwrap_err().to_string();
+            assert!(e.contains(want), "{camera:?}: {e}");
         }
     }
 }

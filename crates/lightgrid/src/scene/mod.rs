@@ -766,34 +766,46 @@ impl Scene {
         order.into_iter().map(|(_, i)| i).collect()
     }
 
-    /// A fingerprint of everything [`Scene::static_geometry`] depends on (objects, meshes,
-    /// materials): equal fingerprints mean equal static geometry.
-    pub fn static_fingerprint(&self) -> u64 {
+    /// A hash of everything a renderer uploads once per scene or bakes each frame from the
+    /// scene rather than from the [`FrameState`]: every mesh, every object's mesh, material
+    /// and placement, the materials and every texel. Two scenes with one fingerprint render
+    /// the same frame from the same state (`Renderer::render` compares them with it).
+    pub fn content_fingerprint(&self) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         let words = |h: &mut std::collections::hash_map::DefaultHasher, v: &[f32]| {
             bytemuck::cast_slice::<f32, u32>(v).hash(h)
         };
-        self.meshes.len().hash(&mut h);
-        for o in self.objects.iter().filter(|o| self.is_static_opaque(o)) {
-            (o.mesh, o.material).hash(&mut h);
-            words(&mut h, &o.local.to_cols_array());
-            let mesh = &self.meshes[o.mesh];
+        for mesh in &self.meshes {
             mesh.indices.hash(&mut h);
             words(&mut h, bytemuck::cast_slice(&mesh.positions));
             words(&mut h, bytemuck::cast_slice(&mesh.normals));
             words(&mut h, bytemuck::cast_slice(&mesh.uvs));
         }
+        for o in &self.objects {
+            (o.mesh, o.material, o.is_static()).hash(&mut h);
+            words(&mut h, &o.local.to_cols_array());
+        }
         for m in &self.materials {
             words(&mut h, bytemuck::cast_slice(&[m.to_gpu()]));
+            m.alpha_cutoff.is_some().hash(&mut h);
         }
-        // Textures by size and every 61st byte: hashing every texel each frame would cost a
-        // millisecond per megabyte, and scenes do not repaint a texture texel by texel.
         for t in &self.textures {
-            (t.width, t.height, t.rgba.len()).hash(&mut h);
-            t.rgba.iter().step_by(61).for_each(|b| b.hash(&mut h));
+            (t.width, t.height, &t.rgba).hash(&mut h);
         }
         h.finish()
+    }
+
+    /// The vertices and indices [`Scene::frame_geometry`] bakes every frame (the moving and
+    /// the transparent objects'): the room a renderer leaves after the static geometry.
+    pub fn frame_geometry_len(&self) -> (usize, usize) {
+        self.objects
+            .iter()
+            .filter(|o| !self.is_static_opaque(o))
+            .map(|o| &self.meshes[o.mesh])
+            .fold((0, 0), |(v, i), m| {
+                (v + m.positions.len(), i + m.indices.len())
+            })
     }
 
     fn bake(&self, o: &Object, m: Mat4, base: u32, out: &mut Geometry) {
@@ -978,5 +990,77 @@ mod tests {
             ..ok
         });
         assert!(e.contains("position [0, 2e12, 0]"), "{e}");
+    }
+
+    /// What the renderer uploads once per scene or bakes from the scene changes the
+    /// fingerprint, down to one texel; what a frame's state carries does not.
+    #[test]
+    fn the_content_fingerprint_sees_every_uploaded_byte_and_nothing_else() {
+        let mut base = catalog::build("robots-few", &catalog::SceneParams::default()).unwrap();
+        base.textures.push(Texture {
+            width: 4,
+            height: 4,
+            rgba: vec![200; 64],
+        });
+        let fp = base.content_fingerprint();
+        let moving = base.objects.iter().position(|o| !o.is_static()).unwrap();
+        let static_ = base.objects.iter().position(|o| o.is_static()).unwrap();
+        type Change = Box<dyn Fn(&mut Scene)>;
+        let changed: Vec<(&str, Change)> = vec![
+            ("a texel", Box::new(|s| s.textures[0].rgba[1] = 7)),
+            (
+                "a moving object's mesh",
+                Box::new(move |s| {
+                    let m = s.objects[moving].mesh;
+                    s.meshes[m].positions[0].x += 0.5;
+                }),
+            ),
+            (
+                "a static object's placement",
+                Box::new(move |s| s.objects[static_].local.w_axis.x += 1.0),
+            ),
+            (
+                "a material's alpha test",
+                Box::new(|s| s.materials[0].alpha_cutoff = Some(0.0)),
+            ),
+            (
+                "a material's colour",
+                Box::new(|s| s.materials[0].diffuse.x += 0.25),
+            ),
+            (
+                "an object made static",
+                Box::new(move |s| s.objects[moving].motion = Motion::Static),
+            ),
+        ];
+        for (what, change) in &changed {
+            let mut s = base.clone();
+            change(&mut s);
+            assert_ne!(s.content_fingerprint(), fp, "{what}");
+        }
+        let mut same = base.clone();
+        same.lights.truncate(1);
+        same.camera_path.keys[0].1.x += 3.0;
+        same.name = "renamed".into();
+        assert_eq!(
+            same.content_fingerprint(),
+            fp,
+            "lights, camera and name are state"
+        );
+    }
+
+    #[test]
+    fn the_room_left_for_a_frame_is_what_a_frame_bakes() {
+        let scene = catalog::build("robots-many", &catalog::SceneParams::default()).unwrap();
+        for frame in [0, 40] {
+            let g = scene.frame_geometry(&scene.frame(frame), 0);
+            assert_eq!(
+                scene.frame_geometry_len(),
+                (g.vertices.len(), g.indices.len())
+            );
+        }
+        assert!(
+            scene.frame_geometry_len().0 > 0,
+            "robots-many has moving robots"
+        );
     }
 }
