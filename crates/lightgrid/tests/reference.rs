@@ -1,7 +1,9 @@
 //! GPU: the forward reference guarded by a blessed PNG, and a frame that is really lit.
 //!
 //! `LIGHTGRID_BLESS=1 cargo test --release -p lightgrid --test reference` rewrites the
-//! blessed images. On failure the actual image and a diff image go to target/test-output/.
+//! blessed images, each only after the frame matched the CPU shading reference
+//! (`common::shading`: every clean sampled pixel within one level), and never under `CI=true`.
+//! On failure the actual image and a diff image go to target/test-output/.
 
 mod common;
 
@@ -45,6 +47,16 @@ fn check_against_golden(scene: &str, frame: u32, size: (u32, u32)) {
     let image = render_forward(scene, frame, size);
     let name = golden_name(scene, frame, size);
     if common::blessing() {
+        // Blessed only what a shading reference it did not produce agrees with.
+        let s = catalog::build(scene, &SceneParams::default()).unwrap();
+        let f = common::shading::Frame::new(&s, frame, size);
+        let mut checked = common::shading::Checked::default();
+        common::shading::compare(&f, &image, common::shading::Model::Full, 3, &mut checked);
+        assert!(
+            checked.pixels >= 100,
+            "{name}: only {} pixels could be checked against the shading reference; not blessed",
+            checked.pixels
+        );
         let golden = common::golden_dir().join(&name);
         save_png(&image, &golden).unwrap();
         eprintln!("blessed {}", golden.display());

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod gltf_fixture;
+pub mod shading;
 
 use glam::Vec3;
 use lightgrid::culling::{

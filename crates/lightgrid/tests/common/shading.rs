@@ -1,0 +1,365 @@
+//! The CPU shading reference `forward` is checked against (`tests/shading_reference.rs`) and
+//! that gates re-blessing the golden images (`tests/reference.rs`): a ray caster and the light
+//! function written here from the papers' formulas and the shaders' documented contract, not
+//! generated from the WGSL.
+
+use glam::{DVec3, Vec3};
+use lightgrid::consts::{
+    EXPOSURE, MATERIAL_SHADER_CAR_PAINT, MATERIAL_SHADER_RIM, POINT_LIGHT_COS, SCENE_AMBIENT,
+};
+use lightgrid::scene::{Light, Material, Scene, Spot};
+use lightgrid::{RenderSettings, Renderer};
+
+/// The light model a `forward` variant implements.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Model {
+    /// `forward`: diffuse and specular per light.
+    Full,
+    /// `forward_mono`: the light pre-pass's compromise, the specular summed as luminance and
+    /// given the diffuse irradiance's colour (deferred-shading-vs-deferred-lighting).
+    Mono,
+    /// `forward_mono_albedo`: the specular albedo reduced to its luminance in every channel.
+    MonoAlbedo,
+}
+
+impl Model {
+    pub fn pipeline(self) -> &'static str {
+        match self {
+            Model::Full => "forward",
+            Model::Mono => "forward_mono",
+            Model::MonoAlbedo => "forward_mono_albedo",
+        }
+    }
+}
+
+/// A triangle of the frame, camera-relative (the renderer's space), in drawing order.
+struct Triangle {
+    p: [DVec3; 3],
+    n: [Vec3; 3],
+    material: usize,
+    transparent: bool,
+}
+
+/// A ray's meeting with a triangle: distance along the ray and the barycentric weights.
+#[derive(Clone, Copy)]
+pub struct Hit {
+    t: f64,
+    triangle: usize,
+    w: [f64; 3],
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The frame as the reference sees it: triangles, lights and the camera, all camera-relative.
+pub struct Frame<'s> {
+    scene: &'s Scene,
+    triangles: Vec<Triangle>,
+    lights: Vec<Light>,
+    /// Camera basis: right, up, forward (world orientation).
+    basis: [DVec3; 3],
+    tan_half_fov: f64,
+    near: f64,
+    size: (u32, u32),
+}
+
+impl<'s> Frame<'s> {
+    pub fn new(scene: &'s Scene, frame: u32, size: (u32, u32)) -> Self {
+        let state = scene.frame(frame);
+        let eye = state.camera.eye;
+        let g = scene.geometry(&state);
+        let triangles = g
+            .indices
+            .chunks_exact(3)
+            .enumerate()
+            .map(|(k, t)| {
+                let v = [t[0], t[1], t[2]].map(|i| g.vertices[i as usize]);
+                Triangle {
+                    // As the vertex stage: world minus the eye in f32.
+                    p: v.map(|v| (Vec3::from(v.position) - eye).as_dvec3()),
+                    n: v.map(|v| Vec3::from(v.normal)),
+                    material: v[0].material as usize,
+                    transparent: k * 3 >= g.opaque_indices,
+                }
+            })
+            .collect();
+        let lights = state
+            .lights
+            .iter()
+            .map(|l| Light {
+                position: l.position - eye,
+                ..*l
+            })
+            .collect();
+        let c = state.camera;
+        let forward = (c.target - c.eye).as_dvec3().normalize();
+        let right = forward.cross(c.up.as_dvec3()).normalize();
+        let up = right.cross(forward);
+        Frame {
+            scene,
+            triangles,
+            lights,
+            basis: [right, up, forward],
+            tan_half_fov: (f64::from(c.fov_y) * 0.5).tan(),
+            near: f64::from(c.near),
+            size,
+        }
+    }
+
+    /// The ray through framebuffer position (x, y) (pixels, y down).
+    pub fn ray(&self, x: f64, y: f64) -> DVec3 {
+        let (w, h) = (f64::from(self.size.0), f64::from(self.size.1));
+        let aspect = w / h;
+        let sx = (x / w * 2.0 - 1.0) * self.tan_half_fov * aspect;
+        let sy = (1.0 - y / h * 2.0) * self.tan_half_fov;
+        let [r, u, f] = self.basis;
+        (r * sx + u * sy + f).normalize()
+    }
+
+    /// Every triangle the ray meets beyond the near plane (Möller-Trumbore, in f64).
+    fn hits(&self, d: DVec3) -> Vec<Hit> {
+        let mut out = Vec::new();
+        for (i, tri) in self.triangles.iter().enumerate() {
+            let [a, b, c] = tri.p;
+            let (e1, e2) = (b - a, c - a);
+            let p = d.cross(e2);
+            let det = e1.dot(p);
+            if det.abs() < 1e-18 {
+                continue;
+            }
+            let s = -a / det;
+            let u = s.dot(p);
+            let q = s.cross(e1);
+            let v = d.dot(q);
+            if u < 0.0 || v < 0.0 || u + v > 1.0 {
+                continue;
+            }
+            let t = e2.dot(q);
+            if t * d.dot(self.basis[2]) > self.near {
+                out.push(Hit {
+                    t,
+                    triangle: i,
+                    w: [1.0 - u - v, u, v],
+                });
+            }
+        }
+        out
+    }
+
+    pub fn material(&self, hit: &Hit) -> &Material {
+        &self.scene.materials[self.triangles[hit.triangle].material]
+    }
+
+    /// Does the material's alpha test drop the fragment (glTF MASK)? Without a texture the
+    /// fragment's alpha is the material's.
+    fn discarded(&self, hit: &Hit) -> bool {
+        let m = self.material(hit);
+        m.alpha_cutoff.is_some_and(|c| m.alpha < c)
+    }
+
+    /// What a pixel's centre ray sees: the nearest opaque surface and the glass in front of
+    /// it, in drawing order. None where there is no opaque surface.
+    pub fn seen(&self, x: f64, y: f64) -> Option<(Hit, Vec<Hit>, f64)> {
+        let mut hits = self.hits(self.ray(x, y));
+        hits.retain(|h| !self.discarded(h));
+        let opaque = hits
+            .iter()
+            .filter(|h| !self.triangles[h.triangle].transparent)
+            .min_by(|a, b| a.t.total_cmp(&b.t))
+            .copied()?;
+        let second = hits
+            .iter()
+            .filter(|h| !self.triangles[h.triangle].transparent && h.triangle != opaque.triangle)
+            .map(|h| h.t)
+            .fold(f64::INFINITY, f64::min);
+        let mut glass: Vec<Hit> = hits
+            .into_iter()
+            .filter(|h| self.triangles[h.triangle].transparent && h.t < opaque.t)
+            .collect();
+        glass.sort_by_key(|h| h.triangle);
+        Some((opaque, glass, second))
+    }
+
+    /// The pixel's reference colour, or None where its surface is ambiguous: an edge (a ray a
+    /// third of a pixel off the centre meets other triangles), a second surface within 0.1 %
+    /// of the depth, a texture.
+    pub fn reference(&self, px: u32, py: u32, model: Model) -> Option<(Vec3, bool)> {
+        let (x, y) = (f64::from(px) + 0.5, f64::from(py) + 0.5);
+        let (opaque, glass, second) = self.seen(x, y)?;
+        if second < opaque.t * 1.001 {
+            return None;
+        }
+        let key = |o: &Hit, g: &[Hit]| {
+            let mut k = vec![o.triangle];
+            k.extend(g.iter().map(|h| h.triangle));
+            k
+        };
+        let here = key(&opaque, &glass);
+        for (dx, dy) in [(-1.0, 0.0), (1.0, 0.0), (0.0, -1.0), (0.0, 1.0)] {
+            let (o, g, _) = self.seen(x + dx / 3.0, y + dy / 3.0)?;
+            if key(&o, &g) != here {
+                return None;
+            }
+        }
+        if std::iter::once(&opaque)
+            .chain(&glass)
+            .any(|h| self.material(h).texture.is_some())
+        {
+            return None;
+        }
+        let d = self.ray(x, y);
+        let (mut colour, lit) = self.shade(&opaque, d, model);
+        let mut any_lit = lit;
+        for h in &glass {
+            let (c, lit) = self.shade(h, d, model);
+            let a = self.material(h).alpha;
+            colour = c * a + colour * (1.0 - a);
+            any_lit |= lit;
+        }
+        Some((colour, any_lit))
+    }
+
+    /// The surface at `hit` lit by every light (linear HDR), and whether any light reached it.
+    fn shade(&self, hit: &Hit, ray: DVec3, model: Model) -> (Vec3, bool) {
+        let tri = &self.triangles[hit.triangle];
+        let at = |v: [DVec3; 3]| v[0] * hit.w[0] + v[1] * hit.w[1] + v[2] * hit.w[2];
+        let position = at(tri.p).as_vec3();
+        let mut normal = at(tri.n.map(Vec3::as_dvec3)).normalize().as_vec3();
+        // Two-sided: a triangle wound clockwise as seen is a back face, lit from its side.
+        let [a, b, c] = tri.p;
+        if (b - a).cross(c - a).dot(ray) > 0.0 {
+            normal = -normal;
+        }
+        let m = self.material(hit);
+        let view = -position.normalize();
+        let (shader, paint, power) = m.shader.gpu();
+        let grazing = (1.0 - normal.dot(view).clamp(0.0, 1.0)).powf(power);
+        let diffuse = match shader {
+            MATERIAL_SHADER_CAR_PAINT => m.diffuse.lerp(paint, grazing),
+            MATERIAL_SHADER_RIM => m.diffuse + paint * grazing,
+            _ => m.diffuse,
+        };
+        let specular = match model {
+            Model::MonoAlbedo => Vec3::splat(luminance(m.specular)),
+            _ => m.specular,
+        };
+        let (mut e_diffuse, mut e_specular, mut e_specular_lum) = (Vec3::ZERO, Vec3::ZERO, 0.0);
+        let mut lit = false;
+        for light in &self.lights {
+            let to_light = light.position - position;
+            let dist_sq = to_light.length_squared();
+            if dist_sq >= light.range * light.range {
+                continue;
+            }
+            let l = to_light / dist_sq.sqrt();
+            let n_dot_l = normal.dot(l);
+            let cone = match light.spot {
+                None => 1.0,
+                Some(Spot {
+                    direction,
+                    cos_inner,
+                    cos_outer,
+                }) => {
+                    assert!(cos_outer > POINT_LIGHT_COS);
+                    let t =
+                        ((-l.dot(direction) - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
+                    t * t * (3.0 - 2.0 * t)
+                }
+            };
+            if n_dot_l <= 0.0 || cone <= 0.0 {
+                continue;
+            }
+            let window = (1.0 - dist_sq / (light.range * light.range)).clamp(0.0, 1.0);
+            let radiance = light.color * light.intensity * (window * window * cone);
+            let h = (l + view).normalize();
+            let d = radiance * n_dot_l;
+            let s = radiance * (normal.dot(h).max(0.0).powf(m.shininess) * n_dot_l);
+            e_diffuse += d;
+            e_specular += s;
+            e_specular_lum += luminance(s);
+            lit |= d.max_element() > 1e-3;
+        }
+        let specular_light = match model {
+            Model::Mono if luminance(e_diffuse) <= 1e-8 => Vec3::splat(e_specular_lum),
+            Model::Mono => e_diffuse * (e_specular_lum / luminance(e_diffuse)),
+            _ => e_specular,
+        };
+        let base = m.emissive + m.ambient * SCENE_AMBIENT;
+        (base + e_diffuse * diffuse + specular_light * specular, lit)
+    }
+}
+
+/// Linear HDR to the display's 8-bit sRGB: the tone curve, then the sRGB encoding.
+pub fn display(c: Vec3) -> [u8; 3] {
+    let tone = |x: f32| 1.0 - (-x.max(0.0) * EXPOSURE).exp();
+    let srgb = |x: f32| {
+        if x <= 0.003_130_8 {
+            12.92 * x
+        } else {
+            1.055 * x.powf(1.0 / 2.4) - 0.055
+        }
+    };
+    c.to_array()
+        .map(|x| (srgb(tone(x)).clamp(0.0, 1.0) * 255.0).round() as u8)
+}
+
+/// How a frame compared: pixels checked, of them lit, behind glass, and the worst difference.
+#[derive(Debug, Default)]
+pub struct Checked {
+    pub pixels: usize,
+    pub lit: usize,
+    pub glass: usize,
+    pub shaders: [usize; 3],
+    pub worst: u8,
+}
+
+/// Compare every `step`-th pixel of `image`, `model`'s frame of `f`, with the reference;
+/// panics at the first pixel differing by more than one level. `out` counts what was checked.
+pub fn compare(f: &Frame, image: &image::RgbaImage, model: Model, step: u32, out: &mut Checked) {
+    let (w, h) = f.size;
+    for py in (step / 2..h).step_by(step as usize) {
+        for px in (step / 2..w).step_by(step as usize) {
+            let Some((hdr, lit)) = f.reference(px, py, model) else {
+                continue;
+            };
+            let want = display(hdr);
+            let got = image.get_pixel(px, py).0;
+            let worst = (0..3).map(|c| got[c].abs_diff(want[c])).max().unwrap();
+            assert!(
+                worst <= 1,
+                "{}, {}: pixel ({px}, {py}) is {:?}, the reference {want:?} (HDR {hdr})",
+                f.scene.name,
+                model.pipeline(),
+                &got[..3]
+            );
+            if model == Model::Full {
+                out.pixels += 1;
+                out.lit += usize::from(lit);
+                let centre = (f64::from(px) + 0.5, f64::from(py) + 0.5);
+                let (opaque, glass, _) = f.seen(centre.0, centre.1).unwrap();
+                out.glass += usize::from(!glass.is_empty());
+                out.shaders[f.material(&opaque).shader.gpu().0 as usize] += 1;
+            }
+            out.worst = out.worst.max(worst);
+        }
+    }
+}
+
+/// Render `frame` of `scene` with each model's `forward` and [`compare`] it.
+pub fn check(
+    ctx: &lightgrid::gpu::GpuContext,
+    scene: &Scene,
+    frame: u32,
+    size: (u32, u32),
+    step: u32,
+) -> Checked {
+    let f = Frame::new(scene, frame, size);
+    let mut r = Renderer::new(ctx, size.0, size.1, RenderSettings::default()).unwrap();
+    let mut out = Checked::default();
+    for model in [Model::Full, Model::Mono, Model::MonoAlbedo] {
+        let image = r.render(scene, frame, model.pipeline()).unwrap().image;
+        compare(&f, &image, model, step, &mut out);
+    }
+    out
+}
