@@ -202,7 +202,7 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     }
     for c in &top {
         if c.assign.is_some() {
-            for a in Assign::ALL.iter().filter(|a| **a != Assign::Auto) {
+            for a in Assign::all().filter(|a| *a != Assign::Auto) {
                 push(
                     Candidate {
                         assign: Some(a.name()),
@@ -411,7 +411,7 @@ fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
         tile_size: c.tile.unwrap_or(plan.base.tile_size),
         assign: c
             .assign
-            .and_then(|a| Assign::ALL.into_iter().find(|x| x.name() == a))
+            .and_then(|a| Assign::all().find(|x| x.name() == a))
             .unwrap_or(plan.base.assign),
         ..plan.base
     }

@@ -56,7 +56,7 @@ pub(crate) fn list() -> Result<()> {
         outln!("  {:<24} {} ({}){msaa}", p.id, p.description, p.paper);
     }
     outln!("light assignment (--assign, for grid pipelines):");
-    for a in lightgrid::culling::Assign::ALL {
+    for a in lightgrid::culling::Assign::all() {
         outln!("  {:<10} {}", a.name(), a.description());
     }
     Ok(())

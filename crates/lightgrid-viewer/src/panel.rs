@@ -148,7 +148,7 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
         egui::ComboBox::from_label("assignment")
             .selected_text(draft.settings.assign.name())
             .show_ui(ui, |ui| {
-                for a in Assign::ALL {
+                for a in Assign::all() {
                     ui.selectable_value(&mut draft.settings.assign, a, a.name())
                         .on_hover_text(a.description());
                 }

@@ -732,11 +732,11 @@ fn auto_assignment_resolves_by_adapter_and_light_count() {
         Assign::Auto.resolve(AUTO_GATHER_MAX_LIGHTS + 1, false),
         Assign::BvhGpu
     );
-    for a in Assign::ALL.into_iter().filter(|&a| a != Assign::Auto) {
+    for a in Assign::all().filter(|&a| a != Assign::Auto) {
         assert_eq!(a.resolve(5, true), a);
         assert_eq!(a.resolve(5_000_000, false), a);
     }
-    let names: Vec<&str> = Assign::ALL.iter().map(|a| a.name()).collect();
+    let names: Vec<&str> = Assign::all().map(|a| a.name()).collect();
     assert_eq!(
         names,
         ["cpu", "gather", "scatter", "bvh", "bvh-gpu", "auto"]

@@ -43,7 +43,7 @@ pub use oracle::{
     ideal_fragment_computations, ideal_fragment_counts, ideal_lighting_computations,
     ideal_pixel_counts, oracle_fragment_lights, oracle_tile_lights,
 };
-pub use registry::{find_strategy, StrategyInfo, STRATEGIES};
+pub use registry::{find_strategy, StrategyInfo, ASSIGN_VALUES, STRATEGIES};
 pub use spot_ray::{ray_test_count, RayTestCount};
 pub use strategy::AssignStrategy;
 pub(crate) use strategy::{bind_cull_group, cull_layout, CullFrame};

@@ -250,7 +250,8 @@ impl GBufferFormat {
     }
 }
 
-/// Who builds the light grid (`--assign`).
+/// Who builds the light grid (`--assign`): the typed id of a row of the strategy registry
+/// (`culling::STRATEGIES`, which also holds each one's name and description), or `Auto`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Assign {
@@ -276,38 +277,6 @@ pub enum Assign {
 pub const AUTO_GATHER_MAX_LIGHTS: usize = 8192;
 
 impl Assign {
-    pub const ALL: [Assign; 6] = [
-        Assign::Cpu,
-        Assign::Gather,
-        Assign::Scatter,
-        Assign::Bvh,
-        Assign::BvhGpu,
-        Assign::Auto,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Assign::Cpu => "cpu",
-            Assign::Gather => "gather",
-            Assign::Scatter => "scatter",
-            Assign::Bvh => "bvh",
-            Assign::BvhGpu => "bvh-gpu",
-            Assign::Auto => "auto",
-        }
-    }
-
-    /// One line on how the strategy works (`lightgrid list`).
-    pub fn description(self) -> &'static str {
-        match self {
-            Assign::Cpu => "CPU: projected sphere rectangles, per-cell depth test (rayon); grid uploaded",
-            Assign::Gather => "GPU: one workgroup per occupied cell tests every light (forward-plus §4)",
-            Assign::Scatter => "GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell (forward-plus §4)",
-            Assign::Bvh => "light BVH built on the CPU each frame, walked per occupied cell on the GPU (tiled-forward-shading §4.4)",
-            Assign::BvhGpu => "the same BVH built on the GPU (Morton codes, radix sort), walked the same way",
-            Assign::Auto => "software adapter: cpu; hardware GPU: gather up to 8192 lights, bvh-gpu above",
-        }
-    }
-
     /// The strategy used for a frame with `lights` lights. `auto` on a software adapter
     /// (lavapipe, which shares the CPU's cores) is `cpu` at every count: measured fastest from
     /// 1k to 1M lights (README, "Light assignment scaling"). On a hardware GPU it is `gather`

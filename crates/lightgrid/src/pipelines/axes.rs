@@ -38,14 +38,7 @@ pub trait SettingValue: Copy + PartialEq + Sized + 'static {
 
 impl SettingValue for Assign {
     const FLAG: &'static str = "assign";
-    const VALUES: &'static [Self] = &[
-        Assign::Auto,
-        Assign::Cpu,
-        Assign::Gather,
-        Assign::Scatter,
-        Assign::Bvh,
-        Assign::BvhGpu,
-    ];
+    const VALUES: &'static [Self] = &crate::culling::ASSIGN_VALUES;
     fn name(self) -> &'static str {
         Assign::name(self)
     }
