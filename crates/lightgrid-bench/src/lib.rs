@@ -17,7 +17,7 @@ mod report;
 mod run;
 mod scaling;
 
-pub use claims::{evaluate_claims, Claim, Verdict};
+pub use claims::{evaluate_claims, Band, Basis, Claim, Threshold, Verdict};
 pub use outdir::{
     check_out_dir, manifest_name, Earlier, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE,
     STOPPED_BY_SIGNAL,

@@ -600,17 +600,18 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             })
         };
         let has_glass = opened.scene.has_transparency();
-        if !config.transparency && has_glass {
-            scenes.push(open(false)?.scene);
-            continue;
-        }
+        // Without its glass when asked (then measured at every range factor too).
+        let scene = match !config.transparency && has_glass {
+            true => open(false)?.scene,
+            false => opened.scene,
+        };
         if !config.range_scales.is_empty() {
             for &f in &config.range_scales {
-                scenes.push(range_scaled(&opened.scene, f));
+                scenes.push(range_scaled(&scene, f));
             }
             continue;
         }
-        scenes.push(opened.scene);
+        scenes.push(scene);
         if config.opaque_variants && config.transparency && has_glass {
             let mut opaque = open(false)?.scene;
             opaque.name = format!("{}{OPAQUE_SUFFIX}", opaque.name);

@@ -19,9 +19,10 @@ use std::path::PathBuf;
 pub(crate) enum Preset {
     /// CI-sized smoke run: robots-many at 160x90, 4 frames, every pipeline.
     Quick,
-    /// The papers' configurations: robots-many and robots-few, frames 0..259 every 5, 16- and
-    /// 32-bit G-buffers, 32-pixel tiles (the papers'), at 1920x1080 on a hardware GPU or
-    /// 640x360 on a software one.
+    /// The papers' configurations: robots-many and robots-few without the robots' glass (the
+    /// papers' scenes have none), frames 0..259 every 5, 16- and 32-bit G-buffers, the papers'
+    /// tile count (32-pixel tiles at 1920x1080 on a hardware GPU; 11-pixel tiles at 640x360
+    /// on a software one).
     Paper,
     /// A scene dominated by spot lights (tiled-deferred-tricks' case): robots-many with every
     /// light a spot, frames 0..259 every 20, grid pipelines culling by sphere and by cone,
@@ -46,14 +47,14 @@ pub(crate) enum Preset {
     /// and tiled deferred, deferred and deferred lighting, frames 0..259 every 20,
     /// the lights-per-tile heatmap on Fig. 2(b)'s fixed 0 to 50 scale.
     ForwardPlus,
-    /// Light ranges (tiled-forward-shading Fig. 4.2(a)): robots-many with every light's
-    /// range scaled by 0.5 to 16, `forward`, `tiled_forward_prez` and `tiled_deferred`, frames
+    /// Light ranges (tiled-forward-shading Fig. 4.2(a)): robots-many without its glass, every
+    /// light's range scaled by 0.5 to 16, `forward`, `tiled_forward_prez` and `tiled_deferred`, frames
     /// 0..259 every 65, at 320x180 on a software adapter: where tiling stops paying.
     LightRange,
     /// Depth bounds (tiled-forward-shading §4.4, 22.4 → 15.6 → 10.9 ms): tiled forward
     /// without pre-Z, then tiled and clustered forward with pre-Z culling by no bounds, the
-    /// minimum only, the maximum only and both, on robots-many, frames 0..259 every 20,
-    /// 32-pixel tiles.
+    /// minimum only, the maximum only and both, on robots-many without its glass, frames
+    /// 0..259 every 20, the paper's tile count (as the paper preset).
     DepthBounds,
 }
 
@@ -144,6 +145,17 @@ pub(crate) struct ReportArgs {
 /// 12.5 to 200, the length of its street).
 const LIGHT_RANGE_SCALES: [f32; 6] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
 
+/// The papers' tile edge at 1920x1080 (tiled-shading §8, tiled-forward-shading §4): 2,040
+/// tiles of 32 pixels.
+const PAPER_TILE: u32 = 32;
+
+/// The tile edge that gives a frame `width` wide the papers' tile count: 32 pixels at 1920,
+/// 11 at 640 (1,947 tiles at 640x360 against their 2,040), so lights per tile and culling
+/// ratios compare with theirs.
+pub(crate) fn paper_tile(width: u32) -> u32 {
+    ((f64::from(PAPER_TILE) * f64::from(width) / 1920.0).round() as u32).max(1)
+}
+
 /// Forward+ Fig. 2(b)'s lights-per-tile scale (the forward-plus preset's heatmap).
 const FORWARD_PLUS_HEATMAP_MAX: u32 = 50;
 
@@ -209,6 +221,15 @@ fn study(
     }
 }
 
+/// The papers' frame size on a hardware GPU, a third of it on a software one.
+fn papers_size(hardware: bool) -> (u32, u32) {
+    if hardware {
+        (1920, 1080)
+    } else {
+        (640, 360)
+    }
+}
+
 /// A preset's values of the setting `T` is the type of.
 fn measure<T: SettingValue>(values: &[T]) -> (&'static str, Vec<String>) {
     (
@@ -260,7 +281,7 @@ pub(crate) fn bench_config(
         },
         Some(Preset::Paper) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
-            size: Some(if hardware { (1920, 1080) } else { (640, 360) }),
+            size: Some(papers_size(hardware)),
             settings: vec![measure(&[GBufferFormat::F16, GBufferFormat::F32])],
             repeat: if hardware { 3 } else { 1 },
             // The references of the mono-specular pipelines only exist to test their images.
@@ -269,8 +290,10 @@ pub(crate) fn bench_config(
                 .filter(|p| p.reference != p.id || p.id == lightgrid::pipelines::REFERENCE)
                 .map(|p| p.id.to_string())
                 .collect(),
-            // tiled-shading §8 and tiled-forward-shading use 32x32 tiles.
-            tile: Some(32),
+            // tiled-shading §8 and tiled-forward-shading: 32x32 tiles at 1920x1080, and
+            // scenes without transparent objects (the transparency preset measures the glass).
+            tile: Some(paper_tile(papers_size(hardware).0)),
+            transparency: false,
             ..everything()
         },
         Some(Preset::ForwardPlus) => BenchDefaults {
@@ -297,6 +320,7 @@ pub(crate) fn bench_config(
             frames: "0..259:65",
             size: Some(if hardware { (1280, 720) } else { (320, 180) }),
             range_scales: LIGHT_RANGE_SCALES.to_vec(),
+            transparency: false,
             ..study(hardware, |_| false)
         },
         Some(Preset::DepthBounds) => BenchDefaults {
@@ -308,8 +332,9 @@ pub(crate) fn bench_config(
             .map(String::from)
             .to_vec(),
             settings: vec![measure(&DepthBounds::ALL)],
-            // tiled-forward-shading measures 32x32 tiles.
-            tile: Some(32),
+            // tiled-forward-shading measures 32x32 tiles at 1920x1080, without glass.
+            tile: Some(paper_tile(papers_size(hardware).0)),
+            transparency: false,
             ..study(hardware, |_| false)
         },
         Some(Preset::Clustered) => BenchDefaults {

@@ -37,11 +37,70 @@ impl Verdict {
     }
 }
 
+/// What a verdict rests on: frames measured on this adapter, or a traffic model evaluated at
+/// a measured quantity (the deferred-lighting blog's byte budgets: a verdict on the model, not
+/// a measurement of bytes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Basis {
+    Measured,
+    Model,
+}
+
+/// The paper's words for a quantity and the interval of its measured value that counts as
+/// them (both ends included; `f64::INFINITY` for "at least"). Where a paper gives a figure
+/// ("about 25%", "1.5 to 2 times", "6x") the band is that figure with the margin written
+/// beside the constant; the verdict is `contains`, and the summary prints `describe`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Band {
+    /// The paper's words.
+    pub words: &'static str,
+    /// What is measured, as a ratio or a value.
+    pub quantity: &'static str,
+    pub low: f64,
+    pub high: f64,
+}
+
+impl Band {
+    pub fn contains(&self, x: f64) -> bool {
+        x >= self.low && x <= self.high
+    }
+
+    /// "'by about 25%': tiled_forward_prez ms / tiled_deferred ms in 1.15 to 1.35".
+    pub fn describe(&self) -> String {
+        let range = match (self.low, self.high) {
+            (l, h) if h.is_infinite() => format!("at least {l}"),
+            (l, h) if l <= 0.0 => format!("at most {h}"),
+            (l, h) => format!("{l} to {h}"),
+        };
+        format!("\"{}\": {} {range}", self.words, self.quantity)
+    }
+}
+
+/// A claim's threshold: a [`Band`] around the paper's figure, or a rule in words for the
+/// claims that order pipelines rather than give a figure.
+#[derive(Clone, Copy, Debug)]
+pub enum Threshold {
+    Band(&'static Band),
+    Rule(&'static str),
+}
+
+impl Threshold {
+    fn describe(self) -> String {
+        match self {
+            Threshold::Band(b) => b.describe(),
+            Threshold::Rule(r) => r.to_string(),
+        }
+    }
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Claim {
     pub scene: String,
     pub statement: &'static str,
     pub source: &'static str,
+    /// What counts as the statement holding: the paper's words and the measured interval.
+    pub threshold: String,
+    pub basis: Basis,
     pub evidence: String,
     pub verdict: Verdict,
 }
@@ -51,12 +110,15 @@ impl Claim {
         scene: impl Into<String>,
         statement: &'static str,
         source: &'static str,
+        threshold: Threshold,
         (evidence, verdict): (String, Verdict),
     ) -> Self {
         Claim {
             scene: scene.into(),
             statement,
             source,
+            threshold: threshold.describe(),
+            basis: Basis::Measured,
             evidence,
             verdict,
         }
@@ -185,110 +247,151 @@ fn culled<'a>(r: &'a BenchResults, scene: &str) -> Vec<&'a RunRecord> {
         .collect()
 }
 
-/// A claim checked on each scene: its statement, its source and the check.
-type PerScene = (
-    &'static str,
-    &'static str,
-    fn(&BenchResults, &str) -> (String, Verdict),
-);
+/// A claim checked on each scene: its statement, its source, what counts as it holding, what
+/// its verdict rests on, and the check.
+struct PerScene {
+    statement: &'static str,
+    source: &'static str,
+    threshold: Threshold,
+    basis: Basis,
+    check: fn(&BenchResults, &str) -> (String, Verdict),
+}
 
 /// The claims checked on every scene of a run, in the order summary.md lists them.
 const PER_SCENE: &[PerScene] = &[
-    (
-        "Tiled deferred shading is much less variable than traditional deferred shading",
-        "tiled-shading §8.1, Fig. 2",
-        variability,
-    ),
-    (
-        "Deferred-Stencil performs the fewest lighting computations (closest to the ideal)",
-        "tiled-shading §8, Fig. 3",
-        stencil_fewest,
-    ),
-    (
-        "Tiled forward is the least efficient and is substantially improved by a pre-Z pass and depth bounds",
-        "tiled-shading §8, Fig. 3",
-        tiled_forward_worst,
-    ),
-    (
-        "Frame times follow the lighting computations: a roughly fixed cost per lighting operation",
-        "tiled-shading §8, Figs. 2-3",
-        time_follows_computations,
-    ),
-    (
-        "Traditional deferred slows with a fatter G-buffer; tiled deferred is much less affected",
-        "tiled-shading §8.1, Tables 2-3",
-        gbuffer_size,
-    ),
-    (
-        "Forward+ (tiled forward with pre-Z and culling) is faster in total than deferred lighting",
-        "forward-plus §5, Fig. 3",
-        forward_plus_vs_deferred,
-    ),
-    (
-        "Forward+ is faster in total than compute-based deferred lighting [And11], stage by stage: pre-pass, light culling and lighting, final shading",
-        "forward-plus §5, Fig. 3",
-        forward_plus_by_stages,
-    ),
-    (
-        "Tiled deferred outperforms tiled forward (with pre-Z) in the plain case, by about 25%",
-        "tiled-forward-shading Fig. 4.1(a)",
-        plain_case,
-    ),
-    (
-        "Deferred lighting gives at most a marginal GPU advantage over deferred shading",
-        "deferred-shading-vs-deferred-lighting",
-        lighting_marginal,
-    ),
-    (
-        "At 4x MSAA tiled forward outperforms tiled deferred with equal quality by 1.5 to 2 times",
-        "tiled-forward-shading Fig. 4.1(c)",
-        msaa_forward_faster,
-    ),
-    (
-        "The Z-reduction over every sample grows almost linearly with the sample count (0.75 ms at 1x to 5.1 ms at 8x)",
-        "tiled-forward-shading §4.6",
-        z_reduction_scales,
-    ),
-    (
-        "Tiled deferred has the fastest worst case of the culling techniques",
-        "tiled-shading §8.3",
-        fastest_worst_case,
-    ),
-    (
-        "With few lights, tiled forward shading is competitive with tiled deferred (within 25%)",
-        "tiled-shading §8.3, Table 3",
-        few_lights_competitive,
-    ),
-    (
-        "At equal lighting computations, tiled forward with pre-Z is about four times slower than tiled deferred, plus a constant offset",
-        "tiled-shading §8.2",
-        prez_per_computation,
-    ),
-    (
-        "Deferred-Stencil is competitive (within 25% of tiled deferred) with a 16-bit G-buffer, not with a 32-bit one",
-        "tiled-shading §8.1, Tables 2-3",
-        stencil_gbuffer,
-    ),
-    (
-        "Deferred lighting writes more than deferred shading once more than 0.5 lights reach a pixel on average (the traffic model at the measured lights per pixel)",
-        "deferred-shading-vs-deferred-lighting",
-        write_break_even,
-    ),
-    (
-        "With monochrome specular on both sides, deferred lighting writes as much as deferred shading (the traffic model at the measured lights per pixel)",
-        "deferred-shading-vs-deferred-lighting (the compromise)",
-        mono_writes,
-    ),
-    (
-        "With monochrome specular on both sides, deferred lighting reads less than deferred shading once more than 2 lights reach a pixel on average",
-        "deferred-shading-vs-deferred-lighting (the compromise)",
-        mono_reads,
-    ),
-    (
-        "With monochrome specular on both sides, deferred lighting needs less render-target memory per pixel than deferred shading (16 against 20 bytes)",
-        "deferred-shading-vs-deferred-lighting (the compromise)",
-        mono_memory,
-    ),
+    PerScene {
+        statement: "Tiled deferred shading is much less variable than traditional deferred shading",
+        source: "tiled-shading §8.1, Fig. 2",
+        threshold: Threshold::Band(&VARIABILITY),
+        basis: Basis::Measured,
+        check: variability,
+    },
+    PerScene {
+        statement: "Deferred-Stencil performs the fewest lighting computations (closest to the ideal)",
+        source: "tiled-shading §8, Fig. 3",
+        threshold: Threshold::Rule("deferred_stencil's lighting computations at most every other culling pipeline's"),
+        basis: Basis::Measured,
+        check: stencil_fewest,
+    },
+    PerScene {
+        statement: "Tiled forward is the least efficient and is substantially improved by a pre-Z pass and depth bounds",
+        source: "tiled-shading §8, Fig. 3",
+        threshold: Threshold::Band(&SUBSTANTIALLY_FEWER),
+        basis: Basis::Measured,
+        check: tiled_forward_worst,
+    },
+    PerScene {
+        statement: "Frame times follow the lighting computations: a roughly fixed cost per lighting operation",
+        source: "tiled-shading §8, Figs. 2-3",
+        threshold: Threshold::Band(&FOLLOWS),
+        basis: Basis::Measured,
+        check: time_follows_computations,
+    },
+    PerScene {
+        statement: "Traditional deferred slows with a fatter G-buffer; tiled deferred is much less affected",
+        source: "tiled-shading §8.1, Tables 2-3",
+        threshold: Threshold::Band(&GBUFFER_SLOWS),
+        basis: Basis::Measured,
+        check: gbuffer_size,
+    },
+    PerScene {
+        statement: "Forward+ (tiled forward with pre-Z and culling) is faster in total than deferred lighting",
+        source: "forward-plus §5, Fig. 3",
+        threshold: Threshold::Rule("tiled_forward_prez's avg ms below deferred's and light_prepass's"),
+        basis: Basis::Measured,
+        check: forward_plus_vs_deferred,
+    },
+    PerScene {
+        statement: "Forward+ is faster in total than compute-based deferred lighting [And11], stage by stage: pre-pass, light culling and lighting, final shading",
+        source: "forward-plus §5, Fig. 3",
+        threshold: Threshold::Rule("the three stages' total below tiled_light_prepass's"),
+        basis: Basis::Measured,
+        check: forward_plus_by_stages,
+    },
+    PerScene {
+        statement: "Tiled deferred outperforms tiled forward (with pre-Z) in the plain case, by about 25%",
+        source: "tiled-forward-shading Fig. 4.1(a)",
+        threshold: Threshold::Band(&PLAIN_CASE),
+        basis: Basis::Measured,
+        check: plain_case,
+    },
+    PerScene {
+        statement: "Deferred lighting gives at most a marginal GPU advantage over deferred shading",
+        source: "deferred-shading-vs-deferred-lighting",
+        threshold: Threshold::Band(&MARGINAL),
+        basis: Basis::Measured,
+        check: lighting_marginal,
+    },
+    PerScene {
+        statement: "At 4x MSAA tiled forward outperforms tiled deferred with equal quality by 1.5 to 2 times",
+        source: "tiled-forward-shading Fig. 4.1(c)",
+        threshold: Threshold::Band(&MSAA_FASTER),
+        basis: Basis::Measured,
+        check: msaa_forward_faster,
+    },
+    PerScene {
+        statement: "The Z-reduction over every sample grows almost linearly with the sample count (0.75 ms at 1x to 5.1 ms at 8x)",
+        source: "tiled-forward-shading §4.6",
+        threshold: Threshold::Band(&ALMOST_LINEAR),
+        basis: Basis::Measured,
+        check: z_reduction_scales,
+    },
+    PerScene {
+        statement: "Tiled deferred has the fastest worst case of the culling techniques",
+        source: "tiled-shading §8.3",
+        threshold: Threshold::Rule("tiled_deferred's worst frame at most every other culling pipeline's worst"),
+        basis: Basis::Measured,
+        check: fastest_worst_case,
+    },
+    PerScene {
+        statement: "With few lights, tiled forward shading is competitive with tiled deferred (within 25%)",
+        source: "tiled-shading §8.3, Table 3",
+        threshold: Threshold::Band(&COMPETITIVE),
+        basis: Basis::Measured,
+        check: few_lights_competitive,
+    },
+    PerScene {
+        statement: "At equal lighting computations, tiled forward with pre-Z is about four times slower than tiled deferred, plus a constant offset",
+        source: "tiled-shading §8.2",
+        threshold: Threshold::Band(&FOUR_TIMES),
+        basis: Basis::Measured,
+        check: prez_per_computation,
+    },
+    PerScene {
+        statement: "Deferred-Stencil is competitive (within 25% of tiled deferred) with a 16-bit G-buffer, not with a 32-bit one",
+        source: "tiled-shading §8.1, Tables 2-3",
+        threshold: Threshold::Rule(STENCIL_RULE),
+        basis: Basis::Measured,
+        check: stencil_gbuffer,
+    },
+    PerScene {
+        statement: "Deferred lighting writes more than deferred shading once more than 0.5 lights reach a pixel on average (the traffic model at the measured lights per pixel)",
+        source: "deferred-shading-vs-deferred-lighting",
+        threshold: Threshold::Rule("lighting's modelled writes above shading's exactly when the measured lights per pixel exceed 0.5"),
+        basis: Basis::Model,
+        check: write_break_even,
+    },
+    PerScene {
+        statement: "With monochrome specular on both sides, deferred lighting writes as much as deferred shading (the traffic model at the measured lights per pixel)",
+        source: "deferred-shading-vs-deferred-lighting (the compromise)",
+        threshold: Threshold::Rule("the modelled writes within 5% of each other"),
+        basis: Basis::Model,
+        check: mono_writes,
+    },
+    PerScene {
+        statement: "With monochrome specular on both sides, deferred lighting reads less than deferred shading once more than 2 lights reach a pixel on average",
+        source: "deferred-shading-vs-deferred-lighting (the compromise)",
+        threshold: Threshold::Rule("lighting's modelled reads below shading's exactly when the measured lights per pixel exceed 2"),
+        basis: Basis::Model,
+        check: mono_reads,
+    },
+    PerScene {
+        statement: "With monochrome specular on both sides, deferred lighting needs less render-target memory per pixel than deferred shading (16 against 20 bytes)",
+        source: "deferred-shading-vs-deferred-lighting (the compromise)",
+        threshold: Threshold::Rule("light_prepass_mono's render targets per pixel fewer than deferred_mono's"),
+        basis: Basis::Measured,
+        check: mono_memory,
+    },
 ];
 
 pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
@@ -296,8 +399,17 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
     let mut scenes: Vec<&str> = r.runs.iter().map(|x| x.scene.as_str()).collect();
     scenes.dedup();
     for scene in scenes {
-        for &(statement, source, check) in PER_SCENE {
-            out.push(Claim::new(scene, statement, source, check(r, scene)));
+        for c in PER_SCENE {
+            out.push(Claim {
+                basis: c.basis,
+                ..Claim::new(
+                    scene,
+                    c.statement,
+                    c.source,
+                    c.threshold,
+                    (c.check)(r, scene),
+                )
+            });
         }
     }
     out.extend(view_dependence(r));
@@ -537,5 +649,67 @@ mod tests {
         assert_eq!(stencil_competitive(1.1, 1.6).1, Verdict::Held);
         assert_eq!(stencil_competitive(1.4, 1.6).1, Verdict::NotHeld);
         assert_eq!(stencil_competitive(1.1, 1.2).1, Verdict::NotHeld);
+    }
+
+    /// Every band holds at both ends and fails just outside them, holds the paper's own
+    /// figure, and says its words and interval.
+    #[test]
+    fn bands_hold_at_both_ends_and_the_papers_figure() {
+        // (band, the paper's own figure)
+        let bands: [(&Band, f64); 13] = [
+            (&VARIABILITY, 2.0),
+            (&SUBSTANTIALLY_FEWER, 2.0),
+            (&FOLLOWS, 0.9),
+            (&GBUFFER_SLOWS, 1.2),
+            (&PLAIN_CASE, 1.25),
+            (&MARGINAL, 1.0),
+            (&MSAA_FASTER, 1.75),
+            (&ALMOST_LINEAR, 5.1 / 0.75 / 8.0),
+            (&COMPETITIVE, 1.25),
+            (&FOUR_TIMES, 4.0),
+            (&SUBGROUP_SIX_TIMES, 6.0),
+            (&ONE_SIDE_ENOUGH, 1.05),
+            (&ONE_SIDE_ENOUGH, 1.10),
+        ];
+        for (band, figure) in bands {
+            assert!(band.contains(figure), "{band:?} must hold {figure}");
+            assert!(band.contains(band.low), "{band:?}: low end");
+            assert!(!band.contains(band.low - 1e-9), "{band:?}: below");
+            if band.high.is_finite() {
+                assert!(band.contains(band.high), "{band:?}: high end");
+                assert!(!band.contains(band.high + 1e-9), "{band:?}: above");
+            }
+            let text = band.describe();
+            assert!(
+                text.contains(band.words) && text.contains(band.quantity),
+                "{text}"
+            );
+        }
+        assert_eq!(
+            PLAIN_CASE.describe(),
+            "\"by about 25%\": tiled_forward_prez ÷ tiled_deferred avg ms 1.15 to 1.35"
+        );
+        assert!(VARIABILITY.describe().ends_with("at least 1.5"));
+        assert!(ONE_SIDE_ENOUGH.describe().ends_with("at most 1.1"));
+        // The paper's "1.5 to 2 times" is that interval, no wider.
+        assert_eq!((MSAA_FASTER.low, MSAA_FASTER.high), (1.5, 2.0));
+        // The Deferred-Stencil rule in words names the competitive bound.
+        assert!(STENCIL_RULE.contains(&format!("at most {}", COMPETITIVE.high)));
+    }
+
+    #[test]
+    fn model_verdicts_are_the_traffic_model_claims_and_every_claim_has_a_threshold() {
+        let model: Vec<&str> = PER_SCENE
+            .iter()
+            .filter(|c| c.basis == Basis::Model)
+            .map(|c| c.statement)
+            .collect();
+        assert_eq!(model.len(), 3, "{model:?}");
+        assert!(model
+            .iter()
+            .all(|s| s.to_lowercase().contains("deferred lighting")));
+        for c in PER_SCENE {
+            assert!(!c.threshold.describe().is_empty(), "{}", c.statement);
+        }
     }
 }
