@@ -1,5 +1,8 @@
 //! The `lightgrid` binary as a user runs it: outputs, and clear errors with non-zero exits.
 
+/// The library's test helpers (GPU context, the missing-light cases and the shading reference).
+#[path = "../../lightgrid/tests/common/mod.rs"]
+mod common;
 mod support;
 
 use std::path::Path;
@@ -936,4 +939,51 @@ fn diff_max_over_catches_a_small_dark_region() {
         assert!(!o.status.success(), "--max-over {bad} accepted");
         assert!(!stderr(&o).contains("panicked"), "{bad}: {}", stderr(&o));
     }
+}
+
+/// A real dim (or distant) light missing from a frame, as a culling bug would leave it out:
+/// README's check, `lightgrid diff --max-over 4:5`, fails the frame without it (a distant
+/// light changes 10 pixels by more than 4 levels at 192x108) and passes a grid pipeline's
+/// frame with it.
+#[test]
+fn diff_max_over_catches_a_dim_or_distant_missing_light() {
+    use lightgrid::scene::catalog::{self, SceneParams};
+    let ctx = common::gpu();
+    let dir = temp_dir("diff-missing-light");
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (size, frame) = ((192, 108), 200);
+    let mut r = lightgrid::Renderer::new(&ctx, size.0, size.1, Default::default()).unwrap();
+    let save = |name: &str, image: &image::RgbaImage| {
+        let path = dir.join(name);
+        image.save(&path).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let without = save(
+        "without.png",
+        &r.render(&s, frame, "forward").unwrap().image,
+    );
+    for case in common::MissingLight::ALL {
+        let with = common::with_missing_light(&s, frame, size, case);
+        let reference = save(
+            "with.png",
+            &r.render(&with, frame, "forward").unwrap().image,
+        );
+        let grid = save(
+            "grid.png",
+            &r.render(&with, frame, "clustered_deferred").unwrap().image,
+        );
+        let o = lightgrid(&["diff", &reference, &without, "--max-over", "4:5"]);
+        assert!(
+            !o.status.success(),
+            "{case:?}: the missing light passed --max-over 4:5"
+        );
+        assert!(
+            stderr(&o).contains("pixels differ by more than 4 levels"),
+            "{}",
+            stderr(&o)
+        );
+        let o = lightgrid(&["diff", &reference, &grid, "--max-over", "4:5"]);
+        assert!(o.status.success(), "{case:?}: {}", stderr(&o));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -4,6 +4,9 @@
 //! here fails (never passes) when the window cannot be made: Xvfb missing, no adapter able
 //! to present, or the viewer refusing to start.
 
+/// The library's test helpers (GPU context, the missing-light cases and the shading reference).
+#[path = "../../lightgrid/tests/common/mod.rs"]
+mod common;
 mod support;
 
 use std::io::{BufRead, BufReader};
@@ -202,6 +205,46 @@ fn a_scripted_session_shows_what_the_headless_renderer_renders() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The flip-through's bound on a screenshot against its reference's: tests/pipelines.rs's
+/// widest (the G-buffer's 16-bit rounding and the light-volume meshes' tessellation: mean 0.5,
+/// p99 2, at most 5 pixels over 4 levels; measured 0 over 1 level); a missing light, even a
+/// dim one, breaks the count (`a_dim_or_distant_missing_light_fails_the_flip_tolerance`).
+const FLIP_TOLERANCE: common::ImageTolerance = common::ImageTolerance {
+    max_mean: 0.5,
+    max_p99: 2.0,
+    level: 4,
+    max_over: 5,
+    fine: None,
+};
+
+/// The flip-through's bound catches one dim or distant missing light on its own frame
+/// (robots-few, frame 120, 203x117): `forward` with the light against `forward` without.
+#[test]
+fn a_dim_or_distant_missing_light_fails_the_flip_tolerance() {
+    use lightgrid::scene::catalog::{self, SceneParams};
+    let ctx = common::gpu();
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let (size, frame) = ((203, 117), 120);
+    let settings = lightgrid::RenderSettings {
+        tile_size: 12,
+        ..Default::default()
+    };
+    let mut r = lightgrid::Renderer::new(&ctx, size.0, size.1, settings).unwrap();
+    let unlit = r.render(&s, frame, "forward").unwrap().image;
+    for case in common::MissingLight::ALL {
+        let with = common::with_missing_light(&s, frame, size, case);
+        let lit = r.render(&with, frame, "forward").unwrap().image;
+        let grid = r.render(&with, frame, "tiled_deferred").unwrap().image;
+        common::assert_missing_light_fails(
+            "view flip-through",
+            case,
+            FLIP_TOLERANCE,
+            [&lit, &grid, &unlit],
+            None,
+        );
+    }
+}
+
 /// Every pipeline the registry has, flipped through live in one window at 1x, shows the
 /// image its reference renders (`forward`, or the one with the same approximations).
 #[test]
@@ -246,14 +289,13 @@ fn flipping_through_every_pipeline_keeps_the_image() {
         let reference = load(&dir.join(format!("{}.png", p.reference)));
         assert_eq!(reference.dimensions(), (203, 117));
         let id = p.id;
-        let (mean, max) = difference(&load(&dir.join(format!("{id}.png"))), &reference);
-        eprintln!("{id} vs {}: mean {mean:.4}, max {max}", p.reference);
-        // tests/pipelines.rs allows the G-buffer's 16-bit rounding and the light-volume
-        // meshes' tessellation a few levels; a missing light shows as tens of levels.
-        assert!(
-            mean < 0.6 && max <= 24,
-            "{id} vs forward: mean {mean}, max {max}"
+        let cmp = common::compare_images(
+            &reference,
+            &load(&dir.join(format!("{id}.png"))),
+            FLIP_TOLERANCE,
         );
+        eprintln!("{id} vs {}: {}", p.reference, cmp.describe());
+        assert!(cmp.passes(), "{id} vs {}: {}", p.reference, cmp.describe());
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -47,7 +47,10 @@ fn tolerance(id: &str) -> common::ImageTolerance {
             max_mean: 0.02,
             max_p99: 1.0,
             level: 4,
-            max_over: 10,
+            // Measured 0; 5 for other drivers, under the 13 pixels a distant missing light
+            // changes at 192x108.
+            max_over: 5,
+            fine: None,
         },
         // Deferred shades a pixel at its centre (the samples' mean depth: forward's point),
         // but each sample of an edge pixel where it lies, where forward shades each surface
@@ -79,6 +82,12 @@ fn tolerance(id: &str) -> common::ImageTolerance {
             max_p99: 8.0,
             level: 24,
             max_over: 12,
+            // Off the edges (`common::msaa_edge_pixels`) the deferred family shades forward's
+            // points: measured at most 4 pixels over 4 levels (deferred_stencil, robots-many
+            // behind glass), 0 for the kernels; a dim missing light leaves 311 there at
+            // 192x108 (`a_dim_or_distant_missing_light_fails_every_msaa_tolerance`), which
+            // the 24-level bound alone lets through (1 pixel over 24).
+            fine: Some((4, 5)),
         },
     }
 }
@@ -117,7 +126,13 @@ fn render_all(s: &Scene, frame: u32, (w, h): (u32, u32), settings: RenderSetting
         }
         let reference = &references[p.reference];
         let out = r.render(s, frame, p.id).unwrap();
-        let cmp = common::compare_images(&reference.image, &out.image, tolerance(p.id));
+        let edges = common::msaa_edge_pixels(&reference.depth_samples, (w, h));
+        let cmp = common::compare_images_outside(
+            &reference.image,
+            &out.image,
+            tolerance(p.id),
+            Some(&edges),
+        );
         eprintln!("MEASURED {name}: {}", cmp.describe());
         if !cmp.passes() {
             let dir = common::output_dir();
@@ -251,6 +266,50 @@ fn every_msaa_pipeline_equals_forward_at_4x_on_robots_many() {
     render_all(&s, 0, (160, 90), msaa(16));
 }
 
+/// One dim or distant missing light fails every MSAA tolerance, while the pipeline rendered
+/// with the light passes. The deferred family's tolerance sees a missing light only off the
+/// edge pixels, where it shades forward's points: the dim light there (311 pixels over 4
+/// levels at 192x108), not the distant one, whose 13 pixels lie on the edges of the far
+/// robots (3 off them, as many as round-off leaves); for that family the grid's oracle per
+/// sample plane (`check_grid`) is what catches a distant light missing from a cell.
+#[test]
+fn a_dim_or_distant_missing_light_fails_every_msaa_tolerance() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (size, frame) = ((192, 108), 200);
+    let mut r = Renderer::new(&ctx, size.0, size.1, msaa(16)).unwrap();
+    for case in common::MissingLight::ALL {
+        let with = common::with_missing_light(&s, frame, size, case);
+        let mut references = std::collections::BTreeMap::new();
+        let seen = |p: &&lightgrid::pipelines::PipelineInfo| {
+            let edge_allowance = tolerance(p.id).fine.is_some();
+            !(edge_allowance && matches!(case, common::MissingLight::Distant))
+        };
+        for p in PIPELINES
+            .iter()
+            .filter(|p| p.msaa == Msaa::Supported && p.reference != p.id)
+            .filter(seen)
+        {
+            if !references.contains_key(p.reference) {
+                let reference = r.render(&with, frame, p.reference).unwrap();
+                references.insert(p.reference, reference);
+            }
+            let lit = r.render(&with, frame, p.id).unwrap().image;
+            let unlit = r.render(&s, frame, p.id).unwrap().image;
+            let what = format!("{} --msaa {SAMPLES}", p.id);
+            let reference = &references[p.reference];
+            let edges = common::msaa_edge_pixels(&reference.depth_samples, size);
+            common::assert_missing_light_fails(
+                &what,
+                case,
+                tolerance(p.id),
+                [&reference.image, &lit, &unlit],
+                Some(&edges),
+            );
+        }
+    }
+}
+
 #[test]
 fn every_msaa_pipeline_equals_forward_at_4x_odd_size_first_person() {
     let s = catalog::build("random-fps", &SceneParams::default()).unwrap();
@@ -280,10 +339,11 @@ fn the_single_kernel_finds_the_grid_kernels_edges_at_any_tile_size() {
         let grid = r.render(&s, 40, "tiled_deferred").unwrap();
         let single = r.render(&s, 40, "tiled_deferred_single").unwrap();
         let name = format!("tiled_deferred_single at {w}x{h}, {tile}-pixel tiles");
-        let cmp = common::compare_images(
+        let cmp = common::compare_images_outside(
             &reference.image,
             &single.image,
             tolerance("tiled_deferred_single"),
+            Some(&common::msaa_edge_pixels(&reference.depth_samples, (w, h))),
         );
         eprintln!("MEASURED {name}: {}", cmp.describe());
         assert!(cmp.passes(), "{name}: {}", cmp.describe());
@@ -334,6 +394,7 @@ fn the_single_kernel_at_4x_with_a_64_pixel_tile_and_8000_lights_equals_the_grid_
         max_p99: 1.0,
         level: 2,
         max_over: 0,
+        fine: None,
     };
     let cmp = common::compare_images(&grid.image, &single.image, rounding);
     eprintln!(
@@ -535,6 +596,7 @@ fn the_in_kernel_resolve_equals_the_separate_resolve() {
                 max_p99: 1.0,
                 level: 2,
                 max_over: 0,
+                fine: None,
             },
         );
         assert!(

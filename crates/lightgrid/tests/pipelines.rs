@@ -37,10 +37,11 @@ struct Tolerance {
     why: &'static str,
 }
 
-/// The G-buffer pipelines' count allowance: measured 0 pixels over 1 level; 10 (a twentieth of
-/// the 200-pixel disc) for silhouette pixels whose position another driver rebuilds from depth
-/// differently.
-const GBUFFER_OVER: u64 = 10;
+/// The count allowance of every pipeline measured at 0 pixels over 1 level: 5, for silhouette
+/// pixels another driver rasterizes or rebuilds from depth differently. Bounded from above by
+/// the smallest missing light the tests use: a distant one changes 13 pixels by more than 4
+/// levels at 192x108 (`a_dim_or_distant_missing_light_fails_every_tolerance`).
+const EDGE_OVER: u64 = 5;
 
 const TOLERANCES: &[Tolerance] = &[
     Tolerance {
@@ -58,18 +59,18 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.01,
         max_p99: 1.0,
         level: 4,
-        max_over: 10,
+        max_over: EDGE_OVER,
         why: "as tiled_forward (the pre-pass uses the same invariant vertex stage), except single \
               pixels on an edge shared by two faces at exactly equal depth, where LessEqual keeps \
               the face drawn last and forward's Less the one drawn first (affects max, not p99; \
-              measured 0 such pixels on lavapipe, 10 allowed)",
+              measured 0 such pixels on lavapipe, 5 allowed)",
     },
     Tolerance {
         id: "tiled_deferred",
         max_mean: 0.1,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "16-bit G-buffer normals and colours, and positions rebuilt from depth instead of \
               interpolated",
     },
@@ -78,7 +79,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.1,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "as tiled_deferred",
     },
     Tolerance {
@@ -86,7 +87,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.01,
         max_p99: 1.0,
         level: 4,
-        max_over: 10,
+        max_over: EDGE_OVER,
         why: "as tiled_forward_prez: same fragments, each cluster list holds every light reaching \
               its samples",
     },
@@ -95,7 +96,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.1,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "as tiled_deferred",
     },
     Tolerance {
@@ -103,7 +104,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.5,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "16-bit G-buffer, positions rebuilt from depth, and per-light additive blending into \
               the 16-bit HDR target (forward sums in 32-bit registers): where many lights overlap \
               the rounding of each blend shifts many pixels by one level (measured: mean 0.36, \
@@ -114,7 +115,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.5,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "as deferred",
     },
     Tolerance {
@@ -122,7 +123,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.5,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "as deferred, against forward_mono_albedo (the same one-value specular albedo)",
     },
     Tolerance {
@@ -130,7 +131,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.5,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "positions rebuilt from depth, and diffuse and specular irradiance summed by 16-bit \
               blending before the material multiplies them",
     },
@@ -139,7 +140,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.5,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "as light_prepass, against forward_mono (the same monochrome-specular model)",
     },
     Tolerance {
@@ -147,7 +148,7 @@ const TOLERANCES: &[Tolerance] = &[
         max_mean: 0.5,
         max_p99: 2.0,
         level: 4,
-        max_over: GBUFFER_OVER,
+        max_over: EDGE_OVER,
         why: "as light_prepass_mono (positions rebuilt from depth, irradiance stored in 16 bits \
               before the material multiplies it), summed in registers instead of blended",
     },
@@ -164,6 +165,7 @@ fn tolerance(id: &str) -> common::ImageTolerance {
         max_p99: row.max_p99,
         level: row.level,
         max_over: row.max_over,
+        fine: None,
     }
 }
 
@@ -373,6 +375,36 @@ fn a_darkened_disc_fails_every_tolerance() {
             p.id,
             cmp.describe()
         );
+    }
+}
+
+/// One missing light that is dim (at the edge of its range) or distant, not the brightest:
+/// every pipeline rendered without it fails its tolerance against the reference rendered
+/// with it, by the count of pixels over the level, while rendered with it the pipeline passes.
+#[test]
+fn a_dim_or_distant_missing_light_fails_every_tolerance() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (size, frame) = ((192, 108), 200);
+    let mut r = Renderer::new(&ctx, size.0, size.1, settings(16)).unwrap();
+    for case in common::MissingLight::ALL {
+        let with = common::with_missing_light(&s, frame, size, case);
+        let mut references = std::collections::HashMap::new();
+        for p in PIPELINES.iter().filter(|p| is_reference(p)) {
+            references.insert(p.id, r.render(&with, frame, p.id).unwrap().image);
+        }
+        for p in PIPELINES.iter().filter(|p| !is_reference(p)) {
+            let lit = r.render(&with, frame, p.id).unwrap().image;
+            let unlit = r.render(&s, frame, p.id).unwrap().image;
+            let reference = &references[p.reference];
+            common::assert_missing_light_fails(
+                p.id,
+                case,
+                tolerance(p.id),
+                [reference, &lit, &unlit],
+                None,
+            );
+        }
     }
 }
 

@@ -340,6 +340,16 @@ fn scatter_at_1280x720_matches_cpu_assignment() {
     assert_eq!(scatter.stats.grid_indices, cpu.stats.grid_indices);
 }
 
+/// clustered_deferred's tolerance in pipelines.rs: 16-bit G-buffer rounding, no missing light
+/// (at most 5 pixels over 4 levels).
+const CLUSTERED_DEFERRED: common::ImageTolerance = common::ImageTolerance {
+    max_mean: 0.1,
+    max_p99: 2.0,
+    level: 4,
+    max_over: 5,
+    fine: None,
+};
+
 /// The same failure at a size `forward` can check: 320x180 with 4-pixel tiles has as many
 /// cells (80 x 45 tiles x 32 slices) as 1280x720 with 16-pixel ones, so a near light's
 /// rectangle x slices loop ran past the guard there too.
@@ -355,10 +365,22 @@ fn scatter_with_4_pixel_tiles_matches_forward() {
     let mut r = Renderer::new(&ctx, 320, 180, settings).unwrap();
     let scatter = r.render(&scene, 200, "clustered_deferred").unwrap();
     let forward = r.render(&scene, 200, "forward").unwrap();
-    let (d, _) = diff(&forward.image, &scatter.image).unwrap();
-    // clustered_deferred's tolerance in pipelines.rs (G-buffer precision, no missing light).
-    assert!(d.mean <= 0.1 && d.p99 <= 2.0, "{d:?}");
+    let cmp = common::compare_images(&forward.image, &scatter.image, CLUSTERED_DEFERRED);
+    assert!(cmp.passes(), "{}", cmp.describe());
     assert!(scatter.stats.lighting_computations >= Some(scatter.stats.ideal_lighting_computations));
+    // The tolerance catches one dim or distant light missing from the lists.
+    for case in common::MissingLight::ALL {
+        let with = common::with_missing_light(&scene, 200, (320, 180), case);
+        let reference = r.render(&with, 200, "forward").unwrap().image;
+        let lit = r.render(&with, 200, "clustered_deferred").unwrap().image;
+        common::assert_missing_light_fails(
+            "clustered_deferred --assign scatter --tile 4",
+            case,
+            CLUSTERED_DEFERRED,
+            [&reference, &lit, &scatter.image],
+            None,
+        );
+    }
 }
 
 /// `render --scene stress --lights 8000 --size 64x64 --tile 64 --pipeline

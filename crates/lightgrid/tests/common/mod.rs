@@ -90,6 +90,10 @@ pub struct ImageTolerance {
     pub max_p99: f64,
     pub level: u8,
     pub max_over: u64,
+    /// A second (level, max_over) bound: a tight level with room for the few pixels the main
+    /// level exists for (the MSAA edge pixels that differ by design), so a dim missing light,
+    /// which changes many pixels by a few levels, cannot hide under the main level.
+    pub fine: Option<(u8, u64)>,
 }
 
 /// What [`compare_images`] measured.
@@ -97,6 +101,8 @@ pub struct ImageComparison {
     pub summary: lightgrid::image_io::DiffSummary,
     /// Pixels whose difference exceeds the tolerance's `level`.
     pub over: u64,
+    /// Pixels over the `fine` bound's level (0 without one).
+    pub over_fine: u64,
     /// The visual diff image (`image_io::diff`).
     pub visual: image::RgbaImage,
     pub tolerance: ImageTolerance,
@@ -119,6 +125,12 @@ impl ImageComparison {
                 self.over, t.level, t.max_over
             ));
         }
+        if let Some((level, max_over)) = t.fine.filter(|&(_, max)| self.over_fine > max) {
+            v.push(format!(
+                "{} pixels differ by more than {level} levels (at most {max_over} allowed)",
+                self.over_fine
+            ));
+        }
         v
     }
 
@@ -130,16 +142,18 @@ impl ImageComparison {
     pub fn describe(&self) -> String {
         let (d, t) = (&self.summary, &self.tolerance);
         format!(
-            "mean {:.4} p99 {} max {}, {} pixels over {} levels (allowed mean {} p99 {}, {} over {}){}",
+            "mean {:.4} p99 {} max {}, {} pixels over {} levels{} (allowed mean {} p99 {}, {} over {}{}){}",
             d.mean,
             d.p99,
             d.max,
             self.over,
             t.level,
+            t.fine.map_or(String::new(), |(l, _)| format!(", {} over {l}", self.over_fine)),
             t.max_mean,
             t.max_p99,
             t.max_over,
             t.level,
+            t.fine.map_or(String::new(), |(l, m)| format!(", {m} over {l}")),
             match self.violations() {
                 v if v.is_empty() => String::new(),
                 v => format!(": {}", v.join("; ")),
@@ -161,19 +175,189 @@ pub fn pixels_over(a: &image::RgbaImage, b: &image::RgbaImage, level: u8) -> u64
         .sum()
 }
 
-/// `image_io::diff` plus the count of pixels over the tolerance's level.
+/// `image_io::diff` plus the count of pixels over the tolerance's level (and over its `fine`
+/// level).
 pub fn compare_images(
     expected: &image::RgbaImage,
     actual: &image::RgbaImage,
     tolerance: ImageTolerance,
 ) -> ImageComparison {
+    compare_images_outside(expected, actual, tolerance, None)
+}
+
+/// [`compare_images`] with the `fine` bound counting only the pixels `excluded` does not
+/// mark (row-major; the MSAA edge pixels of [`msaa_edge_pixels`]).
+pub fn compare_images_outside(
+    expected: &image::RgbaImage,
+    actual: &image::RgbaImage,
+    tolerance: ImageTolerance,
+    excluded: Option<&[bool]>,
+) -> ImageComparison {
     let (summary, visual) = lightgrid::image_io::diff(expected, actual).unwrap();
+    let over_fine = tolerance.fine.map_or(0, |(level, _)| {
+        (expected.pixels().zip(actual.pixels()).enumerate())
+            .filter(|(i, _)| !excluded.is_some_and(|e| e[*i]))
+            .filter(|(_, (p, q))| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap() > level)
+            .count() as u64
+    });
     ImageComparison {
         summary,
         over: pixels_over(expected, actual, tolerance.level),
+        over_fine,
         visual,
         tolerance,
     }
+}
+
+/// The pixels of an MSAA frame (its depth, one plane per sample) whose samples do not lie on
+/// one plane, with their eight neighbours: where a deferred pipeline shades each sample's
+/// surface and forward the pixel centre's, so they differ by design. Depth (`A / w - B`) is
+/// affine in screen space over a plane, so a pixel is an edge when one of its samples is
+/// background and another is not, or when the fourth sample departs from the plane through
+/// the other three (at the standard 4x sample positions) by more than 1e-5 of its depth.
+pub fn msaa_edge_pixels(depth_samples: &[Vec<f32>], (w, h): (u32, u32)) -> Vec<bool> {
+    assert_eq!(depth_samples.len(), 4, "the standard 4x sample positions");
+    const AT: [(f64, f64); 4] = [
+        (0.375, 0.125),
+        (0.875, 0.375),
+        (0.125, 0.625),
+        (0.625, 0.875),
+    ];
+    let n = (w * h) as usize;
+    let edge: Vec<bool> = (0..n)
+        .map(|i| {
+            let d: Vec<f64> = depth_samples
+                .iter()
+                .map(|plane| f64::from(plane[i]))
+                .collect();
+            if d.iter().any(|&x| x <= 0.0) {
+                return d.iter().any(|&x| x > 0.0);
+            }
+            // The plane d = a + b x + c y through samples 0, 1 and 2, at sample 3.
+            let [(x0, y0), (x1, y1), (x2, y2), (x3, y3)] = AT;
+            let det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+            let b = ((d[1] - d[0]) * (y2 - y0) - (d[2] - d[0]) * (y1 - y0)) / det;
+            let c = ((x1 - x0) * (d[2] - d[0]) - (x2 - x0) * (d[1] - d[0])) / det;
+            let predicted = d[0] + b * (x3 - x0) + c * (y3 - y0);
+            (predicted - d[3]).abs() > 1e-5 * d[3]
+        })
+        .collect();
+    (0..n)
+        .map(|i| {
+            let (x, y) = ((i as u32 % w) as i64, (i as u32 / w) as i64);
+            (-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    let (nx, ny) = (x + dx, y + dy);
+                    nx >= 0
+                        && ny >= 0
+                        && nx < i64::from(w)
+                        && ny < i64::from(h)
+                        && edge[(ny * i64::from(w) + nx) as usize]
+                })
+            })
+        })
+        .collect()
+}
+
+/// The lights the missing-light self-tests add and then leave out, as a culling bug that drops
+/// one light from its cells would: the tolerances must catch a light that is dim, not only
+/// the brightest one.
+#[derive(Clone, Copy, Debug)]
+pub enum MissingLight {
+    /// The scene's median light (colour, intensity, range) 0.8 of its range above the
+    /// surface seen at the middle of the image's lower fifth (the near ground, where a lit
+    /// region covers pixels): only the outer edge of its range reaches anything, at most
+    /// (1 - 0.8²)² = 13% of its radiance.
+    DimAtRangeEdge,
+    /// The same light half its range above a distant surface of the image's middle row (the
+    /// one farther than three quarters of that row's): brighter, but small in the frame.
+    Distant,
+}
+
+impl MissingLight {
+    pub const ALL: [MissingLight; 2] = [MissingLight::DimAtRangeEdge, MissingLight::Distant];
+}
+
+/// `scene` with the light of `case` added as its last light, placed from what frame `frame`
+/// shows at `size` (the CPU ray caster of `shading` finds the surfaces).
+pub fn with_missing_light(
+    scene: &lightgrid::scene::Scene,
+    frame: u32,
+    size: (u32, u32),
+    case: MissingLight,
+) -> lightgrid::scene::Scene {
+    let f = shading::Frame::new(scene, frame, size);
+    let eye = scene.frame(frame).camera.eye;
+    let seen = |x: u32, y: u32| {
+        let (cx, cy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+        f.seen(cx, cy)
+            .map(|(hit, _, _)| eye + (f.ray(cx, cy) * hit.t).as_vec3())
+    };
+    let (w, h) = size;
+    let (surface, height) = match case {
+        MissingLight::DimAtRangeEdge => (seen(w / 2, h * 4 / 5), 0.8),
+        MissingLight::Distant => {
+            let mut row: Vec<Vec3> = (0..w).filter_map(|x| seen(x, h / 2)).collect();
+            row.sort_by(|a, b| a.distance(eye).total_cmp(&b.distance(eye)));
+            (row.get(row.len() * 3 / 4).copied(), 0.5)
+        }
+    };
+    let surface = surface.expect("a surface to light");
+    let mut lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
+    lights.sort_by(|a, b| a.intensity.total_cmp(&b.intensity));
+    let median = lights[lights.len() / 2];
+    let mut out = scene.clone();
+    out.lights.push(lightgrid::scene::SceneLight {
+        light: Light::point(
+            surface + Vec3::Y * (median.range * height),
+            median.color,
+            median.intensity,
+            median.range,
+        ),
+        anchor: lightgrid::scene::LightAnchor::World,
+    });
+    out
+}
+
+/// The missing-light self-test of `tolerance`: `reference` rendered the scene with the light
+/// of `case`, `with` is the image under test with it and `without` the same image without it.
+/// The first passes; the second must fail, and by the count of pixels over the level (mean
+/// and p99 alone let a small region through). Also that the light mattered: at least 10
+/// pixels of the reference change by more than 4 levels without it, or the case tests
+/// nothing.
+pub fn assert_missing_light_fails(
+    what: &str,
+    case: MissingLight,
+    tolerance: ImageTolerance,
+    [reference, with, without]: [&image::RgbaImage; 3],
+    excluded: Option<&[bool]>,
+) {
+    let intact = compare_images_outside(reference, with, tolerance, excluded);
+    assert!(
+        intact.passes(),
+        "{what}, {case:?}: with the light: {}",
+        intact.describe()
+    );
+    let missing = compare_images_outside(reference, without, tolerance, excluded);
+    eprintln!(
+        "MEASURED {what}, {case:?}: with {}; without {}",
+        intact.describe(),
+        missing.describe()
+    );
+    let caught_by_count = missing.over > tolerance.max_over
+        || tolerance
+            .fine
+            .is_some_and(|(_, max)| missing.over_fine > max);
+    assert!(
+        caught_by_count,
+        "{what}, {case:?}: a missing light passes the count bound: {}",
+        missing.describe()
+    );
+    let changed = pixels_over(reference, without, 4);
+    assert!(
+        changed >= 10,
+        "{what}, {case:?}: the light changes only {changed} pixels"
+    );
 }
 
 /// `image` with a disc of `pixels` pixels darkened by `levels` in every channel: what

@@ -43,7 +43,7 @@ struct Triangle {
 /// A ray's meeting with a triangle: distance along the ray and the barycentric weights.
 #[derive(Clone, Copy)]
 pub struct Hit {
-    t: f64,
+    pub t: f64,
     triangle: usize,
     w: [f64; 3],
 }
