@@ -67,10 +67,15 @@ impl Band {
 
     /// "'by about 25%': tiled_forward_prez ms / tiled_deferred ms in 1.15 to 1.35".
     pub fn describe(&self) -> String {
+        // Two decimals at most, trailing zeros dropped (4/3 as 1.33, 1.5 as 1.5).
+        let num = |x: f64| {
+            let s = format!("{x:.2}");
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        };
         let range = match (self.low, self.high) {
-            (l, h) if h.is_infinite() => format!("at least {l}"),
-            (l, h) if l <= 0.0 => format!("at most {h}"),
-            (l, h) => format!("{l} to {h}"),
+            (l, h) if h.is_infinite() => format!("at least {}", num(l)),
+            (l, h) if l <= 0.0 => format!("at most {}", num(h)),
+            (l, h) => format!("{} to {}", num(l), num(h)),
         };
         format!("\"{}\": {} {range}", self.words, self.quantity)
     }
@@ -690,6 +695,8 @@ mod tests {
             "\"by about 25%\": tiled_forward_prez ÷ tiled_deferred avg ms 1.15 to 1.35"
         );
         assert!(VARIABILITY.describe().ends_with("at least 1.5"));
+        assert!(SUBSTANTIALLY_FEWER.describe().ends_with("at least 1.33"));
+        assert!(FOUR_TIMES.describe().ends_with("2.5 to 6"));
         assert!(ONE_SIDE_ENOUGH.describe().ends_with("at most 1.1"));
         // The paper's "1.5 to 2 times" is that interval, no wider.
         assert_eq!((MSAA_FASTER.low, MSAA_FASTER.high), (1.5, 2.0));
