@@ -10,8 +10,9 @@
 //! centre meet the same triangles, no second surface within 0.1 % of the depth, not a
 //! texture), every channel of `forward`, `forward_mono` and `forward_mono_albedo` must be
 //! within one level of the reference, on every catalog scene (with spots and headlights, every
-//! material shader and the glass) and on the test glTF room. A plane under one light, worked
-//! out by hand, checks the reference itself.
+//! material shader and the glass), on the test glTF room and on a catalog scene exported to
+//! GLB and loaded back. A plane under one light, worked out by hand, checks the reference
+//! itself.
 
 mod common;
 
@@ -66,6 +67,28 @@ fn forward_equals_the_reference_on_a_gltf_room() {
         assert!(c.pixels >= 150 && c.lit * 4 >= c.pixels, "{c:?}");
         assert!(c.glass > 0, "no pixel behind the room's glass: {c:?}");
     }
+}
+
+/// The second glTF file: a catalog scene with spots and headlights written as GLB by
+/// `gltf::export` and read back, so the importer's path (nodes, materials from `extras`,
+/// KHR_lights_punctual spots, the exported camera) feeds the frame the reference checks.
+#[test]
+fn forward_equals_the_reference_on_an_exported_and_loaded_scene() {
+    let ctx = common::gpu();
+    let params = SceneParams {
+        spot_fraction: 0.3,
+        headlights: true,
+        ..Default::default()
+    };
+    let original = catalog::build("robots-few", &params).unwrap();
+    let bytes = lightgrid::scene::gltf::export(&original, 120, (160, 96)).unwrap();
+    let opts = lightgrid::scene::gltf::LoadOptions::default();
+    let scene = lightgrid::scene::gltf::load_bytes(&bytes, "robots-few.glb", None, &opts)
+        .unwrap()
+        .scene;
+    let c = check(&ctx, &scene, 0, (160, 96), 4);
+    eprintln!("exported robots-few: {c:?}");
+    assert!(c.pixels >= 150 && c.lit * 4 >= c.pixels, "{c:?}");
 }
 
 /// A plane under one light, worked out by hand: the reference (and `forward`) at three
