@@ -283,7 +283,9 @@ pub fn run(out: Option<&str>) -> Result<(), Box<dyn std::error::Error>> {
     println!("culled {LIGHTS} lights: {report:?}");
     println!("grid vs every light: mean {mean:.4}, p99 {p99}, max {max}, {over} pixels over 4 levels");
     if let Some(path) = out {
-        image::save_buffer(path, grid_image, W, H, image::ExtendedColorType::Rgba8)?;
+        // Whole or not at all: a temporary file renamed over the path.
+        let image = image::RgbaImage::from_raw(W, H, grid_image.to_vec()).ok_or("image size")?;
+        lightgrid::image_io::save_png(&image, std::path::Path::new(path))?;
         println!("wrote {path}");
     }
     if !report.is_complete() || mean > 0.01 || p99 > 1 || over > 0 {
