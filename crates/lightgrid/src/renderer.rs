@@ -370,8 +370,11 @@ impl Renderer {
     /// opaque geometry are uploaded now, once; each frame then uploads only its
     /// [`FrameState`] (lights, uniforms, moving and transparent objects). The renderer keeps
     /// the `Arc`, so a viewer and its analysis worker can share one scene without copies.
+    /// A scene whose indices do not hold (`Scene::validate_structure`) is refused, and the
+    /// renderer then holds none.
     pub fn set_scene(&mut self, scene: Arc<Scene>) -> Result<()> {
         self.scene = None;
+        scene.validate_structure()?;
         scoped(&self.device.clone(), "uploading the scene", || {
             self.upload_static(scene)
         })?

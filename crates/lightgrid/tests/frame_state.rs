@@ -139,3 +139,31 @@ fn a_scene_whose_contents_change_is_uploaded_again() {
     let again = r.render(&first, 5, "tiled_forward").unwrap();
     assert_eq!(max_difference(&again.image, &a.image), 0.0);
 }
+
+/// A scene given from Rust whose indices do not hold is refused by `set_scene` with the
+/// reason (never a panic while baking it), and the renderer then renders nothing until a
+/// good scene comes.
+#[test]
+fn a_scene_whose_indices_do_not_hold_is_refused() {
+    let ctx = common::gpu();
+    let good = scene();
+    let mut r = Renderer::new(&ctx, 32, 32, RenderSettings::default()).unwrap();
+    type Break = fn(&mut Scene);
+    let cases: [(Break, &str); 4] = [
+        (|s| s.objects[0].material = 10_000, "missing material"),
+        (|s| s.objects[0].mesh = 10_000, "missing mesh"),
+        (|s| s.meshes[0].indices[0] = u32::MAX, "index out of range"),
+        (|s| s.meshes[0].normals.truncate(1), "normals"),
+    ];
+    for (damage, want) in cases {
+        let mut bad = good.clone();
+        damage(&mut bad);
+        let e = r.set_scene(Arc::new(bad.clone())).unwrap_err();
+        assert!(e.to_string().contains(want), "{want}: {e}");
+        assert!(r.scene().is_none());
+        let e = r.render(&bad, 0, "forward").map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains(want), "{want}: {e}");
+    }
+    r.set_scene(Arc::new(good.clone())).unwrap();
+    r.render_state(&good.frame(0), "forward").unwrap();
+}

@@ -845,6 +845,13 @@ impl Scene {
         for (i, l) in self.lights.iter().enumerate() {
             l.light.validate(i)?;
         }
+        self.validate_structure()
+    }
+
+    /// What a renderer needs of a scene to bake it (`Renderer::set_scene`): every index in
+    /// range (objects to meshes and materials, materials to textures, triangles to vertices),
+    /// one normal and one UV per position, and the table sizes within the GPU's limits.
+    pub fn validate_structure(&self) -> Result<()> {
         if self.materials.len() > crate::consts::MAX_MATERIALS {
             return Err(Error::invalid(
                 "scene",
@@ -891,6 +898,19 @@ impl Scene {
                 return Err(Error::invalid(
                     "scene",
                     format!("object {i} references a missing material"),
+                ));
+            }
+            if mesh.normals.len() != mesh.positions.len() || mesh.uvs.len() != mesh.positions.len()
+            {
+                return Err(Error::invalid(
+                    "scene",
+                    format!(
+                        "mesh {} has {} positions but {} normals and {} UVs",
+                        o.mesh,
+                        mesh.positions.len(),
+                        mesh.normals.len(),
+                        mesh.uvs.len()
+                    ),
                 ));
             }
             if mesh
