@@ -6,7 +6,7 @@ use crate::args::{
 };
 use anyhow::Result;
 use clap::Args;
-use lightgrid::frame::{DepthBounds, GridLists, MsaaResolve};
+use lightgrid::frame::{DepthBounds, DepthMask, GridLists, MsaaResolve};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
@@ -56,6 +56,12 @@ pub(crate) enum Preset {
     /// minimum only, the maximum only and both, on robots-many without its glass, frames
     /// 0..259 every 20, the paper's tile count (as the paper preset).
     DepthBounds,
+    /// Culling past the papers: the grids built from the depth buffer (tiled and clustered,
+    /// forward and deferred) with and without 2.5D depth masks (`--depth-mask`; Harada et al.
+    /// 2012), 16-pixel tiles, on robots-many, robots-few and scattered without glass, frames
+    /// 0..259 every 20, at the papers' size (640x360 on a software adapter): lighting
+    /// computations against the ideal, assignment time and grid memory per grid.
+    Culling,
 }
 
 #[derive(Args)]
@@ -334,6 +340,22 @@ pub(crate) fn bench_config(
             settings: vec![measure(&DepthBounds::ALL)],
             // tiled-forward-shading measures 32x32 tiles at 1920x1080, without glass.
             tile: Some(paper_tile(papers_size(hardware).0)),
+            transparency: false,
+            ..study(hardware, |_| false)
+        },
+        Some(Preset::Culling) => BenchDefaults {
+            scenes: vec!["robots-many", "robots-few", "scattered"],
+            pipelines: [
+                ids::TILED_FORWARD_PREZ,
+                ids::TILED_DEFERRED,
+                ids::CLUSTERED_FORWARD,
+                ids::CLUSTERED_DEFERRED,
+            ]
+            .map(String::from)
+            .to_vec(),
+            settings: vec![measure(&DepthMask::ALL)],
+            size: Some(papers_size(hardware)),
+            tile: Some(16),
             transparency: false,
             ..study(hardware, |_| false)
         },

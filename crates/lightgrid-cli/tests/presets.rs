@@ -16,6 +16,63 @@ fn bench(args: &[&str]) -> std::path::PathBuf {
     out
 }
 
+/// The culling preset measures every grid with and without 2.5D depth masks, on its three
+/// scenes, and the masks never add lighting computations.
+#[test]
+fn culling_preset_measures_every_grid_with_and_without_depth_masks() {
+    let out = bench(&[
+        "--preset",
+        "culling",
+        "--size",
+        "96x54",
+        "--frames",
+        "0..259:130",
+    ]);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|c| *c == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let (mask, pipe, scene, frame) = (
+        col("depth_mask"),
+        col("pipeline"),
+        col("scene"),
+        col("frame"),
+    );
+    let lit = col("lighting_computations");
+    let mut counts = std::collections::BTreeMap::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let key = (
+            f[scene].to_string(),
+            f[pipe].to_string(),
+            f[frame].to_string(),
+        );
+        let n: u64 = f[lit].parse().unwrap();
+        counts
+            .entry(key)
+            .or_insert_with(std::collections::BTreeMap::new)
+            .insert(f[mask].to_string(), n);
+    }
+    let scenes: std::collections::BTreeSet<&str> = counts.keys().map(|k| k.0.as_str()).collect();
+    assert_eq!(scenes.len(), 3, "{scenes:?}");
+    for p in [
+        "tiled_forward_prez",
+        "tiled_deferred",
+        "clustered_forward",
+        "clustered_deferred",
+    ] {
+        assert!(counts.keys().any(|k| k.1 == p), "{p} not measured");
+    }
+    for (key, by_mask) in &counts {
+        let (on, off) = (by_mask["on"], by_mask["off"]);
+        assert!(on <= off, "{key:?}: {on} with masks, {off} without");
+    }
+}
+
 #[test]
 fn depth_bounds_preset_measures_every_step_and_checks_its_claims() {
     let out = bench(&[

@@ -29,6 +29,9 @@ pub struct FrameOutput {
     /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
     /// their CPU twin); None for pipelines without a grid.
     pub cell_bounds: Option<Vec<[f32; 2]>>,
+    /// Each cell's 2.5D depth mask (`culling::NO_MASK` everywhere unless `--depth-mask on`);
+    /// None for pipelines without a grid.
+    pub cell_masks: Option<Vec<crate::culling::CellMask>>,
     /// The frame's depth buffer (row-major, reversed-Z: `crate::depth`); with MSAA its sample 0.
     pub depth: Vec<f32>,
     /// Every sample of the depth buffer, one plane per sample (one plane without MSAA).
@@ -288,14 +291,15 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     };
     let grid_is_pipelines = a.grid.is_some();
     let assign_gpu_ms = a.finished.assign_gpu_ms.filter(|_| grid_is_pipelines);
-    let (grid, cell_bounds, assign, assign_cpu_ms) = match a.grid {
+    let (grid, cell_bounds, cell_masks, assign, assign_cpu_ms) = match a.grid {
         Some(b) => (
             b.grid,
             Some(b.cell_bounds),
+            Some(b.cell_masks),
             Some(b.assign.name().to_string()),
             Some(b.cpu_ms),
         ),
-        None => (bounded, None, None, None),
+        None => (bounded, None, None, None, None),
     };
     // The strategy's cost: its GPU passes and its CPU work (a wait for the GPU, which `cpu`
     // with depth bounds makes, is the frame's `cpu_wait_ms`: it also covers the passes before).
@@ -364,6 +368,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         grid,
         grid_is_pipelines,
         cell_bounds,
+        cell_masks,
         depth,
         depth_samples,
         counts,

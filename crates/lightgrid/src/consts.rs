@@ -207,6 +207,14 @@ pub const DEPTH_BOUNDS_MIN: u32 = 1;
 pub const DEPTH_BOUNDS_MAX: u32 = 2;
 pub const DEPTH_BOUNDS_NONE: u32 = 3;
 
+/// 2.5D culling (`--depth-mask on`; Harada et al. 2012, "A 2.5D culling for Forward+"): each
+/// cell's depth bounds are cut into this many equal bins, one bit each of a 32-bit mask that
+/// says which bins hold samples (`culling/depth_mask.rs`).
+pub const DEPTH_MASK_BINS: u32 = 32;
+/// A cell mask's bits when the cell has no mask (`--depth-mask off`, cells without depth
+/// bounds, transparent lists): every light that passes the other tests is listed.
+pub const DEPTH_MASK_ALL: u32 = u32::MAX;
+
 /// Material shaders (`scene::MaterialShader`, tiled-forward-shading §4.7): the id each
 /// material carries, and the value of the WGSL override `MATERIAL_SHADER` that makes a
 /// pipeline branch on the material instead of being specialised to one shader.
@@ -256,6 +264,8 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("ASSIGN_THREADS", WgslConst::U32(ASSIGN_THREADS)),
     ("CELL_LIST_CAPACITY", WgslConst::U32(CELL_LIST_CAPACITY)),
     ("MAX_SLICES", WgslConst::U32(MAX_SLICES)),
+    ("DEPTH_MASK_BINS", WgslConst::U32(DEPTH_MASK_BINS)),
+    ("DEPTH_MASK_ALL", WgslConst::U32(DEPTH_MASK_ALL)),
     ("BVH_WIDTH", WgslConst::U32(BVH_WIDTH)),
     ("BVH_LEAF", WgslConst::U32(BVH_LEAF)),
     ("BVH_STACK", WgslConst::U32(BVH_STACK)),

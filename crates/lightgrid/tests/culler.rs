@@ -1,6 +1,7 @@
 //! `LightCuller` through its public API only, as another wgpu renderer uses it: its own
 //! device, its own depth buffer (written by its own shader, every sample its own depth), its
-//! own lights. Every strategy × tiles/clusters × depth-bounds mode, and MSAA depth, is checked
+//! own lights. Every strategy × tiles/clusters × depth-bounds mode, 2.5D depth masks, and MSAA
+//! depth, is checked
 //! on the GPU against a brute-force oracle in the test's own WGSL: every light that reaches a
 //! sample must be listed in the sample's cell (found with the caller-facing accessor). Then
 //! the lists' growth from the culler's reports, and each kind of bad use refused with the
@@ -9,7 +10,7 @@
 use glam::{Mat4, Vec3};
 use lightgrid::{
     CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullStrategy, DepthBounds,
-    LightCuller,
+    DepthMask, LightCuller,
 };
 use wgpu::util::DeviceExt;
 
@@ -562,8 +563,8 @@ fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLay
 }
 
 /// Cull one frame with `config` and check it against the oracle; a frame whose lists did not
-/// fit is culled again (the lists grew from its report).
-fn check(caller: &Caller, config: CullConfig, what: &str) {
+/// fit is culled again (the lists grew from its report). Returns the lights listed per sample.
+fn check(caller: &Caller, config: CullConfig, what: &str) -> f64 {
     let mut culler = LightCuller::new(&caller.device, &caller.queue, config).expect("culler");
     let (mut r, mut report) = caller.frame(&mut culler);
     if report.overflowed {
@@ -594,6 +595,7 @@ fn check(caller: &Caller, config: CullConfig, what: &str) {
         "{what}: {per_sample:.1} lights listed per sample of {}",
         caller.light_count
     );
+    per_sample
 }
 
 const STRATEGIES: [CullStrategy; 3] = CullStrategy::ALL;
@@ -629,6 +631,39 @@ fn every_strategy_grid_and_depth_bounds_mode_lists_every_reaching_light() {
                     &caller,
                     config,
                     &format!("{strategy:?} {grid:?} {depth_bounds:?}"),
+                );
+            }
+        }
+    }
+}
+
+/// 2.5D culling through the public API (`CullConfig::depth_mask`): every strategy and grid,
+/// with and without MSAA depth, lists every reaching light, and never more per sample than
+/// the same grid without masks. (This caller's depth has noise per sample, which fills every
+/// bin of a tile, so the masks drop next to nothing here; `tests/pipelines.rs` checks that
+/// they drop lights on the catalog's robots in front of the street.)
+#[test]
+fn depth_masks_list_every_reaching_light() {
+    let (device, queue) = device();
+    let eye = Vec3::new(3.0, 2.0, 10.0);
+    let lights = lights(&camera(eye, false), 300, 17);
+    for samples in [1, 4] {
+        let caller = Caller::new(&device, &queue, samples, camera(eye, false), &lights);
+        for strategy in STRATEGIES {
+            for grid in GRIDS {
+                let config = |depth_mask| CullConfig {
+                    grid,
+                    strategy,
+                    samples,
+                    depth_mask,
+                    ..CullConfig::default()
+                };
+                let what = format!("{strategy:?} {grid:?} MSAA {samples}");
+                let on = check(&caller, config(DepthMask::On), &format!("{what} mask on"));
+                let off = check(&caller, config(DepthMask::Off), &format!("{what} mask off"));
+                assert!(
+                    on <= off,
+                    "{what}: {on:.2} listed with masks, {off:.2} without"
                 );
             }
         }
@@ -1001,6 +1036,11 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         },
         CullConfig {
             index_capacity: 0,
+            ..CullConfig::default()
+        },
+        CullConfig {
+            depth_mask: DepthMask::On,
+            depth_bounds: DepthBounds::Min,
             ..CullConfig::default()
         },
     ] {

@@ -318,7 +318,7 @@ fn gather_and_bvh_twins_contain_the_oracle_in_randomized_cases() {
         coverage.add(s, &dims, &case.lights, &oracle);
         let bvh = build_bvh(s, &case.lights);
         inner_nodes += bvh.nodes.iter().filter(|n| !n.is_leaf()).count();
-        let walked = traverse_bvh_cpu(s, &dims, &case.lights, &bounds, &bvh);
+        let walked = traverse_bvh_cpu(s, &dims, &case.lights, &bounds, None, &bvh);
         assert_eq!(walked, gather, "case {case_index}: the BVH pruned a light");
     }
     // At least half of what the cases measured (oracle (cell, light) pairs).
@@ -367,7 +367,7 @@ fn grid_checks_catch_one_missing_light() {
                 s,
                 g,
                 &case.lights,
-                &bounds,
+                (&bounds, None),
                 false,
                 4,
             )

@@ -10,6 +10,7 @@
 mod common;
 
 use lightgrid::culling::ViewSetup;
+use lightgrid::frame::DepthMask;
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{LightAnchor, Rng, Scene, SceneLight};
 use lightgrid::{RenderSettings, Renderer};
@@ -29,6 +30,8 @@ struct Config {
     pipeline: &'static str,
     scenes: usize,
     lights: usize,
+    /// 2.5D culling (`--depth-mask`).
+    depth_mask: DepthMask,
 }
 
 /// What the scenes of a run measured, for the bounds at the end.
@@ -39,6 +42,8 @@ struct Totals {
     hits: u64,
     at_slice_boundary: u64,
     disagreements: usize,
+    /// Opaque cells whose 2.5D mask left bins out (`--depth-mask on`).
+    masked_cells: usize,
     /// Seconds spent rendering (and downloading), per strategy, and checking on the CPU.
     render_s: Vec<f64>,
     check_s: f64,
@@ -90,6 +95,7 @@ fn run(
                     tile_size: config.tile,
                     slices: config.slices,
                     assign,
+                    depth_mask: config.depth_mask,
                     ..Default::default()
                 };
                 Renderer::new(ctx, w, h, settings).unwrap()
@@ -113,12 +119,13 @@ fn run(
             for (si, (assign, r)) in strategies.iter().zip(&mut renderers).enumerate() {
                 let what = format!(
                     "scene {k} of config {ci} ({} f{frame}, {} --assign {} {w}x{h} tile {} \
-                     slices {})",
+                     slices {} mask {})",
                     scene.name,
                     config.pipeline,
                     assign.name(),
                     config.tile,
-                    config.slices
+                    config.slices,
+                    config.depth_mask.name()
                 );
                 let t = Instant::now();
                 let out = r.render(&scene, frame, config.pipeline).unwrap();
@@ -135,8 +142,29 @@ fn run(
                 if !near_far {
                     common::check_cell_bounds(&what, &setup, &grid.dims, bounds, &out.depth, 2);
                 }
+                let masks = out
+                    .cell_masks
+                    .as_deref()
+                    .expect("a grid pipeline reports its masks");
+                let planes: Vec<&[f32]> = out.depth_samples.iter().map(|p| &p[..]).collect();
+                totals.masked_cells += common::check_cell_masks(
+                    &what,
+                    &setup,
+                    &grid.dims,
+                    masks,
+                    &planes,
+                    config.depth_mask == DepthMask::On,
+                    !near_far,
+                );
                 totals.disagreements += common::check_grid_against_twin(
-                    &what, *assign, &setup, grid, &lights, bounds, near_far, 4,
+                    &what,
+                    *assign,
+                    &setup,
+                    grid,
+                    &lights,
+                    (bounds, Some(masks)),
+                    near_far,
+                    4,
                 );
                 // Same geometry, camera and pipeline: every strategy's frame has the same depth.
                 let oracle = oracle.get_or_insert_with(|| {
@@ -186,6 +214,7 @@ fn gpu_strategies_contain_the_oracle_in_small_randomized_scenes() {
             pipeline: common::grid_pipelines()[i % common::grid_pipelines().len()],
             scenes: 5,
             lights: 240,
+            depth_mask: DepthMask::Off,
         })
         .collect();
     let mut totals = Totals::default();
@@ -235,6 +264,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
             pipeline: "clustered_deferred",
             scenes: 2,
             lights: 240,
+            depth_mask: DepthMask::Off,
         },
         Config {
             size: (1280, 720),
@@ -243,6 +273,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
             pipeline: "clustered_forward",
             scenes: 1,
             lights: 240,
+            depth_mask: DepthMask::Off,
         },
         Config {
             size: (1280, 720),
@@ -251,6 +282,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
             pipeline: "tiled_deferred",
             scenes: 1,
             lights: 240,
+            depth_mask: DepthMask::Off,
         },
     ];
     let mut totals = Totals::default();
@@ -279,4 +311,51 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
         partial_tiles: 0,
     };
     totals.check(&measured, "1280x720");
+}
+
+/// 2.5D culling (`--depth-mask on`): the same randomized lights (behind, around and in front
+/// of the camera, crossing the near plane, spots from narrow to 180 degrees, at screen edges)
+/// on the pipelines whose grids come from the depth buffer, odd sizes and every tile size,
+/// tiled and clustered, with the glass's transparent lists: every strategy's grid holds every
+/// light the oracle finds reaching a sample, equals its twin fed with the GPU's masks, and the
+/// masks hold every sample's bin (`common::check_cell_masks`). The catalog's backdrops put
+/// robots in front of the street, so tiles straddle depth discontinuities: the masks must
+/// leave bins out in many cells, or the test would not exercise them.
+#[test]
+fn gpu_strategies_with_depth_masks_contain_the_oracle() {
+    let ctx = common::gpu();
+    let mut rng = Rng::new(25);
+    let depth_pipelines: Vec<&str> = common::grid_pipelines()
+        .into_iter()
+        .filter(|id| *id != "tiled_forward")
+        .collect();
+    let configs: Vec<Config> = (0..8)
+        .map(|i| Config {
+            size: (64 + 2 * rng.below(68) + 1, 48 + 2 * rng.below(51) + 1),
+            tile: TILES[(3 * i + 1) % TILES.len()],
+            slices: [1, 8, 1, 32][i % 4],
+            pipeline: depth_pipelines[i % depth_pipelines.len()],
+            scenes: 3,
+            lights: 240,
+            depth_mask: DepthMask::On,
+        })
+        .collect();
+    let mut totals = Totals::default();
+    run(&ctx, &configs, (2525, &SceneParams::default()), &mut totals);
+    eprintln!(
+        "depth masks: scenes per strategy {:?}, {} oracle hits checked, {} twin \
+         disagreements, {} cells with a partial mask, {:?}",
+        totals.scenes, totals.hits, totals.disagreements, totals.masked_cells, totals.coverage
+    );
+    assert!(
+        totals.scenes.iter().all(|&n| n == 24),
+        "{:?}",
+        totals.scenes
+    );
+    assert!(
+        totals.masked_cells >= 1000,
+        "masks left bins out in only {} cells",
+        totals.masked_cells
+    );
+    assert!(totals.hits >= 10_000, "{} oracle hits", totals.hits);
 }

@@ -10,7 +10,7 @@
 mod common;
 
 use lightgrid::culling::{LightGrid, ViewSetup};
-use lightgrid::frame::DepthBounds;
+use lightgrid::frame::{DepthBounds, DepthMask, GridLists};
 use lightgrid::image_io::{diff, save_png};
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::Assign;
@@ -619,13 +619,27 @@ fn check_assign(
             r.settings().depth_bounds,
         );
     }
+    let masks = out
+        .cell_masks
+        .as_deref()
+        .expect("a grid pipeline reports its masks");
+    let planes: Vec<&[f32]> = out.depth_samples.iter().map(|p| &p[..]).collect();
+    common::check_cell_masks(
+        &what,
+        &setup,
+        &grid.dims,
+        masks,
+        &planes,
+        r.settings().depth_mask == DepthMask::On && !near_far,
+        r.settings().msaa == 1 || !lightgrid::pipelines::find(id).unwrap().forward_shading,
+    );
     common::check_grid_against_twin(
         &what,
         assign,
         &setup,
         grid,
         &state.lights,
-        &bounds,
+        (&bounds, Some(masks)),
         near_far,
         4,
     );
@@ -769,6 +783,141 @@ fn depth_bound_modes_open_the_bounds_and_keep_the_image() {
             "{id}: both {both}, min {min}, max {max}, none {none}"
         );
         assert!(none > both, "{id}: opening the bounds changed nothing");
+    }
+}
+
+/// 2.5D culling (`--depth-mask on`) on every pipeline whose grid comes from the depth buffer,
+/// with every strategy, tiled and clustered, at a size and tile that do not divide, with the
+/// glass's transparent lists: the image is the reference's, the grid its twin's fed with the
+/// GPU's masks and holds the oracle's lights (opaque samples and transparent fragments), the
+/// masks hold every sample's bin, and the lighting computations never exceed those of the
+/// same grid without masks (a light the mask drops reaches no sample of the cell). On the
+/// tiled grids (robots in front of the street: tiles over depth discontinuities) the masks
+/// must drop lights.
+#[test]
+fn depth_masks_keep_the_image_and_only_drop_lights() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h, frame) = (203, 117, 120);
+    let ids: Vec<&str> = common::grid_pipelines()
+        .into_iter()
+        .filter(|id| *id != "tiled_forward")
+        .collect();
+    let mut references = std::collections::HashMap::new();
+    for id in &ids {
+        let r = lightgrid::pipelines::find(id).unwrap().reference;
+        references.entry(r).or_insert_with(|| {
+            Renderer::new(&ctx, w, h, settings(12))
+                .unwrap()
+                .render(&s, frame, r)
+                .unwrap()
+                .image
+        });
+    }
+    let with = |assign, depth_mask| RenderSettings {
+        tile_size: 12,
+        slices: 16,
+        assign,
+        depth_mask,
+        ..Default::default()
+    };
+    let mut fewer = std::collections::HashMap::new();
+    for assign in common::strategies() {
+        let mut on = Renderer::new(&ctx, w, h, with(assign, DepthMask::On)).unwrap();
+        let mut off = Renderer::new(&ctx, w, h, with(assign, DepthMask::Off)).unwrap();
+        for id in &ids {
+            let reference = &references[lightgrid::pipelines::find(id).unwrap().reference];
+            check_assign(&mut on, &s, frame, id, reference);
+            let count = |r: &mut Renderer| {
+                let out = r.render(&s, frame, id).unwrap();
+                (out.stats.lighting_computations.unwrap(), out.image)
+            };
+            let (masked, masked_image) = count(&mut on);
+            let (plain, plain_image) = count(&mut off);
+            let what = format!("{id} --assign {}", assign.name());
+            assert!(
+                masked <= plain,
+                "{what}: {masked} with masks, {plain} without"
+            );
+            let (d, _) = diff(&masked_image, &plain_image).unwrap();
+            assert!(d.max <= 1.0, "{what}: the masks changed the image: {d:?}");
+            if masked < plain {
+                *fewer.entry(*id).or_insert(0) += 1;
+            }
+        }
+    }
+    for id in ["tiled_forward_prez", "tiled_deferred"] {
+        assert_eq!(
+            fewer.get(id),
+            Some(&common::strategies().len()),
+            "{id}: the masks dropped no light with some strategy ({fewer:?})"
+        );
+    }
+}
+
+/// 2.5D culling with 4x MSAA (every sample's bin, and with forward shading every fragment's
+/// range) and with one shared list for opaque and transparent fragments (the transparent
+/// range sets every bin it covers): the image equals the same grid's without masks, the count
+/// never exceeds it, and the grid holds the oracle's lights.
+#[test]
+fn depth_masks_with_msaa_and_shared_lists() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h, frame) = (161, 93, 200);
+    for (msaa, lists) in [
+        (4, GridLists::Separate),
+        (1, GridLists::Shared),
+        (4, GridLists::Shared),
+    ] {
+        if msaa > 1 && !lightgrid::frame::msaa_counts(&ctx, Default::default()).contains(&msaa) {
+            panic!("the adapter offers no {msaa}x MSAA");
+        }
+        for assign in [Assign::Cpu, Assign::Gather, Assign::Scatter] {
+            let with = |depth_mask| RenderSettings {
+                tile_size: 16,
+                slices: 16,
+                assign,
+                msaa,
+                lists,
+                depth_mask,
+                ..Default::default()
+            };
+            let mut on = Renderer::new(&ctx, w, h, with(DepthMask::On)).unwrap();
+            let mut off = Renderer::new(&ctx, w, h, with(DepthMask::Off)).unwrap();
+            for id in [
+                "tiled_forward_prez",
+                "clustered_forward",
+                "tiled_deferred",
+                "clustered_deferred",
+            ] {
+                let what = format!(
+                    "{id} --assign {} --msaa {msaa} --lists {lists:?}",
+                    assign.name()
+                );
+                let a = on.render(&s, frame, id).unwrap();
+                let b = off.render(&s, frame, id).unwrap();
+                let state = s.frame(frame);
+                let setup = ViewSetup::new(&state.camera, w, h);
+                let planes: Vec<&[f32]> = a.depth_samples.iter().map(|p| &p[..]).collect();
+                common::check_cell_masks(
+                    &what,
+                    &setup,
+                    &a.grid.dims,
+                    a.cell_masks.as_deref().unwrap(),
+                    &planes,
+                    true,
+                    msaa == 1 || id.ends_with("deferred"),
+                );
+                common::check_grid_contains_oracle(&what, &setup, &a.grid, &state.lights, &a.depth);
+                let (m, p) = (
+                    a.stats.lighting_computations.unwrap(),
+                    b.stats.lighting_computations.unwrap(),
+                );
+                assert!(m <= p, "{what}: {m} with masks, {p} without");
+                let (d, _) = diff(&a.image, &b.image).unwrap();
+                assert!(d.max <= 1.0, "{what}: the masks changed the image: {d:?}");
+            }
+        }
     }
 }
 

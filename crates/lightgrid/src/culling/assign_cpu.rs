@@ -14,7 +14,7 @@
 use super::strategy::check_index_capacity;
 use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{GridDims, LightGrid, ViewLight, ViewSetup};
+use super::{depth_mask_meets, CellMask, GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -43,6 +43,19 @@ pub enum DepthRange<'a> {
     /// goes into the clusters of its rectangle whose slices its view-depth interval spans and
     /// whose samples' bounds it overlaps.
     Cells(&'a [[f32; 2]]),
+    /// As `Cells`, with each cell's 2.5D depth mask (`--depth-mask on`, `depth_mask.rs`): a
+    /// light must also meet a bin of the cell holding samples.
+    Masked(&'a [[f32; 2]], &'a [CellMask]),
+}
+
+impl<'a> DepthRange<'a> {
+    /// The cell bounds, unless every cell spans near..far.
+    fn bounds(&self) -> Option<&'a [[f32; 2]]> {
+        match *self {
+            DepthRange::NearFar => None,
+            DepthRange::Cells(b) | DepthRange::Masked(b, _) => Some(b),
+        }
+    }
 }
 
 /// Range of s = u / w over the disc (centre (cu, cw), radius r) clipped to w >= near, where u
@@ -138,7 +151,7 @@ pub fn cell_spheres(
                 setup.cell_sphere(dims.tile_rect(t), lo, hi)
             })
             .collect(),
-        DepthRange::Cells(bounds) => bounds
+        DepthRange::Cells(bounds) | DepthRange::Masked(bounds, _) => bounds
             .iter()
             .enumerate()
             .map(|(cell, &[lo, hi])| {
@@ -199,6 +212,10 @@ pub fn assign_cpu(
     let overlaps = |p: &Placed, lo: f32, hi: f32| {
         lo <= hi && p.w_max >= lo * (1.0 - DEPTH_SLACK) && p.w_min <= hi * (1.0 + DEPTH_SLACK)
     };
+    let in_mask = |p: &Placed, cell: usize| match depth {
+        DepthRange::Masked(_, masks) => depth_mask_meets(&masks[cell], p.w_min, p.w_max),
+        _ => true,
+    };
     // Spots culled by their cone test it against each cell's bounding sphere.
     let spheres = cell_spheres(setup, dims, &depth, lights);
     let cone_reaches = |p: &Placed, cell: usize| {
@@ -219,13 +236,13 @@ pub fn assign_cpu(
                     .expect("bucketed lights are placed");
                 for tx in p.tx0..=p.tx1 {
                     let tile = ty * dims.tiles_x as usize + tx as usize;
-                    match depth {
-                        DepthRange::NearFar => {
+                    match depth.bounds() {
+                        None => {
                             if cone_reaches(p, tile) {
                                 out.push((tile as u32, l));
                             }
                         }
-                        DepthRange::Cells(bounds) => {
+                        Some(bounds) => {
                             let k0 = dims.slice_of(p.w_min * (1.0 - DEPTH_SLACK));
                             let k1 = dims.slice_of(p.w_max * (1.0 + DEPTH_SLACK));
                             for layer in 0..dims.lists.layers() as usize {
@@ -233,7 +250,10 @@ pub fn assign_cpu(
                                     let cell =
                                         layer * dims.layer_cells() + k as usize * tiles + tile;
                                     let [lo, hi] = bounds[cell];
-                                    if overlaps(p, lo, hi) && cone_reaches(p, cell) {
+                                    if overlaps(p, lo, hi)
+                                        && in_mask(p, cell)
+                                        && cone_reaches(p, cell)
+                                    {
                                         out.push((cell as u32, l));
                                     }
                                 }
@@ -286,6 +306,7 @@ impl AssignStrategy for CpuStrategy {
         let mut parts = Vec::new();
         if depth {
             parts.push((a.bounds.buffer(), (a.dims.cell_count() * 8) as u64));
+            parts.push((a.bounds.mask_buffer(), (a.dims.cell_count() * 16) as u64));
         }
         if let Some(range) = a.range {
             parts.extend(range.readback());
@@ -293,6 +314,7 @@ impl AssignStrategy for CpuStrategy {
         let bytes = enc.download_all(&parts)?;
         let cell_bounds: Option<Vec<[f32; 2]>> =
             depth.then(|| bytemuck::pod_collect_to_vec(&bytes[0]));
+        let masks: Option<Vec<CellMask>> = depth.then(|| bytemuck::pod_collect_to_vec(&bytes[1]));
         let dims = &match a.range {
             Some(_) => {
                 super::depth_range::sliced(a.dims, &bytes[parts.len() - 2], &bytes[parts.len() - 1])
@@ -300,9 +322,9 @@ impl AssignStrategy for CpuStrategy {
             None => *a.dims,
         };
         let start = Instant::now();
-        let range = match &cell_bounds {
-            None => DepthRange::NearFar,
-            Some(b) => DepthRange::Cells(b),
+        let range = match (&cell_bounds, &masks) {
+            (Some(b), Some(m)) => DepthRange::Masked(b, m),
+            _ => DepthRange::NearFar,
         };
         let grid = assign_cpu(&a.f.setup, dims, a.f.lights, range);
         let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -312,6 +334,7 @@ impl AssignStrategy for CpuStrategy {
             cpu_ms,
             cpu_grid: Some(grid),
             cell_bounds,
+            cell_masks: masks,
         })
     }
 }

@@ -48,6 +48,8 @@ pub struct GridSetup<'a> {
     pub depth_bounds: crate::frame::DepthBounds,
     /// How the cell-bounds kernel reduces depths (`--depth-reduction`).
     pub depth_reduction: crate::frame::DepthReduction,
+    /// 2.5D culling (`--depth-mask`).
+    pub depth_mask: crate::frame::DepthMask,
     /// Index entries the lists start with (`GridBuffers::INITIAL_INDEX_CAPACITY`); they grow
     /// from the frame counters.
     pub index_capacity: u64,
@@ -58,6 +60,8 @@ pub struct BuiltGrid {
     pub grid: LightGrid,
     /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
     pub cell_bounds: Vec<[f32; 2]>,
+    /// Each cell's 2.5D depth mask (`depth_mask.rs`; no mask unless `--depth-mask on`).
+    pub cell_masks: Vec<super::CellMask>,
     /// The strategy that ran (`auto` resolved).
     pub assign: Assign,
     /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
@@ -71,6 +75,7 @@ struct LastFrame {
     cpu_ms: f64,
     cpu_grid: Option<LightGrid>,
     cell_bounds: Option<Vec<[f32; 2]>>,
+    cell_masks: Option<Vec<super::CellMask>>,
     /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
     near_far: [f32; 2],
 }
@@ -111,10 +116,13 @@ impl GridBuilder {
                 device,
                 cull_layout,
                 ctx.scene_layout,
-                ctx.samples,
+                super::cell_bounds::CellBoundsKey {
+                    samples: ctx.samples,
+                    depth_bounds: ctx.depth_bounds,
+                    reduction: ctx.depth_reduction,
+                    depth_mask: ctx.depth_mask,
+                },
                 ctx.forward_opaque,
-                ctx.depth_bounds,
-                ctx.depth_reduction,
             ),
             range: (slices > 1 && source == CellSource::Depth)
                 .then(|| DepthRangePass::new(device, cull_layout, ctx.samples)),
@@ -247,6 +255,7 @@ impl GridBuilder {
             cpu_ms: run.cpu_ms,
             cpu_grid: run.cpu_grid,
             cell_bounds: run.cell_bounds,
+            cell_masks: run.cell_masks,
             near_far: [f.setup.near, f.setup.far],
         });
         Ok(())
@@ -305,9 +314,15 @@ impl GridBuilder {
             }
             (None, CellSource::Depth) => self.bounds.read(device, queue)?,
         };
+        let cell_masks = match (&last.cell_masks, self.source) {
+            (Some(m), _) => m.clone(),
+            (None, CellSource::NearFar) => vec![super::NO_MASK; last.dims.cell_count()],
+            (None, CellSource::Depth) => self.bounds.read_masks(device, queue)?,
+        };
         Ok(BuiltGrid {
             grid,
             cell_bounds,
+            cell_masks,
             assign: last.assign,
             cpu_ms: last.cpu_ms,
         })

@@ -9,7 +9,7 @@
 //! spheres, padded for round-off), so the traversal never prunes a light the gather test
 //! would keep, and the lists it builds equal gather's.
 
-use super::gather::{box_margin, cpu_frustum, light_margin, CpuFrustum};
+use super::gather::{box_margin, cell_frustum, light_margin, CpuFrustum};
 use super::gpu_assign::{bvh_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use super::{GridDims, LightGrid, ViewLight, ViewSetup};
@@ -191,13 +191,14 @@ pub fn traverse_bvh_cpu(
     dims: &GridDims,
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
+    masks: Option<&[super::CellMask]>,
     bvh: &LightBvh,
 ) -> LightGrid {
     let views: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
     let lists: Vec<Vec<u32>> = (0..dims.cell_count())
         .into_par_iter()
         .map(|c| {
-            let f = cpu_frustum(setup, dims, c % dims.tile_count(), cell_bounds[c]);
+            let f = cell_frustum(setup, dims, c, cell_bounds, masks);
             let mut out = Vec::new();
             let mut stack = Vec::new();
             if bvh.nodes.first().is_some_and(|root| box_in_cell(&f, root)) {

@@ -12,10 +12,10 @@
 //! both sides of every cell, to the cell's slice: twin [`open_bounds`].
 
 use super::CullFrame;
-use super::{GridDims, GridLists, ViewSetup};
+use super::{CellMask, GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
-use crate::frame::{DepthBounds, DepthReduction, FrameEncoder};
+use crate::frame::{DepthBounds, DepthMask, DepthReduction, FrameEncoder};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compute_pipeline, every_sample_count, msaa_defs, src, Def, ShaderKey};
 
@@ -30,6 +30,7 @@ pub(crate) struct CellBoundsKey {
     pub samples: u32,
     pub depth_bounds: DepthBounds,
     pub reduction: DepthReduction,
+    pub depth_mask: DepthMask,
 }
 
 impl ShaderKey for CellBoundsKey {
@@ -40,11 +41,14 @@ impl ShaderKey for CellBoundsKey {
         for samples in every_sample_count() {
             for depth_bounds in DepthBounds::ALL {
                 for reduction in DepthReduction::ALL {
-                    out.push(CellBoundsKey {
-                        samples,
-                        depth_bounds,
-                        reduction,
-                    });
+                    for depth_mask in DepthMask::ALL {
+                        out.push(CellBoundsKey {
+                            samples,
+                            depth_bounds,
+                            reduction,
+                            depth_mask,
+                        });
+                    }
                 }
             }
         }
@@ -58,6 +62,7 @@ impl ShaderKey for CellBoundsKey {
             "SUBGROUP_REDUCTION",
             self.reduction == DepthReduction::Subgroup,
         ));
+        defs.push(Def::Bool("DEPTH_MASK", self.depth_mask == DepthMask::On));
         defs
     }
 
@@ -67,6 +72,7 @@ impl ShaderKey for CellBoundsKey {
             src::SCENE_BINDINGS,
             src::GRID_CELL,
             src::MSAA,
+            super::DEPTH_MASK_WGSL,
             include_str!("cell_bounds.wgsl"),
         ]
     }
@@ -193,23 +199,24 @@ pub struct CellBoundsPass {
     bounds: wgpu::Buffer,
     occupied: wgpu::Buffer,
     occupancy: wgpu::Buffer,
+    /// Each cell's 2.5D depth mask (`depth_mask.rs`; no mask without `--depth-mask on`).
+    masks: wgpu::Buffer,
     cells: usize,
 }
 
 impl CellBoundsPass {
-    /// The kernel over a depth target of `samples` samples per pixel.
+    /// The kernel `key` names (over a depth target of `key.samples` samples per pixel).
     /// `forward_opaque`: a forward pass shades the opaque fragments from these bounds' grid.
     /// `scene_layout`: the renderer's group 0, with which an MSAA grid's fragment bounds draw
     /// its geometry (none for a caller's depth buffer: [`super::LightCuller`]).
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         cull_layout: &wgpu::BindGroupLayout,
         scene_layout: Option<&wgpu::BindGroupLayout>,
-        samples: u32,
+        key: CellBoundsKey,
         forward_opaque: bool,
-        depth_bounds: DepthBounds,
-        reduction: DepthReduction,
     ) -> Self {
+        let samples = key.samples;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cell bounds (group 1)"),
             entries: &[
@@ -219,14 +226,10 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),
                 crate::gpu::buffer_entry(4, crate::gpu::STORAGE_RW),
                 crate::gpu::buffer_entry(5, crate::gpu::STORAGE_READ),
+                crate::gpu::buffer_entry(6, crate::gpu::STORAGE_RW),
             ],
         });
-        let s = CellBoundsKey {
-            samples,
-            depth_bounds,
-            reduction,
-        }
-        .shader();
+        let s = key.shader();
         let layouts = [Some(cull_layout), Some(&layout)];
         let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);
@@ -261,6 +264,7 @@ impl CellBoundsPass {
                     | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
+            masks: storage_buffer(device, "cell depth masks", 1 << 15),
             cells: 0,
         }
     }
@@ -272,6 +276,12 @@ impl CellBoundsPass {
             &mut self.bounds,
             "cell bounds",
             (self.cells * 8) as u64,
+        );
+        grow_storage(
+            device,
+            &mut self.masks,
+            "cell depth masks",
+            (self.cells * 16) as u64,
         );
         grow_storage(
             device,
@@ -306,6 +316,7 @@ impl CellBoundsPass {
                 self.occupied.as_entire_binding(),
                 self.occupancy.as_entire_binding(),
                 fragment_bounds.as_entire_binding(),
+                self.masks.as_entire_binding(),
             ],
         );
         encoder.clear_buffer(&self.occupancy, 0, None);
@@ -329,6 +340,8 @@ impl CellBoundsPass {
         self.ensure(device, dims);
         let all = vec![range; self.cells];
         queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&all));
+        let masks = vec![super::NO_MASK; self.cells];
+        queue.write_buffer(&self.masks, 0, bytemuck::cast_slice(&masks));
         let list: Vec<u32> = (0..self.cells as u32).collect();
         queue.write_buffer(&self.occupied, 0, bytemuck::cast_slice(&list));
         let n = self.cells as u32;
@@ -346,6 +359,11 @@ impl CellBoundsPass {
         &self.bounds
     }
 
+    /// The cells' 2.5D depth masks (`array<vec4<u32>>`, one per cell: `depth_mask.rs`).
+    pub fn mask_buffer(&self) -> &wgpu::Buffer {
+        &self.masks
+    }
+
     /// The occupied cells (`array<u32>`, in no particular order).
     pub fn occupied_buffer(&self) -> &wgpu::Buffer {
         &self.occupied
@@ -361,6 +379,12 @@ impl CellBoundsPass {
     /// work is submitted).
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<[f32; 2]>> {
         let bytes = download(device, queue, &self.bounds, (self.cells * 8) as u64)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// The masks of the last recorded frame (as [`CellBoundsPass::read`]).
+    pub fn read_masks(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<CellMask>> {
+        let bytes = download(device, queue, &self.masks, (self.cells * 16) as u64)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 }

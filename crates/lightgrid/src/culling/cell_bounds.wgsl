@@ -18,6 +18,39 @@
 // With MSAA, the bounds of the fragments each cell's shading will look up
 // (`fragment_bounds.wgsl`: (0xffffffff - min bits, max bits), zero = none); unused without.
 @group(1) @binding(5) var<storage, read> fragment_bounds: array<u32>;
+// Each cell's 2.5D depth mask (depth_mask.wgsl): with DEPTH_MASK (`--depth-mask on`) the bins
+// of its bounds that hold samples, found by a second sweep over the tile once the bounds are
+// known; otherwise, and for the transparent layer, no mask.
+@group(1) @binding(6) var<storage, read_write> cell_masks: array<vec4<u32>>;
+
+#if DEPTH_MASK
+// Per slice of the tile: the mask's (lo, inv) as bits, and the bins holding samples.
+var<workgroup> mask_scale: array<vec2<u32>, MAX_SLICES>;
+var<workgroup> mask_bits: array<atomic<u32>, MAX_SLICES>;
+
+// The bins of `span`, inflated by the slack as a sample is, in slice k's mask (none when the
+// span is empty).
+fn mask_span(k: u32, span: vec2<f32>) -> u32 {
+    if (span.x > span.y) {
+        return 0u;
+    }
+    let m = vec4<u32>(0u, mask_scale[k].x, mask_scale[k].y, 0u);
+    return depth_mask_span(span.x * (1.0 - ASSIGN_DEPTH_SLACK), span.y * (1.0 + ASSIGN_DEPTH_SLACK), m);
+}
+
+// 2. A sample's bins in the slices its distance (with the slack) lies in, as `include_depth`.
+fn mask_sample(d: f32) {
+    if (!is_background(d)) {
+        let w = view_distance_from_depth(d);
+        let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+        let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+        atomicOr(&mask_bits[k0], mask_span(k0, vec2<f32>(w, w)));
+        if (k1 != k0) {
+            atomicOr(&mask_bits[k1], mask_span(k1, vec2<f32>(w, w)));
+        }
+    }
+}
+#endif
 
 #if SUBGROUP_REDUCTION
 // `--depth-reduction subgroup`: the invocations' register bounds, one subgroup min/max, and
@@ -139,8 +172,50 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
             }
         }
         write_bounds(cell, open_bounds(k, b));
+#if DEPTH_MASK
+        // 1. The mask's bins over the cell's bounds (`--depth-mask` needs both bounds, so these
+        // are `b`); what is not a sample (MSAA forward fragments, the transparent part of a
+        // shared list) sets every bin of its range.
+        let inv = select(0.0, f32(DEPTH_MASK_BINS) / (b.y - b.x), b.y > b.x);
+        mask_scale[k] = vec2<u32>(bitcast<u32>(b.x), bitcast<u32>(inv));
+        var bits = mask_span(k, fragment_range(cell));
+        if (grid.lists == GRID_LISTS_SHARED) {
+            bits = bits | mask_span(k, transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi))));
+        }
+        atomicStore(&mask_bits[k], bits);
+#else
+        cell_masks[cell] = depth_mask_none();
+#endif
+        if (grid.lists == GRID_LISTS_SEPARATE) {
+            cell_masks[grid.layer_cells + cell] = depth_mask_none();
+        }
     }
     check_loop(k, grid.slices);
+#if DEPTH_MASK
+    workgroupBarrier();
+    var my = lid.y;
+    for (; my < grid.tile_size; my = my + TILE_THREADS) {
+        var mx = lid.x;
+        for (; mx < grid.tile_size; mx = mx + TILE_THREADS) {
+            let p = origin + vec2<u32>(mx, my);
+            if (p.x < size.x && p.y < size.y) {
+                for (var s = 0u; s < SAMPLES; s = s + 1u) {
+                    mask_sample(textureLoad(depth_tex, p, s));
+                }
+            }
+        }
+        check_loop(mx, grid.tile_size);
+    }
+    check_loop(my, grid.tile_size);
+    workgroupBarrier();
+    // 3. The masks.
+    var mk = li;
+    for (; mk < grid.slices; mk = mk + TILE_THREADS * TILE_THREADS) {
+        let sc = mask_scale[mk];
+        cell_masks[mk * tiles + tile] = vec4<u32>(atomicLoad(&mask_bits[mk]), sc.x, sc.y, 0u);
+    }
+    check_loop(mk, grid.slices);
+#endif
 }
 
 fn write_bounds(cell: u32, b: vec2<f32>) {

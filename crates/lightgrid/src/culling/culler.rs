@@ -20,7 +20,9 @@ use super::builder::{GridBuilder, GridSetup};
 use super::grid::GridDims;
 use super::strategy::{bind_cull_group, cull_layout, CellSource, CullFrame};
 use crate::consts::POINT_LIGHT_COS;
-use crate::frame::{Assign, DepthBounds, DepthReduction, FrameEncoder, GridLists, SpotCull};
+use crate::frame::{
+    Assign, DepthBounds, DepthMask, DepthReduction, FrameEncoder, GridLists, SpotCull,
+};
 use crate::gpu::{
     buffer_entry, groups_1d, grow_storage, storage_buffer, FrameCounters, FrameTag, PassTimer,
     STORAGE_READ, STORAGE_RW, UNIFORM,
@@ -163,6 +165,9 @@ pub struct CullConfig {
     pub index_capacity: u32,
     /// Spot lights culled by their cone as well as their bounding sphere.
     pub spot_cull: SpotCull,
+    /// 2.5D culling ([`DepthMask::On`]): each cell also keeps a mask of which of 32 bins of
+    /// its depth bounds hold samples; needs [`DepthBounds::Both`].
+    pub depth_mask: DepthMask,
 }
 
 impl Default for CullConfig {
@@ -176,6 +181,7 @@ impl Default for CullConfig {
             max_lights: 1 << 16,
             index_capacity: super::GridBuffers::INITIAL_INDEX_CAPACITY,
             spot_cull: SpotCull::Cone,
+            depth_mask: DepthMask::Off,
         }
     }
 }
@@ -287,7 +293,7 @@ impl CullReport {
 
 /// Storage buffers the culling kernels' pipeline layouts bind in one stage at most (scatter's
 /// three groups; `tests/culler.rs` creates every strategy on a device with exactly this).
-pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 15;
+pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 16;
 
 /// The caller-facing WGSL: the grid's bindings (declared at group `GROUP`) and the accessors,
 /// the cell addressing shared with lightgrid's own shaders (`grid_cell.wgsl`) renamed into
@@ -449,6 +455,15 @@ impl LightCuller {
         crate::frame::validate_tile_size(tile_size).map_err(config_error)?;
         crate::frame::validate_slices(slices).map_err(config_error)?;
         crate::frame::validate_msaa(config.samples).map_err(config_error)?;
+        if config.depth_mask == DepthMask::On && config.depth_bounds != DepthBounds::Both {
+            return refuse(
+                CullInput::Config,
+                format!(
+                    "depth_mask On needs depth_bounds Both (the mask's bins cut the samples' own bounds), not {:?}",
+                    config.depth_bounds
+                ),
+            );
+        }
         if config.max_lights == 0 {
             return refuse(CullInput::Config, "max_lights must be at least 1");
         }
@@ -497,6 +512,7 @@ impl LightCuller {
                     forward_opaque: false,
                     depth_bounds: config.depth_bounds,
                     depth_reduction: DepthReduction::Atomics,
+                    depth_mask: config.depth_mask,
                     index_capacity: u64::from(config.index_capacity),
                 },
                 slices,
@@ -602,7 +618,7 @@ impl LightCuller {
         }
     }
 
-    /// The limits a device needs for the culler: the defaults, with the 15 storage buffers per
+    /// The limits a device needs for the culler: the defaults, with the 16 storage buffers per
     /// stage the kernels bind and the adapter's largest storage bindings (long light lists),
     /// for `wgpu::DeviceDescriptor::required_limits`.
     pub fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {

@@ -6,7 +6,7 @@
 
 use super::gpu_assign::{gather_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{GridDims, LightGrid, ViewLight, ViewSetup};
+use super::{depth_mask_meets, CellMask, GridDims, LightGrid, ViewLight, ViewSetup, NO_MASK};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -23,6 +23,8 @@ pub(super) struct CpuFrustum {
     /// Bounding sphere of the frustum piece (`ViewSetup::cell_sphere` over the slack-widened
     /// bounds), for spot cones.
     pub sphere: (Vec3, f32),
+    /// The cell's 2.5D depth mask (`depth_mask.rs`; [`NO_MASK`] unless the caller sets it).
+    pub mask: CellMask,
 }
 
 pub(super) fn cpu_frustum(
@@ -52,7 +54,24 @@ pub(super) fn cpu_frustum(
             w_bounds[0] * (1.0 - ASSIGN_DEPTH_SLACK),
             w_bounds[1] * (1.0 + ASSIGN_DEPTH_SLACK),
         ),
+        mask: NO_MASK,
     }
+}
+
+/// The frustum of cell `c` (`cell_frustum` in assign_bindings.wgsl): its tile's planes, its
+/// bounds and, when given, its depth mask.
+pub(super) fn cell_frustum(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    c: usize,
+    cell_bounds: &[[f32; 2]],
+    masks: Option<&[CellMask]>,
+) -> CpuFrustum {
+    let mut f = cpu_frustum(setup, dims, c % dims.tile_count(), cell_bounds[c]);
+    if let Some(m) = masks {
+        f.mask = m[c];
+    }
+    f
 }
 
 /// How far inside the cell's frustum the light is (≥ 0: inside, as `sphere_in_tile` decides);
@@ -67,7 +86,30 @@ pub(super) fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
     for p in &f.planes {
         m = m.min(p.dot(center) + r);
     }
+    if m >= 0.0 && !depth_mask_meets(&f.mask, w - r, w + r) {
+        // Outside every bin holding samples: as far out as the nearest such bin is (a
+        // size for the tests' round-off reading, not a distance the GPU computes).
+        return -mask_gap(&f.mask, w - r, w + r);
+    }
     m
+}
+
+/// How far the span `[w0, w1]` is from the nearest bin of `m` holding samples, in view
+/// distance (positive when they do not meet).
+fn mask_gap(m: &CellMask, w0: f32, w1: f32) -> f32 {
+    let (lo, inv) = (f32::from_bits(m[1]), f32::from_bits(m[2]));
+    if inv <= 0.0 || m[0] == 0 {
+        return f32::INFINITY;
+    }
+    let width = 1.0 / inv;
+    (0..32)
+        .filter(|b| m[0] & (1 << b) != 0)
+        .map(|b| {
+            let (b0, b1) = (lo + b as f32 * width, lo + (b + 1) as f32 * width);
+            (b0 - w1).max(w0 - b1).max(0.0)
+        })
+        .fold(f32::INFINITY, f32::min)
+        .max(f32::MIN_POSITIVE)
 }
 
 /// `light_in_tile` in WGSL: the light's bounding sphere against the frustum, and a spot's
@@ -96,22 +138,27 @@ pub(super) fn box_margin(f: &CpuFrustum, lo: Vec3, hi: Vec3) -> f32 {
     for p in &f.planes {
         m = m.min(p.dot(Vec3::select(p.cmpgt(Vec3::ZERO), hi, lo)));
     }
+    if m >= 0.0 && !depth_mask_meets(&f.mask, w_lo, w_hi) {
+        return -mask_gap(&f.mask, w_lo, w_hi);
+    }
     m
 }
 
 /// Per cell and light, the gather test's margin (cells in grid order, lights in order).
-/// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`).
+/// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`); `masks`: per
+/// cell its 2.5D depth mask, for a grid built with `--depth-mask on`.
 pub fn gather_margins(
     setup: &ViewSetup,
     dims: &GridDims,
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
+    masks: Option<&[CellMask]>,
 ) -> Vec<Vec<f32>> {
     let view: Vec<ViewLight> = lights.iter().map(|l| setup.to_view(l)).collect();
     (0..dims.cell_count())
         .into_par_iter()
         .map(|c| {
-            let f = cpu_frustum(setup, dims, c % dims.tile_count(), cell_bounds[c]);
+            let f = cell_frustum(setup, dims, c, cell_bounds, masks);
             view.iter().map(|v| light_margin(&f, v)).collect()
         })
         .collect()
@@ -125,7 +172,18 @@ pub fn assign_gather_cpu(
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
 ) -> LightGrid {
-    let lists: Vec<Vec<u32>> = gather_margins(setup, dims, lights, cell_bounds)
+    assign_gather_cpu_masked(setup, dims, lights, cell_bounds, None)
+}
+
+/// [`assign_gather_cpu`] of a grid built with `--depth-mask on`: `masks` per cell.
+pub fn assign_gather_cpu_masked(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    lights: &[Light],
+    cell_bounds: &[[f32; 2]],
+    masks: Option<&[CellMask]>,
+) -> LightGrid {
+    let lists: Vec<Vec<u32>> = gather_margins(setup, dims, lights, cell_bounds, masks)
         .into_iter()
         .map(|m| {
             m.iter()

@@ -74,6 +74,7 @@ impl AssignCommon {
                 STORAGE_RW,
                 STORAGE_READ,
                 STORAGE_READ,
+                STORAGE_READ,
             ],
         );
         AssignCommon {
@@ -84,7 +85,7 @@ impl AssignCommon {
         }
     }
 
-    /// Group 1 for a frame: grow the spill list, bind the grid and the cell bounds.
+    /// Group 1 for a frame: grow the spill list, bind the grid and the cell bounds and masks.
     pub fn bind(
         &mut self,
         device: &wgpu::Device,
@@ -106,6 +107,7 @@ impl AssignCommon {
                 self.spill_cells.as_entire_binding(),
                 bounds.occupied_buffer().as_entire_binding(),
                 bounds.occupancy_buffer().as_entire_binding(),
+                bounds.mask_buffer().as_entire_binding(),
             ],
         )
     }

@@ -9,6 +9,7 @@ mod bvh;
 mod bvh_gpu;
 mod cell_bounds;
 mod culler;
+mod depth_mask;
 mod depth_range;
 mod fragment_bounds;
 mod gather;
@@ -35,8 +36,11 @@ pub use culler::{
     CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
     LightCuller,
 };
+pub use depth_mask::{
+    cell_masks_cpu, depth_mask_meets, depth_mask_span, mask_scale, CellMask, NO_MASK,
+};
 pub use depth_range::{depth_range_cpu, slicing_range, DepthRangePass};
-pub use gather::{assign_gather_cpu, gather_margins};
+pub use gather::{assign_gather_cpu, assign_gather_cpu_masked, gather_margins};
 pub use gpu_assign::check_index_capacity;
 pub use grid::{GridBuffers, GridDims, GridLists, LightGrid};
 pub use oracle::{
@@ -52,8 +56,13 @@ pub use crate::consts::pass_labels as labels;
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
-/// `tile_frustum` / `light_in_tile` (needs the scene bindings).
-pub(crate) const TILE_FRUSTUM_WGSL: &str = include_str!("tile_frustum.wgsl");
+/// `tile_frustum` / `light_in_tile` (needs the scene bindings), with the 2.5D depth mask test.
+pub(crate) const TILE_FRUSTUM_WGSL: &str = concat!(
+    include_str!("depth_mask.wgsl"),
+    include_str!("tile_frustum.wgsl")
+);
+/// The 2.5D depth mask's bins (`depth_mask.rs`).
+pub(crate) const DEPTH_MASK_WGSL: &str = include_str!("depth_mask.wgsl");
 
 /// Every assignment shader, for the validation test: every value of the keyed stages.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {

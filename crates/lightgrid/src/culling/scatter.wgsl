@@ -180,7 +180,8 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         let cell = (s / n) * grid.layer_cells + (k0 + s % n) * tiles + tile;
         let b = cell_bounds[cell];
         let in_depth = b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
-        if (in_depth && (!by_cone || cone_margin(light, tile_frustum(xy, grid.tile_size, b).sphere) >= 0.0)) {
+        let in_mask = depth_mask_meets(cell_masks[cell], w_min, w_max);
+        if (in_depth && in_mask && (!by_cone || cone_margin(light, tile_frustum(xy, grid.tile_size, b).sphere) >= 0.0)) {
             let slot = atomicAdd(&frame_counters[COUNTER_PAIRS_NEEDED], 1u);
             if (slot < capacity) {
                 pair_keys[slot] = cell;

@@ -129,6 +129,8 @@ pub struct StrategyRun {
     pub cpu_grid: Option<LightGrid>,
     /// The cell bounds, when the strategy read them back.
     pub cell_bounds: Option<Vec<[f32; 2]>>,
+    /// The cells' depth masks, read back with the bounds.
+    pub cell_masks: Option<Vec<super::CellMask>>,
 }
 
 /// One light-assignment strategy.

@@ -9,6 +9,9 @@ struct TileFrustum {
     // Bounding sphere (centre, radius) of the frustum piece between the slack-widened depth
     // bounds: what spot cones are tested against (`ViewSetup::cell_sphere`).
     sphere: vec4<f32>,
+    // The cell's 2.5D depth mask (`depth_mask.wgsl`); none unless the cell came from a grid
+    // built with `--depth-mask on` (`cell_frustum` in assign_bindings.wgsl).
+    mask: vec4<u32>,
 }
 
 // `tile`: tile coordinates; `w_range`: the view-distance [min, max] of the samples the frustum
@@ -28,6 +31,7 @@ fn tile_frustum(tile: vec2<u32>, tile_size: u32, w_range: vec2<f32>) -> TileFrus
     f.planes[3] = normalize(vec3<f32>(0.0, -1.0, -ndc_lo.y / p11));
     f.w_min = w_range.x;
     f.w_max = w_range.y;
+    f.mask = depth_mask_none();
     f.sphere = frustum_sphere(ndc_lo, ndc_hi, w_range.x * (1.0 - ASSIGN_DEPTH_SLACK), w_range.y * (1.0 + ASSIGN_DEPTH_SLACK));
     return f;
 }
@@ -64,6 +68,9 @@ fn depth_to_w_range(depth_range: vec2<f32>) -> vec2<f32> {
 fn sphere_in_tile(f: TileFrustum, c: vec3<f32>, r: f32) -> bool {
     let w = -c.z;
     if (f.w_min > f.w_max || w + r < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK) || w - r > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)) {
+        return false;
+    }
+    if (!depth_mask_meets(f.mask, w - r, w + r)) {
         return false;
     }
     for (var i = 0u; i < 4u; i = i + 1u) {
@@ -103,6 +110,9 @@ fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     let w_lo = -hi.z;
     let w_hi = -lo.z;
     if (f.w_min > f.w_max || w_hi < f.w_min * (1.0 - ASSIGN_DEPTH_SLACK) || w_lo > f.w_max * (1.0 + ASSIGN_DEPTH_SLACK)) {
+        return false;
+    }
+    if (!depth_mask_meets(f.mask, w_lo, w_hi)) {
         return false;
     }
     for (var i = 0u; i < 4u; i = i + 1u) {

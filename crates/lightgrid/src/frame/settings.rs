@@ -29,6 +29,34 @@ pub struct RenderSettings {
     pub depth_bounds: DepthBounds,
     /// How the cell-bounds kernel reduces a tile's depths (`--depth-reduction`).
     pub depth_reduction: DepthReduction,
+    /// 2.5D culling of grids built from the depth buffer (`--depth-mask`).
+    #[serde(default)]
+    pub depth_mask: DepthMask,
+}
+
+/// 2.5D culling (Harada et al. 2012, "A 2.5D culling for Forward+"): each cell of a grid built
+/// from the depth buffer keeps a 32-bit mask of which of 32 equal bins of its depth bounds hold
+/// samples, and a light is listed only where the bins its view-depth span covers meet the
+/// mask (`culling/depth_mask.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DepthMask {
+    /// The cell's depth bounds only.
+    #[default]
+    Off,
+    /// The bounds and the mask.
+    On,
+}
+
+impl DepthMask {
+    pub const ALL: [DepthMask; 2] = [DepthMask::Off, DepthMask::On];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            DepthMask::Off => "off",
+            DepthMask::On => "on",
+        }
+    }
 }
 
 /// How the cell-bounds kernel reduces a tile's samples to its `[min, max]` (tiled-shading
@@ -164,6 +192,7 @@ impl Default for RenderSettings {
             msaa_resolve: MsaaResolve::Separate,
             depth_bounds: DepthBounds::Both,
             depth_reduction: DepthReduction::Atomics,
+            depth_mask: DepthMask::Off,
         }
     }
 }
@@ -180,6 +209,16 @@ impl RenderSettings {
             ));
         }
         validate_msaa(self.msaa)?;
+        if self.depth_mask == DepthMask::On && self.depth_bounds != DepthBounds::Both {
+            return Err(crate::error::Error::invalid(
+                "depth-mask",
+                format!(
+                    "on needs --depth-bounds both (the mask's bins cut the samples' own bounds), \
+                     not {}",
+                    self.depth_bounds.name()
+                ),
+            ));
+        }
         validate_slices(self.slices)
     }
 }

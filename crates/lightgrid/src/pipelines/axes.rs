@@ -9,8 +9,8 @@
 
 use super::PipelineInfo;
 use crate::frame::{
-    Assign, DepthBounds, DepthReduction, GBufferFormat, GridLists, MaterialDraws, MsaaResolve,
-    RenderSettings, SpotCull,
+    Assign, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, MaterialDraws,
+    MsaaResolve, RenderSettings, SpotCull,
 };
 
 /// A setting's values by name (the option's values, the results' columns).
@@ -124,6 +124,20 @@ impl SettingValue for DepthBounds {
             DepthBounds::Min => "far side open: [min, slice far]",
             DepthBounds::Max => "near side open: [slice near, max]",
             DepthBounds::None => "every cell spans its slice",
+        }
+    }
+}
+
+impl SettingValue for DepthMask {
+    const FLAG: &'static str = "depth-mask";
+    const VALUES: &'static [Self] = &DepthMask::ALL;
+    fn name(self) -> &'static str {
+        DepthMask::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            DepthMask::Off => "the cell's depth bounds only",
+            DepthMask::On => "2.5D culling: a 32-bit mask of the bounds' bins that hold samples (Harada et al. 2012)",
         }
     }
 }
@@ -361,6 +375,19 @@ pub const AXES: &[Axis] = &[
         },
         label: |v| format!("{v} reduction"),
     },
+    Axis {
+        flag: "depth-mask",
+        column: "depth_mask",
+        help: "2.5D culling of the grids --assign builds from the depth buffer (needs --depth-bounds both)",
+        values: values::<DepthMask>,
+        applies: |p, _| p.depth_bounds && p.assign,
+        get: |s| s.depth_mask.name().to_string(),
+        set: |s, v| {
+            s.depth_mask = DepthMask::parse(v)?;
+            Ok(())
+        },
+        label: |v| format!("mask {v}"),
+    },
 ];
 
 /// The value of the setting `T` is the type of, in `settings`.
@@ -458,6 +485,7 @@ mod tests {
         check::<MsaaResolve>();
         check::<DepthBounds>();
         check::<DepthReduction>();
+        check::<DepthMask>();
         check::<GBufferFormat>();
     }
 

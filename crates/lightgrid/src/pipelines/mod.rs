@@ -52,6 +52,7 @@ impl PipelineContext<'_> {
             forward_opaque: true,
             depth_bounds: self.settings.depth_bounds,
             depth_reduction: self.settings.depth_reduction,
+            depth_mask: self.settings.depth_mask,
             index_capacity: u64::from(crate::culling::GridBuffers::INITIAL_INDEX_CAPACITY),
         }
     }

@@ -79,6 +79,7 @@ impl TransparentPass {
                 // Not the technique's grid: `--depth-bounds` is about that one.
                 depth_bounds: crate::frame::DepthBounds::Both,
                 depth_reduction: crate::frame::DepthReduction::Atomics,
+                depth_mask: crate::frame::DepthMask::Off,
                 ..ctx.grid_setup()
             },
             1,

@@ -7,8 +7,8 @@ pub mod shading;
 
 use glam::Vec3;
 use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu, cell_bounds_cpu, oracle_tile_lights, DepthRange, GridDims,
-    LightGrid, ViewSetup,
+    assign_cpu, assign_gather_cpu_masked, cell_bounds_cpu, cell_masks_cpu, oracle_tile_lights,
+    CellMask, DepthRange, GridDims, GridLists, LightGrid, ViewSetup, NO_MASK,
 };
 use lightgrid::gpu::GpuContext;
 use lightgrid::pipelines::Assign;
@@ -494,13 +494,14 @@ pub fn edge_case_lights(rng: &mut Rng, camera: &Camera, setup: &ViewSetup, n: us
     lights
 }
 
-/// The grid a strategy's CPU twin builds from the given cell bounds.
+/// The grid a strategy's CPU twin builds from the given cell bounds (and, for a grid built
+/// with `--depth-mask on`, its cells' masks).
 pub fn twin(
     assign: Assign,
     setup: &ViewSetup,
     grid: &LightGrid,
     lights: &[Light],
-    bounds: &[[f32; 2]],
+    (bounds, masks): (&[[f32; 2]], Option<&[CellMask]>),
     near_far: bool,
 ) -> LightGrid {
     let dims = &grid.dims;
@@ -508,9 +509,15 @@ pub fn twin(
         Assign::Cpu | Assign::Scatter if near_far => {
             assign_cpu(setup, dims, lights, DepthRange::NearFar)
         }
-        Assign::Cpu | Assign::Scatter => assign_cpu(setup, dims, lights, DepthRange::Cells(bounds)),
+        Assign::Cpu | Assign::Scatter => {
+            let range = match masks {
+                Some(m) => DepthRange::Masked(bounds, m),
+                None => DepthRange::Cells(bounds),
+            };
+            assign_cpu(setup, dims, lights, range)
+        }
         Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
-            assign_gather_cpu(setup, dims, lights, bounds)
+            assign_gather_cpu_masked(setup, dims, lights, bounds, masks)
         }
         Assign::Auto => unreachable!("resolved by the renderer"),
     }
@@ -624,10 +631,11 @@ pub fn check_grid_against_twin(
     setup: &ViewSetup,
     grid: &LightGrid,
     lights: &[Light],
-    bounds: &[[f32; 2]],
+    bounds: (&[[f32; 2]], Option<&[CellMask]>),
     near_far: bool,
     max_disagreements: usize,
 ) -> usize {
+    let cell_bounds = bounds.0;
     let total: u64 = grid.cells.iter().map(|c| u64::from(c[1])).sum();
     assert_eq!(total, grid.indices.len() as u64, "{what}");
     let sets = sorted_cells(what, grid);
@@ -668,7 +676,7 @@ pub fn check_grid_against_twin(
                 "{what}: cell {c} (layer {}, slice {}, bounds {:?}) misses light {l}: {:?}",
                 grid.dims.layer_of_cell(c),
                 grid.dims.slice_of_cell(c),
-                bounds[c],
+                cell_bounds[c],
                 lights[*l as usize]
             );
         }
@@ -681,7 +689,7 @@ pub fn check_grid_against_twin(
                 "{what}: cell {c} (layer {}, slice {}, bounds {:?}) lists light {l} out of reach: {:?}",
                 grid.dims.layer_of_cell(c),
                 grid.dims.slice_of_cell(c),
-                bounds[c],
+                cell_bounds[c],
                 lights[*l as usize]
             );
         }
@@ -778,6 +786,59 @@ impl FrameOracle {
         }
         check
     }
+}
+
+/// The GPU's 2.5D depth masks (`--depth-mask on`) against their CPU twin over the frame's
+/// depth samples, with the GPU's own bins (`lo`, `inv`): every bin the twin sets with half the
+/// slack is set, and (without MSAA forward fragments or shared transparent lists, which set
+/// whole ranges the twin does not see) none is set that the twin does not set with twice
+/// the slack. With `on` false every cell has no mask. Returns the opaque cells whose mask
+/// leaves bins out.
+pub fn check_cell_masks(
+    what: &str,
+    setup: &ViewSetup,
+    dims: &GridDims,
+    masks: &[CellMask],
+    planes: &[&[f32]],
+    on: bool,
+    exact_samples: bool,
+) -> usize {
+    assert_eq!(masks.len(), dims.cell_count(), "{what}: mask count");
+    if !on {
+        assert!(
+            masks.iter().all(|m| *m == NO_MASK),
+            "{what}: a mask without --depth-mask on"
+        );
+        return 0;
+    }
+    let slack = lightgrid::consts::ASSIGN_DEPTH_SLACK;
+    let narrow = cell_masks_cpu(setup, dims, planes, masks, None, slack * 0.5);
+    let wide = cell_masks_cpu(setup, dims, planes, masks, None, slack * 2.0);
+    let layer = dims.layer_cells();
+    let mut partial = 0;
+    for c in 0..dims.cell_count() {
+        let (g, n, w) = (masks[c][0], narrow[c][0], wide[c][0]);
+        if c >= layer {
+            assert_eq!(masks[c], NO_MASK, "{what}: transparent cell {c} has a mask");
+            continue;
+        }
+        assert_eq!(
+            g & n,
+            n,
+            "{what}: cell {c} leaves out sample bins: gpu {g:032b} cpu {n:032b}"
+        );
+        if exact_samples && dims.lists != GridLists::Shared {
+            assert_eq!(
+                g & !w,
+                0,
+                "{what}: cell {c} sets bins without samples: gpu {g:032b} cpu {w:032b}"
+            );
+        }
+        if g != 0 && g != u32::MAX {
+            partial += 1;
+        }
+    }
+    partial
 }
 
 /// [`FrameOracle::check`] of a frame's grid on its depth buffer.
