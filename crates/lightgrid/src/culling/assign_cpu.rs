@@ -306,6 +306,10 @@ impl AssignStrategy for CpuStrategy {
         let mut parts = Vec::new();
         if depth {
             parts.push((a.bounds.buffer(), (a.dims.cell_count() * 8) as u64));
+        }
+        // The masks only where the kernel computes them (`--depth-mask on`).
+        let masked = depth && a.bounds.masked();
+        if masked {
             parts.push((a.bounds.mask_buffer(), (a.dims.cell_count() * 16) as u64));
         }
         if let Some(range) = a.range {
@@ -314,7 +318,7 @@ impl AssignStrategy for CpuStrategy {
         let bytes = enc.download_all(&parts)?;
         let cell_bounds: Option<Vec<[f32; 2]>> =
             depth.then(|| bytemuck::pod_collect_to_vec(&bytes[0]));
-        let masks: Option<Vec<CellMask>> = depth.then(|| bytemuck::pod_collect_to_vec(&bytes[1]));
+        let masks: Option<Vec<CellMask>> = masked.then(|| bytemuck::pod_collect_to_vec(&bytes[1]));
         let dims = &match a.range {
             Some(_) => {
                 super::depth_range::sliced(a.dims, &bytes[parts.len() - 2], &bytes[parts.len() - 1])
@@ -324,6 +328,7 @@ impl AssignStrategy for CpuStrategy {
         let start = Instant::now();
         let range = match (&cell_bounds, &masks) {
             (Some(b), Some(m)) => DepthRange::Masked(b, m),
+            (Some(b), None) => DepthRange::Cells(b),
             _ => DepthRange::NearFar,
         };
         let grid = assign_cpu(&a.f.setup, dims, a.f.lights, range);

@@ -201,6 +201,8 @@ pub struct CellBoundsPass {
     occupancy: wgpu::Buffer,
     /// Each cell's 2.5D depth mask (`depth_mask.rs`; no mask without `--depth-mask on`).
     masks: wgpu::Buffer,
+    /// `--depth-mask on`: the kernel fills `masks` (else every cell has none).
+    masked: bool,
     cells: usize,
 }
 
@@ -265,6 +267,7 @@ impl CellBoundsPass {
                 mapped_at_creation: false,
             }),
             masks: storage_buffer(device, "cell depth masks", 1 << 15),
+            masked: key.depth_mask == DepthMask::On,
             cells: 0,
         }
     }
@@ -357,6 +360,11 @@ impl CellBoundsPass {
     /// The bounds on the GPU (`array<vec2<f32>>`, one per cell).
     pub fn buffer(&self) -> &wgpu::Buffer {
         &self.bounds
+    }
+
+    /// Whether the kernel computes depth masks (`--depth-mask on`).
+    pub fn masked(&self) -> bool {
+        self.masked
     }
 
     /// The cells' 2.5D depth masks (`array<vec4<u32>>`, one per cell: `depth_mask.rs`).
