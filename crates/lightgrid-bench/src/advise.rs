@@ -20,9 +20,9 @@
 //! the recommendation says why, against the runner-up.
 
 use crate::run::Progress;
-use lightgrid::frame::{Assign, RenderSettings};
+use lightgrid::frame::{Assign, DepthMask, RenderSettings};
 use lightgrid::gpu::GpuContext;
-use lightgrid::pipelines::{self, Msaa, PipelineInfo, REFERENCE};
+use lightgrid::pipelines::{self, Msaa, PipelineInfo, SettingValue, REFERENCE};
 use lightgrid::realtime::{play, PlayPlan};
 use lightgrid::scene::Scene;
 use lightgrid::Renderer;
@@ -46,6 +46,9 @@ pub struct Candidate {
     pub tile: Option<u32>,
     /// The strategy, `auto` resolved (pipelines with an `--assign` grid only).
     pub assign: Option<&'static str>,
+    /// 2.5D culling (`--depth-mask on`), tried by the refinement where the setting applies;
+    /// None: as given.
+    pub depth_mask: Option<DepthMask>,
 }
 
 impl Candidate {
@@ -56,6 +59,9 @@ impl Candidate {
         }
         if let Some(a) = self.assign {
             s += &format!(" assign {a}");
+        }
+        if let Some(m) = self.depth_mask {
+            s += &format!(" depth-mask {}", m.name());
         }
         s
     }
@@ -154,6 +160,7 @@ pub fn survey(assign_auto: &'static str) -> Vec<Candidate> {
             pipeline: p.id,
             tile: p.uses_grid.then_some(lightgrid::consts::DEFAULT_TILE_SIZE),
             assign: p.assign.then_some(assign_auto),
+            depth_mask: None,
         })
         .collect()
 }
@@ -163,11 +170,12 @@ pub const REFERENCE_CANDIDATE: Candidate = Candidate {
     pipeline: REFERENCE,
     tile: None,
     assign: None,
+    depth_mask: None,
 };
 
 /// Step 2: for the fastest `REFINE_TOP` grid pipelines measured so far, the other tiles at
-/// their strategy, then the other strategies at their best tile. Candidates already in
-/// `done` are left out.
+/// their strategy, then the other strategies, then 2.5D culling (`--depth-mask on`, where the
+/// settings table says it applies). Candidates already in `done` are left out.
 pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     let ranked = rank(done.to_vec());
     let top: Vec<Candidate> = ranked
@@ -194,6 +202,19 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
             push(
                 Candidate {
                     tile: Some(t),
+                    ..*c
+                },
+                &mut out,
+            );
+        }
+    }
+    let mask_axis = lightgrid::pipelines::find_axis(DepthMask::FLAG).expect("a row");
+    for c in &top {
+        let settings = RenderSettings::default();
+        if c.depth_mask.is_none() && (mask_axis.applies)(info(c), &settings) {
+            push(
+                Candidate {
+                    depth_mask: Some(DepthMask::On),
                     ..*c
                 },
                 &mut out,
@@ -240,6 +261,9 @@ pub fn options(c: &Candidate) -> String {
     }
     if let Some(a) = c.assign {
         s += &format!(" --assign {a}");
+    }
+    if let Some(m) = c.depth_mask {
+        s += &format!(" --depth-mask {}", m.name());
     }
     s
 }
@@ -413,6 +437,7 @@ fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
             .assign
             .and_then(|a| Assign::all().find(|x| x.name() == a))
             .unwrap_or(plan.base.assign),
+        depth_mask: c.depth_mask.unwrap_or(plan.base.depth_mask),
         ..plan.base
     }
 }
@@ -521,6 +546,7 @@ mod tests {
                 pipeline,
                 tile,
                 assign: tile.map(|_| "cpu"),
+                depth_mask: None,
             },
             outcome: Outcome::Measured {
                 frame_ms: ms,
@@ -626,14 +652,36 @@ mod tests {
         assert!(r.contains(&Candidate {
             pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
             tile: Some(32),
-            assign: Some("cpu")
+            assign: Some("cpu"),
+            depth_mask: None,
         }));
         assert!(r.contains(&Candidate {
             pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
             tile: Some(16),
-            assign: Some("gather")
+            assign: Some("gather"),
+            depth_mask: None,
         }));
         assert!(!r.iter().any(|c| c.assign == Some("auto")));
+        // 2.5D culling for the top grid pipelines whose grids come from the depth buffer
+        // (the settings table's rule), not for tiled_forward (no depth bounds).
+        let masked: std::collections::BTreeSet<&str> = r
+            .iter()
+            .filter(|c| c.depth_mask == Some(DepthMask::On))
+            .map(|c| c.pipeline)
+            .collect();
+        assert_eq!(
+            masked,
+            [
+                lightgrid::pipelines::ids::CLUSTERED_FORWARD,
+                lightgrid::pipelines::ids::TILED_DEFERRED,
+            ]
+            .into()
+        );
+        let c = r
+            .iter()
+            .find(|c| c.depth_mask == Some(DepthMask::On))
+            .unwrap();
+        assert!(options(c).ends_with("--depth-mask on"), "{}", options(c));
     }
 
     #[test]

@@ -89,8 +89,14 @@ pub(crate) fn advise(adapter: Option<&str>, a: &AdviseArgs) -> Result<()> {
 }
 
 fn print_table(advice: &Advice) -> Result<()> {
+    // The configuration column as wide as its longest label.
+    let width = (advice.ranking.iter())
+        .map(|m| m.candidate.label().len())
+        .max()
+        .unwrap_or(0)
+        .max(44);
     outln!(
-        "{:<4} {:<44} {:>10} {:>9} {:>10} {:>10}  note",
+        "{:<4} {:<width$} {:>10} {:>9} {:>10} {:>10}  note",
         "rank",
         "configuration",
         "frame ms",
@@ -117,7 +123,7 @@ fn print_table(advice: &Advice) -> Result<()> {
             Outcome::Failed { reason } => ("-".into(), "-".into(), format!("failed: {reason}")),
         };
         outln!(
-            "{:<4} {:<44} {:>10} {:>9} {:>10} {:>10}  {}{}",
+            "{:<4} {:<width$} {:>10} {:>9} {:>10} {:>10}  {}{}",
             i + 1,
             m.candidate.label(),
             ms,
