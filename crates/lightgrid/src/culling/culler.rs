@@ -455,15 +455,8 @@ impl LightCuller {
         crate::frame::validate_tile_size(tile_size).map_err(config_error)?;
         crate::frame::validate_slices(slices).map_err(config_error)?;
         crate::frame::validate_msaa(config.samples).map_err(config_error)?;
-        if config.depth_mask == DepthMask::On && config.depth_bounds != DepthBounds::Both {
-            return refuse(
-                CullInput::Config,
-                format!(
-                    "depth_mask On needs depth_bounds Both (the mask's bins cut the samples' own bounds), not {:?}",
-                    config.depth_bounds
-                ),
-            );
-        }
+        crate::frame::validate_depth_mask(config.depth_mask, config.depth_bounds)
+            .map_err(config_error)?;
         if config.max_lights == 0 {
             return refuse(CullInput::Config, "max_lights must be at least 1");
         }

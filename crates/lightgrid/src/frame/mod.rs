@@ -11,9 +11,9 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_msaa, validate_slices, validate_tile_size, Assign, DepthBounds, DepthMask,
-    DepthReduction, GBufferFormat, GridLists, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
-    AUTO_GATHER_MAX_LIGHTS,
+    validate_depth_mask, validate_msaa, validate_slices, validate_tile_size, Assign, DepthBounds,
+    DepthMask, DepthReduction, GBufferFormat, GridLists, MaterialDraws, MsaaResolve,
+    RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};
 

@@ -209,16 +209,7 @@ impl RenderSettings {
             ));
         }
         validate_msaa(self.msaa)?;
-        if self.depth_mask == DepthMask::On && self.depth_bounds != DepthBounds::Both {
-            return Err(crate::error::Error::invalid(
-                "depth-mask",
-                format!(
-                    "on needs --depth-bounds both (the mask's bins cut the samples' own bounds), \
-                     not {}",
-                    self.depth_bounds.name()
-                ),
-            ));
-        }
+        validate_depth_mask(self.depth_mask, self.depth_bounds)?;
         validate_slices(self.slices)
     }
 }
@@ -243,6 +234,25 @@ pub fn validate_tile_size(tile_size: u32) -> crate::error::Result<()> {
         return Err(crate::error::Error::invalid(
             "tile size",
             format!("{tile_size}: must be between {MIN_TILE_SIZE} and {MAX_TILE_SIZE} pixels"),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuse 2.5D culling over bounds opened on a side: the mask's bins cut the samples' own
+/// bounds (the renderer's settings and `LightCuller`'s config both ask this).
+pub fn validate_depth_mask(
+    depth_mask: DepthMask,
+    depth_bounds: DepthBounds,
+) -> crate::error::Result<()> {
+    if depth_mask == DepthMask::On && depth_bounds != DepthBounds::Both {
+        return Err(crate::error::Error::invalid(
+            "depth-mask",
+            format!(
+                "on needs both depth bounds (the mask's bins cut the samples' own bounds), \
+                 not {}",
+                depth_bounds.name()
+            ),
         ));
     }
     Ok(())
