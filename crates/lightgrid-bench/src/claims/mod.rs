@@ -14,7 +14,7 @@ mod tiled_shading;
 use crate::report::run_name;
 use deferred_lighting::*;
 use forward_plus::*;
-use lightgrid::frame::DepthBounds;
+use lightgrid::frame::{DepthBounds, DepthMask};
 use serde::Serialize;
 use tiled_forward_shading::*;
 use tiled_shading::*;
@@ -162,7 +162,7 @@ fn find_bounds<'a>(
 }
 
 /// The one search the three above name: a run recorded without a depth-bounds setting
-/// culled by both bounds (the default).
+/// culled by both bounds (the default), and without 2.5D depth masks.
 fn find_run<'a>(
     r: &'a BenchResults,
     scene: &str,
@@ -177,6 +177,8 @@ fn find_run<'a>(
             && x.msaa() == samples
             && (x.gbuffer_bits().is_none() || x.gbuffer_bits() == bits.or(Some(16)))
             && x.varied::<DepthBounds>().unwrap_or_default() == bounds
+            // The papers' grids have no 2.5D masks (`--preset culling` measures both).
+            && x.varied::<DepthMask>().unwrap_or_default() == DepthMask::Off
     })
 }
 
