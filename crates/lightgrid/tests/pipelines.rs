@@ -1569,3 +1569,36 @@ fn cameras_the_depth_buffer_cannot_hold_are_refused() {
     }
     assert!(r.render(&with_planes(&s, 1e-20, 1e6), 0, REFERENCE).is_ok());
 }
+
+/// 2.5D culling on real content: the glTF room with its own camera, a 0.01 near plane and a
+/// 10^6 far plane, 120 km from the origin, with 256 lights added, at a size and tile no other
+/// test uses: every pipeline renders `forward`'s image with `--depth-mask on`.
+#[test]
+fn depth_masks_on_a_gltf_file_far_from_the_origin_with_a_tiny_near_plane() {
+    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
+    use lightgrid::scene::source::{add_lights, AddLights};
+    let bytes = common::gltf_fixture::room().glb();
+    let mut s = load_bytes(&bytes, "room.glb", None, &LoadOptions::default())
+        .unwrap()
+        .scene;
+    add_lights(
+        &mut s,
+        &AddLights {
+            count: 256,
+            range: None,
+        },
+        5,
+    )
+    .unwrap();
+    let s = with_planes(
+        &moved(&s, glam::Vec3::new(1.0e5, 30.0, -7.0e4)),
+        0.01,
+        1.0e6,
+    );
+    let masked = RenderSettings {
+        depth_mask: DepthMask::On,
+        slices: 24,
+        ..settings(9)
+    };
+    check(&s, 33, (217, 131), masked);
+}
