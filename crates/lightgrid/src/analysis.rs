@@ -31,7 +31,7 @@ pub struct FrameOutput {
     pub cell_bounds: Option<Vec<[f32; 2]>>,
     /// Each cell's 2.5D depth mask (`culling::NO_MASK` everywhere unless `--depth-mask on`);
     /// None for pipelines without a grid.
-    pub cell_masks: Option<Vec<crate::culling::CellMask>>,
+    pub cell_culls: Option<Vec<crate::culling::CellCull>>,
     /// The frame's depth buffer (row-major, reversed-Z: `crate::depth`); with MSAA its sample 0.
     pub depth: Vec<f32>,
     /// Every sample of the depth buffer, one plane per sample (one plane without MSAA).
@@ -291,11 +291,11 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
     };
     let grid_is_pipelines = a.grid.is_some();
     let assign_gpu_ms = a.finished.assign_gpu_ms.filter(|_| grid_is_pipelines);
-    let (grid, cell_bounds, cell_masks, assign, assign_cpu_ms) = match a.grid {
+    let (grid, cell_bounds, cell_culls, assign, assign_cpu_ms) = match a.grid {
         Some(b) => (
             b.grid,
             Some(b.cell_bounds),
-            Some(b.cell_masks),
+            Some(b.cell_culls),
             Some(b.assign.name().to_string()),
             Some(b.cpu_ms),
         ),
@@ -368,7 +368,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         grid,
         grid_is_pipelines,
         cell_bounds,
-        cell_masks,
+        cell_culls,
         depth,
         depth_samples,
         counts,

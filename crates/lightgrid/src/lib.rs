@@ -31,7 +31,7 @@ pub use culling::{
     LightCuller,
 };
 pub use error::{Error, Result};
-pub use frame::{DepthBounds, DepthMask, SpotCull};
+pub use frame::{CellBox, DepthBounds, DepthMask, SpotCull};
 pub use frame::{FinishedFrame, RenderSettings, SubmittedFrame};
 pub use renderer::{max_frame_edge, validate_size, Renderer, MAX_FRAMES_IN_FLIGHT};
 pub use stats::{Distribution, FrameStats, TimingSource};

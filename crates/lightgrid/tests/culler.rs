@@ -9,8 +9,8 @@
 
 use glam::{Mat4, Vec3};
 use lightgrid::{
-    CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullStrategy, DepthBounds,
-    DepthMask, LightCuller,
+    CellBox, CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullStrategy,
+    DepthBounds, DepthMask, LightCuller,
 };
 use wgpu::util::DeviceExt;
 
@@ -637,13 +637,14 @@ fn every_strategy_grid_and_depth_bounds_mode_lists_every_reaching_light() {
     }
 }
 
-/// 2.5D culling through the public API (`CullConfig::depth_mask`): every strategy and grid,
-/// with and without MSAA depth, lists every reaching light, and never more per sample than
-/// the same grid without masks. (This caller's depth has noise per sample, which fills every
-/// bin of a tile, so the masks drop next to nothing here; `tests/pipelines.rs` checks that
-/// they drop lights on the catalog's robots in front of the street.)
+/// 2.5D culling and tight cells through the public API (`CullConfig::depth_mask`,
+/// `CullConfig::cell_box`): every strategy and grid, with and without MSAA depth, lists every
+/// reaching light, and never more per sample than the same grid without them. (This caller's
+/// depth has noise per sample, which fills every bin of a tile, so the masks drop next to
+/// nothing here; `tests/pipelines.rs` checks that masks and boxes drop lights on the
+/// catalog's robots in front of the street.)
 #[test]
-fn depth_masks_list_every_reaching_light() {
+fn depth_masks_and_cell_boxes_list_every_reaching_light() {
     let (device, queue) = device();
     let eye = Vec3::new(3.0, 2.0, 10.0);
     let lights = lights(&camera(eye, false), 300, 17);
@@ -651,20 +652,33 @@ fn depth_masks_list_every_reaching_light() {
         let caller = Caller::new(&device, &queue, samples, camera(eye, false), &lights);
         for strategy in STRATEGIES {
             for grid in GRIDS {
-                let config = |depth_mask| CullConfig {
+                let config = |depth_mask, cell_box| CullConfig {
                     grid,
                     strategy,
                     samples,
                     depth_mask,
+                    cell_box,
                     ..CullConfig::default()
                 };
                 let what = format!("{strategy:?} {grid:?} MSAA {samples}");
-                let on = check(&caller, config(DepthMask::On), &format!("{what} mask on"));
-                let off = check(&caller, config(DepthMask::Off), &format!("{what} mask off"));
-                assert!(
-                    on <= off,
-                    "{what}: {on:.2} listed with masks, {off:.2} without"
+                let off = check(
+                    &caller,
+                    config(DepthMask::Off, CellBox::Off),
+                    &format!("{what} plain"),
                 );
+                for (mask, cell_box) in
+                    [(DepthMask::On, CellBox::Off), (DepthMask::Off, CellBox::On)]
+                {
+                    let on = check(
+                        &caller,
+                        config(mask, cell_box),
+                        &format!("{what} mask {} box {}", mask.name(), cell_box.name()),
+                    );
+                    assert!(
+                        on <= off,
+                        "{what}: {on:.2} listed with mask {mask:?} box {cell_box:?}, {off:.2} without"
+                    );
+                }
             }
         }
     }
@@ -1041,6 +1055,11 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         CullConfig {
             depth_mask: DepthMask::On,
             depth_bounds: DepthBounds::Min,
+            ..CullConfig::default()
+        },
+        CullConfig {
+            cell_box: CellBox::On,
+            depth_bounds: DepthBounds::None,
             ..CullConfig::default()
         },
     ] {

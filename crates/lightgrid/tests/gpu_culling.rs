@@ -10,7 +10,7 @@
 mod common;
 
 use lightgrid::culling::ViewSetup;
-use lightgrid::frame::DepthMask;
+use lightgrid::frame::{CellBox, DepthMask};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{LightAnchor, Rng, Scene, SceneLight};
 use lightgrid::{RenderSettings, Renderer};
@@ -32,6 +32,8 @@ struct Config {
     lights: usize,
     /// 2.5D culling (`--depth-mask`).
     depth_mask: DepthMask,
+    /// Tight cells (`--cell-box`).
+    cell_box: CellBox,
 }
 
 /// What the scenes of a run measured, for the bounds at the end.
@@ -44,6 +46,8 @@ struct Totals {
     disagreements: usize,
     /// Opaque cells whose 2.5D mask left bins out (`--depth-mask on`).
     masked_cells: usize,
+    /// Opaque cells with a tight box (`--cell-box on`).
+    boxed_cells: usize,
     /// Seconds spent rendering (and downloading), per strategy, and checking on the CPU.
     render_s: Vec<f64>,
     check_s: f64,
@@ -96,6 +100,7 @@ fn run(
                     slices: config.slices,
                     assign,
                     depth_mask: config.depth_mask,
+                    cell_box: config.cell_box,
                     ..Default::default()
                 };
                 Renderer::new(ctx, w, h, settings).unwrap()
@@ -119,13 +124,14 @@ fn run(
             for (si, (assign, r)) in strategies.iter().zip(&mut renderers).enumerate() {
                 let what = format!(
                     "scene {k} of config {ci} ({} f{frame}, {} --assign {} {w}x{h} tile {} \
-                     slices {} mask {})",
+                     slices {} mask {} box {})",
                     scene.name,
                     config.pipeline,
                     assign.name(),
                     config.tile,
                     config.slices,
-                    config.depth_mask.name()
+                    config.depth_mask.name(),
+                    config.cell_box.name()
                 );
                 let t = Instant::now();
                 let out = r.render(&scene, frame, config.pipeline).unwrap();
@@ -142,27 +148,33 @@ fn run(
                 if !near_far {
                     common::check_cell_bounds(&what, &setup, &grid.dims, bounds, &out.depth, 2);
                 }
-                let masks = out
-                    .cell_masks
+                let culls = out
+                    .cell_culls
                     .as_deref()
-                    .expect("a grid pipeline reports its masks");
+                    .expect("a grid pipeline reports its culling records");
                 let planes: Vec<&[f32]> = out.depth_samples.iter().map(|p| &p[..]).collect();
-                totals.masked_cells += common::check_cell_masks(
+                let seen = common::check_cell_culls(
                     &what,
                     &setup,
                     &grid.dims,
-                    masks,
+                    culls,
+                    bounds,
                     &planes,
-                    config.depth_mask == DepthMask::On,
+                    (
+                        config.depth_mask == DepthMask::On,
+                        config.cell_box == CellBox::On,
+                    ),
                     !near_far,
                 );
+                totals.masked_cells += seen.partial_masks;
+                totals.boxed_cells += seen.boxes;
                 totals.disagreements += common::check_grid_against_twin(
                     &what,
                     *assign,
                     &setup,
                     grid,
                     &lights,
-                    (bounds, Some(masks)),
+                    (bounds, Some(culls)),
                     near_far,
                     4,
                 );
@@ -215,6 +227,7 @@ fn gpu_strategies_contain_the_oracle_in_small_randomized_scenes() {
             scenes: 5,
             lights: 240,
             depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
         })
         .collect();
     let mut totals = Totals::default();
@@ -265,6 +278,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
             scenes: 2,
             lights: 240,
             depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
         },
         Config {
             size: (1280, 720),
@@ -274,6 +288,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
             scenes: 1,
             lights: 240,
             depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
         },
         Config {
             size: (1280, 720),
@@ -283,6 +298,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
             scenes: 1,
             lights: 240,
             depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
         },
     ];
     let mut totals = Totals::default();
@@ -318,7 +334,7 @@ fn gpu_strategies_contain_the_oracle_at_1280x720_with_8_pixel_tiles() {
 /// on the pipelines whose grids come from the depth buffer, odd sizes and every tile size,
 /// tiled and clustered, with the glass's transparent lists: every strategy's grid holds every
 /// light the oracle finds reaching a sample, equals its twin fed with the GPU's masks, and the
-/// masks hold every sample's bin (`common::check_cell_masks`). The catalog's backdrops put
+/// masks hold every sample's bin (`common::check_cell_culls`). The catalog's backdrops put
 /// robots in front of the street, so tiles straddle depth discontinuities: the masks must
 /// leave bins out in many cells, or the test would not exercise them.
 #[test]
@@ -338,6 +354,7 @@ fn gpu_strategies_with_depth_masks_contain_the_oracle() {
             scenes: 3,
             lights: 240,
             depth_mask: DepthMask::On,
+            cell_box: CellBox::Off,
         })
         .collect();
     let mut totals = Totals::default();
@@ -358,4 +375,54 @@ fn gpu_strategies_with_depth_masks_contain_the_oracle() {
         totals.masked_cells
     );
     assert!(totals.hits >= 10_000, "{} oracle hits", totals.hits);
+}
+
+/// Tight cells (`--cell-box on`), alone and with 2.5D masks: over randomized lights at odd
+/// sizes, tiled and clustered, with the glass's transparent lists, every strategy's grid
+/// holds every light the oracle finds reaching a sample, equals its twin fed with the GPU's
+/// boxes, and every occupied opaque cell's box holds its samples' footprints and no more
+/// (`common::check_cell_culls`).
+#[test]
+fn gpu_strategies_with_cell_boxes_contain_the_oracle() {
+    let ctx = common::gpu();
+    let mut rng = Rng::new(31);
+    let depth_pipelines: Vec<&str> = common::grid_pipelines()
+        .into_iter()
+        .filter(|id| *id != "tiled_forward")
+        .collect();
+    let configs: Vec<Config> = (0..8)
+        .map(|i| Config {
+            size: (64 + 2 * rng.below(68) + 1, 48 + 2 * rng.below(51) + 1),
+            tile: TILES[(3 * i + 2) % TILES.len()],
+            slices: [1, 8, 1, 32][i % 4],
+            pipeline: depth_pipelines[(i + 1) % depth_pipelines.len()],
+            scenes: 3,
+            lights: 240,
+            depth_mask: [DepthMask::Off, DepthMask::On][(i / 2) % 2],
+            cell_box: CellBox::On,
+        })
+        .collect();
+    let mut totals = Totals::default();
+    run(&ctx, &configs, (2525, &SceneParams::default()), &mut totals);
+    eprintln!(
+        "cell boxes: scenes per strategy {:?}, {} oracle hits checked, {} twin \
+         disagreements, {} cells with a box, {:?}",
+        totals.scenes, totals.hits, totals.disagreements, totals.boxed_cells, totals.coverage
+    );
+    assert!(
+        totals.scenes.iter().all(|&n| n == 24),
+        "{:?}",
+        totals.scenes
+    );
+    assert!(
+        totals.boxed_cells >= 1000,
+        "only {} cells had a box",
+        totals.boxed_cells
+    );
+    assert!(totals.hits >= 10_000, "{} oracle hits", totals.hits);
+    let c = &totals.coverage;
+    assert!(
+        c.behind > 0 && c.crossing_near > 0 && c.off_screen > 0 && c.partial_tiles > 0,
+        "the lights missed a case: {c:?}"
+    );
 }

@@ -10,7 +10,7 @@
 mod common;
 
 use lightgrid::culling::{LightGrid, ViewSetup};
-use lightgrid::frame::{DepthBounds, DepthMask, GridLists};
+use lightgrid::frame::{CellBox, DepthBounds, DepthMask, GridLists};
 use lightgrid::image_io::{diff, save_png};
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::Assign;
@@ -619,18 +619,22 @@ fn check_assign(
             r.settings().depth_bounds,
         );
     }
-    let masks = out
-        .cell_masks
+    let culls = out
+        .cell_culls
         .as_deref()
-        .expect("a grid pipeline reports its masks");
+        .expect("a grid pipeline reports its culling records");
     let planes: Vec<&[f32]> = out.depth_samples.iter().map(|p| &p[..]).collect();
-    common::check_cell_masks(
+    common::check_cell_culls(
         &what,
         &setup,
         &grid.dims,
-        masks,
+        culls,
+        &bounds,
         &planes,
-        r.settings().depth_mask == DepthMask::On && !near_far,
+        (
+            r.settings().depth_mask == DepthMask::On && !near_far,
+            r.settings().cell_box == CellBox::On && !near_far,
+        ),
         r.settings().msaa == 1 || !lightgrid::pipelines::find(id).unwrap().forward_shading,
     );
     common::check_grid_against_twin(
@@ -639,7 +643,7 @@ fn check_assign(
         &setup,
         grid,
         &state.lights,
-        (&bounds, Some(masks)),
+        (&bounds, Some(culls)),
         near_far,
         4,
     );
@@ -796,6 +800,47 @@ fn depth_bound_modes_open_the_bounds_and_keep_the_image() {
 /// must drop lights.
 #[test]
 fn depth_masks_keep_the_image_and_only_drop_lights() {
+    sample_culling_keeps_the_image_and_only_drops_lights(
+        "masks",
+        |s| RenderSettings {
+            depth_mask: DepthMask::On,
+            ..s
+        },
+        &["tiled_forward_prez", "tiled_deferred"],
+    );
+}
+
+/// Tight cells (`--cell-box on`) as the masks above: every depth-bounded grid pipeline with
+/// every strategy equals the reference, its twin fed with the GPU's boxes and the oracle; the
+/// boxes hold every sample's footprint and no more; the image is the plain grid's and the
+/// lighting computations fewer on every pipeline, tiled and clustered (the box of a cell's
+/// samples is smaller than its frustum piece almost everywhere).
+#[test]
+fn cell_boxes_keep_the_image_and_only_drop_lights() {
+    sample_culling_keeps_the_image_and_only_drops_lights(
+        "boxes",
+        |s| RenderSettings {
+            cell_box: CellBox::On,
+            ..s
+        },
+        &[
+            "tiled_forward_prez",
+            "tiled_deferred",
+            "clustered_forward",
+            "clustered_deferred",
+        ],
+    );
+}
+
+/// A per-sample culling setting (`on` turns it on) against the same grid without it, on
+/// robots-many with every strategy: the image and grid checks of `check_assign`, the same
+/// image within 1 level, never more lighting computations, and fewer on each of `must_drop`
+/// with every strategy.
+fn sample_culling_keeps_the_image_and_only_drops_lights(
+    name: &str,
+    on: fn(RenderSettings) -> RenderSettings,
+    must_drop: &[&str],
+) {
     let ctx = common::gpu();
     let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
     let (w, h, frame) = (203, 117, 120);
@@ -814,17 +859,16 @@ fn depth_masks_keep_the_image_and_only_drop_lights() {
                 .image
         });
     }
-    let with = |assign, depth_mask| RenderSettings {
+    let plain = |assign| RenderSettings {
         tile_size: 12,
         slices: 16,
         assign,
-        depth_mask,
         ..Default::default()
     };
     let mut fewer = std::collections::HashMap::new();
     for assign in common::strategies() {
-        let mut on = Renderer::new(&ctx, w, h, with(assign, DepthMask::On)).unwrap();
-        let mut off = Renderer::new(&ctx, w, h, with(assign, DepthMask::Off)).unwrap();
+        let mut on = Renderer::new(&ctx, w, h, on(plain(assign))).unwrap();
+        let mut off = Renderer::new(&ctx, w, h, plain(assign)).unwrap();
         for id in &ids {
             let reference = &references[lightgrid::pipelines::find(id).unwrap().reference];
             check_assign(&mut on, &s, frame, id, reference);
@@ -837,30 +881,31 @@ fn depth_masks_keep_the_image_and_only_drop_lights() {
             let what = format!("{id} --assign {}", assign.name());
             assert!(
                 masked <= plain,
-                "{what}: {masked} with masks, {plain} without"
+                "{what}: {masked} with {name}, {plain} without"
             );
             let (d, _) = diff(&masked_image, &plain_image).unwrap();
-            assert!(d.max <= 1.0, "{what}: the masks changed the image: {d:?}");
+            assert!(d.max <= 1.0, "{what}: the {name} changed the image: {d:?}");
             if masked < plain {
                 *fewer.entry(*id).or_insert(0) += 1;
             }
         }
     }
-    for id in ["tiled_forward_prez", "tiled_deferred"] {
+    for id in must_drop {
         assert_eq!(
             fewer.get(id),
             Some(&common::strategies().len()),
-            "{id}: the masks dropped no light with some strategy ({fewer:?})"
+            "{id}: the {name} dropped no light with some strategy ({fewer:?})"
         );
     }
 }
 
-/// 2.5D culling with 4x MSAA (every sample's bin, and with forward shading every fragment's
-/// range) and with one shared list for opaque and transparent fragments (the transparent
-/// range sets every bin it covers): the image equals the same grid's without masks, the count
-/// never exceeds it, and the grid holds the oracle's lights.
+/// 2.5D culling and tight cells together with 4x MSAA (every sample's bin and footprint, and
+/// with forward shading every fragment's range: its bins and its tile over the range) and with
+/// one shared list for opaque and transparent fragments (the transparent range sets every bin
+/// it covers and widens the box by its tile over it): the image equals the same grid's
+/// without either, the count never exceeds it, and the grid holds the oracle's lights.
 #[test]
-fn depth_masks_with_msaa_and_shared_lists() {
+fn depth_masks_and_cell_boxes_with_msaa_and_shared_lists() {
     let ctx = common::gpu();
     let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
     let (w, h, frame) = (161, 93, 200);
@@ -873,17 +918,18 @@ fn depth_masks_with_msaa_and_shared_lists() {
             panic!("the adapter offers no {msaa}x MSAA");
         }
         for assign in [Assign::Cpu, Assign::Gather, Assign::Scatter] {
-            let with = |depth_mask| RenderSettings {
+            let with = |depth_mask, cell_box| RenderSettings {
                 tile_size: 16,
                 slices: 16,
                 assign,
                 msaa,
                 lists,
                 depth_mask,
+                cell_box,
                 ..Default::default()
             };
-            let mut on = Renderer::new(&ctx, w, h, with(DepthMask::On)).unwrap();
-            let mut off = Renderer::new(&ctx, w, h, with(DepthMask::Off)).unwrap();
+            let mut on = Renderer::new(&ctx, w, h, with(DepthMask::On, CellBox::On)).unwrap();
+            let mut off = Renderer::new(&ctx, w, h, with(DepthMask::Off, CellBox::Off)).unwrap();
             for id in [
                 "tiled_forward_prez",
                 "clustered_forward",
@@ -899,13 +945,14 @@ fn depth_masks_with_msaa_and_shared_lists() {
                 let state = s.frame(frame);
                 let setup = ViewSetup::new(&state.camera, w, h);
                 let planes: Vec<&[f32]> = a.depth_samples.iter().map(|p| &p[..]).collect();
-                common::check_cell_masks(
+                common::check_cell_culls(
                     &what,
                     &setup,
                     &a.grid.dims,
-                    a.cell_masks.as_deref().unwrap(),
+                    a.cell_culls.as_deref().unwrap(),
+                    a.cell_bounds.as_deref().unwrap(),
                     &planes,
-                    true,
+                    (true, true),
                     msaa == 1 || id.ends_with("deferred"),
                 );
                 common::check_grid_contains_oracle(&what, &setup, &a.grid, &state.lights, &a.depth);
@@ -913,9 +960,12 @@ fn depth_masks_with_msaa_and_shared_lists() {
                     a.stats.lighting_computations.unwrap(),
                     b.stats.lighting_computations.unwrap(),
                 );
-                assert!(m <= p, "{what}: {m} with masks, {p} without");
+                assert!(m <= p, "{what}: {m} with masks and boxes, {p} without");
                 let (d, _) = diff(&a.image, &b.image).unwrap();
-                assert!(d.max <= 1.0, "{what}: the masks changed the image: {d:?}");
+                assert!(
+                    d.max <= 1.0,
+                    "{what}: masks and boxes changed the image: {d:?}"
+                );
             }
         }
     }

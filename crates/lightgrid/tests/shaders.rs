@@ -3,7 +3,7 @@
 //! early depth test; every shader starts with the constants prelude.
 
 use lightgrid::consts::{MSAA_COUNTS, WGSL_CONSTS};
-use lightgrid::frame::{DepthBounds, DepthMask, DepthReduction};
+use lightgrid::frame::{CellBox, DepthBounds, DepthMask, DepthReduction};
 use lightgrid::passes::GBufferLayout;
 use lightgrid::pipelines::all_shaders;
 use lightgrid::pipelines::PIPELINES;
@@ -38,7 +38,7 @@ fn stage<'a>(shaders: &'a [ComposedShader], stage: &str) -> Vec<&'a ComposedShad
 }
 
 /// Each keyed stage is composed for every value its key can take: every MSAA count the
-/// renderer can request, every depth-bounds × reduction × depth mask, every G-buffer layout, each once.
+/// renderer can request, every depth-bounds × reduction × depth mask × cell box, every G-buffer layout, each once.
 #[test]
 fn every_key_value_is_composed_once() {
     let shaders = all_shaders();
@@ -50,7 +50,10 @@ fn every_key_value_is_composed_once() {
     let expected = [
         (
             "cell_bounds",
-            msaa * DepthBounds::ALL.len() * DepthReduction::ALL.len() * DepthMask::ALL.len(),
+            msaa * DepthBounds::ALL.len()
+                * DepthReduction::ALL.len()
+                * DepthMask::ALL.len()
+                * CellBox::ALL.len(),
         ),
         ("depth_range", msaa),
         ("tonemap", msaa),

@@ -19,8 +19,9 @@
 // dispatched indirectly, one workgroup per entry.
 @group(1) @binding(5) var<storage, read> occupied_cells: array<u32>;
 @group(1) @binding(6) var<storage, read> occupancy: array<u32, 4>;
-// Each cell's 2.5D depth mask (depth_mask.wgsl; no mask unless `--depth-mask on`).
-@group(1) @binding(7) var<storage, read> cell_masks: array<vec4<u32>>;
+// Each cell's 2.5D depth mask and tight box (cell_box.wgsl; neither unless `--depth-mask on`
+// / `--cell-box on`).
+@group(1) @binding(7) var<storage, read> cell_culls: array<CellCull>;
 
 // The cell a per-cell workgroup works on, or NO_CELL for a workgroup past the end of its list
 // (the dispatch is rounded up to whole rows). `spill`: the spill pass's list.
@@ -48,7 +49,10 @@ fn cell_frustum(c: u32) -> TileFrustum {
     let tile = c % (grid.tiles_x * grid.tiles_y);
     let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);
     var f = tile_frustum(xy, grid.tile_size, cell_bounds[c]);
-    f.mask = cell_masks[c];
+    let cull = cell_culls[c];
+    f.mask = cull.mask;
+    f.box_lo = cull.lo;
+    f.box_hi = cull.hi;
     return f;
 }
 

@@ -14,7 +14,7 @@
 use super::strategy::check_index_capacity;
 use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{depth_mask_meets, CellMask, GridDims, LightGrid, ViewLight, ViewSetup};
+use super::{depth_mask_meets, CellCull, GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -43,9 +43,10 @@ pub enum DepthRange<'a> {
     /// goes into the clusters of its rectangle whose slices its view-depth interval spans and
     /// whose samples' bounds it overlaps.
     Cells(&'a [[f32; 2]]),
-    /// As `Cells`, with each cell's 2.5D depth mask (`--depth-mask on`, `depth_mask.rs`): a
-    /// light must also meet a bin of the cell holding samples.
-    Masked(&'a [[f32; 2]], &'a [CellMask]),
+    /// As `Cells`, with each cell's culling record (`cell_box.rs`): with `--depth-mask on` a
+    /// light must also meet a bin of the cell holding samples (`depth_mask.rs`), with
+    /// `--cell-box on` its sphere must reach the cell's box.
+    Culled(&'a [[f32; 2]], &'a [CellCull]),
 }
 
 impl<'a> DepthRange<'a> {
@@ -53,7 +54,7 @@ impl<'a> DepthRange<'a> {
     fn bounds(&self) -> Option<&'a [[f32; 2]]> {
         match *self {
             DepthRange::NearFar => None,
-            DepthRange::Cells(b) | DepthRange::Masked(b, _) => Some(b),
+            DepthRange::Cells(b) | DepthRange::Culled(b, _) => Some(b),
         }
     }
 }
@@ -151,7 +152,7 @@ pub fn cell_spheres(
                 setup.cell_sphere(dims.tile_rect(t), lo, hi)
             })
             .collect(),
-        DepthRange::Cells(bounds) | DepthRange::Masked(bounds, _) => bounds
+        DepthRange::Cells(bounds) | DepthRange::Culled(bounds, _) => bounds
             .iter()
             .enumerate()
             .map(|(cell, &[lo, hi])| {
@@ -212,8 +213,17 @@ pub fn assign_cpu(
     let overlaps = |p: &Placed, lo: f32, hi: f32| {
         lo <= hi && p.w_max >= lo * (1.0 - DEPTH_SLACK) && p.w_min <= hi * (1.0 + DEPTH_SLACK)
     };
-    let in_mask = |p: &Placed, cell: usize| match depth {
-        DepthRange::Masked(_, masks) => depth_mask_meets(&masks[cell], p.w_min, p.w_max),
+    // `sphere_meets_box` in WGSL: the same `d`, compared squared.
+    let in_cull = |p: &Placed, cell: usize| match depth {
+        DepthRange::Culled(_, culls) => {
+            let m = &culls[cell];
+            depth_mask_meets(&m.mask, p.w_min, p.w_max)
+                && m.view_box().is_none_or(|(lo, hi)| {
+                    let (c, r) = (p.view.center, p.view.radius);
+                    let d = (lo - c).max(Vec3::ZERO).max(c - hi);
+                    d.dot(d) <= r * r
+                })
+        }
         _ => true,
     };
     // Spots culled by their cone test it against each cell's bounding sphere.
@@ -251,7 +261,7 @@ pub fn assign_cpu(
                                         layer * dims.layer_cells() + k as usize * tiles + tile;
                                     let [lo, hi] = bounds[cell];
                                     if overlaps(p, lo, hi)
-                                        && in_mask(p, cell)
+                                        && in_cull(p, cell)
                                         && cone_reaches(p, cell)
                                     {
                                         out.push((cell as u32, l));
@@ -307,10 +317,12 @@ impl AssignStrategy for CpuStrategy {
         if depth {
             parts.push((a.bounds.buffer(), (a.dims.cell_count() * 8) as u64));
         }
-        // The masks only where the kernel computes them (`--depth-mask on`).
-        let masked = depth && a.bounds.masked();
-        if masked {
-            parts.push((a.bounds.mask_buffer(), (a.dims.cell_count() * 16) as u64));
+        // The masks and boxes only where the kernel computes them (`--depth-mask on`,
+        // `--cell-box on`).
+        let culled = depth && a.bounds.culled();
+        if culled {
+            let bytes = a.dims.cell_count() * std::mem::size_of::<CellCull>();
+            parts.push((a.bounds.cull_buffer(), bytes as u64));
         }
         if let Some(range) = a.range {
             parts.extend(range.readback());
@@ -318,7 +330,7 @@ impl AssignStrategy for CpuStrategy {
         let bytes = enc.download_all(&parts)?;
         let cell_bounds: Option<Vec<[f32; 2]>> =
             depth.then(|| bytemuck::pod_collect_to_vec(&bytes[0]));
-        let masks: Option<Vec<CellMask>> = masked.then(|| bytemuck::pod_collect_to_vec(&bytes[1]));
+        let culls: Option<Vec<CellCull>> = culled.then(|| bytemuck::pod_collect_to_vec(&bytes[1]));
         let dims = &match a.range {
             Some(_) => {
                 super::depth_range::sliced(a.dims, &bytes[parts.len() - 2], &bytes[parts.len() - 1])
@@ -326,8 +338,8 @@ impl AssignStrategy for CpuStrategy {
             None => *a.dims,
         };
         let start = Instant::now();
-        let range = match (&cell_bounds, &masks) {
-            (Some(b), Some(m)) => DepthRange::Masked(b, m),
+        let range = match (&cell_bounds, &culls) {
+            (Some(b), Some(m)) => DepthRange::Culled(b, m),
             (Some(b), None) => DepthRange::Cells(b),
             _ => DepthRange::NearFar,
         };
@@ -339,7 +351,7 @@ impl AssignStrategy for CpuStrategy {
             cpu_ms,
             cpu_grid: Some(grid),
             cell_bounds,
-            cell_masks: masks,
+            cell_culls: culls,
         })
     }
 }

@@ -50,6 +50,8 @@ pub struct GridSetup<'a> {
     pub depth_reduction: crate::frame::DepthReduction,
     /// 2.5D culling (`--depth-mask`).
     pub depth_mask: crate::frame::DepthMask,
+    /// Tight cells (`--cell-box`).
+    pub cell_box: crate::frame::CellBox,
     /// Index entries the lists start with (`GridBuffers::INITIAL_INDEX_CAPACITY`); they grow
     /// from the frame counters.
     pub index_capacity: u64,
@@ -60,8 +62,9 @@ pub struct BuiltGrid {
     pub grid: LightGrid,
     /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
     pub cell_bounds: Vec<[f32; 2]>,
-    /// Each cell's 2.5D depth mask (`depth_mask.rs`; no mask unless `--depth-mask on`).
-    pub cell_masks: Vec<super::CellMask>,
+    /// Each cell's 2.5D depth mask and tight box (`cell_box.rs`; neither unless
+    /// `--depth-mask on` / `--cell-box on`).
+    pub cell_culls: Vec<super::CellCull>,
     /// The strategy that ran (`auto` resolved).
     pub assign: Assign,
     /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
@@ -75,7 +78,7 @@ struct LastFrame {
     cpu_ms: f64,
     cpu_grid: Option<LightGrid>,
     cell_bounds: Option<Vec<[f32; 2]>>,
-    cell_masks: Option<Vec<super::CellMask>>,
+    cell_culls: Option<Vec<super::CellCull>>,
     /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
     near_far: [f32; 2],
 }
@@ -121,6 +124,7 @@ impl GridBuilder {
                     depth_bounds: ctx.depth_bounds,
                     reduction: ctx.depth_reduction,
                     depth_mask: ctx.depth_mask,
+                    cell_box: ctx.cell_box,
                 },
                 ctx.forward_opaque,
             ),
@@ -255,7 +259,7 @@ impl GridBuilder {
             cpu_ms: run.cpu_ms,
             cpu_grid: run.cpu_grid,
             cell_bounds: run.cell_bounds,
-            cell_masks: run.cell_masks,
+            cell_culls: run.cell_culls,
             near_far: [f.setup.near, f.setup.far],
         });
         Ok(())
@@ -314,15 +318,15 @@ impl GridBuilder {
             }
             (None, CellSource::Depth) => self.bounds.read(device, queue)?,
         };
-        let cell_masks = match (&last.cell_masks, self.source) {
+        let cell_culls = match (&last.cell_culls, self.source) {
             (Some(m), _) => m.clone(),
-            (None, CellSource::NearFar) => vec![super::NO_MASK; last.dims.cell_count()],
-            (None, CellSource::Depth) => self.bounds.read_masks(device, queue)?,
+            (None, CellSource::NearFar) => vec![super::NO_CULL; last.dims.cell_count()],
+            (None, CellSource::Depth) => self.bounds.read_culls(device, queue)?,
         };
         Ok(BuiltGrid {
             grid,
             cell_bounds,
-            cell_masks,
+            cell_culls,
             assign: last.assign,
             cpu_ms: last.cpu_ms,
         })

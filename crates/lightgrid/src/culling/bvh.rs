@@ -191,14 +191,14 @@ pub fn traverse_bvh_cpu(
     dims: &GridDims,
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
-    masks: Option<&[super::CellMask]>,
+    culls: Option<&[super::CellCull]>,
     bvh: &LightBvh,
 ) -> LightGrid {
     let views: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
     let lists: Vec<Vec<u32>> = (0..dims.cell_count())
         .into_par_iter()
         .map(|c| {
-            let f = cell_frustum(setup, dims, c, cell_bounds, masks);
+            let f = cell_frustum(setup, dims, c, cell_bounds, culls);
             let mut out = Vec::new();
             let mut stack = Vec::new();
             if bvh.nodes.first().is_some_and(|root| box_in_cell(&f, root)) {

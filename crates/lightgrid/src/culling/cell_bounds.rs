@@ -12,10 +12,10 @@
 //! both sides of every cell, to the cell's slice: twin [`open_bounds`].
 
 use super::CullFrame;
-use super::{CellMask, GridDims, GridLists, ViewSetup};
+use super::{CellCull, GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
-use crate::frame::{DepthBounds, DepthMask, DepthReduction, FrameEncoder};
+use crate::frame::{CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::shader::{compute_pipeline, every_sample_count, msaa_defs, src, Def, ShaderKey};
 
@@ -31,6 +31,7 @@ pub(crate) struct CellBoundsKey {
     pub depth_bounds: DepthBounds,
     pub reduction: DepthReduction,
     pub depth_mask: DepthMask,
+    pub cell_box: CellBox,
 }
 
 impl ShaderKey for CellBoundsKey {
@@ -42,12 +43,15 @@ impl ShaderKey for CellBoundsKey {
             for depth_bounds in DepthBounds::ALL {
                 for reduction in DepthReduction::ALL {
                     for depth_mask in DepthMask::ALL {
-                        out.push(CellBoundsKey {
-                            samples,
-                            depth_bounds,
-                            reduction,
-                            depth_mask,
-                        });
+                        for cell_box in CellBox::ALL {
+                            out.push(CellBoundsKey {
+                                samples,
+                                depth_bounds,
+                                reduction,
+                                depth_mask,
+                                cell_box,
+                            });
+                        }
                     }
                 }
             }
@@ -63,6 +67,7 @@ impl ShaderKey for CellBoundsKey {
             self.reduction == DepthReduction::Subgroup,
         ));
         defs.push(Def::Bool("DEPTH_MASK", self.depth_mask == DepthMask::On));
+        defs.push(Def::Bool("CELL_BOX", self.cell_box == CellBox::On));
         defs
     }
 
@@ -72,7 +77,7 @@ impl ShaderKey for CellBoundsKey {
             src::SCENE_BINDINGS,
             src::GRID_CELL,
             src::MSAA,
-            super::DEPTH_MASK_WGSL,
+            super::CELL_CULL_WGSL,
             include_str!("cell_bounds.wgsl"),
         ]
     }
@@ -105,6 +110,9 @@ pub fn open_bounds(
 }
 
 /// The bounds of a cell without samples.
+/// Bytes of one cell's culling record (`CellCull`: mask and box).
+const CULL_BYTES: usize = std::mem::size_of::<CellCull>();
+
 pub const EMPTY_CELL: [f32; 2] = [f32::INFINITY, 0.0];
 
 /// CPU twin of the kernel: the same inputs (depth-buffer values in [0, 1], 1 = no sample,
@@ -199,10 +207,11 @@ pub struct CellBoundsPass {
     bounds: wgpu::Buffer,
     occupied: wgpu::Buffer,
     occupancy: wgpu::Buffer,
-    /// Each cell's 2.5D depth mask (`depth_mask.rs`; no mask without `--depth-mask on`).
-    masks: wgpu::Buffer,
-    /// `--depth-mask on`: the kernel fills `masks` (else every cell has none).
-    masked: bool,
+    /// Each cell's 2.5D depth mask and tight box (`cell_box.rs`: `CellCull`, 48 bytes; neither
+    /// without `--depth-mask on` / `--cell-box on`).
+    culls: wgpu::Buffer,
+    /// `--depth-mask on` or `--cell-box on`: the kernel fills `culls` with something to read.
+    culled: bool,
     cells: usize,
 }
 
@@ -266,8 +275,8 @@ impl CellBoundsPass {
                     | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            masks: storage_buffer(device, "cell depth masks", 1 << 15),
-            masked: key.depth_mask == DepthMask::On,
+            culls: storage_buffer(device, "cell culls", (CULL_BYTES as u64) << 10),
+            culled: key.depth_mask == DepthMask::On || key.cell_box == CellBox::On,
             cells: 0,
         }
     }
@@ -282,9 +291,9 @@ impl CellBoundsPass {
         );
         grow_storage(
             device,
-            &mut self.masks,
-            "cell depth masks",
-            (self.cells * 16) as u64,
+            &mut self.culls,
+            "cell culls",
+            (self.cells * CULL_BYTES) as u64,
         );
         grow_storage(
             device,
@@ -319,7 +328,7 @@ impl CellBoundsPass {
                 self.occupied.as_entire_binding(),
                 self.occupancy.as_entire_binding(),
                 fragment_bounds.as_entire_binding(),
-                self.masks.as_entire_binding(),
+                self.culls.as_entire_binding(),
             ],
         );
         encoder.clear_buffer(&self.occupancy, 0, None);
@@ -343,8 +352,8 @@ impl CellBoundsPass {
         self.ensure(device, dims);
         let all = vec![range; self.cells];
         queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&all));
-        let masks = vec![super::NO_MASK; self.cells];
-        queue.write_buffer(&self.masks, 0, bytemuck::cast_slice(&masks));
+        let culls = vec![super::NO_CULL; self.cells];
+        queue.write_buffer(&self.culls, 0, bytemuck::cast_slice(&culls));
         let list: Vec<u32> = (0..self.cells as u32).collect();
         queue.write_buffer(&self.occupied, 0, bytemuck::cast_slice(&list));
         let n = self.cells as u32;
@@ -362,14 +371,14 @@ impl CellBoundsPass {
         &self.bounds
     }
 
-    /// Whether the kernel computes depth masks (`--depth-mask on`).
-    pub fn masked(&self) -> bool {
-        self.masked
+    /// Whether the kernel computes depth masks or boxes (`--depth-mask on`, `--cell-box on`).
+    pub fn culled(&self) -> bool {
+        self.culled
     }
 
-    /// The cells' 2.5D depth masks (`array<vec4<u32>>`, one per cell: `depth_mask.rs`).
-    pub fn mask_buffer(&self) -> &wgpu::Buffer {
-        &self.masks
+    /// The cells' culling records (`array<CellCull>`, one per cell: `cell_box.rs`).
+    pub fn cull_buffer(&self) -> &wgpu::Buffer {
+        &self.culls
     }
 
     /// The occupied cells (`array<u32>`, in no particular order).
@@ -390,9 +399,9 @@ impl CellBoundsPass {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    /// The masks of the last recorded frame (as [`CellBoundsPass::read`]).
-    pub fn read_masks(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<CellMask>> {
-        let bytes = download(device, queue, &self.masks, (self.cells * 16) as u64)?;
+    /// The culling records of the last recorded frame (as [`CellBoundsPass::read`]).
+    pub fn read_culls(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<CellCull>> {
+        let bytes = download(device, queue, &self.culls, (self.cells * CULL_BYTES) as u64)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 }

@@ -18,10 +18,70 @@
 // With MSAA, the bounds of the fragments each cell's shading will look up
 // (`fragment_bounds.wgsl`: (0xffffffff - min bits, max bits), zero = none); unused without.
 @group(1) @binding(5) var<storage, read> fragment_bounds: array<u32>;
-// Each cell's 2.5D depth mask (depth_mask.wgsl): with DEPTH_MASK (`--depth-mask on`) the bins
-// of its bounds that hold samples, found by a second sweep over the tile once the bounds are
-// known; otherwise, and for the transparent layer, no mask.
-@group(1) @binding(6) var<storage, read_write> cell_masks: array<vec4<u32>>;
+// Each cell's culling record (cell_box.wgsl): with DEPTH_MASK (`--depth-mask on`) its 2.5D
+// depth mask (depth_mask.wgsl), the bins of its bounds that hold samples, found by a second
+// sweep over the tile once the bounds are known; with CELL_BOX (`--cell-box on`) the
+// view-space box of its samples' pixel footprints, reduced in the first sweep; otherwise, and
+// for the transparent layer of separate lists, neither.
+@group(1) @binding(6) var<storage, read_write> cell_culls: array<CellCull>;
+
+#if CELL_BOX
+// Per slice of the tile: the view-space x and y extent of its samples' pixel footprints, as
+// ordered bits (cell_box.wgsl); x0 > x1 while the slice has no sample.
+var<workgroup> box_x0: array<atomic<u32>, MAX_SLICES>;
+var<workgroup> box_x1: array<atomic<u32>, MAX_SLICES>;
+var<workgroup> box_y0: array<atomic<u32>, MAX_SLICES>;
+var<workgroup> box_y1: array<atomic<u32>, MAX_SLICES>;
+
+fn box_include(k: u32, e: vec4<f32>) {
+    atomicMin(&box_x0[k], ordered_bits(e.x));
+    atomicMax(&box_x1[k], ordered_bits(e.y));
+    atomicMin(&box_y0[k], ordered_bits(e.z));
+    atomicMax(&box_y1[k], ordered_bits(e.w));
+}
+
+// A sample of pixel p: its pixel at its view distance widened by the slack, in the slices
+// its distance lies in (as `include_depth`). CPU twin: `cell_boxes_cpu`.
+fn box_sample(d: f32, p: vec2<u32>) {
+    if (!is_background(d)) {
+        let w = view_distance_from_depth(d);
+        let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+        let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+        let q = vec2<f32>(p);
+        let e = rect_extent(vec2<f32>(q.x, q.x + 1.0), vec2<f32>(q.y, q.y + 1.0), w * (1.0 - ASSIGN_DEPTH_SLACK), w * (1.0 + ASSIGN_DEPTH_SLACK));
+        box_include(k0, e);
+        if (k1 != k0) {
+            box_include(k1, e);
+        }
+    }
+}
+
+// Slice k's cell box: its samples' footprints and, over `extra` (a range of what is not a
+// sample: MSAA forward fragments, a shared list's transparent fragments), the tile whose
+// pixels start at `origin`; its depth from the cell's bounds `b`, widened by the slack.
+// None (lo.w == 0) for a cell without samples.
+fn slice_box(k: u32, b: vec2<f32>, extra: vec2<f32>, origin: vec2<u32>) -> array<vec4<f32>, 2> {
+    let x0 = atomicLoad(&box_x0[k]);
+    let x1 = atomicLoad(&box_x1[k]);
+    var has = x0 <= x1;
+    var e = vec4<f32>(from_ordered_bits(x0), from_ordered_bits(x1), from_ordered_bits(atomicLoad(&box_y0[k])), from_ordered_bits(atomicLoad(&box_y1[k])));
+    if (extra.x <= extra.y) {
+        let lo = vec2<f32>(origin);
+        let hi = min(lo + vec2<f32>(f32(grid.tile_size)), frame.viewport);
+        let t = rect_extent(vec2<f32>(lo.x, hi.x), vec2<f32>(lo.y, hi.y), extra.x * (1.0 - ASSIGN_DEPTH_SLACK), extra.y * (1.0 + ASSIGN_DEPTH_SLACK));
+        let u = vec4<f32>(min(e.x, t.x), max(e.y, t.y), min(e.z, t.z), max(e.w, t.w));
+        e = select(t, u, has);
+        has = true;
+    }
+    if (!has || b.x > b.y) {
+        return array<vec4<f32>, 2>(vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    return array<vec4<f32>, 2>(
+        vec4<f32>(e.x, e.z, -b.y * (1.0 + ASSIGN_DEPTH_SLACK), 1.0),
+        vec4<f32>(e.y, e.w, -b.x * (1.0 - ASSIGN_DEPTH_SLACK), 0.0),
+    );
+}
+#endif
 
 #if DEPTH_MASK
 // Per slice of the tile: the mask's (lo, inv) as bits, and the bins holding samples.
@@ -112,6 +172,12 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     for (; k0 < grid.slices; k0 = k0 + TILE_THREADS * TILE_THREADS) {
         atomicStore(&slice_lo[k0], W_INFINITY);
         atomicStore(&slice_hi[k0], 0u);
+#if CELL_BOX
+        atomicStore(&box_x0[k0], 0xffffffffu);
+        atomicStore(&box_x1[k0], 0u);
+        atomicStore(&box_y0[k0], 0xffffffffu);
+        atomicStore(&box_y1[k0], 0u);
+#endif
     }
     check_loop(k0, grid.slices);
     if (li == 0u) {
@@ -144,6 +210,9 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
                     } else {
                         include_depth(d);
                     }
+#if CELL_BOX
+                    box_sample(d, p);
+#endif
                 }
             }
         }
@@ -172,6 +241,19 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
             }
         }
         write_bounds(cell, open_bounds(k, b));
+#if CELL_BOX
+        // `--cell-box` needs both bounds too, so `b` is the cell's bounds.
+        var extra = fragment_range(cell);
+        if (grid.lists == GRID_LISTS_SHARED) {
+            extra = bounds_union(extra, transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi))));
+        }
+        let bx = slice_box(k, b, extra, origin);
+        cell_culls[cell].lo = bx[0];
+        cell_culls[cell].hi = bx[1];
+#else
+        cell_culls[cell].lo = vec4<f32>(0.0);
+        cell_culls[cell].hi = vec4<f32>(0.0);
+#endif
 #if DEPTH_MASK
         // 1. The mask's bins over the cell's bounds (`--depth-mask` needs both bounds, so these
         // are `b`); what is not a sample (MSAA forward fragments, the transparent part of a
@@ -184,10 +266,10 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         }
         atomicStore(&mask_bits[k], bits);
 #else
-        cell_masks[cell] = depth_mask_none();
+        cell_culls[cell].mask = depth_mask_none();
 #endif
         if (grid.lists == GRID_LISTS_SEPARATE) {
-            cell_masks[grid.layer_cells + cell] = depth_mask_none();
+            cell_culls[grid.layer_cells + cell] = cell_cull_none();
         }
     }
     check_loop(k, grid.slices);
@@ -212,7 +294,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     var mk = li;
     for (; mk < grid.slices; mk = mk + TILE_THREADS * TILE_THREADS) {
         let sc = mask_scale[mk];
-        cell_masks[mk * tiles + tile] = vec4<u32>(atomicLoad(&mask_bits[mk]), sc.x, sc.y, 0u);
+        cell_culls[mk * tiles + tile].mask = vec4<u32>(atomicLoad(&mask_bits[mk]), sc.x, sc.y, 0u);
     }
     check_loop(mk, grid.slices);
 #endif

@@ -21,7 +21,7 @@ use super::grid::GridDims;
 use super::strategy::{bind_cull_group, cull_layout, CellSource, CullFrame};
 use crate::consts::POINT_LIGHT_COS;
 use crate::frame::{
-    Assign, DepthBounds, DepthMask, DepthReduction, FrameEncoder, GridLists, SpotCull,
+    Assign, CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder, GridLists, SpotCull,
 };
 use crate::gpu::{
     buffer_entry, groups_1d, grow_storage, storage_buffer, FrameCounters, FrameTag, PassTimer,
@@ -168,6 +168,10 @@ pub struct CullConfig {
     /// 2.5D culling ([`DepthMask::On`]): each cell also keeps a mask of which of 32 bins of
     /// its depth bounds hold samples; needs [`DepthBounds::Both`].
     pub depth_mask: DepthMask,
+    /// Tight cells ([`CellBox::On`]): each occupied cell also keeps the view-space box of its
+    /// samples, and lights are kept by the closest-point test against it; needs
+    /// [`DepthBounds::Both`].
+    pub cell_box: CellBox,
 }
 
 impl Default for CullConfig {
@@ -182,6 +186,7 @@ impl Default for CullConfig {
             index_capacity: super::GridBuffers::INITIAL_INDEX_CAPACITY,
             spot_cull: SpotCull::Cone,
             depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
         }
     }
 }
@@ -455,8 +460,12 @@ impl LightCuller {
         crate::frame::validate_tile_size(tile_size).map_err(config_error)?;
         crate::frame::validate_slices(slices).map_err(config_error)?;
         crate::frame::validate_msaa(config.samples).map_err(config_error)?;
-        crate::frame::validate_depth_mask(config.depth_mask, config.depth_bounds)
-            .map_err(config_error)?;
+        crate::frame::validate_sample_culling(
+            config.depth_mask,
+            config.cell_box,
+            config.depth_bounds,
+        )
+        .map_err(config_error)?;
         if config.max_lights == 0 {
             return refuse(CullInput::Config, "max_lights must be at least 1");
         }
@@ -506,6 +515,7 @@ impl LightCuller {
                     depth_bounds: config.depth_bounds,
                     depth_reduction: DepthReduction::Atomics,
                     depth_mask: config.depth_mask,
+                    cell_box: config.cell_box,
                     index_capacity: u64::from(config.index_capacity),
                 },
                 slices,

@@ -6,7 +6,10 @@
 
 use super::gpu_assign::{gather_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{depth_mask_meets, CellMask, GridDims, LightGrid, ViewLight, ViewSetup, NO_MASK};
+use super::{
+    box_overlap, depth_mask_meets, sphere_box_gap, CellCull, CellMask, GridDims, LightGrid,
+    ViewLight, ViewSetup, NO_MASK,
+};
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -25,6 +28,8 @@ pub(super) struct CpuFrustum {
     pub sphere: (Vec3, f32),
     /// The cell's 2.5D depth mask (`depth_mask.rs`; [`NO_MASK`] unless the caller sets it).
     pub mask: CellMask,
+    /// The cell's tight view-space box (`cell_box.rs`; none unless the caller sets it).
+    pub cell_box: Option<(Vec3, Vec3)>,
 }
 
 pub(super) fn cpu_frustum(
@@ -55,21 +60,23 @@ pub(super) fn cpu_frustum(
             w_bounds[1] * (1.0 + ASSIGN_DEPTH_SLACK),
         ),
         mask: NO_MASK,
+        cell_box: None,
     }
 }
 
 /// The frustum of cell `c` (`cell_frustum` in assign_bindings.wgsl): its tile's planes, its
-/// bounds and, when given, its depth mask.
+/// bounds and, when given, its depth mask and box.
 pub(super) fn cell_frustum(
     setup: &ViewSetup,
     dims: &GridDims,
     c: usize,
     cell_bounds: &[[f32; 2]],
-    masks: Option<&[CellMask]>,
+    culls: Option<&[CellCull]>,
 ) -> CpuFrustum {
     let mut f = cpu_frustum(setup, dims, c % dims.tile_count(), cell_bounds[c]);
-    if let Some(m) = masks {
-        f.mask = m[c];
+    if let Some(m) = culls {
+        f.mask = m[c].mask;
+        f.cell_box = m[c].view_box();
     }
     f
 }
@@ -91,7 +98,10 @@ pub(super) fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
         // size for the tests' round-off reading, not a distance the GPU computes).
         return -mask_gap(&f.mask, w - r, w + r);
     }
-    m
+    match f.cell_box {
+        Some((lo, hi)) if m >= 0.0 => m.min(-sphere_box_gap(lo, hi, center, r)),
+        _ => m,
+    }
 }
 
 /// How far the span `[w0, w1]` is from the nearest bin of `m` holding samples, in view
@@ -141,24 +151,27 @@ pub(super) fn box_margin(f: &CpuFrustum, lo: Vec3, hi: Vec3) -> f32 {
     if m >= 0.0 && !depth_mask_meets(&f.mask, w_lo, w_hi) {
         return -mask_gap(&f.mask, w_lo, w_hi);
     }
-    m
+    match f.cell_box {
+        Some(b) if m >= 0.0 => m.min(box_overlap((lo, hi), b)),
+        _ => m,
+    }
 }
 
 /// Per cell and light, the gather test's margin (cells in grid order, lights in order).
-/// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`); `masks`: per
-/// cell its 2.5D depth mask, for a grid built with `--depth-mask on`.
+/// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`); `culls`: per
+/// cell its 2.5D depth mask and tight box, for a grid built with `--depth-mask on` or `--cell-box on`.
 pub fn gather_margins(
     setup: &ViewSetup,
     dims: &GridDims,
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
-    masks: Option<&[CellMask]>,
+    culls: Option<&[CellCull]>,
 ) -> Vec<Vec<f32>> {
     let view: Vec<ViewLight> = lights.iter().map(|l| setup.to_view(l)).collect();
     (0..dims.cell_count())
         .into_par_iter()
         .map(|c| {
-            let f = cell_frustum(setup, dims, c, cell_bounds, masks);
+            let f = cell_frustum(setup, dims, c, cell_bounds, culls);
             view.iter().map(|v| light_margin(&f, v)).collect()
         })
         .collect()
@@ -175,15 +188,16 @@ pub fn assign_gather_cpu(
     assign_gather_cpu_masked(setup, dims, lights, cell_bounds, None)
 }
 
-/// [`assign_gather_cpu`] of a grid built with `--depth-mask on`: `masks` per cell.
+/// [`assign_gather_cpu`] of a grid built with `--depth-mask on` or `--cell-box on`: its
+/// cells' culling records.
 pub fn assign_gather_cpu_masked(
     setup: &ViewSetup,
     dims: &GridDims,
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
-    masks: Option<&[CellMask]>,
+    culls: Option<&[CellCull]>,
 ) -> LightGrid {
-    let lists: Vec<Vec<u32>> = gather_margins(setup, dims, lights, cell_bounds, masks)
+    let lists: Vec<Vec<u32>> = gather_margins(setup, dims, lights, cell_bounds, culls)
         .into_iter()
         .map(|m| {
             m.iter()

@@ -107,7 +107,7 @@ impl AssignCommon {
                 self.spill_cells.as_entire_binding(),
                 bounds.occupied_buffer().as_entire_binding(),
                 bounds.occupancy_buffer().as_entire_binding(),
-                bounds.mask_buffer().as_entire_binding(),
+                bounds.cull_buffer().as_entire_binding(),
             ],
         )
     }

@@ -8,6 +8,7 @@ mod builder;
 mod bvh;
 mod bvh_gpu;
 mod cell_bounds;
+mod cell_box;
 mod culler;
 mod depth_mask;
 mod depth_range;
@@ -31,6 +32,9 @@ pub(crate) use builder::{CellSource, GridSetup};
 pub use bvh::{build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
 pub use cell_bounds::{
     cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
+};
+pub use cell_box::{
+    box_overlap, cell_boxes_cpu, rect_box, sphere_box_gap, view_extent, CellCull, NO_CULL,
 };
 pub use culler::{
     CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
@@ -56,13 +60,18 @@ pub use crate::consts::pass_labels as labels;
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
-/// `tile_frustum` / `light_in_tile` (needs the scene bindings), with the 2.5D depth mask test.
+/// `tile_frustum` / `light_in_tile` (needs the scene bindings), with the 2.5D depth mask and
+/// tight-cell box tests.
 pub(crate) const TILE_FRUSTUM_WGSL: &str = concat!(
     include_str!("depth_mask.wgsl"),
+    include_str!("cell_box.wgsl"),
     include_str!("tile_frustum.wgsl")
 );
-/// The 2.5D depth mask's bins (`depth_mask.rs`).
-pub(crate) const DEPTH_MASK_WGSL: &str = include_str!("depth_mask.wgsl");
+/// The 2.5D depth mask's bins (`depth_mask.rs`) and the tight cells' record (`cell_box.rs`).
+pub(crate) const CELL_CULL_WGSL: &str = concat!(
+    include_str!("depth_mask.wgsl"),
+    include_str!("cell_box.wgsl")
+);
 
 /// Every assignment shader, for the validation test: every value of the keyed stages.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {

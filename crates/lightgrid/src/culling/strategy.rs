@@ -130,7 +130,7 @@ pub struct StrategyRun {
     /// The cell bounds, when the strategy read them back.
     pub cell_bounds: Option<Vec<[f32; 2]>>,
     /// The cells' depth masks, read back with the bounds.
-    pub cell_masks: Option<Vec<super::CellMask>>,
+    pub cell_culls: Option<Vec<super::CellCull>>,
 }
 
 /// One light-assignment strategy.

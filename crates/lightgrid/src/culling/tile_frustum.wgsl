@@ -12,6 +12,10 @@ struct TileFrustum {
     // The cell's 2.5D depth mask (`depth_mask.wgsl`); none unless the cell came from a grid
     // built with `--depth-mask on` (`cell_frustum` in assign_bindings.wgsl).
     mask: vec4<u32>,
+    // The cell's tight view-space box (cell_box.wgsl; box_lo.w == 0: none), from a grid built
+    // with `--cell-box on`.
+    box_lo: vec4<f32>,
+    box_hi: vec4<f32>,
 }
 
 // `tile`: tile coordinates; `w_range`: the view-distance [min, max] of the samples the frustum
@@ -32,6 +36,8 @@ fn tile_frustum(tile: vec2<u32>, tile_size: u32, w_range: vec2<f32>) -> TileFrus
     f.w_min = w_range.x;
     f.w_max = w_range.y;
     f.mask = depth_mask_none();
+    f.box_lo = vec4<f32>(0.0);
+    f.box_hi = vec4<f32>(0.0);
     f.sphere = frustum_sphere(ndc_lo, ndc_hi, w_range.x * (1.0 - ASSIGN_DEPTH_SLACK), w_range.y * (1.0 + ASSIGN_DEPTH_SLACK));
     return f;
 }
@@ -78,7 +84,7 @@ fn sphere_in_tile(f: TileFrustum, c: vec3<f32>, r: f32) -> bool {
             return false;
         }
     }
-    return true;
+    return sphere_meets_box(f.box_lo, f.box_hi, c, r);
 }
 
 // How far a spot's cone reaches into the view-space sphere `cell` (>= 0: it may reach it);
@@ -121,7 +127,7 @@ fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
             return false;
         }
     }
-    return true;
+    return box_meets_box(f.box_lo, f.box_hi, lo, hi);
 }
 
 // A spot's box in view space: the cone sector's box within its bounding sphere's (CPU twin

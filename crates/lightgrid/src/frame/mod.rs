@@ -11,8 +11,8 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_depth_mask, validate_msaa, validate_slices, validate_tile_size, Assign, DepthBounds,
-    DepthMask, DepthReduction, GBufferFormat, GridLists, MaterialDraws, MsaaResolve,
+    validate_msaa, validate_sample_culling, validate_slices, validate_tile_size, Assign, CellBox,
+    DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, MaterialDraws, MsaaResolve,
     RenderSettings, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};

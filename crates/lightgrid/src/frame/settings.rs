@@ -32,6 +32,33 @@ pub struct RenderSettings {
     /// 2.5D culling of grids built from the depth buffer (`--depth-mask`).
     #[serde(default)]
     pub depth_mask: DepthMask,
+    /// Tight cells of grids built from the depth buffer (`--cell-box`).
+    #[serde(default)]
+    pub cell_box: CellBox,
+}
+
+/// Tight cells: each occupied cell of a grid built from the depth buffer keeps the view-space
+/// box of its samples' pixel footprints, and a light is listed only where its sphere reaches
+/// the box (the closest-point test; `culling/cell_box.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CellBox {
+    /// The cell's frustum piece (its tile's planes and depth bounds) only.
+    #[default]
+    Off,
+    /// The frustum piece and the samples' box.
+    On,
+}
+
+impl CellBox {
+    pub const ALL: [CellBox; 2] = [CellBox::Off, CellBox::On];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            CellBox::Off => "off",
+            CellBox::On => "on",
+        }
+    }
 }
 
 /// 2.5D culling (Harada et al. 2012, "A 2.5D culling for Forward+"): each cell of a grid built
@@ -193,6 +220,7 @@ impl Default for RenderSettings {
             depth_bounds: DepthBounds::Both,
             depth_reduction: DepthReduction::Atomics,
             depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
         }
     }
 }
@@ -209,7 +237,7 @@ impl RenderSettings {
             ));
         }
         validate_msaa(self.msaa)?;
-        validate_depth_mask(self.depth_mask, self.depth_bounds)?;
+        validate_sample_culling(self.depth_mask, self.cell_box, self.depth_bounds)?;
         validate_slices(self.slices)
     }
 }
@@ -239,21 +267,34 @@ pub fn validate_tile_size(tile_size: u32) -> crate::error::Result<()> {
     Ok(())
 }
 
-/// Refuse 2.5D culling over bounds opened on a side: the mask's bins cut the samples' own
-/// bounds (the renderer's settings and `LightCuller`'s config both ask this).
-pub fn validate_depth_mask(
+/// Refuse 2.5D culling or tight cells over bounds opened on a side: the mask's bins cut the
+/// samples' own bounds and the box is the samples' own (the renderer's settings and
+/// `LightCuller`'s config both ask this).
+pub fn validate_sample_culling(
     depth_mask: DepthMask,
+    cell_box: CellBox,
     depth_bounds: DepthBounds,
 ) -> crate::error::Result<()> {
-    if depth_mask == DepthMask::On && depth_bounds != DepthBounds::Both {
-        return Err(crate::error::Error::invalid(
-            "depth-mask",
+    if depth_bounds == DepthBounds::Both {
+        return Ok(());
+    }
+    let refuse = |flag: &'static str, why: &str| {
+        Err(crate::error::Error::invalid(
+            flag,
             format!(
-                "on needs both depth bounds (the mask's bins cut the samples' own bounds), \
-                 not {}",
+                "on needs both depth bounds ({why}), not {}",
                 depth_bounds.name()
             ),
-        ));
+        ))
+    };
+    if depth_mask == DepthMask::On {
+        return refuse("depth-mask", "the mask's bins cut the samples' own bounds");
+    }
+    if cell_box == CellBox::On {
+        return refuse(
+            "cell-box",
+            "the box is the samples' own, as both bounds are",
+        );
     }
     Ok(())
 }

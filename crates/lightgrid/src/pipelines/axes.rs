@@ -9,8 +9,8 @@
 
 use super::PipelineInfo;
 use crate::frame::{
-    Assign, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, MaterialDraws,
-    MsaaResolve, RenderSettings, SpotCull,
+    Assign, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
+    MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
 };
 
 /// A setting's values by name (the option's values, the results' columns).
@@ -138,6 +138,20 @@ impl SettingValue for DepthMask {
         match self {
             DepthMask::Off => "the cell's depth bounds only",
             DepthMask::On => "2.5D culling: a 32-bit mask of the bounds' bins that hold samples (Harada et al. 2012)",
+        }
+    }
+}
+
+impl SettingValue for CellBox {
+    const FLAG: &'static str = "cell-box";
+    const VALUES: &'static [Self] = &CellBox::ALL;
+    fn name(self) -> &'static str {
+        CellBox::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            CellBox::Off => "the cell's frustum piece only",
+            CellBox::On => "tight cells: the view-space box of the cell's samples, tested against each light's sphere exactly",
         }
     }
 }
@@ -387,6 +401,19 @@ pub const AXES: &[Axis] = &[
             Ok(())
         },
         label: |v| format!("mask {v}"),
+    },
+    Axis {
+        flag: "cell-box",
+        column: "cell_box",
+        help: "tight cells of the grids --assign builds from the depth buffer: each cell's samples' view-space box (needs --depth-bounds both)",
+        values: values::<CellBox>,
+        applies: |p, _| p.depth_bounds && p.assign,
+        get: |s| s.cell_box.name().to_string(),
+        set: |s, v| {
+            s.cell_box = CellBox::parse(v)?;
+            Ok(())
+        },
+        label: |v| format!("box {v}"),
     },
 ];
 

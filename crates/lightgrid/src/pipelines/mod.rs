@@ -53,6 +53,7 @@ impl PipelineContext<'_> {
             depth_bounds: self.settings.depth_bounds,
             depth_reduction: self.settings.depth_reduction,
             depth_mask: self.settings.depth_mask,
+            cell_box: self.settings.cell_box,
             index_capacity: u64::from(crate::culling::GridBuffers::INITIAL_INDEX_CAPACITY),
         }
     }

@@ -80,6 +80,7 @@ impl TransparentPass {
                 depth_bounds: crate::frame::DepthBounds::Both,
                 depth_reduction: crate::frame::DepthReduction::Atomics,
                 depth_mask: crate::frame::DepthMask::Off,
+                cell_box: crate::frame::CellBox::Off,
                 ..ctx.grid_setup()
             },
             1,

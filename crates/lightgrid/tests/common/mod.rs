@@ -7,8 +7,9 @@ pub mod shading;
 
 use glam::Vec3;
 use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu_masked, cell_bounds_cpu, cell_masks_cpu, oracle_tile_lights,
-    CellMask, DepthRange, GridDims, GridLists, LightGrid, ViewSetup, NO_MASK,
+    assign_cpu, assign_gather_cpu_masked, cell_bounds_cpu, cell_boxes_cpu, cell_masks_cpu,
+    oracle_tile_lights, CellCull, CellMask, DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
+    NO_MASK,
 };
 use lightgrid::gpu::GpuContext;
 use lightgrid::pipelines::Assign;
@@ -495,13 +496,13 @@ pub fn edge_case_lights(rng: &mut Rng, camera: &Camera, setup: &ViewSetup, n: us
 }
 
 /// The grid a strategy's CPU twin builds from the given cell bounds (and, for a grid built
-/// with `--depth-mask on`, its cells' masks).
+/// with `--depth-mask on` or `--cell-box on`, its cells' culling records).
 pub fn twin(
     assign: Assign,
     setup: &ViewSetup,
     grid: &LightGrid,
     lights: &[Light],
-    (bounds, masks): (&[[f32; 2]], Option<&[CellMask]>),
+    (bounds, masks): (&[[f32; 2]], Option<&[CellCull]>),
     near_far: bool,
 ) -> LightGrid {
     let dims = &grid.dims;
@@ -511,7 +512,7 @@ pub fn twin(
         }
         Assign::Cpu | Assign::Scatter => {
             let range = match masks {
-                Some(m) => DepthRange::Masked(bounds, m),
+                Some(m) => DepthRange::Culled(bounds, m),
                 None => DepthRange::Cells(bounds),
             };
             assign_cpu(setup, dims, lights, range)
@@ -631,7 +632,7 @@ pub fn check_grid_against_twin(
     setup: &ViewSetup,
     grid: &LightGrid,
     lights: &[Light],
-    bounds: (&[[f32; 2]], Option<&[CellMask]>),
+    bounds: (&[[f32; 2]], Option<&[CellCull]>),
     near_far: bool,
     max_disagreements: usize,
 ) -> usize {
@@ -788,57 +789,131 @@ impl FrameOracle {
     }
 }
 
-/// The GPU's 2.5D depth masks (`--depth-mask on`) against their CPU twin over the frame's
-/// depth samples, with the GPU's own bins (`lo`, `inv`): every bin the twin sets with half the
-/// slack is set, and (without MSAA forward fragments or shared transparent lists, which set
-/// whole ranges the twin does not see) none is set that the twin does not set with twice
-/// the slack. With `on` false every cell has no mask. Returns the opaque cells whose mask
-/// leaves bins out.
-pub fn check_cell_masks(
+/// What [`check_cell_culls`] saw.
+#[derive(Default, Debug)]
+pub struct CullCells {
+    /// Opaque cells whose 2.5D mask leaves bins out.
+    pub partial_masks: usize,
+    /// Opaque cells with a tight box.
+    pub boxes: usize,
+}
+
+/// The GPU's culling records against their CPU twins over the frame's depth samples.
+///
+/// 2.5D depth masks (`--depth-mask on`), with the GPU's own bins (`lo`, `inv`): every bin the
+/// twin sets with half the slack is set, and (without MSAA forward fragments or shared
+/// transparent lists, which set whole ranges the twin does not see: `exact_samples` false)
+/// none is set that the twin does not set with twice the slack.
+///
+/// Tight boxes (`--cell-box on`), with the GPU's bounds: every occupied opaque cell has one
+/// holding the twin's box with half the slack (the samples' footprints) and, with
+/// `exact_samples`, held by the twin's box with twice the slack, both within f32 round-off of
+/// the pixel edges.
+///
+/// Off, every cell has no mask / no box; the transparent layer of separate lists never has
+/// either.
+#[allow(clippy::too_many_arguments)]
+pub fn check_cell_culls(
     what: &str,
     setup: &ViewSetup,
     dims: &GridDims,
-    masks: &[CellMask],
+    culls: &[CellCull],
+    bounds: &[[f32; 2]],
     planes: &[&[f32]],
-    on: bool,
+    (mask_on, box_on): (bool, bool),
     exact_samples: bool,
-) -> usize {
-    assert_eq!(masks.len(), dims.cell_count(), "{what}: mask count");
-    if !on {
+) -> CullCells {
+    assert_eq!(culls.len(), dims.cell_count(), "{what}: record count");
+    let mut seen = CullCells::default();
+    let layer = dims.layer_cells();
+    if !mask_on {
         assert!(
-            masks.iter().all(|m| *m == NO_MASK),
+            culls.iter().all(|m| m.mask == NO_MASK),
             "{what}: a mask without --depth-mask on"
         );
-        return 0;
+    } else {
+        let slack = lightgrid::consts::ASSIGN_DEPTH_SLACK;
+        let scales: Vec<CellMask> = culls.iter().map(|c| c.mask).collect();
+        let narrow = cell_masks_cpu(setup, dims, planes, &scales, None, slack * 0.5);
+        let wide = cell_masks_cpu(setup, dims, planes, &scales, None, slack * 2.0);
+        for c in 0..dims.cell_count() {
+            let (g, n, w) = (scales[c][0], narrow[c][0], wide[c][0]);
+            if c >= layer {
+                assert_eq!(
+                    scales[c], NO_MASK,
+                    "{what}: transparent cell {c} has a mask"
+                );
+                continue;
+            }
+            assert_eq!(
+                g & n,
+                n,
+                "{what}: cell {c} leaves out sample bins: gpu {g:032b} cpu {n:032b}"
+            );
+            if exact_samples && dims.lists != GridLists::Shared {
+                assert_eq!(
+                    g & !w,
+                    0,
+                    "{what}: cell {c} sets bins without samples: gpu {g:032b} cpu {w:032b}"
+                );
+            }
+            if g != 0 && g != u32::MAX {
+                seen.partial_masks += 1;
+            }
+        }
+    }
+    if !box_on {
+        assert!(
+            culls.iter().all(|m| m.view_box().is_none()),
+            "{what}: a box without --cell-box on"
+        );
+        return seen;
     }
     let slack = lightgrid::consts::ASSIGN_DEPTH_SLACK;
-    let narrow = cell_masks_cpu(setup, dims, planes, masks, None, slack * 0.5);
-    let wide = cell_masks_cpu(setup, dims, planes, masks, None, slack * 2.0);
-    let layer = dims.layer_cells();
-    let mut partial = 0;
+    let narrow = cell_boxes_cpu(setup, dims, planes, bounds, None, slack * 0.5);
+    let wide = cell_boxes_cpu(setup, dims, planes, bounds, None, slack * 2.0);
+    // Within f32 round-off of the footprints' corners (WGSL's division is not exact).
+    let tol = |v: Vec3, extent: Vec3| v.abs() * 1e-5 + extent * 1e-4 + Vec3::splat(1e-6);
     for c in 0..dims.cell_count() {
-        let (g, n, w) = (masks[c][0], narrow[c][0], wide[c][0]);
-        if c >= layer {
-            assert_eq!(masks[c], NO_MASK, "{what}: transparent cell {c} has a mask");
+        let g = culls[c].view_box();
+        if c >= layer && dims.lists == GridLists::Separate {
+            assert!(g.is_none(), "{what}: transparent cell {c} has a box");
             continue;
         }
-        assert_eq!(
-            g & n,
-            n,
-            "{what}: cell {c} leaves out sample bins: gpu {g:032b} cpu {n:032b}"
+        let [w0, w1] = bounds[c];
+        if w0 > w1 {
+            continue;
+        }
+        if c < layer {
+            seen.boxes += 1;
+        }
+        let Some((lo, hi)) = g else {
+            panic!(
+                "{what}: occupied cell {c} (bounds {:?}) has no box",
+                bounds[c]
+            );
+        };
+        assert!(
+            lo.cmple(hi).all(),
+            "{what}: cell {c}'s box is inverted: {lo} {hi}"
         );
-        if exact_samples && dims.lists != GridLists::Shared {
-            assert_eq!(
-                g & !w,
-                0,
-                "{what}: cell {c} sets bins without samples: gpu {g:032b} cpu {w:032b}"
+        if let Some((nlo, nhi)) = narrow[c] {
+            let t = tol(nlo.abs().max(nhi.abs()), nhi - nlo);
+            assert!(
+                lo.cmple(nlo + t).all() && hi.cmpge(nhi - t).all(),
+                "{what}: cell {c}'s box {lo} {hi} leaves out samples' footprints {nlo} {nhi}"
             );
         }
-        if g != 0 && g != u32::MAX {
-            partial += 1;
+        if exact_samples && dims.lists != GridLists::Shared {
+            let (wlo, whi) = wide[c].expect("an occupied cell has samples");
+            let t = tol(wlo.abs().max(whi.abs()), whi - wlo);
+            assert!(
+                lo.cmpge(wlo - t).all() && hi.cmple(whi + t).all(),
+                "{what}: cell {c}'s box {lo} {hi} is wider than its samples' {wlo} {whi}"
+            );
         }
     }
-    partial
+    seen
 }
 
 /// [`FrameOracle::check`] of a frame's grid on its depth buffer.
