@@ -20,7 +20,7 @@
 //! the recommendation says why, against the runner-up.
 
 use crate::run::Progress;
-use lightgrid::frame::{Assign, DepthMask, RenderSettings};
+use lightgrid::frame::{Assign, CellBox, DepthMask, RenderSettings};
 use lightgrid::gpu::GpuContext;
 use lightgrid::pipelines::{self, Msaa, PipelineInfo, SettingValue, REFERENCE};
 use lightgrid::realtime::{play, PlayPlan};
@@ -49,6 +49,8 @@ pub struct Candidate {
     /// 2.5D culling (`--depth-mask on`), tried by the refinement where the setting applies;
     /// None: as given.
     pub depth_mask: Option<DepthMask>,
+    /// Tight cells (`--cell-box on`), tried as the masks are; None: as given.
+    pub cell_box: Option<CellBox>,
 }
 
 impl Candidate {
@@ -62,6 +64,9 @@ impl Candidate {
         }
         if let Some(m) = self.depth_mask {
             s += &format!(" depth-mask {}", m.name());
+        }
+        if let Some(b) = self.cell_box {
+            s += &format!(" cell-box {}", b.name());
         }
         s
     }
@@ -161,6 +166,7 @@ pub fn survey(assign_auto: &'static str) -> Vec<Candidate> {
             tile: p.uses_grid.then_some(lightgrid::consts::DEFAULT_TILE_SIZE),
             assign: p.assign.then_some(assign_auto),
             depth_mask: None,
+            cell_box: None,
         })
         .collect()
 }
@@ -171,6 +177,7 @@ pub const REFERENCE_CANDIDATE: Candidate = Candidate {
     tile: None,
     assign: None,
     depth_mask: None,
+    cell_box: None,
 };
 
 /// Step 2: for the fastest `REFINE_TOP` grid pipelines measured so far, the other tiles at
@@ -208,13 +215,24 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
             );
         }
     }
+    // Per-sample culling where the settings table says it applies: 2.5D masks, tight boxes.
     let mask_axis = lightgrid::pipelines::find_axis(DepthMask::FLAG).expect("a row");
+    let box_axis = lightgrid::pipelines::find_axis(CellBox::FLAG).expect("a row");
     for c in &top {
         let settings = RenderSettings::default();
         if c.depth_mask.is_none() && (mask_axis.applies)(info(c), &settings) {
             push(
                 Candidate {
                     depth_mask: Some(DepthMask::On),
+                    ..*c
+                },
+                &mut out,
+            );
+        }
+        if c.cell_box.is_none() && (box_axis.applies)(info(c), &settings) {
+            push(
+                Candidate {
+                    cell_box: Some(CellBox::On),
                     ..*c
                 },
                 &mut out,
@@ -264,6 +282,9 @@ pub fn options(c: &Candidate) -> String {
     }
     if let Some(m) = c.depth_mask {
         s += &format!(" --depth-mask {}", m.name());
+    }
+    if let Some(b) = c.cell_box {
+        s += &format!(" --cell-box {}", b.name());
     }
     s
 }
@@ -438,6 +459,7 @@ fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
             .and_then(|a| Assign::all().find(|x| x.name() == a))
             .unwrap_or(plan.base.assign),
         depth_mask: c.depth_mask.unwrap_or(plan.base.depth_mask),
+        cell_box: c.cell_box.unwrap_or(plan.base.cell_box),
         ..plan.base
     }
 }
@@ -547,6 +569,7 @@ mod tests {
                 tile,
                 assign: tile.map(|_| "cpu"),
                 depth_mask: None,
+                cell_box: None,
             },
             outcome: Outcome::Measured {
                 frame_ms: ms,
@@ -654,12 +677,14 @@ mod tests {
             tile: Some(32),
             assign: Some("cpu"),
             depth_mask: None,
+            cell_box: None,
         }));
         assert!(r.contains(&Candidate {
             pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
             tile: Some(16),
             assign: Some("gather"),
             depth_mask: None,
+            cell_box: None,
         }));
         assert!(!r.iter().any(|c| c.assign == Some("auto")));
         // 2.5D culling for the top grid pipelines whose grids come from the depth buffer
@@ -682,6 +707,15 @@ mod tests {
             .find(|c| c.depth_mask == Some(DepthMask::On))
             .unwrap();
         assert!(options(c).ends_with("--depth-mask on"), "{}", options(c));
+        // Tight cells likewise.
+        let boxed: std::collections::BTreeSet<&str> = r
+            .iter()
+            .filter(|c| c.cell_box == Some(CellBox::On))
+            .map(|c| c.pipeline)
+            .collect();
+        assert_eq!(boxed, masked);
+        let c = r.iter().find(|c| c.cell_box == Some(CellBox::On)).unwrap();
+        assert!(options(c).ends_with("--cell-box on"), "{}", options(c));
     }
 
     #[test]

@@ -16,10 +16,11 @@ fn bench(args: &[&str]) -> std::path::PathBuf {
     out
 }
 
-/// The culling preset measures every grid with and without 2.5D depth masks, on its three
-/// scenes, and the masks never add lighting computations.
+/// The culling preset measures every grid with and without 2.5D depth masks and tight cell
+/// boxes, on its three scenes: neither ever adds lighting computations, and the boxes take
+/// some away over the run.
 #[test]
-fn culling_preset_measures_every_grid_with_and_without_depth_masks() {
+fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
     let out = bench(&[
         "--preset",
         "culling",
@@ -36,8 +37,9 @@ fn culling_preset_measures_every_grid_with_and_without_depth_masks() {
             .position(|c| *c == name)
             .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
     };
-    let (mask, pipe, scene, frame) = (
+    let (mask, cell_box, pipe, scene, frame) = (
         col("depth_mask"),
+        col("cell_box"),
         col("pipeline"),
         col("scene"),
         col("frame"),
@@ -55,7 +57,7 @@ fn culling_preset_measures_every_grid_with_and_without_depth_masks() {
         counts
             .entry(key)
             .or_insert_with(std::collections::BTreeMap::new)
-            .insert(f[mask].to_string(), n);
+            .insert((f[mask].to_string(), f[cell_box].to_string()), n);
     }
     let scenes: std::collections::BTreeSet<&str> = counts.keys().map(|k| k.0.as_str()).collect();
     assert_eq!(scenes.len(), 3, "{scenes:?}");
@@ -67,10 +69,22 @@ fn culling_preset_measures_every_grid_with_and_without_depth_masks() {
     ] {
         assert!(counts.keys().any(|k| k.1 == p), "{p} not measured");
     }
-    for (key, by_mask) in &counts {
-        let (on, off) = (by_mask["on"], by_mask["off"]);
-        assert!(on <= off, "{key:?}: {on} with masks, {off} without");
+    let v = |m: &str, b: &str| (m.to_string(), b.to_string());
+    let (mut boxed, mut plain) = (0, 0);
+    for (key, by) in &counts {
+        assert_eq!(by.len(), 4, "{key:?}: {by:?}");
+        let off = by[&v("off", "off")];
+        for (variant, n) in by {
+            assert!(*n <= off, "{key:?}: {n} with {variant:?}, {off} without");
+        }
+        assert!(by[&v("on", "on")] <= by[&v("off", "on")], "{key:?}: {by:?}");
+        boxed += by[&v("off", "on")];
+        plain += off;
     }
+    assert!(
+        boxed < plain,
+        "the boxes dropped no light: {boxed} of {plain}"
+    );
 }
 
 #[test]

@@ -156,6 +156,7 @@ fn frame_memory(
     (width, height): (u32, u32),
     lighting_computations: Option<u64>,
     grid: Option<&LightGrid>,
+    culled: bool,
 ) -> FrameMemory {
     let pixels = u64::from(width) * u64::from(height);
     let t = model.traffic;
@@ -165,8 +166,15 @@ fn frame_memory(
     FrameMemory {
         bytes_per_pixel: model.bytes_per_pixel(),
         target_bytes: model.target_bytes(width, height),
-        grid_bytes: grid
-            .map(|g| (g.cells.len() * 8 + g.indices.len() * INDEX_BYTES as usize) as u64),
+        // With 2.5D masks or tight boxes, each cell's culling record is part of the grid.
+        grid_bytes: grid.map(|g| {
+            let record = if culled {
+                std::mem::size_of::<crate::culling::CellCull>()
+            } else {
+                0
+            };
+            (g.cells.len() * (8 + record) + g.indices.len() * INDEX_BYTES as usize) as u64
+        }),
         modelled_write_bytes: modelled(t.write_per_pixel, t.write_per_lit),
         modelled_read_bytes: modelled(t.read_per_pixel, t.read_per_lit),
         forward_plus_table1: grid
@@ -312,6 +320,10 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         (width, height),
         opaque_lighting_computations,
         grid_is_pipelines.then_some(&grid),
+        a.info.depth_bounds
+            && a.info.assign
+            && (settings.depth_mask == crate::frame::DepthMask::On
+                || settings.cell_box == crate::frame::CellBox::On),
     );
     Ok(FrameOutput {
         image,

@@ -83,7 +83,8 @@ pub struct FrameMemory {
     pub targets: Vec<TargetBytes>,
     pub bytes_per_pixel: u32,
     pub target_bytes: u64,
-    /// Bytes of the CPU grid uploaded this frame (cells + index lists), if any.
+    /// Bytes of the frame's light grid (cells + index lists, and each cell's 48-byte culling
+    /// record with `--depth-mask on` or `--cell-box on`), if any.
     pub grid_bytes: Option<u64>,
     pub traffic: Traffic,
     /// The traffic model applied to this frame's pixels and lighting computations.
