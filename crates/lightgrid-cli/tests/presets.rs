@@ -85,6 +85,33 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
         boxed < plain,
         "the boxes dropped no light: {boxed} of {plain}"
     );
+    // Harada's claim on the two tiled grids and the tight-cluster claim on the two clustered
+    // ones, per scene, each with its evidence and a verdict.
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for (claim, pipelines) in [
+        (
+            "2.5D culling (a 32-bit mask",
+            ["tiled_forward_prez", "tiled_deferred"],
+        ),
+        (
+            "Tight clusters (each cluster",
+            ["clustered_forward", "clustered_deferred"],
+        ),
+    ] {
+        let lines: Vec<&str> = summary.lines().filter(|l| l.contains(claim)).collect();
+        assert_eq!(lines.len(), 3 * 2, "'{claim}': {lines:#?}");
+        for l in &lines {
+            assert!(
+                pipelines.iter().any(|p| l.contains(&format!("| {p}: "))),
+                "{l}"
+            );
+            assert!(l.contains("lighting computations with"), "{l}");
+            assert!(
+                l.contains("**held**") || l.contains("**did not hold**"),
+                "{l}"
+            );
+        }
+    }
 }
 
 #[test]

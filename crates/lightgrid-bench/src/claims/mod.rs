@@ -6,15 +6,17 @@
 use super::{BenchResults, RunRecord};
 use lightgrid::pipelines::ids;
 
+mod culling;
 mod deferred_lighting;
 mod forward_plus;
 mod tiled_forward_shading;
 mod tiled_shading;
 
 use crate::report::run_name;
+use culling::*;
 use deferred_lighting::*;
 use forward_plus::*;
-use lightgrid::frame::{DepthBounds, DepthMask};
+use lightgrid::frame::{CellBox, DepthBounds, DepthMask};
 use serde::Serialize;
 use tiled_forward_shading::*;
 use tiled_shading::*;
@@ -162,7 +164,7 @@ fn find_bounds<'a>(
 }
 
 /// The one search the three above name: a run recorded without a depth-bounds setting
-/// culled by both bounds (the default), and without 2.5D depth masks.
+/// culled by both bounds (the default), and without 2.5D depth masks or tight cell boxes.
 fn find_run<'a>(
     r: &'a BenchResults,
     scene: &str,
@@ -177,8 +179,10 @@ fn find_run<'a>(
             && x.msaa() == samples
             && (x.gbuffer_bits().is_none() || x.gbuffer_bits() == bits.or(Some(16)))
             && x.varied::<DepthBounds>().unwrap_or_default() == bounds
-            // The papers' grids have no 2.5D masks (`--preset culling` measures both).
+            // The papers' grids have no 2.5D masks or tight boxes (`--preset culling`
+            // measures both).
             && x.varied::<DepthMask>().unwrap_or_default() == DepthMask::Off
+            && x.varied::<CellBox>().unwrap_or_default() == CellBox::Off
     })
 }
 
@@ -423,6 +427,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
     out.extend(depth_bound_claims(r));
     out.extend(range_claims(r));
     out.extend(reduction_claims(r));
+    out.extend(culling_claims(r));
     out
 }
 
