@@ -43,8 +43,11 @@ pub struct StackedBars {
 
 /// Size of every chart, in pixels (the SVG's user units).
 pub const SIZE: (u32, u32) = (960, 540);
-/// Width of the legend column at the right.
+/// Width of the legend column at the right, at least (longer names widen it, up to half the
+/// chart).
 const LEGEND_W: u32 = 230;
+/// Legend pixels per character of a name (13-px sans serif, generous).
+const LEGEND_CHAR_PX: u32 = 7;
 /// The family the embedded font is registered as.
 const FONT: &str = "sans-serif";
 const TITLE_PX: f64 = 19.0;
@@ -171,10 +174,12 @@ fn text_style(px: f64) -> TextStyle<'static> {
     (FONT, px).into_font().color(&BLACK)
 }
 
-/// The title across the top, then the body split into the plot and the legend column.
-fn frame<DB: DrawingBackend>(
+/// The title across the top, then the body split into the plot and a legend column wide
+/// enough for the longest of `names`.
+fn frame<'a, DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
+    names: impl Iterator<Item = &'a str>,
 ) -> Result<Panes<DB>, Box<dyn Error>>
 where
     DB::ErrorType: 'static,
@@ -182,7 +187,9 @@ where
     root.fill(&WHITE)?;
     let body = root.titled(title, text_style(TITLE_PX))?;
     let (w, _) = root.dim_in_pixel();
-    Ok(body.split_horizontally(w - LEGEND_W))
+    let longest = names.map(|n| n.chars().count() as u32).max().unwrap_or(0);
+    let legend_w = (longest * LEGEND_CHAR_PX + 50).clamp(LEGEND_W, w / 2);
+    Ok(body.split_horizontally(w - legend_w))
 }
 
 /// The legend column: a line (or block) of each entry's colour and its name.
@@ -201,7 +208,7 @@ where
     area.draw(&Rectangle::new(
         [
             (x - 6, top - step / 2 - 4),
-            (LEGEND_W as i32 - 8, bottom + step / 2 + 4),
+            (area.dim_in_pixel().0 as i32 - 8, bottom + step / 2 + 4),
         ],
         RGBColor(200, 200, 200).stroke_width(1),
     ))?;
@@ -258,7 +265,8 @@ impl LineChart {
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let (plot, legend_area) = frame(root, &self.title)?;
+        let names = self.series.iter().map(|s| s.name.as_str());
+        let (plot, legend_area) = frame(root, &self.title, names)?;
         let mut chart = ChartBuilder::on(&plot)
             .margin(12)
             .margin_right(24)
@@ -329,7 +337,7 @@ impl StackedBars {
     where
         DB::ErrorType: 'static,
     {
-        let (plot, legend_area) = frame(root, &self.title)?;
+        let (plot, legend_area) = frame(root, &self.title, self.segment_names().into_iter())?;
         let n = self.bars.len().max(1);
         let totals = self
             .bars
