@@ -1620,11 +1620,13 @@ fn cameras_the_depth_buffer_cannot_hold_are_refused() {
     assert!(r.render(&with_planes(&s, 1e-20, 1e6), 0, REFERENCE).is_ok());
 }
 
-/// 2.5D culling on real content: the glTF room with its own camera, a 0.01 near plane and a
-/// 10^6 far plane, 120 km from the origin, with 256 lights added, at a size and tile no other
-/// test uses: every pipeline renders `forward`'s image with `--depth-mask on`.
+/// 2.5D culling and tight cells on real content: the glTF room with its own camera, a 0.01
+/// near plane and a 10^6 far plane, 120 km from the origin, with 256 lights added, at a size
+/// and tile no other test uses: every pipeline renders `forward`'s image with `--depth-mask
+/// on` and with `--cell-box on` (the boxes' view-space coordinates are camera-relative, so
+/// the distance from the origin does not reach them).
 #[test]
-fn depth_masks_on_a_gltf_file_far_from_the_origin_with_a_tiny_near_plane() {
+fn depth_masks_and_cell_boxes_on_a_gltf_file_far_from_the_origin_with_a_tiny_near_plane() {
     use lightgrid::scene::gltf::{load_bytes, LoadOptions};
     use lightgrid::scene::source::{add_lights, AddLights};
     let bytes = common::gltf_fixture::room().glb();
@@ -1651,4 +1653,10 @@ fn depth_masks_on_a_gltf_file_far_from_the_origin_with_a_tiny_near_plane() {
         ..settings(9)
     };
     check(&s, 33, (217, 131), masked);
+    let boxed = RenderSettings {
+        cell_box: CellBox::On,
+        slices: 24,
+        ..settings(9)
+    };
+    check(&s, 33, (217, 131), boxed);
 }
