@@ -131,20 +131,29 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
             "the cells' [min, max] bounds"
         );
     }
-    // With 2.5D culling the masks come back in the same wait.
-    let masked = RenderSettings {
-        depth_mask: lightgrid::DepthMask::On,
-        ..cpu
-    };
-    let mut m = Renderer::new(&ctx, 96, 54, masked).unwrap();
-    let (submitted, _) = play(&mut m, &scene, "tiled_forward_prez", &frames[..2]);
-    for s in &submitted {
-        assert_eq!(s.io.submits, 2);
-        assert_eq!(
-            s.io.readback_bytes,
-            cells * (8 + 16),
-            "the cells' bounds and depth masks"
-        );
+    // With 2.5D culling or tight cells the cells' records (mask and box) come back in the
+    // same wait.
+    let record = std::mem::size_of::<lightgrid::culling::CellCull>() as u64;
+    for culled in [
+        RenderSettings {
+            depth_mask: lightgrid::DepthMask::On,
+            ..cpu
+        },
+        RenderSettings {
+            cell_box: lightgrid::CellBox::On,
+            ..cpu
+        },
+    ] {
+        let mut m = Renderer::new(&ctx, 96, 54, culled).unwrap();
+        let (submitted, _) = play(&mut m, &scene, "tiled_forward_prez", &frames[..2]);
+        for s in &submitted {
+            assert_eq!(s.io.submits, 2);
+            assert_eq!(
+                s.io.readback_bytes,
+                cells * (8 + record),
+                "the cells' bounds and culling records"
+            );
+        }
     }
     let (submitted, _) = play(&mut r, &scene, "tiled_forward", &frames[..2]);
     assert!(submitted

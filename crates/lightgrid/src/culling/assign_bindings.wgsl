@@ -23,6 +23,12 @@
 // / `--cell-box on`).
 @group(1) @binding(7) var<storage, read> cell_culls: array<CellCull>;
 
+// Cell c's culling record: a grid without masks or boxes binds one record of neither, which
+// every cell reads.
+fn cell_cull(c: u32) -> CellCull {
+    return cell_culls[min(c, arrayLength(&cell_culls) - 1u)];
+}
+
 // The cell a per-cell workgroup works on, or NO_CELL for a workgroup past the end of its list
 // (the dispatch is rounded up to whole rows). `spill`: the spill pass's list.
 const NO_CELL: u32 = 0xffffffffu;
@@ -49,7 +55,7 @@ fn cell_frustum(c: u32) -> TileFrustum {
     let tile = c % (grid.tiles_x * grid.tiles_y);
     let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);
     var f = tile_frustum(xy, grid.tile_size, cell_bounds[c]);
-    let cull = cell_culls[c];
+    let cull = cell_cull(c);
     f.mask = cull.mask;
     f.box_lo = cull.lo;
     f.box_hi = cull.hi;

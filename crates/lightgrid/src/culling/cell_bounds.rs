@@ -34,6 +34,13 @@ pub(crate) struct CellBoundsKey {
     pub cell_box: CellBox,
 }
 
+impl CellBoundsKey {
+    /// Does the kernel write culling records (`--depth-mask on` or `--cell-box on`)?
+    pub fn culled(self) -> bool {
+        self.depth_mask == DepthMask::On || self.cell_box == CellBox::On
+    }
+}
+
 impl ShaderKey for CellBoundsKey {
     const STAGE: &'static str = "cell_bounds";
 
@@ -68,6 +75,7 @@ impl ShaderKey for CellBoundsKey {
         ));
         defs.push(Def::Bool("DEPTH_MASK", self.depth_mask == DepthMask::On));
         defs.push(Def::Bool("CELL_BOX", self.cell_box == CellBox::On));
+        defs.push(Def::Bool("CELL_CULLS", self.culled()));
         defs
     }
 
@@ -112,6 +120,20 @@ pub fn open_bounds(
 /// The bounds of a cell without samples.
 /// Bytes of one cell's culling record (`CellCull`: mask and box).
 const CULL_BYTES: usize = std::mem::size_of::<CellCull>();
+
+/// The records of a grid without masks or boxes: one [`super::NO_CULL`], which every cell
+/// reads (`cell_cull` in assign_bindings.wgsl clamps the index to the buffer), so such a grid
+/// spends 48 bytes on them, not 48 per cell.
+fn no_culls(device: &wgpu::Device) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("cell culls (none)"),
+        contents: bytemuck::bytes_of(&super::NO_CULL),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+    })
+}
 
 pub const EMPTY_CELL: [f32; 2] = [f32::INFINITY, 0.0];
 
@@ -275,8 +297,8 @@ impl CellBoundsPass {
                     | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            culls: storage_buffer(device, "cell culls", (CULL_BYTES as u64) << 10),
-            culled: key.depth_mask == DepthMask::On || key.cell_box == CellBox::On,
+            culls: no_culls(device),
+            culled: key.culled(),
             cells: 0,
         }
     }
@@ -289,12 +311,14 @@ impl CellBoundsPass {
             "cell bounds",
             (self.cells * 8) as u64,
         );
-        grow_storage(
-            device,
-            &mut self.culls,
-            "cell culls",
-            (self.cells * CULL_BYTES) as u64,
-        );
+        if self.culled {
+            grow_storage(
+                device,
+                &mut self.culls,
+                "cell culls",
+                (self.cells * CULL_BYTES) as u64,
+            );
+        }
         grow_storage(
             device,
             &mut self.occupied,
@@ -352,8 +376,10 @@ impl CellBoundsPass {
         self.ensure(device, dims);
         let all = vec![range; self.cells];
         queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&all));
-        let culls = vec![super::NO_CULL; self.cells];
-        queue.write_buffer(&self.culls, 0, bytemuck::cast_slice(&culls));
+        if self.culled {
+            let culls = vec![super::NO_CULL; self.cells];
+            queue.write_buffer(&self.culls, 0, bytemuck::cast_slice(&culls));
+        }
         let list: Vec<u32> = (0..self.cells as u32).collect();
         queue.write_buffer(&self.occupied, 0, bytemuck::cast_slice(&list));
         let n = self.cells as u32;
@@ -399,8 +425,12 @@ impl CellBoundsPass {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    /// The culling records of the last recorded frame (as [`CellBoundsPass::read`]).
+    /// The culling records of the last recorded frame (as [`CellBoundsPass::read`]; every
+    /// cell [`super::NO_CULL`] without masks or boxes).
     pub fn read_culls(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<CellCull>> {
+        if !self.culled {
+            return Ok(vec![super::NO_CULL; self.cells]);
+        }
         let bytes = download(device, queue, &self.culls, (self.cells * CULL_BYTES) as u64)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }

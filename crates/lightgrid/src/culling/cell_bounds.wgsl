@@ -21,8 +21,9 @@
 // Each cell's culling record (cell_box.wgsl): with DEPTH_MASK (`--depth-mask on`) its 2.5D
 // depth mask (depth_mask.wgsl), the bins of its bounds that hold samples, found by a second
 // sweep over the tile once the bounds are known; with CELL_BOX (`--cell-box on`) the
-// view-space box of its samples' pixel footprints, reduced in the first sweep; otherwise, and
-// for the transparent layer of separate lists, neither.
+// view-space box of its samples' pixel footprints, reduced in the first sweep; for the
+// transparent layer of separate lists neither. Without either (CELL_CULLS false) the buffer
+// holds one record of neither, which every cell reads, and the kernel writes nothing.
 @group(1) @binding(6) var<storage, read_write> cell_culls: array<CellCull>;
 
 #if CELL_BOX
@@ -251,8 +252,10 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         cell_culls[cell].lo = bx[0];
         cell_culls[cell].hi = bx[1];
 #else
+#if CELL_CULLS
         cell_culls[cell].lo = vec4<f32>(0.0);
         cell_culls[cell].hi = vec4<f32>(0.0);
+#endif
 #endif
 #if DEPTH_MASK
         // 1. The mask's bins over the cell's bounds (`--depth-mask` needs both bounds, so these
@@ -266,11 +269,15 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         }
         atomicStore(&mask_bits[k], bits);
 #else
+#if CELL_CULLS
         cell_culls[cell].mask = depth_mask_none();
 #endif
+#endif
+#if CELL_CULLS
         if (grid.lists == GRID_LISTS_SEPARATE) {
             cell_culls[grid.layer_cells + cell] = cell_cull_none();
         }
+#endif
     }
     check_loop(k, grid.slices);
 #if DEPTH_MASK
