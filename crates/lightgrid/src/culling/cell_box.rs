@@ -21,7 +21,6 @@
 //! [`box_overlap`] as the WGSL does.
 
 use super::{CellMask, GridDims, GridLists, ViewSetup, NO_MASK};
-use crate::consts::ASSIGN_DEPTH_SLACK;
 use glam::Vec3;
 
 /// One cell's culling record beyond its depth bounds: its 2.5D depth mask (`depth_mask.rs`)
@@ -118,30 +117,17 @@ pub fn cell_boxes_cpu(
     slack: f32,
 ) -> Vec<Option<(Vec3, Vec3)>> {
     let mut boxes: Vec<Option<(Vec3, Vec3)>> = vec![None; dims.cell_count()];
-    for (y, x) in (0..dims.height).flat_map(|y| (0..dims.width).map(move |x| (y, x))) {
-        for plane in planes {
-            let d = plane[(y * dims.width + x) as usize];
-            if crate::depth::is_background(d) {
-                continue;
-            }
-            let w = setup.view_distance(d);
-            let tile = dims.tile_of(x, y);
-            let (px, py) = (x as f32, y as f32);
-            let b = rect_box(
-                setup,
-                [px, px + 1.0],
-                [py, py + 1.0],
-                w * (1.0 - slack),
-                w * (1.0 + slack),
-            );
-            let k0 = dims.slice_of(w * (1.0 - ASSIGN_DEPTH_SLACK));
-            let k1 = dims.slice_of(w * (1.0 + ASSIGN_DEPTH_SLACK));
-            for k in [k0, k1] {
-                let cell = k as usize * dims.tile_count() + tile;
-                boxes[cell] = union(boxes[cell], b);
-            }
-        }
-    }
+    super::cell_bounds::for_each_sample_cell(setup, dims, planes, |(x, y), w, cell| {
+        let (px, py) = (x as f32, y as f32);
+        let b = rect_box(
+            setup,
+            [px, px + 1.0],
+            [py, py + 1.0],
+            w * (1.0 - slack),
+            w * (1.0 + slack),
+        );
+        boxes[cell] = union(boxes[cell], b);
+    });
     let layer = dims.layer_cells();
     for (cell, b) in boxes.iter_mut().enumerate().take(layer) {
         if let Some(r) = extra.map(|e| e[cell]).filter(|r| r[0] <= r[1]) {

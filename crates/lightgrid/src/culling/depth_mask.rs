@@ -23,7 +23,7 @@
 //! the GPU does.
 
 use super::{GridDims, GridLists, ViewSetup};
-use crate::consts::{ASSIGN_DEPTH_SLACK, DEPTH_MASK_ALL, DEPTH_MASK_BINS};
+use crate::consts::{DEPTH_MASK_ALL, DEPTH_MASK_BINS};
 
 /// One cell's mask: `[bits, lo, inv, 0]` (`lo`, `inv`: f32 bits).
 pub type CellMask = [u32; 4];
@@ -84,23 +84,10 @@ pub fn cell_masks_cpu(
     slack: f32,
 ) -> Vec<CellMask> {
     let mut masks: Vec<CellMask> = scales.iter().map(|s| [0, s[1], s[2], 0]).collect();
-    for (y, x) in (0..dims.height).flat_map(|y| (0..dims.width).map(move |x| (y, x))) {
-        for plane in planes {
-            let d = plane[(y * dims.width + x) as usize];
-            if crate::depth::is_background(d) {
-                continue;
-            }
-            let w = setup.view_distance(d);
-            let tile = dims.tile_of(x, y);
-            let k0 = dims.slice_of(w * (1.0 - ASSIGN_DEPTH_SLACK));
-            let k1 = dims.slice_of(w * (1.0 + ASSIGN_DEPTH_SLACK));
-            for k in [k0, k1] {
-                let cell = k as usize * dims.tile_count() + tile;
-                let m = masks[cell];
-                masks[cell][0] |= inflated_span(w, w, slack, &m);
-            }
-        }
-    }
+    super::cell_bounds::for_each_sample_cell(setup, dims, planes, |_, w, cell| {
+        let m = masks[cell];
+        masks[cell][0] |= inflated_span(w, w, slack, &m);
+    });
     let layer = dims.layer_cells();
     match (dims.lists, transparent) {
         (GridLists::Shared, Some(t)) => {
