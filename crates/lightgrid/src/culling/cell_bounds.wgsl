@@ -41,19 +41,14 @@ fn box_include(k: u32, e: vec4<f32>) {
     atomicMax(&box_y1[k], ordered_bits(e.w));
 }
 
-// A sample of pixel p: its pixel at its view distance widened by the slack, in the slices
-// its distance lies in (as `include_depth`). CPU twin: `cell_boxes_cpu`.
-fn box_sample(d: f32, p: vec2<u32>) {
-    if (!is_background(d)) {
-        let w = view_distance_from_depth(d);
-        let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
-        let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
-        let q = vec2<f32>(p);
-        let e = rect_extent(vec2<f32>(q.x, q.x + 1.0), vec2<f32>(q.y, q.y + 1.0), w * (1.0 - ASSIGN_DEPTH_SLACK), w * (1.0 + ASSIGN_DEPTH_SLACK));
-        box_include(k0, e);
-        if (k1 != k0) {
-            box_include(k1, e);
-        }
+// A sample of pixel p at view distance w, in slices k0 and k1 (as `include_depth` finds
+// them): its pixel at its distance widened by the slack. CPU twin: `cell_boxes_cpu`.
+fn box_sample(w: f32, k0: u32, k1: u32, p: vec2<u32>) {
+    let q = vec2<f32>(p);
+    let e = rect_extent(vec2<f32>(q.x, q.x + 1.0), vec2<f32>(q.y, q.y + 1.0), w * (1.0 - ASSIGN_DEPTH_SLACK), w * (1.0 + ASSIGN_DEPTH_SLACK));
+    box_include(k0, e);
+    if (k1 != k0) {
+        box_include(k1, e);
     }
 }
 
@@ -128,14 +123,19 @@ fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {
 }
 #endif
 
+// The empty range (min > max).
+fn no_range() -> vec2<f32> {
+    return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+}
+
 // Cell `cell`'s fragment bounds (min > max when none).
 fn fragment_range(cell: u32) -> vec2<f32> {
     if (SAMPLES == 1u) {
-        return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+        return no_range();
     }
     let lo = fragment_bounds[2u * cell];
     if (lo == 0u) {
-        return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+        return no_range();
     }
     return vec2<f32>(bitcast<f32>(0xffffffffu - lo), bitcast<f32>(fragment_bounds[2u * cell + 1u]));
 }
@@ -147,8 +147,9 @@ var<workgroup> slice_lo: array<atomic<u32>, MAX_SLICES>;
 var<workgroup> tile_hi: atomic<u32>;
 var<workgroup> slice_hi: array<atomic<u32>, MAX_SLICES>;
 
-// A depth-buffer value: the tile maximum, and the slices its view distance lies in.
-fn include_depth(d: f32) {
+// A depth-buffer value of pixel p: the tile maximum, and the slices its view distance lies in
+// (and, with CELL_BOX, their boxes).
+fn include_depth(d: f32, p: vec2<u32>) {
     atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), !is_background(d))));
     if (!is_background(d)) {
         let w = view_distance_from_depth(d);
@@ -159,6 +160,9 @@ fn include_depth(d: f32) {
         if (k1 != k0) {
             include_sample(k1, bits);
         }
+#if CELL_BOX
+        box_sample(w, k0, k1, p);
+#endif
     }
 }
 
@@ -207,13 +211,14 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
                         if (!is_background(d)) {
                             lo = min(lo, bitcast<u32>(w));
                             hi = max(hi, bitcast<u32>(w));
+#if CELL_BOX
+                            // Registers only on a tiled grid: every sample is in slice 0.
+                            box_sample(w, 0u, 0u, p);
+#endif
                         }
                     } else {
-                        include_depth(d);
+                        include_depth(d, p);
                     }
-#if CELL_BOX
-                    box_sample(d, p);
-#endif
                 }
             }
         }
@@ -230,25 +235,25 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     let tiles = grid.tiles_x * grid.tiles_y;
     var k = li;
     for (; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
-        var b = vec2<f32>(bitcast<f32>(atomicLoad(&slice_lo[k])), bitcast<f32>(atomicLoad(&slice_hi[k])));
         let cell = k * tiles + tile;
-        b = bounds_union(b, fragment_range(cell));
+        // What the cell's list serves besides its samples: MSAA forward fragments' range and,
+        // with one shared list, the range transparent fragments may lie in.
+        let fragments = fragment_range(cell);
+        var shared_transparent = no_range();
         if (grid.lists != GRID_LISTS_OPAQUE) {
             let t = transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi)));
             if (grid.lists == GRID_LISTS_SHARED) {
-                b = bounds_union(b, t);
+                shared_transparent = t;
             } else {
                 write_bounds(grid.layer_cells + cell, bounds_union(t, fragment_range(grid.layer_cells + cell)));
             }
         }
+        var b = vec2<f32>(bitcast<f32>(atomicLoad(&slice_lo[k])), bitcast<f32>(atomicLoad(&slice_hi[k])));
+        b = bounds_union(bounds_union(b, fragments), shared_transparent);
         write_bounds(cell, open_bounds(k, b));
 #if CELL_BOX
         // `--cell-box` needs both bounds too, so `b` is the cell's bounds.
-        var extra = fragment_range(cell);
-        if (grid.lists == GRID_LISTS_SHARED) {
-            extra = bounds_union(extra, transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi))));
-        }
-        let bx = slice_box(k, b, extra, origin);
+        let bx = slice_box(k, b, bounds_union(fragments, shared_transparent), origin);
         cell_culls[cell].lo = bx[0];
         cell_culls[cell].hi = bx[1];
 #else
@@ -263,11 +268,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         // shared list) sets every bin of its range.
         let inv = select(0.0, f32(DEPTH_MASK_BINS) / (b.y - b.x), b.y > b.x);
         mask_scale[k] = vec2<u32>(bitcast<u32>(b.x), bitcast<u32>(inv));
-        var bits = mask_span(k, fragment_range(cell));
-        if (grid.lists == GRID_LISTS_SHARED) {
-            bits = bits | mask_span(k, transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi))));
-        }
-        atomicStore(&mask_bits[k], bits);
+        atomicStore(&mask_bits[k], mask_span(k, fragments) | mask_span(k, shared_transparent));
 #else
 #if CELL_CULLS
         cell_culls[cell].mask = depth_mask_none();
@@ -357,7 +358,7 @@ fn transparent_bounds(k: u32, tile_max: f32) -> vec2<f32> {
     let lo = max(frame.near, span.x * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
     let hi = min(tile_max, span.y * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
     if (lo > hi) {
-        return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+        return no_range();
     }
     return vec2<f32>(lo, hi);
 }
