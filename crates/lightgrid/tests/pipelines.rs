@@ -1295,24 +1295,30 @@ fn deferred_mono_matches_its_reference_with_coloured_specular() {
 /// uses; and along its orbit.
 #[test]
 fn every_pipeline_renders_a_gltf_file_like_forward() {
-    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
-    use lightgrid::scene::source::{add_lights, AddLights};
-    let bytes = common::gltf_fixture::room().glb();
-    let mut s = load_bytes(&bytes, "room.glb", None, &LoadOptions::default())
-        .unwrap()
-        .scene;
+    let s = room();
     check(&s, 0, (150, 94), settings(12));
     check(&s, 90, (128, 80), settings(16));
-    add_lights(
-        &mut s,
-        &AddLights {
-            count: 256,
-            range: None,
-        },
-        3,
-    )
-    .unwrap();
-    check(&s, 40, (141, 88), settings(10));
+    check(&with_256_lights_added(s, 3), 40, (141, 88), settings(10));
+}
+
+/// The glTF fixture room as the loader reads it (its own camera and lights).
+fn room() -> lightgrid::scene::Scene {
+    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
+    let bytes = common::gltf_fixture::room().glb();
+    load_bytes(&bytes, "room.glb", None, &LoadOptions::default())
+        .unwrap()
+        .scene
+}
+
+/// `s` with 256 point lights scattered over its bounds (`--add-lights 256`), from `seed`.
+fn with_256_lights_added(mut s: lightgrid::scene::Scene, seed: u64) -> lightgrid::scene::Scene {
+    use lightgrid::scene::source::{add_lights, AddLights};
+    let lights = AddLights {
+        count: 256,
+        range: None,
+    };
+    add_lights(&mut s, &lights, seed).unwrap();
+    s
 }
 
 /// Textures (a glTF file's): an opaque checkerboard, a MASK texture whose holes show what is
@@ -1627,36 +1633,26 @@ fn cameras_the_depth_buffer_cannot_hold_are_refused() {
 /// the distance from the origin does not reach them).
 #[test]
 fn depth_masks_and_cell_boxes_on_a_gltf_file_far_from_the_origin_with_a_tiny_near_plane() {
-    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
-    use lightgrid::scene::source::{add_lights, AddLights};
-    let bytes = common::gltf_fixture::room().glb();
-    let mut s = load_bytes(&bytes, "room.glb", None, &LoadOptions::default())
-        .unwrap()
-        .scene;
-    add_lights(
-        &mut s,
-        &AddLights {
-            count: 256,
-            range: None,
-        },
-        5,
-    )
-    .unwrap();
+    let s = with_256_lights_added(room(), 5);
     let s = with_planes(
         &moved(&s, glam::Vec3::new(1.0e5, 30.0, -7.0e4)),
         0.01,
         1.0e6,
     );
-    let masked = RenderSettings {
-        depth_mask: DepthMask::On,
+    let base = RenderSettings {
         slices: 24,
         ..settings(9)
     };
-    check(&s, 33, (217, 131), masked);
-    let boxed = RenderSettings {
-        cell_box: CellBox::On,
-        slices: 24,
-        ..settings(9)
-    };
-    check(&s, 33, (217, 131), boxed);
+    for culled in [
+        RenderSettings {
+            depth_mask: DepthMask::On,
+            ..base
+        },
+        RenderSettings {
+            cell_box: CellBox::On,
+            ..base
+        },
+    ] {
+        check(&s, 33, (217, 131), culled);
+    }
 }
