@@ -19,7 +19,7 @@ pub const FEWER: &str =
 
 /// The claims of the runs `r` holds in pairs (a setting's `off` and `on` runs of one series).
 pub(super) fn culling_claims(r: &BenchResults) -> Vec<Claim> {
-    let mut out = pairs::<DepthMask>(r, DepthMask::Off, DepthMask::On, |x| !x.reads("slices"))
+    let mut out = pairs::<DepthMask>(r, DepthMask::Off, DepthMask::On, |x| !clustered(x))
         .into_iter()
         .map(|(off, on)| {
             Claim::new(
@@ -32,7 +32,7 @@ pub(super) fn culling_claims(r: &BenchResults) -> Vec<Claim> {
         })
         .collect::<Vec<_>>();
     out.extend(
-        pairs::<CellBox>(r, CellBox::Off, CellBox::On, |x| x.reads("slices"))
+        pairs::<CellBox>(r, CellBox::Off, CellBox::On, clustered)
             .into_iter()
             .map(|(off, on)| {
                 Claim::new(
@@ -72,6 +72,11 @@ fn pairs<T: SettingValue + PartialEq>(
             Some((x, y))
         })
         .collect()
+}
+
+/// Is the run's pipeline a clustered one (the registry's `clustered`)?
+fn clustered(x: &RunRecord) -> bool {
+    lightgrid::pipelines::find(&x.pipeline).is_ok_and(|p| p.clustered)
 }
 
 /// The run's lighting computations summed over its frames (None when any frame lacks them).
