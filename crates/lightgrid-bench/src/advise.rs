@@ -219,7 +219,10 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     let mask_axis = lightgrid::pipelines::find_axis(DepthMask::FLAG).expect("a row");
     let box_axis = lightgrid::pipelines::find_axis(CellBox::FLAG).expect("a row");
     for c in &top {
-        let settings = RenderSettings::default();
+        let settings = RenderSettings {
+            assign: assign_of(c),
+            ..Default::default()
+        };
         if c.depth_mask.is_none() && (mask_axis.applies)(info(c), &settings) {
             push(
                 Candidate {
@@ -241,7 +244,15 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     }
     for c in &top {
         if c.assign.is_some() {
-            for a in Assign::all().filter(|a| *a != Assign::Auto) {
+            // z-binning builds no per-cell lists for masks or boxes to cut.
+            let culling = (
+                c.depth_mask.unwrap_or_default(),
+                c.cell_box.unwrap_or_default(),
+            );
+            for a in Assign::all().filter(|a| {
+                *a != Assign::Auto
+                    && lightgrid::frame::validate_zbin_culling(*a, culling.0, culling.1).is_ok()
+            }) {
                 push(
                     Candidate {
                         assign: Some(a.name()),
@@ -253,6 +264,13 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
         }
     }
     out
+}
+
+/// The strategy a candidate names (`auto` when it names none).
+fn assign_of(c: &Candidate) -> Assign {
+    c.assign
+        .and_then(|a| Assign::all().find(|x| x.name() == a))
+        .unwrap_or_default()
 }
 
 /// Fastest first; measured before unmeasured (kept in the order tried); equal times by

@@ -6,7 +6,7 @@ use crate::args::{
 };
 use anyhow::Result;
 use clap::Args;
-use lightgrid::frame::{CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve};
+use lightgrid::frame::{Assign, CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
@@ -58,7 +58,8 @@ pub(crate) enum Preset {
     DepthBounds,
     /// Culling past the papers: the grids built from the depth buffer (tiled and clustered,
     /// forward and deferred) with and without 2.5D depth masks (`--depth-mask`; Harada et al.
-    /// 2012) and tight cell boxes (`--cell-box`), 16-pixel tiles, on robots-many, robots-few and scattered without glass, frames
+    /// 2012) and tight cell boxes (`--cell-box`), and z-binning (`--assign zbin`, Drobot 2017;
+    /// its bins are the clustered pipelines' slices, one bin on tiled ones), 16-pixel tiles, on robots-many, robots-few and scattered without glass, frames
     /// 0..259 every 20, at the papers' size (640x360 on a software adapter): lighting
     /// computations against the ideal, assignment time and grid memory per grid.
     Culling,
@@ -353,7 +354,11 @@ pub(crate) fn bench_config(
             ]
             .map(String::from)
             .to_vec(),
-            settings: vec![measure(&DepthMask::ALL), measure(&CellBox::ALL)],
+            settings: vec![
+                measure(&[Assign::Auto, Assign::ZBin]),
+                measure(&DepthMask::ALL),
+                measure(&CellBox::ALL),
+            ],
             size: Some(papers_size(hardware)),
             tile: Some(16),
             transparency: false,

@@ -10,7 +10,7 @@ use crate::culling::{
 };
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
-use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel, INDEX_BYTES};
+use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel};
 use crate::passes::{BufferReadback, DepthSamples, Readback, Targets};
 use crate::pipelines::PipelineInfo;
 use crate::scene::{rasterize, FrameState};
@@ -173,7 +173,7 @@ fn frame_memory(
             } else {
                 0
             };
-            (g.cells.len() * (8 + record) + g.indices.len() * INDEX_BYTES as usize) as u64
+            g.stored_bytes() + (g.cells.len() * record) as u64
         }),
         modelled_write_bytes: modelled(t.write_per_pixel, t.write_per_lit),
         modelled_read_bytes: modelled(t.read_per_pixel, t.read_per_lit),

@@ -101,9 +101,17 @@ pub struct GridParams {
     pub lists: u32,
     /// Cells of one layer (tiles × slices).
     pub layer_cells: u32,
+    /// A z-binned grid (`culling/zbin.rs`): 32-bit words of each tile's light mask; 0 for a
+    /// grid of per-cell lists.
+    pub zbin_words: u32,
+    /// A z-binned grid: where the tile masks start in the index buffer (after the sorted
+    /// light indices).
+    pub zbin_masks: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 
-const _: () = assert!(std::mem::size_of::<GridParams>() == 32);
+const _: () = assert!(std::mem::size_of::<GridParams>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 96);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);

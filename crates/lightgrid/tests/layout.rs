@@ -60,7 +60,11 @@ fn gpu_structs_match_wgsl() {
             slice_scale,
             slice_bias,
             lists,
-            layer_cells
+            layer_cells,
+            zbin_words,
+            zbin_masks,
+            _pad0,
+            _pad1
         ]
     );
     check_layout!(

@@ -225,6 +225,7 @@ fn opaque_layer(grid: &lightgrid::culling::LightGrid) -> lightgrid::culling::Lig
         dims,
         cells: grid.cells[..cells].to_vec(),
         indices: grid.indices.clone(),
+        zbins: None,
     }
 }
 

@@ -866,7 +866,7 @@ fn sample_culling_keeps_the_image_and_only_drops_lights(
         ..Default::default()
     };
     let mut fewer = std::collections::HashMap::new();
-    for assign in common::strategies() {
+    for assign in common::list_strategies() {
         let mut on = Renderer::new(&ctx, w, h, on(plain(assign))).unwrap();
         let mut off = Renderer::new(&ctx, w, h, plain(assign)).unwrap();
         for id in &ids {
@@ -893,7 +893,7 @@ fn sample_culling_keeps_the_image_and_only_drops_lights(
     for id in must_drop {
         assert_eq!(
             fewer.get(id),
-            Some(&common::strategies().len()),
+            Some(&common::list_strategies().len()),
             "{id}: the {name} dropped no light with some strategy ({fewer:?})"
         );
     }
@@ -969,6 +969,81 @@ fn depth_masks_and_cell_boxes_with_msaa_and_shared_lists() {
             }
         }
     }
+}
+
+/// Z-binning (`--assign zbin`) on every grid pipeline, with the robots' glass (separate and
+/// shared lists: its bins hold any depth, so the transparent fragments read the same masks)
+/// and with 4x MSAA: the GPU's sorted lights, bins and tile masks equal the CPU twin's
+/// exactly, the lists they stand for hold every light the oracle finds, and the image equals
+/// the same pipeline's with the default strategy's lists.
+#[test]
+fn z_bins_equal_their_twin_and_keep_the_image_with_glass_and_msaa() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h, frame) = (157, 91, 140);
+    let state = s.frame(frame);
+    let setup = ViewSetup::new(&state.camera, w, h);
+    let mut bins_used = 0;
+    for (msaa, lists) in [
+        (1, GridLists::Separate),
+        (1, GridLists::Shared),
+        (4, GridLists::Shared),
+    ] {
+        if msaa > 1 && !lightgrid::frame::msaa_counts(&ctx, Default::default()).contains(&msaa) {
+            panic!("the adapter offers no {msaa}x MSAA");
+        }
+        let with = |assign| RenderSettings {
+            tile_size: 16,
+            slices: 24,
+            assign,
+            msaa,
+            lists,
+            ..Default::default()
+        };
+        let mut zbin = Renderer::new(&ctx, w, h, with(Assign::ZBin)).unwrap();
+        let mut plain = Renderer::new(&ctx, w, h, with(Assign::Auto)).unwrap();
+        for id in common::grid_pipelines() {
+            if msaa > 1
+                && lightgrid::pipelines::find(id).unwrap().msaa
+                    != lightgrid::pipelines::Msaa::Supported
+            {
+                continue;
+            }
+            let what = format!("{id} --assign zbin --msaa {msaa} --lists {lists:?}");
+            let a = zbin.render(&s, frame, id).unwrap();
+            let b = plain.render(&s, frame, id).unwrap();
+            assert_eq!(a.stats.truncated_loops, 0, "{what}");
+            let z = a
+                .grid
+                .zbins
+                .as_ref()
+                .expect("a z-binned grid keeps its compact form");
+            let twin = lightgrid::culling::zbins_cpu(
+                &setup,
+                &a.grid.dims,
+                &state.lights,
+                a.cell_bounds.as_deref().unwrap(),
+            );
+            assert_eq!(z.order, twin.order, "{what}: the sorted lights");
+            assert_eq!(z.bins, twin.bins, "{what}: the bins");
+            let differing = z
+                .masks
+                .iter()
+                .zip(&twin.masks)
+                .filter(|(a, b)| a != b)
+                .count();
+            assert_eq!(
+                differing, 0,
+                "{what}: {differing} tile mask words differ from the twin's"
+            );
+            bins_used += z.bins.iter().filter(|b| b[0] < b[1]).count();
+            common::check_grid_contains_oracle(&what, &setup, &a.grid, &state.lights, &a.depth);
+            let (d, _) = diff(&a.image, &b.image).unwrap();
+            assert!(d.max <= 1.0, "{what}: z-binning changed the image: {d:?}");
+            assert!(a.stats.lighting_computations.unwrap() > 0, "{what}");
+        }
+    }
+    assert!(bins_used > 100, "only {bins_used} bins held lights");
 }
 
 /// `--depth-reduction subgroup` reduces to the same cell bounds as the atomics (the twin's),

@@ -8,9 +8,12 @@
 //! - Tight clusters (Olsson, Billeter and Assarsson 2012 bound each cluster by its samples;
 //!   `--cell-box on` against off, clustered grids): the box of a cluster's samples is smaller
 //!   than its frustum piece, so clusters list fewer lights.
+//! - Drobot 2017, "Improved culling for tiled and clustered rendering" (`--assign zbin`
+//!   against the clustered grid the default strategy builds, clustered pipelines): z-binning's
+//!   per-tile light masks and depth bins are at least as tight as clusters, in no more memory.
 
 use super::{differs_only_in, verdict, BenchResults, Claim, RunRecord, Threshold, Verdict};
-use lightgrid::frame::{CellBox, DepthMask};
+use lightgrid::frame::{Assign, CellBox, DepthMask};
 use lightgrid::pipelines::SettingValue;
 
 /// "Fewer": the culled run's lighting computations below the plain run's.
@@ -44,7 +47,54 @@ pub(super) fn culling_claims(r: &BenchResults) -> Vec<Claim> {
                 )
             }),
     );
+    out.extend(
+        pairs::<Assign>(r, Assign::Auto, Assign::ZBin, clustered)
+            .into_iter()
+            .map(|(clusters, zbins)| {
+                Claim::new(
+                    clusters.scene.as_str(),
+                    "Z-binning (lights sorted by depth, per-bin index ranges, per-tile light masks) is at least as tight as clusters, in no more memory",
+                    "Drobot 2017, \"Improved culling for tiled and clustered rendering\"",
+                    Threshold::Rule(AS_TIGHT),
+                    as_tight_in_no_more_memory(
+                        &clusters.pipeline,
+                        [computations(clusters), computations(zbins)],
+                        [grid_bytes(clusters), grid_bytes(zbins)],
+                    ),
+                )
+            }),
+    );
     out
+}
+
+/// "As tight in no more memory": z-binning against clusters.
+pub const AS_TIGHT: &str = "\"as tight\": z-binning's lighting computations at most the clusters', summed over the same frames, and its grid's bytes (mean over the frames) at most theirs";
+
+/// Did z-binning (`[clusters, zbins]`) evaluate no more lights than clusters in no more grid
+/// memory ([`AS_TIGHT`])?
+pub fn as_tight_in_no_more_memory(
+    pipeline: &str,
+    [c, z]: [Option<u64>; 2],
+    [cb, zb]: [Option<u64>; 2],
+) -> (String, Verdict) {
+    let (Some(c), Some(z), Some(cb), Some(zb)) = (c, z, cb, zb) else {
+        return super::not_measured("the lighting computations and grid bytes of both runs");
+    };
+    let ratio = z as f64 / (c as f64).max(1.0);
+    (
+        format!(
+            "{pipeline}: {z} lighting computations with z-bins, {c} with clusters ({ratio:.3}x); grid {:.1} KiB against {:.1} KiB",
+            zb as f64 / 1024.0,
+            cb as f64 / 1024.0
+        ),
+        verdict(c > 0 && z <= c && zb <= cb),
+    )
+}
+
+/// The run's grid bytes, mean over its frames (None when any frame lacks them).
+fn grid_bytes(x: &RunRecord) -> Option<u64> {
+    let sum: Option<u64> = x.frames.iter().map(|f| f.stats.memory.grid_bytes).sum();
+    sum.map(|s| s / (x.frames.len() as u64).max(1))
 }
 
 /// Runs of the setting `T` at `off` (with `keep`, and the other per-sample culling setting
@@ -55,7 +105,7 @@ fn pairs<T: SettingValue + PartialEq>(
     on: T,
     keep: fn(&RunRecord) -> bool,
 ) -> Vec<(&RunRecord, &RunRecord)> {
-    // The other setting off: each claim compares one technique against the plain grid.
+    // The other settings off: each claim compares one technique against the plain grid.
     let plain = |x: &RunRecord| {
         let mask_off = T::FLAG == DepthMask::FLAG || x.settings.depth_mask == DepthMask::Off;
         let box_off = T::FLAG == CellBox::FLAG || x.settings.cell_box == CellBox::Off;
@@ -121,5 +171,35 @@ mod tests {
         assert!(fewer("tiled_deferred", "boxes", Some(200), Some(150))
             .0
             .contains("0.750x"));
+    }
+
+    #[test]
+    fn z_binning_holds_only_as_tight_and_no_larger() {
+        let held = |c, z, cb, zb| as_tight_in_no_more_memory("p", [c, z], [cb, zb]).1;
+        assert_eq!(
+            held(Some(100), Some(100), Some(10), Some(10)),
+            Verdict::Held
+        );
+        assert_eq!(held(Some(100), Some(80), Some(10), Some(5)), Verdict::Held);
+        // Looser, or larger, or both.
+        assert_eq!(
+            held(Some(100), Some(101), Some(10), Some(5)),
+            Verdict::NotHeld
+        );
+        assert_eq!(
+            held(Some(100), Some(80), Some(10), Some(11)),
+            Verdict::NotHeld
+        );
+        assert_eq!(held(Some(0), Some(0), Some(10), Some(5)), Verdict::NotHeld);
+        assert_eq!(
+            held(Some(100), Some(80), None, Some(5)),
+            Verdict::NotMeasured
+        );
+        let (evidence, _) =
+            as_tight_in_no_more_memory("c", [Some(200), Some(150)], [Some(2048), Some(1024)]);
+        assert!(
+            evidence.contains("0.750x") && evidence.contains("1.0 KiB against 2.0 KiB"),
+            "{evidence}"
+        );
     }
 }

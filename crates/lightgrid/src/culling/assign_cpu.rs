@@ -295,6 +295,7 @@ pub fn assign_cpu(
         dims: *dims,
         cells,
         indices,
+        zbins: None,
     }
 }
 

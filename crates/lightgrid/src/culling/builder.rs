@@ -13,7 +13,6 @@
 
 use super::cell_bounds::CellBoundsPass;
 use super::depth_range::DepthRangePass;
-use super::gpu_assign::read_grid;
 use super::registry::find_strategy;
 pub use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, CullFrame, StrategyContext};
@@ -211,6 +210,8 @@ impl GridBuilder {
             CellSource::Depth if f.transparency => self.lists,
             _ => GridLists::Opaque,
         });
+        let assign = self.assign.resolve(f.light_count, self.software_adapter);
+        let dims = self.strategy(f.device, assign)?.shape(dims, f.light_count);
         if let Some(range) = &self.range {
             range.encode(
                 f,
@@ -226,10 +227,8 @@ impl GridBuilder {
                     .fill(f.device, f.queue, &dims, [f.setup.near, f.setup.far])
             }
         }
-        let assign = self.assign.resolve(f.light_count, self.software_adapter);
         let source = self.source;
         // Disjoint borrows: the strategy list, the grid buffers and the bounds.
-        self.strategy(f.device, assign)?;
         let strategy = self
             .strategies
             .iter_mut()
@@ -302,13 +301,7 @@ impl GridBuilder {
                     .find(|(a, _)| *a == last.assign)
                     .map(|(_, s)| s)
                     .expect("the last frame's strategy exists");
-                read_grid(
-                    device,
-                    queue,
-                    &self.buffers,
-                    &dims,
-                    strategy.grid_entries(values),
-                )?
+                strategy.read_grid(device, queue, &self.buffers, &dims, values)?
             }
         };
         let cell_bounds = match (&last.cell_bounds, self.source) {

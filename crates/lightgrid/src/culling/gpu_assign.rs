@@ -153,6 +153,7 @@ pub fn read_grid(
         dims: *dims,
         cells: bytemuck::pod_collect_to_vec(&cells),
         indices: bytemuck::pod_collect_to_vec(&indices),
+        zbins: None,
     })
 }
 

@@ -29,6 +29,9 @@ pub struct GridDims {
     pub slice_bias: f32,
     /// Which samples the lists cover: opaque samples only, or transparent fragments too.
     pub lists: GridLists,
+    /// A z-binned grid (`--assign zbin`, `zbin.rs`): the light count its tile masks have
+    /// bits for; `None` for a grid of per-cell lists.
+    pub zbin_lights: Option<u32>,
 }
 
 impl GridDims {
@@ -47,6 +50,7 @@ impl GridDims {
             slice_scale: 0.0,
             slice_bias: 0.0,
             lists: GridLists::Opaque,
+            zbin_lights: None,
         })
     }
 
@@ -92,6 +96,14 @@ impl GridDims {
     /// The same grid with lists covering `lists`.
     pub fn with_lists(self, lists: GridLists) -> Self {
         GridDims { lists, ..self }
+    }
+
+    /// The same grid z-binned over `lights` lights (its slices are the depth bins).
+    pub fn with_zbins(self, lights: u32) -> Self {
+        GridDims {
+            zbin_lights: Some(lights),
+            ..self
+        }
     }
 
     /// Cells of one layer: tiles × slices.
@@ -187,6 +199,10 @@ impl GridDims {
             slice_bias,
             lists: self.lists.gpu(),
             layer_cells: self.layer_cells() as u32,
+            zbin_words: self.zbin_lights.map_or(0, |n| n.div_ceil(32)),
+            zbin_masks: self.zbin_lights.unwrap_or(0),
+            _pad0: 0,
+            _pad1: 0,
         }
     }
 }
@@ -197,6 +213,9 @@ pub struct LightGrid {
     pub dims: GridDims,
     pub cells: Vec<[u32; 2]>,
     pub indices: Vec<u32>,
+    /// A z-binned grid's compact form (what the GPU holds); `cells` and `indices` are then
+    /// the lists it stands for.
+    pub zbins: Option<super::ZBins>,
 }
 
 impl LightGrid {
@@ -213,6 +232,7 @@ impl LightGrid {
             dims,
             cells,
             indices,
+            zbins: None,
         }
     }
 
@@ -220,6 +240,15 @@ impl LightGrid {
     pub fn cell(&self, c: usize) -> &[u32] {
         let [offset, count] = self.cells[c];
         &self.indices[offset as usize..(offset + count) as usize]
+    }
+
+    /// Bytes the GPU holds for the grid (not counting the cells' culling records): the
+    /// `(offset, count)` cells and the index lists, or a z-binned grid's compact form.
+    pub fn stored_bytes(&self) -> u64 {
+        match &self.zbins {
+            Some(z) => z.bytes(),
+            None => (self.cells.len() * 8 + self.indices.len() * 4) as u64,
+        }
     }
 
     pub fn average_lights_per_cell(&self) -> f64 {

@@ -15,8 +15,84 @@ fn grid_cell_holds(cell: u32, w: f32) -> bool {
     return w >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
 }
 
+// The lights a sample of `cell` evaluates: its list's length, or for a z-binned grid the set
+// bits of its tile's mask inside its bin's range.
 fn grid_cell_count(cell: u32) -> u32 {
+    if (grid.zbin_words != 0u) {
+        return zbin_count(cell);
+    }
     return grid_cells[cell].y;
+}
+
+// A z-binned grid (culling/zbin.rs, Drobot 2017): the index buffer holds the lights sorted by
+// view depth, then one bit mask over them per screen tile (`zbin_words` words each, from
+// `zbin_masks`); the cell buffer holds per depth bin (the grid's slices) the sorted range
+// (~first, end) of the lights whose depth span meets the bin. A cell (tile, slice, layer)
+// reads its tile's mask within its slice's range: the bins apply at any depth, so transparent
+// fragments need no second list.
+struct ZBinWalk {
+    tile_mask: u32,  // index of the tile's first mask word
+    first: u32,      // the bin's sorted range [first, end)
+    end: u32,
+}
+
+fn zbin_walk(cell: u32) -> ZBinWalk {
+    let c = cell % grid.layer_cells;
+    let tiles = grid.tiles_x * grid.tiles_y;
+    let bin = grid_cells[c / tiles];
+    return ZBinWalk(grid.zbin_masks + (c % tiles) * grid.zbin_words, ~bin.x, bin.y);
+}
+
+// The tile mask's word `k` (k * 32 .. k * 32 + 31 in sorted order) limited to the bin's range.
+fn zbin_word(z: ZBinWalk, k: u32) -> u32 {
+    let lo = max(z.first, k * 32u) - k * 32u;
+    let hi = min(z.end, k * 32u + 32u) - k * 32u;  // > lo for the words the walk visits
+    let range = (0xffffffffu << lo) & (0xffffffffu >> (32u - hi));
+    return grid_indices[z.tile_mask + k] & range;
+}
+
+fn zbin_count(cell: u32) -> u32 {
+    let z = zbin_walk(cell);
+    var n = 0u;
+    if (z.first < z.end) {
+        let last = (z.end - 1u) / 32u;
+        var k = z.first / 32u;
+        for (; k <= last; k = k + 1u) {
+            n += countOneBits(zbin_word(z, k));
+        }
+        check_loop(k, last + 1u);
+    }
+    return n;
+}
+
+// The z-binned form of `grid_shade` (mono: the light pre-pass's irradiance and specular
+// luminance instead of the colour; rgb in both cases, a used only by mono).
+fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
+    let z = zbin_walk(cell);
+    var acc = vec4<f32>(0.0);
+    if (z.first < z.end) {
+        let last = (z.end - 1u) / 32u;
+        var shaded = 0u;
+        var listed = 0u;
+        var k = z.first / 32u;
+        for (; k <= last; k = k + 1u) {
+            var bits = zbin_word(z, k);
+            listed += countOneBits(bits);
+            for (; bits != 0u; bits = bits & (bits - 1u)) {
+                let light = lights[grid_indices[k * 32u + firstTrailingBit(bits)]];
+                if (mono) {
+                    let t = light_terms(s, view_dir, light);
+                    acc += vec4<f32>(t.diffuse, luminance(t.specular));
+                } else {
+                    acc += vec4<f32>(shade_light(s, view_dir, light), 0.0);
+                }
+                shaded += 1u;
+            }
+        }
+        check_loop(k, last + 1u);
+        check_loop(shaded, listed);
+    }
+    return acc;
 }
 
 // The light at position `i` of the cell's list.
@@ -47,6 +123,9 @@ fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> ve
 // The cell's lights' diffuse irradiance (rgb) and specular luminance (a): the light
 // pre-pass's monochrome compromise, summed as the tiled light pre-pass stores it.
 fn grid_irradiance_mono(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec4<f32> {
+    if (grid.zbin_words != 0u) {
+        return zbin_shade(s, view_dir, cell, true);
+    }
     var acc = vec4<f32>(0.0);
     let count = grid_cell_count(cell);
     var i = 0u;
@@ -60,6 +139,9 @@ fn grid_irradiance_mono(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec4<f32>
 
 // Sum of the cell's lights on the surface (Listing 1's computeLight).
 fn grid_shade(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec3<f32> {
+    if (grid.zbin_words != 0u) {
+        return zbin_shade(s, view_dir, cell, false).rgb;
+    }
     var acc = vec3<f32>(0.0);
     let count = grid_cell_count(cell);
     var i = 0u;

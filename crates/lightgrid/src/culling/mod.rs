@@ -23,6 +23,7 @@ mod scan;
 mod scatter;
 mod spot_ray;
 mod strategy;
+mod zbin;
 
 pub use crate::frame::{Assign, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
@@ -55,6 +56,7 @@ pub use registry::{find_strategy, StrategyInfo, ASSIGN_VALUES, STRATEGIES};
 pub use spot_ray::{ray_test_count, RayTestCount};
 pub use strategy::AssignStrategy;
 pub(crate) use strategy::{bind_cull_group, cull_layout, CullFrame};
+pub use zbin::{ordered_bits, zbins_cpu, ZBins};
 
 pub use crate::consts::pass_labels as labels;
 
@@ -87,6 +89,7 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
         bvh_gpu::shader(),
         scatter::shader(),
         culler::prep_shader(),
+        zbin::shader(),
     ]);
     out.extend(culler::embed_shaders());
     out

@@ -56,6 +56,13 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         reads_back: false,
         create: super::bvh_gpu::create_strategy,
     },
+    StrategyInfo {
+        assign: Assign::ZBin,
+        name: "zbin",
+        description: "GPU z-binning (Drobot 2017): lights sorted by depth, per-slice index ranges, per-tile light bit masks",
+        reads_back: false,
+        create: super::zbin::create_strategy,
+    },
 ];
 
 /// `--assign auto`: not a strategy of its own but a choice among the rows
@@ -114,12 +121,18 @@ mod tests {
             Assign::Scatter,
             Assign::Bvh,
             Assign::BvhGpu,
+            Assign::ZBin,
             Assign::Auto,
         ];
         // A match without a wildcard: a new variant must be added to `variants` above.
         for a in variants {
             match a {
-                Assign::Cpu | Assign::Gather | Assign::Scatter | Assign::Bvh | Assign::BvhGpu => {
+                Assign::Cpu
+                | Assign::Gather
+                | Assign::Scatter
+                | Assign::Bvh
+                | Assign::BvhGpu
+                | Assign::ZBin => {
                     assert_eq!(STRATEGIES.iter().filter(|s| s.assign == a).count(), 1);
                 }
                 Assign::Auto => assert!(find_strategy(a).is_none()),

@@ -146,6 +146,22 @@ pub trait AssignStrategy {
     fn grid_entries(&self, _values: &CounterValues) -> u32 {
         0
     }
+    /// The grid's shape for a frame with `lights` lights (a z-binned grid records the light
+    /// count its masks have bits for), before anything is recorded.
+    fn shape(&self, dims: GridDims, _lights: usize) -> GridDims {
+        dims
+    }
+    /// The grid the last frame built, read back (analysis): per-cell lists by default.
+    fn read_grid(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        buffers: &GridBuffers,
+        dims: &GridDims,
+        values: &CounterValues,
+    ) -> Result<LightGrid> {
+        super::gpu_assign::read_grid(device, queue, buffers, dims, self.grid_entries(values))
+    }
 }
 
 /// What a strategy needs to create its GPU objects.

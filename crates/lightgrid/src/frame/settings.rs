@@ -238,8 +238,30 @@ impl RenderSettings {
         }
         validate_msaa(self.msaa)?;
         validate_sample_culling(self.depth_mask, self.cell_box, self.depth_bounds)?;
+        validate_zbin_culling(self.assign, self.depth_mask, self.cell_box)?;
         validate_slices(self.slices)
     }
+}
+
+/// `--assign zbin` keeps no per-cell lists: its tile masks and depth bins are the culling, so
+/// the per-cell 2.5D masks and boxes have nothing to cut.
+pub fn validate_zbin_culling(
+    assign: Assign,
+    depth_mask: DepthMask,
+    cell_box: CellBox,
+) -> crate::error::Result<()> {
+    if assign != Assign::ZBin {
+        return Ok(());
+    }
+    let flag = match (depth_mask, cell_box) {
+        (DepthMask::On, _) => "depth-mask",
+        (_, CellBox::On) => "cell-box",
+        _ => return Ok(()),
+    };
+    Err(crate::error::Error::invalid(
+        flag,
+        "on cuts per-cell lists, which --assign zbin does not build (its tile masks and depth bins are its culling)",
+    ))
 }
 
 /// Refuse a sample count no adapter offers (the adapter's own list is checked by the renderer).
@@ -357,6 +379,9 @@ pub enum Assign {
     /// traversed as `Bvh`.
     #[serde(rename = "bvh-gpu")]
     BvhGpu,
+    /// GPU z-binning (Drobot 2017): lights sorted by view depth, per depth bin (slice) the
+    /// range of sorted lights meeting it, per tile a bit mask of the lights reaching it.
+    ZBin,
     /// By light count: see [`Assign::resolve`].
     #[default]
     Auto,

@@ -394,7 +394,7 @@ pub const AXES: &[Axis] = &[
         column: "depth_mask",
         help: "2.5D culling of the grids --assign builds from the depth buffer (needs --depth-bounds both)",
         values: values::<DepthMask>,
-        applies: |p, _| p.depth_bounds && p.assign,
+        applies: |p, s| p.depth_bounds && p.assign && s.assign != Assign::ZBin,
         get: |s| s.depth_mask.name().to_string(),
         set: |s, v| {
             s.depth_mask = DepthMask::parse(v)?;
@@ -407,7 +407,7 @@ pub const AXES: &[Axis] = &[
         column: "cell_box",
         help: "tight cells of the grids --assign builds from the depth buffer: each cell's samples' view-space box (needs --depth-bounds both)",
         values: values::<CellBox>,
-        applies: |p, _| p.depth_bounds && p.assign,
+        applies: |p, s| p.depth_bounds && p.assign && s.assign != Assign::ZBin,
         get: |s| s.cell_box.name().to_string(),
         set: |s, v| {
             s.cell_box = CellBox::parse(v)?;

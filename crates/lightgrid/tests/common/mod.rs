@@ -8,8 +8,8 @@ pub mod shading;
 use glam::Vec3;
 use lightgrid::culling::{
     assign_cpu, assign_gather_cpu_masked, cell_bounds_cpu, cell_boxes_cpu, cell_masks_cpu,
-    oracle_tile_lights, CellCull, CellMask, DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
-    NO_MASK,
+    oracle_tile_lights, zbins_cpu, CellCull, CellMask, DepthRange, GridDims, GridLists, LightGrid,
+    ViewSetup, NO_MASK,
 };
 use lightgrid::gpu::GpuContext;
 use lightgrid::pipelines::Assign;
@@ -30,6 +30,15 @@ pub fn strategies() -> Vec<Assign> {
     lightgrid::culling::STRATEGIES
         .iter()
         .map(|s| s.assign)
+        .collect()
+}
+
+/// The strategies that build per-cell lists (every one but z-binning): those 2.5D masks and
+/// tight boxes cut.
+pub fn list_strategies() -> Vec<Assign> {
+    strategies()
+        .into_iter()
+        .filter(|&a| a != Assign::ZBin)
         .collect()
 }
 
@@ -520,6 +529,7 @@ pub fn twin(
         Assign::Gather | Assign::Bvh | Assign::BvhGpu => {
             assign_gather_cpu_masked(setup, dims, lights, bounds, masks)
         }
+        Assign::ZBin => zbins_cpu(setup, dims, lights, bounds).into_grid(*dims),
         Assign::Auto => unreachable!("resolved by the renderer"),
     }
 }
@@ -756,7 +766,12 @@ impl FrameOracle {
     /// neighbouring slice, which must then list the light.
     pub fn check(&self, what: &str, setup: &ViewSetup, grid: &LightGrid) -> OracleCheck {
         let dims = self.dims;
-        assert_eq!(grid.dims, dims, "{what}: the oracle is for other cells");
+        // The same cells, whether lists or z-bins stand for them.
+        let cells = GridDims {
+            zbin_lights: None,
+            ..grid.dims
+        };
+        assert_eq!(cells, dims, "{what}: the oracle is for other cells");
         let sets = sorted_cells(what, grid);
         let mut check = OracleCheck::default();
         for (c, must) in self.cells.iter().enumerate() {

@@ -1,0 +1,119 @@
+// Z-binning (Drobot 2017, "Improved culling for tiled and clustered rendering"), built on the
+// GPU by zbin.rs (CPU twin: `zbins_cpu`):
+// 1. keys_main: each light's view depth (its bounding sphere's centre) as an order-preserving
+//    key, sorted with its index by the radix sort (radix_sort.wgsl); the sorted indices are
+//    copied to the front of the grid's index buffer;
+// 2. bins_main: one invocation per sorted light widens the index range [first, end) of every
+//    depth bin its sphere's view-depth span covers (the grid's slices; atomics, the first
+//    stored complemented so both grow with atomicMax from a zeroed buffer);
+// 3. masks_main: one workgroup per screen tile keeps the bit mask of the sorted lights that
+//    reach the tile's frustum over the depth range of all its cells' bounds (every slice and
+//    layer: opaque samples, transparent fragments and MSAA fragment centres alike).
+// A sample shades the set bits of its tile's mask inside its bin's range (light_grid.wgsl).
+
+@group(1) @binding(0) var<uniform> grid: GridParams;
+@group(1) @binding(1) var<storage, read> cell_bounds: array<vec2<f32>>;
+// The grid's cell buffer: per bin (~first, end) while building.
+@group(1) @binding(2) var<storage, read_write> bins: array<atomic<u32>>;
+// The grid's index buffer: the sorted light indices, then the tile masks at grid.zbin_masks.
+@group(1) @binding(3) var<storage, read_write> zbin_out: array<u32>;
+@group(1) @binding(4) var<storage, read_write> keys: array<u32>;
+@group(1) @binding(5) var<storage, read_write> vals: array<u32>;
+
+fn item(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.y * nwg.x * ASSIGN_THREADS + gid.x;
+}
+
+fn view_sphere(l: u32) -> vec4<f32> {
+    let b = light_bounds[l];
+    return vec4<f32>((frame.view * vec4<f32>(b.xyz, 1.0)).xyz, b.w);
+}
+
+@compute @workgroup_size(ASSIGN_THREADS)
+fn keys_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let l = item(gid, nwg);
+    if (l >= frame.light_count) {
+        return;
+    }
+    keys[l] = ordered_bits(-view_sphere(l).z);
+    vals[l] = l;
+}
+
+@compute @workgroup_size(ASSIGN_THREADS)
+fn bins_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = item(gid, nwg);
+    if (i >= frame.light_count) {
+        return;
+    }
+    let s = view_sphere(zbin_out[i]);
+    let lo = (-s.z - s.w) * (1.0 - ASSIGN_DEPTH_SLACK);
+    let hi = (-s.z + s.w) * (1.0 + ASSIGN_DEPTH_SLACK);
+    // A sphere wholly in front of the near plane or behind the far plane reaches no sample.
+    if (hi < frame.near * (1.0 - ASSIGN_DEPTH_SLACK) || lo > frame.far * (1.0 + ASSIGN_DEPTH_SLACK)) {
+        return;
+    }
+    let k1 = grid_slice(hi);
+    var k = grid_slice(lo);
+    for (; k <= k1; k = k + 1u) {
+        atomicMax(&bins[2u * k], ~i);
+        atomicMax(&bins[2u * k + 1u], i + 1u);
+    }
+    check_loop(k, k1 + 1u);
+}
+
+var<workgroup> range_lo: array<f32, ASSIGN_THREADS>;
+var<workgroup> range_hi: array<f32, ASSIGN_THREADS>;
+
+@compute @workgroup_size(ASSIGN_THREADS)
+fn masks_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let tiles = grid.tiles_x * grid.tiles_y;
+    let t = wg.y * nwg.x + wg.x;
+    // The union of the bounds of the tile's cells (every slice and layer).
+    var lo = 3.4e38;
+    var hi = -3.4e38;
+    let layers = grid_cell_total() / max(tiles, 1u);
+    var k = li;
+    if (t < tiles) {
+        for (; k < layers; k = k + ASSIGN_THREADS) {
+            let b = cell_bounds[k * tiles + t];
+            if (b.x <= b.y) {
+                lo = min(lo, b.x);
+                hi = max(hi, b.y);
+            }
+        }
+        check_loop(k, layers);
+    }
+    range_lo[li] = lo;
+    range_hi[li] = hi;
+    for (var step = ASSIGN_THREADS / 2u; step > 0u; step = step / 2u) {
+        workgroupBarrier();
+        if (li < step) {
+            range_lo[li] = min(range_lo[li], range_lo[li + step]);
+            range_hi[li] = max(range_hi[li], range_hi[li + step]);
+        }
+    }
+    workgroupBarrier();
+    if (t >= tiles) {
+        return;
+    }
+    let range = vec2<f32>(range_lo[0], range_hi[0]);
+    let f = tile_frustum(vec2<u32>(t % grid.tiles_x, t / grid.tiles_x), grid.tile_size, range);
+    let words = grid.zbin_words;
+    var w = li;
+    for (; w < words; w = w + ASSIGN_THREADS) {
+        var bits = 0u;
+        if (range.x <= range.y) {
+            let first = w * 32u;
+            let n = min(32u, frame.light_count - first);
+            var j = 0u;
+            for (; j < n; j = j + 1u) {
+                if (light_in_tile(f, zbin_out[first + j])) {
+                    bits = bits | (1u << j);
+                }
+            }
+            check_loop(j, n);
+        }
+        zbin_out[grid.zbin_masks + t * words + w] = bits;
+    }
+    check_loop(w, words);
+}
