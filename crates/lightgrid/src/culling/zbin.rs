@@ -260,12 +260,13 @@ impl AssignStrategy for ZBinStrategy {
             u64::from(n) * 4,
         );
         run(encoder, timer, &self.bins, "assign: zbin bins", per_light);
+        let mask_words = u64::from(tiles) * u64::from(n.div_ceil(32));
         run(
             encoder,
             timer,
             &self.masks,
             "assign: zbin masks",
-            groups_1d(tiles),
+            groups_1d(mask_words.div_ceil(u64::from(ASSIGN_THREADS)) as u32),
         );
         Ok(StrategyRun::default())
     }

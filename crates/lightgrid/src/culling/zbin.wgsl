@@ -6,7 +6,7 @@
 // 2. bins_main: one invocation per sorted light widens the index range [first, end) of every
 //    depth bin its sphere's view-depth span covers (the grid's slices; atomics, the first
 //    stored complemented so both grow with atomicMax from a zeroed buffer);
-// 3. masks_main: one workgroup per screen tile keeps the bit mask of the sorted lights that
+// 3. masks_main: one invocation per tile and mask word keeps the bit mask of the sorted lights that
 //    reach the tile's frustum over the depth range of all its cells' bounds (every slice and
 //    layer: opaque samples, transparent fragments and MSAA fragment centres alike).
 // A sample shades the set bits of its tile's mask inside its bin's range (light_grid.wgsl).
@@ -61,59 +61,40 @@ fn bins_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     check_loop(k, k1 + 1u);
 }
 
-var<workgroup> range_lo: array<f32, ASSIGN_THREADS>;
-var<workgroup> range_hi: array<f32, ASSIGN_THREADS>;
-
+// One invocation per (tile, mask word): the union of the bounds of the tile's cells (every
+// slice and layer), then the word's 32 sorted lights against the tile's frustum over it.
 @compute @workgroup_size(ASSIGN_THREADS)
-fn masks_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = item(gid, nwg);
     let tiles = grid.tiles_x * grid.tiles_y;
-    let t = wg.y * nwg.x + wg.x;
-    // The union of the bounds of the tile's cells (every slice and layer).
-    var lo = 3.4e38;
-    var hi = -3.4e38;
-    let layers = grid_cell_total() / max(tiles, 1u);
-    var k = li;
-    if (t < tiles) {
-        for (; k < layers; k = k + ASSIGN_THREADS) {
-            let b = cell_bounds[k * tiles + t];
-            if (b.x <= b.y) {
-                lo = min(lo, b.x);
-                hi = max(hi, b.y);
-            }
-        }
-        check_loop(k, layers);
-    }
-    range_lo[li] = lo;
-    range_hi[li] = hi;
-    for (var step = ASSIGN_THREADS / 2u; step > 0u; step = step / 2u) {
-        workgroupBarrier();
-        if (li < step) {
-            range_lo[li] = min(range_lo[li], range_lo[li + step]);
-            range_hi[li] = max(range_hi[li], range_hi[li + step]);
-        }
-    }
-    workgroupBarrier();
-    if (t >= tiles) {
+    let words = grid.zbin_words;
+    if (g >= tiles * words) {
         return;
     }
-    let range = vec2<f32>(range_lo[0], range_hi[0]);
-    let f = tile_frustum(vec2<u32>(t % grid.tiles_x, t / grid.tiles_x), grid.tile_size, range);
-    let words = grid.zbin_words;
-    var w = li;
-    for (; w < words; w = w + ASSIGN_THREADS) {
-        var bits = 0u;
-        if (range.x <= range.y) {
-            let first = w * 32u;
-            let n = min(32u, frame.light_count - first);
-            var j = 0u;
-            for (; j < n; j = j + 1u) {
-                if (light_in_tile(f, zbin_out[first + j])) {
-                    bits = bits | (1u << j);
-                }
-            }
-            check_loop(j, n);
+    let t = g / words;
+    let w = g % words;
+    var range = vec2<f32>(3.4e38, -3.4e38);
+    let layers = grid_cell_total() / tiles;
+    var k = 0u;
+    for (; k < layers; k = k + 1u) {
+        let b = cell_bounds[k * tiles + t];
+        if (b.x <= b.y) {
+            range = vec2<f32>(min(range.x, b.x), max(range.y, b.y));
         }
-        zbin_out[grid.zbin_masks + t * words + w] = bits;
     }
-    check_loop(w, words);
+    check_loop(k, layers);
+    var bits = 0u;
+    if (range.x <= range.y) {
+        let f = tile_frustum(vec2<u32>(t % grid.tiles_x, t / grid.tiles_x), grid.tile_size, range);
+        let first = w * 32u;
+        let n = min(32u, frame.light_count - first);
+        var j = 0u;
+        for (; j < n; j = j + 1u) {
+            if (light_in_tile(f, zbin_out[first + j])) {
+                bits = bits | (1u << j);
+            }
+        }
+        check_loop(j, n);
+    }
+    zbin_out[grid.zbin_masks + g] = bits;
 }

@@ -765,13 +765,17 @@ impl FrameOracle {
     /// only a cluster sample within round-off of a slice boundary may count for the
     /// neighbouring slice, which must then list the light.
     pub fn check(&self, what: &str, setup: &ViewSetup, grid: &LightGrid) -> OracleCheck {
-        let dims = self.dims;
         // The same cells, whether lists or z-bins stand for them.
-        let cells = GridDims {
+        let cells = |d: GridDims| GridDims {
             zbin_lights: None,
-            ..grid.dims
+            ..d
         };
-        assert_eq!(cells, dims, "{what}: the oracle is for other cells");
+        let dims = cells(self.dims);
+        assert_eq!(
+            cells(grid.dims),
+            dims,
+            "{what}: the oracle is for other cells"
+        );
         let sets = sorted_cells(what, grid);
         let mut check = OracleCheck::default();
         for (c, must) in self.cells.iter().enumerate() {
