@@ -29,6 +29,7 @@ pub(crate) fn shader() -> ComposedShader {
             src::GRID_CELL,
             super::TILE_FRUSTUM_WGSL,
             include_str!("assign_bindings.wgsl"),
+            include_str!("light_tiles.wgsl"),
             include_str!("scatter.wgsl"),
         ],
     )

@@ -12,6 +12,7 @@
 //! structure: no second list. GPU build: `zbin.wgsl` (keys, the radix sort shared with
 //! scatter and the GPU BVH, bins, masks); CPU twin: [`zbins_cpu`], in the same f32 arithmetic.
 
+use super::assign_cpu::project_sphere;
 use super::gather::{cpu_frustum, light_margin};
 use super::radix_sort::RadixSort;
 use super::scan::ScanPass;
@@ -37,6 +38,7 @@ pub(crate) fn shader() -> ComposedShader {
             src::SCENE_BINDINGS,
             super::TILE_FRUSTUM_WGSL,
             src::GRID_CELL,
+            include_str!("light_tiles.wgsl"),
             include_str!("zbin.wgsl"),
         ],
     )
@@ -124,6 +126,7 @@ pub fn zbins_cpu(
     let mut order: Vec<u32> = (0..lights.len() as u32).collect();
     order.sort_by_key(|&l| ordered_bits(-view[l as usize].center.z));
     let mut bins = vec![[u32::MAX, 0u32]; dims.slices as usize];
+    let mut in_depth = vec![false; order.len()];
     for (i, &l) in order.iter().enumerate() {
         let v = &view[l as usize];
         let w = -v.center.z;
@@ -134,17 +137,32 @@ pub fn zbins_cpu(
         {
             continue;
         }
+        in_depth[i] = true;
         for b in &mut bins[dims.slice_of(lo) as usize..=dims.slice_of(hi) as usize] {
             b[0] = b[0].min(i as u32);
             b[1] = b[1].max(i as u32 + 1);
         }
     }
+    // Each sorted light's tile rectangle (none for a light outside near..far), the masks'
+    // pre-filter.
+    let tile = dims.tile_size;
+    let rects: Vec<Option<[u32; 4]>> = order
+        .iter()
+        .zip(&in_depth)
+        .map(|(&l, &inside)| {
+            let r = project_sphere(setup, &view[l as usize]).filter(|_| inside)?;
+            Some([r.x0 / tile, r.x1 / tile, r.y0 / tile, r.y1 / tile])
+        })
+        .collect();
     let words = lights.len().div_ceil(32);
     let mut masks = vec![0u32; dims.tile_count() * words];
     for (t, mask) in masks.chunks_mut(words.max(1)).enumerate() {
         let f = cpu_frustum(setup, dims, t, tile_range(dims, cell_bounds, t));
+        let (tx, ty) = (t as u32 % dims.tiles_x, t as u32 / dims.tiles_x);
         for (i, &l) in order.iter().enumerate() {
-            if light_margin(&f, &view[l as usize]) >= 0.0 {
+            let in_rect = rects[i]
+                .is_some_and(|[x0, x1, y0, y1]| (x0..=x1).contains(&tx) && (y0..=y1).contains(&ty));
+            if in_rect && light_margin(&f, &view[l as usize]) >= 0.0 {
                 mask[i / 32] |= 1 << (i % 32);
             }
         }

@@ -5,10 +5,12 @@
 //    copied to the front of the grid's index buffer;
 // 2. bins_main: one invocation per sorted light widens the index range [first, end) of every
 //    depth bin its sphere's view-depth span covers (the grid's slices; atomics, the first
-//    stored complemented so both grow with atomicMax from a zeroed buffer);
-// 3. masks_main: one invocation per tile and mask word keeps the bit mask of the sorted lights that
-//    reach the tile's frustum over the depth range of all its cells' bounds (every slice and
-//    layer: opaque samples, transparent fragments and MSAA fragment centres alike).
+//    stored complemented so both grow with atomicMax from a zeroed buffer), and keeps the
+//    light's projected tile rectangle (light_tiles.wgsl);
+// 3. masks_main: one invocation per tile and mask word keeps the bit mask of the sorted lights
+//    whose rectangle holds the tile and that reach the tile's frustum over the depth range of
+//    all its cells' bounds (every slice and layer: opaque samples, transparent fragments and
+//    MSAA fragment centres alike).
 // A sample shades the set bits of its tile's mask inside its bin's range (light_grid.wgsl).
 
 @group(1) @binding(0) var<uniform> grid: GridParams;
@@ -48,9 +50,18 @@ fn bins_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let s = view_sphere(zbin_out[i]);
     let lo = (-s.z - s.w) * (1.0 - ASSIGN_DEPTH_SLACK);
     let hi = (-s.z + s.w) * (1.0 + ASSIGN_DEPTH_SLACK);
+    // The sorted keys and values are spent: they now hold each sorted light's tile rectangle
+    // (x0 | x1 << 16, y0 | y1 << 16; x0 > x1: none), the masks' pre-filter.
+    keys[i] = 0xffffu;
+    vals[i] = 0u;
     // A sphere wholly in front of the near plane or behind the far plane reaches no sample.
     if (hi < frame.near * (1.0 - ASSIGN_DEPTH_SLACK) || lo > frame.far * (1.0 + ASSIGN_DEPTH_SLACK)) {
         return;
+    }
+    let rect = light_tiles(s.xyz, s.w);
+    if (rect.x <= rect.z && rect.y <= rect.w) {
+        keys[i] = u32(rect.x) | (u32(rect.z) << 16u);
+        vals[i] = u32(rect.y) | (u32(rect.w) << 16u);
     }
     let k1 = grid_slice(hi);
     var k = grid_slice(lo);
@@ -85,12 +96,17 @@ fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     check_loop(k, layers);
     var bits = 0u;
     if (range.x <= range.y) {
-        let f = tile_frustum(vec2<u32>(t % grid.tiles_x, t / grid.tiles_x), grid.tile_size, range);
+        let xy = vec2<u32>(t % grid.tiles_x, t / grid.tiles_x);
+        let f = tile_frustum(xy, grid.tile_size, range);
         let first = w * 32u;
         let n = min(32u, frame.light_count - first);
         var j = 0u;
         for (; j < n; j = j + 1u) {
-            if (light_in_tile(f, zbin_out[first + j])) {
+            let rx = keys[first + j];
+            let ry = vals[first + j];
+            let in_rect = xy.x >= (rx & 0xffffu) && xy.x <= (rx >> 16u)
+                && xy.y >= (ry & 0xffffu) && xy.y <= (ry >> 16u);
+            if (in_rect && light_in_tile(f, zbin_out[first + j])) {
                 bits = bits | (1u << j);
             }
         }
