@@ -35,8 +35,9 @@ struct Out { @location(0) grid: vec4<f32>, @location(1) all: vec4<f32> }
 @fragment fn fs(v: V) -> Out {
     let cell = light_grid_cell(v.clip.xy, v.dist);
     var grid = vec3<f32>(0.0);
-    for (var i = 0u; i < light_grid_count(cell); i++) {
-        grid += light(lights[light_grid_light(cell, i)], v);
+    var walk = light_grid_walk(cell);
+    while (light_grid_next(&walk)) {
+        grid += light(lights[walk.light], v);
     }
     var all = vec3<f32>(0.0);
     for (var i = 0u; i < camera.count; i++) {

@@ -123,6 +123,11 @@ pub enum CullStrategy {
     /// A light BVH built on the GPU each frame, walked per occupied cell
     /// (tiled-forward-shading §4.4).
     BvhGpu,
+    /// Z-binning (Drobot 2017): lights sorted by view depth, per depth bin (the clusters'
+    /// slices; one bin for tiles) the range of sorted lights meeting it, per tile a bit mask
+    /// of the lights reaching it. Read it with `light_grid_walk` / `light_grid_next`; not
+    /// with [`CullConfig::depth_mask`] or [`CullConfig::cell_box`].
+    ZBin,
     /// `Gather` up to 8192 lights, `BvhGpu` above.
     #[default]
     Auto,
@@ -130,10 +135,11 @@ pub enum CullStrategy {
 
 impl CullStrategy {
     /// The strategies `Auto` chooses between and the one it does not, each by name.
-    pub const ALL: [CullStrategy; 3] = [
+    pub const ALL: [CullStrategy; 4] = [
         CullStrategy::Gather,
         CullStrategy::Scatter,
         CullStrategy::BvhGpu,
+        CullStrategy::ZBin,
     ];
 
     fn assign(self) -> Assign {
@@ -141,6 +147,7 @@ impl CullStrategy {
             CullStrategy::Gather => Assign::Gather,
             CullStrategy::Scatter => Assign::Scatter,
             CullStrategy::BvhGpu => Assign::BvhGpu,
+            CullStrategy::ZBin => Assign::ZBin,
             CullStrategy::Auto => Assign::Auto,
         }
     }
@@ -464,6 +471,12 @@ impl LightCuller {
             config.depth_mask,
             config.cell_box,
             config.depth_bounds,
+        )
+        .map_err(config_error)?;
+        crate::frame::validate_zbin_culling(
+            config.strategy.assign(),
+            config.depth_mask,
+            config.cell_box,
         )
         .map_err(config_error)?;
         if config.max_lights == 0 {

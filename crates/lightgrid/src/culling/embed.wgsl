@@ -4,10 +4,16 @@
 // caller's:
 //
 //     let cell = light_grid_cell(frag.position.xy, view_distance);
-//     for (var i = 0u; i < light_grid_count(cell); i++) {
-//         let light = my_lights[light_grid_light(cell, i)];
+//     var walk = light_grid_walk(cell);
+//     while (light_grid_next(&walk)) {
+//         let light = my_lights[walk.light];
 //         ...
 //     }
+//
+// The walk reads whatever the strategy built: per-cell lists, or z-binning's sorted lights,
+// per-bin ranges and per-tile masks (`CullStrategy::ZBin`). `light_grid_count` and
+// `light_grid_light(cell, i)` index a cell's lights directly: constant time on lists, a
+// scan of the tile's mask words on z-bins.
 
 // LightGridParams: lightgrid's GridParams (shading/types.wgsl), renamed.
 
@@ -17,14 +23,102 @@
 // Each cell's view-distance bounds its list was built for ([min, max], min > max: no samples).
 @group(LIGHT_GRID_GROUP) @binding(3) var<storage, read> light_grid_bounds: array<vec2<f32>>;
 
-// How many lights cell `cell` lists.
-fn light_grid_count(cell: u32) -> u32 {
-    return light_grid_cells[cell].y;
+// Where a walk over a cell's lights stands.
+struct LightGridWalk {
+    // The light `light_grid_next` found last (an index into the caller's light buffer).
+    light: u32,
+    // Lists: the next position and one past the last. Z-bins: the next mask word and one
+    // past the last word of the bin's range.
+    next: u32,
+    end: u32,
+    // Lists: the cell's offset. Z-bins: the tile's first mask word.
+    base: u32,
+    // Z-bins: the bin's sorted range [first, last] and the current word's bits left.
+    first: u32,
+    last: u32,
+    bits: u32,
 }
 
-// The index in the caller's light buffer of the `i`-th light of cell `cell`.
+// A walk over cell `cell`'s lights (the cell of any layer).
+fn light_grid_walk(cell: u32) -> LightGridWalk {
+    if (light_grid.zbin_words == 0u) {
+        let c = light_grid_cells[cell];
+        return LightGridWalk(0u, 0u, c.y, c.x, 0u, 0u, 0u);
+    }
+    let c = cell % light_grid.layer_cells;
+    let tiles = light_grid.tiles_x * light_grid.tiles_y;
+    let bin = light_grid_cells[c / tiles];
+    let first = ~bin.x;
+    let base = light_grid.zbin_masks + (c % tiles) * light_grid.zbin_words;
+    if (first >= bin.y) {
+        return LightGridWalk(0u, 0u, 0u, base, 1u, 0u, 0u);
+    }
+    return LightGridWalk(0u, first / 32u, (bin.y - 1u) / 32u + 1u, base, first, bin.y - 1u, 0u);
+}
+
+// The walk's mask word `k` limited to the bin's range (z-bins).
+fn light_grid_word(w: LightGridWalk, k: u32) -> u32 {
+    let lo = max(w.first, k * 32u) - k * 32u;
+    let hi = min(w.last, k * 32u + 31u) - k * 32u;
+    return light_grid_indices[w.base + k] & (0xffffffffu << lo) & (0xffffffffu >> (31u - hi));
+}
+
+// The next light of the walk into `(*w).light`; false when there is none left.
+fn light_grid_next(w: ptr<function, LightGridWalk>) -> bool {
+    if (light_grid.zbin_words == 0u) {
+        if ((*w).next >= (*w).end) {
+            return false;
+        }
+        (*w).light = light_grid_indices[(*w).base + (*w).next];
+        (*w).next += 1u;
+        return true;
+    }
+    while ((*w).bits == 0u) {
+        if ((*w).next >= (*w).end) {
+            return false;
+        }
+        (*w).bits = light_grid_word(*w, (*w).next);
+        (*w).next += 1u;
+    }
+    let b = firstTrailingBit((*w).bits);
+    (*w).bits &= (*w).bits - 1u;
+    (*w).light = light_grid_indices[((*w).next - 1u) * 32u + b];
+    return true;
+}
+
+// How many lights cell `cell` has.
+fn light_grid_count(cell: u32) -> u32 {
+    if (light_grid.zbin_words == 0u) {
+        return light_grid_cells[cell].y;
+    }
+    let w = light_grid_walk(cell);
+    var n = 0u;
+    for (var k = w.next; k < w.end; k++) {
+        n += countOneBits(light_grid_word(w, k));
+    }
+    return n;
+}
+
+// The index in the caller's light buffer of the `i`-th light of cell `cell` (i below
+// `light_grid_count(cell)`).
 fn light_grid_light(cell: u32, i: u32) -> u32 {
-    return light_grid_indices[light_grid_cells[cell].x + i];
+    if (light_grid.zbin_words == 0u) {
+        return light_grid_indices[light_grid_cells[cell].x + i];
+    }
+    let w = light_grid_walk(cell);
+    var left = i;
+    for (var k = w.next; k < w.end; k++) {
+        var bits = light_grid_word(w, k);
+        let n = countOneBits(bits);
+        if (left < n) {
+            for (var j = 0u; j < left; j++) {
+                bits &= bits - 1u;
+            }
+            return light_grid_indices[k * 32u + firstTrailingBit(bits)];
+        }
+        left -= n;
+    }
+    return 0u;
 }
 
 // Cell addressing, the same as lightgrid's own shaders (grid_cell.wgsl, renamed):

@@ -289,8 +289,8 @@ impl AssignStrategy for ZBinStrategy {
         Ok(StrategyRun::default())
     }
 
-    fn grid_entries(&self, _values: &CounterValues) -> u32 {
-        0
+    fn grid_entries(&self, values: &CounterValues) -> u32 {
+        values.index_needed()
     }
 
     fn read_grid(

@@ -39,6 +39,11 @@ fn keys_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     }
     keys[l] = ordered_bits(-view_sphere(l).z);
     vals[l] = l;
+    if (l == 0u) {
+        // The grid's index entries, reported as every strategy's are.
+        let entries = frame.light_count + grid.tiles_x * grid.tiles_y * grid.zbin_words;
+        atomicMax(&frame_counters[COUNTER_INDEX_NEEDED], entries);
+    }
 }
 
 @compute @workgroup_size(ASSIGN_THREADS)
