@@ -17,8 +17,9 @@ fn bench(args: &[&str]) -> std::path::PathBuf {
 }
 
 /// The culling preset measures every grid with and without 2.5D depth masks and tight cell
-/// boxes, on its three scenes: neither ever adds lighting computations, and the boxes take
-/// some away over the run.
+/// boxes, and z-binned, on its three scenes: neither masks nor boxes ever add lighting
+/// computations, the boxes take some away over the run, and each claim (Harada's, tight
+/// clusters', Drobot's) is judged per scene and pipeline.
 #[test]
 fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
     let out = bench(&[
@@ -37,12 +38,13 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
             .position(|c| *c == name)
             .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
     };
-    let (mask, cell_box, pipe, scene, frame) = (
+    let (mask, cell_box, pipe, scene, frame, assign) = (
         col("depth_mask"),
         col("cell_box"),
         col("pipeline"),
         col("scene"),
         col("frame"),
+        col("assign"),
     );
     let lit = col("lighting_computations");
     let mut counts = std::collections::BTreeMap::new();
@@ -54,10 +56,15 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
             f[frame].to_string(),
         );
         let n: u64 = f[lit].parse().unwrap();
+        // Z-binning's runs have no masks or boxes (they do not apply to it).
+        let variant = match f[assign] {
+            "zbin" => ("zbin".to_string(), "zbin".to_string()),
+            _ => (f[mask].to_string(), f[cell_box].to_string()),
+        };
         counts
             .entry(key)
             .or_insert_with(std::collections::BTreeMap::new)
-            .insert((f[mask].to_string(), f[cell_box].to_string()), n);
+            .insert(variant, n);
     }
     let scenes: std::collections::BTreeSet<&str> = counts.keys().map(|k| k.0.as_str()).collect();
     assert_eq!(scenes.len(), 3, "{scenes:?}");
@@ -72,11 +79,12 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
     let v = |m: &str, b: &str| (m.to_string(), b.to_string());
     let (mut boxed, mut plain) = (0, 0);
     for (key, by) in &counts {
-        assert_eq!(by.len(), 4, "{key:?}: {by:?}");
+        assert_eq!(by.len(), 5, "{key:?}: {by:?}");
         let off = by[&v("off", "off")];
-        for (variant, n) in by {
+        for (variant, n) in by.iter().filter(|(v, _)| v.0 != "zbin") {
             assert!(*n <= off, "{key:?}: {n} with {variant:?}, {off} without");
         }
+        assert!(by[&v("zbin", "zbin")] > 0, "{key:?}: {by:?}");
         assert!(by[&v("on", "on")] <= by[&v("off", "on")], "{key:?}: {by:?}");
         boxed += by[&v("off", "on")];
         plain += off;
@@ -95,6 +103,10 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
         ),
         (
             "Tight clusters (each cluster",
+            ["clustered_forward", "clustered_deferred"],
+        ),
+        (
+            "Z-binning (lights sorted by depth",
             ["clustered_forward", "clustered_deferred"],
         ),
     ] {

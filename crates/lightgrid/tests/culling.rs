@@ -739,7 +739,7 @@ fn auto_assignment_resolves_by_adapter_and_light_count() {
     let names: Vec<&str> = Assign::all().map(|a| a.name()).collect();
     assert_eq!(
         names,
-        ["cpu", "gather", "scatter", "bvh", "bvh-gpu", "auto"]
+        ["cpu", "gather", "scatter", "bvh", "bvh-gpu", "zbin", "auto"]
     );
 }
 

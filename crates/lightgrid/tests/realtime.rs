@@ -195,7 +195,9 @@ fn static_geometry_is_uploaded_once() {
 fn a_frame_whose_lists_did_not_fit_is_reported_and_later_frames_fit() {
     let ctx = common::gpu();
     let scene = stress(20_000);
-    for assign in gpu_strategies() {
+    // Z-bins are sized from the frame's light count: nothing to outgrow (tests/culler.rs
+    // checks that their first frame is complete).
+    for assign in gpu_strategies().filter(|&a| a != Assign::ZBin) {
         let settings = RenderSettings {
             assign,
             ..Default::default()

@@ -51,7 +51,14 @@ fn zbin_word(z: ZBinWalk, k: u32) -> u32 {
     return grid_indices[z.tile_mask + k] & range;
 }
 
+// The cell `zbin_shade` shaded last and how many lights it evaluated: the pipelines ask for
+// the count after shading, and need not walk the masks twice.
+var<private> zbin_shaded: vec2<u32> = vec2<u32>(0xffffffffu, 0u);
+
 fn zbin_count(cell: u32) -> u32 {
+    if (zbin_shaded.x == cell) {
+        return zbin_shaded.y;
+    }
     let z = zbin_walk(cell);
     var n = 0u;
     if (z.first < z.end) {
@@ -91,6 +98,7 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
         }
         check_loop(k, last + 1u);
         check_loop(shaded, listed);
+        zbin_shaded = vec2<u32>(cell, shaded);
     }
     return acc;
 }
