@@ -206,6 +206,15 @@ impl Renderer {
                 ),
             ));
         }
+        if settings.light_loop == crate::frame::LightLoop::Subgroup && !ctx.subgroups {
+            return Err(Error::invalid(
+                "light loop",
+                format!(
+                    "subgroup: {} has no subgroup operations; use lane",
+                    ctx.adapter_label()
+                ),
+            ));
+        }
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {

@@ -10,7 +10,7 @@
 mod common;
 
 use lightgrid::culling::{LightGrid, ViewSetup};
-use lightgrid::frame::{CellBox, DepthBounds, DepthMask, GridLists};
+use lightgrid::frame::{CellBox, DepthBounds, DepthMask, GridLists, LightLoop};
 use lightgrid::image_io::{diff, save_png};
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::Assign;
@@ -1044,6 +1044,60 @@ fn z_bins_equal_their_twin_and_keep_the_image_with_glass_and_msaa() {
         }
     }
     assert!(bins_used > 100, "only {bins_used} bins held lights");
+}
+
+/// `--light-loop subgroup` (the light loop scalarized over the subgroup) on every grid
+/// pipeline, over the CPU's sorted lists, the GPU gather's unordered ones and z-bins, with the
+/// robots' glass and with 4x MSAA: every sample evaluates exactly its own lights (the same
+/// lighting computations as the per-lane loop) and the image is the per-lane loop's.
+#[test]
+fn the_subgroup_light_loop_evaluates_each_samples_own_lights() {
+    let ctx = common::gpu();
+    assert!(
+        ctx.subgroups,
+        "lavapipe has subgroups; this adapter does not"
+    );
+    let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
+    let (w, h, frame) = (149, 87, 60);
+    for (msaa, assign) in [
+        (1, Assign::Cpu),
+        (1, Assign::Gather),
+        (1, Assign::ZBin),
+        (4, Assign::Gather),
+        (4, Assign::ZBin),
+    ] {
+        let with = |light_loop| RenderSettings {
+            tile_size: 16,
+            slices: 16,
+            assign,
+            msaa,
+            light_loop,
+            ..Default::default()
+        };
+        let mut lane = Renderer::new(&ctx, w, h, with(LightLoop::Lane)).unwrap();
+        let mut subgroup = Renderer::new(&ctx, w, h, with(LightLoop::Subgroup)).unwrap();
+        for id in common::grid_pipelines() {
+            if msaa > 1
+                && lightgrid::pipelines::find(id).unwrap().msaa
+                    != lightgrid::pipelines::Msaa::Supported
+            {
+                continue;
+            }
+            let what = format!("{id} --assign {} --msaa {msaa}", assign.name());
+            let a = subgroup.render(&s, frame, id).unwrap();
+            let b = lane.render(&s, frame, id).unwrap();
+            assert_eq!(a.stats.truncated_loops, 0, "{what}");
+            assert_eq!(
+                a.stats.lighting_computations, b.stats.lighting_computations,
+                "{what}: the subgroup loop evaluated other lights"
+            );
+            let (d, _) = diff(&a.image, &b.image).unwrap();
+            assert!(
+                d.max <= 1.0,
+                "{what}: the subgroup loop changed the image: {d:?}"
+            );
+        }
+    }
 }
 
 /// `--depth-reduction subgroup` reduces to the same cell bounds as the atomics (the twin's),

@@ -60,9 +60,10 @@ fn every_key_value_is_composed_once() {
         ("depth_samples", msaa),
         ("deferred", GBufferLayout::ALL.len() * msaa),
         ("light_prepass", msaa),
-        ("tiled_light_prepass", msaa),
-        // The grid pipelines' kernel and the single kernel.
-        ("tiled_deferred", 2 * msaa),
+        // Each light loop (--light-loop lane, subgroup).
+        ("tiled_light_prepass", 2 * msaa),
+        // The grid pipelines' kernel with each light loop, and the single kernel.
+        ("tiled_deferred", 3 * msaa),
         // Only above one sample per pixel.
         ("sample_expand", msaa - 1),
     ];

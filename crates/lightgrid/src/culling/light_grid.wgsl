@@ -72,37 +72,6 @@ fn zbin_count(cell: u32) -> u32 {
     return n;
 }
 
-// The z-binned form of `grid_shade` (mono: the light pre-pass's irradiance and specular
-// luminance instead of the colour; rgb in both cases, a used only by mono).
-fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
-    let z = zbin_walk(cell);
-    var acc = vec4<f32>(0.0);
-    if (z.first < z.end) {
-        let last = (z.end - 1u) / 32u;
-        var shaded = 0u;
-        var listed = 0u;
-        var k = z.first / 32u;
-        for (; k <= last; k = k + 1u) {
-            var bits = zbin_word(z, k);
-            listed += countOneBits(bits);
-            for (; bits != 0u; bits = bits & (bits - 1u)) {
-                let light = lights[grid_indices[k * 32u + firstTrailingBit(bits)]];
-                if (mono) {
-                    let t = light_terms(s, view_dir, light);
-                    acc += vec4<f32>(t.diffuse, luminance(t.specular));
-                } else {
-                    acc += vec4<f32>(shade_light(s, view_dir, light), 0.0);
-                }
-                shaded += 1u;
-            }
-        }
-        check_loop(k, last + 1u);
-        check_loop(shaded, listed);
-        zbin_shaded = vec2<u32>(cell, shaded);
-    }
-    return acc;
-}
-
 // The light at position `i` of the cell's list.
 fn grid_light(cell: u32, i: u32) -> Light {
     return lights[grid_indices[grid_cells[cell].x + i]];
@@ -128,34 +97,15 @@ fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> ve
     return grid_shade(s, view_dir, cell);
 }
 
-// The cell's lights' diffuse irradiance (rgb) and specular luminance (a): the light
-// pre-pass's monochrome compromise, summed as the tiled light pre-pass stores it.
-fn grid_irradiance_mono(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec4<f32> {
-    if (grid.zbin_words != 0u) {
-        return zbin_shade(s, view_dir, cell, true);
+// One light's term in a loop's sum: the colour (rgb), or for the light pre-pass's monochrome
+// compromise the diffuse irradiance (rgb) and the specular luminance (a).
+fn light_sum(s: Surface, view_dir: vec3<f32>, light: Light, mono: bool) -> vec4<f32> {
+    if (mono) {
+        let t = light_terms(s, view_dir, light);
+        return vec4<f32>(t.diffuse, luminance(t.specular));
     }
-    var acc = vec4<f32>(0.0);
-    let count = grid_cell_count(cell);
-    var i = 0u;
-    for (; i < count; i = i + 1u) {
-        let t = light_terms(s, view_dir, grid_light(cell, i));
-        acc += vec4<f32>(t.diffuse, luminance(t.specular));
-    }
-    check_loop(i, count);
-    return acc;
+    return vec4<f32>(shade_light(s, view_dir, light), 0.0);
 }
 
-// Sum of the cell's lights on the surface (Listing 1's computeLight).
-fn grid_shade(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec3<f32> {
-    if (grid.zbin_words != 0u) {
-        return zbin_shade(s, view_dir, cell, false).rgb;
-    }
-    var acc = vec3<f32>(0.0);
-    let count = grid_cell_count(cell);
-    var i = 0u;
-    for (; i < count; i = i + 1u) {
-        acc += shade_light(s, view_dir, grid_light(cell, i));
-    }
-    check_loop(i, count);
-    return acc;
-}
+// The light loop itself, `grid_shade`, `grid_irradiance_mono` and `zbin_shade`, is in
+// light_loop_lane.wgsl (one lane at a time) or light_loop_subgroup.wgsl (`--light-loop`).

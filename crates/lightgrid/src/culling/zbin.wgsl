@@ -77,10 +77,10 @@ fn bins_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     check_loop(k, k1 + 1u);
 }
 
-// One invocation per (tile, mask word): the word's 32 sorted lights whose rectangle holds the
-// tile, against the tile's frustum over the union of the bounds of its cells (every slice and
-// layer), found at the first such light (most words have none: lavapipe measured 18 ms per
-// robots-many frame finding it for every word).
+// One invocation per (mask word, tile), neighbouring tiles side by side so that the lanes
+// of a SIMD group test the same light: the tile's range is the union of the bounds of its
+// cells (every slice and layer), and each of the word's 32 sorted lights whose rectangle
+// holds the tile is tested against the tile's frustum over it.
 @compute @workgroup_size(ASSIGN_THREADS)
 fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let g = item(gid, nwg);
@@ -89,39 +89,35 @@ fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if (g >= tiles * words) {
         return;
     }
-    let t = g / words;
-    let xy = vec2<u32>(t % grid.tiles_x, t / grid.tiles_x);
-    let first = (g % words) * 32u;
-    let n = min(32u, frame.light_count - first);
-    var bits = 0u;
-    var found = false;
-    var f: TileFrustum;
-    var j = 0u;
-    for (; j < n; j = j + 1u) {
-        let rx = keys[first + j];
-        let ry = vals[first + j];
-        if (xy.x < (rx & 0xffffu) || xy.x > (rx >> 16u) || xy.y < (ry & 0xffffu) || xy.y > (ry >> 16u)) {
-            continue;
-        }
-        if (!found) {
-            found = true;
-            var range = vec2<f32>(3.4e38, -3.4e38);
-            let layers = grid_cell_total() / tiles;
-            var k = 0u;
-            for (; k < layers; k = k + 1u) {
-                let b = cell_bounds[k * tiles + t];
-                if (b.x <= b.y) {
-                    range = vec2<f32>(min(range.x, b.x), max(range.y, b.y));
-                }
-            }
-            check_loop(k, layers);
-            // No samples: the frustum is empty and holds no light.
-            f = tile_frustum(xy, grid.tile_size, range);
-        }
-        if (light_in_tile(f, zbin_out[first + j])) {
-            bits = bits | (1u << j);
+    let t = g % tiles;
+    let word = g / tiles;
+    var range = vec2<f32>(3.4e38, -3.4e38);
+    let layers = grid_cell_total() / tiles;
+    var k = 0u;
+    for (; k < layers; k = k + 1u) {
+        let b = cell_bounds[k * tiles + t];
+        if (b.x <= b.y) {
+            range = vec2<f32>(min(range.x, b.x), max(range.y, b.y));
         }
     }
-    check_loop(j, n);
-    zbin_out[grid.zbin_masks + g] = bits;
+    check_loop(k, layers);
+    var bits = 0u;
+    if (range.x <= range.y) {
+        let xy = vec2<u32>(t % grid.tiles_x, t / grid.tiles_x);
+        let f = tile_frustum(xy, grid.tile_size, range);
+        let first = word * 32u;
+        let n = min(32u, frame.light_count - first);
+        var j = 0u;
+        for (; j < n; j = j + 1u) {
+            let rx = keys[first + j];
+            let ry = vals[first + j];
+            let in_rect = xy.x >= (rx & 0xffffu) && xy.x <= (rx >> 16u)
+                && xy.y >= (ry & 0xffffu) && xy.y <= (ry >> 16u);
+            if (in_rect && light_in_tile(f, zbin_out[first + j])) {
+                bits = bits | (1u << j);
+            }
+        }
+        check_loop(j, n);
+    }
+    zbin_out[grid.zbin_masks + t * words + word] = bits;
 }

@@ -35,6 +35,32 @@ pub struct RenderSettings {
     /// Tight cells of grids built from the depth buffer (`--cell-box`).
     #[serde(default)]
     pub cell_box: CellBox,
+    /// The light loop of grid pipelines (`--light-loop`).
+    #[serde(default)]
+    pub light_loop: LightLoop,
+}
+
+/// How grid pipelines loop over a sample's lights (`--light-loop`; `culling/light_loop_*.wgsl`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightLoop {
+    /// Each lane walks its own cell's lights.
+    #[default]
+    Lane,
+    /// The subgroup takes its lanes' lights one at a time for all of them (the same light's
+    /// data for every lane that lists it); needs an adapter with subgroups.
+    Subgroup,
+}
+
+impl LightLoop {
+    pub const ALL: [LightLoop; 2] = [LightLoop::Lane, LightLoop::Subgroup];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            LightLoop::Lane => "lane",
+            LightLoop::Subgroup => "subgroup",
+        }
+    }
 }
 
 /// Tight cells: each occupied cell of a grid built from the depth buffer keeps the view-space
@@ -221,6 +247,7 @@ impl Default for RenderSettings {
             depth_reduction: DepthReduction::Atomics,
             depth_mask: DepthMask::Off,
             cell_box: CellBox::Off,
+            light_loop: LightLoop::Lane,
         }
     }
 }

@@ -9,7 +9,7 @@
 
 use super::PipelineInfo;
 use crate::frame::{
-    Assign, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
+    Assign, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop,
     MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
 };
 
@@ -138,6 +138,20 @@ impl SettingValue for DepthMask {
         match self {
             DepthMask::Off => "the cell's depth bounds only",
             DepthMask::On => "2.5D culling: a 32-bit mask of the bounds' bins that hold samples (Harada et al. 2012)",
+        }
+    }
+}
+
+impl SettingValue for LightLoop {
+    const FLAG: &'static str = "light-loop";
+    const VALUES: &'static [Self] = &LightLoop::ALL;
+    fn name(self) -> &'static str {
+        LightLoop::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            LightLoop::Lane => "each lane walks its own cell's lights",
+            LightLoop::Subgroup => "the subgroup takes its lanes' lights one at a time for all of them (needs subgroups)",
         }
     }
 }
@@ -414,6 +428,19 @@ pub const AXES: &[Axis] = &[
             Ok(())
         },
         label: |v| format!("box {v}"),
+    },
+    Axis {
+        flag: "light-loop",
+        column: "light_loop",
+        help: "the light loop of the pipelines that shade from a grid: per lane, or scalarized over the subgroup (one light at a time for all lanes; adapters with subgroups)",
+        values: values::<LightLoop>,
+        applies: |p, _| p.uses_grid,
+        get: |s| s.light_loop.name().to_string(),
+        set: |s, v| {
+            s.light_loop = LightLoop::parse(v)?;
+            Ok(())
+        },
+        label: |v| format!("{v} loop"),
     },
 ];
 

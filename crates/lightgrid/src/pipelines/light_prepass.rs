@@ -98,15 +98,36 @@ pub(super) fn shaders_tiled() -> Vec<ComposedShader> {
 }
 
 /// The irradiance kernel for attributes of `samples` samples per pixel: one pixel per
-/// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`).
-pub(super) type TiledKernelKey = SamplesKey<TiledKernelStage>;
+/// invocation, or above one the edge-aware kernel (`tiled_light_prepass_msaa.wgsl`), with the
+/// light loop `light_loop`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct TiledKernelKey {
+    pub samples: u32,
+    pub light_loop: crate::frame::LightLoop,
+}
 
-pub(super) enum TiledKernelStage {}
-
-impl SampleStage for TiledKernelStage {
+impl crate::shader::ShaderKey for TiledKernelKey {
     const STAGE: &'static str = "tiled_light_prepass";
 
-    fn parts(samples: u32) -> Vec<&'static str> {
+    fn all() -> Vec<Self> {
+        crate::frame::LightLoop::ALL
+            .into_iter()
+            .flat_map(|light_loop| {
+                crate::shader::every_sample_count().map(move |samples| Self {
+                    samples,
+                    light_loop,
+                })
+            })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<crate::shader::Def> {
+        crate::shader::msaa_defs(self.samples)
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        let samples = self.samples;
+
         // The kernel and what it shares: the storage outputs at 1x, the edge queue above.
         let (shared, kernel) = if samples > 1 {
             (
@@ -125,6 +146,7 @@ impl SampleStage for TiledKernelStage {
             src::LIGHTING,
             src::MSAA,
             src::LIGHT_GRID,
+            super::light_loop_wgsl(self.light_loop),
             MSAA_SURFACES_WGSL,
             ATTRIBUTES_WGSL,
             shared,
@@ -411,7 +433,11 @@ fn tiled_irradiance(
     let kernel = compute_pipeline(
         ctx.device,
         "tiled light pre-pass irradiance",
-        &TiledKernelKey::new(samples).shader(),
+        &TiledKernelKey {
+            samples,
+            light_loop: ctx.settings.light_loop,
+        }
+        .shader(),
         "main",
         &[
             Some(ctx.scene_layout),

@@ -410,10 +410,18 @@ pub const PIPELINES: &[PipelineInfo] = &[
 /// Every shader the library can create, for the validation test: the shared passes, the
 /// culling stages and the registry's pipelines, every value of each keyed stage
 /// (`shader::ShaderKey::all`), once each (pipelines sharing a stage list it each).
+/// The WGSL light loop a grid-reading shader composes after `shader::src::LIGHT_GRID`.
+pub(crate) fn light_loop_wgsl(l: crate::frame::LightLoop) -> &'static str {
+    match l {
+        crate::frame::LightLoop::Lane => crate::shader::src::LIGHT_LOOP_LANE,
+        crate::frame::LightLoop::Subgroup => crate::shader::src::LIGHT_LOOP_SUBGROUP,
+    }
+}
+
 pub fn all_shaders() -> Vec<ComposedShader> {
     let mut out = crate::passes::shaders();
     out.extend(crate::culling::shaders());
-    out.push(transparent::shader());
+    out.extend(crate::frame::LightLoop::ALL.map(transparent::shader));
     for p in PIPELINES {
         for s in (p.shaders)() {
             match out.iter().find(|o| o.name == s.name) {

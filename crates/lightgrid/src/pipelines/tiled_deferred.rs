@@ -48,15 +48,30 @@ pub(super) enum Kernel {
 pub(super) struct KernelKey {
     pub kernel: Kernel,
     pub samples: u32,
+    /// The grid kernel's light loop (the single kernel culls and loops its own way: `Lane`).
+    pub light_loop: crate::frame::LightLoop,
 }
 
 impl ShaderKey for KernelKey {
     const STAGE: &'static str = "tiled_deferred";
 
     fn all() -> Vec<Self> {
+        use crate::frame::LightLoop;
+        let loops = |kernel| match kernel {
+            Kernel::Grid => LightLoop::ALL.to_vec(),
+            Kernel::Single => vec![LightLoop::Lane],
+        };
         [Kernel::Grid, Kernel::Single]
             .into_iter()
-            .flat_map(|kernel| every_sample_count().map(move |samples| Self { kernel, samples }))
+            .flat_map(|kernel| {
+                loops(kernel).into_iter().flat_map(move |light_loop| {
+                    every_sample_count().map(move |samples| Self {
+                        kernel,
+                        samples,
+                        light_loop,
+                    })
+                })
+            })
             .collect()
     }
 
@@ -73,7 +88,9 @@ impl ShaderKey for KernelKey {
             GBUFFER_READ_WGSL,
         ];
         match self.kernel {
-            Kernel::Grid => parts.push(src::LIGHT_GRID),
+            Kernel::Grid => {
+                parts.extend([src::LIGHT_GRID, super::light_loop_wgsl(self.light_loop)])
+            }
             Kernel::Single => parts.extend([TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL]),
         }
         if self.samples == 1 {
@@ -361,6 +378,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
     let kernel = KernelKey {
         kernel: Kernel::Grid,
         samples,
+        light_loop: ctx.settings.light_loop,
     }
     .shader();
     let shading = compute_pipeline(
@@ -442,6 +460,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
     let kernel = KernelKey {
         kernel: Kernel::Single,
         samples,
+        light_loop: crate::frame::LightLoop::Lane,
     }
     .shader();
     let shading = compute_pipeline(

@@ -21,10 +21,16 @@ use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, L
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
+    crate::frame::LightLoop::ALL.map(shader).to_vec()
+}
+
+/// The forward shading pass with the light loop `l`.
+fn shader(l: crate::frame::LightLoop) -> ComposedShader {
     let mut parts = SCENE_PARTS.to_vec();
     parts.push(crate::shader::src::LIGHT_GRID);
+    parts.push(super::light_loop_wgsl(l));
     parts.push(include_str!("tiled_forward.wgsl"));
-    vec![compose("tiled_forward", &parts)]
+    compose(&format!("tiled_forward ({} loop)", l.name()), &parts)
 }
 
 struct TiledForward {
@@ -43,7 +49,7 @@ enum Kind {
 }
 
 fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
-    let module = create_module(ctx.device, &shaders()[0]);
+    let module = create_module(ctx.device, &shader(ctx.settings.light_loop));
     let prepass = kind != Kind::Plain;
     let builder = LightCuller::for_renderer(
         &ctx.grid_setup(),

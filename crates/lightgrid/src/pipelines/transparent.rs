@@ -19,11 +19,13 @@ use crate::gpu::CounterValues;
 use crate::passes::geometry::{draw_transparent, MaterialPipelines};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 
-pub(super) fn shader() -> ComposedShader {
+/// The transparent pass with the light loop `l`.
+pub(super) fn shader(l: crate::frame::LightLoop) -> ComposedShader {
     let mut parts = SCENE_PARTS.to_vec();
     parts.push(crate::shader::src::LIGHT_GRID);
+    parts.push(super::light_loop_wgsl(l));
     parts.push(include_str!("transparent.wgsl"));
-    compose("transparent", &parts)
+    compose(&format!("transparent ({} loop)", l.name()), &parts)
 }
 
 /// Where a technique's transparent fragments find their lights.
@@ -68,7 +70,7 @@ fn blended_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
 
 impl TransparentPass {
     pub fn new(ctx: &PipelineContext) -> Self {
-        let module = create_module(ctx.device, &shader());
+        let module = create_module(ctx.device, &shader(ctx.settings.light_loop));
         // A GPU strategy (gather), so the frame still makes one submission and no readback,
         // over the opaque depth; one list per tile covering near..max.
         let own_grid = LightCuller::for_renderer(

@@ -22,10 +22,16 @@ pub mod src {
     /// Cell addressing (`grid_slice`, `grid_cell`); needs a `grid` binding.
     pub const GRID_CELL: &str = include_str!("../culling/grid_cell.wgsl");
     /// Group-1 grid bindings and the shading accessor (includes `GRID_CELL`).
+    /// The grid's bindings, cell addressing and z-bin walk; one of the light loops below
+    /// follows it.
     pub const LIGHT_GRID: &str = concat!(
         include_str!("../culling/grid_cell.wgsl"),
         include_str!("../culling/light_grid.wgsl")
     );
+    /// `grid_shade` and `grid_irradiance_mono`, one lane at a time (`--light-loop lane`).
+    pub const LIGHT_LOOP_LANE: &str = include_str!("../culling/light_loop_lane.wgsl");
+    /// The same, scalarized over the subgroup (`--light-loop subgroup`).
+    pub const LIGHT_LOOP_SUBGROUP: &str = include_str!("../culling/light_loop_subgroup.wgsl");
     pub const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
     /// `tone(c)`: the tone curve.
     pub const TONE: &str = include_str!("../shading/tone.wgsl");
