@@ -432,9 +432,9 @@ pub const AXES: &[Axis] = &[
     Axis {
         flag: "light-loop",
         column: "light_loop",
-        help: "the light loop of the pipelines that shade from a grid: per lane, or scalarized over the subgroup (one light at a time for all lanes; adapters with subgroups)",
+        help: "the light loop of the pipelines that shade from a LightCuller grid: per lane, or scalarized over the subgroup (one light at a time for all lanes; adapters with subgroups)",
         values: values::<LightLoop>,
-        applies: |p, _| p.uses_grid,
+        applies: |p, _| p.assign,
         get: |s| s.light_loop.name().to_string(),
         set: |s, v| {
             s.light_loop = LightLoop::parse(v)?;
