@@ -86,8 +86,9 @@ pub struct BenchConfig {
     /// Discarded renders of the first frame before each pipeline's series.
     pub warmup: u32,
     pub seed: u64,
-    /// For scenes with a variable light count.
-    pub lights: Option<u32>,
+    /// For scenes with a variable light count: each such scene is measured once per count
+    /// (as `<scene>-<n>-lights` when there are several); empty: the scene's own.
+    pub lights: Vec<u32>,
     /// Frame whose lights-per-tile heatmap goes into the report (None: the middle one).
     pub heatmap_frame: Option<u32>,
     /// The heatmap's scale: 0 to this many lights (None: the frame's own maximum).
@@ -207,7 +208,7 @@ impl BenchConfig {
         // One rule for every command: an option that applies to nothing chosen is refused.
         // --lights goes to the scenes that take a light count; with none, the first scene's
         // check says which scenes do.
-        if let Some(n) = self.lights {
+        for &n in &self.lights {
             let taker = self
                 .scenes
                 .iter()
@@ -562,60 +563,72 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 (info.variable_lights, info.robots)
             }
         };
-        let params = SceneParams {
-            seed: config.seed,
-            lights: config.lights.filter(|_| variable_lights),
-            spot_fraction: config.spot_fraction,
-            headlights: config.headlights && robots,
-            transparency: true,
-            material_shaders: config.material_shaders,
+        // One scene per light count for the scenes that take one (named by the count when
+        // there are several), the scene's own count otherwise.
+        let counts: Vec<Option<u32>> = match variable_lights && !config.lights.is_empty() {
+            true => config.lights.iter().map(|&n| Some(n)).collect(),
+            false => vec![None],
         };
-        let open = |transparency| {
-            source::open(&SceneRequest {
-                params: SceneParams {
-                    transparency,
-                    ..params
-                },
-                add_lights: config.add_lights,
-                ..SceneRequest::new(name)
-            })
-        };
-        let mut opened = open(true)?;
-        for w in &opened.warnings {
-            eprintln!("warning: {name}: {w}");
-        }
-        let id = unique_id(&opened.scene.name, &ids);
-        if id != opened.scene.name {
-            eprintln!(
-                "warning: {name}: another scene is named {}; this one is {id} in the results",
-                opened.scene.name
-            );
-        }
-        ids.push(id.clone());
-        opened.scene.name = id.clone();
-        let open = |transparency| {
-            open(transparency).map(|mut o| {
-                o.scene.name = id.clone();
-                o
-            })
-        };
-        let has_glass = opened.scene.has_transparency();
-        // Without its glass when asked (then measured at every range factor too).
-        let scene = match !config.transparency && has_glass {
-            true => open(false)?.scene,
-            false => opened.scene,
-        };
-        if !config.range_scales.is_empty() {
-            for &f in &config.range_scales {
-                scenes.push(range_scaled(&scene, f));
+        for lights in counts {
+            let params = SceneParams {
+                seed: config.seed,
+                lights,
+                spot_fraction: config.spot_fraction,
+                headlights: config.headlights && robots,
+                transparency: true,
+                material_shaders: config.material_shaders,
+            };
+            let open = |transparency| {
+                source::open(&SceneRequest {
+                    params: SceneParams {
+                        transparency,
+                        ..params
+                    },
+                    add_lights: config.add_lights,
+                    ..SceneRequest::new(name)
+                })
+            };
+            let mut opened = open(true)?;
+            for w in &opened.warnings {
+                eprintln!("warning: {name}: {w}");
             }
-            continue;
-        }
-        scenes.push(scene);
-        if config.opaque_variants && config.transparency && has_glass {
-            let mut opaque = open(false)?.scene;
-            opaque.name = format!("{}{OPAQUE_SUFFIX}", opaque.name);
-            scenes.push(opaque);
+            let base = match lights {
+                Some(n) if config.lights.len() > 1 => format!("{}-{n}-lights", opened.scene.name),
+                _ => opened.scene.name.clone(),
+            };
+            let id = unique_id(&base, &ids);
+            if id != base {
+                eprintln!(
+                    "warning: {name}: another scene is named {}; this one is {id} in the results",
+                    opened.scene.name
+                );
+            }
+            ids.push(id.clone());
+            opened.scene.name = id.clone();
+            let open = |transparency| {
+                open(transparency).map(|mut o| {
+                    o.scene.name = id.clone();
+                    o
+                })
+            };
+            let has_glass = opened.scene.has_transparency();
+            // Without its glass when asked (then measured at every range factor too).
+            let scene = match !config.transparency && has_glass {
+                true => open(false)?.scene,
+                false => opened.scene,
+            };
+            if !config.range_scales.is_empty() {
+                for &f in &config.range_scales {
+                    scenes.push(range_scaled(&scene, f));
+                }
+                continue;
+            }
+            scenes.push(scene);
+            if config.opaque_variants && config.transparency && has_glass {
+                let mut opaque = open(false)?.scene;
+                opaque.name = format!("{}{OPAQUE_SUFFIX}", opaque.name);
+                scenes.push(opaque);
+            }
         }
     }
     Ok(scenes)

@@ -35,7 +35,7 @@ fn config() -> BenchConfig {
         repeat: 2,
         warmup: 1,
         seed: 1,
-        lights: None,
+        lights: Vec::new(),
         heatmap_frame: None,
         spot_fraction: 0.0,
         add_lights: None,

@@ -59,7 +59,9 @@ pub(crate) enum Preset {
     /// Culling past the papers: the grids built from the depth buffer (tiled and clustered,
     /// forward and deferred) with and without 2.5D depth masks (`--depth-mask`; Harada et al.
     /// 2012) and tight cell boxes (`--cell-box`), and z-binning (`--assign zbin`, Drobot 2017;
-    /// its bins are the clustered pipelines' slices, one bin on tiled ones), 16-pixel tiles, on robots-many, robots-few and scattered without glass, frames
+    /// its bins are the clustered pipelines' slices, one bin on tiled ones), 16-pixel tiles,
+    /// on robots-many, robots-few, scattered (without glass) and stress (10,000 lights; also
+    /// 100,000 on a hardware GPU), frames
     /// 0..259 every 20, at the papers' size (640x360 on a software adapter): lighting
     /// computations against the ideal, assignment time and grid memory per grid.
     Culling,
@@ -101,9 +103,10 @@ pub(crate) struct BenchArgs {
     /// Discarded renders before each pipeline's series, 0 to 1000 [default: 1].
     #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(0..=MAX_COUNT))]
     pub(crate) warmup: Option<u32>,
-    /// Light count for scenes that take one (refused when no chosen scene does).
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) lights: Option<u32>,
+    /// Light count for scenes that take one (refused when no chosen scene does); a list
+    /// measures each such scene once per count (as `<scene>-<n>-lights`).
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
+    pub(crate) lights: Vec<u32>,
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
     /// Fraction of each scene's lights (0 to 1) turned into spot lights.
@@ -187,6 +190,8 @@ pub(crate) struct BenchDefaults {
     pub(crate) heatmap_max: Option<u32>,
     /// Each scene also without its transparent objects (unless `--transparency` says).
     pub(crate) opaque_variants: bool,
+    /// Light counts of the scenes that take one (unless `--lights` says; empty: their own).
+    pub(crate) lights: Vec<u32>,
 }
 
 /// Without a preset: robots-many's animation every 5 frames (the paper's 5 fps sampling) at
@@ -205,6 +210,7 @@ fn everything() -> BenchDefaults {
         range_scales: Vec::new(),
         heatmap_max: None,
         opaque_variants: false,
+        lights: Vec::new(),
     }
 }
 
@@ -345,7 +351,14 @@ pub(crate) fn bench_config(
             ..study(hardware, |_| false)
         },
         Some(Preset::Culling) => BenchDefaults {
-            scenes: vec!["robots-many", "robots-few", "scattered"],
+            scenes: vec!["robots-many", "robots-few", "scattered", "stress"],
+            // stress at 10,000 lights, and 100,000 on a hardware GPU (on lavapipe a z-binned
+            // frame of 100,000 lights takes 2 s: `--lights 10000,100000` asks for it).
+            lights: if hardware {
+                vec![10_000, 100_000]
+            } else {
+                vec![10_000]
+            },
             pipelines: [
                 ids::TILED_FORWARD_PREZ,
                 ids::TILED_DEFERRED,
@@ -417,7 +430,11 @@ pub(crate) fn bench_config(
         repeat: a.repeat.unwrap_or(repeat),
         warmup: a.warmup.unwrap_or(1),
         seed: a.seed,
-        lights: a.lights,
+        lights: if a.lights.is_empty() {
+            d.lights.clone()
+        } else {
+            a.lights.clone()
+        },
         heatmap_frame: a.heatmap_frame,
         range_scales: if a.range_scale.is_empty() {
             d.range_scales.clone()

@@ -17,7 +17,7 @@ fn bench(args: &[&str]) -> std::path::PathBuf {
 }
 
 /// The culling preset measures every grid with and without 2.5D depth masks and tight cell
-/// boxes, and z-binned, on its three scenes: neither masks nor boxes ever add lighting
+/// boxes, and z-binned, on its four scenes: neither masks nor boxes ever add lighting
 /// computations, the boxes take some away over the run, and each claim (Harada's, tight
 /// clusters', Drobot's) is judged per scene and pipeline.
 #[test]
@@ -67,7 +67,10 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
             .insert(variant, n);
     }
     let scenes: std::collections::BTreeSet<&str> = counts.keys().map(|k| k.0.as_str()).collect();
-    assert_eq!(scenes.len(), 3, "{scenes:?}");
+    // robots-many, robots-few, scattered and stress at 10,000 lights (100,000 only on a
+    // hardware GPU).
+    assert_eq!(scenes.len(), 4, "{scenes:?}");
+    assert!(scenes.contains("stress"), "{scenes:?}");
     for p in [
         "tiled_forward_prez",
         "tiled_deferred",
@@ -111,7 +114,7 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
         ),
     ] {
         let lines: Vec<&str> = summary.lines().filter(|l| l.contains(claim)).collect();
-        assert_eq!(lines.len(), 3 * 2, "'{claim}': {lines:#?}");
+        assert_eq!(lines.len(), 4 * 2, "'{claim}': {lines:#?}");
         for l in &lines {
             assert!(
                 pipelines.iter().any(|p| l.contains(&format!("| {p}: "))),
@@ -124,6 +127,46 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
             );
         }
     }
+}
+
+/// `--lights` as a list measures each scene that takes a light count once per count, named
+/// by it, and the other scenes once.
+#[test]
+fn a_light_count_list_measures_each_count() {
+    let out = bench(&[
+        "--scene",
+        "stress,robots-few",
+        "--lights",
+        "50,80",
+        "--pipelines",
+        "forward",
+        "--size",
+        "64x36",
+        "--frames",
+        "0..0:1",
+    ]);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let scene = header.iter().position(|c| *c == "scene").unwrap();
+    let mut names: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(scene).unwrap())
+        .collect();
+    names.sort();
+    names.dedup();
+    assert_eq!(
+        names,
+        ["robots-few", "stress-50-lights", "stress-80-lights"]
+    );
+    // Each with its own light count (the frames' records).
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let text = json.to_string();
+    assert!(
+        text.contains("\"lights\":50") && text.contains("\"lights\":80"),
+        "{text:.400}"
+    );
 }
 
 #[test]
