@@ -197,23 +197,28 @@ impl Renderer {
         validate_size(ctx, width, height)?;
         settings.validate()?;
         crate::frame::check_msaa(ctx, settings.msaa, settings.gbuffer)?;
-        if settings.depth_reduction == crate::frame::DepthReduction::Subgroup && !ctx.subgroups {
-            return Err(Error::invalid(
+        // The settings that need subgroup operations, and what to use without them.
+        for (wants, what, instead) in [
+            (
+                settings.depth_reduction == crate::frame::DepthReduction::Subgroup,
                 "depth reduction",
-                format!(
-                    "subgroup: {} has no subgroup operations; use atomics",
-                    ctx.adapter_label()
-                ),
-            ));
-        }
-        if settings.light_loop == crate::frame::LightLoop::Subgroup && !ctx.subgroups {
-            return Err(Error::invalid(
+                "atomics",
+            ),
+            (
+                settings.light_loop == crate::frame::LightLoop::Subgroup,
                 "light loop",
-                format!(
-                    "subgroup: {} has no subgroup operations; use lane",
-                    ctx.adapter_label()
-                ),
-            ));
+                "lane",
+            ),
+        ] {
+            if wants && !ctx.subgroups {
+                return Err(Error::invalid(
+                    what,
+                    format!(
+                        "subgroup: {} has no subgroup operations; use {instead}",
+                        ctx.adapter_label()
+                    ),
+                ));
+            }
         }
         let dims = GridDims::new(width, height, settings.tile_size)?;
         let device = &ctx.device;

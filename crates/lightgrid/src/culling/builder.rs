@@ -6,7 +6,9 @@
 //! 2. light assignment by the strategy `--assign` names (resolved per frame for `auto`), one
 //!    [`AssignStrategy`] per row of `registry.rs`: `cpu` (`assign_cpu.rs`, reads the
 //!    bounds back: the papers' CPU pipeline), `gather` (`gather.rs`), `scatter` (`scatter.rs`),
-//!    `bvh` (`bvh.rs`), `bvh-gpu` (`bvh_gpu.rs`); the GPU ones record into the frame's one
+//!    `bvh` (`bvh.rs`), `bvh-gpu` (`bvh_gpu.rs`), `zbin` (`zbin.rs`: the grid z-binned, sorted
+//!    lights with per-slice ranges and per-tile masks, instead of per-cell lists; the
+//!    strategy's `shape` marks the grid so); the GPU ones record into the frame's one
 //!    submission;
 //! 3. the grid is left in [`GridBuffers`] (group 1 of the shading pass). Analysis downloads it
 //!    ([`GridBuilder::download`]); rendering alone never does.

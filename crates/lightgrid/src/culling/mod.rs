@@ -1,5 +1,5 @@
 //! Light assignment: the light grid contract (tiled-shading §6.2), the cell bounds every
-//! strategy reads, the strategies (CPU; GPU gather, scatter and BVH) with their CPU twins,
+//! strategy reads, the strategies (CPU; GPU gather, scatter, BVH and z-binning) with their CPU twins,
 //! [`LightCuller`] (over `builder.rs`'s `GridBuilder`) which runs the one `--assign` names, for lightgrid's renderer and for any other wgpu renderer, and the brute-force oracle that proves
 //! nothing is ever missed.
 
