@@ -322,17 +322,18 @@ fn grid_params_struct() -> &'static str {
     &src::TYPES[start..end]
 }
 
-/// WGSL `text` with its names prefixed (`grid` → `light_grid`, `GridParams` →
-/// `LightGridParams`, `GRID_LISTS_SEPARATE` → `LIGHT_GRID_LISTS_SEPARATE`).
+/// WGSL `text` with its names prefixed (`grid` → `light_grid`, `grid_cell` →
+/// `light_grid_cell`, `GridParams` → `LightGridParams`, `GRID_LISTS_SEPARATE` →
+/// `LIGHT_GRID_LISTS_SEPARATE`).
 fn prefixed(text: &str) -> String {
     let mut out = String::new();
     let mut ident = String::new();
     let flush = |ident: &mut String, out: &mut String| {
         let renamed = match ident.as_str() {
             "grid" => "light_grid".to_string(),
-            "GridParams" => "LightGridParams".to_string(),
             "GRID_LISTS_SEPARATE" => "LIGHT_GRID_LISTS_SEPARATE".to_string(),
             s if s.starts_with("grid_") => format!("light_{s}"),
+            s if s.starts_with("Grid") => format!("Light{s}"),
             s => s.to_string(),
         };
         out.push_str(&renamed);
@@ -653,18 +654,23 @@ impl LightCuller {
     /// - `light_grid_cell(pixel: vec2<f32>, view_distance: f32) -> u32`: the cell of the sample
     ///   at framebuffer position `pixel` (`@builtin(position).xy`) and view distance
     ///   `view_distance` (−z in view space);
-    /// - `light_grid_count(cell: u32) -> u32`: how many lights the cell lists;
+    /// - `light_grid_walk(cell: u32) -> LightGridWalk` and
+    ///   `light_grid_next(walk: ptr<function, LightGridWalk>) -> bool`: the cell's lights one
+    ///   at a time (`walk.light`, the index in the caller's light buffer), whatever the
+    ///   strategy built (lists, or [`CullStrategy::ZBin`]'s bins and masks);
+    /// - `light_grid_count(cell: u32) -> u32`: how many lights the cell has;
     /// - `light_grid_light(cell: u32, i: u32) -> u32`: the index, in the caller's light
-    ///   buffer, of the cell's `i`-th light.
+    ///   buffer, of the cell's `i`-th light (a scan of the mask words on z-bins).
     ///
     /// Every name it declares starts with `light_grid` or `LightGrid`.
     pub fn wgsl(group: u32) -> String {
         format!(
-            "{}\n{}\nconst LIGHT_GRID_LISTS_SEPARATE: u32 = {}u;\n\n{}",
+            "{}\n{}\nconst LIGHT_GRID_LISTS_SEPARATE: u32 = {}u;\n\n{}\n{}",
             prefixed(grid_params_struct()),
             EMBED_WGSL.replace("LIGHT_GRID_GROUP", &group.to_string()),
             crate::consts::GRID_LISTS_SEPARATE,
-            prefixed(src::GRID_CELL)
+            prefixed(src::GRID_CELL),
+            prefixed(src::ZBIN_WALK)
         )
     }
 

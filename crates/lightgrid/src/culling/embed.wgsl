@@ -31,11 +31,11 @@ struct LightGridWalk {
     // past the last word of the bin's range.
     next: u32,
     end: u32,
-    // Lists: the cell's offset. Z-bins: the tile's first mask word.
+    // Lists: the cell's offset.
     base: u32,
-    // Z-bins: the bin's sorted range [first, last] and the current word's bits left.
-    first: u32,
-    last: u32,
+    // Z-bins: the cell's tile and bin (zbin_walk.wgsl, renamed) and the current word's bits
+    // left.
+    zbin: LightGridZBinWalk,
     bits: u32,
 }
 
@@ -43,24 +43,10 @@ struct LightGridWalk {
 fn light_grid_walk(cell: u32) -> LightGridWalk {
     if (light_grid.zbin_words == 0u) {
         let c = light_grid_cells[cell];
-        return LightGridWalk(0u, 0u, c.y, c.x, 0u, 0u, 0u);
+        return LightGridWalk(0u, 0u, c.y, c.x, LightGridZBinWalk(0u, 0u, 0u, 0u, 0u), 0u);
     }
-    let c = cell % light_grid.layer_cells;
-    let tiles = light_grid.tiles_x * light_grid.tiles_y;
-    let bin = light_grid_cells[c / tiles];
-    let first = ~bin.x;
-    let base = light_grid.zbin_masks + (c % tiles) * light_grid.zbin_words;
-    if (first >= bin.y) {
-        return LightGridWalk(0u, 0u, 0u, base, 1u, 0u, 0u);
-    }
-    return LightGridWalk(0u, first / 32u, (bin.y - 1u) / 32u + 1u, base, first, bin.y - 1u, 0u);
-}
-
-// The walk's mask word `k` limited to the bin's range (z-bins).
-fn light_grid_word(w: LightGridWalk, k: u32) -> u32 {
-    let lo = max(w.first, k * 32u) - k * 32u;
-    let hi = min(w.last, k * 32u + 31u) - k * 32u;
-    return light_grid_indices[w.base + k] & (0xffffffffu << lo) & (0xffffffffu >> (31u - hi));
+    let z = light_grid_zbin_walk(cell);
+    return LightGridWalk(0u, z.word0, z.word_end, 0u, z, 0u);
 }
 
 // The next light of the walk into `(*w).light`; false when there is none left.
@@ -77,7 +63,7 @@ fn light_grid_next(w: ptr<function, LightGridWalk>) -> bool {
         if ((*w).next >= (*w).end) {
             return false;
         }
-        (*w).bits = light_grid_word(*w, (*w).next);
+        (*w).bits = light_grid_zbin_word((*w).zbin, (*w).next);
         (*w).next += 1u;
     }
     let b = firstTrailingBit((*w).bits);
@@ -91,10 +77,10 @@ fn light_grid_count(cell: u32) -> u32 {
     if (light_grid.zbin_words == 0u) {
         return light_grid_cells[cell].y;
     }
-    let w = light_grid_walk(cell);
+    let z = light_grid_zbin_walk(cell);
     var n = 0u;
-    for (var k = w.next; k < w.end; k++) {
-        n += countOneBits(light_grid_word(w, k));
+    for (var k = z.word0; k < z.word_end; k++) {
+        n += countOneBits(light_grid_zbin_word(z, k));
     }
     return n;
 }
@@ -105,10 +91,10 @@ fn light_grid_light(cell: u32, i: u32) -> u32 {
     if (light_grid.zbin_words == 0u) {
         return light_grid_indices[light_grid_cells[cell].x + i];
     }
-    let w = light_grid_walk(cell);
+    let z = light_grid_zbin_walk(cell);
     var left = i;
-    for (var k = w.next; k < w.end; k++) {
-        var bits = light_grid_word(w, k);
+    for (var k = z.word0; k < z.word_end; k++) {
+        var bits = light_grid_zbin_word(z, k);
         let n = countOneBits(bits);
         if (left < n) {
             for (var j = 0u; j < left; j++) {

@@ -24,33 +24,6 @@ fn grid_cell_count(cell: u32) -> u32 {
     return grid_cells[cell].y;
 }
 
-// A z-binned grid (culling/zbin.rs, Drobot 2017): the index buffer holds the lights sorted by
-// view depth, then one bit mask over them per screen tile (`zbin_words` words each, from
-// `zbin_masks`); the cell buffer holds per depth bin (the grid's slices) the sorted range
-// (~first, end) of the lights whose depth span meets the bin. A cell (tile, slice, layer)
-// reads its tile's mask within its slice's range: the bins apply at any depth, so transparent
-// fragments need no second list.
-struct ZBinWalk {
-    tile_mask: u32,  // index of the tile's first mask word
-    first: u32,      // the bin's sorted range [first, end)
-    end: u32,
-}
-
-fn zbin_walk(cell: u32) -> ZBinWalk {
-    let c = cell % grid.layer_cells;
-    let tiles = grid.tiles_x * grid.tiles_y;
-    let bin = grid_cells[c / tiles];
-    return ZBinWalk(grid.zbin_masks + (c % tiles) * grid.zbin_words, ~bin.x, bin.y);
-}
-
-// The tile mask's word `k` (k * 32 .. k * 32 + 31 in sorted order) limited to the bin's range.
-fn zbin_word(z: ZBinWalk, k: u32) -> u32 {
-    let lo = max(z.first, k * 32u) - k * 32u;
-    let hi = min(z.end, k * 32u + 32u) - k * 32u;  // > lo for the words the walk visits
-    let range = (0xffffffffu << lo) & (0xffffffffu >> (32u - hi));
-    return grid_indices[z.tile_mask + k] & range;
-}
-
 // The cell `zbin_shade` shaded last and how many lights it evaluated: the pipelines ask for
 // the count after shading, and need not walk the masks twice.
 var<private> zbin_shaded: vec2<u32> = vec2<u32>(0xffffffffu, 0u);
@@ -59,16 +32,13 @@ fn zbin_count(cell: u32) -> u32 {
     if (zbin_shaded.x == cell) {
         return zbin_shaded.y;
     }
-    let z = zbin_walk(cell);
+    let z = grid_zbin_walk(cell);
     var n = 0u;
-    if (z.first < z.end) {
-        let last = (z.end - 1u) / 32u;
-        var k = z.first / 32u;
-        for (; k <= last; k = k + 1u) {
-            n += countOneBits(zbin_word(z, k));
-        }
-        check_loop(k, last + 1u);
+    var k = z.word0;
+    for (; k < z.word_end; k = k + 1u) {
+        n += countOneBits(grid_zbin_word(z, k));
     }
+    check_loop(k, z.word_end);
     return n;
 }
 

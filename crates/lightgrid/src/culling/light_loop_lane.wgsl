@@ -4,26 +4,23 @@
 // The z-binned form of `grid_shade` (mono: the light pre-pass's irradiance and specular
 // luminance instead of the colour; rgb in both cases, a used only by mono).
 fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
-    let z = zbin_walk(cell);
+    let z = grid_zbin_walk(cell);
     var acc = vec4<f32>(0.0);
-    if (z.first < z.end) {
-        let last = (z.end - 1u) / 32u;
-        var shaded = 0u;
-        var listed = 0u;
-        var k = z.first / 32u;
-        for (; k <= last; k = k + 1u) {
-            var bits = zbin_word(z, k);
-            listed += countOneBits(bits);
-            for (; bits != 0u; bits = bits & (bits - 1u)) {
-                let light = lights[grid_indices[k * 32u + firstTrailingBit(bits)]];
-                acc += light_sum(s, view_dir, light, mono);
-                shaded += 1u;
-            }
+    var shaded = 0u;
+    var listed = 0u;
+    var k = z.word0;
+    for (; k < z.word_end; k = k + 1u) {
+        var bits = grid_zbin_word(z, k);
+        listed += countOneBits(bits);
+        for (; bits != 0u; bits = bits & (bits - 1u)) {
+            let light = lights[grid_indices[k * 32u + firstTrailingBit(bits)]];
+            acc += light_sum(s, view_dir, light, mono);
+            shaded += 1u;
         }
-        check_loop(k, last + 1u);
-        check_loop(shaded, listed);
-        zbin_shaded = vec2<u32>(cell, shaded);
     }
+    check_loop(k, z.word_end);
+    check_loop(shaded, listed);
+    zbin_shaded = vec2<u32>(cell, shaded);
     return acc;
 }
 

@@ -37,16 +37,11 @@ fn list_sum(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32>
 }
 
 fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
-    let z = zbin_walk(cell);
-    let has = z.first < z.end;
-    var k0 = NO_LIGHT;
-    var k1 = 0u;
-    if (has) {
-        k0 = z.first / 32u;
-        k1 = (z.end - 1u) / 32u;
-    }
-    let lo = subgroupMin(k0);
-    let hi = subgroupMax(k1);
+    let z = grid_zbin_walk(cell);
+    let has = z.word0 < z.word_end;
+    // The union of the lanes' word ranges, [lo, hi).
+    let lo = subgroupMin(select(NO_LIGHT, z.word0, has));
+    let hi = subgroupMax(z.word_end);
     var acc = vec4<f32>(0.0);
     if (lo == NO_LIGHT) {
         return acc;
@@ -54,10 +49,10 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
     var shaded = 0u;
     var listed = 0u;
     var k = lo;
-    for (; k <= hi; k = k + 1u) {
+    for (; k < hi; k = k + 1u) {
         var mine = 0u;
-        if (has && k >= k0 && k <= k1) {
-            mine = zbin_word(z, k);
+        if (k >= z.word0 && k < z.word_end) {
+            mine = grid_zbin_word(z, k);
         }
         listed += countOneBits(mine);
         for (var any = subgroupOr(mine); any != 0u; any = any & (any - 1u)) {
@@ -68,11 +63,9 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
             }
         }
     }
-    check_loop(k, hi + 1u);
+    check_loop(k, hi);
     check_loop(shaded, listed);
-    if (has) {
-        zbin_shaded = vec2<u32>(cell, shaded);
-    }
+    zbin_shaded = vec2<u32>(cell, shaded);
     return acc;
 }
 

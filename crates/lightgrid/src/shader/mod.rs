@@ -26,8 +26,11 @@ pub mod src {
     /// follows it.
     pub const LIGHT_GRID: &str = concat!(
         include_str!("../culling/grid_cell.wgsl"),
+        include_str!("../culling/zbin_walk.wgsl"),
         include_str!("../culling/light_grid.wgsl")
     );
+    /// The walk over a z-binned grid (in `LIGHT_GRID`; renamed for a LightCuller's caller).
+    pub const ZBIN_WALK: &str = include_str!("../culling/zbin_walk.wgsl");
     /// `grid_shade` and `grid_irradiance_mono`, one lane at a time (`--light-loop lane`).
     pub const LIGHT_LOOP_LANE: &str = include_str!("../culling/light_loop_lane.wgsl");
     /// The same, scalarized over the subgroup (`--light-loop subgroup`).
