@@ -220,7 +220,7 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     let box_axis = lightgrid::pipelines::find_axis(CellBox::FLAG).expect("a row");
     for c in &top {
         let settings = RenderSettings {
-            assign: assign_of(c),
+            assign: named_assign(c).unwrap_or_default(),
             ..Default::default()
         };
         if c.depth_mask.is_none() && (mask_axis.applies)(info(c), &settings) {
@@ -266,11 +266,9 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     out
 }
 
-/// The strategy a candidate names (`auto` when it names none).
-fn assign_of(c: &Candidate) -> Assign {
-    c.assign
-        .and_then(|a| Assign::all().find(|x| x.name() == a))
-        .unwrap_or_default()
+/// The strategy a candidate names, if it names one.
+fn named_assign(c: &Candidate) -> Option<Assign> {
+    c.assign.and_then(|a| Assign::all().find(|x| x.name() == a))
 }
 
 /// Fastest first; measured before unmeasured (kept in the order tried); equal times by
@@ -472,10 +470,7 @@ pub fn advise(
 fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
     RenderSettings {
         tile_size: c.tile.unwrap_or(plan.base.tile_size),
-        assign: c
-            .assign
-            .and_then(|a| Assign::all().find(|x| x.name() == a))
-            .unwrap_or(plan.base.assign),
+        assign: named_assign(c).unwrap_or(plan.base.assign),
         depth_mask: c.depth_mask.unwrap_or(plan.base.depth_mask),
         cell_box: c.cell_box.unwrap_or(plan.base.cell_box),
         ..plan.base

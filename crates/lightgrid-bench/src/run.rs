@@ -599,8 +599,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             let id = unique_id(&base, &ids);
             if id != base {
                 eprintln!(
-                    "warning: {name}: another scene is named {}; this one is {id} in the results",
-                    opened.scene.name
+                    "warning: {name}: another scene is named {base}; this one is {id} in the results"
                 );
             }
             ids.push(id.clone());

@@ -232,12 +232,8 @@ impl AssignStrategy for ZBinStrategy {
         a.grid
             .ensure(device, f.queue, dims, dims.cell_count(), total as usize);
         let (encoder, timer) = enc.parts();
-        // Empty bins: (~first, end) = (0, 0).
-        encoder.clear_buffer(
-            a.grid.cells_buffer(),
-            0,
-            Some((dims.cell_count() * 8) as u64),
-        );
+        // Empty bins: (~first, end) = (0, 0). Only the bins are read (one per slice).
+        encoder.clear_buffer(a.grid.cells_buffer(), 0, Some(u64::from(dims.slices) * 8));
         if n == 0 {
             return Ok(StrategyRun::default());
         }
