@@ -329,6 +329,11 @@ pub(crate) struct SceneOptions {
     /// The materials' own shaders (car paint, rim); off renders every material standard.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub(crate) material_shaders: OnOff,
+    /// Multiplies every light before shading (default: 1 for the catalog; for a glTF file's
+    /// photometric lights, the exposure at which the median light shows mid-grey on a white
+    /// surface at half its range). Up to 1e6.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_positive)]
+    pub(crate) exposure: Option<f64>,
 }
 
 impl SceneOptions {
@@ -345,6 +350,7 @@ impl SceneOptions {
             headlights: false,
             transparency: OnOff::On,
             material_shaders: OnOff::On,
+            exposure: None,
         }
     }
 
@@ -362,6 +368,7 @@ impl SceneOptions {
             },
             camera: self.camera.map(|c| c as usize),
             add_lights: added_lights(self.add_lights, self.light_range)?,
+            exposure: self.exposure.map(|e| e as f32),
         };
         lightgrid::scene::source::check(&req)?;
         Ok(req)

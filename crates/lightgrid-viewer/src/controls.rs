@@ -77,6 +77,7 @@ mod tests {
                 params: SceneParams::default(),
                 camera: None,
                 add_lights: None,
+                exposure: None,
             },
             view: DebugView::Shaded,
         }

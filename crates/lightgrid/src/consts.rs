@@ -187,8 +187,21 @@ pub const MAX_FRAME_EDGE: u32 = 16384;
 /// Global ambient light intensity that multiplies every material's ambient colour.
 pub const SCENE_AMBIENT: f32 = 0.04;
 
-/// Exposure applied before tonemapping the HDR target.
+/// Exposure applied before tonemapping the HDR target. A scene's own exposure
+/// (`scene::Lighting::exposure`, `--exposure`) scales its lights as they are uploaded; this
+/// one stays 1.
 pub const EXPOSURE: f32 = 1.0;
+
+/// `FrameUniforms::brdf` (`scene::Brdf`): Blinn-Phong or glTF's GGX metallic-roughness.
+pub const BRDF_PHONG: u32 = 0;
+pub const BRDF_GGX: u32 = 1;
+/// `FrameUniforms::falloff` (`scene::LightUnits`): the papers' window `(1 − (d/r)²)²`, or
+/// KHR_lights_punctual's inverse square windowed by `clamp(1 − (d/r)⁴, 0, 1)²`.
+pub const FALLOFF_WINDOW: u32 = 0;
+pub const FALLOFF_INVERSE_SQUARE: u32 = 1;
+/// The smallest squared distance the inverse-square falloff divides by (1 cm² in a glTF
+/// file's metres, as Filament clamps it): a light touching a surface stays finite there.
+pub const MIN_LIGHT_DISTANCE_SQ: f32 = 1e-4;
 
 /// Workgroup edge of the full-screen compute passes (8×8 = 64 invocations).
 pub const SCREEN_WORKGROUP: u32 = 8;
@@ -249,6 +262,11 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("MAX_LIGHTS", WgslConst::U32(MAX_LIGHTS)),
     ("SCENE_AMBIENT", WgslConst::F32(SCENE_AMBIENT)),
     ("EXPOSURE", WgslConst::F32(EXPOSURE)),
+    ("BRDF_PHONG", WgslConst::U32(BRDF_PHONG)),
+    ("BRDF_GGX", WgslConst::U32(BRDF_GGX)),
+    ("FALLOFF_WINDOW", WgslConst::U32(FALLOFF_WINDOW)),
+    ("FALLOFF_INVERSE_SQUARE", WgslConst::U32(FALLOFF_INVERSE_SQUARE)),
+    ("MIN_LIGHT_DISTANCE_SQ", WgslConst::F32(MIN_LIGHT_DISTANCE_SQ)),
     ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
     ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),

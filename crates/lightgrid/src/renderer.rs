@@ -30,7 +30,7 @@ use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::base_textures::BaseTextures;
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
-use crate::scene::{Draw, FrameState, Geometry, Light, Scene, SpotCull};
+use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
@@ -553,8 +553,14 @@ impl Renderer {
         let (device, queue) = (&self.device.clone(), &self.queue.clone());
         // Lights and geometry are drawn and shaded camera-relative (`ViewSetup::relative`).
         let eye = state.camera.eye;
+        let lighting = self
+            .scene
+            .as_ref()
+            .map_or_else(Lighting::default, |s| s.scene.lighting);
+        let brdf = self.settings.brdf.unwrap_or(lighting.brdf);
+        let scale = lighting.light_scale(brdf);
         let relative: Vec<_> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
-        let gpu_lights: Vec<GpuLight> = relative.iter().map(Light::to_gpu).collect();
+        let gpu_lights: Vec<GpuLight> = relative.iter().map(|l| l.to_gpu_scaled(scale)).collect();
         let bounds: Vec<[f32; 4]> = relative.iter().map(Light::bounds_gpu).collect();
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
         let bb: &[u8] = bytemuck::cast_slice(&bounds);
@@ -580,8 +586,8 @@ impl Renderer {
             far: state.camera.far,
             spot_cull: u32::from(self.settings.spot_cull == SpotCull::Cone),
             standard_depth: 0,
-            _pad1: 0,
-            _pad2: 0,
+            brdf: brdf.gpu(),
+            falloff: lighting.units.falloff(),
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
         (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64

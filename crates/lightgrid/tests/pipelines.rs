@@ -1650,6 +1650,7 @@ fn coplanar_scene() -> Scene {
             1e6,
         ),
         default_size: (128, 72),
+        lighting: Default::default(),
     }
 }
 

@@ -16,11 +16,13 @@
 
 mod common;
 
-use common::shading::{check, display, Frame, Model};
+use common::shading::{check, check_brdf, display, Frame, Model};
 use glam::Vec3;
 use lightgrid::consts::SCENE_AMBIENT;
 use lightgrid::scene::catalog::{self, SceneParams};
-use lightgrid::scene::{CameraPath, Light, Material, Mesh, Object, Scene, SceneLight};
+use lightgrid::scene::{
+    Brdf, CameraPath, Light, LightUnits, Lighting, Material, Mesh, Object, Scene, SceneLight,
+};
 use lightgrid::{RenderSettings, Renderer};
 
 #[test]
@@ -119,6 +121,7 @@ fn a_plane_under_one_light_has_the_radiance_worked_out_by_hand() {
         // Looking down at the point under the light from above and to the side.
         camera_path: CameraPath::fixed(EYE, Vec3::ZERO, 40.0, 0.1, 100.0),
         default_size: (64, 64),
+        lighting: Default::default(),
     };
     let f = Frame::new(&scene, 0, (64, 64));
     let mut r = Renderer::new(&ctx, 64, 64, RenderSettings::default()).unwrap();
@@ -169,4 +172,248 @@ fn a_plane_under_one_light_has_the_radiance_worked_out_by_hand() {
     }
     // The point under the light is lit brightly; the window is zero beyond the range.
     assert!(display(Vec3::splat(intensity))[0] > 200);
+}
+
+/// GGX (`--brdf ggx`) on catalog scenes, in the papers' units: `forward`, `forward_mono` and
+/// `forward_mono_albedo` equal the reference's GGX written from glTF's appendix B, with
+/// spots, headlights, every material shader and the glass.
+#[test]
+fn forward_equals_the_ggx_reference_on_catalog_scenes() {
+    let ctx = common::gpu();
+    for name in ["robots-few", "random-top"] {
+        let params = SceneParams {
+            spot_fraction: 0.3,
+            headlights: name.starts_with("robots"),
+            ..Default::default()
+        };
+        let scene = catalog::build(name, &params).unwrap();
+        let frame = scene.frame_count() / 3;
+        let c = check_brdf(&ctx, &scene, frame, (160, 96), 5, Some(Brdf::Ggx));
+        eprintln!("{name} frame {frame} ggx: {c:?}");
+        assert!(c.pixels >= 150 && c.lit * 4 >= c.pixels, "{name}: {c:?}");
+    }
+    // And a glTF file's photometric lights shaded with Blinn-Phong (`--brdf phong`).
+    let bytes = common::gltf_fixture::room().glb();
+    let opts = lightgrid::scene::gltf::LoadOptions::default();
+    let room = lightgrid::scene::gltf::load_bytes(&bytes, "room.glb", None, &opts)
+        .unwrap()
+        .scene;
+    let c = check_brdf(&ctx, &room, 0, (160, 96), 4, Some(Brdf::Phong));
+    eprintln!("room phong: {c:?}");
+    assert!(c.pixels >= 150 && c.lit * 4 >= c.pixels, "{c:?}");
+}
+
+fn one_plane(material: Material, lights: Vec<Light>, eye: Vec3, target: Vec3) -> Scene {
+    Scene {
+        name: "plane".into(),
+        meshes: vec![Mesh::ground(-20.0, -20.0, 20.0, 20.0, 0.0)],
+        materials: vec![material],
+        objects: vec![Object {
+            mesh: 0,
+            material: 0,
+            local: glam::Mat4::IDENTITY,
+            motion: lightgrid::scene::Motion::Static,
+        }],
+        paths: vec![],
+        lights: lights
+            .into_iter()
+            .map(|light| SceneLight {
+                light,
+                anchor: lightgrid::scene::LightAnchor::World,
+            })
+            .collect(),
+        textures: vec![],
+        camera_path: CameraPath::fixed(eye, target, 40.0, 0.1, 100.0),
+        default_size: (64, 64),
+        lighting: Lighting {
+            units: LightUnits::Photometric,
+            brdf: Brdf::Ggx,
+            exposure: 1.0,
+        },
+    }
+}
+
+/// KHR_lights_punctual's falloff, by hand: a grey dielectric plane under one 30 cd light 2 m
+/// up (range 8): at ground points 2 to 7 m from the light, `forward` shows the spec's
+/// `I / d²` windowed by `clamp(1 − (d/r)⁴, 0, 1)²`, through glTF's BRDF, within one level.
+#[test]
+fn a_plane_under_one_photometric_light_falls_off_with_the_inverse_square() {
+    let ctx = common::gpu();
+    let eye = Vec3::new(0.0, 12.0, 6.0);
+    let (height, range, candela) = (2.0f32, 8.0f32, 30.0f32);
+    let mut material = Material::plain(Vec3::splat(0.6), 0.04, 30.0);
+    material.ambient = Vec3::ZERO;
+    let light = Light::point(Vec3::new(0.0, height, 0.0), Vec3::ONE, candela, range);
+    let scene = one_plane(material, vec![light], eye, Vec3::new(0.0, 0.0, -1.0));
+    let f = Frame::new(&scene, 0, (64, 64));
+    let mut r = Renderer::new(&ctx, 64, 64, RenderSettings::default()).unwrap();
+    let image = r.render(&scene, 0, "forward").unwrap().image;
+    let mut distances = Vec::new();
+    for py in (4..64).step_by(6) {
+        for px in (4..64).step_by(6) {
+            if f.reference(px, py, Model::Full).is_none() {
+                continue;
+            }
+            let d = f.ray(f64::from(px) + 0.5, f64::from(py) + 0.5);
+            let t = f64::from(eye.y) / -d.y;
+            let p = eye + (d * t).as_vec3();
+            let to_light = Vec3::new(0.0, height, 0.0) - p;
+            let dist = to_light.length();
+            let (l, v) = (to_light / dist, (eye - p).normalize());
+            let window = (1.0 - (dist / range).powi(4)).clamp(0.0, 1.0).powi(2);
+            let e = Vec3::splat(candela / (dist * dist) * window * l.y);
+            let (diffuse, specular) =
+                common::shading::ggx(Vec3::Y, v, l, l.y, 30.0, material.specular, e);
+            let by_hand = diffuse * material.diffuse + specular;
+            let want = display(by_hand);
+            let got = image.get_pixel(px, py).0;
+            for c in 0..3 {
+                assert!(
+                    got[c].abs_diff(want[c]) <= 1,
+                    "({px}, {py}) at {dist} m: forward {:?}, the spec {want:?}",
+                    &got[..3]
+                );
+            }
+            distances.push(dist);
+        }
+    }
+    let (near, far) = distances
+        .iter()
+        .fold((f32::MAX, 0f32), |(a, b), &d| (a.min(d), b.max(d)));
+    assert!(
+        distances.len() >= 20 && near < 3.0 && far > 6.0,
+        "{} points from {near} to {far} m",
+        distances.len()
+    );
+}
+
+/// The directional albedo of glTF's BRDF as the reference writes it: `∫ f (n·l) dω` over the
+/// hemisphere for view cosine `mu_v`, by a midpoint rule in (cos θ, φ).
+fn albedo(alpha: f32, mu_v: f32, f0: f32, diffuse: f32, n: usize) -> f32 {
+    let shininess = 2.0 / (alpha * alpha) - 2.0;
+    let v = Vec3::new((1.0 - mu_v * mu_v).sqrt(), 0.0, mu_v);
+    let mut sum = 0.0f64;
+    for i in 0..n {
+        let mu = (i as f32 + 0.5) / n as f32;
+        for j in 0..2 * n {
+            let phi = (j as f32 + 0.5) / (2 * n) as f32 * std::f32::consts::TAU;
+            let s = (1.0 - mu * mu).sqrt();
+            let l = Vec3::new(s * phi.cos(), s * phi.sin(), mu);
+            let (d, sp) =
+                common::shading::ggx(Vec3::Z, v, l, mu, shininess, Vec3::splat(f0), Vec3::splat(mu));
+            sum += f64::from((d * diffuse + sp).x);
+        }
+    }
+    (sum * std::f64::consts::TAU / (2 * n * n) as f64) as f32
+}
+
+/// A white furnace, on the GPU: a plane lit from 4,096 lights spread evenly in solid angle
+/// over its upper hemisphere (each standing for 2π/4096 sr of radiance 1) shows its
+/// directional albedo. For a mirror-white metal (F0 = 1) at roughness α = 1 single-scattering
+/// GGX loses energy by the model's known amount: seen from straight above the albedo is
+/// exactly 1 − ln 2 (D = 1/π, V = 1/(2(n·l + 1))); from 60° more. A white dielectric
+/// (F0 = 0.04, diffuse 1) stays at or below 1 there. `forward` must show what the integral
+/// says, within 3%, and never more light than arrived.
+#[test]
+fn ggx_neither_creates_nor_loses_energy_beyond_the_models_known_loss() {
+    // The reference's own furnace first: α = 1, seen from above.
+    let a = albedo(1.0, 0.9999, 1.0, 0.0, 400);
+    assert!(
+        (a - (1.0 - std::f32::consts::LN_2)).abs() < 0.003,
+        "{a} against 1 - ln 2"
+    );
+    for alpha in [0.1f32, 0.25, 0.5, 1.0] {
+        for mu_v in [1.0f32, 0.5, 0.2] {
+            let metal = albedo(alpha, mu_v.min(0.9999), 1.0, 0.0, 300);
+            assert!(metal <= 1.005, "metal α {alpha} μ {mu_v}: {metal}");
+            // Sharp lobes lose little; the loss grows with roughness.
+            if alpha <= 0.1 && mu_v > 0.4 {
+                assert!(metal > 0.95, "metal α {alpha} μ {mu_v}: {metal}");
+            }
+        }
+    }
+    let ctx = common::gpu();
+    let (n_mu, n_phi, radius) = (32usize, 128usize, 10.0f32);
+    let count = n_mu * n_phi;
+    let candela = std::f32::consts::TAU * radius * radius / count as f32;
+    let mut lights = Vec::new();
+    for i in 0..n_mu {
+        let mu = (i as f32 + 0.5) / n_mu as f32;
+        for j in 0..n_phi {
+            let phi = (j as f32 + 0.5) / n_phi as f32 * std::f32::consts::TAU;
+            let s = (1.0 - mu * mu).sqrt();
+            let dir = Vec3::new(s * phi.cos(), mu, s * phi.sin());
+            lights.push(Light::point(dir * radius, Vec3::ONE, candela, 1e4));
+        }
+    }
+    // Seen from nearly above (the camera is tilted 8°) and from 60°.
+    for (view_deg, f0, diffuse) in [(8.0f32, 1.0f32, 0.0f32), (60.0, 1.0, 0.0), (8.0, 0.04, 1.0)] {
+        let mut material = Material::plain(Vec3::splat(diffuse), f0, 0.0);
+        material.ambient = Vec3::ZERO;
+        let t = view_deg.to_radians();
+        let eye = Vec3::new(0.0, 3.0 * t.cos(), 3.0 * t.sin());
+        let scene = one_plane(material, lights.clone(), eye, Vec3::ZERO);
+        let mut r = Renderer::new(&ctx, 32, 32, RenderSettings::default()).unwrap();
+        let image = r.render(&scene, 0, "forward").unwrap().image;
+        // The centre pixel's radiance, back through sRGB and the tone curve.
+        let level = f32::from(image.get_pixel(16, 16).0[0]) / 255.0;
+        let linear = if level <= 0.04045 {
+            level / 12.92
+        } else {
+            ((level + 0.055) / 1.055).powf(2.4)
+        };
+        let got = -(1.0 - linear).ln();
+        let want = albedo(1.0, t.cos(), f0, diffuse, 300);
+        eprintln!("view {view_deg}°, F0 {f0}, diffuse {diffuse}: forward {got}, albedo {want}");
+        assert!(
+            (got - want).abs() <= 0.03 * want,
+            "view {view_deg}°: forward shows {got}, the albedo is {want}"
+        );
+        assert!(got <= 1.01, "more light out than in: {got}");
+    }
+}
+
+/// A scene made for another engine (100 boxes, 1,024 lights of 4,000 cd with range 6)
+/// renders as pools of light, not white: with the automatic exposure, under 5 % of the frame
+/// saturates (any channel at 250 or more) and its mean luminance is between 0.08 and 0.5 of
+/// white, and `forward` equals the reference there.
+#[test]
+fn a_gltf_scene_made_for_another_engine_renders_pools_of_light() {
+    let ctx = common::gpu();
+    let bytes = common::gltf_fixture::engine_street(1024).glb();
+    let opts = lightgrid::scene::gltf::LoadOptions::default();
+    let scene = lightgrid::scene::gltf::load_bytes(&bytes, "street.glb", None, &opts)
+        .unwrap()
+        .scene;
+    assert_eq!(scene.lighting.units, LightUnits::Photometric);
+    assert_eq!(scene.lighting.brdf, Brdf::Ggx);
+    let (w, h) = (320, 180);
+    let mut r = Renderer::new(&ctx, w, h, RenderSettings::default()).unwrap();
+    let image = r.render(&scene, 0, "forward").unwrap().image;
+    let pixels = image.pixels().count() as f32;
+    let saturated = image
+        .pixels()
+        .filter(|p| p.0[..3].iter().any(|&c| c >= 250))
+        .count() as f32
+        / pixels;
+    let luminance = image
+        .pixels()
+        .map(|p| {
+            let c = p.0.map(|c| f32::from(c) / 255.0);
+            0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+        })
+        .sum::<f32>()
+        / pixels;
+    eprintln!(
+        "exposure {}: saturated {saturated}, mean luminance {luminance}",
+        scene.lighting.exposure
+    );
+    lightgrid::image_io::save_png(&image, &common::output_dir().join("engine-street.png")).unwrap();
+    assert!(saturated < 0.05, "{saturated} of the frame saturates");
+    assert!(
+        (0.08..=0.5).contains(&luminance),
+        "mean luminance {luminance}"
+    );
+    let c = check(&ctx, &scene, 0, (160, 96), 6);
+    assert!(c.pixels >= 100 && c.lit * 2 >= c.pixels, "{c:?}");
 }

@@ -12,8 +12,8 @@ pub mod targets;
 
 pub use settings::{
     validate_msaa, validate_sample_culling, validate_slices, validate_tile_size,
-    validate_zbin_culling, Assign, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat,
-    GridLists, LightLoop, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
+    validate_zbin_culling, Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction,
+    GBufferFormat, GridLists, LightLoop, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
     AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};

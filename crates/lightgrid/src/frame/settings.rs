@@ -38,6 +38,10 @@ pub struct RenderSettings {
     /// The light loop of grid pipelines (`--light-loop`).
     #[serde(default)]
     pub light_loop: LightLoop,
+    /// The light function's BRDF (`--brdf`); `None` (`auto`): the scene's own
+    /// (`scene::Lighting::brdf`: Blinn-Phong for the catalog, GGX for glTF files).
+    #[serde(default)]
+    pub brdf: Option<Brdf>,
 }
 
 /// How grid pipelines loop over a sample's lights (`--light-loop`; `culling/light_loop_*.wgsl`).
@@ -229,7 +233,7 @@ impl MaterialDraws {
     }
 }
 
-pub use crate::scene::SpotCull;
+pub use crate::scene::{Brdf, SpotCull};
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -248,6 +252,7 @@ impl Default for RenderSettings {
             depth_mask: DepthMask::Off,
             cell_box: CellBox::Off,
             light_loop: LightLoop::Lane,
+            brdf: None,
         }
     }
 }

@@ -9,7 +9,7 @@
 
 use super::PipelineInfo;
 use crate::frame::{
-    Assign, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop,
+    Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop,
     MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
 };
 
@@ -182,6 +182,22 @@ impl SettingValue for DepthReduction {
             DepthReduction::Subgroup => {
                 "registers, then one subgroup min/max (adapters with subgroups; tiled-shading §8)"
             }
+        }
+    }
+}
+
+/// `--brdf`: `auto` (`None`) renders each scene with the BRDF its materials were made for.
+impl SettingValue for Option<Brdf> {
+    const FLAG: &'static str = "brdf";
+    const VALUES: &'static [Self] = &[None, Some(Brdf::Phong), Some(Brdf::Ggx)];
+    fn name(self) -> &'static str {
+        self.map_or("auto", Brdf::name)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            None => "the scene's own: phong for the catalog's scenes (the papers' model), ggx for glTF files",
+            Some(Brdf::Phong) => "Blinn-Phong, as the papers shade",
+            Some(Brdf::Ggx) => "glTF's metallic-roughness BRDF: GGX, Smith height-correlated visibility, Schlick Fresnel, Lambert diffuse",
         }
     }
 }
@@ -441,6 +457,19 @@ pub const AXES: &[Axis] = &[
             Ok(())
         },
         label: |v| format!("{v} loop"),
+    },
+    Axis {
+        flag: "brdf",
+        column: "brdf",
+        help: "the BRDF of the one light function, in every pipeline",
+        values: values::<Option<Brdf>>,
+        applies: |_, _| true,
+        get: |s| SettingValue::name(s.brdf).to_string(),
+        set: |s, v| {
+            s.brdf = <Option<Brdf>>::parse(v)?;
+            Ok(())
+        },
+        label: |v| v.to_string(),
     },
 ];
 

@@ -27,7 +27,7 @@ fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
         specular += luminance(t.specular);
     }
     check_loop(i, frame.light_count);
-    let color = surface_base(s) + diffuse * s.diffuse + mono_specular(diffuse, specular) * s.specular;
+    let color = surface_base(s) + diffuse * s.diffuse + mono_specular(diffuse, specular) * specular_albedo(s);
     return lit(v.clip, color, frame.light_count);
 }
 

@@ -1,7 +1,8 @@
 //! `light_prepass` and `light_prepass_mono`: deferred lighting, as the blog
 //! (deferred-shading-vs-deferred-lighting) lays it out.
 //!
-//! 1. Attributes pass: geometry → normal + specular exponent (RGBA16F) and depth.
+//! 1. Attributes pass: geometry → normal + material index (RGBA16F) and depth; the
+//!    irradiance pass reads the material's exponent and, under GGX, its specular colour.
 //! 2. Irradiance pass (HDR-range targets, additive): a depth-stencil copy, then each light's
 //!    volume (classes in `light_volumes.rs`) adds its diffuse irradiance and specular
 //!    irradiance to two RGBA16F targets; `_mono` keeps only the specular luminance, in the
@@ -11,9 +12,9 @@
 //!
 //! MSAA (tiled-deferred-tricks, as `deferred`): every target holds each sample. After the
 //! copy a full-screen pass sets the stencil's edge bit on the pixels whose samples need
-//! irradiance of their own (`attributes_differ`: geometry against sky, another exponent,
-//! plane or normal; the attributes hold no material id and need none, see
-//! `light_prepass_attributes.wgsl`); every volume class is drawn per pixel where the bit is
+//! irradiance of their own (`attributes_differ`: geometry against sky, another exponent
+//! (under GGX another specular colour), plane or normal; another material alone is no edge,
+//! see `light_prepass_attributes.wgsl`); every volume class is drawn per pixel where the bit is
 //! clear (the irradiance at the pixel centre, written to every sample) and per sample where
 //! it is set. The copy is kept for pass 3, which draws the geometry twice on the same bit:
 //! per pixel elsewhere (sample 0's irradiance, which is every sample's), per sample on edge
@@ -808,7 +809,7 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
     let irr = irradiance_targets * TARGET_BYTES;
     let mut targets = vec![
         ("depth", DEPTH_BYTES),
-        ("attributes (normal, exponent)", TARGET_BYTES),
+        ("attributes (normal, material)", TARGET_BYTES),
         ("diffuse irradiance", TARGET_BYTES),
     ];
     if irradiance_targets == 2 {
@@ -839,7 +840,7 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
 pub(super) fn memory_tiled(settings: &RenderSettings) -> MemoryModel {
     let mut targets = vec![
         ("depth", DEPTH_BYTES),
-        ("attributes (normal, exponent)", TARGET_BYTES),
+        ("attributes (normal, material)", TARGET_BYTES),
         ("irradiance (diffuse, mono specular)", TARGET_BYTES),
         ("hdr", HDR_BYTES),
     ];

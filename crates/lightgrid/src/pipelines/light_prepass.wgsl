@@ -14,11 +14,14 @@
 // Entries with side effects force the early depth and stencil tests, so the per-sample
 // pipelines count only the samples the edge bit lets through.
 
-// --- 1. attributes: normal and specular exponent (depth goes to the depth target)
+// --- 1. attributes: normal and material index (depth goes to the depth target). The index
+// (exact in 16-bit floats up to MAX_MATERIALS, as in the G-buffer's normal) names the
+// exponent and, for GGX's per-light Fresnel, the specular colour F0: the irradiance pass
+// reads both from the material (`light_prepass_attributes.wgsl`).
 @fragment
 fn fs_attributes(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let s = surface_from_vertex(v, front);
-    return vec4<f32>(s.normal, s.shininess);
+    return vec4<f32>(s.normal, f32(s.material));
 }
 
 // --- 2. irradiance: group 2 = attributes + scene depth (light_prepass_attributes.wgsl)
@@ -132,13 +135,13 @@ fn shade(v: VertexOut, front: bool, i: u32) -> vec4<f32> {
     let p = vec2<u32>(v.clip.xy);
     let d = textureLoad(irr_diffuse, p, i).rgb;
     let sp = textureLoad(irr_specular, p, i).rgb;
-    return vec4<f32>(surface_base(s) + d * s.diffuse + sp * s.specular, 1.0);
+    return vec4<f32>(surface_base(s) + d * s.diffuse + sp * specular_albedo(s), 1.0);
 }
 
 fn shade_mono(v: VertexOut, front: bool, i: u32) -> vec4<f32> {
     let s = surface_from_vertex(v, front);
     let d = textureLoad(irr_diffuse, vec2<u32>(v.clip.xy), i);
-    return vec4<f32>(surface_base(s) + d.rgb * s.diffuse + mono_specular(d.rgb, d.a) * s.specular, 1.0);
+    return vec4<f32>(surface_base(s) + d.rgb * s.diffuse + mono_specular(d.rgb, d.a) * specular_albedo(s), 1.0);
 }
 
 // Per pixel (no edge; every pixel without MSAA): each sample holds the pixel's irradiance.

@@ -1,20 +1,36 @@
-// The light pre-pass's attributes (pass 1's normal + specular exponent and depth, each sample
+// The light pre-pass's attributes (pass 1's normal + material index and depth, each sample
 // with MSAA: `shader/msaa.wgsl`'s texture types) as read by its irradiance passes (group 2):
 // the light volumes' fragments (`light_prepass.wgsl`) and the tiled compute kernel
 // (`tiled_light_prepass.wgsl`).
 
-@group(2) @binding(0) var attr_normal_shininess: SampleTexture;
+@group(2) @binding(0) var attr_normal_material: SampleTexture;
 @group(2) @binding(1) var attr_depth: DepthTexture;
 
-// The surface the irradiance is computed at: sample `s` of pixel `p`'s normal and exponent,
-// at camera-relative `position`.
+fn attributes_material(a: vec4<f32>) -> Material {
+    return materials[u32(a.w + 0.5)];
+}
+
+// The surface the irradiance is computed at: sample `s` of pixel `p`'s normal, and its
+// material's exponent and specular colour (GGX's Fresnel F0; Blinn-Phong's irradiance does
+// not read it), at camera-relative `position`.
 fn attributes_surface_at(p: vec2<u32>, s: u32, position: vec3<f32>) -> Surface {
-    let a = textureLoad(attr_normal_shininess, p, s);
+    let a = textureLoad(attr_normal_material, p, s);
+    let m = attributes_material(a);
     var surface: Surface;
     surface.position = position;
     surface.normal = normalize(a.xyz);
-    surface.shininess = a.w;
+    surface.shininess = m.shininess;
+    surface.specular = m.specular;
     return surface;
+}
+
+// Do two samples' attributes give different irradiance from one light at one place: another
+// exponent, or under GGX another specular colour (its Fresnel is inside the irradiance).
+fn attributes_shade_differently(a: vec4<f32>, b: vec4<f32>) -> bool {
+    let ma = attributes_material(a);
+    let mb = attributes_material(b);
+    return ma.shininess != mb.shininess
+        || (frame.brdf == BRDF_GGX && any(ma.specular != mb.specular));
 }
 
 
@@ -32,11 +48,11 @@ fn attributes_sample_surface(p: vec2<u32>, s: u32, depth: f32) -> Surface {
 
 // The MSAA edge test over the attributes (`msaa_surfaces.wgsl`): do samples 0 (depth `d0`,
 // attributes `a0`) and `s` of pixel `p` need irradiance of their own? Geometry against sky,
-// another specular exponent, or another plane or normal. The attributes hold no material
-// id, and need none: the irradiance is a function of position, normal and exponent alone;
-// the materials' colours are applied by the shading pass, whose fragments cover exactly
-// their own triangle's samples, so two materials meeting in one plane with one exponent
-// read one irradiance correctly (the G-buffer's test marks such pixels only because it
+// another specular exponent (under GGX another specular colour), or another plane or normal.
+// Another material alone is no edge: the irradiance is a function of position, normal and
+// exponent (and GGX's F0) alone; the materials' diffuse colours are applied by the shading
+// pass, whose fragments cover exactly their own triangle's samples, so two materials meeting
+// in one plane with one exponent read one irradiance correctly (the G-buffer's test marks such pixels only because it
 // shades the material there too).
 fn attributes_differ(p: vec2<u32>, s: u32, d0: f32, a0: vec4<f32>) -> bool {
     let d = textureLoad(attr_depth, p, s);
@@ -46,14 +62,14 @@ fn attributes_differ(p: vec2<u32>, s: u32, d0: f32, a0: vec4<f32>) -> bool {
     if (is_background(d0)) {
         return false;
     }
-    let a = textureLoad(attr_normal_shininess, p, s);
-    return surfaces_differ(p, s, d0, a0.xyz, d, a.xyz, a.w != a0.w);
+    let a = textureLoad(attr_normal_material, p, s);
+    return surfaces_differ(p, s, d0, a0.xyz, d, a.xyz, attributes_shade_differently(a, a0));
 }
 
 // Is pixel `p` an MSAA edge (some sample differs from sample 0)? Never without MSAA.
 fn attributes_edge(p: vec2<u32>) -> bool {
     let d0 = textureLoad(attr_depth, p, 0);
-    let a0 = textureLoad(attr_normal_shininess, p, 0);
+    let a0 = textureLoad(attr_normal_material, p, 0);
     var edge = false;
     for (var s = 1u; s < SAMPLES; s = s + 1u) {
         edge = edge || attributes_differ(p, s, d0, a0);

@@ -293,6 +293,7 @@ impl Builder {
                 textures: Vec::new(),
                 camera_path,
                 default_size,
+                lighting: Default::default(),
             },
             rng: Rng::new(seed),
         }

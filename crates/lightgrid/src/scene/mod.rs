@@ -6,6 +6,7 @@
 mod camera;
 pub mod catalog;
 pub mod gltf;
+mod lighting;
 mod mesh;
 mod raster;
 mod rng;
@@ -14,6 +15,9 @@ mod view;
 
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
+pub use lighting::{
+    auto_exposure, light_exposure, Brdf, LightUnits, Lighting, AUTO_EXPOSURE_DISTANCE,
+};
 pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};
 pub use rng::Rng;
@@ -336,6 +340,12 @@ impl Light {
 
     /// The light as the GPU reads it (in camera-relative space: [`Self::relative_to`]).
     pub fn to_gpu(&self) -> GpuLight {
+        self.to_gpu_scaled(1.0)
+    }
+
+    /// [`Self::to_gpu`] with the radiance times `scale` (`Lighting::light_scale`: the
+    /// exposure and the BRDF's convention).
+    pub fn to_gpu_scaled(&self, scale: f32) -> GpuLight {
         let (direction, cos_outer, cos_inner) = match self.spot {
             None => (Vec3::ZERO, POINT_LIGHT_COS, POINT_LIGHT_COS),
             Some(s) => (s.direction, s.cos_outer, s.cos_inner),
@@ -343,7 +353,7 @@ impl Light {
         GpuLight {
             position: self.position.to_array(),
             range: self.range,
-            radiance: (self.color * self.intensity).to_array(),
+            radiance: (self.color * (self.intensity * scale)).to_array(),
             cos_inner,
             direction: direction.to_array(),
             cos_outer,
@@ -487,6 +497,8 @@ pub struct Scene {
     pub camera_path: CameraPath,
     /// Frame size used when the user gives none.
     pub default_size: (u32, u32),
+    /// Its lights' units, its materials' BRDF and its exposure (the catalog's: the papers').
+    pub lighting: Lighting,
 }
 
 /// The frame's geometry in world space: opaque triangles first (grouped by material shader),
@@ -793,6 +805,8 @@ impl Scene {
         for t in &self.textures {
             (t.width, t.height, &t.rgba).hash(&mut h);
         }
+        let l = self.lighting;
+        (l.units, l.brdf, l.exposure.to_bits()).hash(&mut h);
         h.finish()
     }
 

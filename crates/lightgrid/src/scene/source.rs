@@ -32,6 +32,9 @@ pub struct SceneRequest {
     /// `--camera N` (files only).
     pub camera: Option<usize>,
     pub add_lights: Option<AddLights>,
+    /// `--exposure`: replaces the scene's (`Lighting::exposure`; the catalog's is 1, a
+    /// file's automatic).
+    pub exposure: Option<f32>,
 }
 
 impl SceneRequest {
@@ -42,6 +45,7 @@ impl SceneRequest {
             params: SceneParams::default(),
             camera: None,
             add_lights: None,
+            exposure: None,
         }
     }
 
@@ -62,6 +66,9 @@ pub struct Opened {
 pub fn check(req: &SceneRequest) -> Result<()> {
     if let Some(add) = req.add_lights {
         check_add_lights(&add)?;
+    }
+    if let Some(e) = req.exposure {
+        check_exposure(e)?;
     }
     if req.is_file() {
         let p = &req.params;
@@ -93,6 +100,24 @@ pub fn check(req: &SceneRequest) -> Result<()> {
         }
         catalog::check_params(&req.spec, &req.params).map(|_| ())
     }
+}
+
+/// The largest `--exposure`: with lights at `LIGHT_LIMITS.max_radiance` a sum over every
+/// light stays finite in f32.
+pub const MAX_EXPOSURE: f32 = 1e6;
+
+/// A positive finite exposure up to [`MAX_EXPOSURE`].
+pub fn check_exposure(e: f32) -> Result<()> {
+    if !(e.is_finite() && e > 0.0 && e <= MAX_EXPOSURE) {
+        return Err(Error::invalid(
+            "--exposure",
+            format!(
+                "{} is not a positive number up to {MAX_EXPOSURE:e}",
+                super::show(e)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn check_add_lights(add: &AddLights) -> Result<()> {
@@ -167,6 +192,9 @@ pub fn open(req: &SceneRequest) -> Result<Opened> {
         add_lights(&mut scene, &add, p.seed)?;
     }
     make_spots(&mut scene, p.seed, p.spot_fraction);
+    if let Some(e) = req.exposure {
+        scene.lighting.exposure = e;
+    }
     if scene.lights.is_empty() && req.is_file() {
         return Err(Error::Gltf {
             path: req.spec.clone(),
@@ -199,6 +227,22 @@ pub fn bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
                     .map(move |p| m.transform_point3(*p))
             }),
     )
+}
+
+/// An added light's intensity in the scene's units: [`ADDED_LIGHT_INTENSITY`] in the papers'
+/// units; in a photometric scene the candela at which, at a quarter of its range and with the
+/// scene's exposure, a white surface facing it shows what the papers' light shows there
+/// (radiance 0.5 × (1 − 1/16)² under Blinn-Phong; `E · exposure / π` under GGX).
+fn added_intensity(lighting: &super::Lighting, range: f32) -> f32 {
+    match lighting.units {
+        super::LightUnits::Papers => ADDED_LIGHT_INTENSITY,
+        super::LightUnits::Photometric => {
+            let d = range * 0.25;
+            let papers = ADDED_LIGHT_INTENSITY * (1.0 - 0.0625f32).powi(2);
+            let window = (1.0 - 0.25f32.powi(4)).powi(2);
+            papers * std::f32::consts::PI * d * d / (lighting.exposure * window)
+        }
+    }
 }
 
 /// The box lights are scattered in: the scene's bounds with every side at least a tenth of
@@ -245,6 +289,7 @@ pub fn add_lights(scene: &mut Scene, add: &AddLights, seed: u64) -> Result<()> {
         .range
         .unwrap_or_else(|| default_added_range(lo, hi, add.count));
     let (lo, hi) = light_box(lo, hi);
+    let intensity = added_intensity(&scene.lighting, range);
     let mut rng = Rng::new(seed ^ 0xadd_11647);
     for _ in 0..add.count {
         let position = Vec3::new(
@@ -254,7 +299,7 @@ pub fn add_lights(scene: &mut Scene, add: &AddLights, seed: u64) -> Result<()> {
         );
         let color = random_light_color(&mut rng);
         scene.lights.push(SceneLight {
-            light: Light::point(position, color, ADDED_LIGHT_INTENSITY, range),
+            light: Light::point(position, color, intensity, range),
             anchor: LightAnchor::World,
         });
     }

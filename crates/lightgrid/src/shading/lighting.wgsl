@@ -15,8 +15,9 @@ struct Surface {
     material: u32,         // index into `materials` (its shader and paint)
 }
 
-// Diffuse and specular irradiance from one light, before the material colours multiply them.
-// The light pre-pass accumulates these two separately; everything else uses `shade_light`.
+// Diffuse and specular irradiance from one light, before the material colours multiply them:
+// the sample's colour is `diffuse * s.diffuse + specular * specular_albedo(s)`. The light
+// pre-pass accumulates these two separately; everything else uses `shade_light`.
 struct LightTerms {
     diffuse: vec3<f32>,
     specular: vec3<f32>,
@@ -30,6 +31,18 @@ fn range_falloff(dist_sq: f32, range: f32) -> f32 {
     return t * t;
 }
 
+// How a light's radiance falls off with distance, by the lights' units (`frame.falloff`,
+// scene/lighting.rs): the papers' window, or KHR_lights_punctual's inverse square with its
+// recommended window clamp(1 - (d/r)^4, 0, 1)^2, which also reaches exactly 0 at the range.
+fn distance_falloff(dist_sq: f32, range: f32) -> f32 {
+    if (frame.falloff == FALLOFF_INVERSE_SQUARE) {
+        let x = dist_sq / (range * range);
+        let t = saturate(1.0 - x * x);
+        return t * t / max(dist_sq, MIN_LIGHT_DISTANCE_SQ);
+    }
+    return range_falloff(dist_sq, range);
+}
+
 // A spot's angular window: 1 inside the inner cone, a smoothstep to exactly 0 at the outer
 // cone, 0 outside; 1 for a point light. `l` is the unit vector from the surface to the light.
 fn spot_falloff(light: Light, l: vec3<f32>) -> f32 {
@@ -39,8 +52,41 @@ fn spot_falloff(light: Light, l: vec3<f32>) -> f32 {
     return smoothstep(light.cos_outer, light.cos_inner, dot(-l, light.direction));
 }
 
-// Blinn-Phong from a point or spot light with a finite range. `view_dir` points from the
-// surface to the eye.
+const INV_PI: f32 = 0.318309886;
+
+// GGX's roughness from the material's Blinn-Phong exponent: alpha = sqrt(2 / (s + 2)), the
+// inverse of the glTF import's s = 2 / alpha^2 - 2 (scene/lighting.rs, `Brdf::Ggx`).
+fn ggx_alpha(shininess: f32) -> f32 {
+    return sqrt(2.0 / (max(shininess, 0.0) + 2.0));
+}
+
+// glTF 2.0's metallic-roughness BRDF (appendix B) for irradiance `e` arriving along `l`:
+// the Lambert term (1 - F) c_diff / pi and F * D * V, with the GGX distribution D, Smith's
+// height-correlated visibility V and Schlick's Fresnel F whose F0 is the specular colour
+// (the spec's fresnel_mix). The Fresnel term holds the specular colour, so `specular_albedo`
+// is 1 under GGX. Both terms depend on F0 per light, which keeps the light pre-pass's split
+// exact because its irradiance pass reads the material's F0 (`light_prepass_attributes.wgsl`):
+// the material's diffuse colour still multiplies the summed diffuse term afterwards.
+fn ggx_terms(s: Surface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32, e: vec3<f32>) -> LightTerms {
+    let h = normalize(l + view_dir);
+    let n_dot_v = saturate(dot(s.normal, view_dir));
+    let n_dot_h = saturate(dot(s.normal, h));
+    let v_dot_h = saturate(dot(view_dir, h));
+    let a = ggx_alpha(s.shininess);
+    let a2 = a * a;
+    let k = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    let d = a2 * INV_PI / (k * k);
+    let vis = 0.5 / (n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2)
+        + n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2));
+    let fresnel = s.specular + (vec3<f32>(1.0) - s.specular) * pow(1.0 - v_dot_h, 5.0);
+    var out: LightTerms;
+    out.diffuse = e * (vec3<f32>(1.0) - fresnel) * INV_PI;
+    out.specular = e * fresnel * (d * vis);
+    return out;
+}
+
+// The light's terms on the surface: Blinn-Phong or GGX (`frame.brdf`) from a point or spot
+// light with a finite range. `view_dir` points from the surface to the eye.
 fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     var out: LightTerms;
     out.diffuse = vec3<f32>(0.0);
@@ -56,17 +102,28 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     if (n_dot_l <= 0.0 || cone <= 0.0) {
         return out;
     }
-    let radiance = light.radiance * (range_falloff(dist_sq, light.range) * cone);
+    // Irradiance: the radiance is uploaded scaled by the exposure and the BRDF's convention
+    // (`Lighting::light_scale`).
+    let e = light.radiance * (distance_falloff(dist_sq, light.range) * cone * n_dot_l);
+    if (frame.brdf == BRDF_GGX) {
+        return ggx_terms(s, view_dir, l, n_dot_l, e);
+    }
     let h = normalize(l + view_dir);
     let n_dot_h = max(dot(s.normal, h), 0.0);
-    out.diffuse = radiance * n_dot_l;
-    out.specular = radiance * (pow(n_dot_h, s.shininess) * n_dot_l);
+    out.diffuse = e;
+    out.specular = e * pow(n_dot_h, s.shininess);
     return out;
+}
+
+// What the specular term is multiplied by: the specular colour under Blinn-Phong; 1 under
+// GGX, whose Fresnel term already holds it.
+fn specular_albedo(s: Surface) -> vec3<f32> {
+    return select(s.specular, vec3<f32>(1.0), frame.brdf == BRDF_GGX);
 }
 
 fn shade_light(s: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
     let t = light_terms(s, view_dir, light);
-    return t.diffuse * s.diffuse + t.specular * s.specular;
+    return t.diffuse * s.diffuse + t.specular * specular_albedo(s);
 }
 
 // Per-material shaders (tiled-forward-shading §4.7: each draw may have its own lighting

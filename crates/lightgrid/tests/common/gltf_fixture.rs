@@ -432,3 +432,52 @@ pub fn textured() -> GltfWriter {
     w.roots = roots;
     w
 }
+
+/// A scene written for another engine, as a user brings one: 100 boxes on a 60 m ground
+/// and `lights` point lights of 4,000 cd with range 6 (KHR_lights_punctual's units: candela,
+/// inverse-square), 0.5 to 2 m above the ground in seeded colours, metallic-roughness
+/// materials, a camera looking over the field.
+pub fn engine_street(lights: usize) -> GltfWriter {
+    let mut w = GltfWriter::default();
+    let ground_m = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8}}));
+    let box_m = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "metallicFactor": 0.2, "roughnessFactor": 0.5}}));
+    let ground = w.mesh(
+        &[
+            -30.0, 0.0, -30.0, 30.0, 0.0, -30.0, 30.0, 0.0, 30.0, -30.0, 0.0, 30.0,
+        ],
+        Some(&[0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0]),
+        Some(&[0, 2, 1, 0, 3, 2]),
+        Some(ground_m),
+        4,
+    );
+    let (cp, cn, ci) = cube();
+    let boxes = w.mesh(&cp, Some(&cn), Some(&ci), Some(box_m), 4);
+    let mut roots = vec![w.node(json!({"mesh": ground}))];
+    for i in 0..100 {
+        let (x, z) = ((i % 10) as f32 * 5.5 - 24.75, (i / 10) as f32 * 5.5 - 24.75);
+        roots.push(w.node(json!({"mesh": boxes, "translation": [x, 0.5, z]})));
+    }
+    // A small LCG: the same field every run.
+    let mut seed = 0x2545_f491_u32;
+    let mut next = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for _ in 0..lights {
+        let pos = [next() * 56.0 - 28.0, 0.5 + next() * 1.5, next() * 56.0 - 28.0];
+        let colour = [0.3 + 0.7 * next(), 0.3 + 0.7 * next(), 0.3 + 0.7 * next()];
+        let l = w.light(
+            json!({"type": "point", "color": colour, "intensity": 4000.0, "range": 6.0}),
+        );
+        roots.push(w.node(
+            json!({"translation": pos, "extensions": {"KHR_lights_punctual": {"light": l}}}),
+        ));
+    }
+    w.cameras.push(
+        json!({"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 1000000.0}}),
+    );
+    let q = Quat::from_rotation_x(-35f32.to_radians()).to_array();
+    roots.push(w.node(json!({"camera": 0, "translation": [0.0, 18.0, 34.0], "rotation": q})));
+    w.roots = roots;
+    w
+}

@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3};
 use lightgrid::consts::{
     EXPOSURE, MATERIAL_SHADER_CAR_PAINT, MATERIAL_SHADER_RIM, POINT_LIGHT_COS, SCENE_AMBIENT,
 };
-use lightgrid::scene::{Light, Material, Scene, Spot};
+use lightgrid::scene::{Brdf, Light, LightUnits, Material, Scene, Spot};
 use lightgrid::{RenderSettings, Renderer};
 
 /// The light model a `forward` variant implements.
@@ -62,10 +62,18 @@ pub struct Frame<'s> {
     tan_half_fov: f64,
     near: f64,
     size: (u32, u32),
+    /// The BRDF shaded with, and what each light's colour × intensity is multiplied by.
+    brdf: Brdf,
+    light_scale: f32,
 }
 
 impl<'s> Frame<'s> {
+    /// The frame as `forward` renders it with the scene's own BRDF (`--brdf auto`).
     pub fn new(scene: &'s Scene, frame: u32, size: (u32, u32)) -> Self {
+        Self::with_brdf(scene, frame, size, scene.lighting.brdf)
+    }
+
+    pub fn with_brdf(scene: &'s Scene, frame: u32, size: (u32, u32), brdf: Brdf) -> Self {
         let state = scene.frame(frame);
         let eye = state.camera.eye;
         let g = scene.geometry(&state);
@@ -104,6 +112,8 @@ impl<'s> Frame<'s> {
             tan_half_fov: (f64::from(c.fov_y) * 0.5).tan(),
             near: f64::from(c.near),
             size,
+            brdf,
+            light_scale: light_scale(scene, brdf),
         }
     }
 
@@ -270,11 +280,16 @@ impl<'s> Frame<'s> {
             if n_dot_l <= 0.0 || cone <= 0.0 {
                 continue;
             }
-            let window = (1.0 - dist_sq / (light.range * light.range)).clamp(0.0, 1.0);
-            let radiance = light.color * light.intensity * (window * window * cone);
-            let h = (l + view).normalize();
-            let d = radiance * n_dot_l;
-            let s = radiance * (normal.dot(h).max(0.0).powf(m.shininess) * n_dot_l);
+            let e = light.color
+                * (light.intensity * self.light_scale)
+                * (falloff(self.scene.lighting.units, dist_sq, light.range) * cone * n_dot_l);
+            let (d, s) = match self.brdf {
+                Brdf::Phong => {
+                    let h = (l + view).normalize();
+                    (e, e * normal.dot(h).max(0.0).powf(m.shininess))
+                }
+                Brdf::Ggx => ggx(normal, view, l, n_dot_l, m.shininess, specular, e),
+            };
             e_diffuse += d;
             e_specular += s;
             e_specular_lum += luminance(s);
@@ -286,8 +301,68 @@ impl<'s> Frame<'s> {
             _ => e_specular,
         };
         let base = m.emissive + m.ambient * SCENE_AMBIENT;
-        (base + e_diffuse * diffuse + specular_light * specular, lit)
+        // GGX's Fresnel holds the specular colour; Blinn-Phong multiplies by it.
+        let specular_albedo = match self.brdf {
+            Brdf::Phong => specular,
+            Brdf::Ggx => Vec3::ONE,
+        };
+        (
+            base + e_diffuse * diffuse + specular_light * specular_albedo,
+            lit,
+        )
     }
+}
+
+/// What a light's colour × intensity is multiplied by: the scene's exposure, and π between
+/// the papers' units (a white Blinn-Phong surface's radiance) and GGX's Lambert `c/π`.
+pub fn light_scale(scene: &Scene, brdf: Brdf) -> f32 {
+    let pi = std::f32::consts::PI;
+    let convention = match (scene.lighting.units, brdf) {
+        (LightUnits::Papers, Brdf::Phong) | (LightUnits::Photometric, Brdf::Ggx) => 1.0,
+        (LightUnits::Papers, Brdf::Ggx) => pi,
+        (LightUnits::Photometric, Brdf::Phong) => 1.0 / pi,
+    };
+    scene.lighting.exposure * convention
+}
+
+/// Distance falloff: the papers' window `(1 − d²/r²)²`, or KHR_lights_punctual's
+/// `clamp(1 − (d/r)⁴, 0, 1)² / d²` (the squared distance at least 1e-4).
+pub fn falloff(units: LightUnits, dist_sq: f32, range: f32) -> f32 {
+    let x = dist_sq / (range * range);
+    match units {
+        LightUnits::Papers => (1.0 - x).clamp(0.0, 1.0).powi(2),
+        LightUnits::Photometric => (1.0 - x * x).clamp(0.0, 1.0).powi(2) / dist_sq.max(1e-4),
+    }
+}
+
+/// glTF 2.0 appendix B, written from its formulas: for irradiance `e` (n·l included) from
+/// direction `l`, the diffuse irradiance `e (1 − F) / π` (times the diffuse colour by the
+/// caller: the spec's `fresnel_mix`) and the specular `e · F · D · V` with roughness
+/// `α = √(2 / (shininess + 2))`:
+/// D = α² / (π ((n·h)² (α² − 1) + 1)²),
+/// V = 0.5 / (n·l √((n·v)² (1 − α²) + α²) + n·v √((n·l)² (1 − α²) + α²)),
+/// F = F0 + (1 − F0)(1 − v·h)⁵.
+pub fn ggx(
+    n: Vec3,
+    v: Vec3,
+    l: Vec3,
+    n_dot_l: f32,
+    shininess: f32,
+    f0: Vec3,
+    e: Vec3,
+) -> (Vec3, Vec3) {
+    let pi = std::f32::consts::PI;
+    let h = (l + v).normalize();
+    let n_dot_v = n.dot(v).clamp(0.0, 1.0);
+    let n_dot_h = n.dot(h).clamp(0.0, 1.0);
+    let v_dot_h = v.dot(h).clamp(0.0, 1.0);
+    let a2 = 2.0 / (shininess.max(0.0) + 2.0);
+    let d = a2 / (pi * (n_dot_h * n_dot_h * (a2 - 1.0) + 1.0).powi(2));
+    let vis = 0.5
+        / (n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt()
+            + n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt());
+    let f = f0 + (Vec3::ONE - f0) * (1.0 - v_dot_h).powi(5);
+    (e * (Vec3::ONE - f) / pi, e * f * (d * vis))
 }
 
 /// Linear HDR to the display's 8-bit sRGB: the tone curve, then the sRGB encoding.
@@ -346,7 +421,8 @@ pub fn compare(f: &Frame, image: &image::RgbaImage, model: Model, step: u32, out
     }
 }
 
-/// Render `frame` of `scene` with each model's `forward` and [`compare`] it.
+/// Render `frame` of `scene` with each model's `forward` and [`compare`] it, with the scene's
+/// own BRDF.
 pub fn check(
     ctx: &lightgrid::gpu::GpuContext,
     scene: &Scene,
@@ -354,8 +430,24 @@ pub fn check(
     size: (u32, u32),
     step: u32,
 ) -> Checked {
-    let f = Frame::new(scene, frame, size);
-    let mut r = Renderer::new(ctx, size.0, size.1, RenderSettings::default()).unwrap();
+    check_brdf(ctx, scene, frame, size, step, None)
+}
+
+/// [`check`] with `--brdf` `brdf` (`None`: auto, the scene's own).
+pub fn check_brdf(
+    ctx: &lightgrid::gpu::GpuContext,
+    scene: &Scene,
+    frame: u32,
+    size: (u32, u32),
+    step: u32,
+    brdf: Option<Brdf>,
+) -> Checked {
+    let f = Frame::with_brdf(scene, frame, size, brdf.unwrap_or(scene.lighting.brdf));
+    let settings = RenderSettings {
+        brdf,
+        ..RenderSettings::default()
+    };
+    let mut r = Renderer::new(ctx, size.0, size.1, settings).unwrap();
     let mut out = Checked::default();
     for model in [Model::Full, Model::Mono, Model::MonoAlbedo] {
         let image = r.render(scene, frame, model.pipeline()).unwrap().image;

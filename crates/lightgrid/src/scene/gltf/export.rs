@@ -4,7 +4,9 @@
 //! `extras.lightgrid`, the frame's lights through KHR_lights_punctual with their ranges, and
 //! the frame's camera.
 
-use super::import::{candela_from_intensity, ExactMaterial};
+use super::import::ExactMaterial;
+use super::LIGHT_MATCH_FRACTION;
+use crate::scene::LightUnits;
 use super::{MAX_FILE_BYTES, MAX_JSON_BYTES, MAX_TRIANGLES, MAX_VERTICES};
 use crate::error::{Error, Result};
 use crate::scene::{bounds_of, Material, Mesh, Scene};
@@ -238,7 +240,7 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         let mut def = json!({
             "type": if l.spot.is_some() { "spot" } else { "point" },
             "color": unit(l.color),
-            "intensity": candela_from_intensity(l.intensity, l.range),
+            "intensity": candela(scene.lighting.units, l),
             "range": l.range,
             "extras": {"lightgrid": {"intensity": l.intensity, "color": l.color.to_array()}},
         });
@@ -296,6 +298,7 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         .collect();
     let mut root = json!({
         "asset": {"version": "2.0", "generator": "lightgrid export"},
+        "extras": {"lightgrid": {"lighting": scene.lighting}},
         "extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {"KHR_lights_punctual": {"lights": lights}},
         "scene": 0,
@@ -344,4 +347,20 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
     out.extend_from_slice(&data);
     Ok(out)
+}
+
+/// A light's glTF intensity in candela. A photometric scene's is its own; the papers' units
+/// have no inverse-square term, so their light is matched to `I / d²` at
+/// [`LIGHT_MATCH_FRACTION`] of the range, where the window is `(1 − f²)²`: another tool
+/// shows it about as bright there. (lightgrid reads its own files back from
+/// `extras.lightgrid`, exactly.)
+fn candela(units: LightUnits, l: &crate::scene::Light) -> f32 {
+    match units {
+        LightUnits::Photometric => l.intensity,
+        LightUnits::Papers => {
+            let d = l.range * LIGHT_MATCH_FRACTION;
+            let window = (1.0 - LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION).powi(2);
+            l.intensity * d * d * window
+        }
+    }
 }

@@ -1,16 +1,15 @@
 //! A parsed glTF document to a lightgrid [`Scene`]: the scene's node hierarchy walked once
 //! (cycles and nodes with two parents refused), every triangle primitive instanced as an
-//! object, materials mapped to the Blinn-Phong model, KHR_lights_punctual lights placed, and
-//! a camera path fitted to the scene.
+//! object, metallic-roughness materials mapped to the light function's terms (rendered with
+//! GGX by default), KHR_lights_punctual lights placed in their photometric units, and a
+//! camera path fitted to the scene.
 
 use super::json::{LightDef, MaterialDef, Node, Primitive};
 use super::read::{Document, Res};
-use super::{
-    LoadOptions, EXTENSIONS_READ, LIGHT_CUTOFF, LIGHT_MATCH_FRACTION, MAX_TRIANGLES, MAX_VERTICES,
-};
+use super::{LoadOptions, EXTENSIONS_READ, LIGHT_CUTOFF, MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::{
-    bounds_of, CameraPath, Light, LightAnchor, Material, MaterialShader, Mesh, Motion, Object,
-    Scene, SceneLight, Spot, Texture,
+    bounds_of, CameraPath, Light, LightAnchor, Lighting, Material, MaterialShader, Mesh, Motion,
+    Object, Scene, SceneLight, Spot, Texture,
 };
 use glam::{Mat4, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -679,23 +678,15 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
     Ok(())
 }
 
-/// Our intensity for a glTF light of `candela` and range `range`: the light function's
-/// window `(1 − (d/r)²)²` has no inverse-square falloff, so the two are matched at a quarter
-/// of the range (`LIGHT_MATCH_FRACTION`): there the file's light gives `I / d²`.
-pub(super) fn intensity_from_candela(candela: f32, range: f32) -> f32 {
-    let d = range * LIGHT_MATCH_FRACTION;
-    let window = (1.0 - LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION).powi(2);
-    candela / (d * d * window)
-}
-
-/// The inverse of [`intensity_from_candela`], for export.
-pub(super) fn candela_from_intensity(intensity: f32, range: f32) -> f32 {
-    let d = range * LIGHT_MATCH_FRACTION;
-    let window = (1.0 - LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION).powi(2);
-    intensity * d * d * window
-}
-
-fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<Option<Light>> {
+/// A file's light as lightgrid's, and whether the file gave its range. Its intensity stays
+/// in candela (the scene's lights are photometric: `Lighting::photometric`), unless the file
+/// lightgrid exported carries the exact intensity in its own units.
+fn map_light(
+    def: &LightDef,
+    index: usize,
+    world: Mat4,
+    walk: &mut Walk,
+) -> Res<Option<(Light, bool)>> {
     let what = format!("light {index}");
     let colour = Vec3::from(def.color.unwrap_or([1.0; 3]));
     let candela = def.intensity.unwrap_or(1.0);
@@ -766,7 +757,7 @@ fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<
     };
     let intensity = number("intensity")
         .filter(|v| *v >= 0.0)
-        .unwrap_or_else(|| intensity_from_candela(candela, range));
+        .unwrap_or(candela);
     let colour = exact
         .and_then(|v| v.get("color"))
         .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
@@ -812,15 +803,14 @@ fn map_light(def: &LightDef, index: usize, world: Mat4, walk: &mut Walk) -> Res<
             && (reason.starts_with("radiance") || reason.starts_with("intensity"));
         if derived {
             format!(
-                "{what}: {reason} (the intensity {} cd gives at range {})",
-                crate::scene::show(candela),
-                crate::scene::show(range)
+                "{what}: {reason} (from the intensity {} cd)",
+                crate::scene::show(candela)
             )
         } else {
             format!("{what}: {reason}")
         }
     })?;
-    Ok(Some(light))
+    Ok(Some((light, def.range.is_some())))
 }
 
 /// Where the camera path starts.
@@ -1061,17 +1051,23 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
             .get(li)
             .ok_or_else(|| format!("a node names light {li}, which does not exist"))?;
         if let Some(light) = map_light(def, li, world, &mut walk)? {
-            lights.push(SceneLight {
-                light,
-                anchor: LightAnchor::World,
-            });
+            lights.push(light);
         }
         if lights.len() > crate::consts::MAX_LIGHTS as usize {
             return Err(format!("more than {} lights", crate::consts::MAX_LIGHTS));
         }
     }
+    let exported = exported_lighting(doc, &mut walk);
+    let ranged: Vec<bool> = lights.iter().map(|(_, r)| *r).collect();
+    let lights = lights
+        .into_iter()
+        .map(|(light, _)| SceneLight {
+            light,
+            anchor: LightAnchor::World,
+        })
+        .collect();
     let (camera_path, default_size) = camera_path(doc, opts, &mut walk)?;
-    let scene = Scene {
+    let mut scene = Scene {
         name: name.to_string(),
         meshes: std::mem::take(&mut walk.meshes),
         materials,
@@ -1081,6 +1077,26 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         textures: textures.textures,
         camera_path,
         default_size,
+        lighting: exported.unwrap_or_else(Lighting::photometric),
     };
+    if exported.is_none() {
+        scene.lighting.exposure = crate::scene::auto_exposure(&scene, &ranged);
+    }
     Ok((scene, walk.finish_warnings()))
+}
+
+/// The lighting conventions a file lightgrid exported records (`extras.lightgrid.lighting`),
+/// if it is one: its lights then carry lightgrid's own intensities.
+fn exported_lighting(doc: &Document, walk: &mut Walk) -> Option<Lighting> {
+    let v = doc.root.extras.as_ref()?.get("lightgrid")?.get("lighting")?;
+    match Lighting::deserialize(v) {
+        Ok(l) if l.exposure.is_finite() && l.exposure > 0.0 => Some(l),
+        _ => {
+            walk.warn(
+                "extras.lightgrid.lighting is malformed; the file's lights are read as photometric"
+                    .to_string(),
+            );
+            None
+        }
+    }
 }

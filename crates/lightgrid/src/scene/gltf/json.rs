@@ -25,6 +25,9 @@ pub(super) struct Root {
     pub samplers: Vec<SamplerDef>,
     pub cameras: Vec<CameraDef>,
     pub extensions: Option<RootExtensions>,
+    /// `extras.lightgrid.lighting`: a scene lightgrid exported keeps its lighting
+    /// conventions (`scene::Lighting`).
+    pub extras: Option<serde_json::Value>,
 }
 
 #[derive(Deserialize, Default)]

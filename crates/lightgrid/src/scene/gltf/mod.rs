@@ -10,11 +10,14 @@
 //! colour's (`baseColorTexture`, PNG or JPEG) is loaded; the others are not read.
 //!
 //! Mapping rules (documented in README "glTF scenes"): metallic-roughness materials by
-//! `import::map_material`'s rule; KHR_lights_punctual point and spot lights keep their range,
-//! a light without one gets the distance where its inverse-square illuminance falls to
-//! [`LIGHT_CUTOFF`], and intensities are matched at [`LIGHT_MATCH_FRACTION`] of the range
-//! (`import::intensity_from_candela`). Files written by [`export`] carry lightgrid's exact
-//! material and light intensity in `extras.lightgrid`, so they load back unchanged.
+//! `import::map_material`'s rule, shaded with GGX unless `--brdf` says otherwise;
+//! KHR_lights_punctual point and spot lights keep their range and their intensity in candela
+//! with the inverse-square falloff (`scene::Lighting::photometric`, with the automatic
+//! exposure), and a light without a range gets the distance where its illuminance falls to
+//! [`LIGHT_CUTOFF`]. Files written by [`export`] carry lightgrid's exact material and light
+//! intensity in `extras.lightgrid` and the scene's lighting conventions at the root, so they
+//! load back unchanged; a catalog scene's papers-unit lights are written in candela matched
+//! at [`LIGHT_MATCH_FRACTION`] of the range.
 
 mod export;
 mod import;
@@ -36,9 +39,11 @@ pub const MAX_JSON_BYTES: u64 = 64 << 20;
 pub const MAX_VERTICES: u32 = 1 << 22;
 /// Most triangles read and baked.
 pub const MAX_TRIANGLES: u32 = 1 << 23;
-/// Illuminance (lux) at which a light without a range is cut off: range = √(I / cutoff).
+/// Illuminance (lux) at which a light without a range is cut off: range = √(I / cutoff). With
+/// the automatic exposure it is far below one display level (a 100 cd light read at 2 m:
+/// 0.02 lux shows 2.5e-4, a tenth of the darkest sRGB step).
 pub const LIGHT_CUTOFF: f32 = 0.02;
-/// Where along its range a glTF light's inverse-square falloff and lightgrid's window agree.
+/// Where along its range an exported papers-unit light and its inverse-square candela agree.
 pub const LIGHT_MATCH_FRACTION: f32 = 0.25;
 /// Extensions read (a file may require these).
 pub const EXTENSIONS_READ: &[&str] = &["KHR_lights_punctual"];

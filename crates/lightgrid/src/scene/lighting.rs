@@ -1,0 +1,277 @@
+//! How a scene's lights are measured and which BRDF its materials were made for
+//! ([`Lighting`]), and what the renderer uploads from that: each light's radiance times one
+//! factor ([`Lighting::light_scale`]), and the BRDF and falloff the one light function
+//! branches on (`shading/lighting.wgsl`, uniforms `brdf` and `falloff`).
+//!
+//! Two kinds of scenes meet here. The catalog reproduces the papers: Blinn-Phong, lights in
+//! the papers' own units with the smooth window `(1 − (d/r)²)²` and no inverse-square term
+//! (tiled-shading §1.1). A glTF file made for another engine means KHR_lights_punctual:
+//! point and spot intensity in candela, inverse-square falloff with `range` as a smooth
+//! cut-off (the specification's recommended window, `clamp(1 − (d/r)⁴, 0, 1)² / d²`), and the
+//! metallic-roughness material of glTF 2.0's appendix B (GGX, Smith height-correlated
+//! visibility, Schlick Fresnel, Lambert diffuse).
+
+use super::{Light, Rng, Scene};
+use glam::Vec3;
+
+/// The shading model of the one light function (`--brdf`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Brdf {
+    /// Blinn-Phong, as the papers shade: `kd (n·l) + ks (n·h)^s (n·l)` times the light.
+    Phong,
+    /// glTF's metallic-roughness BRDF: Lambert `(1 − F) c_diff / π` plus `F·D·V` with the
+    /// GGX distribution `D`, Smith height-correlated visibility `V` and Schlick's Fresnel `F`
+    /// (the material's specular colour is `F0`, its exponent `s` the roughness
+    /// `α = √(2 / (s + 2))`, the usual Blinn-Phong ↔ GGX correspondence the glTF import uses
+    /// the other way).
+    Ggx,
+}
+
+impl Brdf {
+    pub const ALL: [Brdf; 2] = [Brdf::Phong, Brdf::Ggx];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Brdf::Phong => "phong",
+            Brdf::Ggx => "ggx",
+        }
+    }
+
+    /// The uniform's value (`consts::BRDF_*`).
+    pub fn gpu(self) -> u32 {
+        match self {
+            Brdf::Phong => crate::consts::BRDF_PHONG,
+            Brdf::Ggx => crate::consts::BRDF_GGX,
+        }
+    }
+}
+
+/// What a light's colour × intensity means.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightUnits {
+    /// The papers' units: the light's radiance as a white diffuse surface facing it would
+    /// show it under Blinn-Phong, windowed by `(1 − (d/r)²)²` with no inverse-square term.
+    Papers,
+    /// KHR_lights_punctual's: luminous intensity in candela, illuminance `I / d²` windowed by
+    /// `clamp(1 − (d/r)⁴, 0, 1)²` (distances below [`MIN_LIGHT_DISTANCE_SQ`]'s root count as
+    /// it: a light inside a surface does not make it infinite).
+    ///
+    /// [`MIN_LIGHT_DISTANCE_SQ`]: crate::consts::MIN_LIGHT_DISTANCE_SQ
+    Photometric,
+}
+
+impl LightUnits {
+    /// The uniform's value (`consts::FALLOFF_*`).
+    pub fn falloff(self) -> u32 {
+        match self {
+            LightUnits::Papers => crate::consts::FALLOFF_WINDOW,
+            LightUnits::Photometric => crate::consts::FALLOFF_INVERSE_SQUARE,
+        }
+    }
+}
+
+/// A scene's lighting conventions: its lights' units, the BRDF its materials were made for
+/// (what `--brdf auto` renders), and the exposure that turns its light into display units.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Lighting {
+    pub units: LightUnits,
+    pub brdf: Brdf,
+    /// Multiplies every light's radiance before shading (`--exposure`): for photometric
+    /// scenes the display value of one lux on a white diffuse surface, times π.
+    pub exposure: f32,
+}
+
+impl Default for Lighting {
+    /// The catalog's: the papers' units and Blinn-Phong, exposure 1.
+    fn default() -> Self {
+        Lighting {
+            units: LightUnits::Papers,
+            brdf: Brdf::Phong,
+            exposure: 1.0,
+        }
+    }
+}
+
+/// Distance at which the automatic exposure reads a light without a range of its own: a
+/// room-scale two metres.
+pub const AUTO_EXPOSURE_DISTANCE: f32 = 2.0;
+
+impl Lighting {
+    /// A glTF file's: photometric lights, GGX, and exposure 1 until [`auto_exposure`] sets it.
+    pub fn photometric() -> Lighting {
+        Lighting {
+            units: LightUnits::Photometric,
+            brdf: Brdf::Ggx,
+            exposure: 1.0,
+        }
+    }
+
+    /// The factor each light's colour × intensity is multiplied by when uploaded, for shading
+    /// with `brdf`: the exposure, and π between the conventions. The papers' units are the
+    /// radiance a white Lambert surface facing the light shows under Blinn-Phong, whose
+    /// diffuse term `kd (n·l)` has no 1/π; GGX's Lambert term is `c_diff / π`, so under GGX
+    /// papers' lights are π times brighter as irradiance (a white surface looks the same in
+    /// both BRDFs), and photometric lights under Blinn-Phong are π times dimmer.
+    pub fn light_scale(&self, brdf: Brdf) -> f32 {
+        let convention = match (self.units, brdf) {
+            (LightUnits::Papers, Brdf::Phong) | (LightUnits::Photometric, Brdf::Ggx) => 1.0,
+            (LightUnits::Papers, Brdf::Ggx) => std::f32::consts::PI,
+            (LightUnits::Photometric, Brdf::Phong) => std::f32::consts::FRAC_1_PI,
+        };
+        self.exposure * convention
+    }
+}
+
+/// Probe points the automatic exposure reads, at most: fewer with many lights, so a
+/// million-light file costs about 2^24 light evaluations to open.
+const EXPOSURE_PROBES: usize = 256;
+
+/// The automatic exposure of a scene's photometric lights: the typical lit surface shows
+/// mid-grey. Probe points are drawn on the opaque surfaces at frame 0 (area-weighted,
+/// seeded); each sums the illuminance every light gives it (`I / d²`, the range window,
+/// `|n·l|`, a spot's cone; no occlusion), and a white Lambert surface at the median lit probe
+/// shows radiance 1/π, which the tone curve maps to 0.27 (sRGB level 143): pools of light
+/// keep room above and below, however many lights overlap. With no probe lit (lights away
+/// from every surface), [`light_exposure`] reads the lights alone. `ranged[i]`: whether
+/// light `i` had its own range in the file.
+pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
+    let lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
+    let probes = surface_probes(scene, (EXPOSURE_PROBES).min((1 << 24) / lights.len().max(1)).max(16));
+    let mut lit: Vec<f64> = probes
+        .iter()
+        .map(|&(p, n)| {
+            lights
+                .iter()
+                .filter(|l| l.reaches(p))
+                .map(|l| {
+                    let to = l.position - p;
+                    let d2 = to.length_squared();
+                    let x = f64::from(d2 / (l.range * l.range));
+                    let window = (1.0 - x * x).clamp(0.0, 1.0).powi(2);
+                    let cos = f64::from(n.dot(to / d2.sqrt().max(1e-6)).abs());
+                    f64::from(l.intensity) * f64::from(luminance(l.color)) * window * cos
+                        / f64::from(d2.max(crate::consts::MIN_LIGHT_DISTANCE_SQ))
+                })
+                .sum::<f64>()
+        })
+        .filter(|e| e.is_finite() && *e > 0.0)
+        .collect();
+    if lit.is_empty() {
+        let with: Vec<(Light, bool)> = lights
+            .iter()
+            .zip(ranged.iter().chain(std::iter::repeat(&true)))
+            .map(|(l, r)| (*l, *r))
+            .collect();
+        return light_exposure(&with);
+    }
+    lit.sort_by(f64::total_cmp);
+    (1.0 / lit[lit.len() / 2]).clamp(1e-12, 1e6) as f32
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// Up to `n` points with their unit normals on the scene's opaque surfaces at frame 0,
+/// area-weighted, from a fixed seed.
+fn surface_probes(scene: &Scene, n: usize) -> Vec<(Vec3, Vec3)> {
+    let g = scene.geometry(&scene.frame(0));
+    let tris: Vec<[Vec3; 3]> = g.indices[..g.opaque_indices]
+        .chunks_exact(3)
+        .map(|t| [0, 1, 2].map(|k| Vec3::from(g.vertices[t[k] as usize].position)))
+        .collect();
+    let mut cumulative = Vec::with_capacity(tris.len());
+    let mut total = 0.0f64;
+    for [a, b, c] in &tris {
+        total += f64::from((*b - *a).cross(*c - *a).length() * 0.5);
+        cumulative.push(total);
+    }
+    if !(total > 0.0 && total.is_finite()) {
+        return Vec::new();
+    }
+    let mut rng = Rng::new(0xe4_905e);
+    (0..n)
+        .filter_map(|_| {
+            let at = f64::from(rng.unit()) * total;
+            let i = cumulative.partition_point(|&c| c < at).min(tris.len() - 1);
+            let [a, b, c] = tris[i];
+            let (mut u, mut v) = (rng.unit(), rng.unit());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let n = (b - a).cross(c - a).try_normalize()?;
+            Some((a + (b - a) * u + (c - a) * v, n))
+        })
+        .collect()
+}
+
+/// The automatic exposure from the lights alone (`(light, has its own range)`): a white
+/// diffuse surface at half the range of the median light (by the illuminance it gives
+/// there; [`AUTO_EXPOSURE_DISTANCE`] for lights whose range was derived, not given) shows
+/// radiance 1/π: mid-grey, as [`auto_exposure`] puts its median probe.
+pub fn light_exposure(lights: &[(Light, bool)]) -> f32 {
+    let mut e: Vec<f64> = lights
+        .iter()
+        .map(|(l, ranged)| {
+            let d = if *ranged {
+                f64::from(l.range) * 0.5
+            } else {
+                f64::from(AUTO_EXPOSURE_DISTANCE)
+            };
+            // The window at half the range: (1 − (1/2)⁴)².
+            let window = if *ranged { (1.0f64 - 0.0625).powi(2) } else { 1.0 };
+            f64::from(l.intensity) * f64::from(luminance(l.color)) * window / (d * d)
+        })
+        .filter(|e| e.is_finite() && *e > 0.0)
+        .collect();
+    if e.is_empty() {
+        return 1.0;
+    }
+    e.sort_by(f64::total_cmp);
+    (1.0 / e[e.len() / 2]).clamp(1e-12, 1e6) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn a_white_surface_looks_the_same_in_both_brdfs_of_one_scene() {
+        for units in [LightUnits::Papers, LightUnits::Photometric] {
+            let l = Lighting {
+                units,
+                brdf: Brdf::Phong,
+                exposure: 2.0,
+            };
+            // Phong's diffuse kd·E against GGX's kd/π·E.
+            let phong = l.light_scale(Brdf::Phong);
+            let ggx = l.light_scale(Brdf::Ggx) / std::f32::consts::PI;
+            assert!((phong - ggx).abs() < 1e-6, "{units:?}: {phong} {ggx}");
+        }
+        let photometric = Lighting::photometric();
+        assert_eq!(photometric.light_scale(Brdf::Ggx), photometric.exposure);
+    }
+
+    #[test]
+    fn without_a_lit_surface_the_median_light_at_half_its_range_shows_mid_grey() {
+        let light = |cd: f32, range: f32| Light::point(Vec3::ZERO, Vec3::ONE, cd, range);
+        // 4,000 cd, range 6: 4000 × 0.8789 / 9 lux at 3 m.
+        let e = light_exposure(&[(light(4000.0, 6.0), true)]);
+        let want = 9.0 / (4000.0 * 0.878_906_25);
+        assert!((e - want).abs() < want * 1e-5, "{e} {want}");
+        // The median, not the mean: one very bright light does not darken the rest.
+        let e3 = light_exposure(&[
+            (light(4000.0, 6.0), true),
+            (light(4000.0, 6.0), true),
+            (light(4e9, 6.0), true),
+        ]);
+        assert!((e3 - want).abs() < want * 1e-5);
+        // A range-less light is read at two metres.
+        let e = light_exposure(&[(light(100.0, 70.0), false)]);
+        assert!((e - 0.04).abs() < 1e-6, "{e}");
+        assert_eq!(light_exposure(&[]), 1.0);
+    }
+}
