@@ -267,6 +267,20 @@ fn every_msaa_pipeline_equals_forward_at_4x_on_robots_many() {
     render_all(&s, 0, (160, 90), msaa(16));
 }
 
+/// glTF's GGX and photometric lights (the fixture room: metal, glass, spots) with 4x MSAA:
+/// every edge-aware kernel and the light pre-pass's per-sample irradiance (whose edge test
+/// compares the specular colour under GGX) equal `forward`.
+#[test]
+fn every_msaa_pipeline_equals_forward_at_4x_on_a_gltf_file_with_ggx() {
+    use lightgrid::scene::gltf::{load_bytes, LoadOptions};
+    let bytes = common::gltf_fixture::room().glb();
+    let s = load_bytes(&bytes, "room.glb", None, &LoadOptions::default())
+        .unwrap()
+        .scene;
+    assert_eq!(s.lighting.brdf, lightgrid::scene::Brdf::Ggx);
+    render_all(&s, 30, (150, 94), msaa(16));
+}
+
 /// One dim or distant missing light fails every MSAA tolerance, while the pipeline rendered
 /// with the light passes. The deferred family's tolerance sees a missing light only off the
 /// edge pixels, where it shades forward's points: the dim light there (311 pixels over 4

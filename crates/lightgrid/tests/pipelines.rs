@@ -420,6 +420,17 @@ fn robots_many_tile_16() {
     check_scene("robots-many", 200, (160, 90), settings(16));
 }
 
+/// The catalog's street with glTF's GGX (`--brdf ggx`, the papers' units): every pipeline,
+/// the light pre-pass's split and the mono variants included, equals its reference.
+#[test]
+fn robots_many_with_ggx() {
+    let settings = RenderSettings {
+        brdf: Some(lightgrid::scene::Brdf::Ggx),
+        ..settings(16)
+    };
+    check_scene("robots-many", 200, (160, 90), settings);
+}
+
 #[test]
 fn deferred_stencil_culls_more_than_deferred_on_robots_many() {
     let ctx = common::gpu();
