@@ -111,6 +111,76 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
     }
 }
 
+/// The BRDFs side by side (`--brdf phong,ggx`): for each run measured with both, the cost of
+/// one light evaluation, as the slope of a least-squares line of GPU frame time against
+/// lighting computations over the frames (tiled-shading §8.2's fit, `claims::fit_cost`) and
+/// as the mean frame time per mean computation, and the frames' mean times.
+fn brdf_section(s: &mut String, results: &BenchResults, scene: &str) {
+    use lightgrid::scene::Brdf;
+    let runs: Vec<&RunRecord> = results
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.summary.is_some() && r.settings.brdf.is_some())
+        .collect();
+    let twin = |r: &RunRecord, brdf: Brdf| {
+        runs.iter().copied().find(|o| {
+            o.pipeline == r.pipeline
+                && o.settings.brdf == Some(brdf)
+                && lightgrid::RenderSettings {
+                    brdf: r.settings.brdf,
+                    ..o.settings
+                } == r.settings
+        })
+    };
+    let pairs: Vec<(&RunRecord, &RunRecord)> = runs
+        .iter()
+        .filter(|r| r.settings.brdf == Some(Brdf::Phong))
+        .filter_map(|r| Some((*r, twin(r, Brdf::Ggx)?)))
+        .collect();
+    if pairs.is_empty() {
+        return;
+    }
+    s.push_str("
+### The BRDFs: one light evaluation, Blinn-Phong against GGX
+
+ns per lighting computation: the slope of GPU frame time against lighting computations over the frames (least squares), and the mean frame time over the mean count (constant work included).
+
+| pipeline | Blinn-Phong ns (fit) | GGX ns (fit) | fit ratio | Blinn-Phong ns (mean) | GGX ns (mean) | avg ms Blinn-Phong / GGX |
+|---|---|---|---|---|---|---|
+");
+    let cost = |r: &RunRecord| {
+        let frames: Option<Vec<(f64, f64)>> = r
+            .frames
+            .iter()
+            .map(|f| Some((f.stats.lighting_computations? as f64, f.stats.gpu_ms)))
+            .collect();
+        let fit = frames.as_deref().and_then(crate::claims::fit_cost);
+        let m = r.summary.as_ref().expect("filtered");
+        let mean = m
+            .lighting_computations
+            .map(|c| m.gpu_ms.mean * 1e6 / c.mean.max(1.0));
+        (fit.map(|(_, b)| b * 1e6), mean, m.gpu_ms.mean)
+    };
+    let show = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.1}"));
+    for (phong, ggx) in pairs {
+        let (pf, pm, pms) = cost(phong);
+        let (gf, gm, gms) = cost(ggx);
+        let ratio = match (pf, gf) {
+            (Some(p), Some(g)) if p > 0.0 => format!("{:.2}x", g / p),
+            _ => "n/a".into(),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {ratio} | {} | {} | {pms:.2} / {gms:.2} |",
+            run_name(phong).replace(" [phong]", ""),
+            show(pf),
+            show(gf),
+            show(pm),
+            show(gm)
+        );
+    }
+}
+
 /// Test (b) of the spot culling over the scene's frames, when it was measured.
 fn spot_ray_section(s: &mut String, results: &BenchResults, scene: &str) {
     let tests: Vec<_> = results
@@ -704,6 +774,7 @@ fn summary(results: &BenchResults) -> String {
         }
         spot_ray_section(&mut s, results, scene);
         msaa_section(&mut s, results, scene);
+        brdf_section(&mut s, results, scene);
         s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };

@@ -6,7 +6,7 @@ use crate::args::{
 };
 use anyhow::Result;
 use clap::Args;
-use lightgrid::frame::{Assign, CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve};
+use lightgrid::frame::{Assign, Brdf, CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
@@ -65,6 +65,11 @@ pub(crate) enum Preset {
     /// 0..259 every 20, at the papers' size (640x360 on a software adapter): lighting
     /// computations against the ideal, assignment time and grid memory per grid.
     Culling,
+    /// The BRDFs (`--brdf phong,ggx`): forward, tiled and clustered forward and deferred, and
+    /// the light pre-pass (its irradiance split) on robots-many without its glass, frames
+    /// 0..259 every 20, at the papers' size (640x360 on a software adapter): the cost of one
+    /// light evaluation in each, and the frame times side by side.
+    Brdf,
 }
 
 #[derive(Args)]
@@ -372,6 +377,22 @@ pub(crate) fn bench_config(
                 measure(&DepthMask::ALL),
                 measure(&CellBox::ALL),
             ],
+            size: Some(papers_size(hardware)),
+            tile: Some(16),
+            transparency: false,
+            ..study(hardware, |_| false)
+        },
+        Some(Preset::Brdf) => BenchDefaults {
+            pipelines: [
+                ids::FORWARD,
+                ids::TILED_FORWARD_PREZ,
+                ids::TILED_DEFERRED,
+                ids::CLUSTERED_FORWARD,
+                ids::LIGHT_PREPASS,
+            ]
+            .map(String::from)
+            .to_vec(),
+            settings: vec![measure(&[Some(Brdf::Phong), Some(Brdf::Ggx)])],
             size: Some(papers_size(hardware)),
             tile: Some(16),
             transparency: false,

@@ -1136,6 +1136,21 @@ fn light_values_out_of_bounds_are_refused_with_the_cause() {
         &render(&["--add-lights", "5", "--light-range", "1e-30"]),
         "--light-range: 1e-30 is outside 1e-6",
     );
+    // The exposure: zero, negative, NaN, past what keeps every light's sum finite.
+    for bad in ["0", "-1", "nan", "inf", "abc"] {
+        fails_with(
+            &render(&["--exposure", bad]),
+            "is not a positive number below 1e9",
+        );
+    }
+    fails_with(
+        &render(&["--exposure", "5e6"]),
+        "--exposure: 5e6 is not a positive number up to 1e6",
+    );
+    fails_with(
+        &render(&["--brdf", "lambert"]),
+        "'lambert' is not one of auto, phong, ggx",
+    );
 }
 
 #[test]
@@ -1263,7 +1278,7 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
         let o = lightgrid(&args);
         assert!(o.status.success(), "{args:?} refused: {}", stderr(&o));
         assert!(out.exists(), "{args:?} wrote no image");
-        // Every pipeline takes MSAA: nothing to refuse.
+        // Every pipeline takes MSAA and the BRDF: nothing to refuse.
         if let Some(other) = other {
             let needle = format!("{} does not apply to {}", axis.option(), other.id);
             let mut args = render(&["--pipeline", other.id, "--msaa", msaa]);
@@ -1276,7 +1291,11 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
                 "{args:?}: the refusal names no taker"
             );
         } else {
-            assert_eq!(axis.flag, "msaa", "only --msaa applies to every pipeline");
+            assert!(
+                ["msaa", "brdf"].contains(&axis.flag),
+                "only --msaa and --brdf apply to every pipeline, not {}",
+                axis.flag
+            );
         }
     }
 }

@@ -512,13 +512,13 @@ fn corpus() -> Vec<Case> {
             "gives no range lightgrid takes",
         ),
         (
-            "light intensity overflowing at a small range",
+            "light intensity past the radiance limit",
             |d, _| {
                 let l = &mut d["extensions"]["KHR_lights_punctual"]["lights"][0];
                 l["intensity"] = json!(1e30);
                 l["range"] = json!(1e-5);
             },
-            "cd gives at range",
+            "from the intensity 1e30 cd",
         ),
         (
             "light beyond the coordinate bound",

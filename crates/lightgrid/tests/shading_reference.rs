@@ -381,6 +381,8 @@ fn ggx_neither_creates_nor_loses_energy_beyond_the_models_known_loss() {
 fn a_gltf_scene_made_for_another_engine_renders_pools_of_light() {
     let ctx = common::gpu();
     let bytes = common::gltf_fixture::engine_street(1024).glb();
+    // Kept for trying it with the CLI (README, "Light units, BRDFs and exposure").
+    std::fs::write(common::output_dir().join("engine-street.glb"), &bytes).unwrap();
     let opts = lightgrid::scene::gltf::LoadOptions::default();
     let scene = lightgrid::scene::gltf::load_bytes(&bytes, "street.glb", None, &opts)
         .unwrap()

@@ -20,6 +20,7 @@ use lightgrid::frame::{CellBox, DepthBounds, DepthMask};
 use serde::Serialize;
 use tiled_forward_shading::*;
 use tiled_shading::*;
+pub(crate) use tiled_shading::fit_cost;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Verdict {
