@@ -1149,7 +1149,7 @@ fn light_values_out_of_bounds_are_refused_with_the_cause() {
     );
     fails_with(
         &render(&["--brdf", "lambert"]),
-        "'lambert' is not one of auto, phong, ggx",
+        "invalid value 'lambert' for '--brdf <brdf>'",
     );
 }
 
