@@ -1153,6 +1153,33 @@ fn light_values_out_of_bounds_are_refused_with_the_cause() {
     );
 }
 
+/// 256 slices of 4-pixel tiles at 2000x1200 is 38 million cells, whose bounds no storage
+/// binding of lavapipe holds: refused with the numbers and what to change, not a wgpu
+/// validation dump, and no image written.
+#[test]
+fn a_grid_larger_than_the_device_binds_is_refused() {
+    let dir = temp_dir("huge-grid");
+    let out = dir.join("g.png");
+    let args = [
+        "render",
+        "--scene",
+        "robots-few",
+        "--pipeline",
+        "clustered_forward",
+        "--slices",
+        "256",
+        "--tile",
+        "4",
+        "--size",
+        "2000x1200",
+        "--out",
+        s(&out),
+    ];
+    assert_fails_with(&args, "bytes of per-cell records, more than the");
+    assert!(!out.exists(), "an image was written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn export_refuses_what_its_import_cannot_read() {
     let dir = temp_dir("export-limit");

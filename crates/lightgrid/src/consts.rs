@@ -265,8 +265,14 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("BRDF_PHONG", WgslConst::U32(BRDF_PHONG)),
     ("BRDF_GGX", WgslConst::U32(BRDF_GGX)),
     ("FALLOFF_WINDOW", WgslConst::U32(FALLOFF_WINDOW)),
-    ("FALLOFF_INVERSE_SQUARE", WgslConst::U32(FALLOFF_INVERSE_SQUARE)),
-    ("MIN_LIGHT_DISTANCE_SQ", WgslConst::F32(MIN_LIGHT_DISTANCE_SQ)),
+    (
+        "FALLOFF_INVERSE_SQUARE",
+        WgslConst::U32(FALLOFF_INVERSE_SQUARE),
+    ),
+    (
+        "MIN_LIGHT_DISTANCE_SQ",
+        WgslConst::F32(MIN_LIGHT_DISTANCE_SQ),
+    ),
     ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
     ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),

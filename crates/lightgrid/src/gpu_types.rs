@@ -82,10 +82,8 @@ pub struct FrameUniforms {
     /// 1: standard depth (0 at the near plane, cleared to 1), as a caller of
     /// `culling::LightCuller` may have; 0: lightgrid's reversed-Z (`depth.rs`).
     pub standard_depth: u32,
-    /// The light function's BRDF (`consts::BRDF_*`).
-    pub brdf: u32,
-    /// Its distance falloff (`consts::FALLOFF_*`): the lights' units.
-    pub falloff: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// The light grid's shape (`culling/light_grid.wgsl`). A tiled grid has one slice.

@@ -30,7 +30,7 @@ use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::base_textures::BaseTextures;
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
-use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, SpotCull};
+use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, Shading, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
@@ -156,6 +156,9 @@ pub struct Renderer {
     techniques: HashMap<&'static str, Box<dyn Technique>>,
     /// The transparent objects' pass after every technique (created with the first one).
     transparent: Option<TransparentPass>,
+    /// What the techniques' and the transparent pass's modules are made for: the scene's
+    /// lighting with `settings.brdf` (a new scene that changes it drops them, to be made again).
+    shading: Shading,
     settings: RenderSettings,
     dims: GridDims,
     readbacks: AnalysisReadbacks,
@@ -272,6 +275,7 @@ impl Renderer {
                 scene: None,
                 static_upload_bytes: 0,
                 techniques: HashMap::new(),
+                shading: Shading::default(),
                 transparent: None,
                 settings,
                 dims,
@@ -358,6 +362,7 @@ impl Renderer {
                 cull_layout: &self.cull_layout,
                 dims: self.dims,
                 settings: self.settings,
+                shading: self.shading,
                 count_blend: self.count_blend,
                 software_adapter: self.software_adapter,
             };
@@ -435,6 +440,12 @@ impl Renderer {
         self.indices.write(queue, 0, ib);
         self.materials.write(queue, 0, mb);
         self.static_upload_bytes = self.textures.bytes + (vb.len() + ib.len() + mb.len()) as u64;
+        let shading = Shading::of(&scene.lighting, self.settings.brdf);
+        if shading != self.shading {
+            self.techniques.clear();
+            self.transparent = None;
+            self.shading = shading;
+        }
         self.scene = Some(SceneUpload {
             scene,
             fingerprint: OnceLock::new(),
@@ -557,8 +568,8 @@ impl Renderer {
             .scene
             .as_ref()
             .map_or_else(Lighting::default, |s| s.scene.lighting);
-        let brdf = self.settings.brdf.unwrap_or(lighting.brdf);
-        let scale = lighting.light_scale(brdf);
+        // The BRDF the modules were made for (`upload_static` keeps it the scene's).
+        let scale = lighting.light_scale(self.shading.brdf);
         let relative: Vec<_> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
         let gpu_lights: Vec<GpuLight> = relative.iter().map(|l| l.to_gpu_scaled(scale)).collect();
         let bounds: Vec<[f32; 4]> = relative.iter().map(Light::bounds_gpu).collect();
@@ -586,8 +597,8 @@ impl Renderer {
             far: state.camera.far,
             spot_cull: u32::from(self.settings.spot_cull == SpotCull::Cone),
             standard_depth: 0,
-            brdf: brdf.gpu(),
-            falloff: lighting.units.falloff(),
+            _pad1: 0,
+            _pad2: 0,
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
         (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64

@@ -112,8 +112,8 @@ fn gpu_structs_match_wgsl() {
             far,
             spot_cull,
             standard_depth,
-            brdf,
-            falloff
+            _pad1,
+            _pad2
         ]
     );
 }

@@ -157,6 +157,23 @@ fn constants_come_from_the_prelude_not_typed_by_hand() {
     }
 }
 
+/// The light function's BRDF and falloff are written in when a module is made: a shader
+/// holding it compiles only specialized, so no pipeline can shade with a default by mistake.
+#[test]
+fn the_light_function_compiles_only_specialized() {
+    let forward = lightgrid::pipelines::find("forward").unwrap();
+    let shader = &(forward.shaders)()[0];
+    let raw = naga::front::wgsl::parse_str(&shader.source);
+    assert!(raw.is_err(), "an unspecialized module parsed");
+    for shading in lightgrid::scene::Shading::ALL {
+        let s = shader.specialized(shading);
+        assert!(
+            naga::front::wgsl::parse_str(&s.source).is_ok(),
+            "{shading:?}"
+        );
+    }
+}
+
 #[test]
 fn a_broken_shader_is_rejected() {
     let bad = lightgrid::shader::compose("bad", &["fn f() -> f32 { return undefined_name; }"]);
@@ -170,6 +187,7 @@ fn a_broken_shader_is_rejected() {
 fn fragment_shaders_writing_the_counters_force_the_early_depth_test() {
     let mut checked = 0;
     for s in all_shaders() {
+        let s = s.specialized(lightgrid::scene::Shading::default());
         let module = naga::front::wgsl::parse_str(&s.source).unwrap();
         let info = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),

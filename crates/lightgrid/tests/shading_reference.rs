@@ -299,8 +299,15 @@ fn albedo(alpha: f32, mu_v: f32, f0: f32, diffuse: f32, n: usize) -> f32 {
             let phi = (j as f32 + 0.5) / (2 * n) as f32 * std::f32::consts::TAU;
             let s = (1.0 - mu * mu).sqrt();
             let l = Vec3::new(s * phi.cos(), s * phi.sin(), mu);
-            let (d, sp) =
-                common::shading::ggx(Vec3::Z, v, l, mu, shininess, Vec3::splat(f0), Vec3::splat(mu));
+            let (d, sp) = common::shading::ggx(
+                Vec3::Z,
+                v,
+                l,
+                mu,
+                shininess,
+                Vec3::splat(f0),
+                Vec3::splat(mu),
+            );
             sum += f64::from((d * diffuse + sp).x);
         }
     }

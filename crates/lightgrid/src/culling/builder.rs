@@ -214,6 +214,7 @@ impl GridBuilder {
         });
         let assign = self.assign.resolve(f.light_count, self.software_adapter);
         let dims = self.strategy(f.device, assign)?.shape(dims, f.light_count);
+        self.bounds.check_capacity(f.device, &dims)?;
         if let Some(range) = &self.range {
             range.encode(
                 f,

@@ -1044,9 +1044,8 @@ impl Camera {
             far: i.far,
             spot_cull: u32::from(spot_cull == SpotCull::Cone),
             standard_depth: u32::from(self.standard_depth),
-            // The caller shades; the culling kernels read neither.
-            brdf: 0,
-            falloff: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 

@@ -9,6 +9,7 @@ use super::GridDims;
 use crate::frame::{FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::passes::geometry::{draw_scene, geometry_pipeline, GeometryPipelineDesc};
+use crate::scene::Shading;
 use crate::shader::{compose, create_module, src, ComposedShader, SCENE_PARTS};
 
 pub(crate) fn shader() -> ComposedShader {
@@ -35,7 +36,8 @@ impl FragmentBounds {
         samples: u32,
         forward_opaque: bool,
     ) -> Self {
-        let module = create_module(device, &shader());
+        // Fragment bounds evaluate no light: any shading compiles them alike.
+        let module = create_module(device, &shader().specialized(Shading::default()));
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             visibility: wgpu::ShaderStages::FRAGMENT,
             ..crate::gpu::buffer_entry(binding, ty)

@@ -7,6 +7,7 @@ use super::geometry::{draw_scene, geometry_pipeline, GeometryPipelineDesc};
 use super::Targets;
 use crate::frame::FrameInputs;
 use crate::gpu::PassTimer;
+use crate::scene::Shading;
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
 
 pub use crate::frame::GBufferFormat;
@@ -122,7 +123,8 @@ impl GBuffer {
                 })
             })
             .collect();
-        let module = create_module(device, &shader());
+        // The G-buffer pass evaluates no light: any shading compiles it alike.
+        let module = create_module(device, &shader().specialized(Shading::default()));
         let targets: Vec<Option<wgpu::ColorTargetState>> = views
             .iter()
             .map(|v| v.as_ref().map(|_| tf.into()))

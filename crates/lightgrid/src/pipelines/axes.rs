@@ -9,8 +9,8 @@
 
 use super::PipelineInfo;
 use crate::frame::{
-    Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop,
-    MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
+    Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
+    LightLoop, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
 };
 
 /// A setting's values by name (the option's values, the results' columns).

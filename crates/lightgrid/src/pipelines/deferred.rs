@@ -141,7 +141,12 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
         samples,
     );
     let volumes = LightVolumes::new(device, w, h, samples);
-    let module = create_module(device, &DeferredKey { layout, samples }.shader());
+    let module = create_module(
+        device,
+        &DeferredKey { layout, samples }
+            .shader()
+            .specialized(ctx.shading),
+    );
     let targets = volume_targets(ctx.count_blend, samples);
     let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
     let volume = |label: &str, fragment_entry, draw, shading| {

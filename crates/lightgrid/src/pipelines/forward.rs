@@ -37,7 +37,7 @@ pub(super) fn create_mono_albedo(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique> {
-    let module = create_module(ctx.device, &shaders()[0]);
+    let module = create_module(ctx.device, &shaders()[0].specialized(ctx.shading));
     let pipelines = MaterialPipelines::new(
         ctx.device,
         &GeometryPipelineDesc {

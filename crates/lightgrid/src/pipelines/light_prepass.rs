@@ -438,7 +438,8 @@ fn tiled_irradiance(
             samples,
             light_loop: ctx.settings.light_loop,
         }
-        .shader(),
+        .shader()
+        .specialized(ctx.shading),
         "main",
         &[
             Some(ctx.scene_layout),
@@ -471,7 +472,12 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.msaa;
-    let module = create_module(device, &LightPrepassKey::new(samples).shader());
+    let module = create_module(
+        device,
+        &LightPrepassKey::new(samples)
+            .shader()
+            .specialized(ctx.shading),
+    );
     let attributes = geometry_pipeline(
         device,
         &GeometryPipelineDesc {

@@ -30,7 +30,7 @@ fn attributes_shade_differently(a: vec4<f32>, b: vec4<f32>) -> bool {
     let ma = attributes_material(a);
     let mb = attributes_material(b);
     return ma.shininess != mb.shininess
-        || (frame.brdf == BRDF_GGX && any(ma.specular != mb.specular));
+        || (SHADING_BRDF == BRDF_GGX && any(ma.specular != mb.specular));
 }
 
 

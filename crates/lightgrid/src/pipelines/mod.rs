@@ -31,6 +31,9 @@ pub struct PipelineContext<'a> {
     pub cull_layout: &'a wgpu::BindGroupLayout,
     pub dims: GridDims,
     pub settings: RenderSettings,
+    /// The BRDF and light units every module holding the light function is made for
+    /// (`ComposedShader::specialized`).
+    pub shading: crate::scene::Shading,
     /// The adapter can blend into the R32Float count target.
     pub count_blend: bool,
     /// A CPU-emulated adapter (lavapipe): `--assign auto` keeps assignment on the CPU.

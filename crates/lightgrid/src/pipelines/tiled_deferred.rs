@@ -380,7 +380,8 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         samples,
         light_loop: ctx.settings.light_loop,
     }
-    .shader();
+    .shader()
+    .specialized(ctx.shading);
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred shading",
@@ -462,7 +463,8 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
         samples,
         light_loop: crate::frame::LightLoop::Lane,
     }
-    .shader();
+    .shader()
+    .specialized(ctx.shading);
     let shading = compute_pipeline(
         ctx.device,
         "tiled deferred single kernel",

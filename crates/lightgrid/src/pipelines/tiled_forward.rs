@@ -49,7 +49,10 @@ enum Kind {
 }
 
 fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
-    let module = create_module(ctx.device, &shader(ctx.settings.light_loop));
+    let module = create_module(
+        ctx.device,
+        &shader(ctx.settings.light_loop).specialized(ctx.shading),
+    );
     let prepass = kind != Kind::Plain;
     let builder = LightCuller::for_renderer(
         &ctx.grid_setup(),

@@ -70,7 +70,10 @@ fn blended_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
 
 impl TransparentPass {
     pub fn new(ctx: &PipelineContext) -> Self {
-        let module = create_module(ctx.device, &shader(ctx.settings.light_loop));
+        let module = create_module(
+            ctx.device,
+            &shader(ctx.settings.light_loop).specialized(ctx.shading),
+        );
         // A GPU strategy (gather), so the frame still makes one submission and no readback,
         // over the opaque depth; one list per tile covering near..max.
         let own_grid = LightCuller::for_renderer(

@@ -1,7 +1,7 @@
 //! How a scene's lights are measured and which BRDF its materials were made for
 //! ([`Lighting`]), and what the renderer uploads from that: each light's radiance times one
-//! factor ([`Lighting::light_scale`]), and the BRDF and falloff the one light function
-//! branches on (`shading/lighting.wgsl`, uniforms `brdf` and `falloff`).
+//! factor ([`Lighting::light_scale`]), and the BRDF and falloff the one light function is
+//! made for ([`Shading`]: constants in `shading/lighting.wgsl`).
 //!
 //! Two kinds of scenes meet here. The catalog reproduces the papers: Blinn-Phong, lights in
 //! the papers' own units with the smooth window `(1 − (d/r)²)²` and no inverse-square term
@@ -38,7 +38,7 @@ impl Brdf {
         }
     }
 
-    /// The uniform's value (`consts::BRDF_*`).
+    /// The shaders' value (`consts::BRDF_*`).
     pub fn gpu(self) -> u32 {
         match self {
             Brdf::Phong => crate::consts::BRDF_PHONG,
@@ -63,11 +63,60 @@ pub enum LightUnits {
 }
 
 impl LightUnits {
-    /// The uniform's value (`consts::FALLOFF_*`).
+    /// The shaders' value (`consts::FALLOFF_*`).
     pub fn falloff(self) -> u32 {
         match self {
             LightUnits::Papers => crate::consts::FALLOFF_WINDOW,
             LightUnits::Photometric => crate::consts::FALLOFF_INVERSE_SQUARE,
+        }
+    }
+}
+
+/// What a pipeline's shaders are made for: the BRDF and the lights' units (their falloff).
+/// The one light function takes them as constants (`ComposedShader::specialized`), so a
+/// renderer makes its pipelines again when a scene or `--brdf` changes them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Shading {
+    pub brdf: Brdf,
+    pub units: LightUnits,
+}
+
+impl Default for Shading {
+    /// The catalog's: Blinn-Phong in the papers' units.
+    fn default() -> Self {
+        Shading {
+            brdf: Brdf::Phong,
+            units: LightUnits::Papers,
+        }
+    }
+}
+
+impl Shading {
+    /// Every combination (the shader tests validate each).
+    pub const ALL: [Shading; 4] = [
+        Shading {
+            brdf: Brdf::Phong,
+            units: LightUnits::Papers,
+        },
+        Shading {
+            brdf: Brdf::Ggx,
+            units: LightUnits::Papers,
+        },
+        Shading {
+            brdf: Brdf::Phong,
+            units: LightUnits::Photometric,
+        },
+        Shading {
+            brdf: Brdf::Ggx,
+            units: LightUnits::Photometric,
+        },
+    ];
+
+    /// A scene's shading with `--brdf` `brdf` (`None`: auto, the scene's own).
+    pub fn of(lighting: &Lighting, brdf: Option<Brdf>) -> Shading {
+        Shading {
+            brdf: brdf.unwrap_or(lighting.brdf),
+            units: lighting.units,
         }
     }
 }
@@ -138,7 +187,12 @@ const EXPOSURE_PROBES: usize = 256;
 /// light `i` had its own range in the file.
 pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
     let lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
-    let probes = surface_probes(scene, (EXPOSURE_PROBES).min((1 << 24) / lights.len().max(1)).max(16));
+    let probes = surface_probes(
+        scene,
+        (EXPOSURE_PROBES)
+            .min((1 << 24) / lights.len().max(1))
+            .max(16),
+    );
     let mut lit: Vec<f64> = probes
         .iter()
         .map(|&(p, n)| {
@@ -221,7 +275,11 @@ pub fn light_exposure(lights: &[(Light, bool)]) -> f32 {
                 f64::from(AUTO_EXPOSURE_DISTANCE)
             };
             // The window at half the range: (1 − (1/2)⁴)².
-            let window = if *ranged { (1.0f64 - 0.0625).powi(2) } else { 1.0 };
+            let window = if *ranged {
+                (1.0f64 - 0.0625).powi(2)
+            } else {
+                1.0
+            };
             f64::from(l.intensity) * f64::from(luminance(l.color)) * window / (d * d)
         })
         .filter(|e| e.is_finite() && *e > 0.0)

@@ -16,7 +16,7 @@ mod view;
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use lighting::{
-    auto_exposure, light_exposure, Brdf, LightUnits, Lighting, AUTO_EXPOSURE_DISTANCE,
+    auto_exposure, light_exposure, Brdf, LightUnits, Lighting, Shading, AUTO_EXPOSURE_DISTANCE,
 };
 pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};
@@ -862,10 +862,23 @@ impl Scene {
         self.validate_structure()
     }
 
-    /// What a renderer needs of a scene to bake it (`Renderer::set_scene`): every index in
+    /// What a renderer needs of a scene to bake it (`Renderer::set_scene`): an exposure within
+    /// `source::MAX_EXPOSURE`, every index in
     /// range (objects to meshes and materials, materials to textures, triangles to vertices),
     /// one normal and one UV per position, and the table sizes within the GPU's limits.
     pub fn validate_structure(&self) -> Result<()> {
+        let e = self.lighting.exposure;
+        if !(e.is_finite() && e > 0.0 && e <= source::MAX_EXPOSURE) {
+            return Err(Error::invalid(
+                "scene",
+                format!(
+                    "{}'s exposure {} is not a positive number up to {:e}",
+                    self.name,
+                    show(e),
+                    source::MAX_EXPOSURE
+                ),
+            ));
+        }
         if self.materials.len() > crate::consts::MAX_MATERIALS {
             return Err(Error::invalid(
                 "scene",

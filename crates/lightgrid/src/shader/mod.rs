@@ -12,6 +12,7 @@
 //! creation (`constants`); their names come from [`overrides`].
 
 use crate::consts::wgsl_prelude;
+use crate::scene::Shading;
 
 /// Shared WGSL sources, in the order a shader lists them.
 pub mod src {
@@ -303,7 +304,21 @@ pub fn validate_for(
     validate_source(&shader.name, &shader.source_for(early_depth_test))
 }
 
+/// Parse and validate, the light function in every [`Shading`] (each makes other code live);
+/// the module of the first.
 fn validate_source(name: &str, source: &str) -> Result<naga::Module, String> {
+    let mut first = None;
+    for shading in Shading::ALL {
+        let module = validate_one(name, &specialize(source, shading))?;
+        first.get_or_insert(module);
+        if !source.contains(SHADING_BRDF_VALUE) {
+            break;
+        }
+    }
+    Ok(first.expect("one at least"))
+}
+
+fn validate_one(name: &str, source: &str) -> Result<naga::Module, String> {
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| format!("{name}: {}", e.emit_to_string(source)))?;
     naga::valid::Validator::new(
@@ -315,11 +330,35 @@ fn validate_source(name: &str, source: &str) -> Result<naga::Module, String> {
     Ok(module)
 }
 
+/// The placeholders `lighting.wgsl` declares its BRDF and falloff with.
+const SHADING_BRDF_VALUE: &str = "SHADING_BRDF_VALUE";
+const SHADING_FALLOFF_VALUE: &str = "SHADING_FALLOFF_VALUE";
+
+fn specialize(source: &str, shading: Shading) -> String {
+    source
+        .replace(SHADING_BRDF_VALUE, &format!("{}u", shading.brdf.gpu()))
+        .replace(
+            SHADING_FALLOFF_VALUE,
+            &format!("{}u", shading.units.falloff()),
+        )
+}
+
 /// The attribute forward fragment shaders carry to keep early-Z although they may write the
 /// frame counters (a side effect that would otherwise move the depth test after shading).
 pub const EARLY_DEPTH_TEST: &str = "@early_depth_test(force)";
 
 impl ComposedShader {
+    /// The shader with the light function's BRDF and falloff written in (`lighting.wgsl`'s
+    /// `SHADING_BRDF` and `SHADING_FALLOFF`): every module holding the light function is made
+    /// from this, and one made without it does not compile. A shader without the light
+    /// function is unchanged.
+    pub fn specialized(&self, shading: Shading) -> ComposedShader {
+        ComposedShader {
+            name: self.name.clone(),
+            source: specialize(&self.source, shading),
+        }
+    }
+
     /// The source a device gets. The one edit that depends on the adapter rather than on a
     /// key: without `SHADER_EARLY_DEPTH_TEST` (a native-only feature: Vulkan, GLES 3.1+) the
     /// forced early depth test is dropped. The image is the same (no shader carrying it

@@ -1,6 +1,14 @@
 // The one light function. Every pipeline shades through `light_terms` / `shade_light`;
 // none has its own attenuation or BRDF.
 
+// The BRDF (BRDF_PHONG or BRDF_GGX) and the distance falloff (FALLOFF_WINDOW, the papers'
+// units, or FALLOFF_INVERSE_SQUARE, photometric) every light is shaded with, written in when a
+// pipeline's module is made (`ComposedShader::specialized`, from the renderer's resolved
+// `scene::Shading`): constants, so the light loop carries no branch, and no registers, for
+// the model a frame does not use. A module made without them does not compile.
+const SHADING_BRDF: u32 = SHADING_BRDF_VALUE;
+const SHADING_FALLOFF: u32 = SHADING_FALLOFF_VALUE;
+
 // A shading sample: everything the light function needs, wherever it came from
 // (interpolated vertex data or a G-buffer).
 struct Surface {
@@ -31,11 +39,11 @@ fn range_falloff(dist_sq: f32, range: f32) -> f32 {
     return t * t;
 }
 
-// How a light's radiance falls off with distance, by the lights' units (`frame.falloff`,
+// How a light's radiance falls off with distance, by the lights' units (`SHADING_FALLOFF`,
 // scene/lighting.rs): the papers' window, or KHR_lights_punctual's inverse square with its
 // recommended window clamp(1 - (d/r)^4, 0, 1)^2, which also reaches exactly 0 at the range.
 fn distance_falloff(dist_sq: f32, range: f32) -> f32 {
-    if (frame.falloff == FALLOFF_INVERSE_SQUARE) {
+    if (SHADING_FALLOFF == FALLOFF_INVERSE_SQUARE) {
         let x = dist_sq / (range * range);
         let t = saturate(1.0 - x * x);
         return t * t / max(dist_sq, MIN_LIGHT_DISTANCE_SQ);
@@ -85,7 +93,7 @@ fn ggx_terms(s: Surface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32, e: vec
     return out;
 }
 
-// The light's terms on the surface: Blinn-Phong or GGX (`frame.brdf`) from a point or spot
+// The light's terms on the surface: Blinn-Phong or GGX (`SHADING_BRDF`) from a point or spot
 // light with a finite range. `view_dir` points from the surface to the eye.
 fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     var out: LightTerms;
@@ -105,20 +113,21 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     // Irradiance: the radiance is uploaded scaled by the exposure and the BRDF's convention
     // (`Lighting::light_scale`).
     let e = light.radiance * (distance_falloff(dist_sq, light.range) * cone * n_dot_l);
-    if (frame.brdf == BRDF_GGX) {
-        return ggx_terms(s, view_dir, l, n_dot_l, e);
+    if (SHADING_BRDF == BRDF_GGX) {
+        out = ggx_terms(s, view_dir, l, n_dot_l, e);
+    } else {
+        let h = normalize(l + view_dir);
+        let n_dot_h = max(dot(s.normal, h), 0.0);
+        out.diffuse = e;
+        out.specular = e * pow(n_dot_h, s.shininess);
     }
-    let h = normalize(l + view_dir);
-    let n_dot_h = max(dot(s.normal, h), 0.0);
-    out.diffuse = e;
-    out.specular = e * pow(n_dot_h, s.shininess);
     return out;
 }
 
 // What the specular term is multiplied by: the specular colour under Blinn-Phong; 1 under
 // GGX, whose Fresnel term already holds it.
 fn specular_albedo(s: Surface) -> vec3<f32> {
-    return select(s.specular, vec3<f32>(1.0), frame.brdf == BRDF_GGX);
+    return select(s.specular, vec3<f32>(1.0), SHADING_BRDF == BRDF_GGX);
 }
 
 fn shade_light(s: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {

@@ -41,8 +41,8 @@ struct FrameUniforms {
     far: f32,
     spot_cull: u32,
     standard_depth: u32,     // 1: depth 0 at the near plane, 1 (the clear) at the far; 0: reversed-Z
-    brdf: u32,               // BRDF_PHONG or BRDF_GGX
-    falloff: u32,            // FALLOFF_WINDOW (the papers' units) or FALLOFF_INVERSE_SQUARE (photometric)
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct GridParams {

@@ -464,11 +464,14 @@ pub fn engine_street(lights: usize) -> GltfWriter {
         (seed >> 8) as f32 / (1u32 << 24) as f32
     };
     for _ in 0..lights {
-        let pos = [next() * 56.0 - 28.0, 0.5 + next() * 1.5, next() * 56.0 - 28.0];
+        let pos = [
+            next() * 56.0 - 28.0,
+            0.5 + next() * 1.5,
+            next() * 56.0 - 28.0,
+        ];
         let colour = [0.3 + 0.7 * next(), 0.3 + 0.7 * next(), 0.3 + 0.7 * next()];
-        let l = w.light(
-            json!({"type": "point", "color": colour, "intensity": 4000.0, "range": 6.0}),
-        );
+        let l =
+            w.light(json!({"type": "point", "color": colour, "intensity": 4000.0, "range": 6.0}));
         roots.push(w.node(
             json!({"translation": pos, "extensions": {"KHR_lights_punctual": {"light": l}}}),
         ));

@@ -6,9 +6,9 @@
 
 use super::import::ExactMaterial;
 use super::LIGHT_MATCH_FRACTION;
-use crate::scene::LightUnits;
 use super::{MAX_FILE_BYTES, MAX_JSON_BYTES, MAX_TRIANGLES, MAX_VERTICES};
 use crate::error::{Error, Result};
+use crate::scene::LightUnits;
 use crate::scene::{bounds_of, Material, Mesh, Scene};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};

@@ -755,9 +755,7 @@ fn map_light(
             .map(|v| v as f32)
             .filter(|v| v.is_finite())
     };
-    let intensity = number("intensity")
-        .filter(|v| *v >= 0.0)
-        .unwrap_or(candela);
+    let intensity = number("intensity").filter(|v| *v >= 0.0).unwrap_or(candela);
     let colour = exact
         .and_then(|v| v.get("color"))
         .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
@@ -1088,7 +1086,12 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
 /// The lighting conventions a file lightgrid exported records (`extras.lightgrid.lighting`),
 /// if it is one: its lights then carry lightgrid's own intensities.
 fn exported_lighting(doc: &Document, walk: &mut Walk) -> Option<Lighting> {
-    let v = doc.root.extras.as_ref()?.get("lightgrid")?.get("lighting")?;
+    let v = doc
+        .root
+        .extras
+        .as_ref()?
+        .get("lightgrid")?
+        .get("lighting")?;
     match Lighting::deserialize(v) {
         Ok(l) if l.exposure.is_finite() && l.exposure > 0.0 => Some(l),
         _ => {
