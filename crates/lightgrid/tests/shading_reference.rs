@@ -102,27 +102,8 @@ fn a_plane_under_one_light_has_the_radiance_worked_out_by_hand() {
     let (height, range, intensity) = (2.0f32, 5.0f32, 3.0f32);
     let material = Material::plain(Vec3::new(0.8, 0.5, 0.2), 0.25, 16.0);
     let light = Light::point(Vec3::new(0.0, height, 0.0), Vec3::ONE, intensity, range);
-    let scene = Scene {
-        name: "plane".into(),
-        meshes: vec![Mesh::ground(-20.0, -20.0, 20.0, 20.0, 0.0)],
-        materials: vec![material],
-        objects: vec![Object {
-            mesh: 0,
-            material: 0,
-            local: glam::Mat4::IDENTITY,
-            motion: lightgrid::scene::Motion::Static,
-        }],
-        paths: vec![],
-        lights: vec![SceneLight {
-            light,
-            anchor: lightgrid::scene::LightAnchor::World,
-        }],
-        textures: vec![],
-        // Looking down at the point under the light from above and to the side.
-        camera_path: CameraPath::fixed(EYE, Vec3::ZERO, 40.0, 0.1, 100.0),
-        default_size: (64, 64),
-        lighting: Default::default(),
-    };
+    // Looking down at the point under the light from above and to the side.
+    let scene = one_plane(material, vec![light], EYE, Vec3::ZERO, Lighting::default());
     let f = Frame::new(&scene, 0, (64, 64));
     let mut r = Renderer::new(&ctx, 64, 64, RenderSettings::default()).unwrap();
     let image = r.render(&scene, 0, "forward").unwrap().image;
@@ -203,7 +184,14 @@ fn forward_equals_the_ggx_reference_on_catalog_scenes() {
     assert!(c.pixels >= 150 && c.lit * 4 >= c.pixels, "{c:?}");
 }
 
-fn one_plane(material: Material, lights: Vec<Light>, eye: Vec3, target: Vec3) -> Scene {
+/// A 40 m ground of `material` under `lights`, seen from `eye`.
+fn one_plane(
+    material: Material,
+    lights: Vec<Light>,
+    eye: Vec3,
+    target: Vec3,
+    lighting: Lighting,
+) -> Scene {
     Scene {
         name: "plane".into(),
         meshes: vec![Mesh::ground(-20.0, -20.0, 20.0, 20.0, 0.0)],
@@ -225,13 +213,16 @@ fn one_plane(material: Material, lights: Vec<Light>, eye: Vec3, target: Vec3) ->
         textures: vec![],
         camera_path: CameraPath::fixed(eye, target, 40.0, 0.1, 100.0),
         default_size: (64, 64),
-        lighting: Lighting {
-            units: LightUnits::Photometric,
-            brdf: Brdf::Ggx,
-            exposure: 1.0,
-        },
+        lighting,
     }
 }
+
+/// Candela, inverse square and GGX, exposure 1: a glTF file's conventions, unscaled.
+const PHOTOMETRIC: Lighting = Lighting {
+    units: LightUnits::Photometric,
+    brdf: Brdf::Ggx,
+    exposure: 1.0,
+};
 
 /// KHR_lights_punctual's falloff, by hand: a grey dielectric plane under one 30 cd light 2 m
 /// up (range 8): at ground points 2 to 7 m from the light, `forward` shows the spec's
@@ -244,7 +235,13 @@ fn a_plane_under_one_photometric_light_falls_off_with_the_inverse_square() {
     let mut material = Material::plain(Vec3::splat(0.6), 0.04, 30.0);
     material.ambient = Vec3::ZERO;
     let light = Light::point(Vec3::new(0.0, height, 0.0), Vec3::ONE, candela, range);
-    let scene = one_plane(material, vec![light], eye, Vec3::new(0.0, 0.0, -1.0));
+    let scene = one_plane(
+        material,
+        vec![light],
+        eye,
+        Vec3::new(0.0, 0.0, -1.0),
+        PHOTOMETRIC,
+    );
     let f = Frame::new(&scene, 0, (64, 64));
     let mut r = Renderer::new(&ctx, 64, 64, RenderSettings::default()).unwrap();
     let image = r.render(&scene, 0, "forward").unwrap().image;
@@ -359,7 +356,7 @@ fn ggx_neither_creates_nor_loses_energy_beyond_the_models_known_loss() {
         material.ambient = Vec3::ZERO;
         let t = view_deg.to_radians();
         let eye = Vec3::new(0.0, 3.0 * t.cos(), 3.0 * t.sin());
-        let scene = one_plane(material, lights.clone(), eye, Vec3::ZERO);
+        let scene = one_plane(material, lights.clone(), eye, Vec3::ZERO, PHOTOMETRIC);
         let mut r = Renderer::new(&ctx, 32, 32, RenderSettings::default()).unwrap();
         let image = r.render(&scene, 0, "forward").unwrap().image;
         // The centre pixel's radiance, back through sRGB and the tone curve.
