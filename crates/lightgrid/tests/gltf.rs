@@ -1148,3 +1148,31 @@ fn loader_review_cases() {
     gltf::load(&path, &LoadOptions::default()).unwrap();
     assert!(t.elapsed() < Duration::from_secs(2), "{:?}", t.elapsed());
 }
+
+/// A file made for another engine keeps its photometric lights through lightgrid: loaded as
+/// candela with GGX and an automatic exposure, exported, and loaded back with the same
+/// lighting and the same intensities (the root's `extras.lightgrid.lighting`); a catalog
+/// scene's export keeps the papers' units and Blinn-Phong.
+#[test]
+fn photometric_lights_and_the_scenes_lighting_survive_export() {
+    use lightgrid::scene::{Brdf, LightUnits};
+    let scene = load(&common::gltf_fixture::engine_street(16).glb())
+        .unwrap()
+        .scene;
+    assert_eq!(scene.lighting.units, LightUnits::Photometric);
+    assert_eq!(scene.lighting.brdf, Brdf::Ggx);
+    assert!(scene.lighting.exposure > 0.0 && scene.lighting.exposure < 1.0);
+    assert!(scene.lights.iter().all(|l| l.light.intensity == 4000.0));
+    let bytes = gltf::export(&scene, 0, (160, 90)).unwrap();
+    let back = load(&bytes).unwrap().scene;
+    assert_eq!(back.lighting, scene.lighting);
+    let cd = |s: &Scene| -> Vec<f32> { s.lights.iter().map(|l| l.light.intensity).collect() };
+    assert_eq!(cd(&back), cd(&scene));
+    // A catalog scene's export keeps the papers' units and Blinn-Phong.
+    let robots = lightgrid::scene::catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let back = load(&gltf::export(&robots, 0, (160, 90)).unwrap())
+        .unwrap()
+        .scene;
+    assert_eq!(back.lighting, robots.lighting);
+    assert_eq!(back.lighting.brdf, Brdf::Phong);
+}
