@@ -160,6 +160,14 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
             ui.selectable_value(&mut draft.settings.msaa, n, format!("{n}x"));
         }
     });
+    ui.horizontal(|ui| {
+        use lightgrid::pipelines::SettingValue;
+        ui.label("BRDF");
+        for &b in <Option<lightgrid::scene::Brdf>>::VALUES {
+            ui.selectable_value(&mut draft.settings.brdf, b, b.name())
+                .on_hover_text(b.help());
+        }
+    });
     ui.add_enabled_ui(pipeline.is_some_and(|p| p.uses_gbuffer()), |ui| {
         ui.horizontal(|ui| {
             ui.label("G-buffer");

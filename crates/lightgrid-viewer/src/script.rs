@@ -28,6 +28,8 @@ pub enum Action {
     Spots(f32),
     Transparency(bool),
     AddLights(u32),
+    /// `brdf auto|phong|ggx` (`--brdf`).
+    Brdf(Option<lightgrid::scene::Brdf>),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -120,6 +122,14 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                 }
                 Action::AddLights(n)
             }
+            "brdf" => {
+                use lightgrid::pipelines::SettingValue;
+                let name = arg.ok_or_else(|| format!("'{step}': brdf needs auto, phong or ggx"))?;
+                Action::Brdf(
+                    <Option<lightgrid::scene::Brdf>>::parse(name)
+                        .map_err(|e| format!("'{step}': {e}"))?,
+                )
+            }
             "pause" => Action::Pause,
             "play" => Action::Play,
             "panel" => match arg {
@@ -172,6 +182,9 @@ mod tests {
                 Action::AddLights(300)
             ]
         );
+        let s = parse("brdf ggx; brdf auto").unwrap();
+        assert_eq!(s[0].action, Action::Brdf(Some(lightgrid::scene::Brdf::Ggx)));
+        assert_eq!(s[1].action, Action::Brdf(None));
     }
 
     #[test]
@@ -182,6 +195,8 @@ mod tests {
             "at 3",
             "fly away",
             "tile",
+            "brdf",
+            "brdf lambert",
             "tile -4",
             "tile NaN",
             "resize 300",

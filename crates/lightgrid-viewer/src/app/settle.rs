@@ -76,6 +76,7 @@ impl App {
             Action::Pipeline(id) => next.pipeline = pipelines::find(id)?.id.to_string(),
             Action::Tile(n) => next.settings.tile_size = *n,
             Action::Msaa(n) => next.settings.msaa = *n,
+            Action::Brdf(b) => next.settings.brdf = *b,
             Action::View(v) => next.view = *v,
             Action::Spots(f) => next.request.params.spot_fraction = *f,
             Action::Transparency(on) => next.request.params.transparency = *on,
