@@ -1170,9 +1170,33 @@ fn photometric_lights_and_the_scenes_lighting_survive_export() {
     assert_eq!(cd(&back), cd(&scene));
     // A catalog scene's export keeps the papers' units and Blinn-Phong.
     let robots = lightgrid::scene::catalog::build("robots-few", &SceneParams::default()).unwrap();
-    let back = load(&gltf::export(&robots, 0, (160, 90)).unwrap())
-        .unwrap()
-        .scene;
+    let glb = gltf::export(&robots, 0, (160, 90)).unwrap();
+    let back = load(&glb).unwrap().scene;
     assert_eq!(back.lighting, robots.lighting);
     assert_eq!(back.lighting.brdf, Brdf::Phong);
+    // An earlier lightgrid's export (no lighting record, lightgrid's own intensities) is
+    // still read in the papers' units, with a warning; with the intensities gone too, its
+    // candela are photometric.
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut doc: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let bin = glb[20 + json_len + 8..].to_vec();
+    doc.as_object_mut().unwrap().remove("extras");
+    let loaded = load(&GltfWriter::glb_of(&doc, &bin)).unwrap();
+    assert_eq!(loaded.scene.lighting, robots.lighting);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("earlier lightgrid")),
+        "{:?}",
+        loaded.warnings
+    );
+    for l in doc["extensions"]["KHR_lights_punctual"]["lights"]
+        .as_array_mut()
+        .unwrap()
+    {
+        l.as_object_mut().unwrap().remove("extras");
+    }
+    let loaded = load(&GltfWriter::glb_of(&doc, &bin)).unwrap();
+    assert_eq!(loaded.scene.lighting.units, LightUnits::Photometric);
 }

@@ -678,15 +678,24 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
     Ok(())
 }
 
-/// A file's light as lightgrid's, and whether the file gave its range. Its intensity stays
-/// in candela (the scene's lights are photometric: `Lighting::photometric`), unless the file
-/// lightgrid exported carries the exact intensity in its own units.
+/// A file's light as lightgrid's.
+struct MappedLight {
+    light: Light,
+    /// The file gave its range.
+    ranged: bool,
+    /// Its intensity is lightgrid's own, from `extras.lightgrid` (a file lightgrid exported).
+    exact: bool,
+}
+
+/// A file's light as lightgrid's. Its intensity stays in candela (the scene's lights are
+/// photometric: `Lighting::photometric`), unless the file lightgrid exported carries the
+/// exact intensity in its own units.
 fn map_light(
     def: &LightDef,
     index: usize,
     world: Mat4,
     walk: &mut Walk,
-) -> Res<Option<(Light, bool)>> {
+) -> Res<Option<MappedLight>> {
     let what = format!("light {index}");
     let colour = Vec3::from(def.color.unwrap_or([1.0; 3]));
     let candela = def.intensity.unwrap_or(1.0);
@@ -808,7 +817,11 @@ fn map_light(
             format!("{what}: {reason}")
         }
     })?;
-    Ok(Some((light, def.range.is_some())))
+    Ok(Some(MappedLight {
+        light,
+        ranged: def.range.is_some(),
+        exact: number("intensity").is_some_and(|v| v >= 0.0),
+    }))
 }
 
 /// Where the camera path starts.
@@ -1055,12 +1068,20 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
             return Err(format!("more than {} lights", crate::consts::MAX_LIGHTS));
         }
     }
-    let exported = exported_lighting(doc, &mut walk);
-    let ranged: Vec<bool> = lights.iter().map(|(_, r)| *r).collect();
+    let mut exported = exported_lighting(doc, &mut walk);
+    // A file an earlier lightgrid exported records no lighting, but every light carries
+    // lightgrid's own intensity: the papers' units and Blinn-Phong, as it was made.
+    if exported.is_none() && !lights.is_empty() && lights.iter().all(|l| l.exact) {
+        walk.warn(
+            "every light carries lightgrid's own intensity but the file records no lighting (an earlier lightgrid's export): read in the papers' units with Blinn-Phong".to_string(),
+        );
+        exported = Some(Lighting::default());
+    }
+    let ranged: Vec<bool> = lights.iter().map(|l| l.ranged).collect();
     let lights = lights
         .into_iter()
-        .map(|(light, _)| SceneLight {
-            light,
+        .map(|l| SceneLight {
+            light: l.light,
             anchor: LightAnchor::World,
         })
         .collect();
