@@ -149,12 +149,9 @@ ns per lighting computation: the slope of GPU frame time against lighting comput
 |---|---|---|---|---|---|---|
 ");
     let cost = |r: &RunRecord| {
-        let frames: Option<Vec<(f64, f64)>> = r
-            .frames
-            .iter()
-            .map(|f| Some((f.stats.lighting_computations? as f64, f.stats.gpu_ms)))
-            .collect();
-        let fit = frames.as_deref().and_then(crate::claims::fit_cost);
+        let fit = crate::claims::frame_costs(r)
+            .as_deref()
+            .and_then(crate::claims::fit_cost);
         let m = r.summary.as_ref().expect("filtered");
         let mean = m
             .lighting_computations

@@ -19,8 +19,8 @@ use forward_plus::*;
 use lightgrid::frame::{CellBox, DepthBounds, DepthMask};
 use serde::Serialize;
 use tiled_forward_shading::*;
-pub(crate) use tiled_shading::fit_cost;
 use tiled_shading::*;
+pub(crate) use tiled_shading::{fit_cost, frame_costs};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Verdict {

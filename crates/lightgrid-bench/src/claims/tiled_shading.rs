@@ -292,6 +292,15 @@ pub fn competitive(pipeline: &str, forward_ms: f64, deferred_ms: f64) -> (String
     )
 }
 
+/// A run's frames as (lighting computations, GPU ms), the points [`fit_cost`] fits; None
+/// where a frame has no count.
+pub fn frame_costs(run: &RunRecord) -> Option<Vec<(f64, f64)>> {
+    run.frames
+        .iter()
+        .map(|f| Some((f.stats.lighting_computations? as f64, f.stats.gpu_ms)))
+        .collect()
+}
+
 /// Least-squares line `ms = a + b × computations` over a run's frames: (a, b).
 pub fn fit_cost(frames: &[(f64, f64)]) -> Option<(f64, f64)> {
     if frames.len() < 3 {
@@ -327,13 +336,7 @@ pub fn four_times(prez: (f64, f64), deferred: (f64, f64)) -> (String, Verdict) {
 
 /// Claim 13: ms against lighting computations per frame, fitted for both.
 pub(super) fn prez_per_computation(r: &BenchResults, scene: &str) -> (String, Verdict) {
-    let series = |p: &str| -> Option<Vec<(f64, f64)>> {
-        find(r, scene, p, None)?
-            .frames
-            .iter()
-            .map(|f| Some((f.stats.lighting_computations? as f64, f.stats.gpu_ms)))
-            .collect()
-    };
+    let series = |p: &str| frame_costs(find(r, scene, p, None)?);
     match (
         series(ids::TILED_FORWARD_PREZ)
             .as_deref()

@@ -29,8 +29,6 @@ pub enum Brdf {
 }
 
 impl Brdf {
-    pub const ALL: [Brdf; 2] = [Brdf::Phong, Brdf::Ggx];
-
     pub fn name(self) -> &'static str {
         match self {
             Brdf::Phong => "phong",
@@ -63,6 +61,16 @@ pub enum LightUnits {
 }
 
 impl LightUnits {
+    /// The range window at `x` = (d / range)², as `distance_falloff` in `lighting.wgsl` applies
+    /// it (before the inverse square of photometric lights): the papers' `(1 − x)²`, or
+    /// KHR_lights_punctual's `clamp(1 − x², 0, 1)²`.
+    pub fn window(self, x: f64) -> f64 {
+        match self {
+            LightUnits::Papers => (1.0 - x).clamp(0.0, 1.0).powi(2),
+            LightUnits::Photometric => (1.0 - x * x).clamp(0.0, 1.0).powi(2),
+        }
+    }
+
     /// The shaders' value (`consts::FALLOFF_*`).
     pub fn falloff(self) -> u32 {
         match self {
@@ -193,7 +201,7 @@ pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
             .min((1 << 24) / lights.len().max(1))
             .max(16),
     );
-    let mut lit: Vec<f64> = probes
+    let lit: Vec<f64> = probes
         .iter()
         .map(|&(p, n)| {
             lights
@@ -202,26 +210,32 @@ pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
                 .map(|l| {
                     let to = l.position - p;
                     let d2 = to.length_squared();
-                    let x = f64::from(d2 / (l.range * l.range));
-                    let window = (1.0 - x * x).clamp(0.0, 1.0).powi(2);
+                    let window =
+                        LightUnits::Photometric.window(f64::from(d2 / (l.range * l.range)));
                     let cos = f64::from(n.dot(to / d2.sqrt().max(1e-6)).abs());
                     f64::from(l.intensity) * f64::from(luminance(l.color)) * window * cos
                         / f64::from(d2.max(crate::consts::MIN_LIGHT_DISTANCE_SQ))
                 })
                 .sum::<f64>()
         })
-        .filter(|e| e.is_finite() && *e > 0.0)
         .collect();
-    if lit.is_empty() {
+    median_exposure(lit).unwrap_or_else(|| {
         let with: Vec<(Light, bool)> = lights
             .iter()
             .zip(ranged.iter().chain(std::iter::repeat(&true)))
             .map(|(l, r)| (*l, *r))
             .collect();
-        return light_exposure(&with);
-    }
-    lit.sort_by(f64::total_cmp);
-    (1.0 / lit[lit.len() / 2]).clamp(1e-12, 1e6) as f32
+        light_exposure(&with)
+    })
+}
+
+/// The exposure that shows the median of the positive finite illuminances `e` as 1, or None
+/// without one.
+fn median_exposure(mut e: Vec<f64>) -> Option<f32> {
+    e.retain(|e| e.is_finite() && *e > 0.0);
+    e.sort_by(f64::total_cmp);
+    let median = *e.get(e.len() / 2)?;
+    Some((1.0 / median).clamp(1e-12, 1e6) as f32)
 }
 
 fn luminance(c: Vec3) -> f32 {
@@ -266,29 +280,20 @@ fn surface_probes(scene: &Scene, n: usize) -> Vec<(Vec3, Vec3)> {
 /// there; [`AUTO_EXPOSURE_DISTANCE`] for lights whose range was derived, not given) shows
 /// radiance 1/π: mid-grey, as [`auto_exposure`] puts its median probe.
 pub fn light_exposure(lights: &[(Light, bool)]) -> f32 {
-    let mut e: Vec<f64> = lights
+    let e = lights
         .iter()
         .map(|(l, ranged)| {
-            let d = if *ranged {
-                f64::from(l.range) * 0.5
+            // Half the range, where the window is (1 − (1/2)⁴)².
+            let (d, window) = if *ranged {
+                let half = f64::from(l.range) * 0.5;
+                (half, LightUnits::Photometric.window(0.25))
             } else {
-                f64::from(AUTO_EXPOSURE_DISTANCE)
-            };
-            // The window at half the range: (1 − (1/2)⁴)².
-            let window = if *ranged {
-                (1.0f64 - 0.0625).powi(2)
-            } else {
-                1.0
+                (f64::from(AUTO_EXPOSURE_DISTANCE), 1.0)
             };
             f64::from(l.intensity) * f64::from(luminance(l.color)) * window / (d * d)
         })
-        .filter(|e| e.is_finite() && *e > 0.0)
         .collect();
-    if e.is_empty() {
-        return 1.0;
-    }
-    e.sort_by(f64::total_cmp);
-    (1.0 / e[e.len() / 2]).clamp(1e-12, 1e6) as f32
+    median_exposure(e).unwrap_or(1.0)
 }
 
 #[cfg(test)]

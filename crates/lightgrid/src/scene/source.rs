@@ -237,10 +237,12 @@ fn added_intensity(lighting: &super::Lighting, range: f32) -> f32 {
     match lighting.units {
         super::LightUnits::Papers => ADDED_LIGHT_INTENSITY,
         super::LightUnits::Photometric => {
-            let d = range * 0.25;
-            let papers = ADDED_LIGHT_INTENSITY * (1.0 - 0.0625f32).powi(2);
-            let window = (1.0 - 0.25f32.powi(4)).powi(2);
-            papers * std::f32::consts::PI * d * d / (lighting.exposure * window)
+            // At a quarter of the range: (d / range)² = 1/16.
+            let d = f64::from(range) * 0.25;
+            let papers =
+                f64::from(ADDED_LIGHT_INTENSITY) * super::LightUnits::Papers.window(0.0625);
+            let window = super::LightUnits::Photometric.window(0.0625);
+            (papers * std::f64::consts::PI * d * d / (f64::from(lighting.exposure) * window)) as f32
         }
     }
 }

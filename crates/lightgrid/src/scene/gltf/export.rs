@@ -359,8 +359,8 @@ fn candela(units: LightUnits, l: &crate::scene::Light) -> f32 {
         LightUnits::Photometric => l.intensity,
         LightUnits::Papers => {
             let d = l.range * LIGHT_MATCH_FRACTION;
-            let window = (1.0 - LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION).powi(2);
-            l.intensity * d * d * window
+            let window = units.window(f64::from(LIGHT_MATCH_FRACTION * LIGHT_MATCH_FRACTION));
+            l.intensity * d * d * window as f32
         }
     }
 }
