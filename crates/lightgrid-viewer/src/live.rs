@@ -129,6 +129,7 @@ mod tests {
             overflowed,
             msaa_shading: None,
             fragments_off_bounds: 0,
+            shadow_rays: 0,
         }
     }
 

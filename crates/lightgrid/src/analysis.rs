@@ -216,6 +216,8 @@ pub(crate) struct AnalysisInput<'r> {
     pub wall_ms: f64,
     /// The technique resolved MSAA inside its kernel (wrote the display target itself).
     pub resolved_in_kernel: bool,
+    /// Lights lit without shadows (`--shadow-lights`).
+    pub unshadowed: u32,
 }
 
 /// Read the frame's copies back and compute its statistics.
@@ -349,6 +351,10 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             msaa: settings.msaa,
             msaa_shading: a.finished.msaa_shading,
             fragments_off_bounds: a.finished.fragments_off_bounds,
+            shadow_rays: (settings.shadows != crate::scene::Shadows::Off)
+                .then_some(a.finished.shadow_rays),
+            unshadowed_lights: (settings.shadows != crate::scene::Shadows::Off)
+                .then_some(a.unshadowed),
             msaa_resolve: a.finished.msaa_shading.map(|_| {
                 if a.resolved_in_kernel {
                     crate::frame::MsaaResolve::Kernel

@@ -108,8 +108,11 @@ pub const COUNTER_GEOMETRY_SAMPLES: u32 = 18;
 /// may miss lights (`grid_shade_fragment` in `light_grid.wgsl`): the frame is wrong when
 /// non-zero (the fragment-bounds pass keeps it zero).
 pub const COUNTER_OFF_BOUNDS_FRAGMENTS: u32 = 19;
+/// Shadow rays the light function cast (`--shadows rays`: one per shadow-casting light that
+/// would light a shaded sample).
+pub const COUNTER_SHADOW_RAYS: u32 = 20;
 /// Number of slots.
-pub const COUNTER_SLOTS: u32 = 20;
+pub const COUNTER_SLOTS: u32 = 21;
 
 /// MSAA sample counts lightgrid knows (`--msaa`); the adapter decides which it offers
 /// (`frame::msaa_counts`).
@@ -203,6 +206,19 @@ pub const FALLOFF_INVERSE_SQUARE: u32 = 1;
 /// file's metres, as Filament clamps it): a light touching a surface stays finite there.
 pub const MIN_LIGHT_DISTANCE_SQ: f32 = 1e-4;
 
+/// `scene::Shadows` as the light function's `SHADING_SHADOWS` (`shading/shadows.wgsl`).
+pub const SHADOWS_OFF: u32 = 0;
+pub const SHADOWS_RAYS: u32 = 1;
+/// Entries of a shadow ray's traversal stack: a balanced tree of 2^31 triangles needs 30
+/// (`shadows/bvh.rs`); the renderer refuses a deeper one.
+pub const SHADOW_STACK_DEPTH: u32 = 32;
+/// Most nodes one shadow ray's walk of one tree visits before it is counted as truncated.
+pub const SHADOW_MAX_STEPS: u32 = 1 << 20;
+/// Most triangles in a leaf (`shadows::bvh::LEAF_TRIANGLES`).
+pub const SHADOW_LEAF_TRIANGLES: u32 = 4;
+/// The root of an empty tree in the shadow buffer.
+pub const SHADOW_NO_TREE: u32 = u32::MAX;
+
 /// Workgroup edge of the full-screen compute passes (8×8 = 64 invocations).
 pub const SCREEN_WORKGROUP: u32 = 8;
 
@@ -274,6 +290,15 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
         WgslConst::F32(MIN_LIGHT_DISTANCE_SQ),
     ),
     ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
+    ("SHADOWS_OFF", WgslConst::U32(SHADOWS_OFF)),
+    ("SHADOWS_RAYS", WgslConst::U32(SHADOWS_RAYS)),
+    ("SHADOW_STACK_DEPTH", WgslConst::U32(SHADOW_STACK_DEPTH)),
+    ("SHADOW_MAX_STEPS", WgslConst::U32(SHADOW_MAX_STEPS)),
+    (
+        "SHADOW_LEAF_TRIANGLES",
+        WgslConst::U32(SHADOW_LEAF_TRIANGLES),
+    ),
+    ("SHADOW_NO_TREE", WgslConst::U32(SHADOW_NO_TREE)),
     ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
@@ -319,6 +344,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("COUNTER_SPILL_ARGS", WgslConst::U32(COUNTER_SPILL_ARGS)),
     ("COUNTER_ITEM_ARGS", WgslConst::U32(COUNTER_ITEM_ARGS)),
     ("COUNTER_SLOTS", WgslConst::U32(COUNTER_SLOTS)),
+    ("COUNTER_SHADOW_RAYS", WgslConst::U32(COUNTER_SHADOW_RAYS)),
     ("COUNTER_EDGE_PIXELS", WgslConst::U32(COUNTER_EDGE_PIXELS)),
     (
         "COUNTER_SHADED_SAMPLES",

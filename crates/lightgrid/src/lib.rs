@@ -22,6 +22,7 @@ pub mod realtime;
 mod renderer;
 pub mod scene;
 pub mod shader;
+pub mod shadows;
 pub mod stats;
 
 pub use analysis::FrameOutput;

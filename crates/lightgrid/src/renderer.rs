@@ -101,6 +101,25 @@ struct SceneUpload {
     static_indices: u32,
     /// The static geometry's runs of one material shader each.
     static_draws: Vec<Draw>,
+    /// With `--shadows rays`: the static triangles' hierarchy and shadow space.
+    shadows: Option<crate::shadows::StaticShadows>,
+}
+
+/// A tree a shadow ray's stack cannot walk is refused (the build's balanced trees reach that
+/// depth only past 2^31 triangles).
+fn check_shadow_tree(bvh: &crate::shadows::bvh::TriangleBvh) -> Result<()> {
+    let depth = bvh.depth();
+    if depth >= crate::consts::SHADOW_STACK_DEPTH {
+        return Err(Error::invalid(
+            "shadows",
+            format!(
+                "the shadow rays' hierarchy over {} triangles is {depth} levels deep; the shaders walk at most {}",
+                bvh.triangles.len(),
+                crate::consts::SHADOW_STACK_DEPTH - 1
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// What one frame uploaded.
@@ -117,6 +136,8 @@ struct Uploaded<'s> {
     static_vertices: u32,
     /// Bytes written to the GPU for this frame.
     upload_bytes: u64,
+    /// Lights lit without shadows with `--shadows` on (`--shadow-lights`).
+    unshadowed: u32,
 }
 
 /// Renders frames at one size on one device.
@@ -142,6 +163,11 @@ pub struct Renderer {
     materials: GrowBuffer,
     vertices: GrowBuffer,
     indices: GrowBuffer,
+    /// The shadow rays' buffer (`shading/shadows.wgsl`, group 0 binding 8): a header, the
+    /// static triangles' hierarchy (written once per scene: `shadow_static_written`), the
+    /// moving ones' and the casters (every frame). Two vec4s, never read, without shadows.
+    shadow_data: GrowBuffer,
+    shadow_static_written: bool,
     scene_bind_group: wgpu::BindGroup,
     /// The culling kernels' group 0 over the same buffers.
     cull_bind_group: wgpu::BindGroup,
@@ -241,13 +267,14 @@ impl Renderer {
             let materials = GrowBuffer::new(device, "materials", U::STORAGE, 1 << 12);
             let vertices = GrowBuffer::new(device, "vertices", U::VERTEX, 1 << 20);
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
+            let shadow_data = GrowBuffer::new(device, "shadow rays", U::STORAGE, 32);
             let counters = FrameCounters::new(device, MAX_PASSES);
             let textures = BaseTextures::new(device, &ctx.queue, &[]);
             let (scene_bind_group, cull_bind_group) = Self::bind_scene(
                 device,
                 [&scene_layout, &cull_layout],
                 &uniforms,
-                [&lights, &light_bounds, &materials],
+                [&lights, &light_bounds, &materials, &shadow_data],
                 [counters.buffer(), &targets.pixel_counts],
                 &textures,
             );
@@ -269,6 +296,8 @@ impl Renderer {
                 materials,
                 vertices,
                 indices,
+                shadow_data,
+                shadow_static_written: false,
                 scene_bind_group,
                 cull_bind_group,
                 textures,
@@ -302,7 +331,7 @@ impl Renderer {
         device: &wgpu::Device,
         [layout, cull_layout]: [&wgpu::BindGroupLayout; 2],
         uniforms: &wgpu::Buffer,
-        [lights, light_bounds, materials]: [&GrowBuffer; 3],
+        [lights, light_bounds, materials, shadow_data]: [&GrowBuffer; 4],
         [counters, pixel_counts]: [&wgpu::Buffer; 2],
         textures: &BaseTextures,
     ) -> (wgpu::BindGroup, wgpu::BindGroup) {
@@ -324,6 +353,7 @@ impl Renderer {
                 pixel_counts.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&textures.view),
                 wgpu::BindingResource::Sampler(&textures.sampler),
+                shadow_data.buffer.as_entire_binding(),
             ],
         );
         (scene, cull)
@@ -440,7 +470,13 @@ impl Renderer {
         self.indices.write(queue, 0, ib);
         self.materials.write(queue, 0, mb);
         self.static_upload_bytes = self.textures.bytes + (vb.len() + ib.len() + mb.len()) as u64;
-        let shading = Shading::of(&scene.lighting, self.settings.brdf);
+        let shading = Shading::of(&scene.lighting, self.settings.brdf, self.settings.shadows);
+        let shadows = (self.settings.shadows == crate::scene::Shadows::Rays)
+            .then(|| crate::shadows::StaticShadows::new(&scene));
+        if let Some(s) = &shadows {
+            check_shadow_tree(&s.bvh)?;
+        }
+        self.shadow_static_written = false;
         if shading != self.shading {
             self.techniques.clear();
             self.transparent = None;
@@ -452,6 +488,7 @@ impl Renderer {
             static_vertices: geometry.vertices.len() as u32,
             static_indices: geometry.indices.len() as u32,
             static_draws: geometry.draws,
+            shadows,
         });
         Ok(())
     }
@@ -469,6 +506,8 @@ impl Renderer {
         let mut upload_bytes = std::mem::take(&mut self.static_upload_bytes);
         let (bytes, frame_geometry) = self.upload_geometry(state)?;
         upload_bytes += bytes + self.upload_frame_data(state);
+        let (shadow_bytes, unshadowed) = self.upload_shadows(state, &frame_geometry)?;
+        upload_bytes += shadow_bytes;
         let upload = self.scene.as_ref().expect("checked above");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
         let (moving_opaque, moving_transparent) = frame_geometry.split_draws();
@@ -490,7 +529,57 @@ impl Renderer {
             static_vertices,
             state,
             upload_bytes,
+            unshadowed,
         })
+    }
+
+    /// With `--shadows rays`: the moving objects' hierarchy and the frame's shadow casters
+    /// (and the static hierarchy when the buffer is new). Returns the bytes written and the
+    /// lights lit unshadowed.
+    fn upload_shadows(&mut self, state: &FrameState, moving: &Geometry) -> Result<(u64, u32)> {
+        let upload = self.scene.as_ref().expect("checked by upload");
+        let Some(statics) = &upload.shadows else {
+            return Ok((0, 0));
+        };
+        let (width, height) = self.size();
+        let frame = crate::shadows::ShadowFrame::new(
+            statics,
+            moving,
+            upload.static_vertices,
+            &state.camera,
+            width as f32 / height as f32,
+            &state.lights,
+            self.settings.shadow_lights,
+        );
+        check_shadow_tree(&frame.moving)?;
+        let header = frame.header(statics);
+        let rest = frame.frame_data(statics);
+        let start = u64::from(statics.frame_start()) * 16;
+        let total = start + rest.len() as u64 * 16;
+        let (device, queue) = (&self.device.clone(), &self.queue.clone());
+        let mut bytes = 0;
+        if self.shadow_data.reserve(device, total) {
+            self.shadow_static_written = false;
+            self.rebind_scene();
+        }
+        let upload = self.scene.as_ref().expect("checked by upload");
+        let statics = upload.shadows.as_ref().expect("checked above");
+        if !self.shadow_static_written {
+            let data = statics.gpu_data();
+            self.shadow_data.write(
+                queue,
+                u64::from(crate::shadows::HEADER_VEC4S) * 16,
+                bytemuck::cast_slice(&data),
+            );
+            bytes += data.len() as u64 * 16;
+            self.shadow_static_written = true;
+        }
+        self.shadow_data
+            .write(queue, 0, bytemuck::cast_slice(&header));
+        self.shadow_data
+            .write(queue, start, bytemuck::cast_slice(&rest));
+        bytes += (header.len() + rest.len()) as u64 * 16;
+        Ok((bytes, frame.unshadowed() as u32))
     }
 
     /// A frame of `scene` as the caller describes it: the camera, the lights (count, NaN,
@@ -610,7 +699,12 @@ impl Renderer {
             &self.device,
             [&self.scene_layout, &self.cull_layout],
             &self.uniforms,
-            [&self.lights, &self.light_bounds, &self.materials],
+            [
+                &self.lights,
+                &self.light_bounds,
+                &self.materials,
+                &self.shadow_data,
+            ],
             [self.counters.buffer(), &self.targets.pixel_counts],
             &self.textures,
         );
@@ -725,6 +819,7 @@ impl Renderer {
                 geometry_samples: r.values.geometry_samples().into(),
             }),
             fragments_off_bounds: r.values.fragments_off_bounds().into(),
+            shadow_rays: r.values.shadow_rays().into(),
         })
     }
 
@@ -887,6 +982,7 @@ impl Renderer {
                 io,
                 reruns,
                 wall_ms,
+                unshadowed: up.unshadowed,
                 resolved_in_kernel: self
                     .techniques
                     .get(info.id)

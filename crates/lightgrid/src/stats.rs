@@ -77,6 +77,12 @@ pub struct FrameStats {
     /// non-zero count, so a written file always says 0.
     #[serde(default)]
     pub fragments_off_bounds: u64,
+    /// Shadow rays cast (`--shadows rays`; None without shadows).
+    #[serde(default)]
+    pub shadow_rays: Option<u64>,
+    /// Lights lit without shadows this frame (`--shadow-lights`; None without shadows).
+    #[serde(default)]
+    pub unshadowed_lights: Option<u32>,
     /// Where the MSAA deferred kernel resolved this frame: `kernel` (Trick 1) or `separate`
     /// (per-sample buffer, tonemap); None for other frames.
     #[serde(default)]

@@ -165,7 +165,7 @@ fn the_light_function_compiles_only_specialized() {
     let shader = &(forward.shaders)()[0];
     let raw = naga::front::wgsl::parse_str(&shader.source);
     assert!(raw.is_err(), "an unspecialized module parsed");
-    for shading in lightgrid::scene::Shading::ALL {
+    for shading in lightgrid::scene::Shading::all() {
         let s = shader.specialized(shading);
         assert!(
             naga::front::wgsl::parse_str(&s.source).is_ok(),

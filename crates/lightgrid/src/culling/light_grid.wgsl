@@ -42,9 +42,9 @@ fn zbin_count(cell: u32) -> u32 {
     return n;
 }
 
-// The light at position `i` of the cell's list.
-fn grid_light(cell: u32, i: u32) -> Light {
-    return lights[grid_indices[grid_cells[cell].x + i]];
+// The index (into `lights`) of the light at position `i` of the cell's list.
+fn grid_light(cell: u32, i: u32) -> u32 {
+    return grid_indices[grid_cells[cell].x + i];
 }
 
 // A forward fragment: its surface lit by the lights of `cell` (found at the fragment's pixel
@@ -69,7 +69,7 @@ fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> ve
 
 // One light's term in a loop's sum: the colour (rgb), or for the light pre-pass's monochrome
 // compromise the diffuse irradiance (rgb) and the specular luminance (a).
-fn light_sum(s: Surface, view_dir: vec3<f32>, light: Light, mono: bool) -> vec4<f32> {
+fn light_sum(s: Surface, view_dir: vec3<f32>, light: u32, mono: bool) -> vec4<f32> {
     if (mono) {
         let t = light_terms(s, view_dir, light);
         return vec4<f32>(t.diffuse, luminance(t.specular));

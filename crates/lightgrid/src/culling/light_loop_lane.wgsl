@@ -13,8 +13,7 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
         var bits = grid_zbin_word(z, k);
         listed += countOneBits(bits);
         for (; bits != 0u; bits = bits & (bits - 1u)) {
-            let light = lights[grid_indices[k * 32u + firstTrailingBit(bits)]];
-            acc += light_sum(s, view_dir, light, mono);
+            acc += light_sum(s, view_dir, grid_indices[k * 32u + firstTrailingBit(bits)], mono);
             shaded += 1u;
         }
     }

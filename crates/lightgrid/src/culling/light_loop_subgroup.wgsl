@@ -28,7 +28,7 @@ fn list_sum(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32>
             break;
         }
         if (mine == l) {
-            acc += light_sum(s, view_dir, lights[l], mono);
+            acc += light_sum(s, view_dir, l, mono);
             i += 1u;
         }
     }
@@ -58,7 +58,7 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
         for (var any = subgroupOr(mine); any != 0u; any = any & (any - 1u)) {
             let b = firstTrailingBit(any);
             if (((mine >> b) & 1u) != 0u) {
-                acc += light_sum(s, view_dir, lights[grid_indices[k * 32u + b]], mono);
+                acc += light_sum(s, view_dir, grid_indices[k * 32u + b], mono);
                 shaded += 1u;
             }
         }

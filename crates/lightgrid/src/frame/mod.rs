@@ -11,10 +11,10 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_msaa, validate_sample_culling, validate_slices, validate_tile_size,
-    validate_zbin_culling, Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction,
-    GBufferFormat, GridLists, LightLoop, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
-    AUTO_GATHER_MAX_LIGHTS,
+    validate_msaa, validate_sample_culling, validate_shadow_lights, validate_slices,
+    validate_tile_size, validate_zbin_culling, Assign, Brdf, CellBox, DepthBounds, DepthMask,
+    DepthReduction, GBufferFormat, GridLists, LightLoop, MaterialDraws, MsaaResolve,
+    RenderSettings, Shadows, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};
 
@@ -242,4 +242,6 @@ pub struct FinishedFrame {
     /// MSAA forward fragments whose shading point lay outside their cell's bounds, so their
     /// lists may have missed lights: the frame is wrong when non-zero.
     pub fragments_off_bounds: u64,
+    /// Shadow rays the light function cast (`--shadows rays`).
+    pub shadow_rays: u64,
 }

@@ -42,6 +42,13 @@ pub struct RenderSettings {
     /// (`scene::Lighting::brdf`: Blinn-Phong for the catalog, GGX for glTF files).
     #[serde(default)]
     pub brdf: Option<Brdf>,
+    /// How lights cast shadows (`--shadows`), in every pipeline.
+    #[serde(default)]
+    pub shadows: Shadows,
+    /// How many lights cast shadows (`--shadow-lights`): the most important this frame
+    /// (`crate::shadows`); `None`: every light.
+    #[serde(default)]
+    pub shadow_lights: Option<u32>,
 }
 
 /// How grid pipelines loop over a sample's lights (`--light-loop`; `culling/light_loop_*.wgsl`).
@@ -233,7 +240,7 @@ impl MaterialDraws {
     }
 }
 
-pub use crate::scene::{Brdf, SpotCull};
+pub use crate::scene::{Brdf, Shadows, SpotCull};
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -253,6 +260,8 @@ impl Default for RenderSettings {
             cell_box: CellBox::Off,
             light_loop: LightLoop::Lane,
             brdf: None,
+            shadows: Shadows::Off,
+            shadow_lights: None,
         }
     }
 }
@@ -271,6 +280,7 @@ impl RenderSettings {
         validate_msaa(self.msaa)?;
         validate_sample_culling(self.depth_mask, self.cell_box, self.depth_bounds)?;
         validate_zbin_culling(self.assign, self.depth_mask, self.cell_box)?;
+        validate_shadow_lights(self.shadow_lights)?;
         validate_slices(self.slices)
     }
 }
@@ -363,6 +373,19 @@ pub fn validate_slices(slices: u32) -> crate::error::Result<()> {
         ));
     }
     Ok(())
+}
+
+/// `--shadow-lights`: 1 to `MAX_LIGHTS` lights, or every light (`None`). Zero is refused:
+/// `--shadows off` says no light casts.
+pub fn validate_shadow_lights(n: Option<u32>) -> crate::error::Result<()> {
+    use crate::consts::MAX_LIGHTS;
+    match n {
+        Some(n) if !(1..=MAX_LIGHTS).contains(&n) => Err(crate::error::Error::invalid(
+            "shadow-lights",
+            format!("{n}: must be between 1 and {MAX_LIGHTS}, or all (--shadows off for none)"),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Bits per G-buffer channel.

@@ -9,8 +9,8 @@ use super::{wait_idle, PassTimer};
 use crate::consts::{
     COUNTER_EDGE_PIXELS, COUNTER_GEOMETRY_SAMPLES, COUNTER_INDEX_NEEDED, COUNTER_INDEX_OUT_OF_ROOM,
     COUNTER_INVALID_LIGHTS, COUNTER_OFF_BOUNDS_FRAGMENTS, COUNTER_PAIRS_NEEDED,
-    COUNTER_PAIRS_OUT_OF_ROOM, COUNTER_SHADED_SAMPLES, COUNTER_SLOTS, COUNTER_TRUNCATED_LOOPS,
-    COUNTER_WRITE_OVERFLOW,
+    COUNTER_PAIRS_OUT_OF_ROOM, COUNTER_SHADED_SAMPLES, COUNTER_SHADOW_RAYS, COUNTER_SLOTS,
+    COUNTER_TRUNCATED_LOOPS, COUNTER_WRITE_OVERFLOW,
 };
 use crate::error::{Error, Result};
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -58,6 +58,10 @@ impl CounterValues {
     /// MSAA forward fragments outside their cell's bounds (the frame is wrong when non-zero).
     pub fn fragments_off_bounds(&self) -> u32 {
         self.get(COUNTER_OFF_BOUNDS_FRAGMENTS)
+    }
+    /// Shadow rays the light function cast.
+    pub fn shadow_rays(&self) -> u32 {
+        self.get(COUNTER_SHADOW_RAYS)
     }
     /// Lights a `LightCuller` refused (not finite, range not positive).
     pub fn invalid_lights(&self) -> u32 {

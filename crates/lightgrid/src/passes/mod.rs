@@ -279,6 +279,9 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             // The base-colour texture array and its sampler (`base_textures.rs`).
             base_textures::layout_entries()[0],
             base_textures::layout_entries()[1],
+            // The shadow rays' hierarchies and casters (`shading/shadows.wgsl`): a header of
+            // two vec4s at least.
+            storage(8, 32),
         ],
     })
 }

@@ -10,7 +10,7 @@
 use super::PipelineInfo;
 use crate::frame::{
     Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
-    LightLoop, MaterialDraws, MsaaResolve, RenderSettings, SpotCull,
+    LightLoop, MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull,
 };
 
 /// A setting's values by name (the option's values, the results' columns).
@@ -198,6 +198,20 @@ impl SettingValue for Option<Brdf> {
             None => "the scene's own: phong for the catalog's scenes (the papers' model), ggx for glTF files",
             Some(Brdf::Phong) => "Blinn-Phong, as the papers shade",
             Some(Brdf::Ggx) => "glTF's metallic-roughness BRDF: GGX, Smith height-correlated visibility, Schlick Fresnel, Lambert diffuse",
+        }
+    }
+}
+
+impl SettingValue for Shadows {
+    const FLAG: &'static str = "shadows";
+    const VALUES: &'static [Self] = &Shadows::ALL;
+    fn name(self) -> &'static str {
+        Shadows::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Shadows::Off => "no shadows: every light reaches everything in its range",
+            Shadows::Rays => "one ray from each lit sample to each shadow-casting light through a BVH over the opaque triangles (Forward+ §6)",
         }
     }
 }
@@ -470,6 +484,32 @@ pub const AXES: &[Axis] = &[
             Ok(())
         },
         label: |v| v.to_string(),
+    },
+    Axis {
+        flag: "shadows",
+        column: "shadows",
+        help: "how lights cast shadows, in every pipeline",
+        values: values::<Shadows>,
+        applies: |_, _| true,
+        get: |s| s.shadows.name().to_string(),
+        set: |s, v| {
+            s.shadows = Shadows::parse(v)?;
+            Ok(())
+        },
+        label: |v| format!("shadows {v}"),
+    },
+    Axis {
+        flag: "shadow-lights",
+        column: "shadow_lights",
+        help: "how many lights cast shadows with --shadows on: the most important this frame (brightness × screen coverage), 1 to 1048576, or all",
+        values: Vec::new,
+        applies: |_, s| s.shadows != Shadows::Off,
+        get: |s| s.shadow_lights.map_or("all".to_string(), |n| n.to_string()),
+        set: |s, v| {
+            s.shadow_lights = if v == "all" { None } else { Some(number(v)?) };
+            crate::frame::validate_shadow_lights(s.shadow_lights).map_err(|e| e.to_string())
+        },
+        label: |v| format!("{v} shadowed"),
     },
 ];
 

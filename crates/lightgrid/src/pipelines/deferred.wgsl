@@ -31,7 +31,7 @@ fn fs_light(v: VolumeOut, @builtin(sample_mask) mask: u32) -> LitOut {
     let position = position_from_screen(vec2<f32>(p) + vec2<f32>(0.5), centre_depth(gb_depth, p));
     let s = apply_material(raw_surface_from_gbuffer(p, 0u, position));
     let n = select(0u, 1u, counts_for_pixel(mask));
-    return lit(v.clip, shade_light(s, view_dir_to(s.position), lights[v.light]), n);
+    return lit(v.clip, shade_light(s, view_dir_to(s.position), v.light), n);
 }
 
 // One fragment per sample of an edge pixel: the sample's own surface where it lies.
@@ -44,7 +44,7 @@ fn fs_light_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> LitOut {
     }
     let position = position_from_screen(vec2<f32>(p) + sample_position(i), depth);
     let s = apply_material(raw_surface_from_gbuffer(p, i, position));
-    return lit(v.clip, shade_light(s, view_dir_to(s.position), lights[v.light]), 1u);
+    return lit(v.clip, shade_light(s, view_dir_to(s.position), v.light), 1u);
 }
 
 // The light-independent term of every pixel that is no edge, written before the lights add

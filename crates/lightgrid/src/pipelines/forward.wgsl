@@ -22,7 +22,7 @@ fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     var specular = 0.0;
     var i = 0u;
     for (; i < frame.light_count; i = i + 1u) {
-        let t = light_terms(s, view_dir, lights[i]);
+        let t = light_terms(s, view_dir, i);
         diffuse += t.diffuse;
         specular += luminance(t.specular);
     }

@@ -38,7 +38,7 @@ fn irradiance_out(p: vec2<u32>, s: Surface, light: u32, n: u32) -> IrradianceOut
     if (MULTISAMPLED) {
         count_pixel(p, n);
     }
-    let t = light_terms(s, view_dir_to(s.position), lights[light]);
+    let t = light_terms(s, view_dir_to(s.position), light);
     var out: IrradianceOut;
     out.diffuse = vec4<f32>(t.diffuse, 0.0);
     out.specular = vec4<f32>(t.specular, 0.0);

@@ -67,7 +67,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         if (shaded) {
             var j = 0u;
             for (; j < n; j = j + 1u) {
-                acc += shade_light(s, view_dir, lights[batch[j]]);
+                acc += shade_light(s, view_dir, batch[j]);
             }
             check_loop(j, n);
             count += n;

@@ -129,7 +129,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         if (first) {
             var j = 0u;
             for (; j < n; j = j + 1u) {
-                acc0 += shade_light(s0, view0, lights[batch[j]]);
+                acc0 += shade_light(s0, view0, batch[j]);
             }
             check_loop(j, n);
         }
@@ -141,7 +141,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
                 let view_dir = view_dir_to(surface.position);
                 var j = 0u;
                 for (; j < n; j = j + 1u) {
-                    taken_acc[k] += shade_light(surface, view_dir, lights[batch[j]]);
+                    taken_acc[k] += shade_light(surface, view_dir, batch[j]);
                 }
                 check_loop(j, n);
                 k = k + 1u;

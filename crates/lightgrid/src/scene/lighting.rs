@@ -80,51 +80,85 @@ impl LightUnits {
     }
 }
 
-/// What a pipeline's shaders are made for: the BRDF and the lights' units (their falloff).
-/// The one light function takes them as constants (`ComposedShader::specialized`), so a
-/// renderer makes its pipelines again when a scene or `--brdf` changes them.
+/// How lights cast shadows (`--shadows`; `crate::shadows`).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Shadows {
+    /// No shadows: every light reaches every sample in its range (every result before
+    /// shadows landed).
+    #[default]
+    Off,
+    /// One ray from each shaded sample to each shadow-casting light that would light it,
+    /// through a hierarchy over the opaque triangles (Forward+ §6).
+    Rays,
+}
+
+impl Shadows {
+    pub const ALL: [Shadows; 2] = [Shadows::Off, Shadows::Rays];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Shadows::Off => "off",
+            Shadows::Rays => "rays",
+        }
+    }
+
+    /// The shaders' value (`consts::SHADOWS_*`).
+    pub fn gpu(self) -> u32 {
+        match self {
+            Shadows::Off => crate::consts::SHADOWS_OFF,
+            Shadows::Rays => crate::consts::SHADOWS_RAYS,
+        }
+    }
+}
+
+/// What a pipeline's shaders are made for: the BRDF, the lights' units (their falloff) and the
+/// shadows. The one light function takes them as constants (`ComposedShader::specialized`),
+/// so a renderer makes its pipelines again when a scene, `--brdf` or `--shadows` changes them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Shading {
     pub brdf: Brdf,
     pub units: LightUnits,
+    pub shadows: Shadows,
 }
 
 impl Default for Shading {
-    /// The catalog's: Blinn-Phong in the papers' units.
+    /// The catalog's: Blinn-Phong in the papers' units, no shadows.
     fn default() -> Self {
         Shading {
             brdf: Brdf::Phong,
             units: LightUnits::Papers,
+            shadows: Shadows::Off,
         }
     }
 }
 
 impl Shading {
     /// Every combination (the shader tests validate each).
-    pub const ALL: [Shading; 4] = [
-        Shading {
-            brdf: Brdf::Phong,
-            units: LightUnits::Papers,
-        },
-        Shading {
-            brdf: Brdf::Ggx,
-            units: LightUnits::Papers,
-        },
-        Shading {
-            brdf: Brdf::Phong,
-            units: LightUnits::Photometric,
-        },
-        Shading {
-            brdf: Brdf::Ggx,
-            units: LightUnits::Photometric,
-        },
-    ];
+    pub fn all() -> Vec<Shading> {
+        let mut out = Vec::new();
+        for shadows in Shadows::ALL {
+            for units in [LightUnits::Papers, LightUnits::Photometric] {
+                for brdf in [Brdf::Phong, Brdf::Ggx] {
+                    out.push(Shading {
+                        brdf,
+                        units,
+                        shadows,
+                    });
+                }
+            }
+        }
+        out
+    }
 
-    /// A scene's shading with `--brdf` `brdf` (`None`: auto, the scene's own).
-    pub fn of(lighting: &Lighting, brdf: Option<Brdf>) -> Shading {
+    /// A scene's shading with `--brdf` `brdf` (`None`: auto, the scene's own) and `--shadows`.
+    pub fn of(lighting: &Lighting, brdf: Option<Brdf>, shadows: Shadows) -> Shading {
         Shading {
             brdf: brdf.unwrap_or(lighting.brdf),
             units: lighting.units,
+            shadows,
         }
     }
 }

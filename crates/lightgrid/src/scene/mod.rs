@@ -16,7 +16,8 @@ mod view;
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use lighting::{
-    auto_exposure, light_exposure, Brdf, LightUnits, Lighting, Shading, AUTO_EXPOSURE_DISTANCE,
+    auto_exposure, light_exposure, Brdf, LightUnits, Lighting, Shading, Shadows,
+    AUTO_EXPOSURE_DISTANCE,
 };
 pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};

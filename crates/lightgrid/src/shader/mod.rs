@@ -18,7 +18,11 @@ use crate::scene::Shading;
 pub mod src {
     pub const TYPES: &str = include_str!("../shading/types.wgsl");
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
-    pub const LIGHTING: &str = include_str!("../shading/lighting.wgsl");
+    /// The light function and the shadow rays it casts.
+    pub const LIGHTING: &str = concat!(
+        include_str!("../shading/lighting.wgsl"),
+        include_str!("../shading/shadows.wgsl")
+    );
     pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
     /// Cell addressing (`grid_slice`, `grid_cell`); needs a `grid` binding.
     pub const GRID_CELL: &str = include_str!("../culling/grid_cell.wgsl");
@@ -308,7 +312,7 @@ pub fn validate_for(
 /// the module of the first.
 fn validate_source(name: &str, source: &str) -> Result<naga::Module, String> {
     let mut first = None;
-    for shading in Shading::ALL {
+    for shading in Shading::all() {
         let module = validate_one(name, &specialize(source, shading))?;
         first.get_or_insert(module);
         if !source.contains(SHADING_BRDF_VALUE) {
@@ -333,6 +337,7 @@ fn validate_one(name: &str, source: &str) -> Result<naga::Module, String> {
 /// The placeholders `lighting.wgsl` declares its BRDF and falloff with.
 const SHADING_BRDF_VALUE: &str = "SHADING_BRDF_VALUE";
 const SHADING_FALLOFF_VALUE: &str = "SHADING_FALLOFF_VALUE";
+const SHADING_SHADOWS_VALUE: &str = "SHADING_SHADOWS_VALUE";
 
 fn specialize(source: &str, shading: Shading) -> String {
     source
@@ -340,6 +345,10 @@ fn specialize(source: &str, shading: Shading) -> String {
         .replace(
             SHADING_FALLOFF_VALUE,
             &format!("{}u", shading.units.falloff()),
+        )
+        .replace(
+            SHADING_SHADOWS_VALUE,
+            &format!("{}u", shading.shadows.gpu()),
         )
 }
 

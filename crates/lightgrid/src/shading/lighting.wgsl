@@ -8,6 +8,8 @@
 // the model a frame does not use. A module made without them does not compile.
 const SHADING_BRDF: u32 = SHADING_BRDF_VALUE;
 const SHADING_FALLOFF: u32 = SHADING_FALLOFF_VALUE;
+// How lights are shadowed (SHADOWS_OFF or SHADOWS_RAYS), written in the same way.
+const SHADING_SHADOWS: u32 = SHADING_SHADOWS_VALUE;
 
 // A shading sample: everything the light function needs, wherever it came from
 // (interpolated vertex data or a G-buffer).
@@ -93,9 +95,11 @@ fn ggx_terms(s: Surface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32, e: vec
     return out;
 }
 
-// The light's terms on the surface: Blinn-Phong or GGX (`SHADING_BRDF`) from a point or spot
-// light with a finite range. `view_dir` points from the surface to the eye.
-fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
+// Light `index`'s terms on the surface: Blinn-Phong or GGX (`SHADING_BRDF`) from a point or
+// spot light with a finite range, times its visibility where it casts shadows
+// (`SHADING_SHADOWS`, shadows.wgsl). `view_dir` points from the surface to the eye.
+fn light_terms(s: Surface, view_dir: vec3<f32>, index: u32) -> LightTerms {
+    let light = lights[index];
     var out: LightTerms;
     out.diffuse = vec3<f32>(0.0);
     out.specular = vec3<f32>(0.0);
@@ -108,6 +112,10 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, light: Light) -> LightTerms {
     let n_dot_l = dot(s.normal, l);
     let cone = spot_falloff(light, l);
     if (n_dot_l <= 0.0 || cone <= 0.0) {
+        return out;
+    }
+    // Only a light that would light the sample casts its ray.
+    if (SHADING_SHADOWS == SHADOWS_RAYS && shadow_blocked(index, s.position, s.normal, light.position)) {
         return out;
     }
     // Irradiance: the radiance is uploaded scaled by the exposure and the BRDF's convention
@@ -130,7 +138,7 @@ fn specular_albedo(s: Surface) -> vec3<f32> {
     return select(s.specular, vec3<f32>(1.0), SHADING_BRDF == BRDF_GGX);
 }
 
-fn shade_light(s: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
+fn shade_light(s: Surface, view_dir: vec3<f32>, light: u32) -> vec3<f32> {
     let t = light_terms(s, view_dir, light);
     return t.diffuse * s.diffuse + t.specular * specular_albedo(s);
 }
@@ -169,7 +177,7 @@ fn shade_all_lights(s: Surface, view_dir: vec3<f32>) -> vec3<f32> {
     var acc = vec3<f32>(0.0);
     var i = 0u;
     for (; i < frame.light_count; i = i + 1u) {
-        acc += shade_light(s, view_dir, lights[i]);
+        acc += shade_light(s, view_dir, i);
     }
     check_loop(i, frame.light_count);
     return acc;
