@@ -431,6 +431,18 @@ fn robots_many_with_ggx() {
     check_scene("robots-many", 200, (160, 90), settings);
 }
 
+/// The street with ray-cast shadows (`--shadows rays`, every light casting): every pipeline
+/// equals its reference with the same shadows (the rays start from each pipeline's own
+/// surface position: interpolated, or rebuilt from a depth buffer).
+#[test]
+fn robots_many_with_ray_shadows() {
+    let settings = RenderSettings {
+        shadows: lightgrid::scene::Shadows::Rays,
+        ..settings(16)
+    };
+    check_scene("robots-many", 200, (160, 90), settings);
+}
+
 #[test]
 fn deferred_stencil_culls_more_than_deferred_on_robots_many() {
     let ctx = common::gpu();

@@ -104,11 +104,10 @@ fn shadow_blocked(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3<f32>) 
     atomicAdd(&frame_counters[COUNTER_SHADOW_RAYS], 1u);
     let h0 = shadow_data[0];
     let h1 = shadow_data[1];
-    // shadows::ray: pushed off the surface along its normal, stopping as far short of the light.
+    // shadows::ray: pushed off the surface along its normal, ending at the light.
     let b = h0.w + h1.w * length(p);
     let o = p + n * b + h0.xyz;
     let d = light_pos + h0.xyz - o;
-    let t_max = 1.0 - b / max(length(d), b * 2.0);
-    return shadow_tree_blocked(bitcast<u32>(h1.x), o, d, t_max)
-        || shadow_tree_blocked(bitcast<u32>(h1.y), o, d, t_max);
+    return shadow_tree_blocked(bitcast<u32>(h1.x), o, d, 1.0)
+        || shadow_tree_blocked(bitcast<u32>(h1.y), o, d, 1.0);
 }

@@ -65,6 +65,10 @@ pub struct Frame<'s> {
     /// The BRDF shaded with, and what each light's colour × intensity is multiplied by.
     brdf: Brdf,
     light_scale: f32,
+    /// `--shadows rays` with every light casting: a light reaches a surface point only where
+    /// the segment between them crosses no opaque triangle (transparent and alpha-tested ones
+    /// cast none, as `lightgrid::shadows` says).
+    pub shadows: bool,
 }
 
 impl<'s> Frame<'s> {
@@ -114,7 +118,102 @@ impl<'s> Frame<'s> {
             size,
             brdf,
             light_scale: light_scale(scene, brdf),
+            shadows: false,
         }
+    }
+
+    /// Does an opaque triangle (not alpha tested) cross the segment from `from` to `to`
+    /// (camera-relative), strictly between its ends? In f64, every triangle tested.
+    pub fn blocked(&self, from: DVec3, to: DVec3) -> bool {
+        let d = to - from;
+        let end = 1.0 - 1e-6;
+        self.triangles.iter().any(|tri| {
+            if tri.transparent || self.scene.materials[tri.material].alpha_cutoff.is_some() {
+                return false;
+            }
+            let [a, b, c] = tri.p;
+            let (e1, e2) = (b - a, c - a);
+            let p = d.cross(e2);
+            let det = e1.dot(p);
+            if det.abs() < 1e-18 {
+                return false;
+            }
+            let s = (from - a) / det;
+            let u = s.dot(p);
+            let q = s.cross(e1);
+            let v = d.dot(q);
+            let t = e2.dot(q);
+            u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 1e-6 && t < end
+        })
+    }
+
+    /// Per light, is it blocked from the surface at `hit` (false where it would not light it)?
+    fn shadowed(&self, hit: &Hit, ray: DVec3) -> Vec<bool> {
+        let (position, normal) = self.surface(hit, ray);
+        self.lights
+            .iter()
+            .map(|light| {
+                self.contribution(light, position, normal).is_some()
+                    && self.blocked(position.as_dvec3(), light.position.as_dvec3())
+            })
+            .collect()
+    }
+
+    /// The hit's camera-relative position and its normal facing the ray's side.
+    fn surface(&self, hit: &Hit, ray: DVec3) -> (Vec3, Vec3) {
+        let tri = &self.triangles[hit.triangle];
+        let at = |v: [DVec3; 3]| v[0] * hit.w[0] + v[1] * hit.w[1] + v[2] * hit.w[2];
+        let position = at(tri.p).as_vec3();
+        let mut normal = at(tri.n.map(Vec3::as_dvec3)).normalize().as_vec3();
+        // Two-sided: a triangle wound clockwise as seen is a back face, lit from its side.
+        let [a, b, c] = tri.p;
+        if (b - a).cross(c - a).dot(ray) > 0.0 {
+            normal = -normal;
+        }
+        (position, normal)
+    }
+
+    /// The light's direction, squared distance, n·l and cone factor at the point, where it
+    /// lights it (None outside its range, behind the surface or outside its cone).
+    fn contribution(
+        &self,
+        light: &Light,
+        position: Vec3,
+        normal: Vec3,
+    ) -> Option<(Vec3, f32, f32, f32)> {
+        let to_light = light.position - position;
+        let dist_sq = to_light.length_squared();
+        if dist_sq >= light.range * light.range {
+            return None;
+        }
+        let l = to_light / dist_sq.sqrt();
+        let n_dot_l = normal.dot(l);
+        let cone = match light.spot {
+            None => 1.0,
+            Some(Spot {
+                direction,
+                cos_inner,
+                cos_outer,
+            }) => {
+                assert!(cos_outer > POINT_LIGHT_COS);
+                let t = ((-l.dot(direction) - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
+                t * t * (3.0 - 2.0 * t)
+            }
+        };
+        (n_dot_l > 0.0 && cone > 0.0).then_some((l, dist_sq, n_dot_l, cone))
+    }
+
+    /// Which lights are blocked from each surface a pixel ray meets (the opaque one, then the
+    /// glass): a shadow's edge runs through the pixel where the rays around its centre differ.
+    pub fn shadow_key(&self, x: f64, y: f64) -> Option<Vec<Vec<bool>>> {
+        let d = self.ray(x, y);
+        let (opaque, glass, _) = self.seen(x, y)?;
+        Some(
+            std::iter::once(&opaque)
+                .chain(&glass)
+                .map(|h| self.shadowed(h, d))
+                .collect(),
+        )
     }
 
     /// The ray through framebuffer position (x, y) (pixels, y down).
@@ -219,10 +318,21 @@ impl<'s> Frame<'s> {
             return None;
         }
         let d = self.ray(x, y);
-        let (mut colour, lit) = self.shade(&opaque, d, model);
+        let keys = if self.shadows {
+            let centre = self.shadow_key(x, y)?;
+            for (dx, dy) in [(-1.0, 0.0), (1.0, 0.0), (0.0, -1.0), (0.0, 1.0)] {
+                if self.shadow_key(x + dx / 3.0, y + dy / 3.0)? != centre {
+                    return None;
+                }
+            }
+            centre
+        } else {
+            vec![vec![false; self.lights.len()]; 1 + glass.len()]
+        };
+        let (mut colour, lit) = self.shade(&opaque, d, model, &keys[0]);
         let mut any_lit = lit;
-        for h in &glass {
-            let (c, lit) = self.shade(h, d, model);
+        for (h, blocked) in glass.iter().zip(&keys[1..]) {
+            let (c, lit) = self.shade(h, d, model, blocked);
             let a = self.material(h).alpha;
             colour = c * a + colour * (1.0 - a);
             any_lit |= lit;
@@ -230,17 +340,10 @@ impl<'s> Frame<'s> {
         Some((colour, any_lit))
     }
 
-    /// The surface at `hit` lit by every light (linear HDR), and whether any light reached it.
-    fn shade(&self, hit: &Hit, ray: DVec3, model: Model) -> (Vec3, bool) {
-        let tri = &self.triangles[hit.triangle];
-        let at = |v: [DVec3; 3]| v[0] * hit.w[0] + v[1] * hit.w[1] + v[2] * hit.w[2];
-        let position = at(tri.p).as_vec3();
-        let mut normal = at(tri.n.map(Vec3::as_dvec3)).normalize().as_vec3();
-        // Two-sided: a triangle wound clockwise as seen is a back face, lit from its side.
-        let [a, b, c] = tri.p;
-        if (b - a).cross(c - a).dot(ray) > 0.0 {
-            normal = -normal;
-        }
+    /// The surface at `hit` lit by every light not `blocked` (linear HDR), and whether any
+    /// light reached it.
+    fn shade(&self, hit: &Hit, ray: DVec3, model: Model, blocked: &[bool]) -> (Vec3, bool) {
+        let (position, normal) = self.surface(hit, ray);
         let m = self.material(hit);
         let view = -position.normalize();
         let (shader, paint, power) = m.shader.gpu();
@@ -256,28 +359,12 @@ impl<'s> Frame<'s> {
         };
         let (mut e_diffuse, mut e_specular, mut e_specular_lum) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         let mut lit = false;
-        for light in &self.lights {
-            let to_light = light.position - position;
-            let dist_sq = to_light.length_squared();
-            if dist_sq >= light.range * light.range {
+        for (light, &blocked) in self.lights.iter().zip(blocked) {
+            let Some((l, dist_sq, n_dot_l, cone)) = self.contribution(light, position, normal)
+            else {
                 continue;
-            }
-            let l = to_light / dist_sq.sqrt();
-            let n_dot_l = normal.dot(l);
-            let cone = match light.spot {
-                None => 1.0,
-                Some(Spot {
-                    direction,
-                    cos_inner,
-                    cos_outer,
-                }) => {
-                    assert!(cos_outer > POINT_LIGHT_COS);
-                    let t =
-                        ((-l.dot(direction) - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
-                    t * t * (3.0 - 2.0 * t)
-                }
             };
-            if n_dot_l <= 0.0 || cone <= 0.0 {
+            if blocked {
                 continue;
             }
             let e = light.color
@@ -386,6 +473,8 @@ pub struct Checked {
     pub lit: usize,
     pub glass: usize,
     pub shaders: [usize; 3],
+    /// Pixels where some light was blocked (with shadows).
+    pub shadowed: usize,
     pub worst: u8,
 }
 
@@ -414,6 +503,10 @@ pub fn compare(f: &Frame, image: &image::RgbaImage, model: Model, step: u32, out
                 let centre = (f64::from(px) + 0.5, f64::from(py) + 0.5);
                 let (opaque, glass, _) = f.seen(centre.0, centre.1).unwrap();
                 out.glass += usize::from(!glass.is_empty());
+                if f.shadows {
+                    let keys = f.shadow_key(centre.0, centre.1).unwrap();
+                    out.shadowed += usize::from(keys.iter().flatten().any(|&b| b));
+                }
                 out.shaders[f.material(&opaque).shader.gpu().0 as usize] += 1;
             }
             out.worst = out.worst.max(worst);
@@ -442,11 +535,33 @@ pub fn check_brdf(
     step: u32,
     brdf: Option<Brdf>,
 ) -> Checked {
-    let f = Frame::with_brdf(scene, frame, size, brdf.unwrap_or(scene.lighting.brdf));
     let settings = RenderSettings {
         brdf,
         ..RenderSettings::default()
     };
+    check_with(ctx, scene, frame, size, step, settings)
+}
+
+/// [`check`] with `settings`' BRDF and shadows (every light casting).
+pub fn check_with(
+    ctx: &lightgrid::gpu::GpuContext,
+    scene: &Scene,
+    frame: u32,
+    size: (u32, u32),
+    step: u32,
+    settings: RenderSettings,
+) -> Checked {
+    assert!(
+        settings.shadow_lights.is_none(),
+        "the reference shadows every light"
+    );
+    let mut f = Frame::with_brdf(
+        scene,
+        frame,
+        size,
+        settings.brdf.unwrap_or(scene.lighting.brdf),
+    );
+    f.shadows = settings.shadows == lightgrid::scene::Shadows::Rays;
     let mut r = Renderer::new(ctx, size.0, size.1, settings).unwrap();
     let mut out = Checked::default();
     for model in [Model::Full, Model::Mono, Model::MonoAlbedo] {
