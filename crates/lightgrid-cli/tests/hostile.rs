@@ -1153,6 +1153,34 @@ fn light_values_out_of_bounds_are_refused_with_the_cause() {
     );
 }
 
+#[test]
+fn shadow_options_out_of_range_are_refused() {
+    // Zero casters (that is --shadows off), negative, NaN, past the light limit, not a number.
+    for bad in ["0", "-1", "nan", "2000000", "1e3", "some"] {
+        let r = run(&render(&["--shadows", "rays", "--shadow-lights", bad]));
+        assert!(!r.status.success(), "--shadow-lights {bad} accepted");
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(err.contains("--shadow-lights"), "{bad}: {err}");
+        assert!(!err.contains("panicked"), "{bad}: {err}");
+    }
+    fails_with(
+        &render(&["--shadows", "rays", "--shadow-lights", "0"]),
+        "must be between 1 and 1048576, or all (--shadows off for none)",
+    );
+    // A count without shadows applies to nothing.
+    let r = run(&render(&["--shadow-lights", "8"]));
+    assert!(!r.status.success());
+    assert!(
+        String::from_utf8_lossy(&r.stderr).contains("--shadows"),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    fails_with(
+        &render(&["--shadows", "sometimes"]),
+        "invalid value 'sometimes' for '--shadows <shadows>'",
+    );
+}
+
 /// 256 slices of 4-pixel tiles at 2000x1200 is 38 million cells, whose bounds no storage
 /// binding of lavapipe holds: refused with the numbers and what to change, not a wgpu
 /// validation dump, and no image written.

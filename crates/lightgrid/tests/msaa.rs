@@ -127,12 +127,18 @@ fn render_all(s: &Scene, frame: u32, (w, h): (u32, u32), settings: RenderSetting
         let reference = &references[p.reference];
         let out = r.render(s, frame, p.id).unwrap();
         let edges = common::msaa_edge_pixels(&reference.depth_samples, (w, h));
-        let cmp = common::compare_images_outside(
-            &reference.image,
-            &out.image,
-            tolerance(p.id),
-            Some(&edges),
-        );
+        let mut tolerance = tolerance(p.id);
+        if settings.shadows != lightgrid::scene::Shadows::Off && tolerance.fine.is_some() {
+            // With shadows an edge pixel's samples may lie on both sides of a shadow's
+            // outline (a robot's contact shadow starts at its silhouette), so the deferred
+            // family's per-sample shading there and forward's one point at the centre differ
+            // by up to the whole shadow's contrast (measured on robots-few at 200x120: 23
+            // pixels over 24 levels, max 69, all on edges). Any edge pixel may then exceed
+            // the level; off the edges the `fine` bound stays (measured 0 over 4 levels).
+            tolerance.max_over = edges.iter().filter(|&&e| e).count() as _;
+        }
+        let cmp =
+            common::compare_images_outside(&reference.image, &out.image, tolerance, Some(&edges));
         eprintln!("MEASURED {name}: {}", cmp.describe());
         if !cmp.passes() {
             let dir = common::output_dir();
@@ -329,6 +335,18 @@ fn a_dim_or_distant_missing_light_fails_every_msaa_tolerance() {
 fn every_msaa_pipeline_equals_forward_at_4x_odd_size_first_person() {
     let s = catalog::build("random-fps", &SceneParams::default()).unwrap();
     render_all(&s, 40, (97, 61), msaa(7));
+}
+
+/// Ray-cast shadows (`--shadows rays`) with MSAA: the robots' street lit by the 11 lights
+/// they carry, every light casting.
+#[test]
+fn every_msaa_pipeline_equals_forward_at_4x_with_ray_shadows() {
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let settings = RenderSettings {
+        shadows: lightgrid::scene::Shadows::Rays,
+        ..msaa(16)
+    };
+    render_all(&s, 0, (200, 120), settings);
 }
 
 /// The camera inside a glass bubble: every pixel blended over, per sample.

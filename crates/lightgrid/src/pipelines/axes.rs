@@ -538,16 +538,32 @@ pub fn check_axes_apply(
         let ids: Vec<&str> = chosen.iter().map(|p| p.id).collect();
         let takers = axis.takers(settings);
         let takers = if takers.is_empty() {
-            // Only `--msaa-resolve` depends on another setting.
-            let with_msaa = RenderSettings {
-                msaa: 4,
-                ..*settings
-            };
-            format!(
-                "none at --msaa {} (with MSAA: {})",
-                settings.msaa,
-                axis.takers(&with_msaa).join(", ")
-            )
+            // A setting read only when another is on (`--msaa-resolve` with MSAA,
+            // `--shadow-lights` with shadows): name the other.
+            let enabling = [
+                (
+                    "--msaa 4",
+                    RenderSettings {
+                        msaa: 4,
+                        ..*settings
+                    },
+                ),
+                (
+                    "--shadows rays",
+                    RenderSettings {
+                        shadows: Shadows::Rays,
+                        ..*settings
+                    },
+                ),
+            ];
+            enabling
+                .iter()
+                .find_map(|(flag, with)| {
+                    let t = axis.takers(with);
+                    (!t.is_empty())
+                        .then(|| format!("none without {flag} (with it: {})", t.join(", ")))
+                })
+                .unwrap_or_else(|| "none with these settings".to_string())
         } else {
             takers.join(", ")
         };
