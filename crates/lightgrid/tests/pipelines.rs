@@ -1530,30 +1530,6 @@ fn with_planes(s: &Scene, near: f32, far: f32) -> Scene {
     s
 }
 
-/// `s` moved by `d`: static objects, paths, world and circling lights, and the camera.
-fn moved(s: &Scene, d: glam::Vec3) -> Scene {
-    use lightgrid::scene::LightAnchor;
-    let mut s = s.clone();
-    let t = glam::Mat4::from_translation(d);
-    for o in s.objects.iter_mut().filter(|o| o.is_static()) {
-        o.local = t * o.local;
-    }
-    for q in s.paths.iter_mut().flat_map(|p| p.points.iter_mut()) {
-        *q += d;
-    }
-    for l in &mut s.lights {
-        if !matches!(l.anchor, LightAnchor::Object(_)) {
-            l.light.position += d;
-        }
-    }
-    for k in &mut s.camera_path.keys {
-        k.1 += d;
-        k.2 += d;
-    }
-    s.name = format!("{}-moved{:e}", s.name, d.length());
-    s
-}
-
 #[test]
 fn real_camera_planes_render_like_forward() {
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
@@ -1573,12 +1549,22 @@ fn scenes_far_from_the_origin_render_like_forward() {
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
     for d in [1e5, 1e6] {
         check(
-            &moved(&s, glam::Vec3::new(d, 0.0, -d)),
+            &common::moved(&s, glam::Vec3::new(d, 0.0, -d)),
             200,
             (128, 72),
             settings(16),
         );
-    }
+    } // With ray-cast shadows, whose rays start from each pipeline's own surface positions.
+    let shadows = RenderSettings {
+        shadows: lightgrid::scene::Shadows::Rays,
+        ..settings(16)
+    };
+    check(
+        &common::moved(&s, glam::Vec3::new(1e6, 0.0, -1e6)),
+        86,
+        (128, 72),
+        shadows,
+    );
 }
 
 /// The grid of every strategy holds every light the oracle finds, and equals its CPU twin,
@@ -1587,7 +1573,11 @@ fn scenes_far_from_the_origin_render_like_forward() {
 #[test]
 fn the_grid_holds_the_oracles_lights_for_a_tiny_near_plane_far_from_the_origin() {
     let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
-    let s = with_planes(&moved(&s, glam::Vec3::new(-7e5, 3e5, 7e5)), 1e-6, 1e6);
+    let s = with_planes(
+        &common::moved(&s, glam::Vec3::new(-7e5, 3e5, 7e5)),
+        1e-6,
+        1e6,
+    );
     check_strategies(
         &s,
         120,
@@ -1788,7 +1778,7 @@ fn cameras_the_depth_buffer_cannot_hold_are_refused() {
 fn depth_masks_and_cell_boxes_on_a_gltf_file_far_from_the_origin_with_a_tiny_near_plane() {
     let s = with_256_lights_added(room(), 5);
     let s = with_planes(
-        &moved(&s, glam::Vec3::new(1.0e5, 30.0, -7.0e4)),
+        &common::moved(&s, glam::Vec3::new(1.0e5, 30.0, -7.0e4)),
         0.01,
         1.0e6,
     );

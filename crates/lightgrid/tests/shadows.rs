@@ -179,6 +179,25 @@ fn forward_with_ray_shadows_equals_the_reference_that_casts_its_own() {
     }
 }
 
+/// Far from the origin, with the camera's own tiny near plane: shadow space is anchored at
+/// the scene, so `forward` with shadows still equals the reference (no surface shadows
+/// itself), and every pipeline equals `forward`.
+#[test]
+fn ray_shadows_far_from_the_origin_equal_the_reference() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let mut s = common::moved(&s, Vec3::new(1e5, 0.0, -1e5));
+    s.camera_path.near = 0.05;
+    s.camera_path.far = 1e6;
+    let settings = RenderSettings {
+        shadows: Shadows::Rays,
+        ..RenderSettings::default()
+    };
+    let c = check_with(&ctx, &s, s.frame_count() / 3, (128, 72), 4, settings);
+    eprintln!("{}: {c:?}", s.name);
+    assert!(c.pixels >= 100 && c.shadowed * 10 >= c.pixels, "{c:?}");
+}
+
 /// `--shadow-lights N`: N lights cast, the rest are counted as unshadowed; one caster gives an
 /// image between none and all, and fewer rays than all.
 #[test]

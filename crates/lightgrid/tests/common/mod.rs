@@ -1142,3 +1142,27 @@ impl Coverage {
         }
     }
 }
+
+/// `s` moved by `d`: static objects, paths, world and circling lights, and the camera.
+pub fn moved(s: &lightgrid::scene::Scene, d: glam::Vec3) -> lightgrid::scene::Scene {
+    use lightgrid::scene::LightAnchor;
+    let mut s = s.clone();
+    let t = glam::Mat4::from_translation(d);
+    for o in s.objects.iter_mut().filter(|o| o.is_static()) {
+        o.local = t * o.local;
+    }
+    for q in s.paths.iter_mut().flat_map(|p| p.points.iter_mut()) {
+        *q += d;
+    }
+    for l in &mut s.lights {
+        if !matches!(l.anchor, LightAnchor::Object(_)) {
+            l.light.position += d;
+        }
+    }
+    for k in &mut s.camera_path.keys {
+        k.1 += d;
+        k.2 += d;
+    }
+    s.name = format!("{}-moved{:e}", s.name, d.length());
+    s
+}
