@@ -206,9 +206,12 @@ pub const FALLOFF_INVERSE_SQUARE: u32 = 1;
 /// file's metres, as Filament clamps it): a light touching a surface stays finite there.
 pub const MIN_LIGHT_DISTANCE_SQ: f32 = 1e-4;
 
+/// `--shadow-atlas`'s default budget in MiB: a 4096² depth atlas.
+pub const DEFAULT_SHADOW_ATLAS_MIB: u32 = 64;
 /// `scene::Shadows` as the light function's `SHADING_SHADOWS` (`shading/shadows.wgsl`).
 pub const SHADOWS_OFF: u32 = 0;
 pub const SHADOWS_RAYS: u32 = 1;
+pub const SHADOWS_MAPS: u32 = 2;
 /// Entries of a shadow ray's traversal stack: a balanced tree of 2^31 triangles needs 30
 /// (`shadows/bvh.rs`); the renderer refuses a deeper one.
 pub const SHADOW_STACK_DEPTH: u32 = 32;
@@ -292,6 +295,19 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
     ("SHADOWS_OFF", WgslConst::U32(SHADOWS_OFF)),
     ("SHADOWS_RAYS", WgslConst::U32(SHADOWS_RAYS)),
+    ("SHADOWS_MAPS", WgslConst::U32(SHADOWS_MAPS)),
+    (
+        "SHADOW_NORMAL_OFFSET",
+        WgslConst::F32(crate::shadows::maps::NORMAL_OFFSET),
+    ),
+    (
+        "SHADOW_SLOPE_OFFSET",
+        WgslConst::F32(crate::shadows::maps::SLOPE_OFFSET),
+    ),
+    (
+        "SHADOW_MAX_SLOPE",
+        WgslConst::F32(crate::shadows::maps::MAX_SLOPE),
+    ),
     ("SHADOW_STACK_DEPTH", WgslConst::U32(SHADOW_STACK_DEPTH)),
     ("SHADOW_MAX_STEPS", WgslConst::U32(SHADOW_MAX_STEPS)),
     (

@@ -28,6 +28,7 @@ use crate::frame::{
 use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, PassTimer};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::base_textures::BaseTextures;
+use crate::passes::shadow_atlas::ShadowAtlas;
 use crate::passes::{scene_layout, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
 use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, Shading, SpotCull};
@@ -138,6 +139,8 @@ struct Uploaded<'s> {
     upload_bytes: u64,
     /// Lights lit without shadows with `--shadows` on (`--shadow-lights`).
     unshadowed: u32,
+    /// With `--shadows maps`: where the frame's faces lie in the atlas.
+    shadow_layout: Option<crate::shadows::maps::AtlasLayout>,
 }
 
 /// Renders frames at one size on one device.
@@ -168,6 +171,8 @@ pub struct Renderer {
     /// moving ones' and the casters (every frame). Two vec4s, never read, without shadows.
     shadow_data: GrowBuffer,
     shadow_static_written: bool,
+    /// The shadow maps' atlas (`--shadows maps`; 1x1 and unread otherwise).
+    shadow_atlas: ShadowAtlas,
     scene_bind_group: wgpu::BindGroup,
     /// The culling kernels' group 0 over the same buffers.
     cull_bind_group: wgpu::BindGroup,
@@ -267,7 +272,18 @@ impl Renderer {
             let materials = GrowBuffer::new(device, "materials", U::STORAGE, 1 << 12);
             let vertices = GrowBuffer::new(device, "vertices", U::VERTEX, 1 << 20);
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
-            let shadow_data = GrowBuffer::new(device, "shadow rays", U::STORAGE, 32);
+            let shadow_data = GrowBuffer::new(device, "shadows", U::STORAGE, 32);
+            let maps = settings.shadows == crate::scene::Shadows::Maps;
+            let side = if maps {
+                crate::shadows::maps::atlas_side(
+                    settings.shadow_atlas,
+                    device.limits().max_texture_dimension_2d,
+                )
+            } else {
+                1
+            };
+            let mut shadow_atlas = ShadowAtlas::new(device, side, maps);
+            shadow_atlas.bind(device, &uniforms, &shadow_data.buffer);
             let counters = FrameCounters::new(device, MAX_PASSES);
             let textures = BaseTextures::new(device, &ctx.queue, &[]);
             let (scene_bind_group, cull_bind_group) = Self::bind_scene(
@@ -276,7 +292,7 @@ impl Renderer {
                 &uniforms,
                 [&lights, &light_bounds, &materials, &shadow_data],
                 [counters.buffer(), &targets.pixel_counts],
-                &textures,
+                (&textures, &shadow_atlas),
             );
             Renderer {
                 device: device.clone(),
@@ -298,6 +314,7 @@ impl Renderer {
                 indices,
                 shadow_data,
                 shadow_static_written: false,
+                shadow_atlas,
                 scene_bind_group,
                 cull_bind_group,
                 textures,
@@ -333,7 +350,7 @@ impl Renderer {
         uniforms: &wgpu::Buffer,
         [lights, light_bounds, materials, shadow_data]: [&GrowBuffer; 4],
         [counters, pixel_counts]: [&wgpu::Buffer; 2],
-        textures: &BaseTextures,
+        (textures, atlas): (&BaseTextures, &ShadowAtlas),
     ) -> (wgpu::BindGroup, wgpu::BindGroup) {
         let cull = crate::culling::bind_cull_group(
             device,
@@ -354,6 +371,8 @@ impl Renderer {
                 wgpu::BindingResource::TextureView(&textures.view),
                 wgpu::BindingResource::Sampler(&textures.sampler),
                 shadow_data.buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&atlas.view),
+                wgpu::BindingResource::Sampler(&atlas.sampler),
             ],
         );
         (scene, cull)
@@ -506,7 +525,13 @@ impl Renderer {
         let mut upload_bytes = std::mem::take(&mut self.static_upload_bytes);
         let (bytes, frame_geometry) = self.upload_geometry(state)?;
         upload_bytes += bytes + self.upload_frame_data(state);
-        let (shadow_bytes, unshadowed) = self.upload_shadows(state, &frame_geometry)?;
+        let (shadow_bytes, unshadowed, shadow_layout) =
+            if self.settings.shadows == crate::scene::Shadows::Maps {
+                self.upload_shadow_maps(state)?
+            } else {
+                let (bytes, unshadowed) = self.upload_shadows(state, &frame_geometry)?;
+                (bytes, unshadowed, None)
+            };
         upload_bytes += shadow_bytes;
         let upload = self.scene.as_ref().expect("checked above");
         let (static_vertices, static_indices) = (upload.static_vertices, upload.static_indices);
@@ -530,7 +555,36 @@ impl Renderer {
             state,
             upload_bytes,
             unshadowed,
+            shadow_layout,
         })
+    }
+
+    /// With `--shadows maps`: the frame's casters, their tiles and every tile's matrix.
+    /// Returns the bytes written, the lights lit unshadowed and the atlas's layout.
+    fn upload_shadow_maps(
+        &mut self,
+        state: &FrameState,
+    ) -> Result<(u64, u32, Option<crate::shadows::maps::AtlasLayout>)> {
+        let (width, height) = self.size();
+        let casters = crate::shadows::casters(
+            &state.lights,
+            &state.camera,
+            width as f32 / height as f32,
+            self.settings.shadow_lights,
+        );
+        let eye = state.camera.eye;
+        let relative: Vec<Light> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
+        let maps = crate::shadows::maps::MapFrame::new(&relative, &casters, self.shadow_atlas.side)
+            .map_err(|reason| Error::invalid("shadow-atlas", reason))?;
+        let data = maps.gpu_data();
+        let bytes: &[u8] = bytemuck::cast_slice(&data);
+        let device = &self.device.clone();
+        if self.shadow_data.reserve(device, bytes.len() as u64) {
+            self.rebind_scene();
+        }
+        self.shadow_data.write(&self.queue, 0, bytes);
+        let unshadowed = casters.iter().filter(|&&c| !c).count() as u32;
+        Ok((bytes.len() as u64, unshadowed, Some(maps.layout)))
     }
 
     /// With `--shadows rays`: the moving objects' hierarchy and the frame's shadow casters
@@ -706,8 +760,10 @@ impl Renderer {
                 &self.shadow_data,
             ],
             [self.counters.buffer(), &self.targets.pixel_counts],
-            &self.textures,
+            (&self.textures, &self.shadow_atlas),
         );
+        self.shadow_atlas
+            .bind(&self.device, &self.uniforms, &self.shadow_data.buffer);
     }
 
     /// Step 2: record the frame (pipeline, tonemap, `analysis` readback copies when given,
@@ -743,6 +799,10 @@ impl Renderer {
             enc.parts()
                 .0
                 .clear_buffer(&self.targets.pixel_counts, 0, None);
+        }
+        if let Some(layout) = &up.shadow_layout {
+            let (encoder, timer) = enc.parts();
+            self.shadow_atlas.encode(encoder, timer, &inputs, layout);
         }
         technique.encode(&inputs, &mut enc)?;
         if analysis && inputs.has_transparency() {

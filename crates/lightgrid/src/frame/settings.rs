@@ -49,6 +49,13 @@ pub struct RenderSettings {
     /// (`crate::shadows`); `None`: every light.
     #[serde(default)]
     pub shadow_lights: Option<u32>,
+    /// The shadow atlas's budget in MiB (`--shadow-atlas`, `--shadows maps`).
+    #[serde(default = "default_shadow_atlas")]
+    pub shadow_atlas: u32,
+}
+
+fn default_shadow_atlas() -> u32 {
+    crate::consts::DEFAULT_SHADOW_ATLAS_MIB
 }
 
 /// How grid pipelines loop over a sample's lights (`--light-loop`; `culling/light_loop_*.wgsl`).
@@ -262,6 +269,7 @@ impl Default for RenderSettings {
             brdf: None,
             shadows: Shadows::Off,
             shadow_lights: None,
+            shadow_atlas: crate::consts::DEFAULT_SHADOW_ATLAS_MIB,
         }
     }
 }
@@ -281,6 +289,7 @@ impl RenderSettings {
         validate_sample_culling(self.depth_mask, self.cell_box, self.depth_bounds)?;
         validate_zbin_culling(self.assign, self.depth_mask, self.cell_box)?;
         validate_shadow_lights(self.shadow_lights)?;
+        validate_shadow_atlas(self.shadow_atlas)?;
         validate_slices(self.slices)
     }
 }
@@ -386,6 +395,18 @@ pub fn validate_shadow_lights(n: Option<u32>) -> crate::error::Result<()> {
         )),
         _ => Ok(()),
     }
+}
+
+/// `--shadow-atlas`: 1 to `shadows::maps::MAX_ATLAS_MIB` MiB.
+pub fn validate_shadow_atlas(mib: u32) -> crate::error::Result<()> {
+    use crate::shadows::maps::MAX_ATLAS_MIB;
+    if !(1..=MAX_ATLAS_MIB).contains(&mib) {
+        return Err(crate::error::Error::invalid(
+            "shadow-atlas",
+            format!("{mib}: must be between 1 and {MAX_ATLAS_MIB} MiB"),
+        ));
+    }
+    Ok(())
 }
 
 /// Bits per G-buffer channel.

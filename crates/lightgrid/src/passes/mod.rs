@@ -6,6 +6,7 @@ mod gbuffer;
 pub(crate) mod geometry;
 mod light_volumes;
 mod readback;
+pub(crate) mod shadow_atlas;
 mod tonemap;
 
 pub use crate::frame::targets::{
@@ -31,6 +32,7 @@ pub fn shaders() -> Vec<ComposedShader> {
     let mut out = tonemap::TonemapKey::all_shaders();
     out.extend(readback::DepthSamplesKey::all_shaders());
     out.push(gbuffer::shader());
+    out.push(shadow_atlas::shader());
     out
 }
 
@@ -282,6 +284,23 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             // The shadow rays' hierarchies and casters (`shading/shadows.wgsl`): a header of
             // two vec4s at least.
             storage(8, 32),
+            // The shadow atlas and its comparison sampler (`shadow_atlas.rs`).
+            wgpu::BindGroupLayoutEntry {
+                binding: 9,
+                visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 10,
+                visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
         ],
     })
 }

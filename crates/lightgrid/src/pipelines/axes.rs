@@ -212,6 +212,7 @@ impl SettingValue for Shadows {
         match self {
             Shadows::Off => "no shadows: every light reaches everything in its range",
             Shadows::Rays => "one ray from each lit sample to each shadow-casting light through a BVH over the opaque triangles (Forward+ §6)",
+            Shadows::Maps => "shadow maps (a cube per point light, a face per spot) in one atlas of --shadow-atlas MiB, 2x2 PCF",
         }
     }
 }
@@ -501,7 +502,7 @@ pub const AXES: &[Axis] = &[
     Axis {
         flag: "shadow-lights",
         column: "shadow_lights",
-        help: "how many lights cast shadows with --shadows on: the most important this frame (brightness × screen coverage), 1 to 1048576, or all",
+        help: "how many lights cast shadows with --shadows rays or maps: the most important this frame (brightness × screen coverage), 1 to 1048576, or all",
         values: Vec::new,
         applies: |_, s| s.shadows != Shadows::Off,
         get: |s| s.shadow_lights.map_or("all".to_string(), |n| n.to_string()),
@@ -510,6 +511,19 @@ pub const AXES: &[Axis] = &[
             crate::frame::validate_shadow_lights(s.shadow_lights).map_err(|e| e.to_string())
         },
         label: |v| format!("{v} shadowed"),
+    },
+    Axis {
+        flag: "shadow-atlas",
+        column: "shadow_atlas",
+        help: "the shadow atlas's budget in MiB with --shadows maps (1 to 4096): every shadowed light's maps share it, more lights getting smaller maps",
+        values: Vec::new,
+        applies: |_, s| s.shadows == Shadows::Maps,
+        get: |s| s.shadow_atlas.to_string(),
+        set: |s, v| {
+            s.shadow_atlas = number(v)?;
+            crate::frame::validate_shadow_atlas(s.shadow_atlas).map_err(|e| e.to_string())
+        },
+        label: |v| format!("{v} MiB atlas"),
     },
 ];
 
@@ -552,6 +566,13 @@ pub fn check_axes_apply(
                     "--shadows rays",
                     RenderSettings {
                         shadows: Shadows::Rays,
+                        ..*settings
+                    },
+                ),
+                (
+                    "--shadows maps",
+                    RenderSettings {
+                        shadows: Shadows::Maps,
                         ..*settings
                     },
                 ),

@@ -93,15 +93,19 @@ pub enum Shadows {
     /// One ray from each shaded sample to each shadow-casting light that would light it,
     /// through a hierarchy over the opaque triangles (Forward+ §6).
     Rays,
+    /// Shadow maps: a cube per point light, a face per spot, all in flight in one atlas
+    /// (`crate::shadows::maps`).
+    Maps,
 }
 
 impl Shadows {
-    pub const ALL: [Shadows; 2] = [Shadows::Off, Shadows::Rays];
+    pub const ALL: [Shadows; 3] = [Shadows::Off, Shadows::Rays, Shadows::Maps];
 
     pub fn name(self) -> &'static str {
         match self {
             Shadows::Off => "off",
             Shadows::Rays => "rays",
+            Shadows::Maps => "maps",
         }
     }
 
@@ -110,6 +114,7 @@ impl Shadows {
         match self {
             Shadows::Off => crate::consts::SHADOWS_OFF,
             Shadows::Rays => crate::consts::SHADOWS_RAYS,
+            Shadows::Maps => crate::consts::SHADOWS_MAPS,
         }
     }
 }

@@ -8,7 +8,7 @@
 // the model a frame does not use. A module made without them does not compile.
 const SHADING_BRDF: u32 = SHADING_BRDF_VALUE;
 const SHADING_FALLOFF: u32 = SHADING_FALLOFF_VALUE;
-// How lights are shadowed (SHADOWS_OFF or SHADOWS_RAYS), written in the same way.
+// How lights are shadowed (SHADOWS_OFF, SHADOWS_RAYS or SHADOWS_MAPS), written in the same way.
 const SHADING_SHADOWS: u32 = SHADING_SHADOWS_VALUE;
 
 // A shading sample: everything the light function needs, wherever it came from
@@ -114,13 +114,20 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, index: u32) -> LightTerms {
     if (n_dot_l <= 0.0 || cone <= 0.0) {
         return out;
     }
-    // Only a light that would light the sample casts its ray.
+    // Only a light that would light the sample tests its shadow (shadows.wgsl).
+    var visible = 1.0;
     if (SHADING_SHADOWS == SHADOWS_RAYS && shadow_blocked(index, s.position, s.normal, light.position)) {
         return out;
     }
+    if (SHADING_SHADOWS == SHADOWS_MAPS) {
+        visible = shadow_map_visibility(index, s.position, s.normal, light.position, n_dot_l);
+        if (visible <= 0.0) {
+            return out;
+        }
+    }
     // Irradiance: the radiance is uploaded scaled by the exposure and the BRDF's convention
     // (`Lighting::light_scale`).
-    let e = light.radiance * (distance_falloff(dist_sq, light.range) * cone * n_dot_l);
+    let e = light.radiance * (distance_falloff(dist_sq, light.range) * cone * n_dot_l * visible);
     if (SHADING_BRDF == BRDF_GGX) {
         out = ggx_terms(s, view_dir, l, n_dot_l, e);
     } else {

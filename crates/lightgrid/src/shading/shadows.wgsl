@@ -1,3 +1,5 @@
+// Shadows: the ray-cast form first, then the shadow maps (further down).
+//
 // Ray-cast shadows (`--shadows rays`; Forward+ §6: "local short ray casting to the lights"):
 // one ray from the sample to each shadow-casting light that would light it, through two
 // hierarchies over the opaque triangles (src/shadows/: the static objects' and the moving
@@ -110,4 +112,64 @@ fn shadow_blocked(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3<f32>) 
     let d = light_pos + h0.xyz - o;
     return shadow_tree_blocked(bitcast<u32>(h1.x), o, d, 1.0)
         || shadow_tree_blocked(bitcast<u32>(h1.y), o, d, 1.0);
+}
+
+// Shadow maps (`--shadows maps`; src/shadows/maps.rs): every shadowed light's faces are
+// tiles of one depth atlas, rendered before shading. The buffer then holds
+//   [0] bits: atlas side, tile side, tiles per row, slots' first vec4
+//   [1] bits: matrices' first vec4
+//   slots: per light 0 (unshadowed) or (first tile * 2 + cube) + 1, 4 per vec4
+//   matrices: per tile its view-projection's columns (camera-relative -> clip, depth near / w)
+@group(0) @binding(9) var shadow_atlas: texture_depth_2d;
+@group(0) @binding(10) var shadow_sampler: sampler_comparison;
+
+// A tile's view-projection.
+fn shadow_tile_matrix(tile: u32) -> mat4x4<f32> {
+    let at = bitcast<u32>(shadow_data[1].x) + 4u * tile;
+    return mat4x4<f32>(shadow_data[at], shadow_data[at + 1u], shadow_data[at + 2u], shadow_data[at + 3u]);
+}
+
+// How much of light `index` reaches camera-relative `p` (normal `n`, n.l = `n_dot_l`): 1
+// for a light without a map; else the 2x2 PCF of its map at the face the sample lies in,
+// after the slope-scaled normal offset (maps.rs).
+fn shadow_map_visibility(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3<f32>, n_dot_l: f32) -> f32 {
+    let h = bitcast<vec4<u32>>(shadow_data[0]);
+    let slot = bitcast<vec4<u32>>(shadow_data[h.w + index / 4u])[index % 4u];
+    if (slot == 0u) {
+        return 1.0;
+    }
+    let first = (slot - 1u) >> 1u;
+    var face = 0u;
+    if (((slot - 1u) & 1u) != 0u) {
+        let v = p - light_pos;
+        let a = abs(v);
+        if (a.x >= a.y && a.x >= a.z) {
+            face = select(1u, 0u, v.x > 0.0);
+        } else if (a.y >= a.z) {
+            face = select(3u, 2u, v.y > 0.0);
+        } else {
+            face = select(5u, 4u, v.z > 0.0);
+        }
+    }
+    let tile = first + face;
+    let m = shadow_tile_matrix(tile);
+    let side = f32(h.x);
+    let tile_side = f32(h.y);
+    // One texel's world size at the sample's distance along the face's axis: the matrix's
+    // second row is the view's up axis times 1 / tan(half the field of view).
+    let focal = length(vec3<f32>(m[0][1], m[1][1], m[2][1]));
+    let texel = 2.0 * (m * vec4<f32>(p, 1.0)).w / (focal * tile_side);
+    let c = saturate(n_dot_l);
+    let slope = min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 1e-4), SHADOW_MAX_SLOPE);
+    let q = p + n * (texel * (SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET * slope));
+    let clip = m * vec4<f32>(q, 1.0);
+    let ndc = clip.xyz / clip.w;
+    // The 2x2 footprint stays a texel inside the tile.
+    let local = clamp(
+        vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * tile_side,
+        vec2<f32>(1.0),
+        vec2<f32>(tile_side - 1.0),
+    );
+    let origin = vec2<f32>(f32(tile % h.z), f32(tile / h.z)) * tile_side;
+    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, (origin + local) / side, ndc.z);
 }

@@ -20,6 +20,7 @@
 //! the lower index. The others light unshadowed, counted as such ([`ShadowFrame::unshadowed`]).
 
 pub mod bvh;
+pub mod maps;
 
 use crate::scene::{Camera, Geometry, Light, Scene};
 use bvh::{Triangle, TriangleBvh};
