@@ -218,6 +218,8 @@ pub(crate) struct AnalysisInput<'r> {
     pub resolved_in_kernel: bool,
     /// Lights lit without shadows (`--shadow-lights`).
     pub unshadowed: u32,
+    /// With `--shadows maps`: the maps' texture bytes, a face's side, re-used or not.
+    pub shadow_maps: Option<crate::stats::ShadowMapStats>,
 }
 
 /// Read the frame's copies back and compute its statistics.
@@ -355,6 +357,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
                 .then_some(a.finished.shadow_rays),
             unshadowed_lights: (settings.shadows != crate::scene::Shadows::Off)
                 .then_some(a.unshadowed),
+            shadow_maps: a.shadow_maps,
             msaa_resolve: a.finished.msaa_shading.map(|_| {
                 if a.resolved_in_kernel {
                     crate::frame::MsaaResolve::Kernel

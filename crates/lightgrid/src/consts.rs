@@ -212,6 +212,9 @@ pub const DEFAULT_SHADOW_ATLAS_MIB: u32 = 64;
 pub const SHADOWS_OFF: u32 = 0;
 pub const SHADOWS_RAYS: u32 = 1;
 pub const SHADOWS_MAPS: u32 = 2;
+/// Shadow maps re-used light by light (the light-volume pipelines): a face's tile is its cube
+/// face's.
+pub const SHADOWS_MAPS_REUSED: u32 = 3;
 /// Entries of a shadow ray's traversal stack: a balanced tree of 2^31 triangles needs 30
 /// (`shadows/bvh.rs`); the renderer refuses a deeper one.
 pub const SHADOW_STACK_DEPTH: u32 = 32;
@@ -296,6 +299,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("SHADOWS_OFF", WgslConst::U32(SHADOWS_OFF)),
     ("SHADOWS_RAYS", WgslConst::U32(SHADOWS_RAYS)),
     ("SHADOWS_MAPS", WgslConst::U32(SHADOWS_MAPS)),
+    ("SHADOWS_MAPS_REUSED", WgslConst::U32(SHADOWS_MAPS_REUSED)),
     (
         "SHADOW_NORMAL_OFFSET",
         WgslConst::F32(crate::shadows::maps::NORMAL_OFFSET),

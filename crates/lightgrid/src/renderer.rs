@@ -139,8 +139,8 @@ struct Uploaded<'s> {
     upload_bytes: u64,
     /// Lights lit without shadows with `--shadows` on (`--shadow-lights`).
     unshadowed: u32,
-    /// With `--shadows maps`: where the frame's faces lie in the atlas.
-    shadow_layout: Option<crate::shadows::maps::AtlasLayout>,
+    /// With `--shadows maps`: the frame's faces and where they lie.
+    shadow_maps: Option<crate::shadows::maps::MapFrame>,
 }
 
 /// Renders frames at one size on one device.
@@ -171,7 +171,8 @@ pub struct Renderer {
     /// moving ones' and the casters (every frame). Two vec4s, never read, without shadows.
     shadow_data: GrowBuffer,
     shadow_static_written: bool,
-    /// The shadow maps' atlas (`--shadows maps`; 1x1 and unread otherwise).
+    /// The shadow maps' texture (`--shadows maps`; 1x1 and unread otherwise), sized per frame
+    /// to what its faces need within the budget's side (`shadows::maps::atlas_side`).
     shadow_atlas: ShadowAtlas,
     scene_bind_group: wgpu::BindGroup,
     /// The culling kernels' group 0 over the same buffers.
@@ -274,15 +275,7 @@ impl Renderer {
             let indices = GrowBuffer::new(device, "indices", U::INDEX, 1 << 20);
             let shadow_data = GrowBuffer::new(device, "shadows", U::STORAGE, 32);
             let maps = settings.shadows == crate::scene::Shadows::Maps;
-            let side = if maps {
-                crate::shadows::maps::atlas_side(
-                    settings.shadow_atlas,
-                    device.limits().max_texture_dimension_2d,
-                )
-            } else {
-                1
-            };
-            let mut shadow_atlas = ShadowAtlas::new(device, side, maps);
+            let mut shadow_atlas = ShadowAtlas::new(device, maps);
             shadow_atlas.bind(device, &uniforms, &shadow_data.buffer);
             let counters = FrameCounters::new(device, MAX_PASSES);
             let textures = BaseTextures::new(device, &ctx.queue, &[]);
@@ -513,7 +506,9 @@ impl Renderer {
     }
 
     /// Step 1: validate `state` against the scene held and upload what the frame needs.
-    fn upload<'s>(&mut self, state: &'s FrameState) -> Result<Uploaded<'s>> {
+    /// `reuse_maps`: the pipeline re-uses one light's shadow maps
+    /// (`Technique::reuses_shadow_maps`).
+    fn upload<'s>(&mut self, state: &'s FrameState, reuse_maps: bool) -> Result<Uploaded<'s>> {
         let upload = self.scene.as_ref().ok_or_else(|| {
             Error::invalid(
                 "scene",
@@ -525,9 +520,10 @@ impl Renderer {
         let mut upload_bytes = std::mem::take(&mut self.static_upload_bytes);
         let (bytes, frame_geometry) = self.upload_geometry(state)?;
         upload_bytes += bytes + self.upload_frame_data(state);
-        let (shadow_bytes, unshadowed, shadow_layout) =
+        let (shadow_bytes, unshadowed, shadow_maps) =
             if self.settings.shadows == crate::scene::Shadows::Maps {
-                self.upload_shadow_maps(state)?
+                let transparent = frame_geometry.opaque_indices < frame_geometry.indices.len();
+                self.upload_shadow_maps(state, reuse_maps, transparent)?
             } else {
                 let (bytes, unshadowed) = self.upload_shadows(state, &frame_geometry)?;
                 (bytes, unshadowed, None)
@@ -555,16 +551,20 @@ impl Renderer {
             state,
             upload_bytes,
             unshadowed,
-            shadow_layout,
+            shadow_maps,
         })
     }
 
-    /// With `--shadows maps`: the frame's casters, their tiles and every tile's matrix.
-    /// Returns the bytes written, the lights lit unshadowed and the atlas's layout.
+    /// With `--shadows maps`: the frame's casters, their faces and every face's matrix, and a
+    /// texture of the size they need (the re-used tiles, the atlas, or both when a re-using
+    /// pipeline's frame has transparent objects). Returns the bytes written, the lights lit
+    /// unshadowed and the frame's maps.
     fn upload_shadow_maps(
         &mut self,
         state: &FrameState,
-    ) -> Result<(u64, u32, Option<crate::shadows::maps::AtlasLayout>)> {
+        reuse: bool,
+        transparent: bool,
+    ) -> Result<(u64, u32, Option<crate::shadows::maps::MapFrame>)> {
         let (width, height) = self.size();
         let casters = crate::shadows::casters(
             &state.lights,
@@ -574,17 +574,29 @@ impl Renderer {
         );
         let eye = state.camera.eye;
         let relative: Vec<Light> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
-        let maps = crate::shadows::maps::MapFrame::new(&relative, &casters, self.shadow_atlas.side)
-            .map_err(|reason| Error::invalid("shadow-atlas", reason))?;
-        let data = maps.gpu_data();
+        let side = crate::shadows::maps::atlas_side(
+            self.settings.shadow_atlas,
+            self.device.limits().max_texture_dimension_2d,
+        );
+        let maps = crate::shadows::maps::MapFrame::new(
+            &relative,
+            &casters,
+            side,
+            self.settings.shadow_map_size,
+            reuse,
+        )
+        .map_err(|reason| Error::invalid("shadow-atlas", reason))?;
+        let size = maps.texture_size(transparent);
+        let data = maps.gpu_data(size);
         let bytes: &[u8] = bytemuck::cast_slice(&data);
         let device = &self.device.clone();
-        if self.shadow_data.reserve(device, bytes.len() as u64) {
+        let grew = self.shadow_data.reserve(device, bytes.len() as u64);
+        if self.shadow_atlas.fit(device, size) || grew {
             self.rebind_scene();
         }
         self.shadow_data.write(&self.queue, 0, bytes);
         let unshadowed = casters.iter().filter(|&&c| !c).count() as u32;
-        Ok((bytes.len() as u64, unshadowed, Some(maps.layout)))
+        Ok((bytes.len() as u64, unshadowed, Some(maps)))
     }
 
     /// With `--shadows rays`: the moving objects' hierarchy and the frame's shadow casters
@@ -747,6 +759,13 @@ impl Renderer {
         (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64
     }
 
+    /// Does `info`'s technique (prepared) re-use one light's shadow maps?
+    fn reuses_shadow_maps(&self, info: &pipelines::PipelineInfo) -> bool {
+        self.techniques
+            .get(info.id)
+            .is_some_and(|t| t.reuses_shadow_maps())
+    }
+
     /// Group 0 again, after a buffer it binds was replaced.
     fn rebind_scene(&mut self) {
         (self.scene_bind_group, self.cull_bind_group) = Self::bind_scene(
@@ -778,6 +797,12 @@ impl Renderer {
         let queue = &self.queue;
         let technique = self.techniques.get_mut(info.id).expect("prepared");
         self.timer.reset();
+        let reused = up.shadow_maps.as_ref().filter(|m| m.reused).map(|frame| {
+            crate::passes::shadow_atlas::ReusedMaps {
+                atlas: &self.shadow_atlas,
+                frame,
+            }
+        });
         let inputs = FrameInputs {
             device,
             queue,
@@ -792,6 +817,9 @@ impl Renderer {
             setup: up.setup,
             lights: &up.state.lights,
             count_blend: self.count_blend,
+            reused_shadow_maps: reused
+                .as_ref()
+                .map(|r| r as &dyn crate::frame::ReusedShadowMaps),
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
         self.counters.clear(enc.parts().0);
@@ -800,11 +828,24 @@ impl Renderer {
                 .0
                 .clear_buffer(&self.targets.pixel_counts, 0, None);
         }
-        if let Some(layout) = &up.shadow_layout {
+        // Shadow maps all in flight before shading; a re-using pipeline renders each light's
+        // itself, and the atlas after it for the transparent pass's forward shading.
+        let atlas_at = |before: bool| {
+            up.shadow_maps
+                .as_ref()
+                .filter(|m| m.reused != before && (before || inputs.has_transparency()))
+        };
+        if let Some(m) = atlas_at(true) {
             let (encoder, timer) = enc.parts();
-            self.shadow_atlas.encode(encoder, timer, &inputs, layout);
+            self.shadow_atlas
+                .encode_all(encoder, timer, &inputs, &m.atlas);
         }
         technique.encode(&inputs, &mut enc)?;
+        if let Some(m) = atlas_at(false) {
+            let (encoder, timer) = enc.parts();
+            self.shadow_atlas
+                .encode_all(encoder, timer, &inputs, &m.atlas);
+        }
         if analysis && inputs.has_transparency() {
             self.readbacks
                 .encode_opaque_counts(enc.parts().0, &self.targets);
@@ -926,7 +967,7 @@ impl Renderer {
             throttle_ms = start.elapsed().as_secs_f64() * 1e3;
         }
         self.collect(false)?;
-        let up = self.upload(state)?;
+        let up = self.upload(state, self.reuses_shadow_maps(info))?;
         let (serial, io, index) = self.encode_frame(info, &up, false)?;
         self.in_flight.push_back(index);
         while self.in_flight.len() > MAX_FRAMES_IN_FLIGHT {
@@ -980,7 +1021,7 @@ impl Renderer {
         self.finish()?;
         let mut reruns = 0u32;
         // A rerun records the same uploaded frame again with the grown lists.
-        let up = self.upload(state)?;
+        let up = self.upload(state, self.reuses_shadow_maps(info))?;
         loop {
             let start = Instant::now();
             let (serial, io, _) = self.encode_frame(info, &up, true)?;
@@ -1043,6 +1084,17 @@ impl Renderer {
                 reruns,
                 wall_ms,
                 unshadowed: up.unshadowed,
+                shadow_maps: up
+                    .shadow_maps
+                    .as_ref()
+                    .map(|m| crate::stats::ShadowMapStats {
+                        bytes: u64::from(self.shadow_atlas.size.0)
+                            * u64::from(self.shadow_atlas.size.1)
+                            * 4,
+                        face: m.layout.tile,
+                        faces: m.matrices.len() as u32,
+                        reused: m.reused,
+                    }),
                 resolved_in_kernel: self
                     .techniques
                     .get(info.id)

@@ -29,6 +29,20 @@ impl TimingSource {
 }
 
 /// Statistics of one rendered frame.
+/// A frame's shadow maps (`crate::shadows::maps`).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShadowMapStats {
+    /// Bytes of the depth texture the maps were rendered into this frame.
+    pub bytes: u64,
+    /// Texels on a side of one face.
+    pub face: u32,
+    /// Faces rendered (six per cube, one per narrow spot).
+    pub faces: u32,
+    /// One light's maps re-used light by light (the light-volume pipelines), or every
+    /// light's in flight in an atlas.
+    pub reused: bool,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameStats {
     pub scene: String,
@@ -83,6 +97,9 @@ pub struct FrameStats {
     /// Lights lit without shadows this frame (`--shadow-lights`; None without shadows).
     #[serde(default)]
     pub unshadowed_lights: Option<u32>,
+    /// The shadow maps' memory and resolution (`--shadows maps`).
+    #[serde(default)]
+    pub shadow_maps: Option<ShadowMapStats>,
     /// Where the MSAA deferred kernel resolved this frame: `kernel` (Trick 1) or `separate`
     /// (per-sample buffer, tonemap); None for other frames.
     #[serde(default)]

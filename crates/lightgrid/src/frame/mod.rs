@@ -12,9 +12,9 @@ pub mod targets;
 
 pub use settings::{
     validate_msaa, validate_sample_culling, validate_shadow_atlas, validate_shadow_lights,
-    validate_slices, validate_tile_size, validate_zbin_culling, Assign, Brdf, CellBox, DepthBounds,
-    DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop, MaterialDraws, MsaaResolve,
-    RenderSettings, Shadows, SpotCull, AUTO_GATHER_MAX_LIGHTS,
+    validate_shadow_map_size, validate_slices, validate_tile_size, validate_zbin_culling, Assign,
+    Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop,
+    MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};
 
@@ -46,6 +46,18 @@ pub struct FrameInputs<'a> {
     pub lights: &'a [Light],
     /// The count target is blended into (see `PipelineContext::count_blend`).
     pub count_blend: bool,
+    /// `--shadows maps` in a pipeline that re-uses one light's maps (its
+    /// `Technique::reuses_shadow_maps`): render each shadowed light's maps before its volume.
+    pub reused_shadow_maps: Option<&'a dyn ReusedShadowMaps>,
+}
+
+/// Re-used shadow maps (`crate::shadows::maps`): the light-volume pipelines shade one light at
+/// a time and render a shadowed light's maps into the same six tiles just before it.
+pub trait ReusedShadowMaps {
+    /// Does light `i` cast shadows this frame?
+    fn casts(&self, light: usize) -> bool;
+    /// Record light `i`'s maps into the re-used tiles.
+    fn encode_light(&self, encoder: &mut wgpu::CommandEncoder, f: &FrameInputs, light: usize);
 }
 
 impl FrameInputs<'_> {

@@ -52,6 +52,13 @@ pub struct RenderSettings {
     /// The shadow atlas's budget in MiB (`--shadow-atlas`, `--shadows maps`).
     #[serde(default = "default_shadow_atlas")]
     pub shadow_atlas: u32,
+    /// The largest shadow-map face in texels (`--shadow-map-size`, `--shadows maps`).
+    #[serde(default = "default_shadow_map_size")]
+    pub shadow_map_size: u32,
+}
+
+fn default_shadow_map_size() -> u32 {
+    crate::shadows::maps::MAX_TILE
 }
 
 fn default_shadow_atlas() -> u32 {
@@ -270,6 +277,7 @@ impl Default for RenderSettings {
             shadows: Shadows::Off,
             shadow_lights: None,
             shadow_atlas: crate::consts::DEFAULT_SHADOW_ATLAS_MIB,
+            shadow_map_size: crate::shadows::maps::MAX_TILE,
         }
     }
 }
@@ -290,6 +298,7 @@ impl RenderSettings {
         validate_zbin_culling(self.assign, self.depth_mask, self.cell_box)?;
         validate_shadow_lights(self.shadow_lights)?;
         validate_shadow_atlas(self.shadow_atlas)?;
+        validate_shadow_map_size(self.shadow_map_size)?;
         validate_slices(self.slices)
     }
 }
@@ -404,6 +413,18 @@ pub fn validate_shadow_atlas(mib: u32) -> crate::error::Result<()> {
         return Err(crate::error::Error::invalid(
             "shadow-atlas",
             format!("{mib}: must be between 1 and {MAX_ATLAS_MIB} MiB"),
+        ));
+    }
+    Ok(())
+}
+
+/// `--shadow-map-size`: a power of two from `MIN_TILE` to `MAX_TILE` texels.
+pub fn validate_shadow_map_size(texels: u32) -> crate::error::Result<()> {
+    use crate::shadows::maps::{MAX_TILE, MIN_TILE};
+    if !(MIN_TILE..=MAX_TILE).contains(&texels) || !texels.is_power_of_two() {
+        return Err(crate::error::Error::invalid(
+            "shadow-map-size",
+            format!("{texels}: must be a power of two from {MIN_TILE} to {MAX_TILE}"),
         ));
     }
     Ok(())

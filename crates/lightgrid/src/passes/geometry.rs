@@ -362,6 +362,18 @@ pub(crate) fn lighting_attachments<'a>(
     ]
 }
 
+/// [`lighting_attachments`] as an earlier pass left them (the light-volume passes between
+/// re-used shadow maps).
+pub(crate) fn lighting_attachments_loaded<'a>(
+    f: &'a FrameInputs,
+) -> [Option<wgpu::RenderPassColorAttachment<'a>>; 2] {
+    [
+        Some(crate::passes::loaded(&f.targets.hdr)),
+        crate::frame::targets::counts_in_target(f.count_blend, f.targets.samples)
+            .then(|| crate::passes::loaded(&f.targets.counts)),
+    ]
+}
+
 /// Colour targets of a forward lighting pipeline: HDR and (when countable, without MSAA) the
 /// count target.
 pub(crate) fn lighting_targets(

@@ -160,6 +160,38 @@ pub struct VolumeClasses {
     pub cones_from: [u32; 4],
 }
 
+/// The first one-at-a-time class slot of [`LightVolumes`].
+pub const SHADOWED: usize = 4;
+
+impl VolumeClasses {
+    /// Split the classes: the lights `casts` says cast re-used shadow maps (drawn one at a
+    /// time after their maps), and the rest; each list keeps its order (spheres, then cones).
+    pub fn split(self, casts: impl Fn(usize) -> bool, lights: &[Light]) -> (Self, Self) {
+        let part = |list: Vec<u32>| -> (Vec<u32>, Vec<u32>) {
+            list.into_iter().partition(|&i| !casts(i as usize))
+        };
+        let (front, sf) = part(self.front);
+        let (back, sb) = part(self.back);
+        let (full, sfl) = part(self.full);
+        let (stencil, ss) = part(self.stencil);
+        let with_cones = |front: Vec<u32>, back: Vec<u32>, full: Vec<u32>, stencil: Vec<u32>| {
+            let cones_from = [&front, &back, &full, &stencil]
+                .map(|list| list.partition_point(|&i| !cone_volume(&lights[i as usize])) as u32);
+            VolumeClasses {
+                front,
+                back,
+                full,
+                stencil,
+                cones_from,
+            }
+        };
+        (
+            with_cones(front, back, full, stencil),
+            with_cones(sf, sb, sfl, ss),
+        )
+    }
+}
+
 /// Sort the lights into draw classes (see the module docs). Lights that cannot reach any
 /// sample (entirely behind the near plane or beyond the far plane) are left out.
 pub fn classify_lights(setup: &ViewSetup, lights: &[Light], stencil: bool) -> VolumeClasses {
@@ -304,8 +336,12 @@ pub struct LightVolumes {
     cone: Range<u32>,
     cone_base: i32,
     instances: wgpu::Buffer,
-    ranges: [Range<u32>; 4],
-    cones_from: [u32; 4],
+    /// Per class slot (front, back, full, stencil), then per class slot of the lights drawn
+    /// one at a time after their re-used shadow maps ([`SHADOWED`] + class).
+    ranges: [Range<u32>; 8],
+    cones_from: [u32; 8],
+    /// The lights drawn one at a time: (class slot, instance, light index).
+    shadowed: Vec<(usize, u32, u32)>,
     pub depth: wgpu::TextureView,
     /// [`volume_depth_format`] on this device.
     pub depth_format: wgpu::TextureFormat,
@@ -398,7 +434,8 @@ impl LightVolumes {
             cone_base,
             instances: instance_buffer(device, 1 << 14),
             ranges: Default::default(),
-            cones_from: [0; 4],
+            cones_from: [0; 8],
+            shadowed: Vec::new(),
             depth,
             depth_format,
             samples,
@@ -408,18 +445,44 @@ impl LightVolumes {
 
     /// Upload this frame's classes.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, c: &VolumeClasses) {
-        let mut all =
-            Vec::with_capacity(c.front.len() + c.back.len() + c.full.len() + c.stencil.len());
+        self.upload_split(device, queue, c, &VolumeClasses::default());
+    }
+
+    /// Upload this frame's classes: `c` drawn together, `shadowed` one light at a time
+    /// ([`Self::shadowed`], [`Self::draw_one`]) after each one's re-used shadow maps.
+    pub fn upload_split(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        c: &VolumeClasses,
+        shadowed: &VolumeClasses,
+    ) {
+        let mut all = Vec::new();
         let mut start = 0u32;
+        self.shadowed.clear();
         for (slot, list) in [&c.front, &c.back, &c.full, &c.stencil]
             .into_iter()
+            .chain([
+                &shadowed.front,
+                &shadowed.back,
+                &shadowed.full,
+                &shadowed.stencil,
+            ])
             .enumerate()
         {
             all.extend_from_slice(list);
             self.ranges[slot] = start..start + list.len() as u32;
+            if slot >= SHADOWED {
+                self.shadowed.extend(
+                    list.iter()
+                        .enumerate()
+                        .map(|(k, &light)| (slot, self.ranges[slot].start + k as u32, light)),
+                );
+            }
             start += list.len() as u32;
         }
-        self.cones_from = c.cones_from;
+        self.cones_from[..4].copy_from_slice(&c.cones_from);
+        self.cones_from[4..].copy_from_slice(&shadowed.cones_from);
         let bytes: &[u8] = bytemuck::cast_slice(&all);
         if bytes.len() as u64 > self.instances.size() {
             self.instances = instance_buffer(device, (bytes.len() as u64).next_power_of_two());
@@ -431,6 +494,41 @@ impl LightVolumes {
 
     pub fn stencil_count(&self) -> u32 {
         self.ranges[3].len() as u32
+    }
+
+    /// The lights drawn one at a time this frame, in order: (class slot, instance, light),
+    /// for [`Self::draw_one`].
+    pub fn shadowed(&self) -> Vec<(usize, u32, u32)> {
+        self.shadowed.clone()
+    }
+
+    /// The class a one-at-a-time slot holds, and the draws it takes: `Front`, `Back` or `Full`
+    /// with the class's pipeline, or for the stencil class `StencilMark` then `StencilLight`.
+    pub fn shadowed_class(slot: usize) -> VolumeDraw {
+        match slot - SHADOWED {
+            0 => VolumeDraw::Front,
+            1 => VolumeDraw::Back,
+            2 => VolumeDraw::Full,
+            _ => VolumeDraw::StencilLight,
+        }
+    }
+
+    /// Draw instance `i` of one-at-a-time slot `slot` as `draw` with the bound pipeline, made
+    /// for `shading`.
+    pub fn draw_one(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        (slot, i): (usize, u32),
+        draw: VolumeDraw,
+        shading: Shading,
+    ) {
+        self.bind(pass);
+        pass.set_stencil_reference(stencil_reference(draw, shading));
+        if draw == VolumeDraw::Full {
+            pass.draw(0..3, i..i + 1);
+        } else {
+            self.draw_instances(pass, slot, i..i + 1);
+        }
     }
 
     /// A pipeline for one kind of volume draw (see [`VolumeDraw`]).
@@ -725,6 +823,19 @@ impl LightVolumes {
     /// pre-pass's shading pass, [`Self::loaded_attachment`]).
     pub fn kept_attachment(&self) -> wgpu::RenderPassDepthStencilAttachment<'_> {
         let mut a = self.attachment();
+        for store in [
+            &mut a.depth_ops.as_mut().expect("depth").store,
+            &mut a.stencil_ops.as_mut().expect("stencil").store,
+        ] {
+            *store = wgpu::StoreOp::Store;
+        }
+        a
+    }
+
+    /// The copy as an earlier pass left it, kept for the next (the passes between re-used
+    /// shadow maps).
+    pub fn reloaded_attachment(&self) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+        let mut a = self.loaded_attachment();
         for store in [
             &mut a.depth_ops.as_mut().expect("depth").store,
             &mut a.stencil_ops.as_mut().expect("stencil").store,

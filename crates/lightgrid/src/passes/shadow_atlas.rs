@@ -19,7 +19,8 @@ pub fn shader() -> ComposedShader {
 }
 
 pub(crate) struct ShadowAtlas {
-    pub side: u32,
+    /// The texture's size (1x1 without shadow maps).
+    pub size: (u32, u32),
     pub view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
     /// With shadow maps: the pipeline drawing the faces and its group 0's layout.
@@ -28,13 +29,35 @@ pub(crate) struct ShadowAtlas {
 }
 
 impl ShadowAtlas {
-    /// An atlas of `side` texels; `maps`: with the pipeline that draws into it.
-    pub fn new(device: &wgpu::Device, side: u32, maps: bool) -> ShadowAtlas {
+    /// A 1x1 texture; `maps`: with the pipeline that draws into it ([`Self::fit`] sizes it).
+    pub fn new(device: &wgpu::Device, maps: bool) -> ShadowAtlas {
+        let pipeline = maps.then(|| Self::pipeline(device));
+        ShadowAtlas {
+            size: (1, 1),
+            view: Self::texture(device, (1, 1)),
+            sampler: Self::sampler(device),
+            pipeline,
+            bind_group: None,
+        }
+    }
+
+    /// Make the texture `size` (what a frame's layout needs). Returns true when it was
+    /// replaced (group 0 binds its view).
+    pub fn fit(&mut self, device: &wgpu::Device, size: (u32, u32)) -> bool {
+        if self.size == size {
+            return false;
+        }
+        self.view = Self::texture(device, size);
+        self.size = size;
+        true
+    }
+
+    fn texture(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::TextureView {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow atlas"),
+            label: Some("shadow maps"),
             size: wgpu::Extent3d {
-                width: side,
-                height: side,
+                width,
+                height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -44,24 +67,19 @@ impl ShadowAtlas {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
-        let view = texture.create_view(&Default::default());
-        // Bilinear comparison: 2x2 PCF. Reversed depth: a sample is lit where it is at
-        // least as near the light as the nearest occluder.
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        texture.create_view(&Default::default())
+    }
+
+    /// Bilinear comparison: 2x2 PCF. Reversed depth: a sample is lit where it is at least as
+    /// near the light as the nearest occluder.
+    fn sampler(device: &wgpu::Device) -> wgpu::Sampler {
+        device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("shadow comparison"),
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
             compare: Some(wgpu::CompareFunction::GreaterEqual),
             ..Default::default()
-        });
-        let pipeline = maps.then(|| Self::pipeline(device));
-        ShadowAtlas {
-            side,
-            view,
-            sampler,
-            pipeline,
-            bind_group: None,
-        }
+        })
     }
 
     fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
@@ -131,13 +149,39 @@ impl ShadowAtlas {
         }
     }
 
-    /// Render the frame's faces: every opaque run that is not alpha tested, once per tile.
-    pub fn encode(
+    /// All in flight: every face of the frame into its own tile of the atlas.
+    pub fn encode_all(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut PassTimer,
         f: &FrameInputs,
         layout: &AtlasLayout,
+    ) {
+        let faces: Vec<(u32, u32)> = (0..layout.tiles).map(|t| (t, t)).collect();
+        self.encode(encoder, timer.render_pass("shadow maps"), f, layout, &faces);
+    }
+
+    /// Re-used: one light's faces `first..first + count` into the six tiles, before its volume
+    /// (untimed: a frame may shade hundreds of shadowed lights).
+    pub fn encode_light(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        f: &FrameInputs,
+        layout: &AtlasLayout,
+        (first, count): (u32, u32),
+    ) {
+        let faces: Vec<(u32, u32)> = (0..count).map(|k| (k, first + k)).collect();
+        self.encode(encoder, None, f, layout, &faces);
+    }
+
+    /// Draw every opaque run that is not alpha tested once per (tile, face).
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+        f: &FrameInputs,
+        layout: &AtlasLayout,
+        faces: &[(u32, u32)],
     ) {
         let (Some((pipeline, _)), Some(bind_group)) = (&self.pipeline, &self.bind_group) else {
             return;
@@ -153,7 +197,7 @@ impl ShadowAtlas {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: timer.render_pass("shadow maps"),
+            timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -162,13 +206,33 @@ impl ShadowAtlas {
         pass.set_vertex_buffer(0, f.vertices.slice(..));
         pass.set_index_buffer(f.indices.slice(..), wgpu::IndexFormat::Uint32);
         let t = layout.tile as f32;
-        for tile in 0..layout.tiles {
+        for &(tile, face) in faces {
             let (x, y) = layout.origin(tile);
             pass.set_viewport(x as f32, y as f32, t, t, 0.0, 1.0);
             pass.set_scissor_rect(x, y, layout.tile, layout.tile);
             for d in f.opaque.iter().filter(|d| !d.alpha_test) {
-                pass.draw_indexed(d.first..d.first + d.count, 0, tile..tile + 1);
+                pass.draw_indexed(d.first..d.first + d.count, 0, face..face + 1);
             }
+        }
+    }
+}
+
+/// A frame's re-used maps (`FrameInputs::reused_shadow_maps`): the texture and the frame's
+/// faces.
+pub(crate) struct ReusedMaps<'a> {
+    pub atlas: &'a ShadowAtlas,
+    pub frame: &'a crate::shadows::maps::MapFrame,
+}
+
+impl crate::frame::ReusedShadowMaps for ReusedMaps<'_> {
+    fn casts(&self, light: usize) -> bool {
+        self.frame.faces_of(light).is_some()
+    }
+
+    fn encode_light(&self, encoder: &mut wgpu::CommandEncoder, f: &FrameInputs, light: usize) {
+        if let Some(faces) = self.frame.faces_of(light) {
+            self.atlas
+                .encode_light(encoder, f, &self.frame.layout, faces);
         }
     }
 }

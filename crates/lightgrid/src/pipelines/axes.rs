@@ -525,6 +525,19 @@ pub const AXES: &[Axis] = &[
         },
         label: |v| format!("{v} MiB atlas"),
     },
+    Axis {
+        flag: "shadow-map-size",
+        column: "shadow_map_size",
+        help: "the largest shadow-map face in texels with --shadows maps (a power of two, 16 to 1024); faces get smaller when the atlas cannot hold them at this size",
+        values: Vec::new,
+        applies: |_, s| s.shadows == Shadows::Maps,
+        get: |s| s.shadow_map_size.to_string(),
+        set: |s, v| {
+            s.shadow_map_size = number(v)?;
+            crate::frame::validate_shadow_map_size(s.shadow_map_size).map_err(|e| e.to_string())
+        },
+        label: |v| format!("{v}px maps"),
+    },
 ];
 
 /// The value of the setting `T` is the type of, in `settings`.

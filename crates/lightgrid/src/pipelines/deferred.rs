@@ -20,7 +20,10 @@
 //! Groups: 0 scene, 1 depth-copy source (copy draw only), 2 G-buffer.
 
 use super::RenderSettings;
-use super::{lighting_attachments, FrameEncoder, FrameInputs, PipelineContext, Technique};
+use super::{
+    lighting_attachments, lighting_attachments_loaded, FrameEncoder, FrameInputs, PipelineContext,
+    Technique,
+};
 use crate::error::Result;
 use crate::frame::targets::counts_in_target;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, LIGHT_BYTES};
@@ -145,7 +148,7 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
         device,
         &DeferredKey { layout, samples }
             .shader()
-            .specialized(ctx.shading),
+            .specialized(ctx.shading.reusing_maps()),
     );
     let targets = volume_targets(ctx.count_blend, samples);
     let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
@@ -249,7 +252,14 @@ pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
 impl Technique for Deferred {
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let classes = classify_lights(&f.setup, f.lights, self.stencil_mark.is_some());
-        self.volumes.upload(f.device, f.queue, &classes);
+        // With re-used shadow maps, each shadowed light is drawn alone after its maps.
+        let (together, alone) = match f.reused_shadow_maps {
+            Some(maps) => classes.split(|i| maps.casts(i), f.lights),
+            None => (classes, Default::default()),
+        };
+        self.volumes
+            .upload_split(f.device, f.queue, &together, &alone);
+        let alone = self.volumes.shadowed();
         let gbuffer_group = self.gbuffer.read_bind_group(f.device, f.targets);
         let copy_group = self.volumes.copy_bind_group(f.device, &f.targets.depth);
         let (encoder, timer) = enc.parts();
@@ -262,7 +272,11 @@ impl Technique for Deferred {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &lighting_attachments(f),
-            depth_stencil_attachment: Some(self.volumes.attachment()),
+            depth_stencil_attachment: Some(if alone.is_empty() {
+                self.volumes.attachment()
+            } else {
+                self.volumes.kept_attachment()
+            }),
             timestamp_writes: timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,
@@ -305,7 +319,50 @@ impl Technique for Deferred {
                 }
             }
         }
+        drop(pass);
+        for (slot, instance, light) in alone {
+            let maps = f.reused_shadow_maps.expect("split by them");
+            maps.encode_light(encoder, f, light as usize);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("deferred lighting (one shadowed light)"),
+                color_attachments: &lighting_attachments_loaded(f),
+                depth_stencil_attachment: Some(self.volumes.reloaded_attachment()),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(2, &gbuffer_group, &[]);
+            self.draw_alone(&mut pass, (slot, instance));
+        }
         Ok(())
+    }
+
+    fn reuses_shadow_maps(&self) -> bool {
+        true
+    }
+}
+
+impl Deferred {
+    /// One light of the one-at-a-time classes: its class's draws with every shader.
+    fn draw_alone(&self, pass: &mut wgpu::RenderPass, at: (usize, u32)) {
+        let class = LightVolumes::shadowed_class(at.0);
+        if class == VolumeDraw::StencilLight {
+            let mark = self.stencil_mark.as_ref().expect("stencil pipelines");
+            pass.set_pipeline(mark);
+            self.volumes
+                .draw_one(pass, at, VolumeDraw::StencilMark, Shading::PerPixel);
+        }
+        for s in &self.shaders {
+            let pipeline = match class {
+                VolumeDraw::Front => &s.front,
+                VolumeDraw::Back => &s.back,
+                VolumeDraw::Full => &s.full,
+                _ => s.stencil_light.as_ref().expect("stencil pipelines"),
+            };
+            pass.set_pipeline(pipeline);
+            self.volumes.draw_one(pass, at, class, s.shading);
+        }
     }
 }
 

@@ -52,7 +52,9 @@ use crate::passes::{
     additive, classify_lights, Fullscreen, FullscreenVolumeDesc, LightVolumes, Shading, VolumeDraw,
     VolumePipelineDesc, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT, MSAA_SURFACES_WGSL, VOLUME_WGSL,
 };
-use crate::passes::{cleared, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES};
+use crate::passes::{
+    cleared, loaded, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES,
+};
 use crate::shader::{
     compute_pipeline, create_module, src, ComposedShader, SampleStage, SamplesKey, ShaderKey,
     SCENE_PARTS,
@@ -472,11 +474,14 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.msaa;
+    // The volume variants shade one light at a time and re-use one light's shadow maps.
+    let shading = match mode {
+        Mode::Tiled => ctx.shading,
+        Mode::Full | Mode::Mono => ctx.shading.reusing_maps(),
+    };
     let module = create_module(
         device,
-        &LightPrepassKey::new(samples)
-            .shader()
-            .specialized(ctx.shading),
+        &LightPrepassKey::new(samples).shader().specialized(shading),
     );
     let attributes = geometry_pipeline(
         device,
@@ -623,7 +628,13 @@ impl LightPrepass {
             unreachable!("called for the volume variants only")
         };
         let classes = classify_lights(&f.setup, f.lights, false);
-        volumes.upload(f.device, f.queue, &classes);
+        // With re-used shadow maps, each shadowed light is drawn alone after its maps.
+        let (together, alone) = match f.reused_shadow_maps {
+            Some(maps) => classes.split(|i| maps.casts(i), f.lights),
+            None => (classes, Default::default()),
+        };
+        volumes.upload_split(f.device, f.queue, &together, &alone);
+        let alone = volumes.shadowed();
         let copy_group = volumes.copy_bind_group(f.device, &f.targets.depth);
         let label = if *mono {
             "irradiance (mono specular)"
@@ -660,11 +671,43 @@ impl LightPrepass {
                 volumes.draw(&mut pass, draw, s.shading);
             }
         }
+        drop(pass);
+        for (slot, instance, light) in alone {
+            let maps = f.reused_shadow_maps.expect("split by them");
+            maps.encode_light(encoder, f, light as usize);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("irradiance (one shadowed light)"),
+                color_attachments: &[
+                    Some(loaded(diffuse_view)),
+                    specular_view.as_ref().map(loaded),
+                    counts_in_target(f.count_blend, *samples).then(|| loaded(&f.targets.counts)),
+                ],
+                depth_stencil_attachment: Some(volumes.reloaded_attachment()),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(2, attr_group, &[]);
+            let class = LightVolumes::shadowed_class(slot);
+            let k = CLASSES
+                .iter()
+                .position(|&c| c == class)
+                .expect("no stencil class");
+            for s in shaders.iter() {
+                pass.set_pipeline(&s.classes[k]);
+                volumes.draw_one(&mut pass, (slot, instance), class, s.shading);
+            }
+        }
         Ok(())
     }
 }
 
 impl Technique for LightPrepass {
+    fn reuses_shadow_maps(&self) -> bool {
+        matches!(self.irradiance, Irradiance::Volumes { .. })
+    }
+
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
         let attr_group = bind_two(
             f.device,

@@ -83,6 +83,11 @@ pub trait Technique {
     fn resolved_to_display(&self) -> bool {
         false
     }
+    /// Does it shade one light at a time, re-using one light's shadow maps
+    /// (`FrameInputs::reused_shadow_maps`; the light-volume pipelines)?
+    fn reuses_shadow_maps(&self) -> bool {
+        false
+    }
 }
 
 /// How a pipeline renders with MSAA (`--msaa` above 1).
@@ -460,5 +465,6 @@ pub fn find(id: &str) -> Result<&'static PipelineInfo> {
 
 pub(crate) use crate::passes::geometry::{
     begin_lighting_pass, draw_scene, draw_scene_materials, geometry_pipeline, lighting_attachments,
-    lighting_targets, DepthPipelines, GeometryPipelineDesc, MaterialPipelines,
+    lighting_attachments_loaded, lighting_targets, DepthPipelines, GeometryPipelineDesc,
+    MaterialPipelines,
 };

@@ -127,6 +127,9 @@ pub struct Shading {
     pub brdf: Brdf,
     pub units: LightUnits,
     pub shadows: Shadows,
+    /// With shadow maps: the pipeline re-uses one light's maps (the classic deferred
+    /// family's light volumes, `crate::shadows::maps`), so a face's tile is its cube face's.
+    pub reuse_maps: bool,
 }
 
 impl Default for Shading {
@@ -136,6 +139,7 @@ impl Default for Shading {
             brdf: Brdf::Phong,
             units: LightUnits::Papers,
             shadows: Shadows::Off,
+            reuse_maps: false,
         }
     }
 }
@@ -147,11 +151,17 @@ impl Shading {
         for shadows in Shadows::ALL {
             for units in [LightUnits::Papers, LightUnits::Photometric] {
                 for brdf in [Brdf::Phong, Brdf::Ggx] {
-                    out.push(Shading {
-                        brdf,
-                        units,
-                        shadows,
-                    });
+                    for reuse_maps in [false, true] {
+                        if reuse_maps && shadows != Shadows::Maps {
+                            continue;
+                        }
+                        out.push(Shading {
+                            brdf,
+                            units,
+                            shadows,
+                            reuse_maps,
+                        });
+                    }
                 }
             }
         }
@@ -164,6 +174,24 @@ impl Shading {
             brdf: brdf.unwrap_or(lighting.brdf),
             units: lighting.units,
             shadows,
+            reuse_maps: false,
+        }
+    }
+
+    /// The same shading for a pipeline that re-uses one light's shadow maps.
+    pub fn reusing_maps(self) -> Shading {
+        Shading {
+            reuse_maps: true,
+            ..self
+        }
+    }
+
+    /// The light function's `SHADING_SHADOWS` (`consts::SHADOWS_*`).
+    pub fn shadows_gpu(self) -> u32 {
+        if self.shadows == Shadows::Maps && self.reuse_maps {
+            crate::consts::SHADOWS_MAPS_REUSED
+        } else {
+            self.shadows.gpu()
         }
     }
 }

@@ -348,7 +348,7 @@ fn specialize(source: &str, shading: Shading) -> String {
         )
         .replace(
             SHADING_SHADOWS_VALUE,
-            &format!("{}u", shading.shadows.gpu()),
+            &format!("{}u", shading.shadows_gpu()),
         )
 }
 

@@ -8,7 +8,8 @@
 // the model a frame does not use. A module made without them does not compile.
 const SHADING_BRDF: u32 = SHADING_BRDF_VALUE;
 const SHADING_FALLOFF: u32 = SHADING_FALLOFF_VALUE;
-// How lights are shadowed (SHADOWS_OFF, SHADOWS_RAYS or SHADOWS_MAPS), written in the same way.
+// How lights are shadowed (SHADOWS_OFF, SHADOWS_RAYS, SHADOWS_MAPS or SHADOWS_MAPS_REUSED),
+// written in the same way.
 const SHADING_SHADOWS: u32 = SHADING_SHADOWS_VALUE;
 
 // A shading sample: everything the light function needs, wherever it came from
@@ -119,7 +120,7 @@ fn light_terms(s: Surface, view_dir: vec3<f32>, index: u32) -> LightTerms {
     if (SHADING_SHADOWS == SHADOWS_RAYS && shadow_blocked(index, s.position, s.normal, light.position)) {
         return out;
     }
-    if (SHADING_SHADOWS == SHADOWS_MAPS) {
+    if (SHADING_SHADOWS == SHADOWS_MAPS || SHADING_SHADOWS == SHADOWS_MAPS_REUSED) {
         visible = shadow_map_visibility(index, s.position, s.normal, light.position, n_dot_l);
         if (visible <= 0.0) {
             return out;

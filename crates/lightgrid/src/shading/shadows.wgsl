@@ -116,16 +116,18 @@ fn shadow_blocked(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3<f32>) 
 
 // Shadow maps (`--shadows maps`; src/shadows/maps.rs): every shadowed light's faces are
 // tiles of one depth atlas, rendered before shading. The buffer then holds
-//   [0] bits: atlas side, tile side, tiles per row, slots' first vec4
-//   [1] bits: matrices' first vec4
-//   slots: per light 0 (unshadowed) or (first tile * 2 + cube) + 1, 4 per vec4
-//   matrices: per tile its view-projection's columns (camera-relative -> clip, depth near / w)
+//   [0] bits: texture width, tile side, the atlas's tiles per row, slots' first vec4
+//   [1] bits: matrices' first vec4, texture height
+//   slots: per light 0 (unshadowed) or (first face * 2 + cube) + 1, 4 per vec4
+//   matrices: per face its view-projection's columns (camera-relative -> clip, depth near / w)
+// Face f of a light lies in tile f of the atlas (all in flight), or in tile (f - first face)
+// of the one re-used cube, 3 tiles a row (SHADOWS_MAPS_REUSED: the light-volume pipelines).
 @group(0) @binding(9) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(10) var shadow_sampler: sampler_comparison;
 
-// A tile's view-projection.
-fn shadow_tile_matrix(tile: u32) -> mat4x4<f32> {
-    let at = bitcast<u32>(shadow_data[1].x) + 4u * tile;
+// A face's view-projection.
+fn shadow_tile_matrix(face: u32) -> mat4x4<f32> {
+    let at = bitcast<u32>(shadow_data[1].x) + 4u * face;
     return mat4x4<f32>(shadow_data[at], shadow_data[at + 1u], shadow_data[at + 2u], shadow_data[at + 3u]);
 }
 
@@ -151,9 +153,13 @@ fn shadow_map_visibility(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3
             face = select(5u, 4u, v.z > 0.0);
         }
     }
-    let tile = first + face;
-    let m = shadow_tile_matrix(tile);
-    let side = f32(h.x);
+    // Re-used maps hold one light's cube at a time: its face's own tile.
+    var tile = first + face;
+    if (SHADING_SHADOWS == SHADOWS_MAPS_REUSED) {
+        tile = face;
+    }
+    let m = shadow_tile_matrix(first + face);
+    let size = vec2<f32>(f32(h.x), f32(bitcast<u32>(shadow_data[1].y)));
     let tile_side = f32(h.y);
     // One texel's world size at the sample's distance along the face's axis: the matrix's
     // second row is the view's up axis times 1 / tan(half the field of view).
@@ -170,6 +176,10 @@ fn shadow_map_visibility(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3
         vec2<f32>(1.0),
         vec2<f32>(tile_side - 1.0),
     );
-    let origin = vec2<f32>(f32(tile % h.z), f32(tile / h.z)) * tile_side;
-    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, (origin + local) / side, ndc.z);
+    var per_row = h.z;
+    if (SHADING_SHADOWS == SHADOWS_MAPS_REUSED) {
+        per_row = 3u;
+    }
+    let origin = vec2<f32>(f32(tile % per_row), f32(tile / per_row)) * tile_side;
+    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, (origin + local) / size, ndc.z);
 }

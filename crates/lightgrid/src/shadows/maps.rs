@@ -1,14 +1,23 @@
-//! Shadow maps (`--shadows maps`): every shadowed light's maps in flight at once, in one
-//! **atlas** (tiled-shading §5, Table 1's "Re-use shadow maps" row: the tiled and clustered
-//! pipelines shade all lights in one pass, so every shadowed light's map must exist before it).
+//! Shadow maps (`--shadows maps`), in the two ways tiled-shading §5 contrasts (Table 1, row
+//! "Re-use shadow maps": deferred yes, tiled deferred and tiled forward no, "because all lights
+//! are in flight simultaneously"):
 //!
-//! A point light has a cube (six 90° faces), a spot whose half-angle is at most 60° one face
-//! around its axis, a wider spot a cube. Every face is a square tile of the atlas, a
-//! `Depth32Float` texture whose size is the budget (`--shadow-atlas MiB`: the largest power of
-//! two side whose texels fit it, capped by the device). **The tile rule**: with T faces this
-//! frame, the tiles are laid in rows of ⌈√T⌉, and a tile's side is the largest power of two
-//! that fits `side / ⌈√T⌉`, at most [`MAX_TILE`]: more shadowed lights, smaller maps. A frame
-//! whose faces would need tiles under [`MIN_TILE`] texels is refused with the numbers.
+//! - **All in flight** (forward, the tiled and clustered pipelines, and every pipeline's
+//!   transparent pass): every shadowed light's faces are rendered into one **atlas** before
+//!   shading. A point light has a cube (six 90° faces), a spot whose half-angle is at most 60°
+//!   one face around its axis, a wider spot a cube; each face is a square tile.
+//! - **Re-used** (the classic deferred family: `deferred`, `deferred_stencil`, `deferred_mono`,
+//!   `light_prepass`, `light_prepass_mono`, which shade one light volume at a time): one cube's
+//!   six tiles, rendered again just before each shadowed light's volume.
+//!
+//! **The tile rule**: the budget `--shadow-atlas MiB` is a square of 4-byte texels, its side
+//! the largest power of two that fits (capped by the device). With T faces this frame, the
+//! tiles are laid in rows of ⌈√T⌉, and a tile's side is the largest power of two that fits
+//! `side / ⌈√T⌉`, at most `--shadow-map-size` (and [`MAX_TILE`]): more shadowed lights,
+//! smaller maps. The atlas texture is as large as its rows of tiles need (so at one map size
+//! its memory grows with the shadowed lights, up to the budget); the re-used maps are six
+//! tiles of the same size, so both forms shade the same image. A frame whose faces would need
+//! tiles under [`MIN_TILE`] texels is refused with the numbers.
 //!
 //! Depth is reversed (near / w, an infinite far plane), cleared to 0. The light function
 //! (`shading/shadows.wgsl`, `shadow_map_visibility`) picks the face by the major axis, moves
@@ -46,37 +55,56 @@ pub fn atlas_side(mib: u32, max_dimension: u32) -> u32 {
     side
 }
 
-/// Where a frame's faces lie in the atlas.
+/// Where a frame's faces lie in the shadow texture, and how large it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AtlasLayout {
-    pub side: u32,
+    /// The texture's size in texels: all in flight, ⌈√T⌉ tiles a row and as many rows as
+    /// the faces fill; re-used, one cube's six tiles (3 x 2).
+    pub width: u32,
+    pub height: u32,
     pub tile: u32,
     pub per_row: u32,
+    /// Faces this frame (all in flight), or 6 (re-used).
     pub tiles: u32,
 }
 
 impl AtlasLayout {
-    /// The layout for `tiles` faces in an atlas of `side` texels (module docs: the tile rule).
-    pub fn new(side: u32, tiles: u32) -> Result<AtlasLayout, String> {
+    /// All in flight: the layout for `tiles` faces in a budget of `side`² texels with tiles
+    /// of at most `max_tile` (module docs: the tile rule).
+    pub fn new(side: u32, max_tile: u32, tiles: u32) -> Result<AtlasLayout, String> {
         let per_row = (f64::from(tiles.max(1))).sqrt().ceil() as u32;
-        let fit = side / per_row;
+        let fit = (side / per_row).min(max_tile.min(MAX_TILE));
         if fit < MIN_TILE {
             let most = (side / MIN_TILE).pow(2);
-            let mib = (u64::from(side) * u64::from(side) * 4) >> 20;
+            let mib = Self::bytes_of(side, side) >> 20;
             return Err(format!(
                 "the shadow atlas ({side}x{side} texels, {mib} MiB) holds at most {most} shadow-map faces of {MIN_TILE}x{MIN_TILE}; this frame's shadowed lights need {tiles} (a point light 6, a spot 1): raise --shadow-atlas or lower --shadow-lights"
             ));
         }
         let mut tile = MIN_TILE;
-        while tile * 2 <= fit && tile * 2 <= MAX_TILE {
+        while tile * 2 <= fit {
             tile *= 2;
         }
+        let rows = tiles.max(1).div_ceil(per_row);
         Ok(AtlasLayout {
-            side,
+            width: per_row * tile,
+            height: rows * tile,
             tile,
-            per_row: side / tile,
+            per_row,
             tiles,
         })
+    }
+
+    /// Re-used (the classic deferred family): one light's six faces at this layout's tile
+    /// size, rendered again before each shadowed light is shaded.
+    pub fn reused(&self) -> AtlasLayout {
+        AtlasLayout {
+            width: 3 * self.tile,
+            height: 2 * self.tile,
+            tile: self.tile,
+            per_row: 3,
+            tiles: 6,
+        }
     }
 
     /// Tile `t`'s top-left texel.
@@ -87,9 +115,13 @@ impl AtlasLayout {
         )
     }
 
-    /// Bytes of the whole atlas.
-    pub fn bytes(side: u32) -> u64 {
-        u64::from(side) * u64::from(side) * 4
+    /// Bytes of the texture.
+    pub fn bytes(&self) -> u64 {
+        Self::bytes_of(self.width, self.height)
+    }
+
+    fn bytes_of(w: u32, h: u32) -> u64 {
+        u64::from(w) * u64::from(h) * 4
     }
 }
 
@@ -168,18 +200,30 @@ pub fn cube_face(v: Vec3) -> u32 {
     }
 }
 
-/// One frame's maps: which tile each shadowed light starts at, and every tile's matrix.
+/// One frame's maps: each shadowed light's first face, every face's matrix, and where the
+/// faces lie (all in flight, or one light's at a time: `reused`).
 #[derive(Clone, Debug)]
 pub struct MapFrame {
+    /// The atlas of every face (the grid pipelines', and the transparent pass's).
+    pub atlas: AtlasLayout,
+    /// The layout the shaders read: the atlas, or its [`AtlasLayout::reused`] six tiles.
     pub layout: AtlasLayout,
-    /// Per light: 0 for none, else (first tile × 2 + cube) + 1 (`shadows.wgsl`).
+    pub reused: bool,
+    /// Per light: 0 for none, else (first face × 2 + cube) + 1 (`shadows.wgsl`).
     pub slots: Vec<u32>,
     pub matrices: Vec<Mat4>,
 }
 
 impl MapFrame {
-    /// `lights` camera-relative; `casters` from [`super::casters`].
-    pub fn new(lights: &[Light], casters: &[bool], side: u32) -> Result<MapFrame, String> {
+    /// `lights` camera-relative; `casters` from [`super::casters`]; an atlas budget of
+    /// `side`² texels and tiles of at most `max_tile`.
+    pub fn new(
+        lights: &[Light],
+        casters: &[bool],
+        side: u32,
+        max_tile: u32,
+        reused: bool,
+    ) -> Result<MapFrame, String> {
         let mut slots = vec![0; lights.len()];
         let mut matrices = Vec::new();
         for (i, l) in lights.iter().enumerate().filter(|&(i, _)| casters[i]) {
@@ -188,30 +232,55 @@ impl MapFrame {
             slots[i] = first * 2 + u32::from(m.len() == 6) + 1;
             matrices.extend(m);
         }
-        let layout = AtlasLayout::new(side, matrices.len() as u32)?;
+        let atlas = AtlasLayout::new(side, max_tile, matrices.len() as u32)?;
         Ok(MapFrame {
-            layout,
+            atlas,
+            layout: if reused { atlas.reused() } else { atlas },
+            reused,
             slots,
             matrices,
         })
     }
 
-    /// The shadow buffer for `--shadows maps` (`shadows.wgsl`): the header
-    /// `[bits(side), bits(tile), bits(per row), bits(slots' first vec4)]`,
-    /// `[bits(matrices' first vec4), 0, 0, 0]`, the slots (4 per vec4), then 4 vec4s (the
-    /// columns) per tile.
-    pub fn gpu_data(&self) -> Vec<[f32; 4]> {
+    /// Light `i`'s faces (first face, count), if it casts.
+    pub fn faces_of(&self, i: usize) -> Option<(u32, u32)> {
+        let s = *self.slots.get(i)?;
+        (s != 0).then(|| ((s - 1) >> 1, if (s - 1) & 1 == 1 { 6 } else { 1 }))
+    }
+
+    /// The texture both forms fit in: the re-used tiles, and the atlas too when `atlas_too`
+    /// (a re-using pipeline's frame with transparent objects, whose forward-shaded pass needs
+    /// every map in flight).
+    pub fn texture_size(&self, atlas_too: bool) -> (u32, u32) {
+        let l = &self.layout;
+        if atlas_too || !self.reused {
+            (
+                l.width.max(self.atlas.width),
+                l.height.max(self.atlas.height),
+            )
+        } else {
+            (l.width, l.height)
+        }
+    }
+
+    /// The shadow buffer for `--shadows maps` (`shadows.wgsl`) and a texture of `size`: the
+    /// header `[bits(width), bits(tile), bits(atlas's tiles per row), bits(slots' first
+    /// vec4)]`, `[bits(matrices' first vec4), bits(height), 0, 0]`, the slots (4 per vec4),
+    /// then 4 vec4s (the columns) per face. Which tile a face lies in (its own in the atlas, or
+    /// its cube face's when re-used: 3 a row) is the shader's constant (`SHADOWS_MAPS` or
+    /// `SHADOWS_MAPS_REUSED`).
+    pub fn gpu_data(&self, (width, height): (u32, u32)) -> Vec<[f32; 4]> {
         let slots_at = super::HEADER_VEC4S;
         let matrices_at = slots_at + self.slots.len().div_ceil(4) as u32;
         let bits = |v: u32| f32::from_bits(v);
         let mut out = vec![
             [
-                bits(self.layout.side),
-                bits(self.layout.tile),
-                bits(self.layout.per_row),
+                bits(width),
+                bits(self.atlas.tile),
+                bits(self.atlas.per_row),
                 bits(slots_at),
             ],
-            [bits(matrices_at), 0.0, 0.0, 0.0],
+            [bits(matrices_at), bits(height), 0.0, 0.0],
         ];
         for chunk in self.slots.chunks(4) {
             let mut v = [0u32; 4];
@@ -234,11 +303,21 @@ mod tests {
     fn more_faces_get_smaller_tiles_and_too_many_are_refused() {
         let side = atlas_side(64, 16384);
         assert_eq!(side, 4096);
-        assert_eq!(AtlasLayout::new(side, 6).unwrap().tile, MAX_TILE);
-        let many = AtlasLayout::new(side, 6 * 924).unwrap();
+        let one = AtlasLayout::new(side, MAX_TILE, 6).unwrap();
+        assert_eq!(
+            (one.tile, one.width, one.height),
+            (MAX_TILE, 3 * MAX_TILE, 2 * MAX_TILE)
+        );
+        assert_eq!(one.reused(), one);
+        let many = AtlasLayout::new(side, MAX_TILE, 6 * 924).unwrap();
         assert_eq!(many.tile, 32);
-        assert!(many.per_row * many.per_row >= many.tiles);
-        let e = AtlasLayout::new(atlas_side(1, 16384), 6 * 1000).unwrap_err();
+        assert!(many.per_row * (many.height / many.tile) >= many.tiles);
+        assert!(many.width <= side && many.height <= side);
+        // A cap on the tile keeps the resolution and grows the texture with the faces.
+        let capped = AtlasLayout::new(atlas_side(1024, 16384), 64, 6 * 924).unwrap();
+        assert_eq!(capped.tile, 64);
+        assert!(capped.bytes() > 64 * capped.reused().bytes());
+        let e = AtlasLayout::new(atlas_side(1, 16384), MAX_TILE, 6 * 1000).unwrap_err();
         assert!(e.contains("raise --shadow-atlas"), "{e}");
         assert_eq!(atlas_side(1, 16384), 512);
         assert_eq!(atlas_side(4096, 8192), 8192);
@@ -305,13 +384,19 @@ mod tests {
                 ..Light::point(Vec3::Y, Vec3::ONE, 1.0, 5.0)
             },
         ];
-        let f = MapFrame::new(&lights, &[true, false, true], 1024).unwrap();
+        let f = MapFrame::new(&lights, &[true, false, true], 1024, MAX_TILE, false).unwrap();
         assert_eq!(f.slots, vec![1 + 1, 0, 6 * 2 + 1]);
+        assert_eq!(f.faces_of(0), Some((0, 6)));
+        assert_eq!(f.faces_of(1), None);
+        assert_eq!(f.faces_of(2), Some((6, 1)));
         assert_eq!(f.matrices.len(), 7);
-        let data = f.gpu_data();
+        let data = f.gpu_data(f.texture_size(false));
         assert_eq!(data.len(), 2 + 1 + 7 * 4);
         assert_eq!(data[0][3].to_bits(), 2);
         assert_eq!(data[1][0].to_bits(), 3);
         assert_eq!(data[2][2].to_bits(), 13);
+        let r = MapFrame::new(&lights, &[true, false, true], 1024, MAX_TILE, true).unwrap();
+        assert_eq!(r.layout, r.atlas.reused());
+        assert_eq!(r.layout.tiles, 6);
     }
 }
