@@ -1179,6 +1179,58 @@ fn shadow_options_out_of_range_are_refused() {
         &render(&["--shadows", "sometimes"]),
         "invalid value 'sometimes' for '--shadows <shadows>'",
     );
+    // The atlas's budget and a face's size: zero, negative, NaN, past their limits, not a
+    // power of two.
+    for (flag, bad) in [
+        ("--shadow-atlas", "0"),
+        ("--shadow-atlas", "-1"),
+        ("--shadow-atlas", "nan"),
+        ("--shadow-atlas", "5000"),
+        ("--shadow-map-size", "0"),
+        ("--shadow-map-size", "100"),
+        ("--shadow-map-size", "2048"),
+        ("--shadow-map-size", "-16"),
+    ] {
+        let r = run(&render(&["--shadows", "maps", flag, bad]));
+        assert!(!r.status.success(), "{flag} {bad} accepted");
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(
+            err.contains(flag) && !err.contains("panicked"),
+            "{flag} {bad}: {err}"
+        );
+    }
+    // They apply to shadow maps only.
+    fails_with(
+        &render(&["--shadows", "rays", "--shadow-atlas", "8"]),
+        "none without --shadows maps",
+    );
+}
+
+/// An atlas too small for the frame's shadowed lights at the smallest face is refused with
+/// the numbers and what to change, and writes nothing.
+#[test]
+fn a_shadow_atlas_too_small_for_the_lights_is_refused() {
+    let dir = temp_dir("small-atlas");
+    let out = dir.join("s.png");
+    let args = [
+        "render",
+        "--scene",
+        "robots-many",
+        "--size",
+        "64x36",
+        "--shadows",
+        "maps",
+        "--shadow-atlas",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    assert_fails_with(
+        &args,
+        "holds at most 1024 shadow-map faces of 16x16; this frame's shadowed lights need",
+    );
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// 256 slices of 4-pixel tiles at 2000x1200 is 38 million cells, whose bounds no storage

@@ -443,6 +443,19 @@ fn robots_many_with_ray_shadows() {
     check_scene("robots-many", 200, (160, 90), settings);
 }
 
+/// The street with shadow maps for its 128 most important lights: the atlas in the grid
+/// pipelines and `forward`, one light's re-used maps in the light-volume pipelines; every
+/// pipeline equals its reference.
+#[test]
+fn robots_many_with_shadow_maps() {
+    let settings = RenderSettings {
+        shadows: lightgrid::scene::Shadows::Maps,
+        shadow_lights: Some(128),
+        ..settings(16)
+    };
+    check_scene("robots-many", 200, (160, 90), settings);
+}
+
 #[test]
 fn deferred_stencil_culls_more_than_deferred_on_robots_many() {
     let ctx = common::gpu();

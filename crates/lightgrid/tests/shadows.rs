@@ -79,7 +79,8 @@ fn ground_point(f: &Frame, x: f64, y: f64) -> Option<Vec3> {
 /// The shadow's outline lies where the box's corners put it, within a pixel: every ground
 /// pixel whose whole square (centre and corners) is in shadow by the box's geometry shows only
 /// the ambient term, and every one wholly out of it is lit, in `forward` and in pipelines of
-/// each family. The same scene without shadows has no dark ground pixel.
+/// each family, with rays and with shadow maps (atlas, and re-used by the light-volume
+/// pipelines). The same scene without shadows has no dark ground pixel.
 #[test]
 fn a_box_on_a_plane_casts_the_shadow_its_corners_say() {
     let ctx = common::gpu();
@@ -91,16 +92,26 @@ fn a_box_on_a_plane_casts_the_shadow_its_corners_say() {
         shadows: Shadows::Rays,
         ..RenderSettings::default()
     };
-    let mut r = Renderer::new(&ctx, SIZE, SIZE, settings).unwrap();
     let mut unshadowed = Renderer::new(&ctx, SIZE, SIZE, RenderSettings::default()).unwrap();
     let plain = unshadowed.render(&scene, 0, "forward").unwrap().image;
-    for pipeline in [
+    let pipelines = [
         "forward",
         "clustered_deferred",
         "tiled_forward",
         "deferred_stencil",
-    ] {
+        "light_prepass",
+    ];
+    for (shadows, pipeline) in [Shadows::Rays, Shadows::Maps]
+        .into_iter()
+        .flat_map(|s| pipelines.map(|p| (s, p)))
+    {
+        let settings = RenderSettings {
+            shadows,
+            ..settings
+        };
+        let mut r = Renderer::new(&ctx, SIZE, SIZE, settings).unwrap();
         let out = r.render(&scene, 0, pipeline).unwrap();
+        let pipeline = format!("{pipeline} --shadows {}", shadows.name());
         let (mut in_shadow, mut lit) = (0, 0);
         for py in 0..SIZE {
             for px in 0..SIZE {
@@ -139,8 +150,17 @@ fn a_box_on_a_plane_casts_the_shadow_its_corners_say() {
             in_shadow > 300 && lit > 3000,
             "{pipeline}: {in_shadow} / {lit}"
         );
-        let rays = out.stats.shadow_rays.unwrap();
-        assert!(rays > 0, "{pipeline}: no rays counted");
+        if shadows == Shadows::Rays {
+            assert!(
+                out.stats.shadow_rays.unwrap() > 0,
+                "{pipeline}: no rays counted"
+            );
+        } else {
+            let maps = out.stats.shadow_maps.unwrap();
+            assert_eq!((maps.faces, maps.face), (6, 1024), "{pipeline}");
+            // One cube either way: the atlas holds its six faces, as the re-used tiles do.
+            assert_eq!(maps.bytes, 6 * 1024 * 1024 * 4, "{pipeline}");
+        }
         assert_eq!(out.stats.unshadowed_lights, Some(0));
     }
 }
@@ -236,4 +256,32 @@ fn shadow_lights_choose_the_casters_and_count_the_rest() {
         s_off > s_one && s_one > s_all,
         "{s_off} > {s_one} > {s_all}"
     );
+}
+
+/// Shadow maps (every light's cube in the atlas at 1024-texel faces) shade what the
+/// reference's rays say at the same sampled pixels: no acne on lit surfaces, no light leaking
+/// into shadows, on the street with its robots and on the block field.
+#[test]
+fn forward_with_shadow_maps_equals_the_reference_that_casts_rays() {
+    let ctx = common::gpu();
+    for name in ["robots-few", "random-top"] {
+        let params = SceneParams {
+            headlights: name.starts_with("robots"),
+            spot_fraction: 0.3,
+            ..Default::default()
+        };
+        let scene = catalog::build(name, &params).unwrap();
+        let frame = scene.frame_count() / 3;
+        let settings = RenderSettings {
+            shadows: Shadows::Maps,
+            shadow_atlas: 1024,
+            ..RenderSettings::default()
+        };
+        let c = check_with(&ctx, &scene, frame, (128, 72), 4, settings);
+        eprintln!("{name} frame {frame} maps: {c:?}");
+        assert!(
+            c.pixels >= 100 && c.shadowed * 10 >= c.pixels,
+            "{name}: {c:?}"
+        );
+    }
 }
