@@ -178,6 +178,62 @@ ns per lighting computation: the slope of GPU frame time against lighting comput
     }
 }
 
+/// Shadows (`--shadows`): per run with shadows, the frame time, the shadow-map texture's
+/// memory and face size (re-used or all in flight), and the shadow rays per frame.
+fn shadows_section(s: &mut String, results: &BenchResults, scene: &str) {
+    use lightgrid::scene::Shadows;
+    let runs: Vec<&RunRecord> = results
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.summary.is_some())
+        .filter(|r| r.settings.shadows != Shadows::Off)
+        .collect();
+    if runs.is_empty() {
+        return;
+    }
+    s.push_str("
+### Shadows: time, shadow-map memory, rays
+
+Means over the frames. Maps: the depth texture the frame's maps were rendered into (all in flight in an atlas, or one light's re-used by the light-volume pipelines) and a face's side; rays: shadow rays cast per frame.
+
+| run | avg ms | unshadowed lights | maps MiB | face | maps | rays per frame |
+|---|---|---|---|---|---|---|
+");
+    for r in runs {
+        let n = r.frames.len().max(1) as f64;
+        let mean = |f: &dyn Fn(&crate::FrameRecord) -> Option<f64>| {
+            let v: Vec<f64> = r.frames.iter().filter_map(f).collect();
+            (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        };
+        let bytes = mean(&|f| f.stats.shadow_maps.map(|m| m.bytes as f64));
+        let maps = r.frames.iter().find_map(|f| f.stats.shadow_maps);
+        let rays = mean(&|f| f.stats.shadow_rays.map(|x| x as f64));
+        let unshadowed: f64 = r
+            .frames
+            .iter()
+            .filter_map(|f| f.stats.unshadowed_lights)
+            .map(f64::from)
+            .sum::<f64>()
+            / n;
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {unshadowed:.0} | {} | {} | {} | {} |",
+            run_name(r),
+            r.summary.as_ref().expect("filtered").gpu_ms.mean,
+            bytes.map_or("-".into(), |b| format!("{:.2}", b / (1024.0 * 1024.0))),
+            maps.map_or("-".into(), |m| format!("{}²", m.face)),
+            maps.map_or("-".into(), |m| {
+                if m.reused {
+                    "re-used".to_string()
+                } else {
+                    "atlas".to_string()
+                }
+            }),
+            rays.map_or("-".into(), |x| format!("{x:.0}")),
+        );
+    }
+}
+
 /// Test (b) of the spot culling over the scene's frames, when it was measured.
 fn spot_ray_section(s: &mut String, results: &BenchResults, scene: &str) {
     let tests: Vec<_> = results
@@ -772,6 +828,7 @@ fn summary(results: &BenchResults) -> String {
         spot_ray_section(&mut s, results, scene);
         msaa_section(&mut s, results, scene);
         brdf_section(&mut s, results, scene);
+        shadows_section(&mut s, results, scene);
         s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };

@@ -6,7 +6,9 @@ use crate::args::{
 };
 use anyhow::Result;
 use clap::Args;
-use lightgrid::frame::{Assign, Brdf, CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve};
+use lightgrid::frame::{
+    Assign, Brdf, CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve, Shadows,
+};
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
@@ -70,6 +72,14 @@ pub(crate) enum Preset {
     /// 0..259 every 20, at the papers' size (640x360 on a software adapter): the cost of one
     /// light evaluation in each, and the frame times side by side.
     Brdf,
+    /// Shadows (tiled-shading Table 1's "Re-use shadow maps" row; forward-plus §6): robots-many
+    /// without its glass, 8, 64, 256 and all 924 shadowed lights, without shadows, with ray
+    /// casting and with shadow maps at one face size (64 texels, a 1 GiB budget): the
+    /// light-volume pipelines re-use one light's maps (`deferred`, `light_prepass`), the
+    /// others keep every map in flight in an atlas (`forward`, `tiled_deferred`,
+    /// `clustered_forward`); frames 0..259 every 130 at the papers' size (640x360 on a
+    /// software adapter): frame time, shadow-map memory, shadow rays.
+    Shadows,
 }
 
 #[derive(Args)]
@@ -393,6 +403,31 @@ pub(crate) fn bench_config(
             .map(String::from)
             .to_vec(),
             settings: vec![measure(&[Some(Brdf::Phong), Some(Brdf::Ggx)])],
+            size: Some(papers_size(hardware)),
+            tile: Some(16),
+            transparency: false,
+            ..study(hardware, |_| false)
+        },
+        Some(Preset::Shadows) => BenchDefaults {
+            pipelines: [
+                ids::FORWARD,
+                ids::TILED_DEFERRED,
+                ids::CLUSTERED_FORWARD,
+                ids::DEFERRED,
+                ids::LIGHT_PREPASS,
+            ]
+            .map(String::from)
+            .to_vec(),
+            settings: vec![
+                measure(&[Shadows::Off, Shadows::Rays, Shadows::Maps]),
+                (
+                    "shadow-lights",
+                    ["8", "64", "256", "all"].map(String::from).to_vec(),
+                ),
+                ("shadow-map-size", vec!["64".to_string()]),
+                ("shadow-atlas", vec!["1024".to_string()]),
+            ],
+            frames: "0..259:130",
             size: Some(papers_size(hardware)),
             tile: Some(16),
             transparency: false,

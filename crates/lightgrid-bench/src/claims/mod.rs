@@ -9,6 +9,7 @@ use lightgrid::pipelines::ids;
 mod culling;
 mod deferred_lighting;
 mod forward_plus;
+mod shadows;
 mod tiled_forward_shading;
 mod tiled_shading;
 
@@ -429,6 +430,7 @@ pub fn evaluate_claims(r: &BenchResults) -> Vec<Claim> {
     out.extend(range_claims(r));
     out.extend(reduction_claims(r));
     out.extend(culling_claims(r));
+    out.extend(shadows::shadow_claims(r));
     out
 }
 

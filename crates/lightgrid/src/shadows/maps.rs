@@ -326,12 +326,12 @@ mod tests {
     #[test]
     fn tiles_never_overlap_and_stay_in_the_atlas() {
         for tiles in [1, 5, 6, 7, 100, 5544] {
-            let l = AtlasLayout::new(4096, tiles).unwrap();
+            let l = AtlasLayout::new(4096, MAX_TILE, tiles).unwrap();
             let mut seen = std::collections::HashSet::new();
             for t in 0..tiles {
                 let (x, y) = l.origin(t);
                 assert!(
-                    x + l.tile <= l.side && y + l.tile <= l.side,
+                    x + l.tile <= l.width && y + l.tile <= l.height,
                     "{tiles}: tile {t}"
                 );
                 assert!(seen.insert((x, y)), "{tiles}: tile {t} overlaps");
