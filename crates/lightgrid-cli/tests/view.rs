@@ -300,8 +300,8 @@ fn flipping_through_every_pipeline_keeps_the_image() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The scene's options changed live reopen the scene, and the BRDF a new renderer: the frame
-/// equals a headless render made with those options from the start.
+/// The scene's options changed live reopen the scene, and the BRDF and the shadows a new
+/// renderer: the frame equals a headless render made with those options from the start.
 #[test]
 fn scene_options_changed_live_equal_a_render_with_them() {
     let x = Xvfb::start();
@@ -317,9 +317,9 @@ fn scene_options_changed_live_equal_a_render_with_them() {
         "30",
         "--paused",
         "--script",
-        "at 1 add-lights 200; at 2 spots 0.5; at 3 transparency off; at 4 pipeline clustered_forward; at 5 brdf ggx",
+        "at 1 add-lights 200; at 2 spots 0.5; at 3 transparency off; at 4 pipeline clustered_forward; at 5 brdf ggx; at 6 shadows maps",
         "--exit-after-frames",
-        "7",
+        "8",
         "--screenshot",
         shot.to_str().unwrap(),
     ]);
@@ -346,6 +346,8 @@ fn scene_options_changed_live_equal_a_render_with_them() {
         "off",
         "--brdf",
         "ggx",
+        "--shadows",
+        "maps",
         "--out",
         reference.to_str().unwrap(),
     ]);

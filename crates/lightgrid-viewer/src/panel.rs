@@ -168,6 +168,14 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
                 .on_hover_text(b.help());
         }
     });
+    ui.horizontal(|ui| {
+        use lightgrid::pipelines::SettingValue;
+        ui.label("Shadows");
+        for &s in lightgrid::scene::Shadows::VALUES {
+            ui.selectable_value(&mut draft.settings.shadows, s, SettingValue::name(s))
+                .on_hover_text(s.help());
+        }
+    });
     ui.add_enabled_ui(pipeline.is_some_and(|p| p.uses_gbuffer()), |ui| {
         ui.horizontal(|ui| {
             ui.label("G-buffer");

@@ -30,6 +30,8 @@ pub enum Action {
     AddLights(u32),
     /// `brdf auto|phong|ggx` (`--brdf`).
     Brdf(Option<lightgrid::scene::Brdf>),
+    /// `shadows off|rays|maps` (`--shadows`).
+    Shadows(lightgrid::scene::Shadows),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -130,6 +132,14 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                         .map_err(|e| format!("'{step}': {e}"))?,
                 )
             }
+            "shadows" => {
+                use lightgrid::pipelines::SettingValue;
+                let name =
+                    arg.ok_or_else(|| format!("'{step}': shadows needs off, rays or maps"))?;
+                Action::Shadows(
+                    lightgrid::scene::Shadows::parse(name).map_err(|e| format!("'{step}': {e}"))?,
+                )
+            }
             "pause" => Action::Pause,
             "play" => Action::Play,
             "panel" => match arg {
@@ -182,9 +192,13 @@ mod tests {
                 Action::AddLights(300)
             ]
         );
-        let s = parse("brdf ggx; brdf auto").unwrap();
+        let s = parse("brdf ggx; brdf auto; shadows maps").unwrap();
         assert_eq!(s[0].action, Action::Brdf(Some(lightgrid::scene::Brdf::Ggx)));
         assert_eq!(s[1].action, Action::Brdf(None));
+        assert_eq!(
+            s[2].action,
+            Action::Shadows(lightgrid::scene::Shadows::Maps)
+        );
     }
 
     #[test]
@@ -197,6 +211,8 @@ mod tests {
             "tile",
             "brdf",
             "brdf lambert",
+            "shadows",
+            "shadows soft",
             "tile -4",
             "tile NaN",
             "resize 300",

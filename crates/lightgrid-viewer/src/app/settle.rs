@@ -77,6 +77,7 @@ impl App {
             Action::Tile(n) => next.settings.tile_size = *n,
             Action::Msaa(n) => next.settings.msaa = *n,
             Action::Brdf(b) => next.settings.brdf = *b,
+            Action::Shadows(s) => next.settings.shadows = *s,
             Action::View(v) => next.view = *v,
             Action::Spots(f) => next.request.params.spot_fraction = *f,
             Action::Transparency(on) => next.request.params.transparency = *on,
