@@ -38,6 +38,11 @@ pub(crate) struct RenderArgs {
     /// frame's own maximum); Forward+ Fig. 2(b) uses 50.
     #[arg(long, allow_hyphen_values = true, requires = "heatmap", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub(crate) heatmap_max: Option<u32>,
+    /// With --shadows maps: the shadow-map texture the frame rendered to write (a *.png file):
+    /// the atlas of every shadowed light's faces (each texel's distance to its light, near
+    /// white), or a light-volume pipeline's one re-used cube.
+    #[arg(long)]
+    pub(crate) shadow_maps_image: Option<PathBuf>,
 }
 
 pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
@@ -48,6 +53,14 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     files.output("--out", a.out.as_deref(), Kind::Png)?;
     files.output("--stats", a.stats.as_deref(), Kind::Data)?;
     files.output("--heatmap", a.heatmap.as_deref(), Kind::Png)?;
+    files.output(
+        "--shadow-maps-image",
+        a.shadow_maps_image.as_deref(),
+        Kind::Png,
+    )?;
+    if a.shadow_maps_image.is_some() && settings.shadows != lightgrid::scene::Shadows::Maps {
+        anyhow::bail!("--shadow-maps-image needs --shadows maps");
+    }
     a.scene.options.claim(&mut files)?;
     let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
@@ -87,6 +100,12 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     }
     if let Some(path) = &a.stats {
         writes.push((path, serde_json::to_vec_pretty(&out.stats)?));
+    }
+    if let Some(path) = &a.shadow_maps_image {
+        let atlas = renderer
+            .shadow_maps_image()?
+            .ok_or_else(|| anyhow::anyhow!("--shadow-maps-image: no light cast shadows"))?;
+        writes.push((path, encode_png(&atlas, path)?));
     }
     for (path, bytes) in writes {
         write_atomic(path, &bytes)?;

@@ -125,6 +125,39 @@ fn render_writes_image_and_stats() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `--shadow-maps-image`: the atlas of robots-few's 11 cubes at 16² faces (9 a row, 8 rows),
+/// lit texels where geometry was drawn; a light-volume pipeline's one re-used cube (3 x 2).
+#[test]
+fn render_writes_the_shadow_maps_image() {
+    let dir = temp_dir("maps-image");
+    for (pipeline, size) in [("clustered_forward", (144, 128)), ("deferred", (48, 32))] {
+        let png = dir.join(format!("{pipeline}.png"));
+        let o = lightgrid(&[
+            "render",
+            "--scene",
+            "robots-few",
+            "--transparency",
+            "off",
+            "--pipeline",
+            pipeline,
+            "--size",
+            "96x54",
+            "--shadows",
+            "maps",
+            "--shadow-map-size",
+            "16",
+            "--shadow-maps-image",
+            png.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let img = image::open(&png).unwrap().to_luma8();
+        assert_eq!(img.dimensions(), size, "{pipeline}");
+        let drawn = img.pixels().filter(|p| p.0[0] > 0).count();
+        assert!(drawn * 4 > img.len(), "{pipeline}: {drawn} texels drawn");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 fn write_png(path: &Path, f: impl Fn(u32, u32) -> [u8; 4]) {
     let img = image::RgbaImage::from_fn(20, 10, |x, y| image::Rgba(f(x, y)));
     img.save(path).unwrap();

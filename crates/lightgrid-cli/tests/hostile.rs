@@ -1199,11 +1199,42 @@ fn shadow_options_out_of_range_are_refused() {
             "{flag} {bad}: {err}"
         );
     }
-    // They apply to shadow maps only.
+    // They apply to shadow maps only, as the maps' image does.
     fails_with(
         &render(&["--shadows", "rays", "--shadow-atlas", "8"]),
         "none without --shadows maps",
     );
+    let dir = temp_dir("maps-image");
+    let image = dir.join("atlas.png");
+    let image = image.to_str().unwrap();
+    fails_with(
+        &render(&["--shadows", "rays", "--shadow-maps-image", image]),
+        "--shadow-maps-image needs --shadows maps",
+    );
+    fails_with(
+        &render(&[
+            "--shadows",
+            "maps",
+            "--shadow-maps-image",
+            dir.to_str().unwrap(),
+        ]),
+        "--shadow-maps-image",
+    );
+    fails_with(
+        &render(&[
+            "--shadows",
+            "maps",
+            "--shadow-maps-image",
+            &format!("{image}.txt"),
+        ]),
+        "--shadow-maps-image",
+    );
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "nothing written"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// An atlas too small for the frame's shadowed lights at the smallest face is refused with
@@ -1359,9 +1390,15 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
         let value = match (axis.values)().get(1) {
             Some(v) => v.name.to_string(),
             None if axis.flag == "msaa" => "4".into(),
+            None if axis.flag == "shadow-map-size" => "16".into(),
             None => "8".into(),
         };
+        // The shadow maps' options apply only with shadows.
+        let shadows = axis.flag.starts_with("shadow-");
         let mut settings = RenderSettings::default();
+        if shadows {
+            settings.shadows = lightgrid::scene::Shadows::Maps;
+        }
         (axis.set)(&mut settings, &value).unwrap();
         let msaa = if axis.flag == "msaa-resolve" {
             "4"
@@ -1374,6 +1411,9 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
         let taker = taker.unwrap_or_else(|| panic!("{} applies to no pipeline", axis.flag));
         let out = dir.join(format!("{}.png", axis.flag));
         let mut args = render(&["--pipeline", taker.id, "--msaa", msaa]);
+        if shadows {
+            args.extend(["--shadows".into(), "maps".into()]);
+        }
         if axis.flag != "msaa" {
             args.extend([axis.option(), value.clone()]);
         } else {
@@ -1385,7 +1425,7 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
         let o = lightgrid(&args);
         assert!(o.status.success(), "{args:?} refused: {}", stderr(&o));
         assert!(out.exists(), "{args:?} wrote no image");
-        // Every pipeline takes MSAA and the BRDF: nothing to refuse.
+        // Every pipeline takes MSAA, the BRDF and shadows: nothing to refuse.
         if let Some(other) = other {
             let needle = format!("{} does not apply to {}", axis.option(), other.id);
             let mut args = render(&["--pipeline", other.id, "--msaa", msaa]);
@@ -1399,8 +1439,8 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
             );
         } else {
             assert!(
-                ["msaa", "brdf"].contains(&axis.flag),
-                "only --msaa and --brdf apply to every pipeline, not {}",
+                ["msaa", "brdf"].contains(&axis.flag) || axis.flag.starts_with("shadow"),
+                "only --msaa, --brdf and the shadows apply to every pipeline, not {}",
                 axis.flag
             );
         }

@@ -132,7 +132,7 @@ const CMDS: &[Cmd] = &[
             "--warmup",
             "--pipeline",
         ],
-        paths: &["--out", "--stats", "--heatmap"],
+        paths: &["--out", "--stats", "--heatmap", "--shadow-maps-image"],
         safe: &[
             ("--size", "8x8"),
             ("--warmup", "0"),

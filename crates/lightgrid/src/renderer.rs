@@ -759,6 +759,17 @@ impl Renderer {
         (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64
     }
 
+    /// The shadow maps' texture as the last frame left it (`--shadows maps`; analysis: waits
+    /// for the GPU): the atlas of every face, or a light-volume pipeline's last re-used cube
+    /// (the atlas too when its frame had transparent objects). None without shadow maps.
+    pub fn shadow_maps_image(&self) -> Result<Option<image::RgbaImage>> {
+        if self.settings.shadows != crate::scene::Shadows::Maps || self.shadow_atlas.size == (1, 1)
+        {
+            return Ok(None);
+        }
+        self.shadow_atlas.image(&self.device, &self.queue).map(Some)
+    }
+
     /// Does `info`'s technique (prepared) re-use one light's shadow maps?
     fn reuses_shadow_maps(&self, info: &pipelines::PipelineInfo) -> bool {
         self.techniques

@@ -280,6 +280,28 @@ fn a_loop_cut_short_is_counted() {
     let bounds = buffer(16, wgpu::BufferUsages::STORAGE);
     let pixel_counts = buffer(16, wgpu::BufferUsages::STORAGE);
     let textures = lightgrid::passes::base_textures::BaseTextures::new(device, &ctx.queue, &[]);
+    // The shadow bindings (8-10), unread here.
+    let shadow_data = buffer(32, wgpu::BufferUsages::STORAGE);
+    let atlas = device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&Default::default());
+    let compare = device.create_sampler(&wgpu::SamplerDescriptor {
+        compare: Some(wgpu::CompareFunction::GreaterEqual),
+        ..Default::default()
+    });
     let group = bind_resources(
         device,
         "cut loop",
@@ -293,6 +315,9 @@ fn a_loop_cut_short_is_counted() {
             pixel_counts.as_entire_binding(),
             wgpu::BindingResource::TextureView(&textures.view),
             wgpu::BindingResource::Sampler(&textures.sampler),
+            shadow_data.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&atlas),
+            wgpu::BindingResource::Sampler(&compare),
         ],
     );
     let mut encoder = device.create_command_encoder(&Default::default());

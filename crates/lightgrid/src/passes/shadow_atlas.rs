@@ -21,6 +21,7 @@ pub fn shader() -> ComposedShader {
 pub(crate) struct ShadowAtlas {
     /// The texture's size (1x1 without shadow maps).
     pub size: (u32, u32),
+    texture: wgpu::Texture,
     pub view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
     /// With shadow maps: the pipeline drawing the faces and its group 0's layout.
@@ -32,9 +33,11 @@ impl ShadowAtlas {
     /// A 1x1 texture; `maps`: with the pipeline that draws into it ([`Self::fit`] sizes it).
     pub fn new(device: &wgpu::Device, maps: bool) -> ShadowAtlas {
         let pipeline = maps.then(|| Self::pipeline(device));
+        let (texture, view) = Self::texture(device, (1, 1));
         ShadowAtlas {
             size: (1, 1),
-            view: Self::texture(device, (1, 1)),
+            texture,
+            view,
             sampler: Self::sampler(device),
             pipeline,
             bind_group: None,
@@ -47,12 +50,79 @@ impl ShadowAtlas {
         if self.size == size {
             return false;
         }
-        self.view = Self::texture(device, size);
+        (self.texture, self.view) = Self::texture(device, size);
         self.size = size;
         true
     }
 
-    fn texture(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::TextureView {
+    /// The texture as an image (analysis only: blocks): each texel's distance to its light
+    /// on a log scale, near white, far dark; black where no geometry was drawn.
+    pub fn image(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> crate::Result<image::RgbaImage> {
+        let (w, h) = self.size;
+        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadow atlas readback"),
+            size: u64::from(row) * u64::from(h),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::DepthOnly,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit([encoder.finish()]);
+        let bytes = crate::gpu::read_buffer(device, &buffer)?;
+        let depth = |x: u32, y: u32| {
+            let at = (y * row + x * 4) as usize;
+            f32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
+        };
+        // Reversed depth near / w: its log is the distance's, up to each light's near plane.
+        let logs: Vec<f32> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| depth(x, y))
+            .filter(|&d| d > 0.0)
+            .map(f32::ln)
+            .collect();
+        let lo = logs.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = logs.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        Ok(image::RgbaImage::from_fn(w, h, |x, y| {
+            let d = depth(x, y);
+            let v = if d > 0.0 {
+                (40.0 + 215.0 * (d.ln() - lo) / (hi - lo).max(1e-6)) as u8
+            } else {
+                0
+            };
+            image::Rgba([v, v, v, 255])
+        }))
+    }
+
+    fn texture(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+    ) -> (wgpu::Texture, wgpu::TextureView) {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
             size: wgpu::Extent3d {
@@ -64,10 +134,13 @@ impl ShadowAtlas {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: ATLAS_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        texture.create_view(&Default::default())
+        let view = texture.create_view(&Default::default());
+        (texture, view)
     }
 
     /// Bilinear comparison: 2x2 PCF. Reversed depth: a sample is lit where it is at least as
