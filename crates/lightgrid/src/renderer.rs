@@ -484,7 +484,7 @@ impl Renderer {
         self.static_upload_bytes = self.textures.bytes + (vb.len() + ib.len() + mb.len()) as u64;
         let shading = Shading::of(&scene.lighting, self.settings.brdf, self.settings.shadows);
         let shadows = (self.settings.shadows == crate::scene::Shadows::Rays)
-            .then(|| crate::shadows::StaticShadows::new(&scene));
+            .then(|| crate::shadows::StaticShadows::new(&geometry));
         if let Some(s) = &shadows {
             check_shadow_tree(&s.bvh)?;
         }

@@ -22,7 +22,7 @@
 pub mod bvh;
 pub mod maps;
 
-use crate::scene::{Camera, Geometry, Light, Scene};
+use crate::scene::{Camera, Geometry, Light};
 use bvh::{Triangle, TriangleBvh};
 use glam::{Vec3, Vec4Swizzles};
 
@@ -71,8 +71,8 @@ pub struct StaticShadows {
 }
 
 impl StaticShadows {
-    pub fn new(scene: &Scene) -> StaticShadows {
-        let geometry = scene.static_geometry();
+    /// From a scene's `Scene::static_geometry` (the renderer's upload, baked once).
+    pub fn new(geometry: &Geometry) -> StaticShadows {
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         for v in &geometry.vertices {
             lo = lo.min(Vec3::from(v.position));
@@ -89,7 +89,7 @@ impl StaticShadows {
             0.0
         };
         let bias = BIAS_EXTENT * extent.max(1.0);
-        let bvh = TriangleBvh::build(casting_triangles(&geometry, 0, anchor));
+        let bvh = TriangleBvh::build(casting_triangles(geometry, 0, anchor));
         StaticShadows { anchor, bias, bvh }
     }
 
