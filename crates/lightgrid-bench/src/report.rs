@@ -212,7 +212,7 @@ Means over the frames. Maps: the depth texture the frame's maps were rendered in
             f.stats
                 .passes
                 .iter()
-                .find(|p| p.label == "shadow maps")
+                .find(|p| p.label == lightgrid::shadows::maps::PASS_LABEL)
                 .map(|p| p.ms)
         });
         let unshadowed: f64 = r

@@ -231,7 +231,13 @@ impl ShadowAtlas {
         layout: &AtlasLayout,
     ) {
         let faces: Vec<(u32, u32)> = (0..layout.tiles).map(|t| (t, t)).collect();
-        self.encode(encoder, timer.render_pass("shadow maps"), f, layout, &faces);
+        self.encode(
+            encoder,
+            timer.render_pass(crate::shadows::maps::PASS_LABEL),
+            f,
+            layout,
+            &faces,
+        );
     }
 
     /// Re-used: one light's faces `first..first + count` into the six tiles, before its volume
@@ -260,7 +266,7 @@ impl ShadowAtlas {
             return;
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shadow maps"),
+            label: Some(crate::shadows::maps::PASS_LABEL),
             color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.view,

@@ -41,6 +41,8 @@ pub const SPOT_ONE_FACE_DEGREES: f32 = 60.0;
 pub const NORMAL_OFFSET: f32 = 1.0;
 pub const SLOPE_OFFSET: f32 = 1.0;
 pub const MAX_SLOPE: f32 = 4.0;
+/// The atlas pass's label in a frame's pass timings (the bench's summary reads it).
+pub const PASS_LABEL: &str = "shadow maps";
 /// Largest `--shadow-atlas` in MiB.
 pub const MAX_ATLAS_MIB: u32 = 4096;
 
