@@ -48,7 +48,7 @@ pub struct Analysed {
 pub fn serve(ctx: &GpuContext, jobs: Receiver<Job>, done: Sender<Done>) {
     let mut renderer: Option<Renderer> = None;
     for job in jobs {
-        let start = std::time::Instant::now();
+        let start = web_time::Instant::now();
         // A panic in an analysis frame is this job's error, not the window's: the renderer
         // that panicked is dropped and the next job makes a new one.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {

@@ -55,6 +55,13 @@ pub fn refusal(info: &PipelineInfo, settings: &RenderSettings) -> Option<String>
     }
 }
 
+/// Built for a web page (`app/web.rs`).
+pub const WEB: bool = cfg!(target_arch = "wasm32");
+
+/// Why the page offers no debug view and no analysis.
+pub const NATIVE_ONLY: &str = "debug views and analysis frames are native-only: they read the \
+GPU's results back and wait for them, which a web page cannot do (run `lightgrid view`)";
+
 /// The registry's pipelines with why each cannot run now (None: it can).
 pub fn pipeline_choices(settings: &RenderSettings) -> Vec<(&'static PipelineInfo, Option<String>)> {
     pipelines::PIPELINES

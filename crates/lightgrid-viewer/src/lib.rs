@@ -24,4 +24,8 @@ pub mod present;
 pub mod script;
 pub mod surface;
 
-pub use app::{run, ViewOptions, ViewReport};
+#[cfg(not(target_arch = "wasm32"))]
+pub use app::run;
+#[cfg(target_arch = "wasm32")]
+pub use app::web;
+pub use app::{ViewOptions, ViewReport};

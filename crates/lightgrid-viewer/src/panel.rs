@@ -107,7 +107,7 @@ fn status(ui: &mut egui::Ui, info: &PanelInfo) {
 
 fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
     let settings = draft.settings;
-    egui::ComboBox::from_label("pipeline")
+    let combo = egui::ComboBox::from_label("pipeline")
         .selected_text(draft.pipeline.as_str())
         .show_ui(ui, |ui| {
             for (p, refused) in pipeline_choices(&settings) {
@@ -120,11 +120,13 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
                     Some(why) => r.on_disabled_hover_text(why),
                     None => r,
                 };
+                remember_spot(ui.ctx(), &format!("pipeline:{}", p.id), r.rect);
                 if r.clicked() {
                     draft.pipeline = p.id.to_string();
                 }
             }
         });
+    remember_spot(ui.ctx(), "pipeline", combo.response.rect);
     let pipeline = lightgrid::pipelines::find(&draft.pipeline).ok();
     let grid = pipeline.is_some_and(|p| p.uses_grid);
     ui.add_enabled(
@@ -289,9 +291,19 @@ fn debug_views(
 ) {
     ui.horizontal_wrapped(|ui| {
         for v in DebugView::ALL {
-            ui.selectable_value(&mut draft.view, v, v.name());
+            let offered = v == DebugView::Shaded || !crate::controls::WEB;
+            let r = ui.add_enabled(offered, egui::Button::selectable(draft.view == v, v.name()));
+            if r.on_disabled_hover_text(crate::controls::NATIVE_ONLY)
+                .clicked()
+            {
+                draft.view = v;
+            }
         }
     });
+    if crate::controls::WEB {
+        ui.label(RichText::new(crate::controls::NATIVE_ONLY).small());
+        return;
+    }
     if draft.view != DebugView::Shaded {
         match info.analysis.and_then(|(a, _)| a.image.as_ref()) {
             Some(img) => {
@@ -341,6 +353,23 @@ fn debug_views(
             ui.label(format!("lights per cell: avg {avg:.1}, max {max}"));
         }
     }
+}
+
+/// Where the panel's widgets were last drawn, by name, in points ([x, y, w, h]): what a
+/// browser test clicks (`web.rs`, `Shared::spots`).
+type Spots = std::collections::HashMap<String, [f32; 4]>;
+
+fn remember_spot(ctx: &egui::Context, name: &str, r: egui::Rect) {
+    ctx.data_mut(|d| {
+        d.get_temp_mut_or_default::<Spots>(egui::Id::unique("lightgrid spots"))
+            .insert(name.to_string(), [r.min.x, r.min.y, r.width(), r.height()]);
+    });
+}
+
+/// The panel's widgets' places ([`remember_spot`]).
+pub fn spots(ctx: &egui::Context) -> Spots {
+    ctx.data(|d| d.get_temp::<Spots>(egui::Id::unique("lightgrid spots")))
+        .unwrap_or_default()
 }
 
 /// The debug views' colour ramp from 0 to `max`.

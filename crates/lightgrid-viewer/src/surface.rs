@@ -12,6 +12,8 @@ use lightgrid::gpu::GpuContext;
 
 /// Formats the viewer can present, best first. egui draws in gamma space, so a linear 8-bit
 /// format (the blit encodes sRGB itself) comes before the sRGB ones (which encode on write).
+/// A browser prefers one of the two linear formats and warns when another is used (an extra
+/// copy): its preference comes first there (`caps.formats[0]`).
 const PREFERRED: [wgpu::TextureFormat; 4] = [
     wgpu::TextureFormat::Bgra8Unorm,
     wgpu::TextureFormat::Rgba8Unorm,
@@ -53,15 +55,18 @@ impl WindowSurface {
     pub fn new(ctx: &GpuContext, window: Arc<Window>) -> Result<WindowSurface> {
         let surface = create(ctx, &window)?;
         let caps = surface.get_capabilities(&ctx.adapter);
-        let format = PREFERRED
-            .into_iter()
-            .find(|f| caps.formats.contains(f))
-            .with_context(|| {
-                format!(
-                    "the window offers none of the 8-bit formats the viewer draws ({:?})",
-                    caps.formats
-                )
-            })?;
+        let preferred = caps.formats.first().copied();
+        let format = (cfg!(target_arch = "wasm32")
+            && preferred.is_some_and(|f| PREFERRED.contains(&f)))
+        .then_some(preferred)
+        .flatten()
+        .or_else(|| PREFERRED.into_iter().find(|f| caps.formats.contains(f)))
+        .with_context(|| {
+            format!(
+                "the window offers none of the 8-bit formats the viewer draws ({:?})",
+                caps.formats
+            )
+        })?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,

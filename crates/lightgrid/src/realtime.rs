@@ -11,7 +11,7 @@ use crate::scene::Scene;
 use crate::stats::Distribution;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use web_time::Instant;
 
 /// One frame of a real-time run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

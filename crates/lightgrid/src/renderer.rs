@@ -34,7 +34,7 @@ use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
 use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, Shading, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, OnceLock};
-use std::time::Instant;
+use web_time::Instant;
 
 use crate::analysis::FrameOutput;
 
@@ -291,7 +291,8 @@ impl Renderer {
                 device: device.clone(),
                 queue: ctx.queue.clone(),
                 count_blend: ctx.count_blend,
-                software_adapter: ctx.is_software(),
+                // On a page, `auto` never picks the CPU strategy: its readback would wait.
+                software_adapter: ctx.is_software() && cfg!(not(target_arch = "wasm32")),
                 adapter_label: ctx.adapter_label(),
                 targets,
                 tonemap: Tonemap::new(device, settings.msaa),

@@ -47,6 +47,7 @@ impl App {
                         path.display()
                     )),
                     Ok(Shot::Taken) => Ok(true),
+                    Ok(Shot::Wait) => Ok(false),
                     Err(e) => Err(e),
                 };
                 match taken {
@@ -79,6 +80,8 @@ impl App {
             }
         }
         self.leave_when_done(event_loop);
+        #[cfg(target_arch = "wasm32")]
+        self.publish();
         self.request_analysis(now)
     }
 
@@ -107,11 +110,20 @@ impl App {
         let win = self.win.as_mut().context("no window")?;
         let debug = view != DebugView::Shaded && win.debug_texture.is_some();
         if !debug {
-            let finished = win.renderer.finish()?;
-            self.observe(finished);
+            // On the web nothing waits: the shown frame's report comes back a frame or two
+            // later, and the screenshot waits for it.
+            #[cfg(not(target_arch = "wasm32"))]
+            {
+                let finished = win.renderer.finish()?;
+                self.observe(finished);
+            }
             let serial = self.submitted.context("no frame rendered yet")?;
             let Some(report) = self.recent.iter().rfind(|f| f.serial == serial) else {
-                return Ok(Shot::Retry);
+                return Ok(if cfg!(target_arch = "wasm32") {
+                    Shot::Wait
+                } else {
+                    Shot::Retry
+                });
             };
             if report.truncated_loops > 0 || report.fragments_off_bounds > 0 {
                 bail!(
@@ -142,8 +154,13 @@ impl App {
             &capture.view,
         );
         ctx.queue.submit([encoder.finish()]);
-        let image = capture.read(&ctx.device, &ctx.queue)?;
-        lightgrid::image_io::save_png(&image, path)?;
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let image = capture.read(&ctx.device, &ctx.queue)?;
+            lightgrid::image_io::save_png(&image, path)?;
+        }
+        #[cfg(target_arch = "wasm32")]
+        web::read_later(&ctx, capture, path.to_string_lossy().into_owned());
         Ok(Shot::Taken)
     }
 
@@ -182,7 +199,8 @@ impl App {
     /// once a second when asked to.
     pub(super) fn request_analysis(&mut self, now: Instant) -> Result<()> {
         let a = &self.analysis;
-        if a.in_flight {
+        // No analysis worker on the web (`web.rs`): the debug views are native-only there.
+        if a.in_flight || cfg!(target_arch = "wasm32") {
             return Ok(());
         }
         let since = a.last_request.map(|t| now.duration_since(t));

@@ -10,6 +10,15 @@ impl App {
         if let Some(reason) = self.lost.lock().ok().and_then(|mut l| l.take()) {
             bail!("the GPU device was lost ({reason}); restart the viewer");
         }
+        // GPU errors no scope returned to its call: on native a bug, already printed; on the
+        // web every validation error of the last frames (`web.rs`), undone like a failed frame.
+        for e in lightgrid::gpu::take_late_errors() {
+            if cfg!(target_arch = "wasm32") {
+                #[cfg(target_arch = "wasm32")]
+                web::console_error(&format!("lightgrid: {e}"));
+                self.recover(e)?;
+            }
+        }
         let now = Instant::now();
         self.check_patience(now)?;
         self.collect_analysis()?;
@@ -100,10 +109,25 @@ impl App {
             true => Ok(()),
             false => win.renderer.set_scene(self.scene.clone()),
         };
-        match rendered.and_then(|()| win.renderer.render_frame(&state, &pipeline)) {
-            Ok(s) => {
+        // On the web a screenshot cannot wait for its frame's report (`after.rs`): no new
+        // frame replaces the shown one until that report is back.
+        let hold = cfg!(target_arch = "wasm32")
+            && !self.screenshots.is_empty()
+            && self
+                .submitted
+                .is_some_and(|s| !self.recent.iter().any(|f| f.serial == s));
+        let rendered = match hold {
+            true => rendered.map(|()| None),
+            false => rendered.and_then(|()| win.renderer.render_frame(&state, &pipeline).map(Some)),
+        };
+        match rendered {
+            Ok(None) => {}
+            Ok(Some(s)) => {
                 self.submitted = Some(s.serial);
-                self.last_good = self.applied.clone();
+                // On the web a frame's errors arrive later: it is good once it has finished.
+                if cfg!(not(target_arch = "wasm32")) {
+                    self.last_good = self.applied.clone();
+                }
             }
             Err(e) => {
                 self.recover(e)?;
@@ -117,6 +141,9 @@ impl App {
 
     pub(super) fn observe(&mut self, finished: Vec<FinishedFrame>) {
         for f in finished {
+            if cfg!(target_arch = "wasm32") && Some(f.serial) == self.submitted {
+                self.last_good = self.applied.clone();
+            }
             self.figures.finished(&f);
             if self.recent.len() == 8 {
                 self.recent.pop_front();

@@ -21,7 +21,7 @@
 //! older than the state it shows) holds scripts, screenshots and `--exit-after-frames`, so a
 //! scripted run captures exactly the state it asked for.
 
-use crate::analysis::{self, Analysed, Done, Job};
+use crate::analysis::{Analysed, Done, Job};
 use crate::controls::{refusal, Controls, Rebuild};
 use crate::fly::{FlyCamera, Movement};
 use crate::live::LiveFigures;
@@ -40,7 +40,8 @@ use std::collections::{HashSet, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
@@ -51,6 +52,8 @@ mod after;
 mod frame;
 mod input;
 mod settle;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
 /// A size must hold this long before the renderer is rebuilt for it (dragging a window edge
 /// would otherwise make a renderer per pixel); meanwhile the blit clamps the old image.
@@ -104,7 +107,8 @@ pub struct ViewReport {
 }
 
 /// Open the window and run until it is closed, `Esc` is pressed or `exit_after_frames`
-/// have been shown.
+/// have been shown. (The page starts the same app with `web::start`.)
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(opts: ViewOptions) -> Result<ViewReport> {
     let opened = lightgrid::scene::open(&opts.request)?;
     for w in &opened.warnings {
@@ -133,7 +137,7 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
     let ctx = Arc::new(ctx);
     let worker_ctx = ctx.clone();
     std::thread::scope(|s| {
-        s.spawn(move || analysis::serve(&worker_ctx, job_rx, done_tx));
+        s.spawn(move || crate::analysis::serve(&worker_ctx, job_rx, done_tx));
         let mut app = App::new(ctx, opts, opened.scene, jobs, done, lost);
         let ran = run_catching_display_loss(|| event_loop.run_app(&mut app));
         // Dropping the app drops the job sender, which ends the worker.
@@ -158,6 +162,7 @@ pub fn run(opts: ViewOptions) -> Result<ViewReport> {
 /// Run the event loop, turning the panic winit raises when the X server goes away (its X11
 /// backend unwraps every request's reply: `Connection(IoError(..))`) into a "display lost"
 /// error, with no panic message printed; any other panic goes on as a panic.
+#[cfg(not(target_arch = "wasm32"))]
 fn run_catching_display_loss<T>(run: impl FnOnce() -> T) -> Result<T> {
     fn message(payload: &(dyn std::any::Any + Send)) -> String {
         payload
@@ -226,6 +231,9 @@ struct AnalysisState {
 /// How a screenshot attempt ended.
 enum Shot {
     Taken,
+    /// The shown frame's report has not come back yet (the web): try the next frame.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    Wait,
     /// The frame was shown wrong (its lists overflowed and have grown): try the next one.
     Retry,
 }
@@ -355,6 +363,8 @@ impl App {
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        #[cfg(target_arch = "wasm32")]
+        self.publish_fatal(&e);
         if self.fatal.is_none() {
             self.fatal = Some(e);
         }
@@ -366,6 +376,12 @@ impl App {
         let attributes = Window::default_attributes()
             .with_title(self.title())
             .with_inner_size(winit::dpi::PhysicalSize::new(w, h));
+        // The page's canvas, appended to the document's body.
+        #[cfg(target_arch = "wasm32")]
+        let attributes = {
+            use winit::platform::web::WindowAttributesExtWebSys;
+            attributes.with_append(true)
+        };
         let window = Arc::new(
             event_loop
                 .create_window(attributes)

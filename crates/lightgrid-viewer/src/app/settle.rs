@@ -133,6 +133,9 @@ impl App {
         if let Some(why) = refusal(info, &next.settings) {
             return Err(why);
         }
+        if crate::controls::WEB && next.view != DebugView::Shaded {
+            return Err(crate::controls::NATIVE_ONLY.into());
+        }
         // Everything is made before anything is replaced, so a failure leaves the viewer as
         // it was.
         let opened = match rebuild {

@@ -21,7 +21,7 @@ use crate::frame::FrameEncoder;
 use crate::scene::Light;
 use glam::Vec3;
 use rayon::prelude::*;
-use std::time::Instant;
+use web_time::Instant;
 
 /// Pixels covered by a projected light: inclusive pixel index ranges, clipped to the frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

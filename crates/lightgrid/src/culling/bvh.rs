@@ -21,7 +21,7 @@ use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, ST
 use crate::scene::Light;
 use glam::Vec3;
 use rayon::prelude::*;
-use std::time::Instant;
+use web_time::Instant;
 
 pub use crate::gpu_types::BvhNode;
 

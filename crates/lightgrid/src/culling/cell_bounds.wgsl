@@ -124,8 +124,11 @@ fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {
 #endif
 
 // The empty range (min > max).
+// A runtime value: the same bitcast of a constant is a constant infinity, which WGSL
+// refuses (Tint, in browsers; naga lets it through).
 fn no_range() -> vec2<f32> {
-    return vec2<f32>(bitcast<f32>(W_INFINITY), 0.0);
+    var bits = W_INFINITY;
+    return vec2<f32>(bitcast<f32>(bits), 0.0);
 }
 
 // Cell `cell`'s fragment bounds (min > max when none).

@@ -21,7 +21,7 @@ pub use targets::{check_msaa, msaa_counts, Targets};
 use crate::error::Result;
 use crate::gpu::{read_buffer, scoped, PassTimer, PassTiming};
 use crate::scene::{Draw, Light, ViewSetup};
-use std::time::Instant;
+use web_time::Instant;
 
 /// What a pipeline reads to render one frame.
 pub struct FrameInputs<'a> {

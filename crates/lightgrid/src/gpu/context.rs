@@ -93,6 +93,17 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
         .collect()
 }
 
+/// The device's limits: the adapter's own (large light lists need big storage bindings,
+/// and the grid kernels bind up to 16 storage buffers per stage). `LIGHTGRID_LIMITS=webgpu`
+/// asks for WebGPU's defaults instead, what every page may rely on: a pipeline that needs
+/// more is refused with the limit and the count (README, "In a browser").
+fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+    match std::env::var("LIGHTGRID_LIMITS").as_deref() {
+        Ok("webgpu") => wgpu::Limits::default(),
+        _ => adapter.limits(),
+    }
+}
+
 /// Does `wanted` (an index, a backend name, or part of the adapter name) select this adapter?
 fn matches(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
     let w = wanted.trim().to_lowercase();
@@ -156,7 +167,33 @@ impl GpuContext {
         Self::from_adapter(instance, adapter)
     }
 
+    /// The page's context (wasm32): the browser's WebGPU adapter and a device on it. Nothing
+    /// on the web may block, so this is the one `async` constructor.
+    #[cfg(target_arch = "wasm32")]
+    pub async fn for_page() -> Result<Self> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = wgpu::Backends::BROWSER_WEBGPU;
+        let instance = wgpu::Instance::new(desc);
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| {
+                Error::NoAdapter(format!(
+                    "this browser offers no WebGPU adapter ({e}): use a browser with WebGPU \
+                     (Chrome or Edge 113+, Firefox 141+, Safari 26+)"
+                ))
+            })?;
+        Self::open(instance, adapter).await
+    }
+
     fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
+        pollster::block_on(Self::open(instance, adapter))
+    }
+
+    async fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut features = wgpu::Features::empty();
@@ -184,20 +221,22 @@ impl GpuContext {
             label: Some("lightgrid"),
             required_features: features,
             // The adapter's own limits: large light lists need big storage bindings.
-            required_limits: adapter.limits(),
+            required_limits: limits(&adapter),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
         };
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&desc)).map_err(|e| Error::Device {
+        let (device, queue) = adapter
+            .request_device(&desc)
+            .await
+            .map_err(|e| Error::Device {
                 adapter: info.name.clone(),
                 reason: e.to_string(),
             })?;
         // Errors are caught by error scopes around every stage; anything that escapes is a
         // bug, reported loudly rather than turned into a wrong image.
         device.on_uncaptured_error(std::sync::Arc::new(|e| {
-            eprintln!("lightgrid: uncaptured GPU error: {e}");
+            super::report_late("a GPU command", e.to_string());
         }));
         Ok(Self {
             instance,
@@ -213,9 +252,14 @@ impl GpuContext {
 
     /// "name (backend)", as printed in stats and tables.
     pub fn adapter_label(&self) -> String {
+        // A browser may name no adapter (privacy); it still says whether it is a fallback.
+        let name = match (self.info.name.trim(), self.is_software()) {
+            ("", true) => "software adapter",
+            ("", false) => "unnamed adapter",
+            (n, _) => n,
+        };
         format!(
-            "{} ({})",
-            self.info.name,
+            "{name} ({})",
             format!("{:?}", self.info.backend).to_lowercase()
         )
     }

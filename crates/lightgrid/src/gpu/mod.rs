@@ -16,24 +16,81 @@ pub fn scoped<T>(device: &wgpu::Device, stage: &str, f: impl FnOnce() -> T) -> R
     let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let value = f();
-    let v = pollster::block_on(validation.pop());
-    let o = pollster::block_on(oom.pop());
-    // An allocation that fails can also fail validation after it; the cause is memory.
-    match (o, v) {
-        (Some(_), _) => Err(Error::Gpu {
+    // A page's error scopes answer later, from the browser's event loop: what they catch is
+    // a late error ([`take_late_errors`]), which the page reports a frame later.
+    #[cfg(target_arch = "wasm32")]
+    {
+        let stage = stage.to_string();
+        // Popped now, innermost first (wgpu requires it); answered later.
+        let (v, o) = (validation.pop(), oom.pop());
+        wasm_bindgen_futures::spawn_local(async move {
+            let (v, o) = (v.await, o.await);
+            match (o, v) {
+                (Some(_), _) => report_late(&stage, "out of memory".into()),
+                (None, Some(e)) => report_late(&stage, e.to_string()),
+                (None, None) => {}
+            }
+        });
+        Ok(value)
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let v = pollster::block_on(validation.pop());
+        let o = pollster::block_on(oom.pop());
+        // An allocation that fails can also fail validation after it; the cause is memory.
+        match (o, v) {
+            (Some(_), _) => Err(Error::Gpu {
+                stage: stage.to_string(),
+                message: "out of memory".into(),
+            }),
+            (None, Some(e)) => Err(Error::Gpu {
+                stage: stage.to_string(),
+                message: e.to_string(),
+            }),
+            (None, None) => Ok(value),
+        }
+    }
+}
+
+/// GPU errors that no error scope returned to its call: on native, only a bug (printed at
+/// once); on the web, every validation error, since a page's scopes answer after the call.
+static LATE_ERRORS: std::sync::Mutex<Vec<Error>> = std::sync::Mutex::new(Vec::new());
+
+pub(crate) fn report_late(stage: &str, message: String) {
+    #[cfg(not(target_arch = "wasm32"))]
+    eprintln!("lightgrid: uncaptured GPU error during {stage}: {message}");
+    if let Ok(mut errors) = LATE_ERRORS.lock() {
+        errors.push(Error::Gpu {
             stage: stage.to_string(),
-            message: "out of memory".into(),
-        }),
-        (None, Some(e)) => Err(Error::Gpu {
-            stage: stage.to_string(),
-            message: e.to_string(),
-        }),
-        (None, None) => Ok(value),
+            message,
+        });
+    }
+}
+
+/// The GPU errors reported since the last call, oldest first (see [`scoped`]).
+pub fn take_late_errors() -> Vec<Error> {
+    LATE_ERRORS
+        .lock()
+        .map(|mut e| std::mem::take(&mut *e))
+        .unwrap_or_default()
+}
+
+/// A page cannot wait for the GPU: what needs a blocking readback is native-only there.
+#[cfg(target_arch = "wasm32")]
+fn native_only(stage: &str) -> Error {
+    Error::Gpu {
+        stage: stage.to_string(),
+        message: "a web page cannot wait for the GPU; this needs lightgrid's native build".into(),
     }
 }
 
 /// Block until all submitted work is done.
 pub fn wait_idle(device: &wgpu::Device) -> Result<()> {
+    #[cfg(target_arch = "wasm32")]
+    if cfg!(target_arch = "wasm32") {
+        let _ = device;
+        return Err(native_only("waiting for the GPU"));
+    }
     device
         .poll(wgpu::PollType::wait_indefinitely())
         .map(|_| ())

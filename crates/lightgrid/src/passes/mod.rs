@@ -253,8 +253,14 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             },
             storage(1, std::mem::size_of::<GpuLight>()),
             storage(2, std::mem::size_of::<GpuMaterial>()),
-            // Per light its bounding sphere [centre, radius], for culling and light volumes.
-            storage(4, 16),
+            // Per light its bounding sphere [centre, radius]: placing the light volumes
+            // (vertex) and culling in the single-kernel tiled deferred pass (compute). Not
+            // visible to fragment stages, which keeps forward shading with a grid within
+            // WebGPU's 8 storage buffers per stage (the grid adds 3).
+            wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
+                ..storage(4, 16)
+            },
             // The frame counters (`gpu/counters.rs`): written by fragment and compute stages
             // (a vertex stage may not write storage).
             wgpu::BindGroupLayoutEntry {
