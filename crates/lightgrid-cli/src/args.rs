@@ -369,6 +369,7 @@ impl SceneOptions {
             camera: self.camera.map(|c| c as usize),
             add_lights: added_lights(self.add_lights, self.light_range)?,
             exposure: self.exposure.map(|e| e as f32),
+            contents: None,
         };
         lightgrid::scene::source::check(&req)?;
         Ok(req)

@@ -422,15 +422,14 @@ fn base64_decode(s: &str) -> Vec<u8> {
 }
 
 /// The page's frame and the native one are the same pipeline on two implementations of the
-/// GPU (SwiftShader in the browser, lavapipe here), and the two rasterizers place silhouette
-/// pixels differently (measured: 52 of 76,800 pixels over 4 levels, all on outlines). So:
-/// the pipeline tests' bound (`crates/lightgrid/tests/pipelines.rs`: p99 within 2 levels),
-/// and off the outlines (pixels whose 5x5 neighbourhood in the native frame spans at most
-/// `OUTLINE` levels) no pixel more than 4 levels off: a missing or misplaced light changes
-/// a surface's inside, which no outline excuses.
-const OUTLINE: u8 = 16;
-/// The pipeline tests' count of pixels over 4 levels another driver may rasterize
-/// differently; a distant missing light changes 13 at 192x108, more at this size.
+/// GPU (SwiftShader in the browser, lavapipe here), and the two rasterizers place edge pixels
+/// differently: an outline or a sliver of distant geometry lands a pixel over (measured on
+/// robots-many at 320x240: 52 of 76,800 pixels over 4 levels, all but one on edges). So: the
+/// pipeline tests' bound (`crates/lightgrid/tests/pipelines.rs`: p99 within 2 levels), and
+/// off the edges (pixels whose 3x3 neighbourhood spans more than `EDGE` levels in either
+/// image: about a tenth of these frames) at most `EDGE_OVER` pixels more than 4 levels off,
+/// the pipeline tests' count. A missing or misplaced light changes a surface's inside.
+const EDGE: u8 = 8;
 const EDGE_OVER: usize = 5;
 
 fn assert_equal(web: &image::RgbaImage, native: &image::RgbaImage, what: &str) {
@@ -444,44 +443,48 @@ fn assert_equal(web: &image::RgbaImage, native: &image::RgbaImage, what: &str) {
         (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap()
     };
     let (w, h) = native.dimensions();
-    let outline = |x: u32, y: u32| {
-        let c = native.get_pixel(x, y);
-        (x.saturating_sub(2)..=(x + 2).min(w - 1)).any(|i| {
-            (y.saturating_sub(2)..=(y + 2).min(h - 1))
-                .any(|j| diff(c, native.get_pixel(i, j)) > OUTLINE)
+    let on_edge = |im: &image::RgbaImage, x: u32, y: u32| {
+        let c = im.get_pixel(x, y);
+        (x.saturating_sub(1)..=(x + 1).min(w - 1)).any(|i| {
+            (y.saturating_sub(1)..=(y + 1).min(h - 1)).any(|j| diff(c, im.get_pixel(i, j)) > EDGE)
         })
     };
     let (mut over, mut inside) = (0, Vec::new());
     for (x, y, p) in web.enumerate_pixels() {
-        if diff(p, native.get_pixel(x, y)) > 4 {
+        let d = diff(p, native.get_pixel(x, y));
+        if d > 4 {
             over += 1;
-            if !outline(x, y) {
-                inside.push((x, y, diff(p, native.get_pixel(x, y))));
+            if !on_edge(native, x, y) && !on_edge(web, x, y) {
+                inside.push((x, y, d));
             }
         }
     }
     eprintln!(
-        "{what}: web vs native: mean {:.4}, p99 {}, max {}, {over} pixels over 4 levels, {} of them off the outlines",
+        "{what}: web vs native: mean {:.4}, p99 {}, max {}, {over} pixels over 4 levels, {} of them off the edges",
         summary.mean, summary.p99, summary.max, inside.len()
     );
     assert!(
         summary.mean <= 0.5 && summary.p99 <= 2.0 && inside.len() <= EDGE_OVER,
-        "{what}: the page's frame differs from the native render: mean {:.4} (bound 0.5), p99 {} (2), pixels over 4 levels off the outlines (at most {EDGE_OVER}; x, y, levels): {inside:?}",
+        "{what}: the page's frame differs from the native render: mean {:.4} (bound 0.5), p99 {} (2), pixels over 4 levels off the edges (at most {EDGE_OVER}; x, y, levels): {inside:?}",
         summary.mean,
         summary.p99
     );
 }
 
 fn render_native(dir: &Path, pipeline: &str) -> image::RgbaImage {
+    render_scene(dir, "robots-many", pipeline, 130)
+}
+
+fn render_scene(dir: &Path, scene: &str, pipeline: &str, frame: u32) -> image::RgbaImage {
     let out = dir.join(format!("native-{pipeline}.png"));
     let o = lightgrid(&[
         "render",
         "--scene",
-        "robots-many",
+        scene,
         "--pipeline",
         pipeline,
         "--frame",
-        "130",
+        &frame.to_string(),
         "--size",
         "320x240",
         "--out",
@@ -601,5 +604,80 @@ fn a_bad_page_address_is_refused_with_its_reason() {
         );
         b.errors.clear();
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A glTF file given to the page's file picker goes through the same hardened loader as a
+/// path: a good one renders what `lightgrid render --scene FILE` renders, a malformed one
+/// or another kind of file is refused in the panel with the loader's reason, and the scene
+/// shown stays as it was.
+#[test]
+fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let page = build_page();
+    let port = serve(page);
+    let dir = temp_dir("web-gltf");
+    let glb = dir.join("robots.glb");
+    let o = lightgrid(&[
+        "export",
+        "--scene",
+        "robots-few",
+        "--frame",
+        "40",
+        "--out",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "export:\n{}", stderr(&o));
+    let bad = dir.join("broken.glb");
+    std::fs::write(&bad, b"glTF\x02\x00\x00\x00 not really").unwrap();
+    let text = dir.join("notes.txt");
+    std::fs::write(&text, b"hello").unwrap();
+
+    let mut b = Browser::start(dir.join("profile"));
+    let url = format!(
+        "http://127.0.0.1:{port}/index.html?scene=robots-few&pipeline=clustered_forward&size=320x240&paused"
+    );
+    b.call("Page.navigate", serde_json::json!({"url": url}));
+    b.wait_for("the first frames", |s| {
+        s["settled"].as_u64().unwrap_or(0) >= 2
+    });
+    let pick = |b: &mut Browser, file: &Path| {
+        let doc = b.call("DOM.getDocument", serde_json::json!({}));
+        let root = doc["root"]["nodeId"].clone();
+        let input = b.call(
+            "DOM.querySelector",
+            serde_json::json!({"nodeId": root, "selector": "#file"}),
+        );
+        b.call(
+            "DOM.setFileInputFiles",
+            serde_json::json!({"files": [file.to_str().unwrap()], "nodeId": input["nodeId"]}),
+        );
+    };
+
+    for (file, needle) in [(&bad, "broken.glb"), (&text, "not a glTF file")] {
+        pick(&mut b, file);
+        let s = b.wait_for("a refused file", |s| {
+            s["message"].as_str().is_some_and(|m| m.contains(needle))
+        });
+        assert_eq!(
+            s["scene"], "robots-few",
+            "a refused file replaced the scene: {s}"
+        );
+        eprintln!("refused: {}", s["message"]);
+    }
+
+    pick(&mut b, &glb);
+    let s = b.wait_for("the file's frames", |s| {
+        s["scene"] == "robots"
+            && s["pending"] == false
+            && s["message"] == ""
+            && s["settled"].as_u64().unwrap_or(0) >= 2
+    });
+    let frame = s["frame"].as_u64().unwrap() as u32;
+    let web = b.screenshot("file");
+    b.assert_no_errors("the file");
+    web.save(dir.join("web-file.png")).unwrap();
+    let native = render_scene(&dir, glb.to_str().unwrap(), "clustered_forward", frame);
+    assert_equal(&web, &native, "robots.glb, clustered_forward");
     let _ = std::fs::remove_dir_all(&dir);
 }

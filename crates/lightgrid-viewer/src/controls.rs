@@ -73,19 +73,12 @@ pub fn pipeline_choices(settings: &RenderSettings) -> Vec<(&'static PipelineInfo
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lightgrid::scene::catalog::SceneParams;
 
     fn controls() -> Controls {
         Controls {
             pipeline: "forward".into(),
             settings: RenderSettings::default(),
-            request: SceneRequest {
-                spec: "robots-many".into(),
-                params: SceneParams::default(),
-                camera: None,
-                add_lights: None,
-                exposure: None,
-            },
+            request: SceneRequest::new("robots-many"),
             view: DebugView::Shaded,
         }
     }

@@ -8,6 +8,8 @@
 //! - `status()`: the app's state as JSON (pipeline, frame, settled frames, message);
 //! - `request_screenshot(name)` / `take_screenshot(name)`: the shown frame (without the
 //!   panel) as a PNG, read back without waiting;
+//! - `open_file(name, bytes)`: a glTF file from the page's picker or a drop, opened through
+//!   the same loader as a path;
 //! - `spot(name)`: where a panel widget is, for tests that click it;
 //! - `fatal()`: the error that ended the app, if any.
 
@@ -53,6 +55,13 @@ mod page {
             Some(Ok(png)) => Ok(Some(png)),
             Some(Err(e)) => Err(JsValue::from_str(&e)),
         })
+    }
+
+    /// Open a glTF file (its name and bytes: the page's file picker or a drop) on the next
+    /// frame; `status().message` says why not when it cannot be.
+    #[wasm_bindgen]
+    pub fn open_file(name: String, bytes: Vec<u8>) {
+        SHARED.with(|s| s.borrow_mut().files.push((name, bytes)));
     }
 
     #[wasm_bindgen]

@@ -119,6 +119,8 @@ pub struct Shared {
     pub spots: HashMap<String, [f32; 4]>,
     /// The error that ended the app, if one did.
     pub fatal: Option<String>,
+    /// glTF files the page was given (its file picker, or dropped on it): name and bytes.
+    pub files: Vec<(String, Vec<u8>)>,
 }
 
 thread_local! {
@@ -194,23 +196,55 @@ impl App {
                 .as_ref()
                 .and_then(|w| w.egui.ctx.input(|i| i.pointer.latest_pos()))
                 .map_or([-1.0, -1.0], |p| [p.x, p.y]);
-            s.status = format!(
-                "{{\"pointer\":{pointer:?},\"pipeline\":{:?},\"draft\":{:?},\"frame\":{},\"settled\":{},\"pending\":{},\"width\":{w},\"height\":{h},\"adapter\":{:?},\"frames\":{},\"message\":{:?},\"screenshots_waiting\":{}}}",
-                self.applied.pipeline,
-                self.draft.pipeline,
-                self.frame,
-                self.settled,
-                self.pending(Instant::now()),
-                self.report.adapter,
-                self.report.frames,
-                self.message.clone().unwrap_or_default(),
-                self.screenshots.len()
-            );
+            s.status = serde_json::json!({
+                "scene": self.scene.name,
+                "pipeline": self.applied.pipeline,
+                "draft": self.draft.pipeline,
+                "frame": self.frame,
+                "settled": self.settled,
+                "pending": self.pending(Instant::now()),
+                "width": w,
+                "height": h,
+                "adapter": self.report.adapter,
+                "frames": self.report.frames,
+                "message": self.message.clone().unwrap_or_default(),
+                "screenshots_waiting": self.screenshots.len(),
+                "pointer": pointer,
+            })
+            .to_string();
             s.spots = spots;
-            std::mem::take(&mut s.shot_requests)
+            (
+                std::mem::take(&mut s.shot_requests),
+                std::mem::take(&mut s.files),
+            )
         });
+        let (requested, files) = requested;
         self.screenshots
             .extend(requested.into_iter().map(PathBuf::from));
+        for (name, bytes) in files {
+            self.open_file(name, bytes);
+        }
+    }
+
+    /// Open a file the page was given, through the same loader as a path (`scene::open`,
+    /// with the bytes in the request, so later changes reopen it too); a file that cannot
+    /// be opened leaves the scene as it was, with the loader's message in the panel.
+    fn open_file(&mut self, name: String, bytes: Vec<u8>) {
+        if !lightgrid::scene::gltf::is_gltf_path(&name) {
+            self.message = Some(format!(
+                "{name}: not a glTF file (the page opens *.glb and *.gltf files)"
+            ));
+            return;
+        }
+        let mut next = self.applied.clone();
+        next.request = SceneRequest {
+            contents: Some(lightgrid::scene::FileContents(bytes.into())),
+            ..SceneRequest::new(&name)
+        };
+        match self.apply(next) {
+            Ok(()) => self.message = None,
+            Err(e) => self.message = Some(e),
+        }
     }
 
     /// The end of the app: kept for the page to show.

@@ -22,7 +22,7 @@ pub use lighting::{
 pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};
 pub use rng::Rng;
-pub use source::{open, AddLights, Opened, SceneRequest};
+pub use source::{open, AddLights, FileContents, Opened, SceneRequest};
 pub use view::{SpotCull, ViewLight, ViewSetup};
 
 use crate::consts::{MATERIAL_FLAG_TRANSPARENT, MAX_LIGHTS};

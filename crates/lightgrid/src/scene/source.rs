@@ -35,6 +35,26 @@ pub struct SceneRequest {
     /// `--exposure`: replaces the scene's (`Lighting::exposure`; the catalog's is 1, a
     /// file's automatic).
     pub exposure: Option<f32>,
+    /// The file's bytes when they came without a path (a web page's file picker): `spec` is
+    /// then only its name, and relative URIs are refused.
+    pub contents: Option<FileContents>,
+}
+
+/// A file's bytes, shared; two are the same when they are the same allocation (comparing a
+/// request must not compare megabytes).
+#[derive(Clone)]
+pub struct FileContents(pub std::sync::Arc<[u8]>);
+
+impl PartialEq for FileContents {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl std::fmt::Debug for FileContents {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "FileContents({} bytes)", self.0.len())
+    }
 }
 
 impl SceneRequest {
@@ -46,6 +66,7 @@ impl SceneRequest {
             camera: None,
             add_lights: None,
             exposure: None,
+            contents: None,
         }
     }
 
@@ -153,10 +174,23 @@ pub fn open(req: &SceneRequest) -> Result<Opened> {
     check(req)?;
     let p = req.params;
     let (mut scene, warnings) = if req.is_file() {
-        let loaded = gltf::load(
-            &PathBuf::from(&req.spec),
-            &LoadOptions { camera: req.camera },
-        )?;
+        let opts = LoadOptions { camera: req.camera };
+        let loaded = match &req.contents {
+            // Named as a path's scene is (its stem); errors name the file.
+            Some(bytes) => {
+                let stem = std::path::Path::new(&req.spec)
+                    .file_stem()
+                    .map_or("gltf".into(), |s| s.to_string_lossy().into_owned());
+                gltf::load_bytes(&bytes.0, &stem, None, &opts).map_err(|e| match e {
+                    Error::Gltf { reason, .. } => Error::Gltf {
+                        path: req.spec.clone(),
+                        reason,
+                    },
+                    other => other,
+                })?
+            }
+            None => gltf::load(&PathBuf::from(&req.spec), &opts)?,
+        };
         let mut scene = loaded.scene;
         if !p.transparency {
             if !scene.has_transparency() {
