@@ -33,6 +33,8 @@ pub struct PanelInfo<'a> {
     pub message: Option<&'a str>,
     /// Draft and applied differ: the change is waiting to be applied.
     pub applying: bool,
+    /// Pipelines the GPU refused with these settings, and why.
+    pub refused: Vec<(&'a str, &'a str)>,
 }
 
 /// Buttons pressed this frame.
@@ -111,6 +113,10 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
         .selected_text(draft.pipeline.as_str())
         .show_ui(ui, |ui| {
             for (p, refused) in pipeline_choices(&settings) {
+                let refused = refused.or_else(|| {
+                    let gpu = info.refused.iter().find(|(id, _)| *id == p.id);
+                    gpu.map(|(_, why)| why.to_string())
+                });
                 let r = ui.add_enabled(
                     refused.is_none(),
                     egui::Button::selectable(draft.pipeline == p.id, p.id),

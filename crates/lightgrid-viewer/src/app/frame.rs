@@ -16,6 +16,14 @@ impl App {
             if cfg!(target_arch = "wasm32") {
                 #[cfg(target_arch = "wasm32")]
                 web::console_error(&format!("lightgrid: {e}"));
+                let failed = (self.applied.pipeline.clone(), self.applied.settings);
+                if !self
+                    .refused
+                    .iter()
+                    .any(|(p, s, _)| (p, s) == (&failed.0, &failed.1))
+                {
+                    self.refused.push((failed.0, failed.1, e.to_string()));
+                }
                 self.recover(e)?;
             }
         }
@@ -221,6 +229,12 @@ impl App {
             sample_every_second: self.analysis.every_second,
             message: self.message.as_deref(),
             applying: self.draft != self.applied,
+            refused: self
+                .refused
+                .iter()
+                .filter(|(_, s, _)| *s == self.draft.settings)
+                .map(|(p, _, why)| (p.as_str(), why.as_str()))
+                .collect(),
         };
         // A window too small for the panel leaves it out rather than letting egui shrink it
         // to that size (it would stay shrunk when the window grows back).

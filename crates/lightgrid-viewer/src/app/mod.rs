@@ -293,6 +293,9 @@ struct App {
     /// The MSAA counts the adapter offers with a 16- and a 32-bit G-buffer (queried once:
     /// the panel shows them every frame).
     msaa_counts: [Vec<u32>; 2],
+    /// Pipelines the GPU refused with given settings (a page learns it a frame late: its
+    /// limits), with the reason: the panel greys them out.
+    refused: Vec<(String, RenderSettings, String)>,
 }
 
 impl App {
@@ -359,6 +362,7 @@ impl App {
                 ..Default::default()
             },
             msaa_counts,
+            refused: Vec::new(),
         }
     }
 
