@@ -755,3 +755,44 @@ fn every_pipeline_renders_on_the_page_as_natively() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// In a browser that offers only WebGPU's default limits (`?limits=webgpu` asks for them),
+/// the grid pipelines need more storage buffers per stage than the 8 guaranteed: the page
+/// refuses with the browser's reason, which names the limit and the count, never a wrong
+/// or blank frame passed off as right.
+#[test]
+fn with_webgpu_default_limits_the_page_names_the_limit_that_refuses_a_pipeline() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let page = build_page();
+    let port = serve(page);
+    let dir = temp_dir("web-limits");
+    let mut b = Browser::start(dir.join("profile"));
+    let url = format!(
+        "http://127.0.0.1:{port}/index.html?scene=robots-few&pipeline=clustered_forward&size=160x120&paused&limits=webgpu"
+    );
+    b.call("Page.navigate", serde_json::json!({"url": url}));
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let fatal = loop {
+        let f = b.eval("window.lightgrid ? window.lightgrid.fatal() ?? null : null");
+        if let Some(f) = f.as_str() {
+            break f.to_string();
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the page never refused the pipeline"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    eprintln!("refused: {fatal}");
+    assert!(
+        fatal.contains("clustered_forward") && fatal.to_lowercase().contains("storage buffers"),
+        "the refusal does not name the pipeline and the limit: {fatal}"
+    );
+    let shown = b.eval("document.getElementById('error').textContent");
+    assert_eq!(
+        shown.as_str(),
+        Some(fatal.as_str()),
+        "the page does not show the refusal"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

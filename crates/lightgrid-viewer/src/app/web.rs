@@ -20,13 +20,17 @@ use std::collections::HashMap;
 /// `?scene=robots-many&pipeline=clustered_forward&frame=130&size=320x240&paused`.
 pub struct PageOptions {
     pub view: ViewOptions,
+    /// `limits=webgpu`: the device gets WebGPU's default limits, not the adapter's.
+    pub webgpu_limits: bool,
 }
 
 impl PageOptions {
     /// Keys: `scene` (a catalog scene), `pipeline`, `frame`, `size` (`WxH`, the canvas's
-    /// size in physical pixels), `tile`, `msaa`, `paused`, `script` (the viewer's
+    /// size in physical pixels), `tile`, `msaa`, `paused`, `limits` (`adapter`, the
+    /// default, or `webgpu`: WebGPU's default limits), `script` (the viewer's
     /// `at N ACTION; ...`). An unknown key or a bad value is an error, never ignored.
     pub fn from_query(query: &str) -> Result<PageOptions> {
+        let mut webgpu_limits = false;
         let mut view = ViewOptions {
             adapter: None,
             request: SceneRequest::new("robots-many"),
@@ -67,18 +71,28 @@ impl PageOptions {
                 }
                 "msaa" => view.settings.msaa = value.parse().map_err(|_| bad("not 1 or 4"))?,
                 "paused" => view.paused = true,
+                "limits" => {
+                    webgpu_limits = match value.as_str() {
+                        "webgpu" => true,
+                        "adapter" => false,
+                        _ => return Err(bad("adapter or webgpu")),
+                    }
+                }
                 "script" => {
                     view.script = crate::script::parse(&value).map_err(|e| bad(&e))?;
                 }
                 _ => bail!(
-                    "the page's address: unknown key '{key}'; valid: scene, pipeline, frame, size, tile, msaa, paused, script"
+                    "the page's address: unknown key '{key}'; valid: scene, pipeline, frame, size, tile, msaa, paused, limits, script"
                 ),
             }
         }
         view.settings
             .validate()
             .map_err(|e| anyhow!("the page's address: {e}"))?;
-        Ok(PageOptions { view })
+        Ok(PageOptions {
+            view,
+            webgpu_limits,
+        })
     }
 }
 
@@ -145,10 +159,11 @@ pub async fn start(opts: PageOptions) -> Result<()> {
             }
         });
     }));
+    let webgpu_limits = opts.webgpu_limits;
     let opts = opts.view;
     let opened = lightgrid::scene::open(&opts.request)?;
     opened.scene.check_frame(opts.frame)?;
-    let ctx = GpuContext::for_page().await?;
+    let ctx = GpuContext::for_page(webgpu_limits).await?;
     let lost = Arc::new(Mutex::new(None::<String>));
     let flag = lost.clone();
     ctx.device.set_device_lost_callback(move |reason, message| {

@@ -98,11 +98,17 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
 /// asks for WebGPU's defaults instead, what every page may rely on: a pipeline that needs
 /// more is refused with the limit and the count (README, "In a browser").
 fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+    let page_asked = WEB_DEFAULT_LIMITS.load(std::sync::atomic::Ordering::Relaxed);
     match std::env::var("LIGHTGRID_LIMITS").as_deref() {
+        _ if page_asked => wgpu::Limits::default(),
         Ok("webgpu") => wgpu::Limits::default(),
         _ => adapter.limits(),
     }
 }
+
+/// A page asked for WebGPU's default limits (`?limits=webgpu`): a page has no environment.
+static WEB_DEFAULT_LIMITS: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
 
 /// Does `wanted` (an index, a backend name, or part of the adapter name) select this adapter?
 fn matches(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
@@ -169,8 +175,13 @@ impl GpuContext {
 
     /// The page's context (wasm32): the browser's WebGPU adapter and a device on it. Nothing
     /// on the web may block, so this is the one `async` constructor.
+    /// `webgpu_defaults`: ask for WebGPU's default limits, what every page may rely on,
+    /// instead of the adapter's (a pipeline needing more is then refused with the limit).
     #[cfg(target_arch = "wasm32")]
-    pub async fn for_page() -> Result<Self> {
+    pub async fn for_page(webgpu_defaults: bool) -> Result<Self> {
+        if webgpu_defaults {
+            WEB_DEFAULT_LIMITS.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.backends = wgpu::Backends::BROWSER_WEBGPU;
         let instance = wgpu::Instance::new(desc);
