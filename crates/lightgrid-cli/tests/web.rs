@@ -482,6 +482,37 @@ fn assert_close(web: &image::RgbaImage, native: &image::RgbaImage, what: &str, w
     );
 }
 
+/// One test's session: the page built and served, a browser started, the lock that keeps
+/// the tests' browsers one at a time held until it is dropped.
+struct Session {
+    b: Browser,
+    port: u16,
+    dir: PathBuf,
+    _one: std::sync::MutexGuard<'static, ()>,
+}
+
+fn session(name: &str) -> Session {
+    let one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let port = serve(build_page());
+    let dir = temp_dir(name);
+    let b = Browser::start(dir.join("profile"));
+    Session {
+        b,
+        port,
+        dir,
+        _one: one,
+    }
+}
+
+impl Session {
+    /// Open the page with the address query `query`.
+    fn open(&mut self, query: &str) {
+        let url = format!("http://127.0.0.1:{}/index.html?{query}", self.port);
+        self.b
+            .call("Page.navigate", serde_json::json!({"url": url}));
+    }
+}
+
 fn render_native(dir: &Path, pipeline: &str) -> image::RgbaImage {
     render_scene(dir, "robots-many", pipeline, 130)
 }
@@ -509,15 +540,9 @@ fn render_scene(dir: &Path, scene: &str, pipeline: &str, frame: u32) -> image::R
 /// tiled_deferred chosen in the panel; each frame equals the native render.
 #[test]
 fn the_page_renders_what_the_native_renderer_renders_and_switches_from_the_panel() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let page = build_page();
-    let port = serve(page);
-    let dir = temp_dir("web");
-    let mut b = Browser::start(dir.join("profile"));
-    let url = format!(
-        "http://127.0.0.1:{port}/index.html?scene=robots-many&pipeline=clustered_forward&frame=130&size=320x240&paused"
-    );
-    b.call("Page.navigate", serde_json::json!({"url": url}));
+    let mut session = session("web");
+    session.open("scene=robots-many&pipeline=clustered_forward&frame=130&size=320x240&paused");
+    let (b, dir) = (&mut session.b, session.dir.clone());
     let settled = |pipeline: &'static str| {
         move |s: &serde_json::Value| {
             s["pipeline"] == pipeline
@@ -575,19 +600,15 @@ fn the_page_renders_what_the_native_renderer_renders_and_switches_from_the_panel
 /// A bad address is refused on the page with its reason, as the CLI refuses bad options.
 #[test]
 fn a_bad_page_address_is_refused_with_its_reason() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let page = build_page();
-    let port = serve(page);
-    let dir = temp_dir("web-bad");
-    let mut b = Browser::start(dir.join("profile"));
+    let mut session = session("web-bad");
     for (query, needle) in [
         ("pipeline=nope", "unknown pipeline 'nope'"),
         ("size=0x10", "not WIDTHxHEIGHT"),
         ("frame=nan", "not a frame number"),
         ("colour=red", "unknown key 'colour'"),
     ] {
-        let url = format!("http://127.0.0.1:{port}/index.html?{query}");
-        b.call("Page.navigate", serde_json::json!({"url": url}));
+        session.open(query);
+        let b = &mut session.b;
         let deadline = Instant::now() + Duration::from_secs(60);
         let shown = loop {
             let t = b.eval("window.lightgridStarted === false ? document.getElementById('error').textContent : null");
@@ -615,7 +636,7 @@ fn a_bad_page_address_is_refused_with_its_reason() {
         );
         b.errors.clear();
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&session.dir);
 }
 
 /// A glTF file given to the page's file picker goes through the same hardened loader as a
@@ -624,10 +645,8 @@ fn a_bad_page_address_is_refused_with_its_reason() {
 /// shown stays as it was.
 #[test]
 fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let page = build_page();
-    let port = serve(page);
-    let dir = temp_dir("web-gltf");
+    let mut session = session("web-gltf");
+    let dir = session.dir.clone();
     let glb = dir.join("robots.glb");
     let o = lightgrid(&[
         "export",
@@ -644,11 +663,8 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
     let text = dir.join("notes.txt");
     std::fs::write(&text, b"hello").unwrap();
 
-    let mut b = Browser::start(dir.join("profile"));
-    let url = format!(
-        "http://127.0.0.1:{port}/index.html?scene=robots-few&pipeline=clustered_forward&size=320x240&paused"
-    );
-    b.call("Page.navigate", serde_json::json!({"url": url}));
+    session.open("scene=robots-few&pipeline=clustered_forward&size=320x240&paused");
+    let b = &mut session.b;
     b.wait_for("the first frames", |s| {
         s["settled"].as_u64().unwrap_or(0) >= 2
     });
@@ -666,7 +682,7 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
     };
 
     for (file, needle) in [(&bad, "broken.glb"), (&text, "not a glTF file")] {
-        pick(&mut b, file);
+        pick(b, file);
         let s = b.wait_for("a refused file", |s| {
             s["message"].as_str().is_some_and(|m| m.contains(needle))
         });
@@ -677,7 +693,7 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
         eprintln!("refused: {}", s["message"]);
     }
 
-    pick(&mut b, &glb);
+    pick(b, &glb);
     let s = b.wait_for("the file's frames", |s| {
         s["scene"] == "robots"
             && s["pending"] == false
@@ -698,11 +714,8 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
 /// on WebGPU, not the scene.
 #[test]
 fn every_pipeline_renders_on_the_page_as_natively() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let page = build_page();
-    let port = serve(page);
-    let dir = temp_dir("web-every");
-    let mut b = Browser::start(dir.join("profile"));
+    let mut session = session("web-every");
+    let dir = session.dir.clone();
     let mut failures = Vec::new();
     let cases = lightgrid::pipelines::PIPELINES.iter().flat_map(|info| {
         let msaa = matches!(info.msaa, lightgrid::pipelines::Msaa::Supported);
@@ -712,10 +725,10 @@ fn every_pipeline_renders_on_the_page_as_natively() {
     });
     for (id, msaa) in cases {
         let what = format!("{id} msaa {msaa}");
-        let url = format!(
-            "http://127.0.0.1:{port}/index.html?scene=robots-few&pipeline={id}&msaa={msaa}&frame=40&size=160x120&paused"
-        );
-        b.call("Page.navigate", serde_json::json!({"url": url}));
+        session.open(&format!(
+            "scene=robots-few&pipeline={id}&msaa={msaa}&frame=40&size=160x120&paused"
+        ));
+        let b = &mut session.b;
         b.wait_for(&what, |s| {
             s["pipeline"] == id && s["pending"] == false && s["settled"].as_u64().unwrap_or(0) >= 2
         });
@@ -762,15 +775,9 @@ fn every_pipeline_renders_on_the_page_as_natively() {
 /// or blank frame passed off as right.
 #[test]
 fn with_webgpu_default_limits_the_page_names_the_limit_that_refuses_a_pipeline() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let page = build_page();
-    let port = serve(page);
-    let dir = temp_dir("web-limits");
-    let mut b = Browser::start(dir.join("profile"));
-    let url = format!(
-        "http://127.0.0.1:{port}/index.html?scene=robots-few&pipeline=clustered_forward&size=160x120&paused&limits=webgpu"
-    );
-    b.call("Page.navigate", serde_json::json!({"url": url}));
+    let mut session = session("web-limits");
+    session.open("scene=robots-few&pipeline=clustered_forward&size=160x120&paused&limits=webgpu");
+    let (b, dir) = (&mut session.b, session.dir.clone());
     let deadline = Instant::now() + Duration::from_secs(120);
     let fatal = loop {
         let f = b.eval("window.lightgrid ? window.lightgrid.fatal() ?? null : null");
