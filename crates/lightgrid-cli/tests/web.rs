@@ -606,6 +606,8 @@ fn a_bad_page_address_is_refused_with_its_reason() {
         ("size=0x10", "not WIDTHxHEIGHT"),
         ("frame=nan", "not a frame number"),
         ("colour=red", "unknown key 'colour'"),
+        ("scene=%zz%C3%A9%e", "unknown scene '%zzé%e'"),
+        ("limits=9", "adapter or webgpu"),
     ] {
         session.open(query);
         let b = &mut session.b;

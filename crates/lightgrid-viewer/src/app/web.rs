@@ -104,13 +104,16 @@ fn decode(s: &str) -> String {
     while i < bytes.len() {
         match bytes[i] {
             b'+' => out.push(b' '),
-            b'%' if i + 2 < bytes.len() => match u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                Ok(b) => {
-                    out.push(b);
-                    i += 2;
+            b'%' if i + 2 < bytes.len() => {
+                let hex = std::str::from_utf8(&bytes[i + 1..i + 3]).ok();
+                match hex.and_then(|h| u8::from_str_radix(h, 16).ok()) {
+                    Some(b) => {
+                        out.push(b);
+                        i += 2;
+                    }
+                    None => out.push(b'%'),
                 }
-                Err(_) => out.push(b'%'),
-            },
+            }
             b => out.push(b),
         }
         i += 1;
@@ -206,11 +209,6 @@ impl App {
                 .as_ref()
                 .map(|w| w.renderer.size())
                 .unwrap_or_default();
-            let pointer = self
-                .win
-                .as_ref()
-                .and_then(|w| w.egui.ctx.input(|i| i.pointer.latest_pos()))
-                .map_or([-1.0, -1.0], |p| [p.x, p.y]);
             s.status = serde_json::json!({
                 "scene": self.scene.name,
                 "pipeline": self.applied.pipeline,
@@ -224,7 +222,6 @@ impl App {
                 "frames": self.report.frames,
                 "message": self.message.clone().unwrap_or_default(),
                 "screenshots_waiting": self.screenshots.len(),
-                "pointer": pointer,
             })
             .to_string();
             s.spots = spots;
