@@ -569,6 +569,38 @@ fn the_page_renders_what_the_native_renderer_renders_and_switches_from_the_panel
     });
     let second = b.screenshot("tiled_deferred");
     b.assert_no_errors("after the switch");
+    // The screenshot key (P, as the panel's button and F12): the page downloads what the
+    // window shows. (At 320x240 the button is below the panel's fold.)
+    let downloads = dir.join("downloads");
+    std::fs::create_dir_all(&downloads).unwrap();
+    b.call(
+        "Page.setDownloadBehavior",
+        serde_json::json!({"behavior": "allow", "downloadPath": downloads.to_str().unwrap()}),
+    );
+    b.eval("document.querySelector('canvas').focus()");
+    for kind in ["keyDown", "keyUp"] {
+        b.call(
+            "Input.dispatchKeyEvent",
+            serde_json::json!({"type": kind, "key": "p", "code": "KeyP", "windowsVirtualKeyCode": 80}),
+        );
+    }
+    let downloaded = downloads.join("lightgrid-robots-many-tiled_deferred-130.png");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !downloaded.is_file() {
+        assert!(
+            Instant::now() < deadline,
+            "the screenshot was not downloaded: {:?}",
+            std::fs::read_dir(&downloads).unwrap().collect::<Vec<_>>()
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let user = image::open(&downloaded).unwrap().to_rgba8();
+    assert_eq!(
+        user, second,
+        "the downloaded screenshot is not the frame shown"
+    );
+    b.assert_no_errors("the user's screenshot");
     // The page as a user sees it, panel and all (README's picture is one such).
     let shot = b.call(
         "Page.captureScreenshot",

@@ -73,7 +73,9 @@ pub fn draw(ctx: &egui::Context, draft: &mut Controls, info: &PanelInfo) -> Vec<
             scene(ui, draft, info);
             ui.separator();
             ui.horizontal(|ui| {
-                if ui.button("screenshot (F12)").clicked() {
+                let shot = ui.button("screenshot (F12)");
+                remember_spot(ui.ctx(), "screenshot", shot.rect);
+                if shot.clicked() {
                     actions.push(PanelAction::Screenshot);
                 }
                 if ui.button("hide panel (H)").clicked() {

@@ -10,6 +10,7 @@
 //!   panel) as a PNG, read back without waiting;
 //! - `open_file(name, bytes)`: a glTF file from the page's picker or a drop, opened through
 //!   the same loader as a path;
+//! - `take_download()`: a screenshot the user took, which the page downloads;
 //! - `spot(name)`: where a panel widget is, for tests that click it;
 //! - `fatal()`: the error that ended the app, if any.
 
@@ -62,6 +63,17 @@ mod page {
     #[wasm_bindgen]
     pub fn open_file(name: String, bytes: Vec<u8>) {
         SHARED.with(|s| s.borrow_mut().files.push((name, bytes)));
+    }
+
+    /// The next screenshot the user took (F12, P, the panel's button), as [name, PNG], for
+    /// the page to download; None when there is none.
+    #[wasm_bindgen]
+    pub fn take_download() -> Option<js_sys::Array> {
+        let (name, png) = SHARED.with(|s| s.borrow_mut().downloads.pop())?;
+        let pair = js_sys::Array::new();
+        pair.push(&JsValue::from_str(&name));
+        pair.push(&js_sys::Uint8Array::from(png.as_slice()));
+        Some(pair)
     }
 
     #[wasm_bindgen]

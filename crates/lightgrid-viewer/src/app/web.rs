@@ -132,12 +132,15 @@ pub struct Shared {
     /// Screenshots taken (PNG), or why not.
     pub shots: HashMap<String, Result<Vec<u8>, String>>,
     /// Where the panel's widgets are, in CSS pixels of the canvas ([x, y, w, h]):
-    /// `pipeline` (the combo box) and `pipeline:<id>` (its entries, while it is open).
+    /// `pipeline` (the combo box), `pipeline:<id>` (its entries, while it is open) and
+    /// `screenshot` (the button).
     pub spots: HashMap<String, [f32; 4]>,
     /// The error that ended the app, if one did.
     pub fatal: Option<String>,
     /// glTF files the page was given (its file picker, or dropped on it): name and bytes.
     pub files: Vec<(String, Vec<u8>)>,
+    /// Screenshots the user took, for the page to download: file name and PNG.
+    pub downloads: Vec<(String, Vec<u8>)>,
 }
 
 thread_local! {
@@ -325,6 +328,20 @@ pub(super) fn read_later(ctx: &GpuContext, capture: Capture, name: String) {
                 .map_err(|e| e.to_string())?;
             Ok(png)
         });
-        SHARED.with(|s| s.borrow_mut().shots.insert(name, png));
+        SHARED.with(|s| {
+            let mut s = s.borrow_mut();
+            // A file name is a screenshot the user asked for (F12, P, the panel's button):
+            // the page downloads it. Other names are the page script's.
+            match (name.ends_with(".png"), png) {
+                (true, Ok(png)) => {
+                    let file = name.rsplit('/').next().unwrap_or(&name).to_string();
+                    s.downloads.push((file, png));
+                }
+                (true, Err(e)) => console_error(&format!("lightgrid: screenshot {name}: {e}")),
+                (false, png) => {
+                    s.shots.insert(name, png);
+                }
+            }
+        });
     });
 }
