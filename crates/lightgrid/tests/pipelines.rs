@@ -1163,10 +1163,18 @@ fn subgroup_depth_reduction_gives_the_twins_bounds() {
         .render(&s, frame, REFERENCE)
         .unwrap()
         .image;
-    for assign in [Assign::Cpu, Assign::Gather] {
-        let mut r = Renderer::new(&ctx, w, h, subgroup(assign)).unwrap();
-        for id in ["tiled_forward_prez", "tiled_deferred", "clustered_forward"] {
-            check_assign(&mut r, &s, frame, id, &reference);
+    // With tight cells the tiled grids reduce each invocation's box in registers and across
+    // the subgroup too (check_assign holds the boxes to the twin's).
+    for cell_box in CellBox::ALL {
+        for assign in [Assign::Cpu, Assign::Gather] {
+            let settings = RenderSettings {
+                cell_box,
+                ..subgroup(assign)
+            };
+            let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
+            for id in ["tiled_forward_prez", "tiled_deferred", "clustered_forward"] {
+                check_assign(&mut r, &s, frame, id, &reference);
+            }
         }
     }
 }

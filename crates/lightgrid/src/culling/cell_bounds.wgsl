@@ -34,22 +34,20 @@ var<workgroup> box_x1: array<atomic<u32>, MAX_SLICES>;
 var<workgroup> box_y0: array<atomic<u32>, MAX_SLICES>;
 var<workgroup> box_y1: array<atomic<u32>, MAX_SLICES>;
 
-fn box_include(k: u32, e: vec4<f32>) {
-    atomicMin(&box_x0[k], ordered_bits(e.x));
-    atomicMax(&box_x1[k], ordered_bits(e.y));
-    atomicMin(&box_y0[k], ordered_bits(e.z));
-    atomicMax(&box_y1[k], ordered_bits(e.w));
+// Includes a box given as ordered bits (x0, x1, y0, y1) in slice k's.
+fn box_include(k: u32, e: vec4<u32>) {
+    atomicMin(&box_x0[k], e.x);
+    atomicMax(&box_x1[k], e.y);
+    atomicMin(&box_y0[k], e.z);
+    atomicMax(&box_y1[k], e.w);
 }
 
-// A sample of pixel p at view distance w, in slices k0 and k1 (as `include_depth` finds
-// them): its pixel at its distance widened by the slack. CPU twin: `cell_boxes_cpu`.
-fn box_sample(w: f32, k0: u32, k1: u32, p: vec2<u32>) {
+// A sample of pixel p at view distance w: its pixel at its distance widened by the slack, as
+// ordered bits (x0, x1, y0, y1). CPU twin: `cell_boxes_cpu`.
+fn sample_box(w: f32, p: vec2<u32>) -> vec4<u32> {
     let q = vec2<f32>(p);
     let e = rect_extent(vec2<f32>(q.x, q.x + 1.0), vec2<f32>(q.y, q.y + 1.0), w * (1.0 - ASSIGN_DEPTH_SLACK), w * (1.0 + ASSIGN_DEPTH_SLACK));
-    box_include(k0, e);
-    if (k1 != k0) {
-        box_include(k1, e);
-    }
+    return vec4<u32>(ordered_bits(e.x), ordered_bits(e.y), ordered_bits(e.z), ordered_bits(e.w));
 }
 
 // Slice k's cell box: its samples' footprints and, over `extra` (a range of what is not a
@@ -94,16 +92,38 @@ fn mask_span(k: u32, span: vec2<f32>) -> u32 {
     return depth_mask_span(span.x * (1.0 - ASSIGN_DEPTH_SLACK), span.y * (1.0 + ASSIGN_DEPTH_SLACK), m);
 }
 
-// 2. A sample's bins in the slices its distance (with the slack) lies in, as `include_depth`.
-fn mask_sample(d: f32) {
-    if (!is_background(d)) {
-        let w = view_distance_from_depth(d);
-        let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
-        let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
-        atomicOr(&mask_bits[k0], mask_span(k0, vec2<f32>(w, w)));
-        if (k1 != k0) {
-            atomicOr(&mask_bits[k1], mask_span(k1, vec2<f32>(w, w)));
+// 2. Row `row` of the tile's samples: each sample's bins in the slices its distance (with the
+// slack) lies in, as in the first sweep; the bins of a run of samples in one slice are ORed in
+// registers and set with one atomic when the slice changes (see `Run`).
+fn mask_row(origin: vec2<u32>, row: u32, width: u32) {
+    var k = NO_SLICE;
+    var bits = 0u;
+    var x = 0u;
+    for (; x < width; x = x + 1u) {
+        let p = origin + vec2<u32>(x, row);
+        for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            let d = textureLoad(depth_tex, p, s);
+            if (!is_background(d)) {
+                let w = view_distance_from_depth(d);
+                let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+                let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+                if (k0 != k) {
+                    if (k != NO_SLICE) {
+                        atomicOr(&mask_bits[k], bits);
+                    }
+                    k = k0;
+                    bits = 0u;
+                }
+                bits = bits | mask_span(k0, vec2<f32>(w, w));
+                if (k1 != k0) {
+                    atomicOr(&mask_bits[k1], mask_span(k1, vec2<f32>(w, w)));
+                }
+            }
         }
+    }
+    check_loop(x, width);
+    if (k != NO_SLICE) {
+        atomicOr(&mask_bits[k], bits);
     }
 }
 #endif
@@ -111,14 +131,21 @@ fn mask_sample(d: f32) {
 #if SUBGROUP_REDUCTION
 // `--depth-reduction subgroup`: the invocations' register bounds, one subgroup min/max, and
 // one lane per subgroup writes (naga has no subgroupElect): the first active one.
-fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, li: u32) {
+// With CELL_BOX the register box (ordered bits) is reduced the same way.
+fn subgroup_reduce(lo: u32, hi: u32, tile_max: u32, e: vec4<u32>, li: u32) {
     let l = subgroupMin(lo);
     let h = subgroupMax(hi);
     let t = subgroupMax(tile_max);
+#if CELL_BOX
+    let b = vec4<u32>(subgroupMin(e.x), subgroupMax(e.y), subgroupMin(e.z), subgroupMax(e.w));
+#endif
     if (li == subgroupBroadcastFirst(li)) {
         atomicMin(&slice_lo[0], l);
         atomicMax(&slice_hi[0], h);
         atomicMax(&tile_hi, t);
+#if CELL_BOX
+        box_include(0u, b);
+#endif
     }
 }
 #endif
@@ -150,28 +177,73 @@ var<workgroup> slice_lo: array<atomic<u32>, MAX_SLICES>;
 var<workgroup> tile_hi: atomic<u32>;
 var<workgroup> slice_hi: array<atomic<u32>, MAX_SLICES>;
 
-// A depth-buffer value of pixel p: the tile maximum, and the slices its view distance lies in
-// (and, with CELL_BOX, their boxes).
-fn include_depth(d: f32, p: vec2<u32>) {
-    atomicMax(&tile_hi, bitcast<u32>(select(frame.far, view_distance_from_depth(d), !is_background(d))));
-    if (!is_background(d)) {
-        let w = view_distance_from_depth(d);
-        let bits = bitcast<u32>(w);
-        let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
-        let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
-        include_sample(k0, bits);
-        if (k1 != k0) {
-            include_sample(k1, bits);
-        }
+// No slice: a run that holds no sample yet.
+const NO_SLICE: u32 = 0xffffffffu;
+
+// Distances [lo, hi] (bits) and, with CELL_BOX, box e (ordered bits) into slice k's.
+fn include_run(k: u32, lo: u32, hi: u32, e: vec4<u32>) {
+    atomicMin(&slice_lo[k], lo);
+    atomicMax(&slice_hi[k], hi);
 #if CELL_BOX
-        box_sample(w, k0, k1, p);
+    box_include(k, e);
 #endif
-    }
 }
 
-fn include_sample(k: u32, bits: u32) {
-    atomicMin(&slice_lo[k], bits);
-    atomicMax(&slice_hi[k], bits);
+// 1. Row `row` of the tile (`width` pixels from `origin`): the slices each sample's view
+// distance lies in (with the slack, both when it is near a boundary; with CELL_BOX their
+// boxes). Returns the row's maximum distance, an empty pixel counting as the far plane (the
+// tile maximum).
+// A run, consecutive samples of the row in one slice (run_k), is reduced in registers (the
+// distances' bits and, with CELL_BOX, the footprints' box as ordered bits) and included in
+// the slice's workgroup bounds with one set of atomics when the slice changes or the row
+// ends. A row of a surface mostly stays in one slice, so this takes the workgroup atomics
+// from one set per sample to about one per row (lavapipe runs them in software); min and max
+// do not depend on the order, so the bounds are those per-sample atomics give.
+fn bounds_row(origin: vec2<u32>, row: u32, width: u32) -> u32 {
+    var run_k = NO_SLICE;
+    var run_lo = 0u;
+    var run_hi = 0u;
+    var run_box = vec4<u32>(0u);
+    var row_hi = 0u;
+    var x = 0u;
+    for (; x < width; x = x + 1u) {
+        let p = origin + vec2<u32>(x, row);
+        for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            let d = textureLoad(depth_tex, p, s);
+            let w = view_distance_from_depth(d);
+            row_hi = max(row_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
+            if (!is_background(d)) {
+                let bits = bitcast<u32>(w);
+                let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+                let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+                var e = vec4<u32>(0u);
+#if CELL_BOX
+                e = sample_box(w, p);
+#endif
+                if (k0 != run_k) {
+                    if (run_k != NO_SLICE) {
+                        include_run(run_k, run_lo, run_hi, run_box);
+                    }
+                    run_k = k0;
+                    run_lo = bits;
+                    run_hi = bits;
+                    run_box = e;
+                } else {
+                    run_lo = min(run_lo, bits);
+                    run_hi = max(run_hi, bits);
+                    run_box = vec4<u32>(min(run_box.x, e.x), max(run_box.y, e.y), min(run_box.z, e.z), max(run_box.w, e.w));
+                }
+                if (k1 != k0) {
+                    include_run(k1, bits, bits, e);
+                }
+            }
+        }
+    }
+    check_loop(x, width);
+    if (run_k != NO_SLICE) {
+        include_run(run_k, run_lo, run_hi, run_box);
+    }
+    return row_hi;
 }
 
 @compute @workgroup_size(TILE_THREADS, TILE_THREADS)
@@ -194,45 +266,46 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     workgroupBarrier();
     let size = textureDimensions(depth_tex);
     let origin = wg.xy * grid.tile_size;
+    // The tile's pixels that are on the screen.
+    let extent = min(vec2<u32>(grid.tile_size), size - min(origin, size));
     // `--depth-reduction subgroup` on a tiled grid: this invocation's samples in registers
     // (bit patterns, ordered as the distances are), reduced across the subgroup below.
     let registers = SUBGROUP_REDUCTION && grid.slices == 1u;
-    var lo = W_INFINITY;
-    var hi = 0u;
-    var t_hi = 0u;
-    var y = lid.y;
-    for (; y < grid.tile_size; y = y + TILE_THREADS) {
-        var x = lid.x;
-        for (; x < grid.tile_size; x = x + TILE_THREADS) {
-            let p = origin + vec2<u32>(x, y);
-            if (p.x < size.x && p.y < size.y) {
+    if (registers) {
+        var lo = W_INFINITY;
+        var hi = 0u;
+        var t_hi = 0u;
+        var e = vec4<u32>(0xffffffffu, 0u, 0xffffffffu, 0u);
+        var y = lid.y;
+        for (; y < extent.y; y = y + TILE_THREADS) {
+            var x = lid.x;
+            for (; x < extent.x; x = x + TILE_THREADS) {
+                let p = origin + vec2<u32>(x, y);
                 for (var s = 0u; s < SAMPLES; s = s + 1u) {
                     let d = textureLoad(depth_tex, p, s);
-                    if (registers) {
-                        let w = view_distance_from_depth(d);
-                        t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
-                        if (!is_background(d)) {
-                            lo = min(lo, bitcast<u32>(w));
-                            hi = max(hi, bitcast<u32>(w));
+                    let w = view_distance_from_depth(d);
+                    t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
+                    if (!is_background(d)) {
+                        lo = min(lo, bitcast<u32>(w));
+                        hi = max(hi, bitcast<u32>(w));
 #if CELL_BOX
-                            // Registers only on a tiled grid: every sample is in slice 0.
-                            box_sample(w, 0u, 0u, p);
+                        // Registers only on a tiled grid: every sample is in slice 0.
+                        let b = sample_box(w, p);
+                        e = vec4<u32>(min(e.x, b.x), max(e.y, b.y), min(e.z, b.z), max(e.w, b.w));
 #endif
-                        }
-                    } else {
-                        include_depth(d, p);
                     }
                 }
             }
+            check_loop(x, extent.x);
         }
-        check_loop(x, grid.tile_size);
-    }
-    check_loop(y, grid.tile_size);
+        check_loop(y, extent.y);
 #if SUBGROUP_REDUCTION
-    if (registers) {
-        subgroup_reduce(lo, hi, t_hi, li);
-    }
+        subgroup_reduce(lo, hi, t_hi, e, li);
 #endif
+    } else if (li < extent.y) {
+        // One invocation per row of the tile (MAX_TILE_SIZE <= TILE_THREADS², consts.rs).
+        atomicMax(&tile_hi, bounds_row(origin, li, extent.x));
+    }
     workgroupBarrier();
     let tile = wg.y * grid.tiles_x + wg.x;
     let tiles = grid.tiles_x * grid.tiles_y;
@@ -286,20 +359,9 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     check_loop(k, grid.slices);
 #if DEPTH_MASK
     workgroupBarrier();
-    var my = lid.y;
-    for (; my < grid.tile_size; my = my + TILE_THREADS) {
-        var mx = lid.x;
-        for (; mx < grid.tile_size; mx = mx + TILE_THREADS) {
-            let p = origin + vec2<u32>(mx, my);
-            if (p.x < size.x && p.y < size.y) {
-                for (var s = 0u; s < SAMPLES; s = s + 1u) {
-                    mask_sample(textureLoad(depth_tex, p, s));
-                }
-            }
-        }
-        check_loop(mx, grid.tile_size);
+    if (li < extent.y) {
+        mask_row(origin, li, extent.x);
     }
-    check_loop(my, grid.tile_size);
     workgroupBarrier();
     // 3. The masks.
     var mk = li;
