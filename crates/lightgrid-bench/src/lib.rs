@@ -25,7 +25,7 @@ pub use outdir::{
 pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     prepare, run, AxisValues, BenchConfig, BenchResults, FrameRange, FrameRecord, PreparedBench,
-    Progress, RunRecord, RunSummary, SpotRayTest, TimesFrom, SOURCES,
+    Progress, RunRecord, RunSummary, SpotRayTest, TimesFrom, SOURCES, SPOTS_SUFFIX,
 };
 pub use scaling::{
     run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,

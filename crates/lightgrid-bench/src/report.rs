@@ -242,6 +242,65 @@ Means over the frames. Maps: the depth texture the frame's maps were rendered in
     }
 }
 
+/// Culling past the papers (`--preset culling`; a run that measures 2.5D masks, tight cells
+/// or z-binning): per grid, the lighting computations against the ideal, the GPU frame time,
+/// what the assignment costs in it (its GPU passes, and the `cpu` strategy's own time beside
+/// it) and the grid's memory, all means over the frames. Issue 31's goal is the best grid
+/// near 1× the ideal with assignment at most 15% of its frame.
+fn culling_section(s: &mut String, results: &BenchResults, scene: &str) {
+    use lightgrid::frame::{Assign, CellBox, DepthMask};
+    let c = &results.config;
+    let studied = c.values_of::<DepthMask>().len() > 1
+        || c.values_of::<CellBox>().len() > 1
+        || c.values_of::<Assign>().contains(&Assign::ZBin);
+    let runs: Vec<&RunRecord> = (results.runs.iter())
+        .filter(|r| r.scene == scene && r.summary.is_some())
+        .filter(|r| r.frames.iter().any(|f| f.stats.memory.grid_bytes.is_some()))
+        .collect();
+    if !studied || runs.is_empty() {
+        return;
+    }
+    s.push_str("
+### Culling: the grids' computations, assignment cost and memory
+
+Means over the frames. Assignment: the GPU passes labelled `assign: ...` in the real-time frame (depth range, cell bounds with their masks and boxes, and a GPU strategy's kernels) and their share of its GPU time; `--assign cpu` (what `auto` is on a software adapter) also spends the CPU time beside it, measured in the analysis render. Memory: cells, lists (or z-bins and their masks) and, with masks or boxes, the cells' records.
+
+| grid | × ideal | avg ms | assignment GPU ms (share) | assignment CPU ms | grid KiB |
+|---|---|---|---|---|---|
+");
+    for r in runs {
+        let m = r.summary.as_ref().expect("filtered");
+        let ratio = m.lighting_computations.map_or("-".into(), |l| {
+            format!(
+                "{:.2}",
+                l.mean / m.ideal_lighting_computations.mean.max(1.0)
+            )
+        });
+        let assign: f64 = (m.passes.iter())
+            .filter(|p| {
+                p.label
+                    .starts_with(lightgrid::culling::labels::ASSIGN_PREFIX)
+            })
+            .map(|p| p.ms)
+            .sum();
+        let mean = |f: &dyn Fn(&crate::FrameRecord) -> Option<f64>| {
+            let v: Vec<f64> = r.frames.iter().filter_map(f).collect();
+            (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        };
+        let cpu = mean(&|f| f.stats.assign_cpu_ms);
+        let bytes = mean(&|f| f.stats.memory.grid_bytes.map(|b| b as f64));
+        let _ = writeln!(
+            s,
+            "| {} | {ratio} | {:.2} | {assign:.2} ({:.0}%) | {} | {} |",
+            run_name(r),
+            m.gpu_ms.mean,
+            100.0 * assign / m.gpu_ms.mean.max(1e-9),
+            cpu.map_or("-".into(), |x| format!("{x:.2}")),
+            bytes.map_or("-".into(), |b| format!("{:.1}", b / 1024.0)),
+        );
+    }
+}
+
 /// Test (b) of the spot culling over the scene's frames, when it was measured.
 fn spot_ray_section(s: &mut String, results: &BenchResults, scene: &str) {
     let tests: Vec<_> = results
@@ -689,15 +748,28 @@ fn summary(results: &BenchResults) -> String {
             "- transparent objects off (`--transparency off`): the papers' scenes have none; `--preset transparency` measures the glass"
         );
     }
-    if c.spot_fraction > 0.0 {
+    if c.has_spots() {
         let culls: Vec<&str> = (c.values_of::<SpotCull>().iter())
             .map(|&x| spot_cull_name(x))
             .collect();
+        let fractions = c.spot_fractions();
+        let listed: Vec<String> = fractions.iter().map(|f| f.to_string()).collect();
+        let shares: Vec<String> = fractions
+            .iter()
+            .map(|f| format!("{:.0}%", f * 100.0))
+            .collect();
+        let named = match fractions.len() {
+            1 => String::new(),
+            _ => format!(
+                ", each scene once per fraction (`<scene>{}<fraction>` above 0)",
+                crate::run::SPOTS_SUFFIX
+            ),
+        };
         let _ = writeln!(
             s,
-            "- spot lights: {:.0}% of each scene's lights (`--spot-fraction {}`); grid pipelines cull them by {} (`[sphere]`: the cone's bounding sphere; `[cone]`: the sphere, then the cone against each cell's bounding sphere)",
-            c.spot_fraction * 100.0,
-            c.spot_fraction,
+            "- spot lights: {} of each scene's lights (`--spot-fraction {}`){named}; grid pipelines cull them by {} (`[sphere]`: the cone's bounding sphere; `[cone]`: the sphere, then the cone against each cell's bounding sphere)",
+            shares.join(" and "),
+            listed.join(","),
             culls.join(" and by ")
         );
     }
@@ -837,6 +909,7 @@ fn summary(results: &BenchResults) -> String {
         msaa_section(&mut s, results, scene);
         brdf_section(&mut s, results, scene);
         shadows_section(&mut s, results, scene);
+        culling_section(&mut s, results, scene);
         s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
         for r in results.runs.iter().filter(|r| &r.scene == scene) {
             let Some(m) = &r.summary else { continue };

@@ -99,9 +99,12 @@ pub struct BenchConfig {
     /// too large leave nothing for tiling to cull). Empty: the scenes as they are.
     #[serde(default)]
     pub range_scales: Vec<f32>,
-    /// Fraction of each scene's lights made spots (`--spot-fraction`).
-    #[serde(default)]
-    pub spot_fraction: f32,
+    /// Fractions of each scene's lights made spots (`--spot-fraction`, each 0 to 1). With
+    /// several, every scene is measured once per fraction, as `<scene>-spots-<f>` for those
+    /// above 0 (the culling preset's `0,1`: each scene as it is and all-spot). Empty: 0.
+    /// Results written before it was a list hold one number (`spot_fraction`), read as one.
+    #[serde(default, alias = "spot_fraction", deserialize_with = "one_or_many")]
+    pub spot_fractions: Vec<f32>,
     /// Headlights on the robots of the scenes that have them (`--headlights`).
     #[serde(default)]
     pub headlights: bool,
@@ -134,7 +137,38 @@ fn default_on() -> bool {
     true
 }
 
+/// A number or a list of them, as a list (`spot_fractions`, written as one number before).
+fn one_or_many<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<f32>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany {
+        One(f32),
+        Many(Vec<f32>),
+    }
+    Ok(match OneOrMany::deserialize(d)? {
+        OneOrMany::One(f) => vec![f],
+        OneOrMany::Many(v) => v,
+    })
+}
+
+/// The suffix of a scene measured with some of its lights spots when several fractions are
+/// (`<scene>-spots-<fraction>`).
+pub const SPOTS_SUFFIX: &str = "-spots-";
+
 impl BenchConfig {
+    /// The spot fractions measured (`[0]` when none is given).
+    pub fn spot_fractions(&self) -> Vec<f32> {
+        match self.spot_fractions.is_empty() {
+            true => vec![0.0],
+            false => self.spot_fractions.clone(),
+        }
+    }
+
+    /// Are some of the scenes' lights made spots?
+    pub fn has_spots(&self) -> bool {
+        self.spot_fractions.iter().any(|&f| f > 0.0)
+    }
+
     /// The values `axis` is measured at: those listed, else its default.
     pub fn values(&self, axis: &Axis) -> Vec<String> {
         match self.settings.iter().find(|a| a.flag == axis.flag) {
@@ -234,11 +268,20 @@ impl BenchConfig {
             ..Default::default()
         }
         .validate()?;
-        let params = SceneParams {
-            spot_fraction: self.spot_fraction,
-            ..Default::default()
-        };
-        check(&self.scenes[0], params)?;
+        let fractions = self.spot_fractions();
+        for (i, &spot_fraction) in fractions.iter().enumerate() {
+            if fractions[..i].contains(&spot_fraction) {
+                return Err(invalid(
+                    "--spot-fraction",
+                    format!("{spot_fraction} is listed twice"),
+                ));
+            }
+            let params = SceneParams {
+                spot_fraction,
+                ..Default::default()
+            };
+            check(&self.scenes[0], params)?;
+        }
         if self.headlights {
             // As --lights: refused only when no chosen scene has robots.
             let taker = self
@@ -569,11 +612,15 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             true => config.lights.iter().map(|&n| Some(n)).collect(),
             false => vec![None],
         };
-        for lights in counts {
+        let fractions = config.spot_fractions();
+        let variants = counts
+            .iter()
+            .flat_map(|&n| fractions.iter().map(move |&f| (n, f)));
+        for (lights, spot_fraction) in variants {
             let params = SceneParams {
                 seed: config.seed,
                 lights,
-                spot_fraction: config.spot_fraction,
+                spot_fraction,
                 headlights: config.headlights && robots,
                 transparency: true,
                 material_shaders: config.material_shaders,
@@ -592,10 +639,13 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             for w in &opened.warnings {
                 eprintln!("warning: {name}: {w}");
             }
-            let base = match lights {
+            let mut base = match lights {
                 Some(n) if config.lights.len() > 1 => format!("{}-{n}-lights", opened.scene.name),
                 _ => opened.scene.name.clone(),
             };
+            if fractions.len() > 1 && spot_fraction > 0.0 {
+                base = format!("{base}{SPOTS_SUFFIX}{spot_fraction}");
+            }
             let id = unique_id(&base, &ids);
             if id != base {
                 eprintln!(
@@ -817,7 +867,9 @@ impl<'a> Measuring<'a> {
                 heatmaps.push((scene.name.clone(), info.id.to_string(), f, map));
             }
             let tested = |t: &SpotRayTest| t.scene == scene.name && t.frame == f;
-            if self.config.spot_fraction > 0.0 && !results.spot_ray_tests.iter().any(tested) {
+            let spots =
+                self.config.has_spots() && scene.lights.iter().any(|l| l.light.spot.is_some());
+            if spots && !results.spot_ray_tests.iter().any(tested) {
                 let state = scene.frame(f);
                 let setup =
                     lightgrid::scene::ViewSetup::new(&state.camera, record.width, record.height);
@@ -1019,6 +1071,11 @@ pub fn run(
 }
 
 impl PreparedBench {
+    /// The scenes it measures, as the results name them.
+    pub fn scenes(&self) -> &[lightgrid::scene::Scene] {
+        &self.scenes
+    }
+
     /// Run the prepared benchmark. `stop` is polled after every render; when set, the results
     /// so far are returned with [`Outcome::Interrupted`]. An error part-way is returned the same
     /// way, as [`Outcome::Failed`] with what was measured before it.

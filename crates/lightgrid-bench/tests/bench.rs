@@ -37,7 +37,7 @@ fn config() -> BenchConfig {
         seed: 1,
         lights: Vec::new(),
         heatmap_frame: None,
-        spot_fraction: 0.0,
+        spot_fractions: Vec::new(),
         add_lights: None,
         heatmap_max: None,
         range_scales: vec![],
@@ -408,7 +408,7 @@ fn spot_culls_are_measured_side_by_side() {
         pipelines: vec!["forward".into(), "clustered_deferred".into()],
         frames: FrameRange::parse("0..259:200").unwrap(),
         repeat: 1,
-        spot_fraction: 1.0,
+        spot_fractions: vec![1.0],
         settings: vec![AxisValues {
             flag: "spot-cull".into(),
             values: vec!["sphere".into(), "cone".into()],
@@ -469,4 +469,51 @@ fn spot_culls_are_measured_side_by_side() {
     let back = lightgrid_bench::read_results(&dir.join("results.json")).unwrap();
     assert_eq!(back.runs, results.runs);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A spot-fraction list measures every scene once per fraction, named for the fractions above
+/// 0 (the culling preset's all-spot scenes); the all-spot scene's lights are all spots and the
+/// other's none; a fraction listed twice is refused; a results file written when the fraction
+/// was one number reads as a list of one.
+#[test]
+fn spot_fraction_lists_measure_each_scene_once_per_fraction() {
+    let cfg = BenchConfig {
+        scenes: vec!["robots-few".into(), "stress".into()],
+        lights: vec![50],
+        spot_fractions: vec![0.0, 1.0],
+        ..config()
+    };
+    let prepared = lightgrid_bench::prepare(&cfg).unwrap();
+    let names: Vec<&str> = prepared.scenes().iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "robots-few",
+            "robots-few-spots-1",
+            "stress",
+            "stress-spots-1"
+        ]
+    );
+    for s in prepared.scenes() {
+        let spots = s.lights.iter().filter(|l| l.light.spot.is_some()).count();
+        assert!(!s.lights.is_empty(), "{}", s.name);
+        match s.name.contains(lightgrid_bench::SPOTS_SUFFIX) {
+            true => assert_eq!(spots, s.lights.len(), "{}", s.name),
+            false => assert_eq!(spots, 0, "{}", s.name),
+        }
+    }
+    let twice = BenchConfig {
+        spot_fractions: vec![1.0, 0.0, 1.0],
+        ..cfg.clone()
+    };
+    let e = lightgrid_bench::prepare(&twice).err().expect("refused");
+    assert!(e.to_string().contains("listed twice"), "{e}");
+    let mut old = serde_json::to_value(&cfg).unwrap();
+    let fields = old.as_object_mut().unwrap();
+    fields
+        .remove("spot_fractions")
+        .expect("the list is written");
+    fields.insert("spot_fraction".into(), serde_json::json!(0.5));
+    let read: BenchConfig = serde_json::from_value(old).unwrap();
+    assert_eq!(read.spot_fractions, vec![0.5]);
 }

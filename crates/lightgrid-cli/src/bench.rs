@@ -63,9 +63,10 @@ pub(crate) enum Preset {
     /// 2012) and tight cell boxes (`--cell-box`), and z-binning (`--assign zbin`, Drobot 2017;
     /// its bins are the clustered pipelines' slices, one bin on tiled ones), 16-pixel tiles,
     /// on robots-many, robots-few, scattered (without glass) and stress (10,000 lights; also
-    /// 100,000 on a hardware GPU), frames
-    /// 0..259 every 20, at the papers' size (640x360 on a software adapter): lighting
-    /// computations against the ideal, assignment time and grid memory per grid.
+    /// 100,000 on a hardware GPU), each as it is and with every light a spot (`--spot-fraction
+    /// 0,1`; robots-many's is the spots preset's scene), frames 0..259 every 20, at the papers'
+    /// size (640x360 on a software adapter): lighting computations against the ideal,
+    /// assignment time and grid memory per grid.
     Culling,
     /// The BRDFs (`--brdf phong,ggx`): forward, tiled and clustered forward and deferred, and
     /// the light pre-pass (its irradiance split) on robots-many without its glass, frames
@@ -124,9 +125,10 @@ pub(crate) struct BenchArgs {
     pub(crate) lights: Vec<u32>,
     #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
     pub(crate) seed: u64,
-    /// Fraction of each scene's lights (0 to 1) turned into spot lights.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_fraction)]
-    pub(crate) spot_fraction: Option<f64>,
+    /// Fraction of each scene's lights (0 to 1) turned into spot lights; a list measures
+    /// every scene once per fraction (as `<scene>-spots-<f>` for those above 0).
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = parse_fraction)]
+    pub(crate) spot_fraction: Vec<f64>,
     /// Give every robot two headlights (spot lights), in the scenes that have robots.
     #[arg(long)]
     pub(crate) headlights: bool,
@@ -191,7 +193,8 @@ pub(crate) struct BenchDefaults {
     pub(crate) size: Option<(u32, u32)>,
     pub(crate) repeat: u32,
     pub(crate) pipelines: Vec<String>,
-    pub(crate) spot_fraction: f32,
+    /// Spot fractions, each scene measured once per fraction (unless `--spot-fraction` says).
+    pub(crate) spot_fractions: Vec<f32>,
     /// The values settings of the library's table are measured at (unless their options
     /// say): `--flag` without dashes and the values.
     pub(crate) settings: Vec<(&'static str, Vec<String>)>,
@@ -218,7 +221,7 @@ fn everything() -> BenchDefaults {
         size: None,
         repeat: 1,
         pipelines: PIPELINES.iter().map(|p| p.id.to_string()).collect(),
-        spot_fraction: 0.0,
+        spot_fractions: Vec::new(),
         settings: Vec::new(),
         transparency: true,
         tile: None,
@@ -281,7 +284,7 @@ pub(crate) fn bench_config(
             ..everything()
         },
         Some(Preset::Spots) => BenchDefaults {
-            spot_fraction: 1.0,
+            spot_fractions: vec![1.0],
             settings: vec![measure(&[SpotCull::Sphere, SpotCull::Cone])],
             ..study(hardware, |p| p.uses_grid)
         },
@@ -367,6 +370,9 @@ pub(crate) fn bench_config(
         },
         Some(Preset::Culling) => BenchDefaults {
             scenes: vec!["robots-many", "robots-few", "scattered", "stress"],
+            // Each scene as it is and with every light a spot (the spots preset's scene is
+            // `robots-many-spots-1`).
+            spot_fractions: vec![0.0, 1.0],
             // stress at 10,000 lights, and 100,000 on a hardware GPU (on lavapipe a z-binned
             // frame of 100,000 lights takes 2 s: `--lights 10000,100000` asks for it).
             lights: if hardware {
@@ -498,7 +504,10 @@ pub(crate) fn bench_config(
             a.range_scale.iter().map(|&f| f as f32).collect()
         },
         heatmap_max: a.heatmap_max.or(d.heatmap_max),
-        spot_fraction: a.spot_fraction.map_or(d.spot_fraction, |f| f as f32),
+        spot_fractions: match a.spot_fraction.is_empty() {
+            true => d.spot_fractions.clone(),
+            false => a.spot_fraction.iter().map(|&f| f as f32).collect(),
+        },
         headlights: a.headlights,
         transparency: if a.transparency.is_empty() {
             d.transparency

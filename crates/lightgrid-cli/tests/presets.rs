@@ -68,9 +68,13 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
     }
     let scenes: std::collections::BTreeSet<&str> = counts.keys().map(|k| k.0.as_str()).collect();
     // robots-many, robots-few, scattered and stress at 10,000 lights (100,000 only on a
-    // hardware GPU).
-    assert_eq!(scenes.len(), 4, "{scenes:?}");
-    assert!(scenes.contains("stress"), "{scenes:?}");
+    // hardware GPU), each as it is and all-spot.
+    assert_eq!(scenes.len(), 8, "{scenes:?}");
+    for s in ["robots-many", "robots-few", "scattered", "stress"] {
+        assert!(scenes.contains(s), "{s} not in {scenes:?}");
+        let spots = format!("{s}-spots-1");
+        assert!(scenes.contains(spots.as_str()), "{spots} not in {scenes:?}");
+    }
     for p in [
         "tiled_forward_prez",
         "tiled_deferred",
@@ -99,6 +103,18 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
     // Harada's claim on the two tiled grids and the tight-cluster claim on the two clustered
     // ones, per scene, each with its evidence and a verdict.
     let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    // Per scene, every grid's assignment share and memory.
+    let sections = summary.matches("### Culling: the grids'").count();
+    assert_eq!(sections, 8, "{summary}");
+    let rows: Vec<&str> = (summary.lines())
+        .filter(|l| l.starts_with("| clustered_forward [zbin] |") && l.split('|').count() == 8)
+        .collect();
+    assert_eq!(rows.len(), 8, "{rows:#?}");
+    for row in rows {
+        assert!(row.contains("%)"), "no assignment share in {row}");
+        let kib: f64 = row.split('|').nth(6).unwrap().trim().parse().unwrap();
+        assert!(kib > 0.0, "no grid memory in {row}");
+    }
     for (claim, pipelines) in [
         (
             "2.5D culling (a 32-bit mask",
@@ -114,7 +130,7 @@ fn culling_preset_measures_every_grid_with_and_without_masks_and_boxes() {
         ),
     ] {
         let lines: Vec<&str> = summary.lines().filter(|l| l.contains(claim)).collect();
-        assert_eq!(lines.len(), 4 * 2, "'{claim}': {lines:#?}");
+        assert_eq!(lines.len(), 8 * 2, "'{claim}': {lines:#?}");
         for l in &lines {
             assert!(
                 pipelines.iter().any(|p| l.contains(&format!("| {p}: "))),
