@@ -1,5 +1,6 @@
 // cell_bounds: one workgroup per screen tile reduces its samples' view distances into the
-// [min, max] of every cell (tile x depth slice) of the tile; a cell without samples gets
+// [min, max] of every cell (tile x depth slice) of the tile, an invocation per row of the tile
+// in registers (`bounds_row`), per run of samples in one slice into workgroup atomics; a cell without samples gets
 // min > max (+inf, 0). A sample within ASSIGN_DEPTH_SLACK of a slice boundary counts for both
 // slices, as the shading pass may place it in either. Positive floats order like their bit
 // patterns, so u32 atomics do the reduction. CPU twin: `cell_bounds_cpu` (cell_bounds.rs).
@@ -246,10 +247,10 @@ fn bounds_row(origin: vec2<u32>, row: u32, width: u32) -> u32 {
     return row_hi;
 }
 
-@compute @workgroup_size(TILE_THREADS, TILE_THREADS)
-fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+@compute @workgroup_size(CELL_THREADS)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k0 = li;
-    for (; k0 < grid.slices; k0 = k0 + TILE_THREADS * TILE_THREADS) {
+    for (; k0 < grid.slices; k0 = k0 + CELL_THREADS) {
         atomicStore(&slice_lo[k0], W_INFINITY);
         atomicStore(&slice_hi[k0], 0u);
 #if CELL_BOX
@@ -276,41 +277,38 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
         var hi = 0u;
         var t_hi = 0u;
         var e = vec4<u32>(0xffffffffu, 0u, 0xffffffffu, 0u);
-        var y = lid.y;
-        for (; y < extent.y; y = y + TILE_THREADS) {
-            var x = lid.x;
-            for (; x < extent.x; x = x + TILE_THREADS) {
-                let p = origin + vec2<u32>(x, y);
-                for (var s = 0u; s < SAMPLES; s = s + 1u) {
-                    let d = textureLoad(depth_tex, p, s);
-                    let w = view_distance_from_depth(d);
-                    t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
-                    if (!is_background(d)) {
-                        lo = min(lo, bitcast<u32>(w));
-                        hi = max(hi, bitcast<u32>(w));
+        let pixels = extent.x * extent.y;
+        var i = li;
+        for (; i < pixels; i = i + CELL_THREADS) {
+            let p = origin + vec2<u32>(i % extent.x, i / extent.x);
+            for (var s = 0u; s < SAMPLES; s = s + 1u) {
+                let d = textureLoad(depth_tex, p, s);
+                let w = view_distance_from_depth(d);
+                t_hi = max(t_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
+                if (!is_background(d)) {
+                    lo = min(lo, bitcast<u32>(w));
+                    hi = max(hi, bitcast<u32>(w));
 #if CELL_BOX
-                        // Registers only on a tiled grid: every sample is in slice 0.
-                        let b = sample_box(w, p);
-                        e = vec4<u32>(min(e.x, b.x), max(e.y, b.y), min(e.z, b.z), max(e.w, b.w));
+                    // Registers only on a tiled grid: every sample is in slice 0.
+                    let b = sample_box(w, p);
+                    e = vec4<u32>(min(e.x, b.x), max(e.y, b.y), min(e.z, b.z), max(e.w, b.w));
 #endif
-                    }
                 }
             }
-            check_loop(x, extent.x);
         }
-        check_loop(y, extent.y);
+        check_loop(i, pixels);
 #if SUBGROUP_REDUCTION
         subgroup_reduce(lo, hi, t_hi, e, li);
 #endif
     } else if (li < extent.y) {
-        // One invocation per row of the tile (MAX_TILE_SIZE <= TILE_THREADS², consts.rs).
+        // One invocation per row of the tile (CELL_THREADS is MAX_TILE_SIZE).
         atomicMax(&tile_hi, bounds_row(origin, li, extent.x));
     }
     workgroupBarrier();
     let tile = wg.y * grid.tiles_x + wg.x;
     let tiles = grid.tiles_x * grid.tiles_y;
     var k = li;
-    for (; k < grid.slices; k = k + TILE_THREADS * TILE_THREADS) {
+    for (; k < grid.slices; k = k + CELL_THREADS) {
         let cell = k * tiles + tile;
         // What the cell's list serves besides its samples: MSAA forward fragments' range and,
         // with one shared list, the range transparent fragments may lie in.
@@ -365,7 +363,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid:
     workgroupBarrier();
     // 3. The masks.
     var mk = li;
-    for (; mk < grid.slices; mk = mk + TILE_THREADS * TILE_THREADS) {
+    for (; mk < grid.slices; mk = mk + CELL_THREADS) {
         let sc = mask_scale[mk];
         cell_culls[mk * tiles + tile].mask = vec4<u32>(atomicLoad(&mask_bits[mk]), sc.x, sc.y, 0u);
     }
