@@ -27,12 +27,6 @@ pub const MAX_TILE_SIZE: u32 = 64;
 /// 16×16 = 256 invocations stride over the tile's pixels, so any tile size works.
 pub const TILE_THREADS: u32 = 16;
 
-/// Invocations of the cell-bounds kernel's workgroup (one per tile): one per row of the
-/// largest tile, each reducing its row in registers (`cell_bounds.wgsl`). Not 256 for the
-/// pixels: lavapipe runs every invocation of a workgroup through its barriers, idle or not,
-/// and the rows need MAX_TILE_SIZE.
-pub const CELL_THREADS: u32 = MAX_TILE_SIZE;
-
 /// Light indices the single-kernel tiled deferred pipeline culls into workgroup memory at a
 /// time. More lights per tile are handled in further batches, never dropped.
 pub const TILE_LIGHT_BATCH: u32 = 1024;
@@ -327,7 +321,6 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("SHADOW_NO_TREE", WgslConst::U32(SHADOW_NO_TREE)),
     ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
-    ("CELL_THREADS", WgslConst::U32(CELL_THREADS)),
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),
     ("SLICING_MIN_RATIO", WgslConst::F32(SLICING_MIN_RATIO)),

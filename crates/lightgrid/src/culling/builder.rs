@@ -128,6 +128,7 @@ impl GridBuilder {
                     cell_box: ctx.cell_box,
                 },
                 ctx.forward_opaque,
+                ctx.tiles.tile_size,
             ),
             range: (slices > 1 && source == CellSource::Depth)
                 .then(|| DepthRangePass::new(device, cull_layout, ctx.samples)),

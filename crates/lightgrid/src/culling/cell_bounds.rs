@@ -17,7 +17,10 @@ use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::{Error, Result};
 use crate::frame::{CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
-use crate::shader::{compute_pipeline, every_sample_count, msaa_defs, src, Def, ShaderKey};
+use crate::shader::{
+    compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, src, Def,
+    ShaderKey,
+};
 
 /// The cell-bounds kernel's variants: the depth target's samples, `--depth-bounds`
 /// (`DEPTH_BOUNDS`) and `--depth-reduction` (`SUBGROUP_REDUCTION`: tiled-shading §8's
@@ -249,8 +252,13 @@ pub struct CellBoundsPass {
     fragments: Option<super::fragment_bounds::FragmentBounds>,
     /// Binding 5 without MSAA (unread).
     no_fragments: wgpu::Buffer,
-    pipeline: wgpu::ComputePipeline,
+    /// `main` for tiles of `.0` pixels: a workgroup of one invocation per row (the override
+    /// CELL_THREADS; lavapipe runs every invocation of a workgroup through its barriers, idle
+    /// or not, so 64 for a 16-pixel tile cost a third more than 16).
+    pipeline: (u32, wgpu::ComputePipeline),
     args: wgpu::ComputePipeline,
+    shader: crate::shader::ComposedShader,
+    cull_layout: wgpu::BindGroupLayout,
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     bounds: wgpu::Buffer,
@@ -264,17 +272,30 @@ pub struct CellBoundsPass {
     cells: usize,
 }
 
+/// The kernel's `main` for tiles of `tile_size` pixels: one invocation per row.
+fn main_pipeline(
+    device: &wgpu::Device,
+    shader: &crate::shader::ComposedShader,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    tile_size: u32,
+) -> wgpu::ComputePipeline {
+    let threads = [(overrides::CELL_THREADS, f64::from(tile_size))];
+    compute_pipeline_with(device, "cell bounds", shader, "main", layouts, &threads)
+}
+
 impl CellBoundsPass {
     /// The kernel `key` names (over a depth target of `key.samples` samples per pixel).
     /// `forward_opaque`: a forward pass shades the opaque fragments from these bounds' grid.
     /// `scene_layout`: the renderer's group 0, with which an MSAA grid's fragment bounds draw
-    /// its geometry (none for a caller's depth buffer: [`super::LightCuller`]).
+    /// its geometry (none for a caller's depth buffer: [`super::LightCuller`]). `tile_size`:
+    /// the grid's tiles (another size later builds the kernel again).
     pub(crate) fn new(
         device: &wgpu::Device,
         cull_layout: &wgpu::BindGroupLayout,
         scene_layout: Option<&wgpu::BindGroupLayout>,
         key: CellBoundsKey,
         forward_opaque: bool,
+        tile_size: u32,
     ) -> Self {
         let samples = key.samples;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -291,7 +312,7 @@ impl CellBoundsPass {
         });
         let s = key.shader();
         let layouts = [Some(cull_layout), Some(&layout)];
-        let pipeline = compute_pipeline(device, "cell bounds", &s, "main", &layouts);
+        let pipeline = (tile_size, main_pipeline(device, &s, &layouts, tile_size));
         let args = compute_pipeline(device, "cell bounds args", &s, "args_main", &layouts);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cell bounds params"),
@@ -311,6 +332,8 @@ impl CellBoundsPass {
             no_fragments: storage_buffer(device, "no fragment bounds", 16),
             pipeline,
             args,
+            shader: s,
+            cull_layout: cull_layout.clone(),
             layout,
             params,
             bounds: storage_buffer(device, "cell bounds", 1 << 14),
@@ -384,6 +407,11 @@ impl CellBoundsPass {
     pub fn encode(&mut self, f: &CullFrame, enc: &mut FrameEncoder, dims: &GridDims) {
         let (device, queue, cull, depth) = (f.device, f.queue, f.bind_group, f.depth());
         self.ensure(device, dims);
+        if self.pipeline.0 != dims.tile_size {
+            let layouts = [Some(&self.cull_layout), Some(&self.layout)];
+            let main = main_pipeline(device, &self.shader, &layouts, dims.tile_size);
+            self.pipeline = (dims.tile_size, main);
+        }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
         let fragment_bounds = match (&mut self.fragments, f.scene) {
             (Some(fragments), Some(scene)) => {
@@ -409,7 +437,7 @@ impl CellBoundsPass {
         );
         encoder.clear_buffer(&self.occupancy, 0, None);
         let mut pass = timer.begin_compute(encoder, super::labels::CELL_BOUNDS);
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(&self.pipeline.1);
         pass.set_bind_group(0, cull, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.dispatch_workgroups(dims.tiles_x, dims.tiles_y, 1);

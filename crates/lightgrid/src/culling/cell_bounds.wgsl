@@ -247,6 +247,11 @@ fn bounds_row(origin: vec2<u32>, row: u32, width: u32) -> u32 {
     return row_hi;
 }
 
+// Invocations per workgroup: one per row of the grid's tiles (`shader::overrides`; the
+// default is the largest tile). Not an invocation per pixel: lavapipe runs every invocation of
+// a workgroup through its barriers, idle or not.
+override CELL_THREADS: u32 = MAX_TILE_SIZE;
+
 @compute @workgroup_size(CELL_THREADS)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k0 = li;
@@ -301,7 +306,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
         subgroup_reduce(lo, hi, t_hi, e, li);
 #endif
     } else if (li < extent.y) {
-        // One invocation per row of the tile (CELL_THREADS is MAX_TILE_SIZE).
+        // One invocation per row of the tile (CELL_THREADS is at least the tile size).
         atomicMax(&tile_hi, bounds_row(origin, li, extent.x));
     }
     workgroupBarrier();

@@ -290,8 +290,16 @@ pub mod overrides {
     pub const RESOLVE_IN_KERNEL: &str = "RESOLVE_IN_KERNEL";
     /// `sample_expand.wgsl`: the frame's width in pixels.
     pub const WIDTH: &str = "WIDTH";
+    /// `cell_bounds.wgsl`: invocations per workgroup, one per row of the grid's tiles.
+    pub const CELL_THREADS: &str = "CELL_THREADS";
     /// Every override of the library's shaders.
-    pub const ALL: [&str; 4] = [MULTISAMPLED, MATERIAL_SHADER, RESOLVE_IN_KERNEL, WIDTH];
+    pub const ALL: [&str; 5] = [
+        MULTISAMPLED,
+        MATERIAL_SHADER,
+        RESOLVE_IN_KERNEL,
+        WIDTH,
+        CELL_THREADS,
+    ];
 }
 
 /// Parse and validate with naga; the error message carries naga's annotated source span.
