@@ -178,23 +178,44 @@ impl Capture {
 
     /// Wait for what was drawn and return it as RGBA (BGRA surfaces swizzled).
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<image::RgbaImage> {
+        let bytes =
+            (self.copy(device, queue).read(device)).context("reading the screenshot back")?;
+        Ok(self.image(bytes))
+    }
+
+    /// As [`Self::read`] without waiting (the web page): `done` gets the image, or why there
+    /// is none, once the browser has mapped the copy.
+    pub fn read_later(
+        self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        done: impl FnOnce(std::result::Result<image::RgbaImage, String>) + wgpu::WasmNotSend + 'static,
+    ) {
+        let readback = self.copy(device, queue);
+        readback.read_later(move |bytes| done(bytes.map(|b| self.image(b))));
+    }
+
+    /// Submit the copy of what was drawn into a readback buffer.
+    fn copy(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Readback {
         let readback = Readback::new(device, "screenshot", self.width, self.height);
         let mut encoder = device.create_command_encoder(&Default::default());
         readback.encode(&mut encoder, &self.texture, wgpu::TextureAspect::All);
         queue.submit([encoder.finish()]);
-        let mut out = readback
-            .read(device)
-            .context("reading the screenshot back")?;
+        readback
+    }
+
+    /// The copied bytes as an opaque RGBA image (BGRA surfaces swizzled).
+    fn image(&self, mut bytes: Vec<u8>) -> image::RgbaImage {
         let bgra = matches!(
             self.texture.format(),
             wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
         );
-        for px in out.chunks_exact_mut(4) {
+        for px in bytes.chunks_exact_mut(4) {
             if bgra {
                 px.swap(0, 2);
             }
             px[3] = 255;
         }
-        Ok(image::RgbaImage::from_raw(self.width, self.height, out).expect("size matches"))
+        image::RgbaImage::from_raw(self.width, self.height, bytes).expect("size matches")
     }
 }

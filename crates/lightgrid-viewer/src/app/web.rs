@@ -13,6 +13,7 @@
 //!   also written to the browser's console.
 
 use super::*;
+use lightgrid::gpu::DeviceLimits;
 use std::cell::RefCell;
 use std::collections::HashMap;
 
@@ -20,8 +21,8 @@ use std::collections::HashMap;
 /// `?scene=robots-many&pipeline=clustered_forward&frame=130&size=320x240&paused`.
 pub struct PageOptions {
     pub view: ViewOptions,
-    /// `limits=webgpu`: the device gets WebGPU's default limits, not the adapter's.
-    pub webgpu_limits: bool,
+    /// `limits=adapter|webgpu`: the device gets the adapter's limits or WebGPU's defaults.
+    pub limits: DeviceLimits,
 }
 
 impl PageOptions {
@@ -30,7 +31,7 @@ impl PageOptions {
     /// default, or `webgpu`: WebGPU's default limits), `script` (the viewer's
     /// `at N ACTION; ...`). An unknown key or a bad value is an error, never ignored.
     pub fn from_query(query: &str) -> Result<PageOptions> {
-        let mut webgpu_limits = false;
+        let mut limits = DeviceLimits::Adapter;
         let mut view = ViewOptions {
             adapter: None,
             request: SceneRequest::new("robots-many"),
@@ -72,9 +73,9 @@ impl PageOptions {
                 "msaa" => view.settings.msaa = value.parse().map_err(|_| bad("not 1 or 4"))?,
                 "paused" => view.paused = true,
                 "limits" => {
-                    webgpu_limits = match value.as_str() {
-                        "webgpu" => true,
-                        "adapter" => false,
+                    limits = match value.as_str() {
+                        "webgpu" => DeviceLimits::WebGpu,
+                        "adapter" => DeviceLimits::Adapter,
                         _ => return Err(bad("adapter or webgpu")),
                     }
                 }
@@ -89,10 +90,7 @@ impl PageOptions {
         view.settings
             .validate()
             .map_err(|e| anyhow!("the page's address: {e}"))?;
-        Ok(PageOptions {
-            view,
-            webgpu_limits,
-        })
+        Ok(PageOptions { view, limits })
     }
 }
 
@@ -165,11 +163,11 @@ pub async fn start(opts: PageOptions) -> Result<()> {
             }
         });
     }));
-    let webgpu_limits = opts.webgpu_limits;
+    let limits = opts.limits;
     let opts = opts.view;
     let opened = lightgrid::scene::open(&opts.request)?;
     opened.scene.check_frame(opts.frame)?;
-    let ctx = GpuContext::for_page(webgpu_limits).await?;
+    let ctx = GpuContext::for_page(limits).await?;
     let lost = Arc::new(Mutex::new(None::<String>));
     let flag = lost.clone();
     ctx.device.set_device_lost_callback(move |reason, message| {
@@ -273,55 +271,8 @@ impl App {
 /// Read `capture` back without waiting: the PNG (or the error) lands in [`Shared::shots`]
 /// under `name` once the browser has mapped the buffer.
 pub(super) fn read_later(ctx: &GpuContext, capture: Capture, name: String) {
-    let (width, height) = (capture.texture.width(), capture.texture.height());
-    let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("screenshot readback"),
-        size: u64::from(row) * u64::from(height),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        capture.texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-    );
-    ctx.queue.submit([encoder.finish()]);
-    let bgra = matches!(
-        capture.texture.format(),
-        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-    );
-    let mapped = buffer.clone();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-        let png = r.map_err(|e| e.to_string()).and_then(|()| {
-            let data = mapped.get_mapped_range(..).map_err(|e| e.to_string())?;
-            let mut pixels = Vec::with_capacity((width * height * 4) as usize);
-            for y in 0..height as usize {
-                let start = y * row as usize;
-                pixels.extend_from_slice(&data[start..start + width as usize * 4]);
-            }
-            drop(data);
-            mapped.unmap();
-            for px in pixels.chunks_exact_mut(4) {
-                if bgra {
-                    px.swap(0, 2);
-                }
-                px[3] = 255;
-            }
-            let image = image::RgbaImage::from_raw(width, height, pixels).ok_or("size")?;
+    capture.read_later(&ctx.device, &ctx.queue, move |image| {
+        let png = image.and_then(|image| {
             let mut png = Vec::new();
             image
                 .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)

@@ -1,7 +1,7 @@
 // cell_bounds: one workgroup per screen tile reduces its samples' view distances into the
-// [min, max] of every cell (tile x depth slice) of the tile, an invocation per row of the tile
-// in registers (`bounds_row`), per run of samples in one slice into workgroup atomics; a cell without samples gets
-// min > max (+inf, 0). A sample within ASSIGN_DEPTH_SLACK of a slice boundary counts for both
+// [min, max] of every cell (tile x depth slice) of the tile: an invocation per row of the tile
+// reduces it in registers (`bounds_row`), each run of samples in one slice into workgroup
+// atomics. A cell without samples gets min > max (+inf, 0). A sample within ASSIGN_DEPTH_SLACK of a slice boundary counts for both
 // slices, as the shading pass may place it in either. Positive floats order like their bit
 // patterns, so u32 atomics do the reduction. CPU twin: `cell_bounds_cpu` (cell_bounds.rs).
 // Cells with samples are also appended to `occupied_cells` (in no particular order), and
@@ -95,7 +95,7 @@ fn mask_span(k: u32, span: vec2<f32>) -> u32 {
 
 // 2. Row `row` of the tile's samples: each sample's bins in the slices its distance (with the
 // slack) lies in, as in the first sweep; the bins of a run of samples in one slice are ORed in
-// registers and set with one atomic when the slice changes (see `Run`).
+// registers and set with one atomic when the slice changes (as `bounds_row`'s runs).
 fn mask_row(origin: vec2<u32>, row: u32, width: u32) {
     var k = NO_SLICE;
     var bits = 0u;

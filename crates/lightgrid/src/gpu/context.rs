@@ -93,22 +93,34 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
         .collect()
 }
 
-/// The device's limits: the adapter's own (large light lists need big storage bindings,
-/// and the grid kernels bind up to 16 storage buffers per stage). `LIGHTGRID_LIMITS=webgpu`
-/// asks for WebGPU's defaults instead, what every page may rely on: a pipeline that needs
-/// more is refused with the limit and the count (README, "In a browser").
-fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
-    let page_asked = WEB_DEFAULT_LIMITS.load(std::sync::atomic::Ordering::Relaxed);
-    match std::env::var("LIGHTGRID_LIMITS").as_deref() {
-        _ if page_asked => wgpu::Limits::default(),
-        Ok("webgpu") => wgpu::Limits::default(),
-        _ => adapter.limits(),
-    }
+/// The limits a device is asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviceLimits {
+    /// The adapter's own: large light lists need big storage bindings, and the grid kernels
+    /// bind up to 16 storage buffers per stage.
+    Adapter,
+    /// WebGPU's defaults, what every page may rely on: a pipeline that needs more is refused
+    /// with the limit and the count (README, "In a browser").
+    WebGpu,
 }
 
-/// A page asked for WebGPU's default limits (`?limits=webgpu`): a page has no environment.
-static WEB_DEFAULT_LIMITS: std::sync::atomic::AtomicBool =
-    std::sync::atomic::AtomicBool::new(false);
+impl DeviceLimits {
+    /// What the environment asks for: `LIGHTGRID_LIMITS=webgpu` shows natively what a page
+    /// on WebGPU's defaults gets; otherwise the adapter's.
+    pub fn from_env() -> Self {
+        match std::env::var("LIGHTGRID_LIMITS").as_deref() {
+            Ok("webgpu") => DeviceLimits::WebGpu,
+            _ => DeviceLimits::Adapter,
+        }
+    }
+
+    fn of(self, adapter: &wgpu::Adapter) -> wgpu::Limits {
+        match self {
+            DeviceLimits::Adapter => adapter.limits(),
+            DeviceLimits::WebGpu => wgpu::Limits::default(),
+        }
+    }
+}
 
 /// Does `wanted` (an index, a backend name, or part of the adapter name) select this adapter?
 fn matches(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
@@ -175,13 +187,10 @@ impl GpuContext {
 
     /// The page's context (wasm32): the browser's WebGPU adapter and a device on it. Nothing
     /// on the web may block, so this is the one `async` constructor.
-    /// `webgpu_defaults`: ask for WebGPU's default limits, what every page may rely on,
-    /// instead of the adapter's (a pipeline needing more is then refused with the limit).
+    /// `limits`: the adapter's, or WebGPU's defaults (the page's `?limits=webgpu`; a page has
+    /// no environment).
     #[cfg(target_arch = "wasm32")]
-    pub async fn for_page(webgpu_defaults: bool) -> Result<Self> {
-        if webgpu_defaults {
-            WEB_DEFAULT_LIMITS.store(true, std::sync::atomic::Ordering::Relaxed);
-        }
+    pub async fn for_page(limits: DeviceLimits) -> Result<Self> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.backends = wgpu::Backends::BROWSER_WEBGPU;
         let instance = wgpu::Instance::new(desc);
@@ -197,14 +206,18 @@ impl GpuContext {
                      (Chrome or Edge 113+, Firefox 141+, Safari 26+)"
                 ))
             })?;
-        Self::open(instance, adapter).await
+        Self::open(instance, adapter, limits).await
     }
 
     fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
-        pollster::block_on(Self::open(instance, adapter))
+        pollster::block_on(Self::open(instance, adapter, DeviceLimits::from_env()))
     }
 
-    async fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
+    async fn open(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        limits: DeviceLimits,
+    ) -> Result<Self> {
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut features = wgpu::Features::empty();
@@ -231,8 +244,7 @@ impl GpuContext {
         let desc = wgpu::DeviceDescriptor {
             label: Some("lightgrid"),
             required_features: features,
-            // The adapter's own limits: large light lists need big storage bindings.
-            required_limits: limits(&adapter),
+            required_limits: limits.of(&adapter),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,

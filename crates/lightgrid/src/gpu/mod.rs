@@ -4,7 +4,7 @@ mod context;
 mod counters;
 mod timing;
 
-pub use context::{list_adapters, AdapterSummary, GpuContext};
+pub use context::{list_adapters, AdapterSummary, DeviceLimits, GpuContext};
 pub use counters::{CounterValues, FrameCounters, FrameReadback, FrameTag, COUNTER_BYTES};
 pub use timing::{FrameTimings, PassTimer, PassTiming, TimedPass};
 

@@ -62,12 +62,36 @@ impl Readback {
 
     /// The texture's bytes, rows packed (waits for the GPU).
     pub fn read(&self, device: &wgpu::Device) -> Result<Vec<u8>> {
-        let bytes = read_buffer(device, &self.buffer)?;
+        Ok(self.packed(&read_buffer(device, &self.buffer)?))
+    }
+
+    /// As [`Self::read`] without waiting (the web page, where nothing may block): `done` gets
+    /// the bytes, or why there are none, once the copy's submission is done and the buffer
+    /// mapped (on native, when the device is next polled).
+    pub fn read_later(
+        self,
+        done: impl FnOnce(std::result::Result<Vec<u8>, String>) + wgpu::WasmNotSend + 'static,
+    ) {
+        let buffer = self.buffer.clone();
+        buffer.map_async(wgpu::MapMode::Read, .., move |mapped| {
+            let bytes = mapped.map_err(|e| e.to_string()).and_then(|()| {
+                let data = (self.buffer.get_mapped_range(..)).map_err(|e| e.to_string())?;
+                let bytes = self.packed(&data);
+                drop(data);
+                self.buffer.unmap();
+                Ok(bytes)
+            });
+            done(bytes);
+        });
+    }
+
+    /// The rows of `bytes` (as copied, each padded) without their padding.
+    fn packed(&self, bytes: &[u8]) -> Vec<u8> {
         let row = (self.width * 4) as usize;
-        Ok(bytes
+        bytes
             .chunks_exact(self.padded_row as usize)
             .flat_map(|r| r[..row].iter().copied())
-            .collect())
+            .collect()
     }
 
     /// As [`Self::read`], as 32-bit floats (depth or counts).
