@@ -202,15 +202,18 @@ fn write_atomic_with(
     // inode, so the temporary file must carry it.
     let mode = std::fs::metadata(&target).ok().map(|m| m.permissions());
     let tmp = Temporary::new(dir.join(sibling_name("tmp")));
-    let mut file = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(tmp.path())
-        .map_err(io)?;
-    write(&mut file).map_err(io)?;
-    // Errors a full disk reports only when the data is flushed show here, not after the rename.
-    file.sync_data().map_err(io)?;
-    drop(file);
+    {
+        // Closed at the end of this block, before the rename or copy.
+        let mut file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(tmp.path())
+            .map_err(io)?;
+        write(&mut file).map_err(io)?;
+        // Errors a full disk reports only when the data is flushed show here, not after the
+        // rename.
+        file.sync_data().map_err(io)?;
+    }
     if hard_linked(&target) {
         // A rename would give this name a new inode and leave the file's other names with the
         // old bytes. The whole new content exists (and fitted on the disk) in the temporary
