@@ -32,6 +32,17 @@ pub(crate) fn run_name(r: &RunRecord) -> String {
 
 /// The pipeline, with the spot culling and the transparent lists when the run measured more
 /// than one.
+/// A run's mean lighting computations as a multiple of the ideal, two decimals; `missing`
+/// where the run counted none.
+fn times_ideal(m: &super::RunSummary, missing: &str) -> String {
+    m.lighting_computations.map_or(missing.into(), |x| {
+        format!(
+            "{:.2}",
+            x.mean / m.ideal_lighting_computations.mean.max(1.0)
+        )
+    })
+}
+
 fn pipeline_label(r: &RunRecord) -> String {
     let mut label = r.pipeline.clone();
     // Each setting that names the run, in the table's order, as its row says (the G-buffer
@@ -60,12 +71,7 @@ fn msaa_section(s: &mut String, results: &BenchResults, scene: &str) {
     s.push_str("\n### MSAA (tiled-forward-shading Fig. 4.4)\n\nEvery target holds each sample; forward pipelines shade once per pixel and surface (hardware MSAA), the deferred kernels once per pixel plus every other covered sample of an edge pixel (tiled-deferred-tricks), and the tonemap resolves after the tone curve. *Cell bounds* is the Z-reduction over every sample (§4.6); with MSAA, *fragment bounds* adds every fragment's pixel-centre distance to its cell first (`fragment_bounds.wgsl`).\n\n| pipeline | samples | avg ms | × ideal | render targets MiB | cell bounds ms | fragment bounds ms | edge pixels | samples shaded / with geometry |\n|---|---|---|---|---|---|---|---|---|\n");
     for r in runs {
         let m = r.summary.as_ref().expect("filtered");
-        let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-            format!(
-                "{:.2}",
-                x.mean / m.ideal_lighting_computations.mean.max(1.0)
-            )
-        });
+        let ratio = times_ideal(m, "n/a");
         let pass_ms = |label: &str| {
             m.passes
                 .iter()
@@ -270,12 +276,7 @@ Means over the frames. Assignment: the GPU passes labelled `assign: ...` in the 
 ");
     for r in runs {
         let m = r.summary.as_ref().expect("filtered");
-        let ratio = m.lighting_computations.map_or("-".into(), |l| {
-            format!(
-                "{:.2}",
-                l.mean / m.ideal_lighting_computations.mean.max(1.0)
-            )
-        });
+        let ratio = times_ideal(m, "-");
         let assign: f64 = (m.passes.iter())
             .filter(|p| {
                 p.label
@@ -815,12 +816,7 @@ fn summary(results: &BenchResults) -> String {
             let lc = m
                 .lighting_computations
                 .map_or("n/a".into(), |x| format!("{:.0}", x.mean));
-            let ratio = m.lighting_computations.map_or("n/a".into(), |x| {
-                format!(
-                    "{:.2}",
-                    x.mean / m.ideal_lighting_computations.mean.max(1.0)
-                )
-            });
+            let ratio = times_ideal(m, "n/a");
             let eff = m
                 .efficiency
                 .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0));
