@@ -1,9 +1,10 @@
 // cell_bounds: one workgroup per screen tile reduces its samples' view distances into the
 // [min, max] of every cell (tile x depth slice) of the tile: an invocation per row of the tile
 // reduces it in registers (`bounds_row`), each run of samples in one slice into workgroup
-// atomics. A cell without samples gets min > max (+inf, 0). A sample within ASSIGN_DEPTH_SLACK of a slice boundary counts for both
-// slices, as the shading pass may place it in either. Positive floats order like their bit
-// patterns, so u32 atomics do the reduction. CPU twin: `cell_bounds_cpu` (cell_bounds.rs).
+// atomics. A cell without samples gets min > max (+inf, 0). A sample within
+// ASSIGN_DEPTH_SLACK of a slice boundary counts for both slices, as the shading pass may place
+// it in either. Positive floats order like their bit patterns, so u32 atomics do the
+// reduction. CPU twin: `cell_bounds_cpu` (cell_bounds.rs).
 // Cells with samples are also appended to `occupied_cells` (in no particular order), and
 // args_main turns their number into indirect dispatch arguments, so the per-cell assignment
 // kernels run one workgroup per occupied cell instead of one per cell.
