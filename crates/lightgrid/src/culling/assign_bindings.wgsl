@@ -59,6 +59,7 @@ fn cell_frustum(c: u32) -> TileFrustum {
     f.mask = cull.mask;
     f.box_lo = cull.lo;
     f.box_hi = cull.hi;
+    f.sphere = cone_sphere(f.sphere, cull.lo, cull.hi);
     return f;
 }
 

@@ -14,7 +14,7 @@
 use super::strategy::check_index_capacity;
 use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{depth_mask_meets, CellCull, GridDims, LightGrid, ViewLight, ViewSetup};
+use super::{cone_sphere, depth_mask_meets, CellCull, GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -127,9 +127,10 @@ pub fn project_sphere(setup: &ViewSetup, light: &ViewLight) -> Option<PixelRect>
     })
 }
 
-/// Per cell, the bounding sphere of its frustum piece (`ViewSetup::cell_sphere`) over the
-/// depth range its samples span (near..far without bounds; nothing for an empty cell); None
-/// when no light is culled by a cone (no spots, or `SpotCull::Sphere`).
+/// Per cell, the sphere spot cones are tested against: the bounding sphere of its frustum
+/// piece (`ViewSetup::cell_sphere`) over the depth range its samples span (near..far without
+/// bounds; nothing for an empty cell), or its tight box's where smaller ([`cone_sphere`]);
+/// None when no light is culled by a cone (no spots, or `SpotCull::Sphere`).
 pub fn cell_spheres(
     setup: &ViewSetup,
     dims: &GridDims,
@@ -161,7 +162,11 @@ pub fn cell_spheres(
                 }
                 let lo = lo * (1.0 - DEPTH_SLACK);
                 let hi = hi * (1.0 + DEPTH_SLACK);
-                setup.cell_sphere(dims.tile_rect(cell % tiles), lo, hi)
+                let sphere = setup.cell_sphere(dims.tile_rect(cell % tiles), lo, hi);
+                match depth {
+                    DepthRange::Culled(_, culls) => cone_sphere(sphere, culls[cell].view_box()),
+                    _ => sphere,
+                }
             })
             .collect(),
     };

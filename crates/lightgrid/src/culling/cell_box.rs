@@ -6,7 +6,8 @@
 //! widened by the slack `ASSIGN_DEPTH_SLACK`, so every MSAA sample position of the pixel lies
 //! inside), and a light is listed only where its sphere reaches the box: the exact
 //! closest-point test, `|max(lo - c, 0, c - hi)| <= r`. A spot's sector box (and a BVH node's
-//! box) must overlap it too.
+//! box) must overlap it too, and a spot's cone is tested against the box's bounding sphere
+//! ([`cone_sphere`]) instead of the frustum piece's.
 //!
 //! What is not a sample widens the box by its whole tile frustum over its depth range: an MSAA
 //! forward fragment's range and, with one shared list, the range transparent fragments may
@@ -95,6 +96,24 @@ pub fn sphere_box_gap(lo: Vec3, hi: Vec3, c: Vec3, r: f32) -> f32 {
 /// `box_meets_box` in WGSL decides `a.lo <= b.hi && a.hi >= b.lo` on every axis).
 pub fn box_overlap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> f32 {
     (b.1 - a.0).min(a.1 - b.0).min_element()
+}
+
+/// The sphere a spot's cone is tested against (`cone_sphere` in WGSL): the bounding sphere
+/// of the cell's tight box where the cell has one and it is the smaller, else `frustum`, the
+/// frustum piece's. Either holds every point the cell shades, so the cone test stays
+/// conservative; the box's is smaller wherever the box is (a cell's samples on one surface).
+pub fn cone_sphere(frustum: (Vec3, f32), cell_box: Option<(Vec3, Vec3)>) -> (Vec3, f32) {
+    match cell_box {
+        Some((lo, hi)) => {
+            let r = (hi - lo).length() * 0.5;
+            if r < frustum.1 {
+                ((lo + hi) * 0.5, r)
+            } else {
+                frustum
+            }
+        }
+        None => frustum,
+    }
 }
 
 fn union(a: Option<(Vec3, Vec3)>, b: (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
@@ -192,6 +211,25 @@ mod tests {
         assert_eq!(view_extent(-0.5, 0.5, 1.0, 2.0, 4.0), [-2.0, 2.0]);
         assert_eq!(view_extent(0.25, 0.5, 0.5, 2.0, 4.0), [1.0, 4.0]);
         assert_eq!(view_extent(-0.5, -0.25, 0.5, 2.0, 4.0), [-4.0, -1.0]);
+    }
+
+    #[test]
+    fn the_cone_sphere_is_the_boxs_where_smaller_and_holds_its_corners() {
+        let frustum = (Vec3::new(0.0, 0.0, -10.0), 5.0);
+        assert_eq!(cone_sphere(frustum, None), frustum);
+        let (lo, hi) = (Vec3::new(-1.0, 2.0, -12.0), Vec3::new(1.0, 3.0, -9.0));
+        let (c, r) = cone_sphere(frustum, Some((lo, hi)));
+        assert_eq!(c, Vec3::new(0.0, 2.5, -10.5));
+        for i in 0..8 {
+            let corner = Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo);
+            assert!(
+                corner.distance(c) <= r * (1.0 + 1e-6),
+                "corner {corner} outside"
+            );
+        }
+        // A box larger than the frustum piece's sphere leaves that sphere.
+        let big = (Vec3::splat(-10.0), Vec3::splat(10.0));
+        assert_eq!(cone_sphere(frustum, Some(big)), frustum);
     }
 
     #[test]

@@ -7,8 +7,8 @@
 use super::gpu_assign::{gather_shader, CellKernels};
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use super::{
-    box_overlap, depth_mask_meets, sphere_box_gap, CellCull, CellMask, GridDims, LightGrid,
-    ViewLight, ViewSetup, NO_MASK,
+    box_overlap, cone_sphere, depth_mask_meets, sphere_box_gap, CellCull, CellMask, GridDims,
+    LightGrid, ViewLight, ViewSetup, NO_MASK,
 };
 use crate::consts::ASSIGN_DEPTH_SLACK;
 use crate::error::Result;
@@ -77,6 +77,7 @@ pub(super) fn cell_frustum(
     if let Some(m) = culls {
         f.mask = m[c].mask;
         f.cell_box = m[c].view_box();
+        f.sphere = cone_sphere(f.sphere, f.cell_box);
     }
     f
 }

@@ -35,7 +35,8 @@ pub use cell_bounds::{
     cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
 };
 pub use cell_box::{
-    box_overlap, cell_boxes_cpu, rect_box, sphere_box_gap, view_extent, CellCull, NO_CULL,
+    box_overlap, cell_boxes_cpu, cone_sphere, rect_box, sphere_box_gap, view_extent, CellCull,
+    NO_CULL,
 };
 pub use culler::{
     CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,

@@ -113,7 +113,7 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         let in_depth = b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
         let cull = cell_cull(cell);
         let in_cull = depth_mask_meets(cull.mask, w_min, w_max) && sphere_meets_box(cull.lo, cull.hi, c, radius);
-        if (in_depth && in_cull && (!by_cone || cone_margin(light, tile_frustum(xy, grid.tile_size, b).sphere) >= 0.0)) {
+        if (in_depth && in_cull && (!by_cone || cone_margin(light, cone_sphere(tile_frustum(xy, grid.tile_size, b).sphere, cull.lo, cull.hi)) >= 0.0)) {
             let slot = atomicAdd(&frame_counters[COUNTER_PAIRS_NEEDED], 1u);
             if (slot < capacity) {
                 pair_keys[slot] = cell;

@@ -111,6 +111,14 @@ fn cone_margin(light: Light, cell: vec4<f32>) -> f32 {
     return min(m, min(along + r, r - (light.cos_outer * across - along * sin_outer)));
 }
 
+// The sphere a spot's cone is tested against: the bounding sphere of the cell's tight box
+// (lo.w != 0: it has one) where it is the smaller, else `sphere`, the frustum piece's (CPU
+// twin and argument: `cone_sphere`, cell_box.rs).
+fn cone_sphere(sphere: vec4<f32>, lo: vec4<f32>, hi: vec4<f32>) -> vec4<f32> {
+    let r = length(hi.xyz - lo.xyz) * 0.5;
+    return select(sphere, vec4<f32>((lo.xyz + hi.xyz) * 0.5, r), lo.w != 0.0 && r < sphere.w);
+}
+
 // Does the view-space box [lo, hi] reach into the frustum (the BVH's node test; spots' boxes)?
 fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     let w_lo = -hi.z;
