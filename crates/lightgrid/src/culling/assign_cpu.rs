@@ -14,7 +14,9 @@
 use super::strategy::check_index_capacity;
 use super::strategy::CellSource;
 use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{cone_sphere, depth_mask_meets, CellCull, GridDims, LightGrid, ViewLight, ViewSetup};
+use super::{
+    box_overlap, cone_sphere, depth_mask_meets, CellCull, GridDims, LightGrid, ViewLight, ViewSetup,
+};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
@@ -188,6 +190,8 @@ pub fn assign_cpu(
         w_min: f32,
         w_max: f32,
         view: ViewLight,
+        /// A spot's sector box (`ViewLight::reach_box`), tested against cells' tight boxes.
+        sector: Option<(Vec3, Vec3)>,
     }
     let placed: Vec<Option<Placed>> = lights
         .par_iter()
@@ -202,6 +206,7 @@ pub fn assign_cpu(
                 ty1: rect.y1 / t,
                 w_min: -v.center.z - v.radius,
                 w_max: -v.center.z + v.radius,
+                sector: v.reach_box(),
                 view: v,
             })
         })
@@ -218,7 +223,8 @@ pub fn assign_cpu(
     let overlaps = |p: &Placed, lo: f32, hi: f32| {
         lo <= hi && p.w_max >= lo * (1.0 - DEPTH_SLACK) && p.w_min <= hi * (1.0 + DEPTH_SLACK)
     };
-    // `sphere_meets_box` in WGSL: the same `d`, compared squared.
+    // `sphere_meets_box` in WGSL: the same `d`, compared squared; a spot's sector box must
+    // overlap the cell's box too (`box_meets_box`).
     let in_cull = |p: &Placed, cell: usize| match depth {
         DepthRange::Culled(_, culls) => {
             let m = &culls[cell];
@@ -226,7 +232,7 @@ pub fn assign_cpu(
                 && m.view_box().is_none_or(|(lo, hi)| {
                     let (c, r) = (p.view.center, p.view.radius);
                     let d = (lo - c).max(Vec3::ZERO).max(c - hi);
-                    d.dot(d) <= r * r
+                    d.dot(d) <= r * r && p.sector.is_none_or(|s| box_overlap(s, (lo, hi)) >= 0.0)
                 })
         }
         _ => true,

@@ -97,6 +97,9 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let w_max = -c.z + b.w;
     // Spots culled by their cone test it against each cell's sphere, as assign_cpu does.
     let by_cone = frame.spot_cull != 0u && light.cos_outer > POINT_LIGHT_COS;
+    // A spot's sector box must overlap a cell's tight box too (the sphere's box otherwise,
+    // which the sphere test already implies), as assign_cpu tests.
+    let sector = reach_box(l, c, radius);
     let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);
     let k0 = grid_slice(w_min * (1.0 - ASSIGN_DEPTH_SLACK));
     let k1 = grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
@@ -112,7 +115,7 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         let b = cell_bounds[cell];
         let in_depth = b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
         let cull = cell_cull(cell);
-        let in_cull = depth_mask_meets(cull.mask, w_min, w_max) && sphere_meets_box(cull.lo, cull.hi, c, radius);
+        let in_cull = depth_mask_meets(cull.mask, w_min, w_max) && sphere_meets_box(cull.lo, cull.hi, c, radius) && box_meets_box(cull.lo, cull.hi, sector[0], sector[1]);
         if (in_depth && in_cull && (!by_cone || cone_margin(light, cone_sphere(tile_frustum(xy, grid.tile_size, b).sphere, cull.lo, cull.hi)) >= 0.0)) {
             let slot = atomicAdd(&frame_counters[COUNTER_PAIRS_NEEDED], 1u);
             if (slot < capacity) {
