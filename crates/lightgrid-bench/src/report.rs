@@ -30,8 +30,6 @@ pub(crate) fn run_name(r: &RunRecord) -> String {
     }
 }
 
-/// The pipeline, with the spot culling and the transparent lists when the run measured more
-/// than one.
 /// A run's mean lighting computations as a multiple of the ideal, two decimals; `missing`
 /// where the run counted none.
 fn times_ideal(m: &super::RunSummary, missing: &str) -> String {
@@ -43,6 +41,8 @@ fn times_ideal(m: &super::RunSummary, missing: &str) -> String {
     })
 }
 
+/// The pipeline, with the spot culling and the transparent lists when the run measured more
+/// than one.
 fn pipeline_label(r: &RunRecord) -> String {
     let mut label = r.pipeline.clone();
     // Each setting that names the run, in the table's order, as its row says (the G-buffer
