@@ -19,13 +19,14 @@ mod scaling;
 
 pub use claims::{evaluate_claims, Band, Basis, Claim, Threshold, Verdict};
 pub use outdir::{
-    check_out_dir, manifest_name, Earlier, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE,
+    check_out_dir, manifest_name, Committed, Earlier, OutDir, Outcome, LOCK_FILE, MANIFEST_FILE,
     STOPPED_BY_SIGNAL,
 };
-pub use report::{read_results, write_report, REPORT_FILES, SCHEMA_VERSION};
+pub use report::{read_results, write_derived, write_report, REPORT_FILES, SCHEMA_VERSION};
 pub use run::{
     prepare, run, AxisValues, BenchConfig, BenchResults, FrameRange, FrameRecord, PreparedBench,
-    Progress, RunRecord, RunSummary, SpotRayTest, TimesFrom, SOURCES, SPOTS_SUFFIX,
+    Progress, RunRecord, RunSummary, SpotRayTest, TimesFrom, MAX_RANGE_SCALE, SOURCES,
+    SPOTS_SUFFIX,
 };
 pub use scaling::{
     run_scaling, scaling_growth, scaling_table, write_scaling, ScalingConfig, ScalingPoint,
@@ -38,6 +39,33 @@ pub(crate) fn invalid(what: &'static str, reason: impl Into<String>) -> lightgri
         what,
         reason: reason.into(),
     }
+}
+
+/// Refuse a list option whose values would measure one series twice: `key` gives each
+/// value's identity (`1` and `1.0` are one number, an alias and its name one setting, two
+/// spellings or links of a file one file). The one rule for every list option of `bench`,
+/// `scaling` and `memory`.
+pub fn check_distinct<T: std::fmt::Display, K: PartialEq>(
+    flag: &str,
+    values: &[T],
+    key: impl Fn(&T) -> K,
+) -> lightgrid::Result<()> {
+    let keys: Vec<K> = values.iter().map(key).collect();
+    for (i, k) in keys.iter().enumerate() {
+        if let Some(j) = keys[..i].iter().position(|e| e == k) {
+            let (a, b) = (values[j].to_string(), values[i].to_string());
+            let what = if a == b {
+                format!("{b} is listed twice")
+            } else {
+                format!("{a} and {b} are the same value")
+            };
+            return Err(invalid(
+                "option list",
+                format!("{flag}: {what} (each value names one measured series); give each once"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Real-time frames played before a series' measured ones, so the measurement starts with

@@ -259,12 +259,13 @@ impl OutDir {
     /// list this run's files in the command's manifest. A file that another command's run
     /// wrote, or that lightgrid did not write, is never replaced unless `--force` was given:
     /// the run is refused before anything moves and its files are kept in a directory of their
-    /// own that the error names. Returns the files in place and the files removed.
-    pub fn commit(
-        &self,
-        written: &[PathBuf],
-        earlier: Earlier,
-    ) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
+    /// own that the error names. A run that did not `complete` (failed or interrupted) does not
+    /// replace an earlier run of the command: its files are set aside in a directory of their
+    /// own ([`Committed::set_aside`]) and the earlier ones stay as they were; with no earlier
+    /// run it is placed as a complete one is. Everything that could stop the move part-way (a
+    /// name given twice, a staged file missing, a directory or other non-file where a file
+    /// goes) is checked before anything moves.
+    pub fn commit(&self, written: &[PathBuf], earlier: Earlier, complete: bool) -> Result<Committed> {
         let own = manifest_name(&self.command);
         let old = self.listed(&own);
         let names: Vec<String> = written
@@ -272,6 +273,18 @@ impl OutDir {
             .filter_map(|p| p.file_name())
             .map(|n| n.to_string_lossy().into_owned())
             .collect();
+        self.check_movable(written, &names)?;
+        let earlier_run = old
+            .iter()
+            .any(|n| std::fs::symlink_metadata(self.dir.join(n)).is_ok());
+        if !complete && earlier_run {
+            let aside = self.set_aside("incomplete")?;
+            return Ok(Committed {
+                placed: Vec::new(),
+                removed: Vec::new(),
+                set_aside: Some(aside),
+            });
+        }
         // Other commands' manifests, to refuse replacing their files and to hand over the
         // names a forced run took.
         let mut others: Vec<(String, Vec<String>)> = Vec::new();
@@ -307,11 +320,8 @@ impl OutDir {
                 .take(3)
                 .map(|n| format!("{n} ({})", owner(n)))
                 .collect();
-            let kept = self
-                .dir
-                .join(format!("lightgrid-{}-{}", self.command, std::process::id()));
-            let kept_note = match std::fs::rename(self.staging(), &kept) {
-                Ok(()) => format!("this run's files are in {}", kept.display()),
+            let kept_note = match self.set_aside("refused") {
+                Ok(kept) => format!("this run's files are in {}", kept.display()),
                 Err(e) => format!("this run's files could not be kept: {e}"),
             };
             return Err(invalid(format!(
@@ -354,12 +364,85 @@ impl OutDir {
             }
         }
         self.write_manifest(&own, &listed)?;
-        Ok((placed, removed))
+        Ok(Committed {
+            placed,
+            removed,
+            set_aside: None,
+        })
+    }
+
+    /// Refuse, before anything moves, a commit that would stop part-way: a name given twice
+    /// (two files of the run would be one), a staged file that is not there, or a name whose
+    /// place in the directory holds a directory or another non-file.
+    fn check_movable(&self, written: &[PathBuf], names: &[String]) -> Result<()> {
+        if names.len() != written.len() {
+            return Err(invalid("a file of the run has no name".into()));
+        }
+        for (i, (path, name)) in written.iter().zip(names).enumerate() {
+            if names[..i].contains(name) {
+                return Err(invalid(format!(
+                    "two files of this run are both named {name}; nothing was moved into {}",
+                    self.dir.display()
+                )));
+            }
+            if !std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+                return Err(invalid(format!(
+                    "{} was not written; nothing was moved into {}",
+                    path.display(),
+                    self.dir.display()
+                )));
+            }
+            let to = self.dir.join(name);
+            if std::fs::symlink_metadata(&to).is_ok_and(|m| m.is_dir() || !m.is_file() && !m.file_type().is_symlink()) {
+                return Err(invalid(format!(
+                    "{} is not a regular file and cannot be replaced; nothing was changed",
+                    to.display()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Move the staging directory, with this run's files, to `lightgrid-COMMAND-WHY-PID` in
+    /// the directory (it is no longer removed on drop), and return its path.
+    fn set_aside(&self, why: &str) -> Result<PathBuf> {
+        let kept = self.dir.join(format!(
+            "lightgrid-{}-{why}-{}",
+            self.command,
+            std::process::id()
+        ));
+        std::fs::rename(self.staging(), &kept).map_err(io(&kept))?;
+        Ok(kept)
     }
 
     fn write_manifest(&self, manifest: &str, names: &[String]) -> Result<()> {
         let text: String = names.iter().map(|n| format!("{n}\n")).collect();
         lightgrid::image_io::write_atomic(&self.dir.join(manifest), text.as_bytes())
+    }
+}
+
+/// What [`OutDir::commit`] did.
+#[derive(Debug)]
+pub struct Committed {
+    /// The run's files, in the directory.
+    pub placed: Vec<PathBuf>,
+    /// Files of the command's earlier run that this one did not write, removed.
+    pub removed: Vec<PathBuf>,
+    /// Where the files of a run that did not complete went, when an earlier run's files stay
+    /// in the directory in their place.
+    pub set_aside: Option<PathBuf>,
+}
+
+impl Committed {
+    /// A sentence for the user when the run's files were set aside.
+    pub fn note(&self, dir: &Path) -> Option<String> {
+        self.set_aside.as_ref().map(|aside| {
+            format!(
+                "the earlier run's files in {} are kept as they were; this run's are in {}",
+                dir.display(),
+                aside.display()
+            )
+        })
     }
 }
 
@@ -413,7 +496,7 @@ mod tests {
                 p
             })
             .collect();
-        out.commit(&written, earlier).map(drop)
+        out.commit(&written, earlier, true).map(drop)
     }
 
     #[test]

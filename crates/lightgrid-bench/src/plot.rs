@@ -116,11 +116,20 @@ pub fn short_number(v: f64) -> String {
     format!("{txt}{s}")
 }
 
-/// The range an axis shows: whole decades on log axes, from zero (or below) on linear value
-/// axes, the data's extent on linear x axes.
+/// The largest magnitude an axis reaches: values past it (up to f64's 1.8e308, which a
+/// results file may hold) are drawn at it, so every range, width and tick count stays finite.
+const AXIS_LIMIT: f64 = 1e300;
+/// The most decades a log axis spans; values below the lowest are drawn on it.
+const MAX_DECADES: i32 = 30;
+
+/// The range an axis shows: whole decades on log axes (at most [`MAX_DECADES`], within
+/// 1e-300..1e300), from zero (or below) on linear value axes, the data's extent on linear x
+/// axes (within ±[`AXIS_LIMIT`]). Bounded for any value: a tick or grid computation over it
+/// takes a bounded number of steps.
 fn axis_range(values: impl Iterator<Item = f64>, log: bool, from_zero: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        let v = v.clamp(-AXIS_LIMIT, AXIS_LIMIT);
         lo = lo.min(v);
         hi = hi.max(v);
     }
@@ -128,8 +137,11 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool, from_zero: bool) -> 
         return if log { (1.0, 10.0) } else { (0.0, 1.0) };
     }
     if log {
-        let (a, b) = (lo.log10().floor(), hi.log10().ceil());
-        (10f64.powf(a), 10f64.powf(b.max(a + 1.0)))
+        let limit = AXIS_LIMIT.log10() as i32;
+        let b = (hi.log10().ceil() as i32).clamp(-limit, limit);
+        let a = (lo.log10().floor() as i32).clamp(-limit, limit).min(b - 1);
+        let a = a.max(b - MAX_DECADES);
+        (10f64.powi(a), 10f64.powi(b))
     } else if from_zero {
         let lo = lo.min(0.0);
         let hi = if hi > lo {
@@ -145,10 +157,14 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool, from_zero: bool) -> 
     }
 }
 
-/// Ticks of a log axis over whole decades `lo..hi`: labelled decades (and 2 and 5 times
-/// them when there are few), grid lines at every integer multiple within a decade.
+/// Ticks of a log axis over whole decades `lo..hi` (an [`axis_range`]): labelled decades
+/// (and 2 and 5 times them when there are few), grid lines at every integer multiple within
+/// a decade. At most [`MAX_DECADES`] decades, whatever the range.
 fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
-    let (a, b) = (lo.log10().round() as i32, hi.log10().round() as i32);
+    let limit = AXIS_LIMIT.log10() as i32 + 1;
+    let exponent = |v: f64| (v.log10().round() as i32).clamp(-limit, limit);
+    let b = exponent(hi);
+    let a = exponent(lo).max(b - MAX_DECADES);
     let mantissas: &[f64] = if b - a <= 2 { &[1.0, 2.0, 5.0] } else { &[1.0] };
     let mut bold = Vec::new();
     let mut light = Vec::new();
@@ -163,6 +179,9 @@ fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
 }
 
 type DrawResult = Result<(), Box<dyn Error>>;
+
+/// An x range and a y range.
+type Ranges = ((f64, f64), (f64, f64));
 
 /// The plot area and the legend column of a chart.
 type Panes<DB> = (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>);
@@ -250,15 +269,24 @@ impl LineChart {
                 .with_key_points(bold)
                 .with_light_points(light)
         };
+        let within = ((x0, x1), (y0, y1));
         match (self.log_x, self.log_y) {
-            (false, false) => self.draw_on(root, lin(x0, x1), lin(y0, y1)),
-            (false, true) => self.draw_on(root, lin(x0, x1), log(y0, y1)),
-            (true, false) => self.draw_on(root, log(x0, x1), lin(y0, y1)),
-            (true, true) => self.draw_on(root, log(x0, x1), log(y0, y1)),
+            (false, false) => self.draw_on(root, lin(x0, x1), lin(y0, y1), within),
+            (false, true) => self.draw_on(root, lin(x0, x1), log(y0, y1), within),
+            (true, false) => self.draw_on(root, log(x0, x1), lin(y0, y1), within),
+            (true, true) => self.draw_on(root, log(x0, x1), log(y0, y1), within),
         }
     }
 
-    fn draw_on<DB, X, Y>(&self, root: &DrawingArea<DB, Shift>, x: X, y: Y) -> DrawResult
+    /// Draw on the coordinates `x`, `y`, with points outside `within` (the axes' ranges)
+    /// drawn on its edge.
+    fn draw_on<DB, X, Y>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        x: X,
+        y: Y,
+        within: Ranges,
+    ) -> DrawResult
     where
         DB: DrawingBackend,
         DB::ErrorType: 'static,
@@ -293,6 +321,7 @@ impl LineChart {
                 .copied()
                 .filter(|&(x, y)| x.is_finite() && y.is_finite())
                 .filter(|&(x, y)| (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0))
+                .map(|(x, y)| (x.clamp(within.0 .0, within.0 .1), y.clamp(within.1 .0, within.1 .1)))
                 .collect();
             let line = rgb.stroke_width(2);
             if s.emphasis {
@@ -367,8 +396,13 @@ impl StackedBars {
             let mut acc = 0.0;
             chart.draw_series(segs.iter().map(|(name, v)| {
                 let c = color(names.iter().position(|m| m == name).unwrap_or(0));
-                let r = Rectangle::new([(left, acc), (right, acc + v)], c.filled());
-                acc += v;
+                let (bottom, top) = (acc, acc + v);
+                let on_axis = |y: f64| if y.is_nan() { y0 } else { y.clamp(y0, y1) };
+                let r = Rectangle::new(
+                    [(left, on_axis(bottom)), (right, on_axis(top))],
+                    c.filled(),
+                );
+                acc = top;
                 r
             }))?;
         }

@@ -1079,8 +1079,19 @@ pub fn write_report(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> 
         results,
     })
     .map_err(|e| invalid("results", e.to_string()))?;
+    let p = dir.join("results.json");
+    write_atomic(&p, &json)?;
+    written.push(p);
+    written.extend(write_derived(dir, results)?);
+    Ok(written)
+}
+
+/// Write what is derived from `results` into `dir` (the CSV, the summary and the plots), not
+/// `results.json` itself: `report` reads that file and leaves it as it is, fields it does not
+/// know included. Returns the paths written.
+pub fn write_derived(dir: &Path, results: &BenchResults) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
     for (name, bytes) in [
-        ("results.json", json),
         ("results.csv", csv(results)?),
         ("summary.md", summary(results).into_bytes()),
     ] {

@@ -209,6 +209,28 @@ impl BenchConfig {
 
     pub fn validate(&self) -> Result<()> {
         check_range_scales(&self.range_scales)?;
+        // Every list names series: a value given twice, or two values that are one, would
+        // measure one series twice under one name.
+        crate::check_distinct("--scene", &self.scenes, |s| scene_key(s))?;
+        crate::check_distinct("--pipelines", &self.pipelines, |p| {
+            pipelines::find(p).map_or(p.trim().to_string(), |i| i.id.to_string())
+        })?;
+        crate::check_distinct("--lights", &self.lights, |&n| n)?;
+        crate::check_distinct("--spot-fraction", &self.spot_fractions(), |&f| f)?;
+        crate::check_distinct("--range-scale", &self.range_scales, |&f| f)?;
+        for a in &self.settings {
+            let canonical = |v: &String| match pipelines::find_axis(&a.flag) {
+                Some(axis) => {
+                    let mut s = RenderSettings::default();
+                    match (axis.set)(&mut s, v) {
+                        Ok(()) => (axis.get)(&s),
+                        Err(_) => v.clone(),
+                    }
+                }
+                None => v.clone(),
+            };
+            crate::check_distinct(&format!("--{}", a.flag), &a.values, canonical)?;
+        }
         if self.scenes.is_empty() || self.pipelines.is_empty() {
             return Err(invalid("bench", "needs at least one scene and pipeline"));
         }
@@ -268,14 +290,7 @@ impl BenchConfig {
             ..Default::default()
         }
         .validate()?;
-        let fractions = self.spot_fractions();
-        for (i, &spot_fraction) in fractions.iter().enumerate() {
-            if fractions[..i].contains(&spot_fraction) {
-                return Err(invalid(
-                    "--spot-fraction",
-                    format!("{spot_fraction} is listed twice"),
-                ));
-            }
+        for spot_fraction in self.spot_fractions() {
             let params = SceneParams {
                 spot_fraction,
                 ..Default::default()
@@ -596,6 +611,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
     // Scene ids: two files with one file name (a/model.glb, b/model.glb) would be one scene
     // in the results and the report's files; the later ones get a number ("model-2").
     let mut ids: Vec<String> = Vec::new();
+    let mut sources: Vec<String> = Vec::new();
     for name in &config.scenes {
         // What applies to this scene: a light count and headlights only where the catalog
         // scene takes them, transparency off only where there is some.
@@ -666,21 +682,60 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 true => open(false)?.scene,
                 false => opened.scene,
             };
+            let source = match (lights, fractions.len() > 1) {
+                (Some(n), _) if config.lights.len() > 1 => format!("--scene {name} with {n} lights"),
+                (_, true) => format!("--scene {name} at spot fraction {spot_fraction}"),
+                _ => format!("--scene {name}"),
+            };
             if !config.range_scales.is_empty() {
                 for &f in &config.range_scales {
                     scenes.push(range_scaled(&scene, f));
+                    sources.push(format!("{source} at --range-scale {f}"));
                 }
                 continue;
             }
             scenes.push(scene);
+            sources.push(source.clone());
             if config.opaque_variants && config.transparency && has_glass {
                 let mut opaque = open(false)?.scene;
                 opaque.name = format!("{}{OPAQUE_SUFFIX}", opaque.name);
                 scenes.push(opaque);
+                sources.push(format!("{source} without its glass (--transparency on,off)"));
             }
         }
     }
+    check_scene_names(&scenes, &sources)?;
     Ok(scenes)
+}
+
+/// What a `--scene` value is: a catalog scene by name, a file by what it is on disk (two
+/// spellings or links of one file are one scene).
+fn scene_key(spec: &str) -> String {
+    match gltf::is_gltf_path(spec) {
+        true => format!(
+            "file {:?}",
+            lightgrid::image_io::file_identity(std::path::Path::new(spec))
+        ),
+        false => spec.to_string(),
+    }
+}
+
+/// Refuse scenes of one run that would be measured under one name (a file named like a
+/// catalog scene's variant, `robots-few-opaque.glb` beside `robots-few` measured without its
+/// glass): their series, rows and files would be one. `sources` says where each came from.
+fn check_scene_names(scenes: &[lightgrid::scene::Scene], sources: &[String]) -> Result<()> {
+    for (i, s) in scenes.iter().enumerate() {
+        if let Some(j) = scenes[..i].iter().position(|o| o.name == s.name) {
+            return Err(invalid(
+                "--scene",
+                format!(
+                    "{} and {} would both be measured as {}; rename the file or leave one out",
+                    sources[j], sources[i], s.name
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `name`, or `name-2`, `name-3`, ... when an earlier scene of the run took it.
@@ -707,13 +762,16 @@ fn range_scaled(scene: &lightgrid::scene::Scene, factor: f32) -> lightgrid::scen
     s
 }
 
+/// The largest `--range-scale` factor.
+pub const MAX_RANGE_SCALE: f32 = 1000.0;
+
 /// Refuse range factors that are not finite and positive (or absurd).
 fn check_range_scales(scales: &[f32]) -> Result<()> {
     for &f in scales {
-        if !(f.is_finite() && f > 0.0 && f <= 1000.0) {
+        if !(f.is_finite() && f > 0.0 && f <= MAX_RANGE_SCALE) {
             return Err(invalid(
                 "--range-scale",
-                format!("{f} is not a factor from above 0 to 1000"),
+                format!("{f} is not a factor above 0 and at most {MAX_RANGE_SCALE}"),
             ));
         }
     }

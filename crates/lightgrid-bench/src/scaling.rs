@@ -133,6 +133,9 @@ impl ScalingConfig {
                 format!("{} has a fixed light count; use stress", self.scene),
             ));
         }
+        crate::check_distinct("--lights", &self.lights, |&n| n)?;
+        let strategies: Vec<&str> = self.strategies.iter().map(|a| a.name()).collect();
+        crate::check_distinct("--assign", &strategies, |&n| n)?;
         if self.lights.is_empty() || self.strategies.is_empty() {
             return Err(invalid(
                 "scaling",

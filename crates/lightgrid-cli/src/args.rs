@@ -8,7 +8,6 @@ use lightgrid::pipelines::{Axis, SettingValue, AXES};
 use lightgrid::scene::catalog::SceneParams;
 use lightgrid::scene::{AddLights, SceneRequest};
 use lightgrid::RenderSettings;
-use std::path::Path;
 
 /// Frame size as WIDTHxHEIGHT.
 #[derive(Clone, Copy, Debug)]
@@ -70,6 +69,38 @@ pub(crate) fn parse_positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(v) if v > 0.0 && v < 1e9 => Ok(v),
         _ => Err(format!("'{s}' is not a positive number below 1e9")),
+    }
+}
+
+/// A number above 0 and at most `max` (the bounds the message states are the ones enforced).
+fn parse_up_to(s: &str, min: f64, max: f64) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v >= min && v <= max => Ok(v),
+        _ => Err(format!("'{s}' is not a number from {min:e} to {max:e}")),
+    }
+}
+
+/// `--exposure`: from [`MIN_EXPOSURE`] (tinier factors are 0 in f32, so nothing would show)
+/// to the library's largest ([`lightgrid::scene::source::MAX_EXPOSURE`]).
+pub(crate) fn parse_exposure(s: &str) -> Result<f64, String> {
+    parse_up_to(
+        s,
+        MIN_EXPOSURE,
+        f64::from(lightgrid::scene::source::MAX_EXPOSURE),
+    )
+}
+
+/// The smallest `--exposure`: an f32 keeps it (and its products with a light) above 0.
+pub(crate) const MIN_EXPOSURE: f64 = 1e-30;
+
+/// `--range-scale`: a factor above 0 and at most [`lightgrid_bench::MAX_RANGE_SCALE`].
+pub(crate) fn parse_range_scale(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= f64::from(lightgrid_bench::MAX_RANGE_SCALE) => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a factor above 0 and at most {}",
+            lightgrid_bench::MAX_RANGE_SCALE
+        )),
     }
 }
 
@@ -331,8 +362,8 @@ pub(crate) struct SceneOptions {
     pub(crate) material_shaders: OnOff,
     /// Multiplies every light before shading (default: 1 for the catalog; for a glTF file's
     /// photometric lights, the exposure at which the median light shows mid-grey on a white
-    /// surface at half its range). Up to 1e6.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_positive)]
+    /// surface at half its range). 1e-30 to 1e6.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_exposure)]
     pub(crate) exposure: Option<f64>,
 }
 
@@ -375,12 +406,9 @@ impl SceneOptions {
         Ok(req)
     }
 
-    /// A glTF scene file is an input no output may replace.
+    /// A glTF scene file, and the files it reads, are inputs no output may replace.
     pub(crate) fn claim(&self, files: &mut Files) -> Result<()> {
-        if lightgrid::scene::gltf::is_gltf_path(&self.scene) {
-            files.input("--scene", Path::new(&self.scene))?;
-        }
-        Ok(())
+        files.scene("--scene", &self.scene)
     }
 
     /// The scene these options name, built or loaded (warnings about skipped parts of a file
@@ -520,18 +548,27 @@ pub(crate) fn progress_bar() -> impl FnMut(&lightgrid_bench::Progress) {
 }
 
 /// The exit of a long run: an error (non-zero status) when it did not complete, saying how
-/// it ended and where the partial results are.
-pub(crate) fn run_outcome(outcome: &lightgrid_bench::Outcome, out: &std::path::Path) -> Result<()> {
+/// it ended and where the partial results are (set aside beside an earlier run's files,
+/// which stay as they were, or in `out` when there was none).
+pub(crate) fn run_outcome(
+    outcome: &lightgrid_bench::Outcome,
+    out: &std::path::Path,
+    committed: &lightgrid_bench::Committed,
+) -> Result<()> {
     if !outcome.is_complete() {
-        anyhow::bail!(
-            "{}\nwhat was measured is in {} (marked {})",
-            outcome.describe(),
-            out.display(),
-            match outcome {
-                lightgrid_bench::Outcome::Failed(_) => "failed",
-                _ => "interrupted",
-            }
-        );
+        let marked = match outcome {
+            lightgrid_bench::Outcome::Failed(_) => "failed",
+            _ => "interrupted",
+        };
+        let place = match &committed.set_aside {
+            Some(aside) => format!(
+                "{} (marked {marked}); the earlier run's files in {} are kept as they were",
+                aside.display(),
+                out.display()
+            ),
+            None => format!("{} (marked {marked})", out.display()),
+        };
+        anyhow::bail!("{}\nwhat was measured is in {place}", outcome.describe());
     }
     Ok(())
 }

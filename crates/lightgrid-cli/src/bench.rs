@@ -14,6 +14,7 @@ use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
 use lightgrid::pipelines::PIPELINES;
 use lightgrid::pipelines::{Axis, SettingValue, SpotCull};
+use crate::files::Files;
 use lightgrid_bench::{check_out_dir, AxisValues, BenchConfig, FrameRange, OutDir};
 use std::path::PathBuf;
 
@@ -149,7 +150,7 @@ pub(crate) struct BenchArgs {
     pub(crate) heatmap_max: Option<u32>,
     /// Measure every scene once per factor with all its lights' ranges scaled by it
     /// (a list, e.g. 0.5,1,2,4; each above 0 and at most 1000), as `<scene>-range-x<factor>`.
-    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = crate::args::parse_positive)]
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', value_parser = crate::args::parse_range_scale)]
     pub(crate) range_scale: Vec<f64>,
     /// Output directory (created; files an earlier bench run wrote there and this one does not
     /// are removed, other commands' files are kept; an existing directory lightgrid did not
@@ -475,6 +476,10 @@ pub(crate) fn bench_config(
             .filter(|p| !p.is_empty())
             .collect(),
     };
+    let transparency: Vec<&str> = (a.transparency.iter())
+        .map(|t| if t.on() { "on" } else { "off" })
+        .collect();
+    lightgrid_bench::check_distinct("--transparency", &transparency, |&t| t)?;
     let config = BenchConfig {
         scenes: if a.scenes.is_empty() {
             scenes.iter().map(|s| s.to_string()).collect()
@@ -524,8 +529,8 @@ pub(crate) fn bench_config(
         .given
         .iter()
         .any(|(axis, _)| axis.flag == MsaaResolve::FLAG);
-    crate::args::check_msaa_resolve(resolve_given, &config.msaa_counts())?;
     config.validate()?;
+    crate::args::check_msaa_resolve(resolve_given, &config.msaa_counts())?;
     let chosen: Vec<_> = config
         .pipelines
         .iter()
@@ -556,6 +561,10 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
             lightgrid::frame::check_msaa(&ctx, n, g)?;
         }
     }
+    let mut files = Files::default();
+    for scene in &config.scenes {
+        files.scene("--scene", scene)?;
+    }
     let prepared = lightgrid_bench::prepare(&config)?;
     let dir = OutDir::claim(&a.out, "bench", a.force)?;
     let stop = stop_on_ctrl_c()?;
@@ -575,7 +584,9 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
     let written = lightgrid_bench::write_report(dir.staging(), &results)?;
-    let (written, _) = dir.commit(&written, lightgrid_bench::Earlier::Remove)?;
+    files.placed("--out", &a.out, &written)?;
+    let complete = results.outcome.is_complete();
+    let committed = dir.commit(&written, lightgrid_bench::Earlier::Remove, complete)?;
     let claims = lightgrid_bench::evaluate_claims(&results);
     let held = claims
         .iter()
@@ -585,27 +596,33 @@ pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
         .iter()
         .filter(|c| c.verdict != lightgrid_bench::Verdict::NotMeasured)
         .count();
+    let place = committed.set_aside.as_deref().unwrap_or(&a.out);
     outln!(
         "{} runs in {}; {held} of {measured} measured claims held; {} files in {} (start with summary.md)",
         results.runs.len(),
         format_duration(start.elapsed().as_secs_f64()),
         written.len(),
-        a.out.display()
+        place.display()
     );
-    run_outcome(&results.outcome, &a.out)
+    run_outcome(&results.outcome, &a.out, &committed)
 }
 
 pub(crate) fn report(a: &ReportArgs) -> Result<()> {
-    let results = lightgrid_bench::read_results(&a.dir.join("results.json"))?;
-    // The bench's files are the report's: they are rewritten under the bench's manifest, the
-    // heatmaps and anything else the run wrote kept. Written aside first, so a report that
-    // fails part-way changes nothing.
+    let results_json = a.dir.join("results.json");
+    let results = lightgrid_bench::read_results(&results_json)?;
+    // The bench's files are the report's: the derived ones are rewritten under the bench's
+    // manifest; results.json (which the report only reads), the heatmaps and anything else
+    // the run wrote are kept. Written aside first and checked before anything moves, so a
+    // report that fails changes nothing.
     let dir = OutDir::claim(&a.dir, "bench", false)?;
-    let written = lightgrid_bench::write_report(dir.staging(), &results)?;
-    let (written, _) = dir.commit(&written, lightgrid_bench::Earlier::Keep)?;
+    let written = lightgrid_bench::write_derived(dir.staging(), &results)?;
+    let mut files = Files::default();
+    files.input("DIR/results.json", &results_json)?;
+    files.placed("DIR", &a.dir, &written)?;
+    let committed = dir.commit(&written, lightgrid_bench::Earlier::Keep, true)?;
     outln!(
-        "{} files rewritten in {} (heatmaps are kept from the run)",
-        written.len(),
+        "{} files rewritten in {} (results.json, read, and the heatmaps are kept from the run)",
+        committed.placed.len(),
         a.dir.display()
     );
     Ok(())

@@ -2,6 +2,7 @@
 //! compared with the `forward` reference.
 
 use crate::args::{run_outcome, stop_on_ctrl_c, SceneArgs, Size};
+use crate::files::Files;
 use anyhow::{bail, Result};
 use clap::Args;
 use lightgrid::gpu::GpuContext;
@@ -83,6 +84,8 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     // Only whether it can be written, here: what the directory holds is checked by the claim
     // below, after the options (which a user fixes first) and before anything is rendered.
     check_out_dir(&a.out_dir, true)?;
+    let mut files = Files::default();
+    a.scene.options.claim(&mut files)?;
     let scene = a.scene.options.build()?;
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.scene.size, &scene);
@@ -260,16 +263,24 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let path = dir.staging().join(COMPARE_JSON);
     write_atomic(&path, &serde_json::to_vec_pretty(&summary)?)?;
     written.push(path);
-    // Images of pipelines that failed this time must not stay from an earlier run.
-    dir.commit(&written, Earlier::Remove)?;
+    // Images of pipelines that failed this time must not stay from an earlier run. A table
+    // with failed pipelines is a whole answer (every pipeline was tried); an interrupted one
+    // is not, and does not replace an earlier run's.
+    files.placed("--out-dir", &a.out_dir, &written)?;
+    let whole = !matches!(outcome, Outcome::Interrupted(_));
+    let committed = dir.commit(&written, Earlier::Remove, whole)?;
+    let place = committed.set_aside.as_deref().unwrap_or(&a.out_dir);
     outln!(
         "images and stats in {} ({COMPARE_JSON}: the table)",
-        a.out_dir.display()
+        place.display()
     );
     match outcome {
         Outcome::Complete => Ok(()),
-        Outcome::Failed(reason) => bail!("{reason}"),
-        o => run_outcome(&o, &a.out_dir),
+        Outcome::Failed(reason) => match committed.note(&a.out_dir) {
+            Some(note) => bail!("{reason}\n{note}"),
+            None => bail!("{reason}"),
+        },
+        o => run_outcome(&o, &a.out_dir, &committed),
     }
 }
 

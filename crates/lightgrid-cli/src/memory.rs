@@ -28,6 +28,7 @@ pub(crate) struct MemoryArgs {
 }
 
 pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
+    lightgrid_bench::check_distinct("--msaa", &a.msaa, |&n| n)?;
     for &n in &a.msaa {
         lightgrid::frame::validate_msaa(n)?;
     }

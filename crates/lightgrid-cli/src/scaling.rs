@@ -111,7 +111,12 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
     eprintln!();
     results.command = std::env::args().collect::<Vec<_>>().join(" ");
     let written = lightgrid_bench::write_scaling(&results, dir.staging())?;
-    dir.commit(&written, lightgrid_bench::Earlier::Remove)?;
+    crate::files::Files::default().placed("--out", &a.out, &written)?;
+    let committed = dir.commit(
+        &written,
+        lightgrid_bench::Earlier::Remove,
+        results.outcome.is_complete(),
+    )?;
     outln!("{}", lightgrid_bench::scaling_table(&results));
     outln!("{}", lightgrid_bench::scaling_growth(&results));
     outln!(
@@ -121,5 +126,5 @@ pub(crate) fn scaling(adapter: Option<&str>, a: &ScalingArgs) -> Result<()> {
         lightgrid_bench::SCALING_FILES.join(", "),
         a.out.display()
     );
-    run_outcome(&results.outcome, &a.out)
+    run_outcome(&results.outcome, &a.out, &committed)
 }

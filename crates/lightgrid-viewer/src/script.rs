@@ -5,7 +5,8 @@
 //! Syntax: steps separated by `;`, each `at N ACTION` (N: the displayed frame, from 0 to
 //! [`MAX_AT`]) or a bare `ACTION` (frame 0); the steps due at one frame run together in that
 //! frame, up to a screenshot or a resize (which wait for the frame to show them). Actions:
-//! `pipeline ID`, `tile N`, `msaa N`, `view shaded|lights|bounds|wasted`, `resize WxH`,
+//! `pipeline ID`, `tile N`, `msaa N`, `view shaded|lights|bounds|wasted`, `resize WxH`
+//! (each edge 1 to [`MAX_RESIZE_EDGE`]),
 //! `frame F` (jump the animation), `pause`, `play`, `panel on|off`, `screenshot FILE.png`,
 //! and the scene's options (the scene is opened again): `spots F` (the spot fraction, 0 to
 //! 1), `transparency on|off`, `add-lights N` (N scattered lights; 0 removes them).
@@ -40,9 +41,14 @@ pub struct Step {
     pub action: Action,
 }
 
-/// Latest settled frame a step may be due at: about three minutes at 60 frames per second,
-/// and more than any test or demo here waits; `at 4294967295` would never end.
-pub const MAX_AT: u32 = 10_000;
+/// Latest settled frame a step may be due at: 17 seconds at 60 frames per second, a few
+/// minutes at a software adapter's rate, and more than any test or demo here waits;
+/// `at 4294967295` would never end.
+pub const MAX_AT: u32 = 1_000;
+
+/// Largest window edge `resize` asks for: a 4K display's width and more (a larger window
+/// than any screen shows would render for minutes a frame on a software adapter).
+pub const MAX_RESIZE_EDGE: u32 = 4096;
 
 fn number(word: Option<&str>, what: &str, step: &str) -> Result<u32, String> {
     let w = word.ok_or_else(|| format!("'{step}': {what} needs a number"))?;
@@ -91,12 +97,13 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                 let w = number(Some(w), "resize width", step)?;
                 let h = number(Some(h), "resize height", step)?;
                 if w == 0 || h == 0 {
-                    return Err(format!("'{step}': both edges must be at least 1"));
-                }
-                if w > lightgrid::consts::MAX_FRAME_EDGE || h > lightgrid::consts::MAX_FRAME_EDGE {
                     return Err(format!(
-                        "'{step}': edges above {} are not supported",
-                        lightgrid::consts::MAX_FRAME_EDGE
+                        "'{step}': both edges must be 1 to {MAX_RESIZE_EDGE}"
+                    ));
+                }
+                if w > MAX_RESIZE_EDGE || h > MAX_RESIZE_EDGE {
+                    return Err(format!(
+                        "'{step}': both edges must be 1 to {MAX_RESIZE_EDGE}"
                     ));
                 }
                 Action::Resize(w, h)
@@ -232,12 +239,19 @@ mod tests {
             "transparency maybe",
             "add-lights -1",
             "add-lights 99999999",
-            "at 10001 pause",
+            "at 1001 pause",
+            "resize 4097x10",
+            "resize 16384x16384",
             "at 4294967295 pause",
         ] {
             assert!(parse(bad).is_err(), "{bad} parsed");
         }
         assert_eq!(parse(" ; ;").unwrap(), vec![]);
         assert_eq!(parse(&format!("at {MAX_AT} pause")).unwrap()[0].at, MAX_AT);
+        let edge = format!("resize {MAX_RESIZE_EDGE}x{MAX_RESIZE_EDGE}");
+        assert_eq!(
+            parse(&edge).unwrap()[0].action,
+            Action::Resize(MAX_RESIZE_EDGE, MAX_RESIZE_EDGE)
+        );
     }
 }

@@ -371,21 +371,41 @@ pub fn check_writable(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// What a path names, for telling whether two arguments name the same file: the canonical path
-/// of an existing file (symlinks followed), else its canonical directory joined with its name.
-/// Paths whose directory does not exist are returned as given (they fail the writability check).
-pub fn file_identity(path: &Path) -> std::path::PathBuf {
+/// What a file is, for telling whether two paths name the same file: an existing file by its
+/// device and inode where the platform has them (so hard links, symlinks and `./` spellings of
+/// one file are one identity), otherwise by its canonical path (symlinks followed), and a path
+/// that does not exist yet by its canonical directory joined with its name. Paths whose
+/// directory does not exist are kept as given (they fail the writability check).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum FileIdentity {
+    /// An existing file's device and inode.
+    Inode { device: u64, inode: u64 },
+    /// A canonical path: of an existing file where there are no inodes, or where a new file
+    /// would be created.
+    Path(std::path::PathBuf),
+}
+
+/// The [`FileIdentity`] of `path`.
+pub fn file_identity(path: &Path) -> FileIdentity {
+    #[cfg(unix)]
+    if let Ok(m) = std::fs::metadata(path) {
+        use std::os::unix::fs::MetadataExt;
+        return FileIdentity::Inode {
+            device: m.dev(),
+            inode: m.ino(),
+        };
+    }
     if let Ok(p) = std::fs::canonicalize(path) {
-        return p;
+        return FileIdentity::Path(p);
     }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    match (std::fs::canonicalize(dir), path.file_name()) {
+    FileIdentity::Path(match (std::fs::canonicalize(dir), path.file_name()) {
         (Ok(d), Some(name)) => d.join(name),
         _ => path.to_path_buf(),
-    }
+    })
 }
 
 #[cfg(test)]

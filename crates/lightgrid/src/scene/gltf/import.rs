@@ -864,9 +864,13 @@ fn chosen_camera(
         .map(|(_, w)| *w)
         .ok_or_else(|| format!("--camera {n}: no node of the scene places camera {n}"))?;
     if doc.root.cameras[n].kind != "perspective" {
+        let kind = &doc.root.cameras[n].kind;
+        let article = match kind.starts_with(['a', 'e', 'i', 'o', 'u']) {
+            true => "an",
+            false => "a",
+        };
         return Err(format!(
-            "--camera {n}: a {} camera; only perspective cameras are rendered",
-            doc.root.cameras[n].kind
+            "--camera {n}: {article} {kind} camera; only perspective cameras are rendered"
         ));
     }
     Ok(Some((n, world)))

@@ -69,6 +69,13 @@ pub fn is_gltf_path(spec: &str) -> bool {
     lower.ends_with(".gltf") || lower.ends_with(".glb")
 }
 
+/// The files beside a `.gltf` or `.glb` file that it reads (its buffers and images named by
+/// URI, resolved as [`load`] resolves them): what no output may replace while the file is an
+/// input. Lenient: a file that cannot be read or parsed lists nothing (loading it fails).
+pub fn files_named_by(path: &Path) -> Vec<std::path::PathBuf> {
+    read::files_named_by(path)
+}
+
 /// Load a `.gltf` or `.glb` file; relative URIs resolve beside it.
 pub fn load(path: &Path, opts: &LoadOptions) -> Result<Loaded> {
     let fail = |reason: String| Error::Gltf {

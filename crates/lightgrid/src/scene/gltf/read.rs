@@ -98,6 +98,70 @@ pub(super) fn read_limited(path: &Path) -> Res<Vec<u8>> {
     std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// The JSON part of a `.gltf` or `.glb` file, read without its binary chunk (at most
+/// [`MAX_JSON_BYTES`]).
+fn read_json_part(path: &Path) -> Res<Vec<u8>> {
+    use std::io::Read;
+    let fail = |e: std::io::Error| format!("{}: {e}", path.display());
+    let meta = std::fs::metadata(path).map_err(fail)?;
+    if !meta.is_file() {
+        return Err(format!("{} is not a regular file", path.display()));
+    }
+    let mut file = std::fs::File::open(path).map_err(fail)?;
+    let mut head = [0u8; 20];
+    let got = (&mut file).take(20).read(&mut head).map_err(fail)?;
+    let (skip, len) = if got == 20 && head.starts_with(GLB_MAGIC) {
+        let len = u32_at(&head, 12).unwrap_or(0);
+        (20u64, u64::from(len))
+    } else {
+        (0, meta.len())
+    };
+    if len > MAX_JSON_BYTES {
+        return Err(format!("{}: the JSON part is too large", path.display()));
+    }
+    let mut file = std::fs::File::open(path).map_err(fail)?;
+    std::io::copy(&mut (&mut file).take(skip), &mut std::io::sink()).map_err(fail)?;
+    let mut json = Vec::new();
+    file.take(len).read_to_end(&mut json).map_err(fail)?;
+    Ok(json)
+}
+
+/// The files beside the document at `path` that it names as buffers or images, resolved
+/// as [`Document::fetch`] resolves them (percent-decoded, relative to the document's folder;
+/// `data:` and remote URIs name no file). Read leniently: whatever of the file can be read
+/// is listed, and a file that cannot be read lists nothing (loading it then fails).
+pub(super) fn files_named_by(path: &Path) -> Vec<PathBuf> {
+    let Ok(json) = read_json_part(path) else {
+        return Vec::new();
+    };
+    let json = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&json);
+    let Ok(root) = serde_json::from_slice::<serde_json::Value>(json) else {
+        return Vec::new();
+    };
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut files = Vec::new();
+    for key in ["buffers", "images"] {
+        let entries = root.get(key).and_then(|v| v.as_array());
+        for entry in entries.into_iter().flatten() {
+            let Some(uri) = entry.get("uri").and_then(|u| u.as_str()) else {
+                continue;
+            };
+            if uri.starts_with("data:") || uri.contains("://") {
+                continue;
+            }
+            if let Ok(rel) = percent_decode(uri) {
+                if Path::new(&rel).is_relative() {
+                    files.push(base.join(rel));
+                }
+            }
+        }
+    }
+    files
+}
+
 /// Decode standard base64 (RFC 4648 §4; padding optional, whitespace refused).
 fn base64(text: &str) -> Res<Vec<u8>> {
     let text = text.trim_end_matches('=');
