@@ -265,7 +265,12 @@ impl OutDir {
     /// run it is placed as a complete one is. Everything that could stop the move part-way (a
     /// name given twice, a staged file missing, a directory or other non-file where a file
     /// goes) is checked before anything moves.
-    pub fn commit(&self, written: &[PathBuf], earlier: Earlier, complete: bool) -> Result<Committed> {
+    pub fn commit(
+        &self,
+        written: &[PathBuf],
+        earlier: Earlier,
+        complete: bool,
+    ) -> Result<Committed> {
         let own = manifest_name(&self.command);
         let old = self.listed(&own);
         let names: Vec<String> = written
@@ -393,7 +398,9 @@ impl OutDir {
                 )));
             }
             let to = self.dir.join(name);
-            if std::fs::symlink_metadata(&to).is_ok_and(|m| m.is_dir() || !m.is_file() && !m.file_type().is_symlink()) {
+            if std::fs::symlink_metadata(&to)
+                .is_ok_and(|m| m.is_dir() || !m.is_file() && !m.file_type().is_symlink())
+            {
                 return Err(invalid(format!(
                     "{} is not a regular file and cannot be replaced; nothing was changed",
                     to.display()

@@ -683,7 +683,9 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 false => opened.scene,
             };
             let source = match (lights, fractions.len() > 1) {
-                (Some(n), _) if config.lights.len() > 1 => format!("--scene {name} with {n} lights"),
+                (Some(n), _) if config.lights.len() > 1 => {
+                    format!("--scene {name} with {n} lights")
+                }
                 (_, true) => format!("--scene {name} at spot fraction {spot_fraction}"),
                 _ => format!("--scene {name}"),
             };
@@ -700,7 +702,9 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 let mut opaque = open(false)?.scene;
                 opaque.name = format!("{}{OPAQUE_SUFFIX}", opaque.name);
                 scenes.push(opaque);
-                sources.push(format!("{source} without its glass (--transparency on,off)"));
+                sources.push(format!(
+                    "{source} without its glass (--transparency on,off)"
+                ));
             }
         }
     }

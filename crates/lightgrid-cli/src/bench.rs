@@ -4,6 +4,7 @@ use crate::args::{
     check_applies, format_duration, parse_fraction, parse_size, progress_bar, run_outcome,
     stop_on_ctrl_c, AxisListArgs, OnOff, Size, MAX_COUNT,
 };
+use crate::files::Files;
 use anyhow::Result;
 use clap::Args;
 use lightgrid::frame::{
@@ -14,7 +15,6 @@ use lightgrid::passes::GBufferFormat;
 use lightgrid::pipelines::ids;
 use lightgrid::pipelines::PIPELINES;
 use lightgrid::pipelines::{Axis, SettingValue, SpotCull};
-use crate::files::Files;
 use lightgrid_bench::{check_out_dir, AxisValues, BenchConfig, FrameRange, OutDir};
 use std::path::PathBuf;
 
