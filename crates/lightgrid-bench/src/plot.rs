@@ -321,7 +321,12 @@ impl LineChart {
                 .copied()
                 .filter(|&(x, y)| x.is_finite() && y.is_finite())
                 .filter(|&(x, y)| (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0))
-                .map(|(x, y)| (x.clamp(within.0 .0, within.0 .1), y.clamp(within.1 .0, within.1 .1)))
+                .map(|(x, y)| {
+                    (
+                        x.clamp(within.0 .0, within.0 .1),
+                        y.clamp(within.1 .0, within.1 .1),
+                    )
+                })
                 .collect();
             let line = rgb.stroke_width(2);
             if s.emphasis {
@@ -398,10 +403,8 @@ impl StackedBars {
                 let c = color(names.iter().position(|m| m == name).unwrap_or(0));
                 let (bottom, top) = (acc, acc + v);
                 let on_axis = |y: f64| if y.is_nan() { y0 } else { y.clamp(y0, y1) };
-                let r = Rectangle::new(
-                    [(left, on_axis(bottom)), (right, on_axis(top))],
-                    c.filled(),
-                );
+                let r =
+                    Rectangle::new([(left, on_axis(bottom)), (right, on_axis(top))], c.filled());
                 acc = top;
                 r
             }))?;

@@ -165,7 +165,8 @@ pub(crate) struct BenchArgs {
 
 #[derive(Args)]
 pub(crate) struct ReportArgs {
-    /// The benchmark directory (reads results.json, writes the report files next to it).
+    /// The benchmark directory (reads results.json, writes the report files next to it; a
+    /// report that cannot write one of them changes none).
     pub(crate) dir: PathBuf,
 }
 

@@ -59,7 +59,8 @@ enum Command {
     /// Reproduce the papers' evaluations: frame times, lighting computations and memory over
     /// scene animations, written as results.json/.csv, plots and summary.md.
     Bench(bench::BenchArgs),
-    /// Rewrite a benchmark's summary.md and plots from its results.json.
+    /// Rewrite a benchmark's summary.md, results.csv and plots from its results.json (which is
+    /// only read, never rewritten).
     Report(bench::ReportArgs),
     /// Light-assignment scaling: assignment time, index-list size and lighting computations
     /// per strategy (cpu, gather, scatter, bvh, bvh-gpu) on `stress` from 1k to 1M lights.

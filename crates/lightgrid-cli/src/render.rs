@@ -99,7 +99,14 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
         writes.push((path, encode_png(&map, path)?));
     }
     if let Some(path) = &a.stats {
-        writes.push((path, serde_json::to_vec_pretty(&out.stats)?));
+        let mut stats = serde_json::to_value(&out.stats)?;
+        // The ranges lightgrid gave a file's lights that had none (README "glTF scenes").
+        if !scene.derived_ranges.is_empty() {
+            stats["lights_without_range"] = (scene.derived_ranges.iter())
+                .map(|&(light, range)| serde_json::json!({"light": light, "range": range}))
+                .collect();
+        }
+        writes.push((path, serde_json::to_vec_pretty(&stats)?));
     }
     if let Some(path) = &a.shadow_maps_image {
         let atlas = renderer

@@ -44,7 +44,8 @@ pub struct GpuMaterial {
     pub texture: u32,
     /// Alpha test: fragments with alpha below are discarded; 0 for none.
     pub alpha_cutoff: f32,
-    pub _pad0: u32,
+    /// Emissive texture: its layer in the texture array + 1; 0 for none.
+    pub emissive_texture: u32,
     pub _pad1: u32,
 }
 

@@ -42,6 +42,14 @@ fn base_colour(m: Material, uv: vec2<f32>) -> vec4<f32> {
     return select(vec4<f32>(1.0), texel, m.texture != 0u);
 }
 
+// A material's emissive colour at `uv`: its emissive factor times its emissive texture's
+// texel (glTF's emissiveTexture), or the factor alone. Always sampled, as `base_colour`.
+fn emissive_colour(m: Material, uv: vec2<f32>) -> vec3<f32> {
+    let layer = max(m.emissive_texture, 1u) - 1u;
+    let texel = textureSample(base_textures, base_sampler, uv, layer).rgb;
+    return m.emissive * select(vec3<f32>(1.0), texel, m.emissive_texture != 0u);
+}
+
 // The alpha test (glTF MASK): a fragment whose alpha is under its material's cutoff is not
 // there, in any pass (a cutoff of 0 never discards).
 fn alpha_test(m: Material, alpha: f32) {
@@ -75,7 +83,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     s.alpha = m.alpha * base.a;
     s.specular = m.specular;
     s.shininess = m.shininess;
-    s.emissive = m.emissive;
+    s.emissive = emissive_colour(m, v.uv);
     s.ambient = m.ambient * base.rgb;
     s.material = v.material;
     return s;

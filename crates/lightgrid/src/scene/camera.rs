@@ -87,6 +87,10 @@ impl Camera {
 pub struct CameraPath {
     /// (frame, eye, target), frames increasing.
     pub keys: Vec<(u32, Vec3, Vec3)>,
+    /// The camera's up at each key, interpolated as the eyes and targets are; empty for +y
+    /// throughout (the catalog's cameras). A file's camera keeps its roll this way, and one
+    /// looking straight up or down its orientation.
+    pub ups: Vec<Vec3>,
     pub fov_y: f32,
     pub near: f32,
     pub far: f32,
@@ -106,6 +110,7 @@ impl CameraPath {
     pub fn fixed(eye: Vec3, target: Vec3, fov_y_deg: f32, near: f32, far: f32) -> Self {
         CameraPath {
             keys: vec![(0, eye, target)],
+            ups: Vec::new(),
             fov_y: fov_y_deg.to_radians(),
             near,
             far,
@@ -123,10 +128,12 @@ impl CameraPath {
             .keys
             .windows(2)
             .position(|w| frame >= w[0].0 && frame <= w[1].0);
-        let (eye, target) = match seg {
+        let ups = self.ups.len() == n;
+        let up_at = |k: usize| if ups { self.ups[k] } else { Vec3::Y };
+        let (eye, target, up) = match seg {
             None => {
                 let k = if frame < self.keys[0].0 { 0 } else { n - 1 };
-                (self.keys[k].1, self.keys[k].2)
+                (self.keys[k].1, self.keys[k].2, up_at(k))
             }
             Some(i) => {
                 let (f1, f2) = (self.keys[i].0, self.keys[i + 1].0);
@@ -138,16 +145,19 @@ impl CameraPath {
                     k(i as isize + 1),
                     k(i as isize + 2),
                 );
+                let j = |d: isize| (i as isize + d).clamp(0, n as isize - 1) as usize;
+                let up = catmull_rom(up_at(j(-1)), up_at(j(0)), up_at(j(1)), up_at(j(2)), t);
                 (
                     catmull_rom(a.1, b.1, c.1, d.1, t),
                     catmull_rom(a.2, b.2, c.2, d.2, t),
+                    up.try_normalize().unwrap_or(up_at(j(0))),
                 )
             }
         };
         Camera {
             eye,
             target,
-            up: Vec3::Y,
+            up,
             fov_y: self.fov_y,
             near: self.near,
             far: self.far,

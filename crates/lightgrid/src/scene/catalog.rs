@@ -294,6 +294,7 @@ impl Builder {
                 camera_path,
                 default_size,
                 lighting: Default::default(),
+                derived_ranges: Vec::new(),
             },
             rng: Rng::new(seed),
         }
@@ -418,6 +419,7 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
             (200, Vec3::new(-5.0, 9.0, 55.0), Vec3::new(-80.0, 4.0, 75.0)),
             (259, Vec3::new(30.0, 45.0, 130.0), Vec3::new(0.0, 0.0, 0.0)),
         ],
+        ups: Vec::new(),
         fov_y: 60f32.to_radians(),
         near: 0.5,
         far: 800.0,
@@ -741,6 +743,7 @@ fn scattered(p: &SceneParams) -> Scene {
     }
     let camera = CameraPath {
         keys,
+        ups: Vec::new(),
         fov_y: 60f32.to_radians(),
         near: 0.5,
         far: 600.0,
@@ -856,6 +859,7 @@ fn random_top(p: &SceneParams) -> Scene {
             (0, Vec3::new(-20.0, 150.0, 10.0), Vec3::new(-20.0, 0.0, 0.0)),
             (119, Vec3::new(20.0, 150.0, 10.0), Vec3::new(20.0, 0.0, 0.0)),
         ],
+        ups: Vec::new(),
         fov_y: 60f32.to_radians(),
         near: 1.0,
         far: 400.0,
@@ -873,6 +877,7 @@ fn random_fps(p: &SceneParams) -> Scene {
                 Vec3::new(30.0, 2.0, 30.0),
             ),
         ],
+        ups: Vec::new(),
         fov_y: 60f32.to_radians(),
         near: 0.3,
         far: 400.0,
@@ -889,6 +894,7 @@ fn stress(p: &SceneParams) -> Scene {
             (0, Vec3::new(0.0, 110.0, 230.0), Vec3::new(0.0, 0.0, 20.0)),
             (119, Vec3::new(160.0, 90.0, 160.0), Vec3::new(0.0, 0.0, 0.0)),
         ],
+        ups: Vec::new(),
         fov_y: 60f32.to_radians(),
         near: 1.0,
         far: 1000.0,

@@ -262,29 +262,10 @@ const EXPOSURE_PROBES: usize = 256;
 /// light `i` had its own range in the file.
 pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
     let lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
-    let probes = surface_probes(
-        scene,
-        (EXPOSURE_PROBES)
-            .min((1 << 24) / lights.len().max(1))
-            .max(16),
-    );
+    let probes = surface_probes(scene, probe_count(lights.len()));
     let lit: Vec<f64> = probes
         .iter()
-        .map(|&(p, n)| {
-            lights
-                .iter()
-                .filter(|l| l.reaches(p))
-                .map(|l| {
-                    let to = l.position - p;
-                    let d2 = to.length_squared();
-                    let window =
-                        LightUnits::Photometric.window(f64::from(d2 / (l.range * l.range)));
-                    let cos = f64::from(n.dot(to / d2.sqrt().max(1e-6)).abs());
-                    f64::from(l.intensity) * f64::from(luminance(l.color)) * window * cos
-                        / f64::from(d2.max(crate::consts::MIN_LIGHT_DISTANCE_SQ))
-                })
-                .sum::<f64>()
-        })
+        .map(|&(p, n)| illuminance(&lights, p, n))
         .collect();
     median_exposure(lit).unwrap_or_else(|| {
         let with: Vec<(Light, bool)> = lights
@@ -294,6 +275,103 @@ pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
             .collect();
         light_exposure(&with)
     })
+}
+
+/// Probe points read for `lights` lights: fewer with many, so a million-light file costs
+/// about 2^24 light evaluations.
+fn probe_count(lights: usize) -> usize {
+    EXPOSURE_PROBES.min((1 << 24) / lights.max(1)).max(16)
+}
+
+/// The illuminance photometric `lights` give a surface at `p` facing `n` (luminance-weighted:
+/// `I / d²`, the range window, `|n·l|`, a spot's cone; no occlusion).
+fn illuminance(lights: &[Light], p: Vec3, n: Vec3) -> f64 {
+    lights
+        .iter()
+        .filter(|l| l.reaches(p))
+        .map(|l| {
+            let to = l.position - p;
+            let d2 = to.length_squared();
+            let window = LightUnits::Photometric.window(f64::from(d2 / (l.range * l.range)));
+            let cos = f64::from(n.dot(to / d2.sqrt().max(1e-6)).abs());
+            f64::from(l.intensity) * f64::from(luminance(l.color)) * window * cos
+                / f64::from(d2.max(crate::consts::MIN_LIGHT_DISTANCE_SQ))
+        })
+        .sum()
+}
+
+/// Half the darkest step of an 8-bit sRGB display, as linear radiance (the sRGB curve's
+/// linear segment, 1/12.92; the tone curve `1 − e^−x` has slope 1 at black): a light
+/// without a range is cut where it shows less than this on a white surface facing it.
+pub const VISIBLE_RADIANCE: f64 = 0.5 / 255.0 / 12.92;
+
+/// The ranges [`derive_ranges`] gave.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DerivedRanges {
+    /// (light index, range) for each light the file gave no range.
+    pub ranges: Vec<(usize, f32)>,
+    /// How many of them the scene's bounds capped.
+    pub capped: usize,
+    /// Whether any light shows at least [`VISIBLE_RADIANCE`] on a probed surface.
+    pub visible: bool,
+}
+
+/// Ranges for the photometric lights a file gave none (`ranged[i]` false; KHR_lights_punctual
+/// reads a missing range as infinite): the distance where the light shows
+/// [`VISIBLE_RADIANCE`] on a white Lambert surface facing it at the scene's exposure,
+/// `√(exposure · I · max(colour) / (π · VISIBLE_RADIANCE))`, so it scales with the scene's
+/// units and its exposure; capped at the farthest corner of the scene's bounds from the
+/// light (past that it lights nothing). With `auto` (the automatic exposure) the exposure is
+/// read with every such light reaching the whole scene, the ranges derived from it, and the
+/// exposure read again with them.
+pub fn derive_ranges(scene: &mut Scene, ranged: &[bool], auto: bool) -> DerivedRanges {
+    let limits = &super::LIGHT_LIMITS;
+    let clamp = |r: f64| (r as f32).clamp(limits.min_range, limits.max_range);
+    let bounds = super::source::bounds(scene);
+    let unranged: Vec<usize> = (0..scene.lights.len())
+        .filter(|&i| !ranged.get(i).copied().unwrap_or(true))
+        .collect();
+    let cap = |p: Vec3| -> f32 {
+        let Some((lo, hi)) = bounds else {
+            return limits.max_range;
+        };
+        let far = Vec3::new(
+            (p.x - lo.x).abs().max((p.x - hi.x).abs()),
+            (p.y - lo.y).abs().max((p.y - hi.y).abs()),
+            (p.z - lo.z).abs().max((p.z - hi.z).abs()),
+        );
+        clamp(f64::from(far.length()) * 1.01)
+    };
+    let caps: Vec<f32> = (unranged.iter())
+        .map(|&i| cap(scene.lights[i].light.position))
+        .collect();
+    for (&i, &c) in unranged.iter().zip(&caps) {
+        scene.lights[i].light.range = c;
+    }
+    if auto {
+        scene.lighting.exposure = auto_exposure(scene, ranged);
+    }
+    let exposure = f64::from(scene.lighting.exposure);
+    let mut derived = DerivedRanges::default();
+    for (&i, &c) in unranged.iter().zip(&caps) {
+        let l = &mut scene.lights[i].light;
+        let peak = f64::from(l.intensity) * f64::from(l.color.max_element());
+        let r = (exposure * peak / (std::f64::consts::PI * VISIBLE_RADIANCE)).sqrt();
+        let range = clamp(r).min(c);
+        derived.capped += usize::from(range == c);
+        l.range = range;
+        derived.ranges.push((i, range));
+    }
+    if auto && !unranged.is_empty() {
+        scene.lighting.exposure = auto_exposure(scene, ranged);
+    }
+    let lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
+    let exposure = f64::from(scene.lighting.exposure);
+    let probes = surface_probes(scene, probe_count(lights.len()));
+    derived.visible = probes.iter().any(|&(p, n)| {
+        exposure * illuminance(&lights, p, n) / std::f64::consts::PI >= VISIBLE_RADIANCE
+    });
+    derived
 }
 
 /// The exposure that shows the median of the positive finite illuminances `e` as 1, or None

@@ -16,8 +16,8 @@ mod view;
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use lighting::{
-    auto_exposure, light_exposure, Brdf, LightUnits, Lighting, Shading, Shadows,
-    AUTO_EXPOSURE_DISTANCE,
+    auto_exposure, derive_ranges, light_exposure, Brdf, DerivedRanges, LightUnits, Lighting,
+    Shading, Shadows, AUTO_EXPOSURE_DISTANCE, VISIBLE_RADIANCE,
 };
 pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};
@@ -47,6 +47,9 @@ pub struct Material {
     /// ambient colours and the alpha (glTF's `baseColorTexture`), sampled at the vertices'
     /// UVs.
     pub texture: Option<u32>,
+    /// Index into [`Scene::textures`] of a texture multiplying the emissive colour (glTF's
+    /// `emissiveTexture`), sampled as the base colour's is.
+    pub emissive_texture: Option<u32>,
     /// Alpha test (glTF's `MASK`): fragments whose alpha (`alpha` × the texture's) is below
     /// this are discarded in every pass, depth passes included.
     pub alpha_cutoff: Option<f32>,
@@ -103,6 +106,7 @@ impl Material {
             transparent: false,
             shader: MaterialShader::Standard,
             texture: None,
+            emissive_texture: None,
             alpha_cutoff: None,
         }
     }
@@ -137,7 +141,7 @@ impl Material {
             shader,
             texture: self.texture.map_or(0, |t| t + 1),
             alpha_cutoff: self.alpha_cutoff.unwrap_or(0.0),
-            _pad0: 0,
+            emissive_texture: self.emissive_texture.map_or(0, |t| t + 1),
             _pad1: 0,
         }
     }
@@ -500,6 +504,9 @@ pub struct Scene {
     pub default_size: (u32, u32),
     /// Its lights' units, its materials' BRDF and its exposure (the catalog's: the papers').
     pub lighting: Lighting,
+    /// The lights (by index) a file gave no range, with the range lightgrid derived
+    /// (`lighting::derive_ranges`); empty for the catalog.
+    pub derived_ranges: Vec<(usize, f32)>,
 }
 
 /// The frame's geometry in world space: opaque triangles first (grouped by material shader),
@@ -891,7 +898,10 @@ impl Scene {
             ));
         }
         for (i, m) in self.materials.iter().enumerate() {
-            let bad_texture = m.texture.is_some_and(|t| t as usize >= self.textures.len());
+            let bad_texture = [m.texture, m.emissive_texture]
+                .iter()
+                .flatten()
+                .any(|&t| t as usize >= self.textures.len());
             if bad_texture {
                 return Err(Error::invalid(
                     "scene",

@@ -25,7 +25,7 @@ struct Material {
     shader: u32,
     texture: u32,          // layer + 1 in `base_textures`; 0: none
     alpha_cutoff: f32,     // alpha test (glTF MASK); 0: none
-    _pad0: u32,
+    emissive_texture: u32, // layer + 1 in `base_textures`; 0: none
     _pad1: u32,
 }
 

@@ -121,6 +121,9 @@ fn material_json(m: &Material) -> Value {
     if let Some(t) = m.texture {
         v["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": t});
     }
+    if let Some(t) = m.emissive_texture {
+        v["emissiveTexture"] = json!({"index": t});
+    }
     v
 }
 

@@ -6,7 +6,7 @@
 
 use super::json::{LightDef, MaterialDef, Node, Primitive};
 use super::read::{Document, Res};
-use super::{LoadOptions, EXTENSIONS_READ, LIGHT_CUTOFF, MAX_TRIANGLES, MAX_VERTICES};
+use super::{LoadOptions, EXTENSIONS_READ, MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::{
     bounds_of, CameraPath, Light, LightAnchor, Lighting, Material, MaterialShader, Mesh, Motion,
     Object, Scene, SceneLight, Spot, Texture,
@@ -132,6 +132,7 @@ impl ExactMaterial {
             transparent: self.transparent,
             shader,
             texture: None,
+            emissive_texture: None,
             alpha_cutoff: self.alpha_cutoff.filter(|c| c.is_finite()),
         };
         material_is_sane(&m).then_some(m)
@@ -148,11 +149,16 @@ fn material_is_sane(m: &Material) -> bool {
         && (0.0..=1.0).contains(&m.alpha)
 }
 
+/// The largest emissive colour read (`emissiveFactor` × KHR_materials_emissive_strength), as a
+/// light's radiance is bounded: sums over a pixel stay finite in f32.
+const MAX_EMISSIVE: f32 = 1e12;
+
 /// glTF's metallic-roughness material (§3.9.2) to Blinn-Phong, by one documented rule:
 /// diffuse = base × (1 − metallic); specular = mix(0.04, base, metallic) (the dielectric F0
 /// of the specification's BRDF, metals tinted); shininess = 2/α² − 2 with α = roughness²
 /// (the Blinn-Phong exponent whose lobe matches GGX of that α), from 1 to 2048; ambient =
-/// base; emissive = emissiveFactor. `BLEND` is drawn transparent with the base alpha.
+/// base; emissive = emissiveFactor × KHR_materials_emissive_strength, times the
+/// `emissiveTexture` where there is one. `BLEND` is drawn transparent with the base alpha.
 fn map_material(
     def: &MaterialDef,
     index: usize,
@@ -164,6 +170,10 @@ fn map_material(
         Some(t) => Some(textures.load(t.index, index, walk)?),
         None => None,
     };
+    let emissive_texture = match &def.emissive_texture {
+        Some(t) => Some(textures.load(t.index, index, walk)?),
+        None => None,
+    };
     if let Some(exact) = def
         .extras
         .as_ref()
@@ -171,7 +181,13 @@ fn map_material(
         .map(ExactMaterial::deserialize)
     {
         match exact.ok().and_then(|e| e.to_material()) {
-            Some(m) => return Ok(Material { texture, ..m }),
+            Some(m) => {
+                return Ok(Material {
+                    texture,
+                    emissive_texture,
+                    ..m
+                })
+            }
             None => walk.warn(format!(
                 "material {index}: its extras.lightgrid is malformed; the glTF material is used"
             )),
@@ -180,7 +196,15 @@ fn map_material(
     let base = pbr.and_then(|p| p.base_color_factor).unwrap_or([1.0; 4]);
     let metallic = pbr.and_then(|p| p.metallic_factor).unwrap_or(1.0);
     let roughness = pbr.and_then(|p| p.roughness_factor).unwrap_or(1.0);
-    let emissive = def.emissive_factor.unwrap_or([0.0; 3]);
+    // KHR_materials_emissive_strength scales the factor past 1 (physical units).
+    let strength = (def.extensions.as_ref())
+        .and_then(|e| e.emissive_strength.as_ref())
+        .and_then(|s| s.emissive_strength)
+        .unwrap_or(1.0);
+    let emissive = def
+        .emissive_factor
+        .unwrap_or([0.0; 3])
+        .map(|c| c * strength);
     let numbers = base.iter().chain(&emissive).chain([&metallic, &roughness]);
     for v in numbers {
         if !v.is_finite() || *v < 0.0 {
@@ -188,6 +212,11 @@ fn map_material(
                 "material {index}: factors must be finite and non-negative (found {v})"
             ));
         }
+    }
+    if let Some(e) = emissive.iter().find(|&&e| e > MAX_EMISSIVE) {
+        return Err(format!(
+            "material {index}: emissive factor × strength {e} is above {MAX_EMISSIVE:e} (sums of light must stay finite)"
+        ));
     }
     let (metallic, roughness) = (metallic.min(1.0), roughness.min(1.0));
     let colour = Vec3::new(base[0], base[1], base[2]);
@@ -224,6 +253,7 @@ fn map_material(
         transparent,
         shader: MaterialShader::Standard,
         texture,
+        emissive_texture,
         alpha_cutoff: alpha_tested.then_some(cutoff),
     })
 }
@@ -736,23 +766,9 @@ fn map_light(
     let range = match def.range {
         Some(r) if r.is_finite() && r > 0.0 => r,
         Some(r) => return Err(format!("{what}: range {r} is not a positive number")),
-        // Inverse-square light reaches illuminance LIGHT_CUTOFF at sqrt(I / cutoff).
-        None => {
-            // In f64: colour × intensity may overflow f32 (1e30 × 1e10).
-            let peak = f64::from(candela) * f64::from(colour.max_element());
-            let r = (peak / f64::from(LIGHT_CUTOFF)).sqrt();
-            let lim = &crate::scene::LIGHT_LIMITS;
-            if !(f64::from(lim.min_range)..=f64::from(lim.max_range)).contains(&r) {
-                return Err(format!(
-                    "{what}: colour {} × intensity {} cd = {peak:e} gives no range lightgrid takes (it has no range, and would reach {r:e}; ranges are {:e} to {:e})",
-                    crate::scene::show3(colour),
-                    crate::scene::show(candela),
-                    lim.min_range,
-                    lim.max_range
-                ));
-            }
-            r as f32
-        }
+        // Infinite (KHR_lights_punctual): derived once the scene and its exposure are known
+        // (`lighting::derive_ranges`); until then it reaches everything.
+        None => crate::scene::LIGHT_LIMITS.max_range,
     };
     // A file lightgrid exported carries the exact numbers (the glTF ones are rounded through
     // the candela and angle conversions).
@@ -828,6 +844,8 @@ fn map_light(
 struct Start {
     eye: Vec3,
     target: Vec3,
+    /// The camera's up (+y of its node; its roll).
+    up: Vec3,
     fov: f32,
     near: f32,
     far: f32,
@@ -882,7 +900,6 @@ fn placed_start(
     (n, world): (usize, Mat4),
     (centre, radius): (Vec3, f32),
     size: &mut (u32, u32),
-    walk: &mut Walk,
 ) -> Res<Start> {
     let p = doc.root.cameras[n]
         .perspective
@@ -904,17 +921,18 @@ fn placed_start(
             size.1 = ((DEFAULT_WIDTH as f32 / a).round() as u32).max(1);
         }
     }
+    // The camera's full orientation (§3.10.1: it looks down its node's −z with +y up), roll
+    // included; made orthogonal, as a node may scale its axes unevenly.
     let eye = world.transform_point3(Vec3::ZERO);
-    let mut forward = world
+    let no_direction = || format!("camera {n}: its node's transform has no direction");
+    let forward = world
         .transform_vector3(Vec3::NEG_Z)
         .try_normalize()
-        .ok_or_else(|| format!("camera {n}: its node's transform has no direction"))?;
-    if forward.y.abs() > 0.9999 {
-        walk.warn(format!(
-            "camera {n} looks straight up or down; it is tilted slightly (the camera's up is +y)"
-        ));
-        forward = (forward + Vec3::Z * 1e-2).normalize();
-    }
+        .ok_or_else(no_direction)?;
+    let up = world.transform_vector3(Vec3::Y);
+    let up = (up - forward * up.dot(forward))
+        .try_normalize()
+        .ok_or_else(no_direction)?;
     // Without zfar, far enough for the whole scene from anywhere on the orbit.
     let far = p
         .zfar
@@ -922,6 +940,7 @@ fn placed_start(
     Ok(Start {
         eye,
         target: eye + forward * radius.max(1.0),
+        up,
         fov: p.yfov,
         near: p.znear,
         far,
@@ -938,6 +957,7 @@ fn fitted_start(centre: Vec3, radius: f32) -> Start {
     Start {
         eye: centre + dir * dist,
         target: centre,
+        up: Vec3::Y,
         fov,
         near: far / 1000.0,
         far,
@@ -958,8 +978,14 @@ fn orbit(start: &Start, centre: Vec3) -> CameraPath {
             )
         })
         .collect();
+    let ups = (0..=ORBIT_KEYS)
+        .map(|k| {
+            Quat::from_rotation_y(k as f32 / ORBIT_KEYS as f32 * std::f32::consts::TAU) * start.up
+        })
+        .collect();
     CameraPath {
         keys,
+        ups,
         fov_y: start.fov,
         near: start.near,
         far: start.far,
@@ -986,7 +1012,7 @@ fn camera_path(
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let mut size = (DEFAULT_WIDTH, DEFAULT_WIDTH * 9 / 16);
     let start = match chosen_camera(doc, opts, walk)? {
-        Some(placed) => placed_start(doc, placed, (centre, radius), &mut size, walk)?,
+        Some(placed) => placed_start(doc, placed, (centre, radius), &mut size)?,
         None => fitted_start(centre, radius),
     };
     Ok((orbit(&start, centre), size))
@@ -1007,6 +1033,9 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         if !EXTENSIONS_READ.contains(&ext.as_str()) {
             walk.warn(format!("extension {ext} is not read; ignored"));
         }
+    }
+    for w in super::unread::warnings(&doc.root) {
+        walk.warn(w);
     }
     if doc.root.materials.len() >= crate::consts::MAX_MATERIALS {
         return Err(format!(
@@ -1101,10 +1130,31 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         camera_path,
         default_size,
         lighting: exported.unwrap_or_else(Lighting::photometric),
+        derived_ranges: Vec::new(),
     };
-    if exported.is_none() {
-        scene.lighting.exposure = crate::scene::auto_exposure(&scene, &ranged);
+    let derived = crate::scene::derive_ranges(&mut scene, &ranged, exported.is_none());
+    if let (Some(lo), Some(hi)) = (
+        derived.ranges.iter().map(|r| r.1).reduce(f32::min),
+        derived.ranges.iter().map(|r| r.1).reduce(f32::max),
+    ) {
+        let between = match lo == hi {
+            true => crate::scene::show(lo),
+            false => format!("{} to {}", crate::scene::show(lo), crate::scene::show(hi)),
+        };
+        walk.warn(format!(
+            "{} light(s) have no range (infinite in KHR_lights_punctual): each ends where it shows half a display level on a white surface at exposure {}, at {between} ({} capped by the scene's bounds; --stats lists each)",
+            derived.ranges.len(),
+            crate::scene::show(scene.lighting.exposure),
+            derived.capped
+        ));
     }
+    if !derived.visible && !scene.lights.is_empty() {
+        walk.warn(format!(
+            "no light shows half a display level on any surface at exposure {}: the image holds ambient and emissive light only",
+            crate::scene::show(scene.lighting.exposure)
+        ));
+    }
+    scene.derived_ranges = derived.ranges;
     Ok((scene, walk.finish_warnings()))
 }
 

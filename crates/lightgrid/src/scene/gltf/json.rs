@@ -24,6 +24,9 @@ pub(super) struct Root {
     pub images: Vec<ImageDef>,
     pub samplers: Vec<SamplerDef>,
     pub cameras: Vec<CameraDef>,
+    /// Read only to say they are not applied (`unread.rs`).
+    pub skins: Vec<serde_json::Value>,
+    pub animations: Vec<serde_json::Value>,
     pub extensions: Option<RootExtensions>,
     /// `extras.lightgrid.lighting`: a scene lightgrid exported keeps its lighting
     /// conventions (`scene::Lighting`).
@@ -53,6 +56,9 @@ pub(super) struct Node {
     pub mesh: Option<usize>,
     pub camera: Option<usize>,
     pub extensions: Option<NodeExtensions>,
+    pub skin: Option<usize>,
+    /// Morph target weights of the node's mesh (read to say they are not applied).
+    pub weights: Option<Vec<f32>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -71,6 +77,8 @@ pub(super) struct NodeLight {
 #[serde(default)]
 pub(super) struct MeshDef {
     pub primitives: Vec<Primitive>,
+    /// Default morph target weights (read to say they are not applied).
+    pub weights: Option<Vec<f32>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -82,6 +90,8 @@ pub(super) struct Primitive {
     /// 0 points, 1 lines, 2 line loop, 3 line strip, 4 triangles (the default), 5 triangle
     /// strip, 6 triangle fan.
     pub mode: Option<u32>,
+    /// Morph targets (read to say they are not applied).
+    pub targets: Vec<serde_json::Value>,
 }
 
 #[derive(Deserialize, Default)]
@@ -141,6 +151,11 @@ pub(super) struct BufferDef {
 pub(super) struct MaterialDef {
     pub pbr_metallic_roughness: Option<Pbr>,
     pub emissive_factor: Option<[f32; 3]>,
+    pub emissive_texture: Option<TextureRef>,
+    /// Read only to say they are not applied (`unread.rs`).
+    pub normal_texture: Option<TextureRef>,
+    pub occlusion_texture: Option<TextureRef>,
+    pub extensions: Option<MaterialExtensions>,
     pub alpha_mode: Option<String>,
     pub alpha_cutoff: Option<f32>,
     pub extras: Option<serde_json::Value>,
@@ -153,6 +168,21 @@ pub(super) struct Pbr {
     pub base_color_texture: Option<TextureRef>,
     pub metallic_factor: Option<f32>,
     pub roughness_factor: Option<f32>,
+    /// Read only to say it is not applied (`unread.rs`).
+    pub metallic_roughness_texture: Option<TextureRef>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct MaterialExtensions {
+    #[serde(rename = "KHR_materials_emissive_strength")]
+    pub emissive_strength: Option<EmissiveStrength>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct EmissiveStrength {
+    pub emissive_strength: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -175,6 +205,9 @@ pub(super) struct SamplerDef {
     /// 10497 repeat (the default), 33071 clamp, 33648 mirrored repeat.
     pub wrap_s: Option<u32>,
     pub wrap_t: Option<u32>,
+    /// 9728 NEAREST, 9729 LINEAR; the minification filter's NEAREST_MIPMAP_* too.
+    pub mag_filter: Option<u32>,
+    pub min_filter: Option<u32>,
 }
 
 #[derive(Deserialize, Default)]

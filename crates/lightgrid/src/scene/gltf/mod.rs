@@ -6,15 +6,19 @@
 //! recursion and refused if it is not a forest, and any problem is an [`Error::Gltf`] naming
 //! the file and the problem. What the renderer cannot show (points and lines, directional
 //! lights, orthographic cameras, extensions it does not know) is skipped with a warning,
-//! unless the file marks the extension required. Of a material's textures only the base
-//! colour's (`baseColorTexture`, PNG or JPEG) is loaded; the others are not read.
+//! unless the file marks the extension required. Of a material's textures the base colour's
+//! and the emissive one's (PNG or JPEG) are loaded; every other part not applied (normal,
+//! occlusion and metallic-roughness textures, vertex colours, morph targets, skins,
+//! animations, NEAREST filtering) is one warning saying what is drawn instead (`unread.rs`),
+//! and a glTF 1.0 file is refused as one.
 //!
 //! Mapping rules (documented in README "glTF scenes"): metallic-roughness materials by
 //! `import::map_material`'s rule, shaded with GGX unless `--brdf` says otherwise;
 //! KHR_lights_punctual point and spot lights keep their range and their intensity in candela
 //! with the inverse-square falloff (`scene::Lighting::photometric`, with the automatic
-//! exposure), and a light without a range gets the distance where its illuminance falls to
-//! [`LIGHT_CUTOFF`]. Files written by [`export`] carry lightgrid's exact material and light
+//! exposure), and a light without a range gets the distance where it shows half a display
+//! level on a white surface at that exposure, capped by the scene's bounds
+//! (`scene::derive_ranges`). Files written by [`export`] carry lightgrid's exact material and light
 //! intensity in `extras.lightgrid` and the scene's lighting conventions at the root, so they
 //! load back unchanged; a catalog scene's papers-unit lights are written in candela matched
 //! at [`LIGHT_MATCH_FRACTION`] of the range.
@@ -23,6 +27,7 @@ mod export;
 mod import;
 mod json;
 mod read;
+mod unread;
 
 pub use export::export;
 pub use import::ORBIT_FRAMES;
@@ -39,14 +44,10 @@ pub const MAX_JSON_BYTES: u64 = 64 << 20;
 pub const MAX_VERTICES: u32 = 1 << 22;
 /// Most triangles read and baked.
 pub const MAX_TRIANGLES: u32 = 1 << 23;
-/// Illuminance (lux) at which a light without a range is cut off: range = √(I / cutoff). With
-/// the automatic exposure it is far below one display level (a 100 cd light read at 2 m:
-/// 0.02 lux shows 2.5e-4, a tenth of the darkest sRGB step).
-pub const LIGHT_CUTOFF: f32 = 0.02;
 /// Where along its range an exported papers-unit light and its inverse-square candela agree.
 pub const LIGHT_MATCH_FRACTION: f32 = 0.25;
 /// Extensions read (a file may require these).
-pub const EXTENSIONS_READ: &[&str] = &["KHR_lights_punctual"];
+pub const EXTENSIONS_READ: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
 
 /// Choices for loading a file.
 #[derive(Clone, Copy, Debug, Default)]

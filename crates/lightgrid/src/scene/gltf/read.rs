@@ -98,6 +98,15 @@ pub(super) fn read_limited(path: &Path) -> Res<Vec<u8>> {
     std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// `asset.version` of a JSON document, read leniently (whatever else the file holds).
+fn version_of(json: &[u8]) -> Option<String> {
+    let v: serde_json::Value = serde_json::from_slice(json).ok()?;
+    match v.get("asset")?.get("version")? {
+        serde_json::Value::String(s) => Some(s.clone()),
+        other => Some(other.to_string()),
+    }
+}
+
 /// The JSON part of a `.gltf` or `.glb` file, read without its binary chunk (at most
 /// [`MAX_JSON_BYTES`]).
 fn read_json_part(path: &Path) -> Res<Vec<u8>> {
@@ -225,8 +234,16 @@ impl Document {
             ));
         }
         let json = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json);
-        let root: Root =
-            serde_json::from_slice(json).map_err(|e| format!("malformed JSON: {e}"))?;
+        let root: Root = serde_json::from_slice(json).map_err(|e| {
+            // glTF 1.0 has maps where 2.0 has arrays, so its files fail the typed parse:
+            // say which version the file is rather than where the shapes differ.
+            match version_of(json) {
+                Some(v) if !v.starts_with('2') => {
+                    format!("a glTF {v} file (asset.version '{v}'); only glTF 2.0 is read (convert it to 2.0 first, e.g. with the Khronos glTF converters)")
+                }
+                _ => format!("malformed JSON: {e}"),
+            }
+        })?;
         let version = root.asset.as_ref().map(|a| a.version.as_str());
         match version {
             Some(v) if v == "2.0" || v.starts_with("2.") => {}

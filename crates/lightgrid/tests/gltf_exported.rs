@@ -1,0 +1,312 @@
+//! glTF as artists export it (README "glTF scenes"): what lightgrid does not apply is one
+//! warning naming it, a glTF 1.0 file is refused as one, the emissive texture lights what it
+//! says (in every pipeline), the camera keeps its full orientation (roll, straight down), and
+//! a light without a range is cut where the display stops showing it, so a scene in
+//! centimetres renders as the same scene in metres.
+
+mod common;
+
+use common::gltf_fixture::{cube, GltfWriter};
+use glam::{Mat4, Quat, Vec3};
+use lightgrid::scene::gltf::{self, LoadOptions};
+use lightgrid::scene::Scene;
+use lightgrid::{RenderSettings, Renderer};
+use serde_json::json;
+
+fn load(bytes: &[u8]) -> lightgrid::Result<gltf::Loaded> {
+    gltf::load_bytes(bytes, "fixture.gltf", None, &LoadOptions::default())
+}
+
+/// A ground of `half` metres each way at y = 0 (scaled by `unit`), a box on it, a light
+/// `light` above and a camera looking at the box from `camera` (its node rotation `q`).
+fn stage(unit: f32, light: serde_json::Value, camera: Quat, at: Vec3) -> GltfWriter {
+    let mut w = GltfWriter::default();
+    let grey = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8}}));
+    let red = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.2, 0.1, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5}}));
+    let h = 6.0 * unit;
+    let ground = w.mesh(
+        &[-h, 0.0, -h, h, 0.0, -h, h, 0.0, h, -h, 0.0, h],
+        Some(&[0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0]),
+        Some(&[0, 2, 1, 0, 3, 2]),
+        Some(grey),
+        4,
+    );
+    let (cp, cn, ci) = cube();
+    let cp: Vec<f32> = cp.iter().map(|c| c * unit).collect();
+    let boxed = w.mesh(&cp, Some(&cn), Some(&ci), Some(red), 4);
+    let g = w.node(json!({"mesh": ground}));
+    let b = w.node(json!({"mesh": boxed, "translation": [0.0, 0.5 * unit, 0.0]}));
+    let l = w.light(light);
+    let ln = w.node(json!({"translation": [1.0 * unit, 2.5 * unit, 1.5 * unit],
+        "extensions": {"KHR_lights_punctual": {"light": l}}}));
+    w.cameras
+        .push(json!({"type": "perspective", "perspective": {
+        "yfov": 0.9, "znear": 0.05 * unit, "zfar": 100.0 * unit}}));
+    let c = w.node(json!({"camera": 0, "rotation": camera.to_array(),
+        "translation": (at * unit).to_array()}));
+    w.roots = vec![g, b, ln, c];
+    w
+}
+
+/// The camera of [`stage`]: from (0, 3, 6) looking down at the box, rolled `roll` degrees
+/// about its view axis.
+fn looking(roll: f32) -> Quat {
+    Quat::from_rotation_x(-26f32.to_radians()) * Quat::from_rotation_z(roll.to_radians())
+}
+
+const EYE: Vec3 = Vec3::new(0.0, 3.0, 6.0);
+
+fn point(range: Option<f32>, candela: f32) -> serde_json::Value {
+    let mut l = json!({"type": "point", "color": [1.0, 0.9, 0.8], "intensity": candela});
+    if let Some(r) = range {
+        l["range"] = json!(r);
+    }
+    l
+}
+
+fn render(scene: &Scene, pipeline: &str, (w, h): (u32, u32)) -> image::RgbaImage {
+    let ctx = common::gpu();
+    let mut r = Renderer::new(&ctx, w, h, RenderSettings::default()).unwrap();
+    r.render(scene, 0, pipeline).unwrap().image
+}
+
+#[test]
+fn a_gltf_1_file_is_refused_as_one() {
+    // glTF 1.0 keeps its objects in maps by name, where 2.0 has arrays.
+    for version in [json!("1.0"), json!("1.0.2"), json!(1)] {
+        let doc = json!({
+            "asset": {"version": version},
+            "accessors": {"accessor_21": {"bufferView": "bv", "count": 36, "type": "SCALAR"}},
+            "meshes": {"box": {"primitives": []}},
+            "scene": "defaultScene",
+        });
+        let e = load(&serde_json::to_vec(&doc).unwrap())
+            .unwrap_err()
+            .to_string();
+        let v = match &version {
+            serde_json::Value::String(s) => s.clone(),
+            other => other.to_string(),
+        };
+        assert!(
+            e.contains(&format!("a glTF {v} file")) && e.contains("only glTF 2.0 is read"),
+            "{e}"
+        );
+    }
+    // A malformed 2.0 file still says where.
+    let e = load(br#"{"asset": {"version": "2.0"}, "meshes": {"a": 1}}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("malformed JSON"), "{e}");
+}
+
+#[test]
+fn every_part_not_applied_is_named_in_one_warning() {
+    let mut w = stage(1.0, point(Some(8.0), 20.0), looking(0.0), EYE);
+    let tex = w.png(&image::RgbaImage::from_pixel(
+        4,
+        4,
+        image::Rgba([128, 128, 255, 255]),
+    ));
+    w.materials[0]["normalTexture"] = json!({"index": tex});
+    w.materials[0]["occlusionTexture"] = json!({"index": tex, "strength": 0.5});
+    w.materials[1]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = json!({"index": tex});
+    let colours = w.floats(&[1.0; 96], "VEC4");
+    w.meshes[1]["primitives"][0]["attributes"]["COLOR_0"] = json!(colours);
+    let mut doc = w.document(json!({"byteLength": w.bin.len()}));
+    doc["animations"] = json!([{"channels": [], "samplers": []}]);
+    doc["skins"] = json!([{"joints": [0]}]);
+    let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
+    let warned = |needle: &str| {
+        let n = loaded
+            .warnings
+            .iter()
+            .filter(|w| w.contains(needle))
+            .count();
+        assert_eq!(n, 1, "{needle}: {:#?}", loaded.warnings);
+    };
+    warned("material 0 has a normalTexture");
+    warned("material 0 has an occlusionTexture");
+    warned("material 1 has a metallicRoughnessTexture");
+    warned("mesh 1 has vertex colours (COLOR_0)");
+    warned("1 animation(s) are not played");
+    warned("1 skin(s) are not applied");
+    // The same stage without them warns of nothing.
+    let plain = stage(1.0, point(Some(8.0), 20.0), looking(0.0), EYE);
+    assert!(load(&plain.glb()).unwrap().warnings.is_empty());
+}
+
+/// An emissive texture black but for a disc in its middle, on a material whose emissive
+/// factor is white (the usual export): only the disc glows, in every pipeline.
+#[test]
+fn an_emissive_texture_glows_only_where_it_is_lit() {
+    let size = (160, 120);
+    // Strength 20: what glows is white on the display (1 − e^−20).
+    let scene_with = |texture: bool, strength: Option<f32>| {
+        let mut w = stage(1.0, point(Some(8.0), 2.0), looking(0.0), EYE);
+        let disc = image::RgbaImage::from_fn(64, 64, |x, y| {
+            let d = (x as f32 - 31.5).hypot(y as f32 - 31.5);
+            image::Rgba(if d < 10.0 {
+                [255, 255, 255, 255]
+            } else {
+                [0, 0, 0, 255]
+            })
+        });
+        let t = w.png(&disc);
+        w.materials[0]["emissiveFactor"] = json!([1.0, 1.0, 1.0]);
+        if texture {
+            w.materials[0]["emissiveTexture"] = json!({"index": t});
+        }
+        if let Some(s) = strength {
+            w.materials[0]["extensions"] =
+                json!({"KHR_materials_emissive_strength": {"emissiveStrength": s}});
+        }
+        // The ground's UVs: the texture once over it.
+        let uv = w.floats(&[0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], "VEC2");
+        w.meshes[0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+        let loaded = load(&w.glb()).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        loaded.scene
+    };
+    let textured = scene_with(true, Some(20.0));
+    let m = &textured.materials[0];
+    assert!(m.emissive_texture.is_some() && m.emissive == Vec3::splat(20.0));
+    let glow = render(&textured, "forward", size);
+    let flat = render(&scene_with(false, Some(20.0)), "forward", size);
+    let white =
+        |img: &image::RgbaImage| img.pixels().filter(|p| p.0[..3] == [255, 255, 255]).count();
+    // Without the texture the whole ground glows white; with it, only the disc.
+    let (all, disc) = (white(&flat), white(&glow));
+    assert!(
+        all > 3 * disc && disc > 100,
+        "white pixels: {all} flat, {disc} textured"
+    );
+    if std::env::var_os("LIGHTGRID_KEEP_IMAGES").is_some() {
+        glow.save(common::output_dir().join("emissive-disc.png"))
+            .unwrap();
+    }
+    // The disc is the texture's middle: the ground's centre, under the box; the ground's
+    // corners, black in the texture, show the lit grey, not white.
+    let corner = glow.get_pixel(2, size.1 - 3).0;
+    assert!(corner[..3].iter().all(|&c| c < 250), "{corner:?}");
+    // Every pipeline reads the emissive texture as forward does.
+    for info in lightgrid::pipelines::PIPELINES {
+        if info.id == "forward" {
+            continue;
+        }
+        let other = render(&textured, info.id, size);
+        let over = common::pixels_over(&glow, &other, 8);
+        assert!(
+            over <= u64::from(size.0 * size.1) / 100,
+            "{}: {over} pixels over 8 levels from forward",
+            info.id
+        );
+    }
+    // Without KHR_materials_emissive_strength the factor alone.
+    assert_eq!(scene_with(true, None).materials[0].emissive, Vec3::ONE);
+}
+
+/// The view matrix a file's camera node gives: the inverse of its world matrix.
+fn node_view(q: Quat, at: Vec3) -> Mat4 {
+    Mat4::from_rotation_translation(q, at).inverse()
+}
+
+#[test]
+fn the_camera_keeps_its_roll_and_may_look_straight_down() {
+    for (q, what) in [
+        (looking(30.0), "rolled 30°"),
+        (looking(-90.0), "rolled -90°"),
+        (Quat::from_rotation_x(-90f32.to_radians()), "straight down"),
+        (
+            Quat::from_rotation_y(40f32.to_radians()) * Quat::from_rotation_x(90f32.to_radians()),
+            "straight up, turned",
+        ),
+    ] {
+        let at = if what.starts_with("straight down") {
+            Vec3::new(0.0, 8.0, 0.0)
+        } else {
+            EYE
+        };
+        let loaded = load(&stage(1.0, point(Some(8.0), 20.0), q, at).glb()).unwrap();
+        assert!(loaded.warnings.is_empty(), "{what}: {:?}", loaded.warnings);
+        let cam = loaded.scene.camera_path.at(0);
+        let (got, want) = (cam.view(), node_view(q, at));
+        assert!(
+            got.abs_diff_eq(want, 1e-4),
+            "{what}: view\n{got}\nnot the node's\n{want}"
+        );
+    }
+    // Rolled half a turn, the image is the unrolled one turned half a turn: pixel (x, y)
+    // shows what (w-1-x, h-1-y) did.
+    let (w, h) = (96, 64);
+    let upright = load(&stage(1.0, point(Some(8.0), 20.0), looking(0.0), EYE).glb()).unwrap();
+    let turned = load(&stage(1.0, point(Some(8.0), 20.0), looking(180.0), EYE).glb()).unwrap();
+    let a = render(&upright.scene, "forward", (w, h));
+    let b = render(&turned.scene, "forward", (w, h));
+    let rotated = image::imageops::rotate180(&a);
+    let over = common::pixels_over(&rotated, &b, 2);
+    assert!(
+        over <= u64::from(w * h) / 200,
+        "{over} pixels differ from the upright image turned half a turn"
+    );
+    assert!(
+        common::pixels_over(&a, &b, 2) > 500,
+        "the roll changes the image"
+    );
+}
+
+/// Mean brightness of an image (0-255).
+fn mean(img: &image::RgbaImage) -> f64 {
+    img.pixels()
+        .map(|p| p.0[..3].iter().map(|&c| f64::from(c)).sum::<f64>() / 3.0)
+        .sum::<f64>()
+        / (img.width() * img.height()) as f64
+}
+
+#[test]
+fn a_light_without_a_range_lights_a_centimetre_scene_as_a_metre_one() {
+    let size = (128, 96);
+    let scene = |unit: f32, candela: f32| {
+        let loaded = load(&stage(unit, point(None, candela), looking(0.0), EYE).glb()).unwrap();
+        let ranged: Vec<&String> = (loaded.warnings.iter())
+            .filter(|w| w.contains("no range"))
+            .collect();
+        assert_eq!(ranged.len(), 1, "{:?}", loaded.warnings);
+        loaded.scene
+    };
+    // A Blender-style 54 cd light, in a scene in metres and the same scene in centimetres.
+    let metres = scene(1.0, 54.0);
+    let centimetres = scene(100.0, 54.0);
+    let (rm, rc) = (metres.derived_ranges[0].1, centimetres.derived_ranges[0].1);
+    assert!(
+        (rc / rm - 100.0).abs() < 0.5,
+        "the range scales with the scene's units: {rm} m, {rc} cm"
+    );
+    assert_eq!(metres.lights[0].light.range, rm);
+    let a = render(&metres, "forward", size);
+    let b = render(&centimetres, "forward", size);
+    let over = common::pixels_over(&a, &b, 2);
+    assert!(over <= 20, "{over} pixels differ by more than 2 levels");
+    // Lit: far brighter than ambient alone, and a dim light lights it as well (the
+    // exposure follows it).
+    let mut dark = metres.clone();
+    dark.lights.clear();
+    let ambient = render(&dark, "forward", size);
+    assert!(
+        mean(&a) > mean(&ambient) + 20.0,
+        "{} vs ambient {}",
+        mean(&a),
+        mean(&ambient)
+    );
+    let dim = render(&scene(1.0, 0.05), "forward", size);
+    assert!(
+        common::pixels_over(&a, &dim, 2) <= 20,
+        "a 0.05 cd light shows as a 54 cd one"
+    );
+    // So bright against the exposure that the scene's bounds cap it: it reaches the farthest
+    // corner of the ground, and no farther.
+    let corner = Vec3::new(-6.0, 0.0, -6.0).distance(Vec3::new(1.0, 2.5, 1.5));
+    assert!(
+        rm >= corner && rm <= corner * 1.02,
+        "range {rm}, corner {corner}"
+    );
+}
