@@ -84,8 +84,13 @@ fn the_fixture_room_loads_as_described() {
     let lights: Vec<Light> = s.lights.iter().map(|l| l.light).collect();
     assert_eq!(lights[0].position, Vec3::new(-4.0, 2.0, 3.0));
     assert_eq!(lights[0].range, 7.0);
-    let derived = (0.5f32 / gltf::LIGHT_CUTOFF).sqrt();
-    assert!((lights[2].range - derived).abs() < 1e-4);
+    // The rangeless one: cut where it stops showing at the scene's exposure, at most the
+    // farthest corner of the scene's bounds (gltf_exported.rs checks the rule itself).
+    assert_eq!(s.derived_ranges, vec![(2, lights[2].range)]);
+    let (lo, hi) = source::bounds(&s).unwrap();
+    let p = lights[2].position;
+    let corner = (p - lo).abs().max((p - hi).abs()).length();
+    assert!(lights[2].range > 1.0 && lights[2].range <= corner * 1.011, "{}", lights[2].range);
     let down = lights[4].spot.expect("a spot");
     assert!(
         down.direction.distance(Vec3::NEG_Y) < 1e-5,
@@ -105,8 +110,9 @@ fn the_fixture_room_loads_as_described() {
     assert_eq!(s.frame_count(), gltf::ORBIT_FRAMES);
     let half = s.camera_path.at(gltf::ORBIT_FRAMES / 2);
     assert!(half.eye.distance(cam.eye) > 5.0, "the camera orbits");
-    // The warnings say what was skipped, nothing else.
-    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // The warnings say what was skipped or derived, nothing else.
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(loaded.warnings[0].contains("1 light(s) have no range"));
 }
 
 #[test]
@@ -509,7 +515,7 @@ fn corpus() -> Vec<Case> {
                 l["color"] = json!([1e30, 1e30, 1e30]);
                 l["intensity"] = json!(1e10);
             },
-            "gives no range lightgrid takes",
+            "of 1e40 exceeds 1e12",
         ),
         (
             "light intensity past the radiance limit",
