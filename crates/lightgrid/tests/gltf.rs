@@ -87,10 +87,14 @@ fn the_fixture_room_loads_as_described() {
     // The rangeless one: cut where it stops showing at the scene's exposure, at most the
     // farthest corner of the scene's bounds (gltf_exported.rs checks the rule itself).
     assert_eq!(s.derived_ranges, vec![(2, lights[2].range)]);
-    let (lo, hi) = source::bounds(&s).unwrap();
+    let (lo, hi) = source::bounds(s).unwrap();
     let p = lights[2].position;
     let corner = (p - lo).abs().max((p - hi).abs()).length();
-    assert!(lights[2].range > 1.0 && lights[2].range <= corner * 1.011, "{}", lights[2].range);
+    assert!(
+        lights[2].range > 1.0 && lights[2].range <= corner * 1.011,
+        "{}",
+        lights[2].range
+    );
     let down = lights[4].spot.expect("a spot");
     assert!(
         down.direction.distance(Vec3::NEG_Y) < 1e-5,

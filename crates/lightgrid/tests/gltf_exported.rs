@@ -113,7 +113,6 @@ fn every_part_not_applied_is_named_in_one_warning() {
     let colours = w.floats(&[1.0; 96], "VEC4");
     w.meshes[1]["primitives"][0]["attributes"]["COLOR_0"] = json!(colours);
     let mut doc = w.document(json!({"byteLength": w.bin.len()}));
-    doc["animations"] = json!([{"channels": [], "samplers": []}]);
     doc["skins"] = json!([{"joints": [0]}]);
     let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
     let warned = |needle: &str| {
@@ -128,7 +127,6 @@ fn every_part_not_applied_is_named_in_one_warning() {
     warned("material 0 has an occlusionTexture");
     warned("material 1 has a metallicRoughnessTexture");
     warned("mesh 1 has vertex colours (COLOR_0)");
-    warned("1 animation(s) are not played");
     warned("1 skin(s) are not applied");
     // The same stage without them warns of nothing.
     let plain = stage(1.0, point(Some(8.0), 20.0), looking(0.0), EYE);
@@ -309,4 +307,158 @@ fn a_light_without_a_range_lights_a_centimetre_scene_as_a_metre_one() {
         rm >= corner && rm <= corner * 1.02,
         "range {rm}, corner {corner}"
     );
+}
+
+/// [`stage`] with its light node (2) moving in x from `from` to `to` over two seconds
+/// (linear), the box (node 1) turning a quarter turn at one second (step), and the camera
+/// (node 3) rising 1 m over two seconds (cubic spline, zero tangents).
+fn animated(from: f32, to: f32) -> (Vec<u8>, GltfWriter) {
+    let mut w = stage(1.0, point(Some(6.0), 8.0), looking(0.0), EYE);
+    let times = w.floats(&[0.0, 2.0], "SCALAR");
+    let slide = w.floats(&[from, 2.5, 1.5, to, 2.5, 1.5], "VEC3");
+    let step_times = w.floats(&[0.0, 1.0], "SCALAR");
+    let q = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2).to_array();
+    let turn = w.floats(&[0.0, 0.0, 0.0, 1.0, q[0], q[1], q[2], q[3]], "VEC4");
+    let (z, e) = ([0.0f32; 3], EYE.to_array());
+    let rise: Vec<f32> = [z, e, z, z, [e[0], e[1] + 1.0, e[2]], z].concat();
+    let rise = w.floats(&rise, "VEC3");
+    let mut doc = w.document(json!({"byteLength": w.bin.len()}));
+    doc["animations"] = json!([{
+        "channels": [
+            {"sampler": 0, "target": {"node": 2, "path": "translation"}},
+            {"sampler": 1, "target": {"node": 1, "path": "rotation"}},
+            {"sampler": 2, "target": {"node": 3, "path": "translation"}},
+        ],
+        "samplers": [
+            {"input": times, "output": slide},
+            {"input": step_times, "output": turn, "interpolation": "STEP"},
+            {"input": times, "output": rise, "interpolation": "CUBICSPLINE"},
+        ],
+    }]);
+    (GltfWriter::glb_of(&doc, &w.bin), w)
+}
+
+#[test]
+fn a_files_animation_moves_its_nodes_lights_and_camera() {
+    let (bytes, _) = animated(-2.0, 2.0);
+    let loaded = load(&bytes).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let s = &loaded.scene;
+    // Two seconds at 30 frames per second: frames 0 to 60, no orbit added.
+    assert_eq!(gltf::ANIMATION_FPS, 30.0);
+    assert_eq!(s.frame_count(), 61);
+    for (frame, x) in [(0, -2.0), (15, -1.0), (30, 0.0), (60, 2.0), (90, 2.0)] {
+        let p = s.frame(frame).lights[0].position;
+        assert!(
+            p.abs_diff_eq(Vec3::new(x, 2.5, 1.5), 1e-5),
+            "frame {frame}: the light at {p}, not x = {x}"
+        );
+    }
+    // The box turns at one second (step), not before.
+    let box_at = |f: u32| s.frame(f).transforms[1];
+    let quarter = Mat4::from_rotation_translation(
+        Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        Vec3::new(0.0, 0.5, 0.0),
+    );
+    assert!(box_at(29).abs_diff_eq(Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0)), 1e-5));
+    assert!(box_at(30).abs_diff_eq(quarter, 1e-5), "{}", box_at(30));
+    // The camera rises 1 m on a cubic spline with zero tangents: a smoothstep.
+    let eye = |f: u32| s.camera_path.at(f).eye;
+    assert!(eye(0).abs_diff_eq(EYE, 1e-5) && eye(60).abs_diff_eq(EYE + Vec3::Y, 1e-5));
+    assert!((eye(15).y - (EYE.y + 0.15625)).abs() < 1e-4, "{}", eye(15));
+    // The pool of light at the last frame is the one a light placed there lights.
+    let size = (128, 96);
+    let end = render_at(s, "forward", size, 60);
+    let (placed, _) = animated(2.0, 2.0);
+    let placed = load(&placed).unwrap().scene;
+    let still = render_at(&placed, "forward", size, 60);
+    assert!(
+        common::pixels_over(&end, &still, 2) <= 10,
+        "the moved light lights as a placed one"
+    );
+    let start = render_at(s, "forward", size, 0);
+    assert!(
+        common::pixels_over(&start, &end, 8) > 1000,
+        "the pool moves"
+    );
+    // Every pipeline culls the light where it is at frame 30.
+    let mid = render_at(s, "forward", size, 30);
+    for info in lightgrid::pipelines::PIPELINES {
+        let other = render_at(s, info.id, size, 30);
+        let over = common::pixels_over(&mid, &other, 8);
+        assert!(
+            over <= u64::from(size.0 * size.1) / 100,
+            "{}: {over} pixels over 8 levels from forward at frame 30",
+            info.id
+        );
+    }
+}
+
+#[test]
+fn malformed_animations_are_refused_and_extra_ones_named() {
+    let (bytes, w) = animated(-2.0, 2.0);
+    let doc = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let loaded = load(&bytes).unwrap();
+        drop(loaded);
+        let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let mut d: serde_json::Value = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+        edit(&mut d);
+        GltfWriter::glb_of(&d, &w.bin)
+    };
+    for (edit, needle) in [
+        (
+            &(|d: &mut serde_json::Value| {
+                d["animations"][0]["channels"][0]["target"]["node"] = json!(99)
+            }) as &dyn Fn(&mut serde_json::Value),
+            "node 99 does not exist",
+        ),
+        (
+            &|d: &mut serde_json::Value| {
+                d["animations"][0]["samplers"][0]["interpolation"] = json!("BOUNCE")
+            },
+            "interpolation 'BOUNCE'",
+        ),
+        (
+            &|d: &mut serde_json::Value| {
+                d["animations"][0]["samplers"][0]["output"] =
+                    d["animations"][0]["samplers"][0]["input"].clone()
+            },
+            "where 3 components are needed",
+        ),
+        (
+            &|d: &mut serde_json::Value| {
+                d["animations"][0]["samplers"][1]["input"] =
+                    d["animations"][0]["samplers"][0]["input"].clone()
+            },
+            "",
+        ),
+    ] {
+        let r = load(&doc(edit));
+        if needle.is_empty() {
+            // Times from another sampler: still increasing, read as given.
+            assert!(r.is_ok(), "{:?}", r.err());
+        } else {
+            let e = r.unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+        }
+    }
+    let two = doc(&|d| {
+        let first = d["animations"][0].clone();
+        d["animations"].as_array_mut().unwrap().push(first);
+    });
+    let loaded = load(&two).unwrap();
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("animation 0 is played; the file's other 1")),
+        "{:?}",
+        loaded.warnings
+    );
+}
+
+fn render_at(scene: &Scene, pipeline: &str, (w, h): (u32, u32), frame: u32) -> image::RgbaImage {
+    let ctx = common::gpu();
+    let mut r = Renderer::new(&ctx, w, h, RenderSettings::default()).unwrap();
+    r.render(scene, frame, pipeline).unwrap().image
 }

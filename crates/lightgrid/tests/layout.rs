@@ -84,7 +84,7 @@ fn gpu_structs_match_wgsl() {
             shader,
             texture,
             alpha_cutoff,
-            _pad0,
+            emissive_texture,
             _pad1
         ]
     );

@@ -479,6 +479,8 @@ fn wall_scene() -> Scene {
         camera_path: CameraPath::fixed(Vec3::new(0.0, 0.0, 6.0), Vec3::ZERO, 60.0, 0.1, 100.0),
         default_size: (96, 64),
         lighting: Default::default(),
+        derived_ranges: Vec::new(),
+        tracks: Vec::new(),
     }
 }
 

@@ -1685,6 +1685,8 @@ fn coplanar_scene() -> Scene {
         ),
         default_size: (128, 72),
         lighting: Default::default(),
+        derived_ranges: Vec::new(),
+        tracks: Vec::new(),
     }
 }
 

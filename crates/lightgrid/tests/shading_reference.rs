@@ -214,6 +214,8 @@ fn one_plane(
         camera_path: CameraPath::fixed(eye, target, 40.0, 0.1, 100.0),
         default_size: (64, 64),
         lighting,
+        derived_ranges: Vec::new(),
+        tracks: Vec::new(),
     }
 }
 

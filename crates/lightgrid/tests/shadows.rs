@@ -48,6 +48,8 @@ fn box_on_a_plane() -> Scene {
         camera_path: CameraPath::fixed(EYE, Vec3::new(1.5, 0.0, 1.5), 50.0, 0.1, 100.0),
         default_size: (SIZE, SIZE),
         lighting: Lighting::default(),
+        derived_ranges: Vec::new(),
+        tracks: Vec::new(),
     }
 }
 

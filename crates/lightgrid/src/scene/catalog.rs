@@ -295,6 +295,7 @@ impl Builder {
                 default_size,
                 lighting: Default::default(),
                 derived_ranges: Vec::new(),
+                tracks: Vec::new(),
             },
             rng: Rng::new(seed),
         }

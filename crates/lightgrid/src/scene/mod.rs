@@ -438,6 +438,9 @@ pub enum Motion {
         speed: f32,
         start: f32,
     },
+    /// Moves as [`Scene::tracks`]`[track]` says: one transform per frame, applied to `local`
+    /// (a file's own animation; the last frame's is held after it).
+    Track(usize),
 }
 
 /// A mesh placed in the world with a material.
@@ -463,6 +466,8 @@ pub enum LightAnchor {
     World,
     /// Offset from the object's motion frame.
     Object(usize),
+    /// Moved by [`Scene::tracks`]`[t]` (a light on a file's animated node).
+    Track(usize),
     /// Circling a vertical axis: at frame 0 where `light.position` says, then around a
     /// circle of `radius` through it, a turn every `frames_per_turn` frames, the axis at
     /// angle `phase` from it (the Forward+ demo's moving lights).
@@ -507,6 +512,9 @@ pub struct Scene {
     /// The lights (by index) a file gave no range, with the range lightgrid derived
     /// (`lighting::derive_ranges`); empty for the catalog.
     pub derived_ranges: Vec<(usize, f32)>,
+    /// Per-frame transforms of [`Motion::Track`] objects and [`LightAnchor::Track`] lights
+    /// (a file's own animation); empty for the catalog.
+    pub tracks: Vec<Vec<Mat4>>,
 }
 
 /// The frame's geometry in world space: opaque triangles first (grouped by material shader),
@@ -601,6 +609,7 @@ impl Scene {
     fn motion_transform(&self, motion: &Motion, frame: u32) -> Mat4 {
         match motion {
             Motion::Static => Mat4::IDENTITY,
+            Motion::Track(t) => self.track_at(*t, frame),
             Motion::Walk { path, speed, start } => {
                 let (pos, dir) = self.paths[*path].sample(start + speed * frame as f32);
                 // Object space faces +z; turn it toward the direction of travel.
@@ -608,6 +617,17 @@ impl Scene {
                 Mat4::from_rotation_translation(Quat::from_rotation_y(yaw), pos)
             }
         }
+    }
+
+    /// Track `t`'s transform at `frame` (the last one past its end; identity for a track that
+    /// does not exist or is empty).
+    fn track_at(&self, t: usize, frame: u32) -> Mat4 {
+        let track = self.tracks.get(t).map_or(&[][..], Vec::as_slice);
+        track
+            .get(frame as usize)
+            .or(track.last())
+            .copied()
+            .unwrap_or(Mat4::IDENTITY)
     }
 
     /// Evaluate the animation at `frame` (frames past the end hold the last camera key).
@@ -642,6 +662,17 @@ impl Scene {
                     ),
                     ..l.light
                 },
+                LightAnchor::Track(t) => {
+                    let m = self.track_at(t, frame);
+                    Light {
+                        position: m.transform_point3(l.light.position),
+                        spot: l.light.spot.map(|s| Spot {
+                            direction: m.transform_vector3(s.direction).normalize_or(s.direction),
+                            ..s
+                        }),
+                        ..l.light
+                    }
+                }
                 LightAnchor::Object(o) => Light {
                     position: motion[o].transform_point3(l.light.position),
                     spot: l.light.spot.map(|s| Spot {

@@ -54,6 +54,7 @@ impl GltfWriter {
         let comps = match kind {
             "VEC2" => 2,
             "VEC3" => 3,
+            "VEC4" => 4,
             _ => 1,
         };
         let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();

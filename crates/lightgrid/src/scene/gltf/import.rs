@@ -4,6 +4,7 @@
 //! GGX by default), KHR_lights_punctual lights placed in their photometric units, and a
 //! camera path fitted to the scene.
 
+use super::animation;
 use super::json::{LightDef, MaterialDef, Node, Primitive};
 use super::read::{Document, Res};
 use super::{LoadOptions, EXTENSIONS_READ, MAX_TRIANGLES, MAX_VERTICES};
@@ -29,8 +30,13 @@ struct Walk {
     meshes: Vec<Mesh>,
     /// (glTF mesh, primitive, winding flipped) → index into `meshes`, or `None` if skipped.
     cache: HashMap<(usize, usize, bool), Option<usize>>,
-    cameras: Vec<(usize, Mat4)>,
-    lights: Vec<(usize, Mat4)>,
+    /// (camera or light index, world transform, node).
+    cameras: Vec<(usize, Mat4, usize)>,
+    lights: Vec<(usize, Mat4, usize)>,
+    /// The nodes walked, parents before children: (node, parent).
+    order: Vec<(usize, Option<usize>)>,
+    /// The node that placed each of `objects`.
+    object_nodes: Vec<usize>,
     /// Vertices and indices read from accessors, and baked into objects: each bounded.
     read_vertices: u64,
     read_indices: u64,
@@ -678,12 +684,13 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
             }
         }
     };
-    let mut stack: Vec<(usize, Mat4)> = Vec::new();
+    let mut stack: Vec<(usize, Mat4, Option<usize>)> = Vec::new();
     for &r in roots.iter().rev() {
         mark(r)?;
-        stack.push((r, Mat4::IDENTITY));
+        stack.push((r, Mat4::IDENTITY, None));
     }
-    while let Some((ni, parent)) = stack.pop() {
+    while let Some((ni, parent, parent_node)) = stack.pop() {
+        walk.order.push((ni, parent_node));
         let node = &nodes[ni];
         let world = parent * local_matrix(node, ni)?;
         if !world.is_finite() {
@@ -692,17 +699,20 @@ fn walk_nodes(doc: &Document, materials: &MaterialMap, walk: &mut Walk) -> Res<(
             ));
         }
         if let Some(mi) = node.mesh {
+            let before = walk.objects.len();
             instance_mesh(doc, mi, world, materials, walk)?;
+            let placed = walk.objects.len() - before;
+            walk.object_nodes.extend(std::iter::repeat_n(ni, placed));
         }
         if let Some(c) = node.camera {
-            walk.cameras.push((c, world));
+            walk.cameras.push((c, world, ni));
         }
         if let Some(l) = node.extensions.as_ref().and_then(|e| e.lights.as_ref()) {
-            walk.lights.push((l.light, world));
+            walk.lights.push((l.light, world, ni));
         }
         for &c in node.children.iter().rev() {
             mark(c)?;
-            stack.push((c, world));
+            stack.push((c, world, Some(ni)));
         }
     }
     Ok(())
@@ -856,9 +866,9 @@ fn chosen_camera(
     doc: &Document,
     opts: &LoadOptions,
     walk: &mut Walk,
-) -> Res<Option<(usize, Mat4)>> {
+) -> Res<Option<(usize, Mat4, usize)>> {
     let Some(n) = opts.camera else {
-        let first = walk.cameras.iter().copied().find(|(c, _)| {
+        let first = walk.cameras.iter().copied().find(|(c, _, _)| {
             doc.root
                 .cameras
                 .get(*c)
@@ -875,11 +885,11 @@ fn chosen_camera(
             doc.root.cameras.len()
         ));
     }
-    let world = walk
+    let (world, node) = walk
         .cameras
         .iter()
-        .find(|(c, _)| *c == n)
-        .map(|(_, w)| *w)
+        .find(|(c, _, _)| *c == n)
+        .map(|(_, w, node)| (*w, *node))
         .ok_or_else(|| format!("--camera {n}: no node of the scene places camera {n}"))?;
     if doc.root.cameras[n].kind != "perspective" {
         let kind = &doc.root.cameras[n].kind;
@@ -891,7 +901,7 @@ fn chosen_camera(
             "--camera {n}: {article} {kind} camera; only perspective cameras are rendered"
         ));
     }
-    Ok(Some((n, world)))
+    Ok(Some((n, world, node)))
 }
 
 /// The start at perspective camera `n` placed by `world`; its aspect ratio sets `size`.
@@ -997,6 +1007,7 @@ fn camera_path(
     doc: &Document,
     opts: &LoadOptions,
     walk: &mut Walk,
+    sampled: Option<&Sampled>,
 ) -> Res<(CameraPath, (u32, u32))> {
     // The objects are static and placed by their world matrices.
     let placed = walk.objects.iter().flat_map(|o| {
@@ -1011,11 +1022,115 @@ fn camera_path(
     let centre = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let mut size = (DEFAULT_WIDTH, DEFAULT_WIDTH * 9 / 16);
-    let start = match chosen_camera(doc, opts, walk)? {
-        Some(placed) => placed_start(doc, placed, (centre, radius), &mut size)?,
+    let chosen = chosen_camera(doc, opts, walk)?;
+    let start = match chosen {
+        Some((n, world, _)) => placed_start(doc, (n, world), (centre, radius), &mut size)?,
         None => fitted_start(centre, radius),
     };
-    Ok((orbit(&start, centre), size))
+    let Some(sampled) = sampled else {
+        return Ok((orbit(&start, centre), size));
+    };
+    // The file animates itself: its camera as authored, moving with its node if that is
+    // animated, with no orbit added.
+    let mut keys = Vec::new();
+    let mut ups = Vec::new();
+    let track = chosen.and_then(|(_, _, node)| sampled.track_of.get(&node));
+    match (chosen, track) {
+        (Some((n, world, _)), Some(&t)) => {
+            for (f, m) in sampled.tracks[t].iter().enumerate() {
+                let at = placed_start(doc, (n, *m * world), (centre, radius), &mut size)?;
+                keys.push((f as u32, at.eye, at.target));
+                ups.push(at.up);
+            }
+        }
+        _ => {
+            for f in [0, sampled.frames.saturating_sub(1)] {
+                keys.push((f, start.eye, start.target));
+                ups.push(start.up);
+            }
+        }
+    }
+    let path = CameraPath {
+        keys,
+        ups,
+        fov_y: start.fov,
+        near: start.near,
+        far: start.far,
+    };
+    Ok((path, size))
+}
+
+/// Most transforms a file's animation is sampled into (frames × moving nodes that place
+/// something): 128 MiB of matrices. A longer animation is cut to fit, with a warning.
+const MAX_TRACK_MATRICES: usize = 1 << 21;
+
+/// A file's animation sampled: one track (a transform per frame, from the node's place at
+/// rest to its place at that frame) per animated node that places a mesh, a light or a
+/// camera.
+struct Sampled {
+    frames: u32,
+    track_of: HashMap<usize, usize>,
+    tracks: Vec<Vec<Mat4>>,
+}
+
+/// Sample `anim` at every frame for the nodes `walk` placed things with; None when it moves
+/// none of them.
+fn sample(doc: &Document, anim: &animation::Animation, walk: &mut Walk) -> Res<Option<Sampled>> {
+    let nodes = &doc.root.nodes;
+    let mut moving = vec![false; nodes.len()];
+    for &(n, parent) in &walk.order {
+        moving[n] = anim.moves(n) || parent.is_some_and(|p| moving[p]);
+    }
+    let placing = (walk.object_nodes.iter().copied())
+        .chain(walk.lights.iter().map(|l| l.2))
+        .chain(walk.cameras.iter().map(|c| c.2));
+    let owners: std::collections::BTreeSet<usize> = placing.filter(|&n| moving[n]).collect();
+    if owners.is_empty() {
+        return Ok(None);
+    }
+    let owners: Vec<usize> = owners.into_iter().collect();
+    let mut frames = anim.frames();
+    let fit = (MAX_TRACK_MATRICES / owners.len()).max(1) as u32;
+    if frames > fit {
+        walk.warn(format!(
+            "the animation's {} moving nodes are sampled for {fit} frames of its {frames} (at most {MAX_TRACK_MATRICES} transforms are kept)",
+            owners.len()
+        ));
+        frames = fit;
+    }
+    let mut rest = vec![Mat4::IDENTITY; nodes.len()];
+    let mut rest_world = vec![Mat4::IDENTITY; nodes.len()];
+    for &(n, parent) in &walk.order {
+        rest[n] = local_matrix(&nodes[n], n)?;
+        rest_world[n] = parent.map_or(Mat4::IDENTITY, |p| rest_world[p]) * rest[n];
+    }
+    let from_rest: Vec<Mat4> = owners.iter().map(|&n| rest_world[n].inverse()).collect();
+    let mut tracks = vec![Vec::with_capacity(frames as usize); owners.len()];
+    let mut world = rest_world.clone();
+    for f in 0..frames {
+        let t = f as f32 / animation::FPS;
+        for &(n, parent) in &walk.order {
+            if moving[n] {
+                let local = anim.local(&nodes[n], n, rest[n], t);
+                world[n] = parent.map_or(Mat4::IDENTITY, |p| world[p]) * local;
+            }
+        }
+        for (i, &n) in owners.iter().enumerate() {
+            let m = world[n] * from_rest[i];
+            if !m.is_finite() {
+                return Err(format!(
+                    "node {n}: its animated transform at {t:.3} s is not finite"
+                ));
+            }
+            tracks[i].push(m);
+        }
+    }
+    let track_of = owners.iter().enumerate().map(|(i, &n)| (n, i)).collect();
+    Ok(Some(Sampled {
+        frames,
+        track_of,
+        tracks,
+    }))
 }
 
 /// The scene a document describes.
@@ -1080,6 +1195,16 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         default: materials.len().saturating_sub(1),
     };
     walk_nodes(doc, &map, &mut walk)?;
+    // The file's own animation, sampled per frame for what it moves.
+    let mut notes = Vec::new();
+    let animation = animation::read(doc, &mut |w| notes.push(w))?;
+    for note in notes {
+        walk.warn(note);
+    }
+    let sampled = match &animation {
+        Some(a) => sample(doc, a, &mut walk)?,
+        None => None,
+    };
     if walk.objects.is_empty() {
         return Err("the scene has no triangles to render".into());
     }
@@ -1090,12 +1215,18 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         .and_then(|e| e.lights.as_ref())
         .map_or(&[][..], |l| &l.lights[..]);
     let mut lights = Vec::new();
-    for (li, world) in std::mem::take(&mut walk.lights) {
+    let mut light_tracks = Vec::new();
+    for (li, world, node) in walk.lights.clone() {
         let def = defs
             .get(li)
             .ok_or_else(|| format!("a node names light {li}, which does not exist"))?;
         if let Some(light) = map_light(def, li, world, &mut walk)? {
             lights.push(light);
+            light_tracks.push(
+                sampled
+                    .as_ref()
+                    .and_then(|s| s.track_of.get(&node).copied()),
+            );
         }
         if lights.len() > crate::consts::MAX_LIGHTS as usize {
             return Err(format!("more than {} lights", crate::consts::MAX_LIGHTS));
@@ -1113,12 +1244,20 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
     let ranged: Vec<bool> = lights.iter().map(|l| l.ranged).collect();
     let lights = lights
         .into_iter()
-        .map(|l| SceneLight {
+        .zip(light_tracks)
+        .map(|(l, track)| SceneLight {
             light: l.light,
-            anchor: LightAnchor::World,
+            anchor: track.map_or(LightAnchor::World, LightAnchor::Track),
         })
         .collect();
-    let (camera_path, default_size) = camera_path(doc, opts, &mut walk)?;
+    let (camera_path, default_size) = camera_path(doc, opts, &mut walk, sampled.as_ref())?;
+    if let Some(s) = &sampled {
+        for (o, node) in walk.objects.iter_mut().zip(&walk.object_nodes) {
+            if let Some(&t) = s.track_of.get(node) {
+                o.motion = Motion::Track(t);
+            }
+        }
+    }
     let mut scene = Scene {
         name: name.to_string(),
         meshes: std::mem::take(&mut walk.meshes),
@@ -1131,6 +1270,7 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         default_size,
         lighting: exported.unwrap_or_else(Lighting::photometric),
         derived_ranges: Vec::new(),
+        tracks: sampled.map_or_else(Vec::new, |s| s.tracks),
     };
     let derived = crate::scene::derive_ranges(&mut scene, &ranged, exported.is_none());
     if let (Some(lo), Some(hi)) = (

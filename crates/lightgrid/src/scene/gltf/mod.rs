@@ -23,12 +23,14 @@
 //! load back unchanged; a catalog scene's papers-unit lights are written in candela matched
 //! at [`LIGHT_MATCH_FRACTION`] of the range.
 
+mod animation;
 mod export;
 mod import;
 mod json;
 mod read;
 mod unread;
 
+pub use animation::{FPS as ANIMATION_FPS, MAX_FRAMES as MAX_ANIMATION_FRAMES};
 pub use export::export;
 pub use import::ORBIT_FRAMES;
 

@@ -123,12 +123,6 @@ pub(super) fn warnings(root: &Root) -> Vec<String> {
             root.skins.len().max(1)
         ));
     }
-    if !root.animations.is_empty() {
-        out.push(format!(
-            "{} animation(s) are not played: the scene is drawn as its nodes place it",
-            root.animations.len()
-        ));
-    }
     let nearest = |f: Option<u32>| f.is_some_and(|f| f == 9728 || f == 9984 || f == 9986);
     say(
         &mut out,
@@ -167,7 +161,6 @@ mod tests {
             ],
             "nodes": [{"mesh": 1, "weights": [0.5]}, {"mesh": 2}, {"skin": 0}],
             "skins": [{"joints": [0]}],
-            "animations": [{}, {}],
             "samplers": [{"magFilter": 9728}, {"magFilter": 9729}]
         }"#,
         );
@@ -185,9 +178,8 @@ mod tests {
         // Mesh 1 is weighted by its node; mesh 2's targets have no weight.
         assert!(has("morph targets").starts_with("mesh 1 "));
         assert!(has("bind pose").starts_with("1 skin"));
-        assert!(has("not played").starts_with("2 animation"));
         assert!(has("NEAREST").starts_with("sampler 0 "));
-        assert_eq!(w.len(), 9, "{w:#?}");
+        assert_eq!(w.len(), 8, "{w:#?}");
         assert!(warnings(&root("{}")).is_empty());
     }
 
