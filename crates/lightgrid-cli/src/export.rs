@@ -39,6 +39,9 @@ pub(crate) fn export(a: &ExportArgs) -> Result<()> {
     files.output("--out", Some(&a.out), Kind::Data)?;
     a.scene.claim(&mut files)?;
     let scene = a.scene.build()?;
+    for loss in lightgrid::scene::gltf::export_losses(&scene) {
+        eprintln!("warning: {}: {loss}", a.scene.scene);
+    }
     let (w, h) = Size::or_scene(a.size, &scene);
     let bytes = lightgrid::scene::gltf::export(&scene, a.frame, (w, h))?;
     write_atomic(&a.out, &bytes)?;

@@ -271,6 +271,21 @@ pub const MAX_TEXTURE_EDGE: u32 = 1024;
 
 /// Material flag bit: the material is transparent (blended, drawn after opaque geometry).
 pub const MATERIAL_FLAG_TRANSPARENT: u32 = 1;
+/// The material is glTF's metallic-roughness: diffuse, specular and exponent are derived per
+/// sample from `base`, `metallic`, `roughness`, the textures and the vertex colour (by
+/// `gltf::import::map_material`'s rule, which gives the stored colours untextured).
+pub const MATERIAL_FLAG_METALLIC_ROUGHNESS: u32 = 2;
+/// A material's texture slots (`GpuMaterial::uv_sets`, `wraps`).
+pub const TEXTURE_SLOT_BASE: u32 = 0;
+pub const TEXTURE_SLOT_EMISSIVE: u32 = 1;
+pub const TEXTURE_SLOT_METAL_ROUGH: u32 = 2;
+pub const TEXTURE_SLOT_NORMAL: u32 = 3;
+pub const TEXTURE_SLOT_OCCLUSION: u32 = 4;
+/// Texture wrapping (glTF samplers' `wrapS`/`wrapT`): the GPU sampler repeats, clamping and
+/// mirroring are applied to the coordinates.
+pub const WRAP_REPEAT: u32 = 0;
+pub const WRAP_CLAMP: u32 = 1;
+pub const WRAP_MIRROR: u32 = 2;
 
 /// A WGSL constant value: unsigned integer or float.
 #[derive(Clone, Copy, Debug)]
@@ -401,6 +416,26 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
         "MATERIAL_FLAG_TRANSPARENT",
         WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),
     ),
+    (
+        "MATERIAL_FLAG_METALLIC_ROUGHNESS",
+        WgslConst::U32(MATERIAL_FLAG_METALLIC_ROUGHNESS),
+    ),
+    ("TEXTURE_SLOT_BASE", WgslConst::U32(TEXTURE_SLOT_BASE)),
+    (
+        "TEXTURE_SLOT_EMISSIVE",
+        WgslConst::U32(TEXTURE_SLOT_EMISSIVE),
+    ),
+    (
+        "TEXTURE_SLOT_METAL_ROUGH",
+        WgslConst::U32(TEXTURE_SLOT_METAL_ROUGH),
+    ),
+    ("TEXTURE_SLOT_NORMAL", WgslConst::U32(TEXTURE_SLOT_NORMAL)),
+    (
+        "TEXTURE_SLOT_OCCLUSION",
+        WgslConst::U32(TEXTURE_SLOT_OCCLUSION),
+    ),
+    ("WRAP_CLAMP", WgslConst::U32(WRAP_CLAMP)),
+    ("WRAP_MIRROR", WgslConst::U32(WRAP_MIRROR)),
 ];
 
 /// The WGSL prelude: one `const` line per entry of [`WGSL_CONSTS`].

@@ -47,6 +47,26 @@ pub struct GpuMaterial {
     /// Emissive texture: its layer in the texture array + 1; 0 for none.
     pub emissive_texture: u32,
     pub _pad1: u32,
+    /// glTF's metallic-roughness inputs, applied per sample where `flags` has
+    /// `MATERIAL_FLAG_METALLIC_ROUGHNESS` (a file's material): the base colour factor, the
+    /// metallic and roughness factors; the colours above are what they give untextured.
+    pub base: [f32; 3],
+    pub metallic: f32,
+    pub roughness: f32,
+    /// The normal texture's scale (x and y of its tangent-space normal).
+    pub normal_scale: f32,
+    /// The occlusion texture's strength on the ambient term (0: none, 1: all).
+    pub occlusion_strength: f32,
+    /// Metallic-roughness texture (B metallic, G roughness): layer + 1; 0 for none.
+    pub metal_rough_texture: u32,
+    /// Normal texture (tangent space): layer + 1; 0 for none.
+    pub normal_texture: u32,
+    /// Occlusion texture (R): layer + 1; 0 for none.
+    pub occlusion_texture: u32,
+    /// Bit `slot` set: that texture reads texture coordinate set 1 (`TEXTURE_SLOT_*`).
+    pub uv_sets: u32,
+    /// 4 bits per texture slot (bit `4·slot`): wrap along u (2 bits), then v; `WRAP_*`.
+    pub wraps: u32,
 }
 
 /// One vertex in world space (the CPU bakes object transforms each frame).
@@ -57,6 +77,13 @@ pub struct GpuVertex {
     pub normal: [f32; 3],
     pub uv: [f32; 2],
     pub material: u32,
+    /// Tangent (xyz, world space) and bitangent sign (w), for normal textures; zero where
+    /// the mesh has none (and no normal texture reads it).
+    pub tangent: [f32; 4],
+    /// Vertex colour (glTF's `COLOR_0`), multiplying the base colour; white without one.
+    pub color: [f32; 4],
+    /// Texture coordinate set 1 (set 0 where the mesh has none).
+    pub uv1: [f32; 2],
 }
 
 /// Per-frame uniforms: camera matrices, viewport and light count. Positions on the GPU are
@@ -114,8 +141,8 @@ pub struct GridParams {
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
-const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 96);
-const _: () = assert!(std::mem::size_of::<GpuVertex>() == 36);
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 144);
+const _: () = assert!(std::mem::size_of::<GpuVertex>() == 76);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
 
 /// One node of the light BVH: 32 bytes (`BvhNode` in `shading/types.wgsl`).

@@ -397,6 +397,19 @@ impl Renderer {
                 ),
             ));
         }
+        let varies = || (self.scene.as_ref()).and_then(|u| u.scene.per_pixel_specular());
+        if let Some(why) = pipelines::reads_specular_per_material(info.id)
+            .then(varies)
+            .flatten()
+        {
+            return Err(Error::invalid(
+                "pipeline",
+                format!(
+                    "{} reads each material's specular colour and exponent per material (its irradiance pass), and {why}: choose another pipeline",
+                    info.id
+                ),
+            ));
+        }
         if !self.techniques.contains_key(info.id) {
             let device = &self.device;
             let ctx = PipelineContext {

@@ -42,7 +42,7 @@ fn include_fragment_cells(pixel: vec2<f32>, w: f32, layer_offset: u32) {
 @fragment @early_depth_test(force)
 fn fs_opaque(v: VertexOut) {
     let m = materials[v.material];
-    alpha_test(m, m.alpha * base_colour(m, v.uv).a);
+    alpha_test(m, m.alpha * base_colour(m, v, tex_coords(v)).a);
     include_fragment_cells(v.clip.xy, view_distance_from_depth(v.clip.z), 0u);
 }
 

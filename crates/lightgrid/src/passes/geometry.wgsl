@@ -6,6 +6,9 @@ struct VertexIn {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) material: u32,
+    @location(4) tangent: vec4<f32>,
+    @location(5) color: vec4<f32>,
+    @location(6) uv1: vec2<f32>,
 }
 
 struct VertexOut {
@@ -14,6 +17,9 @@ struct VertexOut {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) @interpolate(flat) material: u32,
+    @location(4) tangent: vec4<f32>,
+    @location(5) color: vec4<f32>,
+    @location(6) uv1: vec2<f32>,
 }
 
 @vertex
@@ -27,6 +33,9 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.normal = v.normal;
     out.uv = v.uv;
     out.material = v.material;
+    out.tangent = v.tangent;
+    out.color = v.color;
+    out.uv1 = v.uv1;
     return out;
 }
 
@@ -35,19 +44,67 @@ fn vs_main(v: VertexIn) -> VertexOut {
 @group(0) @binding(6) var base_textures: texture_2d_array<f32>;
 @group(0) @binding(7) var base_sampler: sampler;
 
-// A material's base colour at `uv`: its texture's texel, or 1 without a texture. Always
-// sampled (layer 0 stands in) so the implicit derivatives stay in uniform control flow.
-fn base_colour(m: Material, uv: vec2<f32>) -> vec4<f32> {
-    let texel = textureSample(base_textures, base_sampler, uv, max(m.texture, 1u) - 1u);
-    return select(vec4<f32>(1.0), texel, m.texture != 0u);
+// Where a material's textures are read at a sample: both coordinate sets and their screen
+// derivatives (taken here, in uniform control flow, so textures can be read in branches
+// with explicit gradients: only the textures a material has are sampled).
+struct TexCoords {
+    uv: array<vec2<f32>, 2>,
+    ddx: array<vec2<f32>, 2>,
+    ddy: array<vec2<f32>, 2>,
 }
 
-// A material's emissive colour at `uv`: its emissive factor times its emissive texture's
-// texel (glTF's emissiveTexture), or the factor alone. Always sampled, as `base_colour`.
-fn emissive_colour(m: Material, uv: vec2<f32>) -> vec3<f32> {
-    let layer = max(m.emissive_texture, 1u) - 1u;
-    let texel = textureSample(base_textures, base_sampler, uv, layer).rgb;
-    return m.emissive * select(vec3<f32>(1.0), texel, m.emissive_texture != 0u);
+fn tex_coords(v: VertexOut) -> TexCoords {
+    var t: TexCoords;
+    t.uv = array<vec2<f32>, 2>(v.uv, v.uv1);
+    t.ddx = array<vec2<f32>, 2>(dpdx(v.uv), dpdx(v.uv1));
+    t.ddy = array<vec2<f32>, 2>(dpdy(v.uv), dpdy(v.uv1));
+    return t;
+}
+
+// One coordinate wrapped as a glTF sampler says: the GPU sampler repeats; clamping keeps the
+// coordinate within half a texel of the edges (so the repeat never blends the far edge in),
+// mirroring folds every other repeat back.
+fn wrap_coordinate(x: f32, mode: u32, texels: f32) -> f32 {
+    if (mode == WRAP_CLAMP) {
+        let half = 0.5 / texels;
+        return clamp(x, half, 1.0 - half);
+    }
+    if (mode == WRAP_MIRROR) {
+        let t = fract(x * 0.5) * 2.0;
+        return select(t, 2.0 - t, t > 1.0);
+    }
+    return x;
+}
+
+// Texture slot `slot` of material `m` (layer + 1 in `texture`; 0: none, then `none`) at the
+// sample: its coordinate set and wrapping, the gradients of the unwrapped coordinates (so a
+// seam of the wrapping does not change the mip level).
+fn material_texel(m: Material, t: TexCoords, slot: u32, texture: u32, none: vec4<f32>) -> vec4<f32> {
+    if (texture == 0u) {
+        return none;
+    }
+    let coords = (m.uv_sets >> slot) & 1u;
+    let wrap = (m.wraps >> (4u * slot)) & 15u;
+    let texels = f32(textureDimensions(base_textures).x);
+    let uv = vec2<f32>(
+        wrap_coordinate(t.uv[coords].x, wrap & 3u, texels),
+        wrap_coordinate(t.uv[coords].y, wrap >> 2u, texels),
+    );
+    let layer = texture - 1u;
+    return textureSampleGrad(base_textures, base_sampler, uv, layer, t.ddx[coords], t.ddy[coords]);
+}
+
+// A material's base colour at the sample: its texture's texel times the vertex colour (white
+// without either).
+fn base_colour(m: Material, v: VertexOut, t: TexCoords) -> vec4<f32> {
+    return material_texel(m, t, TEXTURE_SLOT_BASE, m.texture, vec4<f32>(1.0)) * v.color;
+}
+
+// A material's emissive colour at the sample: its emissive factor times its emissive
+// texture's texel (glTF's emissiveTexture), or the factor alone.
+fn emissive_colour(m: Material, t: TexCoords) -> vec3<f32> {
+    let one = vec4<f32>(1.0);
+    return m.emissive * material_texel(m, t, TEXTURE_SLOT_EMISSIVE, m.emissive_texture, one).rgb;
 }
 
 // The alpha test (glTF MASK): a fragment whose alpha is under its material's cutoff is not
@@ -62,7 +119,7 @@ fn alpha_test(m: Material, alpha: f32) {
 @fragment
 fn fs_depth(v: VertexOut) {
     let m = materials[v.material];
-    alpha_test(m, m.alpha * base_colour(m, v.uv).a);
+    alpha_test(m, m.alpha * base_colour(m, v, tex_coords(v)).a);
 }
 
 // The surface a lighting pass shades: the material's colours with its shader applied.
@@ -73,18 +130,54 @@ fn surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
 // The material's own colours (what the G-buffer stores; the shading pass applies the shader).
 fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     let m = materials[v.material];
-    let base = base_colour(m, v.uv);
+    let t = tex_coords(v);
+    let base = base_colour(m, v, t);
     alpha_test(m, m.alpha * base.a);
     var s: Surface;
     s.position = v.position;
+    s.normal = mapped_normal(m, v, t);
     // Two-sided: flip the normal on back faces so thin geometry is lit from both sides.
-    s.normal = normalize(select(-v.normal, v.normal, front_facing));
+    s.normal = select(-s.normal, s.normal, front_facing);
     s.diffuse = m.diffuse * base.rgb;
     s.alpha = m.alpha * base.a;
     s.specular = m.specular;
     s.shininess = m.shininess;
-    s.emissive = emissive_colour(m, v.uv);
-    s.ambient = m.ambient * base.rgb;
+    if ((m.flags & MATERIAL_FLAG_METALLIC_ROUGHNESS) != 0u) {
+        // glTF's metallic-roughness per sample, by the import's rule (map_material):
+        // the texture's B is metallic, G roughness.
+        let one = vec4<f32>(1.0);
+        let mr = material_texel(m, t, TEXTURE_SLOT_METAL_ROUGH, m.metal_rough_texture, one);
+        let metallic = clamp(m.metallic * mr.b, 0.0, 1.0);
+        let roughness = clamp(m.roughness * mr.g, 0.0, 1.0);
+        let colour = m.base * base.rgb;
+        let alpha_g = max(roughness * roughness, 1e-3);
+        s.diffuse = colour * (1.0 - metallic);
+        s.specular = mix(vec3<f32>(0.04), colour, metallic);
+        s.shininess = clamp(2.0 / (alpha_g * alpha_g) - 2.0, 1.0, 2048.0);
+    }
+    s.emissive = emissive_colour(m, t);
+    // Occlusion darkens the ambient term only (glTF: indirect light), by its strength.
+    let occlusion = material_texel(m, t, TEXTURE_SLOT_OCCLUSION, m.occlusion_texture, vec4<f32>(1.0)).r;
+    s.ambient = m.ambient * base.rgb * (1.0 + m.occlusion_strength * (occlusion - 1.0));
     s.material = v.material;
     return s;
+}
+
+// The shading normal: the vertex normal, or the normal texture's tangent-space normal (its
+// x and y times the scale) through the vertex's tangent frame (glTF §3.9.3).
+fn mapped_normal(m: Material, v: VertexOut, t: TexCoords) -> vec3<f32> {
+    let n = normalize(v.normal);
+    if (m.normal_texture == 0u) {
+        return n;
+    }
+    let texel = material_texel(m, t, TEXTURE_SLOT_NORMAL, m.normal_texture, vec4<f32>(0.5, 0.5, 1.0, 1.0));
+    let tn = (texel.xyz * 2.0 - 1.0) * vec3<f32>(m.normal_scale, m.normal_scale, 1.0);
+    let tangent = v.tangent.xyz - n * dot(n, v.tangent.xyz);
+    if (dot(tangent, tangent) < 1e-12) {
+        return n;
+    }
+    let tu = normalize(tangent);
+    let bv = cross(n, tu) * select(1.0, -1.0, v.tangent.w < 0.0);
+    let mapped = tu * tn.x + bv * tn.y + n * tn.z;
+    return select(n, normalize(mapped), dot(mapped, mapped) > 1e-12);
 }

@@ -216,8 +216,10 @@ pub fn count_target(count_blend: bool) -> Option<wgpu::ColorTargetState> {
 
 /// The vertex buffer layout matching `passes/geometry.wgsl`'s `VertexIn`.
 pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
-    const ATTRS: [wgpu::VertexAttribute; 4] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32];
+    const ATTRS: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32,
+        4 => Float32x4, 5 => Float32x4, 6 => Float32x2
+    ];
     wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<GpuVertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,

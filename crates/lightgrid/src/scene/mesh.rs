@@ -1,6 +1,6 @@
 //! Indexed triangle meshes with normals and UVs, and the primitives the catalog builds from.
 
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 /// The axis-aligned bounds (min, max) of `points`; `None` for no points.
 pub fn bounds_of(points: impl IntoIterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
@@ -17,6 +17,13 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     pub uvs: Vec<Vec2>,
     pub indices: Vec<u32>,
+    /// Per vertex, or empty: tangents (xyz, and the bitangent's sign in w) for normal
+    /// textures, from the file or generated (MikkTSpace).
+    pub tangents: Vec<Vec4>,
+    /// Per vertex, or empty (white): colours multiplying the base colour (glTF's `COLOR_0`).
+    pub colors: Vec<Vec4>,
+    /// Per vertex, or empty (set 0 stands in): texture coordinate set 1.
+    pub uvs1: Vec<Vec2>,
 }
 
 impl Mesh {

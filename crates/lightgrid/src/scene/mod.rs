@@ -50,13 +50,38 @@ pub struct Material {
     /// Index into [`Scene::textures`] of a texture multiplying the emissive colour (glTF's
     /// `emissiveTexture`), sampled as the base colour's is.
     pub emissive_texture: Option<u32>,
+    /// glTF's metallic-roughness inputs, for a file's material: the diffuse and specular
+    /// colours and the exponent above are what they give untextured, and the shader derives
+    /// them per sample from these, the textures and the vertex colour.
+    pub metallic_roughness: Option<MetallicRoughness>,
+    /// A tangent-space normal texture (linear, in [`Scene::textures`]) and its scale.
+    pub normal_texture: Option<(u32, f32)>,
+    /// An occlusion texture (R, linear) and its strength on the ambient term.
+    pub occlusion_texture: Option<(u32, f32)>,
+    /// Bit `consts::TEXTURE_SLOT_*` set: that texture reads texture coordinate set 1.
+    pub uv_sets: u32,
+    /// Each texture's wrapping, 4 bits a slot (`GpuMaterial::wraps`).
+    pub wraps: u32,
     /// Alpha test (glTF's `MASK`): fragments whose alpha (`alpha` × the texture's) is below
     /// this are discarded in every pass, depth passes included.
     pub alpha_cutoff: Option<f32>,
 }
 
-/// A base-colour texture: sRGB-encoded RGBA8, rows top to bottom (UV (0, 0) is its first
-/// texel, as in glTF).
+/// glTF's metallic-roughness material inputs (§3.9.2), applied per sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MetallicRoughness {
+    /// The base colour factor (its alpha is the material's `alpha`).
+    pub base: Vec3,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// A texture whose B channel scales `metallic` and G `roughness` (linear, in
+    /// [`Scene::textures`]).
+    pub texture: Option<u32>,
+}
+
+/// A texture: sRGB-encoded RGBA8, rows top to bottom (UV (0, 0) is its first texel, as in
+/// glTF). Linear data (normals, metallic-roughness, occlusion) is stored sRGB-encoded too, so
+/// the sampler's decode gives back the file's values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     pub width: u32,
@@ -107,8 +132,26 @@ impl Material {
             shader: MaterialShader::Standard,
             texture: None,
             emissive_texture: None,
+            metallic_roughness: None,
+            normal_texture: None,
+            occlusion_texture: None,
+            uv_sets: 0,
+            wraps: 0,
             alpha_cutoff: None,
         }
+    }
+
+    /// The textures the material reads, by index into [`Scene::textures`].
+    pub fn textures(&self) -> impl Iterator<Item = u32> {
+        [
+            self.texture,
+            self.emissive_texture,
+            self.metallic_roughness.and_then(|m| m.texture),
+            self.normal_texture.map(|t| t.0),
+            self.occlusion_texture.map(|t| t.0),
+        ]
+        .into_iter()
+        .flatten()
     }
 
     /// A transparent material (glass, bubbles): tinted diffuse, a sharp white highlight,
@@ -124,6 +167,7 @@ impl Material {
 
     pub fn to_gpu(&self) -> GpuMaterial {
         let (shader, paint, paint_power) = self.shader.gpu();
+        let mr = self.metallic_roughness;
         GpuMaterial {
             diffuse: self.diffuse.to_array(),
             alpha: self.alpha,
@@ -132,6 +176,10 @@ impl Material {
             emissive: self.emissive.to_array(),
             flags: if self.transparent {
                 MATERIAL_FLAG_TRANSPARENT
+            } else {
+                0
+            } | if mr.is_some() {
+                crate::consts::MATERIAL_FLAG_METALLIC_ROUGHNESS
             } else {
                 0
             },
@@ -143,6 +191,16 @@ impl Material {
             alpha_cutoff: self.alpha_cutoff.unwrap_or(0.0),
             emissive_texture: self.emissive_texture.map_or(0, |t| t + 1),
             _pad1: 0,
+            base: mr.map_or([0.0; 3], |m| m.base.to_array()),
+            metallic: mr.map_or(0.0, |m| m.metallic),
+            roughness: mr.map_or(0.0, |m| m.roughness),
+            normal_scale: self.normal_texture.map_or(1.0, |t| t.1),
+            occlusion_strength: self.occlusion_texture.map_or(0.0, |t| t.1),
+            metal_rough_texture: mr.and_then(|m| m.texture).map_or(0, |t| t + 1),
+            normal_texture: self.normal_texture.map_or(0, |t| t.0 + 1),
+            occlusion_texture: self.occlusion_texture.map_or(0, |t| t.0 + 1),
+            uv_sets: self.uv_sets,
+            wraps: self.wraps,
         }
     }
 }
@@ -590,6 +648,33 @@ impl Scene {
         self.camera_path.frame_count()
     }
 
+    /// Why the specular colour or exponent of this scene varies within one material (a
+    /// metallic-roughness texture, or a base-colour texture or vertex colours on a metallic
+    /// material: a metal's F0 is its base colour), if it does:
+    /// the light pre-pass pipelines read both per material, so they refuse such a scene.
+    pub fn per_pixel_specular(&self) -> Option<String> {
+        for (i, m) in self.materials.iter().enumerate() {
+            let Some(mr) = m.metallic_roughness else {
+                continue;
+            };
+            if mr.texture.is_some() {
+                return Some(format!("material {i} has a metallic-roughness texture"));
+            }
+            if mr.metallic > 0.0 && m.texture.is_some() {
+                return Some(format!(
+                    "material {i} is metallic with a base-colour texture (its F0)"
+                ));
+            }
+            let coloured = |o: &Object| o.material == i && !self.meshes[o.mesh].colors.is_empty();
+            if mr.metallic > 0.0 && self.objects.iter().any(coloured) {
+                return Some(format!(
+                    "material {i} is metallic and its meshes have vertex colours"
+                ));
+            }
+        }
+        None
+    }
+
     /// Refuse a frame past the end of the animation.
     pub fn check_frame(&self, frame: u32) -> Result<()> {
         let frames = self.frame_count();
@@ -866,12 +951,22 @@ impl Scene {
         let mesh = &self.meshes[o.mesh];
         let first = base + vertices.len() as u32;
         let nm = glam::Mat3::from_mat4(m).inverse().transpose();
+        // A tangent turns with the surface (not as a normal does); a mirroring transform
+        // turns the bitangent's handedness.
+        let handed = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
         for i in 0..mesh.positions.len() {
+            let tangent = mesh.tangents.get(i).map_or([0.0; 4], |t| {
+                let xyz = m.transform_vector3(t.truncate()).normalize_or_zero();
+                xyz.extend(t.w * handed).to_array()
+            });
             vertices.push(GpuVertex {
                 position: m.transform_point3(mesh.positions[i]).to_array(),
                 normal: (nm * mesh.normals[i]).normalize_or_zero().to_array(),
                 uv: mesh.uvs[i].to_array(),
                 material: o.material as u32,
+                tangent,
+                color: mesh.colors.get(i).map_or([1.0; 4], |c| c.to_array()),
+                uv1: mesh.uvs1.get(i).unwrap_or(&mesh.uvs[i]).to_array(),
             });
         }
         indices.extend(mesh.indices.iter().map(|i| i + first));
@@ -929,10 +1024,7 @@ impl Scene {
             ));
         }
         for (i, m) in self.materials.iter().enumerate() {
-            let bad_texture = [m.texture, m.emissive_texture]
-                .iter()
-                .flatten()
-                .any(|&t| t as usize >= self.textures.len());
+            let bad_texture = m.textures().any(|t| t as usize >= self.textures.len());
             if bad_texture {
                 return Err(Error::invalid(
                     "scene",

@@ -27,6 +27,17 @@ struct Material {
     alpha_cutoff: f32,     // alpha test (glTF MASK); 0: none
     emissive_texture: u32, // layer + 1 in `base_textures`; 0: none
     _pad1: u32,
+    // glTF metallic-roughness, per sample where flags has MATERIAL_FLAG_METALLIC_ROUGHNESS
+    base: vec3<f32>,
+    metallic: f32,
+    roughness: f32,
+    normal_scale: f32,
+    occlusion_strength: f32,
+    metal_rough_texture: u32, // layer + 1 (B metallic, G roughness); 0: none
+    normal_texture: u32,      // layer + 1 (tangent space); 0: none
+    occlusion_texture: u32,   // layer + 1 (R); 0: none
+    uv_sets: u32,             // bit TEXTURE_SLOT_*: the slot reads coordinate set 1
+    wraps: u32,               // 4 bits per slot: u then v, WRAP_*
 }
 
 struct FrameUniforms {

@@ -38,6 +38,8 @@ struct Triangle {
     n: [Vec3; 3],
     material: usize,
     transparent: bool,
+    /// A vertex colour other than white (which the reference does not read).
+    coloured: bool,
 }
 
 /// A ray's meeting with a triangle: distance along the ray and the barycentric weights.
@@ -93,6 +95,7 @@ impl<'s> Frame<'s> {
                     n: v.map(|v| Vec3::from(v.normal)),
                     material: v[0].material as usize,
                     transparent: k * 3 >= g.opaque_indices,
+                    coloured: v.iter().any(|v| v.color != [1.0; 4]),
                 }
             })
             .collect();
@@ -292,7 +295,7 @@ impl<'s> Frame<'s> {
 
     /// The pixel's reference colour, or None where its surface is ambiguous: an edge (a ray a
     /// third of a pixel off the centre meets other triangles), a second surface within 0.1 %
-    /// of the depth, a texture.
+    /// of the depth, a texture or a vertex colour (the reference reads neither).
     pub fn reference(&self, px: u32, py: u32, model: Model) -> Option<(Vec3, bool)> {
         let (x, y) = (f64::from(px) + 0.5, f64::from(py) + 0.5);
         let (opaque, glass, second) = self.seen(x, y)?;
@@ -311,10 +314,9 @@ impl<'s> Frame<'s> {
                 return None;
             }
         }
-        if std::iter::once(&opaque)
-            .chain(&glass)
-            .any(|h| self.material(h).texture.is_some())
-        {
+        if std::iter::once(&opaque).chain(&glass).any(|h| {
+            self.material(h).textures().next().is_some() || self.triangles[h.triangle].coloured
+        }) {
             return None;
         }
         let d = self.ray(x, y);

@@ -177,6 +177,41 @@ impl Counts {
     }
 }
 
+/// What [`export`] does not write of `scene`, one line each (a file's per-sample inputs):
+/// the command says so before it writes.
+pub fn export_losses(scene: &Scene) -> Vec<String> {
+    let which = |has: &dyn Fn(&Material) -> bool| -> Vec<usize> {
+        (scene.materials.iter().enumerate())
+            .filter(|(_, m)| has(m))
+            .map(|(i, _)| i)
+            .collect()
+    };
+    let mut out = Vec::new();
+    let mut say = |indices: Vec<usize>, what: &str| {
+        if !indices.is_empty() {
+            out.push(format!("{what} of materials {indices:?} are not exported"));
+        }
+    };
+    say(
+        which(&|m| m.metallic_roughness.is_some_and(|p| p.texture.is_some())),
+        "metallic-roughness textures",
+    );
+    say(which(&|m| m.normal_texture.is_some()), "normal textures");
+    say(
+        which(&|m| m.occlusion_texture.is_some()),
+        "occlusion textures",
+    );
+    say(which(&|m| m.uv_sets != 0), "textures on coordinate set 1");
+    say(
+        which(&|m| m.wraps != 0),
+        "clamped or mirrored texture wrapping",
+    );
+    if scene.meshes.iter().any(|m| !m.colors.is_empty()) {
+        out.push("vertex colours are not exported".into());
+    }
+    out
+}
+
 /// The GLB bytes of `scene` at `frame`, for frames of `size` (the camera's aspect ratio).
 pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     scene.validate()?;

@@ -5,14 +5,14 @@
 //! camera path fitted to the scene.
 
 use super::animation;
-use super::json::{LightDef, MaterialDef, Node, Primitive};
+use super::json::{LightDef, MaterialDef, Node, Primitive, TextureRef};
 use super::read::{Document, Res};
 use super::{LoadOptions, EXTENSIONS_READ, MAX_TRIANGLES, MAX_VERTICES};
 use crate::scene::{
     bounds_of, CameraPath, Light, LightAnchor, Lighting, Material, MaterialShader, Mesh, Motion,
     Object, Scene, SceneLight, Spot, Texture,
 };
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
@@ -139,6 +139,11 @@ impl ExactMaterial {
             shader,
             texture: None,
             emissive_texture: None,
+            metallic_roughness: None,
+            normal_texture: None,
+            occlusion_texture: None,
+            uv_sets: 0,
+            wraps: 0,
             alpha_cutoff: self.alpha_cutoff.filter(|c| c.is_finite()),
         };
         material_is_sane(&m).then_some(m)
@@ -172,13 +177,54 @@ fn map_material(
     walk: &mut Walk,
 ) -> Res<Material> {
     let pbr = def.pbr_metallic_roughness.as_ref();
-    let texture = match pbr.and_then(|p| p.base_color_texture.as_ref()) {
-        Some(t) => Some(textures.load(t.index, index, walk)?),
-        None => None,
+    // Each texture a material reads, in its slot: ours, its coordinate set and wrapping.
+    let mut uv_sets = 0;
+    let mut wraps = 0;
+    let mut slot = |r: Option<&TextureRef>, slot: u32, linear: bool| -> Res<Option<u32>> {
+        let Some(r) = r else { return Ok(None) };
+        let t = textures.load(r.index, index, linear)?;
+        uv_sets |= u32::from(r.tex_coord == 1) << slot;
+        wraps |= t.wrap << (4 * slot);
+        Ok(Some(t.index))
     };
-    let emissive_texture = match &def.emissive_texture {
-        Some(t) => Some(textures.load(t.index, index, walk)?),
-        None => None,
+    use crate::consts::{
+        TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METAL_ROUGH, TEXTURE_SLOT_NORMAL,
+        TEXTURE_SLOT_OCCLUSION,
+    };
+    let texture = slot(
+        pbr.and_then(|p| p.base_color_texture.as_ref()),
+        TEXTURE_SLOT_BASE,
+        false,
+    )?;
+    let emissive_texture = slot(def.emissive_texture.as_ref(), TEXTURE_SLOT_EMISSIVE, false)?;
+    let mr_texture = slot(
+        pbr.and_then(|p| p.metallic_roughness_texture.as_ref()),
+        TEXTURE_SLOT_METAL_ROUGH,
+        true,
+    )?;
+    let normal = slot(def.normal_texture.as_ref(), TEXTURE_SLOT_NORMAL, true)?;
+    let occlusion = slot(def.occlusion_texture.as_ref(), TEXTURE_SLOT_OCCLUSION, true)?;
+    let scale = def
+        .normal_texture
+        .as_ref()
+        .and_then(|t| t.scale)
+        .unwrap_or(1.0);
+    let strength = (def.occlusion_texture.as_ref())
+        .and_then(|t| t.strength)
+        .unwrap_or(1.0);
+    if !scale.is_finite() || !(0.0..=1.0).contains(&strength) {
+        return Err(format!(
+            "material {index}: normalTexture.scale must be finite and occlusionTexture.strength 0 to 1 (found {scale}, {strength})"
+        ));
+    }
+    let textured = |m: Material| Material {
+        texture,
+        emissive_texture,
+        normal_texture: normal.map(|t| (t, scale)),
+        occlusion_texture: occlusion.map(|t| (t, strength)),
+        uv_sets,
+        wraps,
+        ..m
     };
     if let Some(exact) = def
         .extras
@@ -188,11 +234,10 @@ fn map_material(
     {
         match exact.ok().and_then(|e| e.to_material()) {
             Some(m) => {
-                return Ok(Material {
-                    texture,
-                    emissive_texture,
-                    ..m
-                })
+                if mr_texture.is_some() {
+                    walk.warn(format!("material {index}: its metallicRoughnessTexture is not applied to lightgrid's exact material (extras.lightgrid)"));
+                }
+                return Ok(textured(m));
             }
             None => walk.warn(format!(
                 "material {index}: its extras.lightgrid is malformed; the glTF material is used"
@@ -245,7 +290,7 @@ fn map_material(
         ));
     }
     let alpha_tested = mode == "MASK" && texture.is_some();
-    Ok(Material {
+    Ok(textured(Material {
         diffuse: colour * (1.0 - metallic),
         specular: Vec3::splat(0.04).lerp(colour, metallic),
         shininess: (2.0 / (alpha_g * alpha_g) - 2.0).clamp(1.0, 2048.0),
@@ -260,21 +305,62 @@ fn map_material(
         shader: MaterialShader::Standard,
         texture,
         emissive_texture,
+        metallic_roughness: Some(crate::scene::MetallicRoughness {
+            base: colour,
+            metallic,
+            roughness,
+            texture: mr_texture,
+        }),
+        normal_texture: None,
+        occlusion_texture: None,
+        uv_sets: 0,
+        wraps: 0,
         alpha_cutoff: alpha_tested.then_some(cutoff),
-    })
+    }))
 }
 
 /// The file's textures as scene textures, each image decoded once (PNG or JPEG, with
 /// `image_io::decode_image`'s limits).
 struct TextureLoader<'a> {
     doc: &'a Document,
-    by_image: HashMap<usize, u32>,
+    /// (image, linear data) → our texture: an image read as colour and as data is two.
+    by_image: HashMap<(usize, bool), u32>,
     textures: Vec<Texture>,
 }
 
+/// A texture a material reads: ours, and its sampler's wrapping (4 bits: u, then v).
+#[derive(Clone, Copy)]
+struct Loaded {
+    index: u32,
+    wrap: u32,
+}
+
+/// Encode a linear value (0-255) as the sRGB byte the GPU's sRGB decode turns back into it.
+fn srgb_encoded(v: u8) -> u8 {
+    let x = f32::from(v) / 255.0;
+    let e = if x <= 0.003_130_8 {
+        x * 12.92
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (e * 255.0).round().clamp(0.0, 255.0) as u8
+}
+
+/// A glTF sampler wrap mode (10497 repeat, 33071 clamp to edge, 33648 mirrored repeat) as
+/// `consts::WRAP_*`.
+fn wrap_mode(w: Option<u32>) -> Res<u32> {
+    match w.unwrap_or(10497) {
+        10497 => Ok(crate::consts::WRAP_REPEAT),
+        33071 => Ok(crate::consts::WRAP_CLAMP),
+        33648 => Ok(crate::consts::WRAP_MIRROR),
+        other => Err(format!("wrap mode {other} is not 10497, 33071 or 33648")),
+    }
+}
+
 impl TextureLoader<'_> {
-    /// Our index of glTF texture `index` (named by material `material`).
-    fn load(&mut self, index: usize, material: usize, walk: &mut Walk) -> Res<u32> {
+    /// Our texture for glTF texture `index` (named by material `material`): colour
+    /// (sRGB) or, with `linear`, data stored so that the sRGB decode gives its values back.
+    fn load(&mut self, index: usize, material: usize, linear: bool) -> Res<Loaded> {
         let what = format!("material {material}");
         let def = self
             .doc
@@ -285,6 +371,7 @@ impl TextureLoader<'_> {
         let source = def.source.ok_or_else(|| {
             format!("{what}: texture {index} has no source image (an extension's?)")
         })?;
+        let mut wrap = 0;
         if let Some(s) = def.sampler {
             let sampler = self
                 .doc
@@ -292,15 +379,12 @@ impl TextureLoader<'_> {
                 .samplers
                 .get(s)
                 .ok_or_else(|| format!("texture {index}: sampler {s} does not exist"))?;
-            let repeat = |w: Option<u32>| w.is_none_or(|w| w == 10497);
-            if !repeat(sampler.wrap_s) || !repeat(sampler.wrap_t) {
-                walk.warn(format!(
-                    "texture {index}: clamped or mirrored wrapping is not applied; textures repeat"
-                ));
-            }
+            let bad = |e: String| format!("texture {index}: sampler {s}: {e}");
+            wrap = wrap_mode(sampler.wrap_s).map_err(bad)?
+                | wrap_mode(sampler.wrap_t).map_err(bad)? << 2;
         }
-        if let Some(&t) = self.by_image.get(&source) {
-            return Ok(t);
+        if let Some(&t) = self.by_image.get(&(source, linear)) {
+            return Ok(Loaded { index: t, wrap });
         }
         if self.textures.len() >= crate::consts::MAX_TEXTURES {
             return Err(format!(
@@ -332,14 +416,21 @@ impl TextureLoader<'_> {
             );
             rgba = image::imageops::resize(&rgba, nw, nh, image::imageops::FilterType::Triangle);
         }
+        if linear {
+            for p in rgba.pixels_mut() {
+                for c in &mut p.0[..3] {
+                    *c = srgb_encoded(*c);
+                }
+            }
+        }
         self.textures.push(Texture {
             width: rgba.width(),
             height: rgba.height(),
             rgba: rgba.into_raw(),
         });
         let t = self.textures.len() as u32 - 1;
-        self.by_image.insert(source, t);
-        Ok(t)
+        self.by_image.insert((source, linear), t);
+        Ok(Loaded { index: t, wrap })
     }
 }
 
@@ -481,33 +572,59 @@ fn primitive_mesh(
         walk.warn(format!("{what}: no triangles; skipped"));
         return Ok(None);
     }
-    // The UV set the material's base-colour texture names (TEXCOORD_0 without one).
-    let texture = prim
-        .material
-        .and_then(|m| doc.root.materials.get(m))
-        .and_then(|m| m.pbr_metallic_roughness.as_ref())
-        .and_then(|p| p.base_color_texture.as_ref());
-    let set = format!("TEXCOORD_{}", texture.map_or(0, |t| t.tex_coord));
-    if texture.is_some() && !prim.attributes.contains_key(&set) {
-        walk.warn(format!(
-            "{what}: textured without {set}; its texture is sampled at one texel"
-        ));
+    // The texture coordinate sets the primitive's material reads, each checked for.
+    let material = prim.material.and_then(|m| doc.root.materials.get(m));
+    let mut sets = material.map_or(Vec::new(), material_sets);
+    sets.retain(|&s| s <= 1);
+    for set in sets.iter().map(|s| format!("TEXCOORD_{s}")) {
+        if !prim.attributes.contains_key(&set) {
+            walk.warn(format!(
+                "{what}: textured without {set}; its texture is sampled at one texel"
+            ));
+        }
     }
-    let uvs = match prim.attributes.get(&set) {
-        Some(&a) => {
-            let uv: Vec<Vec2> = doc
-                .read_floats(a, 2, &format!("{what} {set}"))?
-                .chunks_exact(2)
-                .map(|c| Vec2::new(c[0], c[1]))
+    let uv_set = |k: u32| -> Res<Option<Vec<Vec2>>> {
+        let set = format!("TEXCOORD_{k}");
+        let Some(&a) = prim.attributes.get(&set) else {
+            return Ok(None);
+        };
+        let uv: Vec<Vec2> = doc
+            .read_floats(a, 2, &format!("{what} {set}"))?
+            .chunks_exact(2)
+            .map(|c| Vec2::new(c[0], c[1]))
+            .collect();
+        if uv.len() != positions.len() || uv.iter().any(|v| !v.is_finite()) {
+            return Err(format!(
+                "{what}: {set} (accessor {a}) needs one finite UV per vertex"
+            ));
+        }
+        Ok(Some(uv))
+    };
+    let uvs = uv_set(0)?.unwrap_or_else(|| vec![Vec2::ZERO; positions.len()]);
+    let uvs1 = match sets.contains(&1) {
+        true => uv_set(1)?.unwrap_or_default(),
+        false => Vec::new(),
+    };
+    let colors = match prim.attributes.get("COLOR_0") {
+        Some(&a) => vertex_colours(doc, a, positions.len(), &what)?,
+        None => Vec::new(),
+    };
+    let normal_texture = material.and_then(|m| m.normal_texture.as_ref());
+    let tangents = match (normal_texture, prim.attributes.get("TANGENT")) {
+        (Some(_), Some(&a)) => {
+            let t: Vec<Vec4> = doc
+                .read_floats(a, 4, &format!("{what} TANGENT"))?
+                .chunks_exact(4)
+                .map(Vec4::from_slice)
                 .collect();
-            if uv.len() != positions.len() || uv.iter().any(|v| !v.is_finite()) {
+            if t.len() != positions.len() || t.iter().any(|v| !v.is_finite()) {
                 return Err(format!(
-                    "{what}: {set} (accessor {a}) needs one finite UV per vertex"
+                    "{what}: TANGENT (accessor {a}) needs one finite tangent per vertex"
                 ));
             }
-            uv
+            t
         }
-        None => vec![Vec2::ZERO; positions.len()],
+        _ => Vec::new(),
     };
     let mut mesh = match prim.attributes.get("NORMAL") {
         Some(&a) => {
@@ -529,6 +646,9 @@ fn primitive_mesh(
                 normals,
                 uvs,
                 indices,
+                tangents,
+                colors,
+                uvs1,
             }
         }
         None => {
@@ -538,9 +658,29 @@ fn primitive_mesh(
                     indices.len()
                 ));
             }
-            flat_mesh(&positions, &uvs, &indices)
+            let welded = Mesh {
+                positions,
+                normals: Vec::new(),
+                uvs,
+                indices,
+                tangents,
+                colors,
+                uvs1,
+            };
+            flat_mesh(&welded)
         }
     };
+    // A normal texture without the file's tangents: MikkTSpace's (glTF §3.7.2.1), on the
+    // texture's coordinate set, each corner its own vertex (its tangent is the corner's).
+    if let Some(t) = normal_texture.filter(|_| mesh.tangents.is_empty()) {
+        if mesh.indices.len() > MAX_VERTICES as usize {
+            return Err(format!(
+                "{what}: {} corners would be more than {MAX_VERTICES} vertices with generated tangents",
+                mesh.indices.len()
+            ));
+        }
+        mesh = with_generated_tangents(&unwelded(&mesh), t.tex_coord);
+    }
     // Normals come from the file's winding; only then is it flipped for a mirroring
     // transform.
     if flipped {
@@ -549,21 +689,120 @@ fn primitive_mesh(
     Ok(Some(mesh))
 }
 
+/// `m` with every corner its own vertex (each per-vertex array expanded alike).
+fn unwelded(m: &Mesh) -> Mesh {
+    fn pick<T: Copy>(v: &[T], idx: &[u32]) -> Vec<T> {
+        if v.is_empty() {
+            return Vec::new();
+        }
+        idx.iter().map(|&i| v[i as usize]).collect()
+    }
+    Mesh {
+        positions: pick(&m.positions, &m.indices),
+        normals: pick(&m.normals, &m.indices),
+        uvs: pick(&m.uvs, &m.indices),
+        tangents: pick(&m.tangents, &m.indices),
+        colors: pick(&m.colors, &m.indices),
+        uvs1: pick(&m.uvs1, &m.indices),
+        indices: (0..m.indices.len() as u32).collect(),
+    }
+}
+
 /// A triangle list without normals as the specification asks to shade it (§3.7.2.1: flat
 /// normals): one vertex per corner, each with its face's normal.
-fn flat_mesh(positions: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Mesh {
-    let mut m = Mesh::default();
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
-        let n = (b - a).cross(c - a).normalize_or(Vec3::Y);
-        for &i in t {
-            m.indices.push(m.positions.len() as u32);
-            m.positions.push(positions[i as usize]);
-            m.uvs.push(uvs[i as usize]);
-            m.normals.push(n);
+fn flat_mesh(welded: &Mesh) -> Mesh {
+    let mut m = unwelded(welded);
+    m.normals = m
+        .positions
+        .chunks_exact(3)
+        .flat_map(|t| [(t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Y); 3])
+        .collect();
+    m
+}
+
+/// An unwelded mesh (three vertices a triangle) with MikkTSpace tangents on coordinate set
+/// `set`.
+fn with_generated_tangents(m: &Mesh, set: u32) -> Mesh {
+    struct Faces<'a> {
+        mesh: &'a Mesh,
+        uvs: &'a [Vec2],
+        tangents: Vec<Vec4>,
+    }
+    impl mikktspace::Geometry for Faces<'_> {
+        fn num_faces(&self) -> usize {
+            self.mesh.positions.len() / 3
+        }
+        fn num_vertices_of_face(&self, _face: usize) -> usize {
+            3
+        }
+        fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.mesh.positions[face * 3 + vert].to_array()
+        }
+        fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.mesh.normals[face * 3 + vert].to_array()
+        }
+        fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+            self.uvs[face * 3 + vert].to_array()
+        }
+        fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
+            self.tangents[face * 3 + vert] = Vec4::from_array(tangent);
         }
     }
-    m
+    let uvs = match set {
+        1 if !m.uvs1.is_empty() => &m.uvs1,
+        _ => &m.uvs,
+    };
+    let mut faces = Faces {
+        mesh: m,
+        uvs,
+        tangents: vec![Vec4::ZERO; m.positions.len()],
+    };
+    // A degenerate mapping leaves zero tangents: the shader then keeps the vertex normal.
+    mikktspace::generate_tangents(&mut faces);
+    Mesh {
+        tangents: faces.tangents,
+        ..m.clone()
+    }
+}
+
+/// `COLOR_0` as colours (VEC3 or VEC4, floats or normalized integers), checked.
+fn vertex_colours(doc: &Document, a: usize, n: usize, what: &str) -> Res<Vec<Vec4>> {
+    let comps = match doc.root.accessors.get(a).map(|acc| acc.kind.as_str()) {
+        Some("VEC3") => 3,
+        Some("VEC4") => 4,
+        _ => {
+            return Err(format!(
+                "{what}: COLOR_0 (accessor {a}) is not VEC3 or VEC4"
+            ))
+        }
+    };
+    let c: Vec<Vec4> = doc
+        .read_floats(a, comps, &format!("{what} COLOR_0"))?
+        .chunks_exact(comps)
+        .map(|c| Vec4::new(c[0], c[1], c[2], if comps == 4 { c[3] } else { 1.0 }))
+        .collect();
+    if c.len() != n || c.iter().any(|v| !v.is_finite() || v.min_element() < 0.0) {
+        return Err(format!(
+            "{what}: COLOR_0 (accessor {a}) needs one finite, non-negative colour per vertex"
+        ));
+    }
+    Ok(c)
+}
+
+/// The texture coordinate sets a material's textures read.
+fn material_sets(m: &MaterialDef) -> Vec<u32> {
+    let pbr = m.pbr_metallic_roughness.as_ref();
+    let refs = [
+        pbr.and_then(|p| p.base_color_texture.as_ref()),
+        pbr.and_then(|p| p.metallic_roughness_texture.as_ref()),
+        m.emissive_texture.as_ref(),
+        m.normal_texture.as_ref(),
+        m.occlusion_texture.as_ref(),
+    ];
+    let mut sets: Vec<u32> = refs.iter().flatten().map(|t| t.tex_coord).collect();
+    sets.sort_unstable();
+    sets.dedup();
+    sets
 }
 
 /// Instance node `ni`'s mesh with world transform `world`.

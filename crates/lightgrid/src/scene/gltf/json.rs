@@ -190,6 +190,10 @@ pub(super) struct EmissiveStrength {
 pub(super) struct TextureRef {
     pub index: usize,
     pub tex_coord: u32,
+    /// `normalTexture.scale`.
+    pub scale: Option<f32>,
+    /// `occlusionTexture.strength`.
+    pub strength: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]

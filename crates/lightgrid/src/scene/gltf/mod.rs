@@ -31,7 +31,7 @@ mod read;
 mod unread;
 
 pub use animation::{FPS as ANIMATION_FPS, MAX_FRAMES as MAX_ANIMATION_FRAMES};
-pub use export::export;
+pub use export::{export, export_losses};
 pub use import::ORBIT_FRAMES;
 
 use crate::error::{Error, Result};

@@ -32,9 +32,9 @@ fn having<T>(items: &[T], has: impl Fn(&T) -> bool) -> Vec<usize> {
         .collect()
 }
 
-/// Does a texture reference read a coordinate set other than 0?
+/// Does a texture reference read a coordinate set past 1?
 fn other_set(t: &Option<TextureRef>) -> bool {
-    t.as_ref().is_some_and(|t| t.tex_coord != 0)
+    t.as_ref().is_some_and(|t| t.tex_coord > 1)
 }
 
 /// One warning for `indices` of `what` (none when empty).
@@ -61,40 +61,16 @@ pub(super) fn warnings(root: &Root) -> Vec<String> {
     }
     say(
         &mut out,
-        having(mats, |m| m.normal_texture.is_some()),
-        "material",
-        "has a normalTexture, which is not read: the geometry's own normals are shaded",
-    );
-    say(
-        &mut out,
         having(mats, |m| {
-            pbr(m).is_some_and(|p| p.metallic_roughness_texture.is_some())
+            let pbr = pbr(m);
+            [&m.emissive_texture, &m.normal_texture, &m.occlusion_texture]
+                .into_iter()
+                .chain(pbr.map(|p| &p.base_color_texture))
+                .chain(pbr.map(|p| &p.metallic_roughness_texture))
+                .any(other_set)
         }),
         "material",
-        "has a metallicRoughnessTexture, which is not read: its metallic and roughness factors hold over the whole surface",
-    );
-    say(
-        &mut out,
-        having(mats, |m| m.occlusion_texture.is_some()),
-        "material",
-        "has an occlusionTexture, which is not read: ambient light is not occluded",
-    );
-    say(
-        &mut out,
-        having(mats, |m| {
-            other_set(&m.emissive_texture) || pbr(m).is_some_and(|p| other_set(&p.base_color_texture))
-        }),
-        "material",
-        "samples a texture with texture coordinate set 1 or above, which is not read: set 0 is used",
-    );
-    let prims = |has: &dyn Fn(&super::json::Primitive) -> bool| {
-        having(&root.meshes, |m| m.primitives.iter().any(has))
-    };
-    say(
-        &mut out,
-        prims(&|p| p.attributes.keys().any(|k| k.starts_with("COLOR_"))),
-        "mesh",
-        "has vertex colours (COLOR_0), which are not read: its materials' colours are drawn alone",
+        "samples a texture with texture coordinate set 2 or above, which is not read: set 0 is used",
     );
     // Morph targets change the shape only with a weight other than 0 (the mesh's default or
     // a node's).
@@ -150,8 +126,8 @@ mod tests {
             "materials": [
                 {"normalTexture": {"index": 0}, "occlusionTexture": {"index": 0}},
                 {"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0},
-                  "baseColorTexture": {"index": 0, "texCoord": 1}}},
-                {"normalTexture": {"index": 0}}
+                  "baseColorTexture": {"index": 0, "texCoord": 2}}},
+                {"normalTexture": {"index": 0, "texCoord": 3}}
             ],
             "meshes": [
                 {"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}}]},
@@ -170,16 +146,13 @@ mod tests {
             assert_eq!(found.len(), 1, "{needle}: {w:#?}");
             found[0].clone()
         };
-        assert!(has("normalTexture").starts_with("materials 0, 2 "));
-        assert!(has("metallicRoughnessTexture").starts_with("material 1 "));
-        assert!(has("occlusionTexture").starts_with("material 0 "));
-        assert!(has("coordinate set 1").starts_with("material 1 "));
-        assert!(has("COLOR_0").starts_with("mesh 0 "));
+        // Read: normal, occlusion and metallic-roughness textures, sets 0 and 1, COLOR_0.
+        assert!(has("coordinate set 2").starts_with("materials 1, 2 "));
         // Mesh 1 is weighted by its node; mesh 2's targets have no weight.
         assert!(has("morph targets").starts_with("mesh 1 "));
         assert!(has("bind pose").starts_with("1 skin"));
         assert!(has("NEAREST").starts_with("sampler 0 "));
-        assert_eq!(w.len(), 8, "{w:#?}");
+        assert_eq!(w.len(), 4, "{w:#?}");
         assert!(warnings(&root("{}")).is_empty());
     }
 
