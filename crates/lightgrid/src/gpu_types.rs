@@ -46,7 +46,8 @@ pub struct GpuMaterial {
     pub alpha_cutoff: f32,
     /// Emissive texture: its layer in the texture array + 1; 0 for none.
     pub emissive_texture: u32,
-    pub _pad1: u32,
+    /// Bit `slot` set: that texture is magnified nearest-texel (glTF's `magFilter` NEAREST).
+    pub nearest: u32,
     /// glTF's metallic-roughness inputs, applied per sample where `flags` has
     /// `MATERIAL_FLAG_METALLIC_ROUGHNESS` (a file's material): the base colour factor, the
     /// metallic and roughness factors; the colours above are what they give untextured.

@@ -367,6 +367,7 @@ impl Renderer {
                 shadow_data.buffer.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&atlas.view),
                 wgpu::BindingResource::Sampler(&atlas.sampler),
+                wgpu::BindingResource::Sampler(&textures.nearest),
             ],
         );
         (scene, cull)

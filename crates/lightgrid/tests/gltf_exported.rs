@@ -113,7 +113,7 @@ fn every_part_not_applied_is_named_in_one_warning() {
     w.meshes[0]["weights"] = json!([0.5]);
     let mut doc = w.document(json!({"byteLength": w.bin.len()}));
     doc["skins"] = json!([{"joints": [0]}]);
-    doc["samplers"] = json!([{"magFilter": 9728}]);
+    doc["samplers"] = json!([{"minFilter": 9984}]);
     doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_texture_transform"]);
     let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
     let warned = |needle: &str| {
@@ -127,7 +127,7 @@ fn every_part_not_applied_is_named_in_one_warning() {
     warned("material 0 samples a texture with texture coordinate set 2 or above");
     warned("mesh 0 has morph targets with weights other than 0");
     warned("1 skin(s) are not applied");
-    warned("sampler 0 asks for NEAREST filtering");
+    warned("sampler 0 asks for a minification filter without mipmaps");
     warned("extension KHR_texture_transform is not read");
     // The same stage without them warns of nothing.
     let plain = stage(1.0, point(Some(8.0), 20.0), looking(0.0), EYE);
@@ -704,14 +704,25 @@ fn vertex_colours_multiply_the_base_colour() {
 /// on its left half and blue on its right, read with `uv` on set 0, `uv1` on set 1, the
 /// texture on `set` with sampler wrapping `wrap`.
 fn emissive_card(uv: [f32; 8], uv1: Option<[f32; 8]>, set: u32, wrap: u32) -> image::RgbaImage {
+    emissive_card_with(uv, uv1, set, json!({"wrapS": wrap, "wrapT": wrap}), 32)
+}
+
+/// [`emissive_card`] with any sampler, the texture `n` texels wide.
+fn emissive_card_with(
+    uv: [f32; 8],
+    uv1: Option<[f32; 8]>,
+    set: u32,
+    sampler: serde_json::Value,
+    n: u32,
+) -> image::RgbaImage {
     let mut w = card(json!({}), uv, uv1, Vec3::new(0.0, 0.0, -3.0));
-    let t = w.png(&halves(32, [255, 0, 0, 255], [0, 0, 255, 255]));
+    let t = w.png(&halves(n, [255, 0, 0, 255], [0, 0, 255, 255]));
     w.materials[0] = json!({"emissiveFactor": [1.0, 1.0, 1.0],
         "emissiveTexture": {"index": t, "texCoord": set},
         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 50.0}},
         "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0]}});
     let mut doc = w.document(json!({"byteLength": w.bin.len()}));
-    doc["samplers"] = json!([{"wrapS": wrap, "wrapT": wrap}]);
+    doc["samplers"] = json!([sampler]);
     doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_emissive_strength"]);
     let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
@@ -753,5 +764,31 @@ fn texture_coordinate_sets_and_wrapping_are_read() {
     assert_eq!(
         quarters(&emissive_card(UNIT_UV, Some(twice), 0, REPEAT)),
         "rrbb"
+    );
+}
+
+#[test]
+fn a_nearest_magnification_keeps_texels_sharp() {
+    // Two texels across the card: magnified linearly their colours blend across the middle,
+    // nearest-texel they meet at one edge.
+    let blended = |img: &image::RgbaImage| {
+        (11..85)
+            .filter(|&x| {
+                let p = img.get_pixel(x, 48).0;
+                p[0] > 40 && p[2] > 40
+            })
+            .count()
+    };
+    let linear = emissive_card_with(UNIT_UV, None, 0, json!({"magFilter": 9729}), 2);
+    let nearest = emissive_card_with(UNIT_UV, None, 0, json!({"magFilter": 9728}), 2);
+    assert!(
+        blended(&linear) > 10,
+        "linear: {} blended pixels",
+        blended(&linear)
+    );
+    assert!(
+        blended(&nearest) <= 2,
+        "nearest: {} blended pixels",
+        blended(&nearest)
     );
 }

@@ -85,7 +85,17 @@ fn gpu_structs_match_wgsl() {
             texture,
             alpha_cutoff,
             emissive_texture,
-            _pad1
+            nearest,
+            base,
+            metallic,
+            roughness,
+            normal_scale,
+            occlusion_strength,
+            metal_rough_texture,
+            normal_texture,
+            occlusion_texture,
+            uv_sets,
+            wraps
         ]
     );
     check_layout!(&module, "BvhNode", BvhNode, [lo, first, hi, count]);

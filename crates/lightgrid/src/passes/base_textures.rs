@@ -17,6 +17,8 @@ pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub struct BaseTextures {
     pub view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
+    /// Nearest-texel magnification (a glTF sampler's `magFilter` NEAREST: pixel art).
+    pub nearest: wgpu::Sampler,
     /// Bytes uploaded (every layer and mip).
     pub bytes: u64,
 }
@@ -105,21 +107,44 @@ impl BaseTextures {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("base-colour sampler"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
+        let sampler = device.create_sampler(&sampler_descriptor());
+        let nearest = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("base-colour sampler, nearest"),
+            mag_filter: wgpu::FilterMode::Nearest,
+            min_filter: wgpu::FilterMode::Nearest,
+            ..sampler_descriptor()
         });
         BaseTextures {
             view,
             sampler,
+            nearest,
             bytes: data.len() as u64,
         }
+    }
+}
+
+/// The trilinear, repeating sampler (wrapping other than repeat is applied to the coordinates
+/// in the shader).
+fn sampler_descriptor() -> wgpu::SamplerDescriptor<'static> {
+    wgpu::SamplerDescriptor {
+        label: Some("base-colour sampler"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        address_mode_w: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    }
+}
+
+/// The layout entry of binding 11, the nearest sampler, fragment stage.
+pub fn nearest_layout_entry() -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding: 11,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
     }
 }
 

@@ -43,6 +43,8 @@ fn vs_main(v: VertexIn) -> VertexOut {
 // per texture, sRGB-decoded when sampled, mipmapped, repeating.
 @group(0) @binding(6) var base_textures: texture_2d_array<f32>;
 @group(0) @binding(7) var base_sampler: sampler;
+// Nearest-texel magnification, for textures whose glTF sampler asks for it.
+@group(0) @binding(11) var nearest_sampler: sampler;
 
 // Where a material's textures are read at a sample: both coordinate sets and their screen
 // derivatives (taken here, in uniform control flow, so textures can be read in branches
@@ -91,6 +93,9 @@ fn material_texel(m: Material, t: TexCoords, slot: u32, texture: u32, none: vec4
         wrap_coordinate(t.uv[coords].y, wrap >> 2u, texels),
     );
     let layer = texture - 1u;
+    if (((m.nearest >> slot) & 1u) != 0u) {
+        return textureSampleGrad(base_textures, nearest_sampler, uv, layer, t.ddx[coords], t.ddy[coords]);
+    }
     return textureSampleGrad(base_textures, base_sampler, uv, layer, t.ddx[coords], t.ddy[coords]);
 }
 

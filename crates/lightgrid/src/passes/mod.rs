@@ -309,6 +309,8 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                 count: None,
             },
+            // The textures' nearest sampler (glTF's magFilter NEAREST).
+            base_textures::nearest_layout_entry(),
         ],
     })
 }

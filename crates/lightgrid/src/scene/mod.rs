@@ -62,6 +62,8 @@ pub struct Material {
     pub uv_sets: u32,
     /// Each texture's wrapping, 4 bits a slot (`GpuMaterial::wraps`).
     pub wraps: u32,
+    /// Bit `consts::TEXTURE_SLOT_*` set: that texture is magnified nearest-texel.
+    pub nearest: u32,
     /// Alpha test (glTF's `MASK`): fragments whose alpha (`alpha` × the texture's) is below
     /// this are discarded in every pass, depth passes included.
     pub alpha_cutoff: Option<f32>,
@@ -137,6 +139,7 @@ impl Material {
             occlusion_texture: None,
             uv_sets: 0,
             wraps: 0,
+            nearest: 0,
             alpha_cutoff: None,
         }
     }
@@ -190,7 +193,7 @@ impl Material {
             texture: self.texture.map_or(0, |t| t + 1),
             alpha_cutoff: self.alpha_cutoff.unwrap_or(0.0),
             emissive_texture: self.emissive_texture.map_or(0, |t| t + 1),
-            _pad1: 0,
+            nearest: self.nearest,
             base: mr.map_or([0.0; 3], |m| m.base.to_array()),
             metallic: mr.map_or(0.0, |m| m.metallic),
             roughness: mr.map_or(0.0, |m| m.roughness),

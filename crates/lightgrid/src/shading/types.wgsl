@@ -26,7 +26,7 @@ struct Material {
     texture: u32,          // layer + 1 in `base_textures`; 0: none
     alpha_cutoff: f32,     // alpha test (glTF MASK); 0: none
     emissive_texture: u32, // layer + 1 in `base_textures`; 0: none
-    _pad1: u32,
+    nearest: u32,          // bit TEXTURE_SLOT_*: the slot is magnified nearest-texel
     // glTF metallic-roughness, per sample where flags has MATERIAL_FLAG_METALLIC_ROUGHNESS
     base: vec3<f32>,
     metallic: f32,

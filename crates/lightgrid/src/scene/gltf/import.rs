@@ -144,6 +144,7 @@ impl ExactMaterial {
             occlusion_texture: None,
             uv_sets: 0,
             wraps: 0,
+            nearest: 0,
             alpha_cutoff: self.alpha_cutoff.filter(|c| c.is_finite()),
         };
         material_is_sane(&m).then_some(m)
@@ -180,11 +181,13 @@ fn map_material(
     // Each texture a material reads, in its slot: ours, its coordinate set and wrapping.
     let mut uv_sets = 0;
     let mut wraps = 0;
+    let mut nearest = 0;
     let mut slot = |r: Option<&TextureRef>, slot: u32, linear: bool| -> Res<Option<u32>> {
         let Some(r) = r else { return Ok(None) };
         let t = textures.load(r.index, index, linear)?;
         uv_sets |= u32::from(r.tex_coord == 1) << slot;
         wraps |= t.wrap << (4 * slot);
+        nearest |= u32::from(t.nearest) << slot;
         Ok(Some(t.index))
     };
     use crate::consts::{
@@ -224,6 +227,7 @@ fn map_material(
         occlusion_texture: occlusion.map(|t| (t, strength)),
         uv_sets,
         wraps,
+        nearest,
         ..m
     };
     if let Some(exact) = def
@@ -315,6 +319,7 @@ fn map_material(
         occlusion_texture: None,
         uv_sets: 0,
         wraps: 0,
+        nearest: 0,
         alpha_cutoff: alpha_tested.then_some(cutoff),
     }))
 }
@@ -328,11 +333,13 @@ struct TextureLoader<'a> {
     textures: Vec<Texture>,
 }
 
-/// A texture a material reads: ours, and its sampler's wrapping (4 bits: u, then v).
+/// A texture a material reads: ours, its sampler's wrapping (4 bits: u, then v) and whether
+/// it magnifies nearest-texel.
 #[derive(Clone, Copy)]
 struct Loaded {
     index: u32,
     wrap: u32,
+    nearest: bool,
 }
 
 /// Encode a linear value (0-255) as the sRGB byte the GPU's sRGB decode turns back into it.
@@ -372,6 +379,7 @@ impl TextureLoader<'_> {
             format!("{what}: texture {index} has no source image (an extension's?)")
         })?;
         let mut wrap = 0;
+        let mut nearest = false;
         if let Some(s) = def.sampler {
             let sampler = self
                 .doc
@@ -382,9 +390,14 @@ impl TextureLoader<'_> {
             let bad = |e: String| format!("texture {index}: sampler {s}: {e}");
             wrap = wrap_mode(sampler.wrap_s).map_err(bad)?
                 | wrap_mode(sampler.wrap_t).map_err(bad)? << 2;
+            nearest = sampler.mag_filter == Some(9728);
         }
         if let Some(&t) = self.by_image.get(&(source, linear)) {
-            return Ok(Loaded { index: t, wrap });
+            return Ok(Loaded {
+                index: t,
+                wrap,
+                nearest,
+            });
         }
         if self.textures.len() >= crate::consts::MAX_TEXTURES {
             return Err(format!(
@@ -430,7 +443,11 @@ impl TextureLoader<'_> {
         });
         let t = self.textures.len() as u32 - 1;
         self.by_image.insert((source, linear), t);
-        Ok(Loaded { index: t, wrap })
+        Ok(Loaded {
+            index: t,
+            wrap,
+            nearest,
+        })
     }
 }
 

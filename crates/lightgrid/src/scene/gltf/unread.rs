@@ -99,14 +99,15 @@ pub(super) fn warnings(root: &Root) -> Vec<String> {
             root.skins.len().max(1)
         ));
     }
-    let nearest = |f: Option<u32>| f.is_some_and(|f| f == 9728 || f == 9984 || f == 9986);
+    // Magnification NEAREST is applied, and minification within mip levels is too fine to
+    // see; a minification without mipmaps (NEAREST, LINEAR) or with the nearest mip level
+    // (*_MIPMAP_NEAREST) is drawn with linearly blended mip levels.
+    let unmipped = |f: Option<u32>| f.is_some_and(|f| matches!(f, 9728 | 9729 | 9984 | 9985));
     say(
         &mut out,
-        having(&root.samplers, |s| {
-            nearest(s.mag_filter) || nearest(s.min_filter)
-        }),
+        having(&root.samplers, |s| unmipped(s.min_filter)),
         "sampler",
-        "asks for NEAREST filtering, which is not applied: textures are filtered trilinearly",
+        "asks for a minification filter without mipmaps or with the nearest mip level, which is not applied: textures are minified with blended mip levels",
     );
     out
 }
@@ -137,7 +138,7 @@ mod tests {
             ],
             "nodes": [{"mesh": 1, "weights": [0.5]}, {"mesh": 2}, {"skin": 0}],
             "skins": [{"joints": [0]}],
-            "samplers": [{"magFilter": 9728}, {"magFilter": 9729}]
+            "samplers": [{"minFilter": 9728}, {"magFilter": 9728, "minFilter": 9986}]
         }"#,
         );
         let w = warnings(&r);
@@ -151,7 +152,7 @@ mod tests {
         // Mesh 1 is weighted by its node; mesh 2's targets have no weight.
         assert!(has("morph targets").starts_with("mesh 1 "));
         assert!(has("bind pose").starts_with("1 skin"));
-        assert!(has("NEAREST").starts_with("sampler 0 "));
+        assert!(has("minification").starts_with("sampler 0 "));
         assert_eq!(w.len(), 4, "{w:#?}");
         assert!(warnings(&root("{}")).is_empty());
     }
