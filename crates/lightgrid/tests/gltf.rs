@@ -986,15 +986,21 @@ fn broken_textures_fail_clearly() {
             .to_string();
         assert!(e.contains(words), "{what}: '{e}' does not say '{words}'");
     }
-    // Clamped wrapping is not applied: a warning, not an error.
+    // Clamped wrapping is applied (the material records it); a wrap mode glTF does not have
+    // is an error naming the sampler.
     let (mut doc, bin) = parts();
     doc["samplers"] = json!([{"wrapS": 33071}]);
     let loaded = load(&GltfWriter::glb_of(&doc, &bin)).unwrap();
-    assert!(
-        loaded.warnings.iter().any(|w| w.contains("wrapping")),
-        "{:?}",
-        loaded.warnings
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    assert_eq!(
+        loaded.scene.materials[0].wraps,
+        lightgrid::consts::WRAP_CLAMP
     );
+    doc["samplers"] = json!([{"wrapS": 1234}]);
+    let e = load(&GltfWriter::glb_of(&doc, &bin))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("sampler 0: wrap mode 1234"), "{e}");
 }
 
 /// Sparse accessors (glTF §3.6.2.3): substitutions over a base view, and over zeros without

@@ -90,6 +90,10 @@ pub(super) struct ExactMaterial {
     /// The alpha test's cutoff (the texture is the glTF material's `baseColorTexture`).
     #[serde(default)]
     pub alpha_cutoff: Option<f32>,
+    /// A file's metallic-roughness inputs (base colour, metallic, roughness), so an exported
+    /// file's material is still derived per sample when read back.
+    #[serde(default)]
+    pub metallic_roughness: Option<([f32; 3], f32, f32)>,
 }
 
 impl ExactMaterial {
@@ -111,6 +115,8 @@ impl ExactMaterial {
             paint: paint.to_array(),
             paint_power,
             alpha_cutoff: m.alpha_cutoff,
+            metallic_roughness: (m.metallic_roughness)
+                .map(|p| (p.base.to_array(), p.metallic, p.roughness)),
         }
     }
 
@@ -139,7 +145,20 @@ impl ExactMaterial {
             shader,
             texture: None,
             emissive_texture: None,
-            metallic_roughness: None,
+            metallic_roughness: self
+                .metallic_roughness
+                .and_then(|(base, metallic, roughness)| {
+                    let ok = base
+                        .iter()
+                        .chain([&metallic, &roughness])
+                        .all(|v| (0.0..=1.0e6).contains(v));
+                    ok.then(|| crate::scene::MetallicRoughness {
+                        base: base.into(),
+                        metallic: metallic.min(1.0),
+                        roughness: roughness.min(1.0),
+                        texture: None,
+                    })
+                }),
             normal_texture: None,
             occlusion_texture: None,
             uv_sets: 0,
@@ -238,10 +257,18 @@ fn map_material(
     {
         match exact.ok().and_then(|e| e.to_material()) {
             Some(m) => {
-                if mr_texture.is_some() {
-                    walk.warn(format!("material {index}: its metallicRoughnessTexture is not applied to lightgrid's exact material (extras.lightgrid)"));
-                }
-                return Ok(textured(m));
+                let mr = match (m.metallic_roughness, mr_texture) {
+                    (Some(p), texture) => Some(crate::scene::MetallicRoughness { texture, ..p }),
+                    (None, Some(_)) => {
+                        walk.warn(format!("material {index}: its metallicRoughnessTexture is not applied to lightgrid's own Blinn-Phong material (extras.lightgrid)"));
+                        None
+                    }
+                    (None, None) => None,
+                };
+                return Ok(textured(Material {
+                    metallic_roughness: mr,
+                    ..m
+                }));
             }
             None => walk.warn(format!(
                 "material {index}: its extras.lightgrid is malformed; the glTF material is used"
