@@ -68,6 +68,10 @@ pub struct GpuMaterial {
     pub uv_sets: u32,
     /// 4 bits per texture slot (bit `4·slot`): wrap along u (2 bits), then v; `WRAP_*`.
     pub wraps: u32,
+    /// Per texture slot, the 2×3 matrix of its `KHR_texture_transform`, row-major (u' is
+    /// a·u plus b·v plus c, v' is d·u plus e·v plus f), six floats a slot from float
+    /// `6·slot`; the identity without one.
+    pub uv_transforms: [[f32; 4]; 8],
 }
 
 /// One vertex in world space (the CPU bakes object transforms each frame).
@@ -142,7 +146,7 @@ pub struct GridParams {
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
-const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 144);
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 272);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 76);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
 

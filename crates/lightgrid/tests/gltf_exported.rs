@@ -114,7 +114,7 @@ fn every_part_not_applied_is_named_in_one_warning() {
     let mut doc = w.document(json!({"byteLength": w.bin.len()}));
     doc["skins"] = json!([{"joints": [0]}]);
     doc["samplers"] = json!([{"minFilter": 9984}]);
-    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_texture_transform"]);
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_sheen"]);
     let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
     let warned = |needle: &str| {
         let n = loaded
@@ -128,7 +128,7 @@ fn every_part_not_applied_is_named_in_one_warning() {
     warned("mesh 0 has morph targets with weights other than 0");
     warned("1 skin(s) are not applied");
     warned("sampler 0 asks for a minification filter without mipmaps");
-    warned("extension KHR_texture_transform is not read");
+    warned("extension KHR_materials_sheen is not read");
     // The same stage without them warns of nothing.
     let plain = stage(1.0, point(Some(8.0), 20.0), looking(0.0), EYE);
     assert!(load(&plain.glb()).unwrap().warnings.is_empty());
@@ -715,15 +715,33 @@ fn emissive_card_with(
     sampler: serde_json::Value,
     n: u32,
 ) -> image::RgbaImage {
+    emissive_card_full(uv, uv1, json!({"texCoord": set}), sampler, n)
+}
+
+/// [`emissive_card_with`] with the texture reference's fields (`texCoord`, `extensions`)
+/// given whole.
+fn emissive_card_full(
+    uv: [f32; 8],
+    uv1: Option<[f32; 8]>,
+    reference: serde_json::Value,
+    sampler: serde_json::Value,
+    n: u32,
+) -> image::RgbaImage {
     let mut w = card(json!({}), uv, uv1, Vec3::new(0.0, 0.0, -3.0));
     let t = w.png(&halves(n, [255, 0, 0, 255], [0, 0, 255, 255]));
+    let mut reference = reference;
+    reference["index"] = json!(t);
     w.materials[0] = json!({"emissiveFactor": [1.0, 1.0, 1.0],
-        "emissiveTexture": {"index": t, "texCoord": set},
+        "emissiveTexture": reference,
         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 50.0}},
         "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0]}});
     let mut doc = w.document(json!({"byteLength": w.bin.len()}));
     doc["samplers"] = json!([sampler]);
-    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_emissive_strength"]);
+    doc["extensionsUsed"] = json!([
+        "KHR_lights_punctual",
+        "KHR_materials_emissive_strength",
+        "KHR_texture_transform"
+    ]);
     let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     every_pipeline_as_forward(&loaded.scene, "emissive card", false)
@@ -791,4 +809,23 @@ fn a_nearest_magnification_keeps_texels_sharp() {
         "nearest: {} blended pixels",
         blended(&nearest)
     );
+}
+
+#[test]
+fn a_texture_transform_moves_turns_and_scales_the_coordinates() {
+    let with = |transform: serde_json::Value, uv1: Option<[f32; 8]>| {
+        let reference = json!({"texCoord": 0, "extensions": {"KHR_texture_transform": transform}});
+        quarters(&emissive_card_full(UNIT_UV, uv1, reference, json!({}), 32))
+    };
+    assert_eq!(with(json!({}), None), "rrbb");
+    assert_eq!(with(json!({"offset": [0.5, 0.0]}), None), "bbrr");
+    assert_eq!(with(json!({"scale": [2.0, 1.0]}), None), "rbrb");
+    // Half a turn: u' = −u (repeating).
+    assert_eq!(
+        with(json!({"rotation": std::f32::consts::PI}), None),
+        "bbrr"
+    );
+    // Its texCoord overrides the reference's: set 1 holds doubled coordinates.
+    let twice = [0.0, 1.0, 2.0, 1.0, 2.0, 0.0, 0.0, 0.0];
+    assert_eq!(with(json!({"texCoord": 1}), Some(twice)), "rbrb");
 }

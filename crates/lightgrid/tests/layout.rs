@@ -95,7 +95,8 @@ fn gpu_structs_match_wgsl() {
             normal_texture,
             occlusion_texture,
             uv_sets,
-            wraps
+            wraps,
+            uv_transforms
         ]
     );
     check_layout!(&module, "BvhNode", BvhNode, [lo, first, hi, count]);

@@ -78,6 +78,11 @@ fn wrap_coordinate(x: f32, mode: u32, texels: f32) -> f32 {
     return x;
 }
 
+// Float `i` of a material's texture transforms.
+fn uv_transform(m: Material, i: u32) -> f32 {
+    return m.uv_transforms[i / 4u][i % 4u];
+}
+
 // Texture slot `slot` of material `m` (layer + 1 in `texture`; 0: none, then `none`) at the
 // sample: its coordinate set and wrapping, the gradients of the unwrapped coordinates (so a
 // seam of the wrapping does not change the mip level).
@@ -88,15 +93,24 @@ fn material_texel(m: Material, t: TexCoords, slot: u32, texture: u32, none: vec4
     let coords = (m.uv_sets >> slot) & 1u;
     let wrap = (m.wraps >> (4u * slot)) & 15u;
     let texels = f32(textureDimensions(base_textures).x);
+    // KHR_texture_transform: the slot's 2x3 matrix on the coordinates, its 2x2 part on
+    // their gradients.
+    let k = 6u * slot;
+    let row_u = vec3<f32>(uv_transform(m, k), uv_transform(m, k + 1u), uv_transform(m, k + 2u));
+    let row_v = vec3<f32>(uv_transform(m, k + 3u), uv_transform(m, k + 4u), uv_transform(m, k + 5u));
+    let moved = vec2<f32>(dot(row_u, vec3<f32>(t.uv[coords], 1.0)), dot(row_v, vec3<f32>(t.uv[coords], 1.0)));
+    let linear = mat2x2<f32>(vec2<f32>(row_u.x, row_v.x), vec2<f32>(row_u.y, row_v.y));
+    let ddx = linear * t.ddx[coords];
+    let ddy = linear * t.ddy[coords];
     let uv = vec2<f32>(
-        wrap_coordinate(t.uv[coords].x, wrap & 3u, texels),
-        wrap_coordinate(t.uv[coords].y, wrap >> 2u, texels),
+        wrap_coordinate(moved.x, wrap & 3u, texels),
+        wrap_coordinate(moved.y, wrap >> 2u, texels),
     );
     let layer = texture - 1u;
     if (((m.nearest >> slot) & 1u) != 0u) {
-        return textureSampleGrad(base_textures, nearest_sampler, uv, layer, t.ddx[coords], t.ddy[coords]);
+        return textureSampleGrad(base_textures, nearest_sampler, uv, layer, ddx, ddy);
     }
-    return textureSampleGrad(base_textures, base_sampler, uv, layer, t.ddx[coords], t.ddy[coords]);
+    return textureSampleGrad(base_textures, base_sampler, uv, layer, ddx, ddy);
 }
 
 // A material's base colour at the sample: its texture's texel times the vertex colour (white

@@ -64,6 +64,8 @@ pub struct Material {
     pub wraps: u32,
     /// Bit `consts::TEXTURE_SLOT_*` set: that texture is magnified nearest-texel.
     pub nearest: u32,
+    /// Per texture slot, its coordinates' transform (glTF's `KHR_texture_transform`).
+    pub uv_transforms: [glam::Affine2; 5],
     /// Alpha test (glTF's `MASK`): fragments whose alpha (`alpha` × the texture's) is below
     /// this are discarded in every pass, depth passes included.
     pub alpha_cutoff: Option<f32>,
@@ -140,6 +142,7 @@ impl Material {
             uv_sets: 0,
             wraps: 0,
             nearest: 0,
+            uv_transforms: [glam::Affine2::IDENTITY; 5],
             alpha_cutoff: None,
         }
     }
@@ -204,6 +207,21 @@ impl Material {
             occlusion_texture: self.occlusion_texture.map_or(0, |t| t.0 + 1),
             uv_sets: self.uv_sets,
             wraps: self.wraps,
+            uv_transforms: {
+                // Six floats a slot, row-major 2x3.
+                let mut flat = [0.0f32; 32];
+                for (slot, t) in self.uv_transforms.iter().enumerate() {
+                    let (m, o) = (t.matrix2, t.translation);
+                    flat[6 * slot..6 * slot + 6].copy_from_slice(&[
+                        m.x_axis.x, m.y_axis.x, o.x, m.x_axis.y, m.y_axis.y, o.y,
+                    ]);
+                }
+                let mut rows = [[0.0; 4]; 8];
+                for (i, r) in rows.iter_mut().enumerate() {
+                    r.copy_from_slice(&flat[4 * i..4 * i + 4]);
+                }
+                rows
+            },
         }
     }
 }

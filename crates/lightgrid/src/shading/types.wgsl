@@ -38,6 +38,7 @@ struct Material {
     occlusion_texture: u32,   // layer + 1 (R); 0: none
     uv_sets: u32,             // bit TEXTURE_SLOT_*: the slot reads coordinate set 1
     wraps: u32,               // 4 bits per slot: u then v, WRAP_*
+    uv_transforms: array<vec4<f32>, 8>, // per slot a 2x3 matrix, 6 floats from 6 * slot
 }
 
 struct FrameUniforms {

@@ -164,6 +164,7 @@ impl ExactMaterial {
             uv_sets: 0,
             wraps: 0,
             nearest: 0,
+            uv_transforms: [glam::Affine2::IDENTITY; 5],
             alpha_cutoff: self.alpha_cutoff.filter(|c| c.is_finite()),
         };
         material_is_sane(&m).then_some(m)
@@ -201,10 +202,14 @@ fn map_material(
     let mut uv_sets = 0;
     let mut wraps = 0;
     let mut nearest = 0;
+    let mut uv_transforms = [glam::Affine2::IDENTITY; 5];
     let mut slot = |r: Option<&TextureRef>, slot: u32, linear: bool| -> Res<Option<u32>> {
         let Some(r) = r else { return Ok(None) };
         let t = textures.load(r.index, index, linear)?;
-        uv_sets |= u32::from(r.tex_coord == 1) << slot;
+        let (transform, set) = texture_transform(r)
+            .map_err(|e| format!("material {index}: KHR_texture_transform: {e}"))?;
+        uv_transforms[slot as usize] = transform;
+        uv_sets |= u32::from(set == 1) << slot;
         wraps |= t.wrap << (4 * slot);
         nearest |= u32::from(t.nearest) << slot;
         Ok(Some(t.index))
@@ -247,6 +252,7 @@ fn map_material(
         uv_sets,
         wraps,
         nearest,
+        uv_transforms,
         ..m
     };
     if let Some(exact) = def
@@ -347,6 +353,7 @@ fn map_material(
         uv_sets: 0,
         wraps: 0,
         nearest: 0,
+        uv_transforms: [glam::Affine2::IDENTITY; 5],
         alpha_cutoff: alpha_tested.then_some(cutoff),
     }))
 }
@@ -367,6 +374,26 @@ struct Loaded {
     index: u32,
     wrap: u32,
     nearest: bool,
+}
+
+/// A texture reference's `KHR_texture_transform` (§ of the extension: translation × rotation
+/// × scale on the coordinates, rotation counter-clockwise in UV space) and the coordinate set
+/// it reads (the extension's `texCoord` overrides the reference's).
+fn texture_transform(r: &TextureRef) -> Res<(glam::Affine2, u32)> {
+    let Some(t) = r.extensions.as_ref().and_then(|e| e.transform.as_ref()) else {
+        return Ok((glam::Affine2::IDENTITY, r.set()));
+    };
+    let offset = glam::Vec2::from(t.offset.unwrap_or([0.0, 0.0]));
+    let rotation = t.rotation.unwrap_or(0.0);
+    let scale = glam::Vec2::from(t.scale.unwrap_or([1.0, 1.0]));
+    if !(offset.is_finite() && rotation.is_finite() && scale.is_finite()) {
+        return Err("offset, rotation and scale must be finite".into());
+    }
+    let (sin, cos) = rotation.sin_cos();
+    // The extension's rotation matrix is [[cos, sin], [-sin, cos]] (columns as written).
+    let rotate = glam::Mat2::from_cols(glam::Vec2::new(cos, -sin), glam::Vec2::new(sin, cos));
+    let m = rotate * glam::Mat2::from_diagonal(scale);
+    Ok((glam::Affine2::from_mat2_translation(m, offset), r.set()))
 }
 
 /// Encode a linear value (0-255) as the sRGB byte the GPU's sRGB decode turns back into it.
@@ -723,7 +750,7 @@ fn primitive_mesh(
                 mesh.indices.len()
             ));
         }
-        mesh = with_generated_tangents(&unwelded(&mesh), t.tex_coord);
+        mesh = with_generated_tangents(&unwelded(&mesh), t.set());
     }
     // Normals come from the file's winding; only then is it flipped for a mirroring
     // transform.
@@ -843,7 +870,7 @@ fn material_sets(m: &MaterialDef) -> Vec<u32> {
         m.normal_texture.as_ref(),
         m.occlusion_texture.as_ref(),
     ];
-    let mut sets: Vec<u32> = refs.iter().flatten().map(|t| t.tex_coord).collect();
+    let mut sets: Vec<u32> = refs.iter().flatten().map(|t| t.set()).collect();
     sets.sort_unstable();
     sets.dedup();
     sets

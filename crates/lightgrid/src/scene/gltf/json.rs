@@ -194,6 +194,34 @@ pub(super) struct TextureRef {
     pub scale: Option<f32>,
     /// `occlusionTexture.strength`.
     pub strength: Option<f32>,
+    pub extensions: Option<TextureRefExtensions>,
+}
+
+impl TextureRef {
+    /// The texture coordinate set read: KHR_texture_transform's `texCoord` overrides the
+    /// reference's own.
+    pub fn set(&self) -> u32 {
+        (self.extensions.as_ref())
+            .and_then(|e| e.transform.as_ref())
+            .and_then(|t| t.tex_coord)
+            .unwrap_or(self.tex_coord)
+    }
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default)]
+pub(super) struct TextureRefExtensions {
+    #[serde(rename = "KHR_texture_transform")]
+    pub transform: Option<TextureTransform>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+pub(super) struct TextureTransform {
+    pub offset: Option<[f32; 2]>,
+    pub rotation: Option<f32>,
+    pub scale: Option<[f32; 2]>,
+    pub tex_coord: Option<u32>,
 }
 
 #[derive(Deserialize, Default)]

@@ -49,7 +49,11 @@ pub const MAX_TRIANGLES: u32 = 1 << 23;
 /// Where along its range an exported papers-unit light and its inverse-square candela agree.
 pub const LIGHT_MATCH_FRACTION: f32 = 0.25;
 /// Extensions read (a file may require these).
-pub const EXTENSIONS_READ: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+pub const EXTENSIONS_READ: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+];
 
 /// Choices for loading a file.
 #[derive(Clone, Copy, Debug, Default)]

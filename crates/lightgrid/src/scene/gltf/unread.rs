@@ -34,7 +34,7 @@ fn having<T>(items: &[T], has: impl Fn(&T) -> bool) -> Vec<usize> {
 
 /// Does a texture reference read a coordinate set past 1?
 fn other_set(t: &Option<TextureRef>) -> bool {
-    t.as_ref().is_some_and(|t| t.tex_coord > 1)
+    t.as_ref().is_some_and(|t| t.set() > 1)
 }
 
 /// One warning for `indices` of `what` (none when empty).
