@@ -82,13 +82,25 @@ pub struct GpuVertex {
     pub normal: [f32; 3],
     pub uv: [f32; 2],
     pub material: u32,
-    /// Tangent (xyz, world space) and bitangent sign (w), for normal textures; zero where
-    /// the mesh has none (and no normal texture reads it).
-    pub tangent: [f32; 4],
-    /// Vertex colour (glTF's `COLOR_0`), multiplying the base colour; white without one.
-    pub color: [f32; 4],
+    /// Tangent (xyz, world space) and bitangent sign (w) as signed normalized 16-bit
+    /// integers, for normal textures; zero where the mesh has none (and no normal texture
+    /// reads it).
+    pub tangent: [i16; 4],
+    /// Vertex colour (glTF's `COLOR_0`, 0 to 1) as normalized bytes, multiplying the base
+    /// colour; white without one.
+    pub color: [u8; 4],
     /// Texture coordinate set 1 (set 0 where the mesh has none).
     pub uv1: [f32; 2],
+}
+
+/// A unit vector's component as a signed normalized 16-bit integer (`Snorm16`).
+pub fn snorm16(v: f32) -> i16 {
+    (v.clamp(-1.0, 1.0) * 32767.0).round() as i16
+}
+
+/// A 0-to-1 value as a normalized byte (`Unorm8`).
+pub fn unorm8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
 }
 
 /// Per-frame uniforms: camera matrices, viewport and light count. Positions on the GPU are
@@ -147,7 +159,7 @@ pub struct GridParams {
 const _: () = assert!(std::mem::size_of::<GridParams>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 272);
-const _: () = assert!(std::mem::size_of::<GpuVertex>() == 76);
+const _: () = assert!(std::mem::size_of::<GpuVertex>() == 56);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
 
 /// One node of the light BVH: 32 bytes (`BvhNode` in `shading/types.wgsl`).

@@ -142,8 +142,14 @@ fn vertex_layout_matches_gpu_vertex() {
             offset_of!(GpuVertex, normal) as u64,
             offset_of!(GpuVertex, uv) as u64,
             offset_of!(GpuVertex, material) as u64,
+            offset_of!(GpuVertex, tangent) as u64,
+            offset_of!(GpuVertex, color) as u64,
+            offset_of!(GpuVertex, uv1) as u64,
         ]
     );
+    // Each attribute's format is its field's size.
+    let sizes: Vec<u64> = layout.attributes.iter().map(|a| a.format.size()).collect();
+    assert_eq!(sizes, [12, 12, 8, 4, 8, 4, 8]);
 }
 
 /// The memory model's byte sizes are the formats' and structs' own, not numbers kept in sync

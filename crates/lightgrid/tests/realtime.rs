@@ -318,6 +318,7 @@ fn a_loop_cut_short_is_counted() {
             shadow_data.as_entire_binding(),
             wgpu::BindingResource::TextureView(&atlas),
             wgpu::BindingResource::Sampler(&compare),
+            wgpu::BindingResource::Sampler(&textures.nearest),
         ],
     );
     let mut encoder = device.create_command_encoder(&Default::default());

@@ -218,7 +218,7 @@ pub fn count_target(count_blend: bool) -> Option<wgpu::ColorTargetState> {
 pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
     const ATTRS: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
         0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32,
-        4 => Float32x4, 5 => Float32x4, 6 => Float32x2
+        4 => Snorm16x4, 5 => Unorm8x4, 6 => Float32x2
     ];
     wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<GpuVertex>() as u64,

@@ -938,6 +938,9 @@ impl Scene {
             words(&mut h, bytemuck::cast_slice(&mesh.positions));
             words(&mut h, bytemuck::cast_slice(&mesh.normals));
             words(&mut h, bytemuck::cast_slice(&mesh.uvs));
+            words(&mut h, bytemuck::cast_slice(&mesh.tangents));
+            words(&mut h, bytemuck::cast_slice(&mesh.colors));
+            words(&mut h, bytemuck::cast_slice(&mesh.uvs1));
         }
         for o in &self.objects {
             (o.mesh, o.material, o.is_static()).hash(&mut h);
@@ -976,9 +979,11 @@ impl Scene {
         // turns the bitangent's handedness.
         let handed = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
         for i in 0..mesh.positions.len() {
-            let tangent = mesh.tangents.get(i).map_or([0.0; 4], |t| {
+            let tangent = mesh.tangents.get(i).map_or([0; 4], |t| {
                 let xyz = m.transform_vector3(t.truncate()).normalize_or_zero();
-                xyz.extend(t.w * handed).to_array()
+                xyz.extend(t.w.signum() * handed)
+                    .to_array()
+                    .map(crate::gpu_types::snorm16)
             });
             vertices.push(GpuVertex {
                 position: m.transform_point3(mesh.positions[i]).to_array(),
@@ -986,7 +991,10 @@ impl Scene {
                 uv: mesh.uvs[i].to_array(),
                 material: o.material as u32,
                 tangent,
-                color: mesh.colors.get(i).map_or([1.0; 4], |c| c.to_array()),
+                color: mesh
+                    .colors
+                    .get(i)
+                    .map_or([255; 4], |c| c.to_array().map(crate::gpu_types::unorm8)),
                 uv1: mesh.uvs1.get(i).unwrap_or(&mesh.uvs[i]).to_array(),
             });
         }

@@ -95,7 +95,7 @@ impl<'s> Frame<'s> {
                     n: v.map(|v| Vec3::from(v.normal)),
                     material: v[0].material as usize,
                     transparent: k * 3 >= g.opaque_indices,
-                    coloured: v.iter().any(|v| v.color != [1.0; 4]),
+                    coloured: v.iter().any(|v| v.color != [255; 4]),
                 }
             })
             .collect();

@@ -159,13 +159,9 @@ impl ExactMaterial {
                         texture: None,
                     })
                 }),
-            normal_texture: None,
-            occlusion_texture: None,
-            uv_sets: 0,
-            wraps: 0,
-            nearest: 0,
-            uv_transforms: [glam::Affine2::IDENTITY; 5],
             alpha_cutoff: self.alpha_cutoff.filter(|c| c.is_finite()),
+            // No textures: `map_material` adds the file's.
+            ..Material::plain(Vec3::ONE, 0.0, 1.0)
         };
         material_is_sane(&m).then_some(m)
     }
@@ -340,21 +336,15 @@ fn map_material(
         },
         transparent,
         shader: MaterialShader::Standard,
-        texture,
-        emissive_texture,
         metallic_roughness: Some(crate::scene::MetallicRoughness {
             base: colour,
             metallic,
             roughness,
             texture: mr_texture,
         }),
-        normal_texture: None,
-        occlusion_texture: None,
-        uv_sets: 0,
-        wraps: 0,
-        nearest: 0,
-        uv_transforms: [glam::Affine2::IDENTITY; 5],
         alpha_cutoff: alpha_tested.then_some(cutoff),
+        // The textures, their sets, wrapping and transforms: `textured`.
+        ..Material::plain(Vec3::ONE, 0.0, 1.0)
     }))
 }
 
