@@ -98,6 +98,9 @@ struct SceneUpload {
     /// `Scene::content_fingerprint`, computed when [`Renderer::render`] first compares a scene
     /// with this one (never on the frame path).
     fingerprint: OnceLock<u64>,
+    /// `Scene::per_pixel_specular`, computed when a light pre-pass pipeline first asks (the
+    /// scene's materials and meshes do not change while it is held).
+    per_pixel_specular: OnceLock<Option<String>>,
     static_vertices: u32,
     static_indices: u32,
     /// The static geometry's runs of one material shader each.
@@ -398,7 +401,13 @@ impl Renderer {
                 ),
             ));
         }
-        let varies = || (self.scene.as_ref()).and_then(|u| u.scene.per_pixel_specular());
+        let varies = || {
+            (self.scene.as_ref()).and_then(|u| {
+                u.per_pixel_specular
+                    .get_or_init(|| u.scene.per_pixel_specular())
+                    .clone()
+            })
+        };
         if let Some(why) = pipelines::reads_specular_per_material(info.id)
             .then(varies)
             .flatten()
@@ -512,6 +521,7 @@ impl Renderer {
         self.scene = Some(SceneUpload {
             scene,
             fingerprint: OnceLock::new(),
+            per_pixel_specular: OnceLock::new(),
             static_vertices: geometry.vertices.len() as u32,
             static_indices: geometry.indices.len() as u32,
             static_draws: geometry.draws,
