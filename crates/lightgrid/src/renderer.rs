@@ -98,9 +98,6 @@ struct SceneUpload {
     /// `Scene::content_fingerprint`, computed when [`Renderer::render`] first compares a scene
     /// with this one (never on the frame path).
     fingerprint: OnceLock<u64>,
-    /// `Scene::per_pixel_specular`, computed when a light pre-pass pipeline first asks (the
-    /// scene's materials and meshes do not change while it is held).
-    per_pixel_specular: OnceLock<Option<String>>,
     static_vertices: u32,
     static_indices: u32,
     /// The static geometry's runs of one material shader each.
@@ -401,25 +398,6 @@ impl Renderer {
                 ),
             ));
         }
-        let varies = || {
-            (self.scene.as_ref()).and_then(|u| {
-                u.per_pixel_specular
-                    .get_or_init(|| u.scene.per_pixel_specular())
-                    .clone()
-            })
-        };
-        if let Some(why) = pipelines::reads_specular_per_material(info.id)
-            .then(varies)
-            .flatten()
-        {
-            return Err(Error::invalid(
-                "pipeline",
-                format!(
-                    "{} reads each material's specular colour and exponent per material (its irradiance pass), and {why}: choose another pipeline",
-                    info.id
-                ),
-            ));
-        }
         if !self.techniques.contains_key(info.id) {
             let device = &self.device;
             let ctx = PipelineContext {
@@ -506,7 +484,7 @@ impl Renderer {
         self.indices.write(queue, 0, ib);
         self.materials.write(queue, 0, mb);
         self.static_upload_bytes = self.textures.bytes + (vb.len() + ib.len() + mb.len()) as u64;
-        let shading = Shading::of(&scene.lighting, self.settings.brdf, self.settings.shadows);
+        let shading = Shading::of(&scene, self.settings.brdf, self.settings.shadows);
         let shadows = (self.settings.shadows == crate::scene::Shadows::Rays)
             .then(|| crate::shadows::StaticShadows::new(&geometry));
         if let Some(s) = &shadows {
@@ -521,7 +499,6 @@ impl Renderer {
         self.scene = Some(SceneUpload {
             scene,
             fingerprint: OnceLock::new(),
-            per_pixel_specular: OnceLock::new(),
             static_vertices: geometry.vertices.len() as u32,
             static_indices: geometry.indices.len() as u32,
             static_draws: geometry.draws,

@@ -513,41 +513,28 @@ fn card_scene(w: &GltfWriter) -> Scene {
     loaded.scene
 }
 
-/// Every pipeline renders `scene` as forward does (within 8 levels at all but 1% of the
-/// pixels), except the light pre-pass ones where `prepass_refuses`, which must refuse it
-/// naming why. A scene with a metal's coloured F0 (`prepass_refuses`) leaves out the mono
-/// variants, whose one-value specular albedo is their documented compromise (README, "the
-/// mono variants").
-fn every_pipeline_as_forward(scene: &Scene, what: &str, prepass_refuses: bool) -> image::RgbaImage {
-    let reference = render(scene, "forward", CARD);
+/// Every pipeline renders `scene` as its reference does (`forward`, or `forward_mono` for the
+/// mono variants, whose one-value specular is their documented compromise), within 8 levels
+/// at all but 1% of the pixels; forward's image.
+fn every_pipeline_as_forward(scene: &Scene, what: &str) -> image::RgbaImage {
+    let ctx = common::gpu();
+    let mut r = Renderer::new(&ctx, CARD.0, CARD.1, RenderSettings::default()).unwrap();
+    let mut references = std::collections::HashMap::new();
     for info in lightgrid::pipelines::PIPELINES {
-        let mono = info.id.contains("mono");
-        if prepass_refuses && mono && !lightgrid::pipelines::reads_specular_per_material(info.id) {
-            continue;
-        }
-        let ctx = common::gpu();
-        let mut r = Renderer::new(&ctx, CARD.0, CARD.1, RenderSettings::default()).unwrap();
-        let out = r.render(scene, 0, info.id);
-        if prepass_refuses && lightgrid::pipelines::reads_specular_per_material(info.id) {
-            let e = out
-                .err()
-                .expect("the light pre-pass refuses per-sample specular")
-                .to_string();
-            assert!(
-                e.contains("specular colour and exponent per material"),
-                "{e}"
-            );
-            continue;
-        }
-        let image = out.unwrap().image;
-        let over = common::pixels_over(&reference, &image, 8);
+        let image = r.render(scene, 0, info.id).unwrap().image;
+        references.insert(info.id, image);
+    }
+    for info in lightgrid::pipelines::PIPELINES {
+        let reference = &references[info.reference];
+        let over = common::pixels_over(reference, &references[info.id], 8);
         assert!(
             over <= u64::from(CARD.0 * CARD.1) / 100,
-            "{what}: {}: {over} pixels over 8 levels from forward",
-            info.id
+            "{what}: {}: {over} pixels over 8 levels from {}",
+            info.id,
+            info.reference
         );
     }
-    reference
+    references.remove(lightgrid::pipelines::REFERENCE).unwrap()
 }
 
 /// Mean colour (0-255) of the pixels in the rectangle `x0..x1` × `y0..y1`.
@@ -581,9 +568,7 @@ fn a_metallic_roughness_texture_makes_half_the_card_dielectric() {
     let t = w.png(&halves(32, [0, 255, 0, 255], [0, 255, 255, 255]));
     w.materials[0] = json!({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.5, 0.2, 1.0],
         "metallicFactor": 1.0, "roughnessFactor": 0.3, "metallicRoughnessTexture": {"index": t}}});
-    let scene = card_scene(&w);
-    assert!(scene.per_pixel_specular().is_some());
-    let img = every_pipeline_as_forward(&scene, "metallic-roughness", true);
+    let img = every_pipeline_as_forward(&card_scene(&w), "metallic-roughness");
     if std::env::var_os("LIGHTGRID_KEEP_IMAGES").is_some() {
         img.save(common::output_dir().join("metallic-roughness-card.png"))
             .unwrap();
@@ -628,7 +613,7 @@ fn a_normal_texture_tilts_where_it_says() {
     let mesh = &scene.meshes[0];
     let along_u = |t: &glam::Vec4| t.truncate().abs_diff_eq(Vec3::X, 1e-4) && t.w.abs() == 1.0;
     assert!(mesh.tangents.iter().all(along_u), "{:?}", mesh.tangents);
-    let img = every_pipeline_as_forward(&scene, "normal texture", false);
+    let img = every_pipeline_as_forward(&scene, "normal texture");
     let (flat, tilted) = (
         region(&img, LEFT, MIDDLE_ROWS),
         region(&img, RIGHT, MIDDLE_ROWS),
@@ -651,9 +636,7 @@ fn occlusion_darkens_the_ambient_term_by_its_strength() {
     let t = w.png(&halves(32, [255, 255, 255, 255], [0, 0, 0, 255]));
     w.materials[0] = json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0],
         "metallicFactor": 0.0}, "occlusionTexture": {"index": t, "strength": 0.5}});
-    let scene = card_scene(&w);
-    assert!(scene.per_pixel_specular().is_none());
-    let img = every_pipeline_as_forward(&scene, "occlusion", false);
+    let img = every_pipeline_as_forward(&card_scene(&w), "occlusion");
     let (open, occluded) = (
         region(&img, LEFT, MIDDLE_ROWS),
         region(&img, RIGHT, MIDDLE_ROWS),
@@ -682,7 +665,7 @@ fn vertex_colours_multiply_the_base_colour() {
     );
     w.meshes[0]["primitives"][0]["attributes"]["COLOR_0"] = json!(red);
     let scene = card_scene(&w);
-    let img = every_pipeline_as_forward(&scene, "vertex colours", false);
+    let img = every_pipeline_as_forward(&scene, "vertex colours");
     let left = region(&img, (8, 16), MIDDLE_ROWS);
     let right_bottom = region(&img, (80, 88), (80, 88));
     assert!(left.x > left.y + 40.0, "red on the left: {left}");
@@ -690,14 +673,9 @@ fn vertex_colours_multiply_the_base_colour() {
         right_bottom.y > right_bottom.x + 40.0,
         "green at the lower right: {right_bottom}"
     );
-    // On a metal the light pre-pass refuses (its F0 varies per vertex).
+    // On a metal the colours are its F0, per sample in every pipeline.
     w.materials[0]["pbrMetallicRoughness"]["metallicFactor"] = json!(1.0);
-    let metal = card_scene(&w);
-    assert!(metal
-        .per_pixel_specular()
-        .unwrap()
-        .contains("vertex colours"));
-    every_pipeline_as_forward(&metal, "vertex colours on a metal", true);
+    every_pipeline_as_forward(&card_scene(&w), "vertex colours on a metal");
 }
 
 /// An emissive card (strength 50, so a texel shows as itself) whose emissive texture is red
@@ -744,7 +722,7 @@ fn emissive_card_full(
     ]);
     let loaded = load(&GltfWriter::glb_of(&doc, &w.bin)).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
-    every_pipeline_as_forward(&loaded.scene, "emissive card", false)
+    every_pipeline_as_forward(&loaded.scene, "emissive card")
 }
 
 /// Which colour each quarter of the card's width shows: 'r', 'b' or '?'.

@@ -103,6 +103,7 @@ impl GBuffer {
         layout: GBufferLayout,
         size: (u32, u32),
         samples: u32,
+        shading: Shading,
     ) -> Self {
         let tf = format.texture_format();
         let views: Vec<Option<wgpu::TextureView>> = TARGET_NAMES
@@ -123,8 +124,9 @@ impl GBuffer {
                 })
             })
             .collect();
-        // The G-buffer pass evaluates no light: any shading compiles it alike.
-        let module = create_module(device, &shader().specialized(Shading::default()));
+        // The G-buffer pass evaluates no light, but reads the materials' inputs as `shading`
+        // says.
+        let module = create_module(device, &shader().specialized(shading));
         let targets: Vec<Option<wgpu::ColorTargetState>> = views
             .iter()
             .map(|v| v.as_ref().map(|_| tf.into()))

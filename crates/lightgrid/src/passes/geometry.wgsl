@@ -39,6 +39,12 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
+// Does any material of the scene read inputs per sample beyond its base colour (a
+// metallic-roughness model, normal, occlusion or emissive textures: `Shading::material_inputs`)?
+// Without them the shader is made without those reads: a software rasterizer runs both sides
+// of a branch, so an untaken one still costs (a third of lavapipe's G-buffer pass).
+const MATERIAL_INPUTS: bool = SHADING_MATERIAL_INPUTS_VALUE;
+
 // The scene's base-colour textures (group 0; `passes/base_textures.rs`): one array, a layer
 // per texture, sRGB-decoded when sampled, mipmapped, repeating.
 @group(0) @binding(6) var base_textures: texture_2d_array<f32>;
@@ -122,6 +128,9 @@ fn base_colour(m: Material, v: VertexOut, t: TexCoords) -> vec4<f32> {
 // A material's emissive colour at the sample: its emissive factor times its emissive
 // texture's texel (glTF's emissiveTexture), or the factor alone.
 fn emissive_colour(m: Material, t: TexCoords) -> vec3<f32> {
+    if (!MATERIAL_INPUTS) {
+        return m.emissive;
+    }
     let one = vec4<f32>(1.0);
     return m.emissive * material_texel(m, t, TEXTURE_SLOT_EMISSIVE, m.emissive_texture, one).rgb;
 }
@@ -161,7 +170,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     s.alpha = m.alpha * base.a;
     s.specular = m.specular;
     s.shininess = m.shininess;
-    if ((m.flags & MATERIAL_FLAG_METALLIC_ROUGHNESS) != 0u) {
+    if (MATERIAL_INPUTS && (m.flags & MATERIAL_FLAG_METALLIC_ROUGHNESS) != 0u) {
         // glTF's metallic-roughness per sample, by the import's rule (map_material):
         // the texture's B is metallic, G roughness.
         let one = vec4<f32>(1.0);
@@ -176,8 +185,11 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     }
     s.emissive = emissive_colour(m, t);
     // Occlusion darkens the ambient term only (glTF: indirect light), by its strength.
-    let occlusion = material_texel(m, t, TEXTURE_SLOT_OCCLUSION, m.occlusion_texture, vec4<f32>(1.0)).r;
-    s.ambient = m.ambient * base.rgb * (1.0 + m.occlusion_strength * (occlusion - 1.0));
+    s.ambient = m.ambient * base.rgb;
+    if (MATERIAL_INPUTS) {
+        let occlusion = material_texel(m, t, TEXTURE_SLOT_OCCLUSION, m.occlusion_texture, vec4<f32>(1.0)).r;
+        s.ambient *= 1.0 + m.occlusion_strength * (occlusion - 1.0);
+    }
     s.material = v.material;
     return s;
 }
@@ -186,7 +198,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
 // x and y times the scale) through the vertex's tangent frame (glTF §3.9.3).
 fn mapped_normal(m: Material, v: VertexOut, t: TexCoords) -> vec3<f32> {
     let n = normalize(v.normal);
-    if (m.normal_texture == 0u) {
+    if (!MATERIAL_INPUTS || m.normal_texture == 0u) {
         return n;
     }
     let texel = material_texel(m, t, TEXTURE_SLOT_NORMAL, m.normal_texture, vec4<f32>(0.5, 0.5, 1.0, 1.0));

@@ -142,6 +142,7 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
         layout,
         (w, h),
         samples,
+        ctx.shading,
     );
     let volumes = LightVolumes::new(device, w, h, samples);
     let module = create_module(

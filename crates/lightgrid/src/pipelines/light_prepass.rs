@@ -1,8 +1,9 @@
 //! `light_prepass` and `light_prepass_mono`: deferred lighting, as the blog
 //! (deferred-shading-vs-deferred-lighting) lays it out.
 //!
-//! 1. Attributes pass: geometry → normal + material index (RGBA16F) and depth; the
-//!    irradiance pass reads the material's exponent and, under GGX, its specular colour.
+//! 1. Attributes pass: geometry → normal + specular exponent (RGBA16F), the specular colour
+//!    (RGB10A2; GGX's Fresnel F0, which its irradiance holds) and depth, each the sample's own
+//!    as forward computes it (a metallic-roughness texture varies them within a material).
 //! 2. Irradiance pass (HDR-range targets, additive): a depth-stencil copy, then each light's
 //!    volume (classes in `light_volumes.rs`) adds its diffuse irradiance and specular
 //!    irradiance to two RGBA16F targets; `_mono` keeps only the specular luminance, in the
@@ -21,7 +22,8 @@
 //! pixels (each sample's own). Material edges need no per-sample pass 3: the rasterizer
 //! gives each triangle's fragment exactly its own samples.
 //!
-//! Groups: pass 1: 0 scene. Pass 2: 0 scene, 1 depth-copy source, 2 attributes + depth.
+//! Groups: pass 1: 0 scene. Pass 2: 0 scene, 1 depth-copy source, 2 attributes + depth +
+//! specular colour.
 //! Pass 3: 0 scene, 1 irradiance.
 //!
 //! `tiled_light_prepass` is compute-based deferred lighting [And11], the baseline Forward+ is
@@ -63,6 +65,13 @@ use crate::shader::{
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
 /// rounded up to what every adapter renders and blends.
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The specular colour (F0, in 0..1): 10 bits a channel keeps a dielectric's 0.04 within
+/// 0.2 % (8 bits would round it to 0.039), in 4 bytes.
+const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgb10a2Unorm;
+
+/// Bytes of the specular-colour target.
+const SPECULAR_BYTES: u32 = 4;
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
     LightPrepassKey::all_shaders()
@@ -304,27 +313,32 @@ struct LightPrepass {
     /// Pass 3 per pixel, then (MSAA) per sample on the edge pixels.
     shade: Vec<(Shading, wgpu::RenderPipeline)>,
     attr_view: wgpu::TextureView,
+    specular_attr_view: wgpu::TextureView,
     diffuse_view: wgpu::TextureView,
     specular_view: Option<wgpu::TextureView>,
     attr_layout: wgpu::BindGroupLayout,
     irr_layout: wgpu::BindGroupLayout,
 }
 
+/// Textures of `samples` samples per pixel, of these sample types by binding.
 fn texture_layout(
     device: &wgpu::Device,
     label: &str,
-    second: wgpu::TextureSampleType,
+    types: &[wgpu::TextureSampleType],
     samples: u32,
 ) -> wgpu::BindGroupLayout {
-    let first = wgpu::TextureSampleType::Float { filterable: false };
+    let entries: Vec<_> = (0u32..)
+        .zip(types)
+        .map(|(binding, &ty)| sampled_texture_entry(binding, ty, samples))
+        .collect();
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
-        entries: &[
-            sampled_texture_entry(0, first, samples),
-            sampled_texture_entry(1, second, samples),
-        ],
+        entries: &entries,
     })
 }
+
+/// A target's sample type as the passes after it read it.
+const UNFILTERED: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
 
 /// A target of `samples` samples per pixel read by a later pass and written as `written` (a
 /// render attachment or storage).
@@ -490,7 +504,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             module: &module,
             fragment_entry: Some("fs_attributes"),
             layouts: &[Some(ctx.scene_layout)],
-            color_targets: &[Some(TARGET_FORMAT.into())],
+            color_targets: &[Some(TARGET_FORMAT.into()), Some(SPECULAR_FORMAT.into())],
             depth_write: true,
             depth_compare: crate::depth::SURFACE,
             samples,
@@ -499,13 +513,13 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let attr_layout = texture_layout(
         device,
         "light pre-pass attributes",
-        wgpu::TextureSampleType::Depth,
+        &[UNFILTERED, wgpu::TextureSampleType::Depth, UNFILTERED],
         samples,
     );
     let irr_layout = texture_layout(
         device,
         "light pre-pass irradiance",
-        wgpu::TextureSampleType::Float { filterable: false },
+        &[UNFILTERED, UNFILTERED],
         samples,
     );
     let irradiance = match mode {
@@ -559,6 +573,15 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             samples,
             attachment,
         ),
+        specular_attr_view: multisampled_texture(
+            device,
+            "attributes (specular colour)",
+            SPECULAR_FORMAT,
+            size,
+            samples,
+            attachment | wgpu::TextureUsages::TEXTURE_BINDING,
+        )
+        .create_view(&Default::default()),
         diffuse_view: target(device, "diffuse irradiance", size, samples, written),
         specular_view: (!mono)
             .then(|| target(device, "specular irradiance", size, samples, attachment)),
@@ -579,25 +602,23 @@ pub(super) fn create_tiled(ctx: &PipelineContext) -> Box<dyn Technique> {
     create(ctx, Mode::Tiled)
 }
 
-fn bind_two(
+/// A group of texture views by binding.
+fn bind_views(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
-    a: &wgpu::TextureView,
-    b: &wgpu::TextureView,
+    views: &[&wgpu::TextureView],
 ) -> wgpu::BindGroup {
+    let entries: Vec<_> = (0u32..)
+        .zip(views)
+        .map(|(binding, view)| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        })
+        .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(a),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(b),
-            },
-        ],
+        entries: &entries,
     })
 }
 
@@ -709,20 +730,22 @@ impl Technique for LightPrepass {
     }
 
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()> {
-        let attr_group = bind_two(
+        let attr_group = bind_views(
             f.device,
             &self.attr_layout,
-            &self.attr_view,
-            &f.targets.depth,
+            &[&self.attr_view, &f.targets.depth, &self.specular_attr_view],
         );
         // Mono has no specular target; its shader reads only binding 0.
         let specular = self.specular_view.as_ref().unwrap_or(&self.diffuse_view);
-        let irr_group = bind_two(f.device, &self.irr_layout, &self.diffuse_view, specular);
+        let irr_group = bind_views(f.device, &self.irr_layout, &[&self.diffuse_view, specular]);
         {
             let (encoder, timer) = enc.parts();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("light pre-pass attributes"),
-                color_attachments: &[Some(cleared(&self.attr_view, wgpu::Color::TRANSPARENT))],
+                color_attachments: &[
+                    Some(cleared(&self.attr_view, wgpu::Color::TRANSPARENT)),
+                    Some(cleared(&self.specular_attr_view, wgpu::Color::TRANSPARENT)),
+                ],
                 depth_stencil_attachment: Some(crate::passes::cleared_depth(&f.targets.depth)),
                 timestamp_writes: timer.render_pass("light pre-pass attributes"),
                 occlusion_query_set: None,
@@ -838,9 +861,9 @@ impl Technique for LightPrepass {
 /// Bytes of one attributes or irradiance target.
 const TARGET_BYTES: u32 = 8;
 
-/// Depth + attributes + two irradiance targets + HDR + the volumes' depth-stencil copy (the
-/// blog's layout; each per sample with MSAA). Per pixel: attributes pass writes depth and
-/// attributes, the copy reads depth and writes the copy (kept: the shading pass tests its
+/// Depth + attributes (normal and exponent, the blog's layout, and the specular colour) + two
+/// irradiance targets + HDR + the volumes' depth-stencil copy (each per sample with MSAA).
+/// Per pixel: attributes pass writes depth and attributes, the copy reads depth and writes the copy (kept: the shading pass tests its
 /// depth and edge bit where the other pipelines test the scene depth), the shading pass reads
 /// the irradiance and writes HDR. Per
 /// lighting computation: read depth, attributes and the light, blend into the irradiance
@@ -858,7 +881,8 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
     let irr = irradiance_targets * TARGET_BYTES;
     let mut targets = vec![
         ("depth", DEPTH_BYTES),
-        ("attributes (normal, material)", TARGET_BYTES),
+        ("attributes (normal, exponent)", TARGET_BYTES),
+        ("attributes (specular colour)", SPECULAR_BYTES),
         ("diffuse irradiance", TARGET_BYTES),
     ];
     if irradiance_targets == 2 {
@@ -871,15 +895,19 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
     MemoryModel::new(
         &targets,
         Traffic {
-            write_per_pixel: DEPTH_BYTES + TARGET_BYTES + VOLUME_DEPTH_BYTES + HDR_BYTES,
+            write_per_pixel: DEPTH_BYTES
+                + TARGET_BYTES
+                + SPECULAR_BYTES
+                + VOLUME_DEPTH_BYTES
+                + HDR_BYTES,
             read_per_pixel: DEPTH_BYTES + irr,
             write_per_lit: irr,
-            read_per_lit: DEPTH_BYTES + TARGET_BYTES + irr + LIGHT_BYTES,
+            read_per_lit: DEPTH_BYTES + TARGET_BYTES + SPECULAR_BYTES + irr + LIGHT_BYTES,
         },
     )
 }
 
-/// The tiled variant [And11]: depth, attributes, one (mono) irradiance target and HDR, no
+/// The tiled variant [And11]: depth, attributes (as above), one (mono) irradiance target and HDR, no
 /// volume depth-stencil. Per pixel: the attributes pass writes depth and attributes, the
 /// cell-bounds kernel reads depth, the irradiance kernel reads depth and attributes once and
 /// writes the irradiance once, the shading pass reads it and writes HDR. Per lighting
@@ -889,7 +917,8 @@ fn memory_with(irradiance_targets: u32) -> MemoryModel {
 pub(super) fn memory_tiled(settings: &RenderSettings) -> MemoryModel {
     let mut targets = vec![
         ("depth", DEPTH_BYTES),
-        ("attributes (normal, material)", TARGET_BYTES),
+        ("attributes (normal, exponent)", TARGET_BYTES),
+        ("attributes (specular colour)", SPECULAR_BYTES),
         ("irradiance (diffuse, mono specular)", TARGET_BYTES),
         ("hdr", HDR_BYTES),
     ];
@@ -902,8 +931,8 @@ pub(super) fn memory_tiled(settings: &RenderSettings) -> MemoryModel {
     MemoryModel::new(
         &targets,
         Traffic {
-            write_per_pixel: DEPTH_BYTES + 2 * TARGET_BYTES + HDR_BYTES,
-            read_per_pixel: 2 * DEPTH_BYTES + 2 * TARGET_BYTES,
+            write_per_pixel: DEPTH_BYTES + 2 * TARGET_BYTES + SPECULAR_BYTES + HDR_BYTES,
+            read_per_pixel: 2 * DEPTH_BYTES + 2 * TARGET_BYTES + SPECULAR_BYTES,
             write_per_lit: 0,
             read_per_lit: INDEX_BYTES + LIGHT_BYTES,
         },

@@ -14,14 +14,21 @@
 // Entries with side effects force the early depth and stencil tests, so the per-sample
 // pipelines count only the samples the edge bit lets through.
 
-// --- 1. attributes: normal and material index (depth goes to the depth target). The index
-// (exact in 16-bit floats up to MAX_MATERIALS, as in the G-buffer's normal) names the
-// exponent and, for GGX's per-light Fresnel, the specular colour F0: the irradiance pass
-// reads both from the material (`light_prepass_attributes.wgsl`).
+// --- 1. attributes: normal and specular exponent, and the specular colour (GGX's Fresnel
+// F0, which its irradiance holds); depth goes to the depth target. Each is the sample's own,
+// as forward shades it (`light_prepass_attributes.wgsl` reads them).
+struct AttributesOut {
+    @location(0) normal_shininess: vec4<f32>,
+    @location(1) specular: vec4<f32>,
+}
+
 @fragment
-fn fs_attributes(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+fn fs_attributes(v: VertexOut, @builtin(front_facing) front: bool) -> AttributesOut {
     let s = surface_from_vertex(v, front);
-    return vec4<f32>(s.normal, f32(s.material));
+    var out: AttributesOut;
+    out.normal_shininess = vec4<f32>(s.normal, s.shininess);
+    out.specular = vec4<f32>(s.specular, 1.0);
+    return out;
 }
 
 // --- 2. irradiance: group 2 = attributes + scene depth (light_prepass_attributes.wgsl)

@@ -1,36 +1,33 @@
-// The light pre-pass's attributes (pass 1's normal + material index and depth, each sample
-// with MSAA: `shader/msaa.wgsl`'s texture types) as read by its irradiance passes (group 2):
-// the light volumes' fragments (`light_prepass.wgsl`) and the tiled compute kernel
-// (`tiled_light_prepass.wgsl`).
+// The light pre-pass's attributes (pass 1's normal + specular exponent, specular colour and
+// depth, each sample with MSAA: `shader/msaa.wgsl`'s texture types) as read by its irradiance
+// passes (group 2): the light volumes' fragments (`light_prepass.wgsl`) and the tiled compute
+// kernel (`tiled_light_prepass.wgsl`). Both specular inputs are the sample's own, as the
+// forward pass computes them (a metallic-roughness texture or a metal's base colour varies
+// them within a material).
 
-@group(2) @binding(0) var attr_normal_material: SampleTexture;
+@group(2) @binding(0) var attr_normal_shininess: SampleTexture;
 @group(2) @binding(1) var attr_depth: DepthTexture;
+@group(2) @binding(2) var attr_specular: SampleTexture;
 
-fn attributes_material(a: vec4<f32>) -> Material {
-    return materials[u32(a.w + 0.5)];
+// The specular colour (GGX's Fresnel F0) of sample `s` of pixel `p`: Blinn-Phong's irradiance
+// does not read it (its shading pass multiplies by the colour).
+fn attributes_specular(p: vec2<u32>, s: u32) -> vec3<f32> {
+    if (SHADING_BRDF == BRDF_GGX) {
+        return textureLoad(attr_specular, p, s).rgb;
+    }
+    return vec3<f32>(0.0);
 }
 
-// The surface the irradiance is computed at: sample `s` of pixel `p`'s normal, and its
-// material's exponent and specular colour (GGX's Fresnel F0; Blinn-Phong's irradiance does
-// not read it), at camera-relative `position`.
+// The surface the irradiance is computed at: sample `s` of pixel `p`'s normal, exponent and
+// specular colour, at camera-relative `position`.
 fn attributes_surface_at(p: vec2<u32>, s: u32, position: vec3<f32>) -> Surface {
-    let a = textureLoad(attr_normal_material, p, s);
-    let m = attributes_material(a);
+    let a = textureLoad(attr_normal_shininess, p, s);
     var surface: Surface;
     surface.position = position;
     surface.normal = normalize(a.xyz);
-    surface.shininess = m.shininess;
-    surface.specular = m.specular;
+    surface.shininess = a.w;
+    surface.specular = attributes_specular(p, s);
     return surface;
-}
-
-// Do two samples' attributes give different irradiance from one light at one place: another
-// exponent, or under GGX another specular colour (its Fresnel is inside the irradiance).
-fn attributes_shade_differently(a: vec4<f32>, b: vec4<f32>) -> bool {
-    let ma = attributes_material(a);
-    let mb = attributes_material(b);
-    return ma.shininess != mb.shininess
-        || (SHADING_BRDF == BRDF_GGX && any(ma.specular != mb.specular));
 }
 
 
@@ -62,14 +59,17 @@ fn attributes_differ(p: vec2<u32>, s: u32, d0: f32, a0: vec4<f32>) -> bool {
     if (is_background(d0)) {
         return false;
     }
-    let a = textureLoad(attr_normal_material, p, s);
-    return surfaces_differ(p, s, d0, a0.xyz, d, a.xyz, attributes_shade_differently(a, a0));
+    let a = textureLoad(attr_normal_shininess, p, s);
+    // Another exponent, or under GGX another specular colour (its Fresnel is inside the
+    // irradiance), gives other irradiance from one light at one place.
+    let other = a.w != a0.w || any(attributes_specular(p, s) != attributes_specular(p, 0u));
+    return surfaces_differ(p, s, d0, a0.xyz, d, a.xyz, other);
 }
 
 // Is pixel `p` an MSAA edge (some sample differs from sample 0)? Never without MSAA.
 fn attributes_edge(p: vec2<u32>) -> bool {
     let d0 = textureLoad(attr_depth, p, 0);
-    let a0 = textureLoad(attr_normal_material, p, 0);
+    let a0 = textureLoad(attr_normal_shininess, p, 0);
     var edge = false;
     for (var s = 1u; s < SAMPLES; s = s + 1u) {
         edge = edge || attributes_differ(p, s, d0, a0);

@@ -444,16 +444,6 @@ pub fn all_shaders() -> Vec<ComposedShader> {
 /// The reference pipeline's id.
 pub const REFERENCE: &str = "forward";
 
-/// Does the pipeline read each material's specular colour and exponent per material (the
-/// light pre-pass's irradiance pass), so that it cannot shade a scene whose specular varies
-/// within a material (`Scene::per_pixel_specular`)?
-pub fn reads_specular_per_material(id: &str) -> bool {
-    matches!(
-        id,
-        ids::LIGHT_PREPASS | ids::LIGHT_PREPASS_MONO | ids::TILED_LIGHT_PREPASS
-    )
-}
-
 fn pipeline_names() -> String {
     PIPELINES
         .iter()

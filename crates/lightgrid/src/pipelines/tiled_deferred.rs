@@ -362,6 +362,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         GBufferLayout::Full,
         (w, h),
         samples,
+        ctx.shading,
     );
     let setup = crate::culling::GridSetup {
         forward_opaque: false,
@@ -421,6 +422,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
         GBufferLayout::Full,
         (w, h),
         samples,
+        ctx.shading,
     );
     let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let params_layout = ctx

@@ -119,9 +119,10 @@ impl Shadows {
     }
 }
 
-/// What a pipeline's shaders are made for: the BRDF, the lights' units (their falloff) and the
-/// shadows. The one light function takes them as constants (`ComposedShader::specialized`),
-/// so a renderer makes its pipelines again when a scene, `--brdf` or `--shadows` changes them.
+/// What a pipeline's shaders are made for: the BRDF, the lights' units (their falloff), the
+/// shadows and whether materials read inputs beyond their base colour. The shaders take them
+/// as constants (`ComposedShader::specialized`), so a renderer makes its pipelines again when a
+/// scene, `--brdf` or `--shadows` changes them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Shading {
     pub brdf: Brdf,
@@ -130,6 +131,10 @@ pub struct Shading {
     /// With shadow maps: the pipeline re-uses one light's maps (the classic deferred
     /// family's light volumes, `crate::shadows::maps`), so a face's tile is its cube face's.
     pub reuse_maps: bool,
+    /// Some material reads inputs per sample beyond its base colour
+    /// ([`super::Material::reads_per_sample_inputs`]); without, the geometry stage is made
+    /// without those reads (`passes/geometry.wgsl`'s `MATERIAL_INPUTS`).
+    pub material_inputs: bool,
 }
 
 impl Default for Shading {
@@ -140,6 +145,7 @@ impl Default for Shading {
             units: LightUnits::Papers,
             shadows: Shadows::Off,
             reuse_maps: false,
+            material_inputs: false,
         }
     }
 }
@@ -155,12 +161,15 @@ impl Shading {
                         if reuse_maps && shadows != Shadows::Maps {
                             continue;
                         }
-                        out.push(Shading {
-                            brdf,
-                            units,
-                            shadows,
-                            reuse_maps,
-                        });
+                        for material_inputs in [false, true] {
+                            out.push(Shading {
+                                brdf,
+                                units,
+                                shadows,
+                                reuse_maps,
+                                material_inputs,
+                            });
+                        }
                     }
                 }
             }
@@ -169,12 +178,13 @@ impl Shading {
     }
 
     /// A scene's shading with `--brdf` `brdf` (`None`: auto, the scene's own) and `--shadows`.
-    pub fn of(lighting: &Lighting, brdf: Option<Brdf>, shadows: Shadows) -> Shading {
+    pub fn of(scene: &super::Scene, brdf: Option<Brdf>, shadows: Shadows) -> Shading {
         Shading {
-            brdf: brdf.unwrap_or(lighting.brdf),
-            units: lighting.units,
+            brdf: brdf.unwrap_or(scene.lighting.brdf),
+            units: scene.lighting.units,
             shadows,
             reuse_maps: false,
+            material_inputs: scene.materials.iter().any(|m| m.reads_per_sample_inputs()),
         }
     }
 

@@ -160,6 +160,15 @@ impl Material {
         .flatten()
     }
 
+    /// Does the material read inputs per sample beyond its base colour (texture and vertex
+    /// colours): glTF's metallic-roughness model, or a normal, occlusion or emissive texture?
+    pub fn reads_per_sample_inputs(&self) -> bool {
+        self.metallic_roughness.is_some()
+            || self.emissive_texture.is_some()
+            || self.normal_texture.is_some()
+            || self.occlusion_texture.is_some()
+    }
+
     /// A transparent material (glass, bubbles): tinted diffuse, a sharp white highlight,
     /// `alpha` coverage.
     pub fn glass(tint: Vec3, alpha: f32) -> Self {
@@ -667,33 +676,6 @@ pub struct FrameState {
 impl Scene {
     pub fn frame_count(&self) -> u32 {
         self.camera_path.frame_count()
-    }
-
-    /// Why the specular colour or exponent of this scene varies within one material (a
-    /// metallic-roughness texture, or a base-colour texture or vertex colours on a metallic
-    /// material: a metal's F0 is its base colour), if it does:
-    /// the light pre-pass pipelines read both per material, so they refuse such a scene.
-    pub fn per_pixel_specular(&self) -> Option<String> {
-        for (i, m) in self.materials.iter().enumerate() {
-            let Some(mr) = m.metallic_roughness else {
-                continue;
-            };
-            if mr.texture.is_some() {
-                return Some(format!("material {i} has a metallic-roughness texture"));
-            }
-            if mr.metallic > 0.0 && m.texture.is_some() {
-                return Some(format!(
-                    "material {i} is metallic with a base-colour texture (its F0)"
-                ));
-            }
-            let coloured = |o: &Object| o.material == i && !self.meshes[o.mesh].colors.is_empty();
-            if mr.metallic > 0.0 && self.objects.iter().any(coloured) {
-                return Some(format!(
-                    "material {i} is metallic and its meshes have vertex colours"
-                ));
-            }
-        }
-        None
     }
 
     /// Refuse a frame past the end of the animation.

@@ -316,16 +316,18 @@ pub fn validate_for(
     validate_source(&shader.name, &shader.source_for(early_depth_test))
 }
 
-/// Parse and validate, the light function in every [`Shading`] (each makes other code live);
-/// the module of the first.
+/// Parse and validate, the shader in every [`Shading`] (each makes other code live; one
+/// source that two shadings make alike is validated once); the module of the first.
 fn validate_source(name: &str, source: &str) -> Result<naga::Module, String> {
     let mut first = None;
+    let mut seen = std::collections::HashSet::new();
     for shading in Shading::all() {
-        let module = validate_one(name, &specialize(source, shading))?;
-        first.get_or_insert(module);
-        if !source.contains(SHADING_BRDF_VALUE) {
-            break;
+        let specialized = specialize(source, shading);
+        if !seen.insert(specialized.clone()) {
+            continue;
         }
+        let module = validate_one(name, &specialized)?;
+        first.get_or_insert(module);
     }
     Ok(first.expect("one at least"))
 }
@@ -346,6 +348,7 @@ fn validate_one(name: &str, source: &str) -> Result<naga::Module, String> {
 const SHADING_BRDF_VALUE: &str = "SHADING_BRDF_VALUE";
 const SHADING_FALLOFF_VALUE: &str = "SHADING_FALLOFF_VALUE";
 const SHADING_SHADOWS_VALUE: &str = "SHADING_SHADOWS_VALUE";
+const SHADING_MATERIAL_INPUTS_VALUE: &str = "SHADING_MATERIAL_INPUTS_VALUE";
 
 fn specialize(source: &str, shading: Shading) -> String {
     source
@@ -357,6 +360,14 @@ fn specialize(source: &str, shading: Shading) -> String {
         .replace(
             SHADING_SHADOWS_VALUE,
             &format!("{}u", shading.shadows_gpu()),
+        )
+        .replace(
+            SHADING_MATERIAL_INPUTS_VALUE,
+            if shading.material_inputs {
+                "true"
+            } else {
+                "false"
+            },
         )
 }
 
