@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
-use support::{lightgrid, stderr, temp_dir};
+use support::{lightgrid, stderr, temp_dir, with_animation};
 
 fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -785,7 +785,8 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
     let text = dir.join("notes.txt");
     std::fs::write(&text, b"hello").unwrap();
 
-    session.open("scene=robots-few&pipeline=tiled_deferred&size=203x117&paused");
+    // Frame 20: inside the animated file's 31 frames (below), which the page keeps.
+    session.open("scene=robots-few&pipeline=tiled_deferred&size=203x117&paused&frame=20");
     let b = &mut session.b;
     b.wait_for("the first frames", |s| {
         s["settled"].as_u64().unwrap_or(0) >= 2
@@ -891,6 +892,46 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
     assert!(
         caught >= 3,
         "only {caught} lights change the frame: the check proves little"
+    );
+
+    // A file that animates itself plays its own animation on the page: at the page's frame
+    // its light and mesh are where the native renderer puts them, which is not where they
+    // start.
+    let animated = dir.join("animated.glb");
+    std::fs::write(&animated, with_animation(&std::fs::read(&glb).unwrap())).unwrap();
+    pick(b, &animated);
+    let s = b.wait_for("the animated file's frames", |s| {
+        s["scene"] == "animated"
+            && s["pending"] == false
+            && s["message"] == ""
+            && s["settled"].as_u64().unwrap_or(0) >= 2
+    });
+    assert_eq!(s["frame"], 20, "the page's frame: {s}");
+    let web = b.screenshot("animated");
+    b.assert_no_errors("the animated file");
+    let at = |frame: u32| {
+        render_scene(
+            &dir,
+            animated.to_str().unwrap(),
+            "tiled_deferred",
+            frame,
+            "203x117",
+        )
+    };
+    let (start, native) = (at(0), at(20));
+    let moved = start
+        .pixels()
+        .zip(native.pixels())
+        .filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 8))
+        .count();
+    assert!(
+        moved > 2 * EDGE_OVER,
+        "the animation moves {moved} pixels only"
+    );
+    assert_equal(
+        &web,
+        &native,
+        "an animated file at frame 20, tiled_deferred",
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,6 +7,7 @@
 mod common;
 
 use common::gltf_fixture::{cube, GltfWriter};
+use common::shading::Model;
 use glam::{Mat4, Quat, Vec3};
 use lightgrid::scene::gltf::{self, LoadOptions};
 use lightgrid::scene::Scene;
@@ -513,9 +514,12 @@ fn card_scene(w: &GltfWriter) -> Scene {
     loaded.scene
 }
 
-/// Every pipeline renders `scene` as its reference does (`forward`, or `forward_mono` for the
-/// mono variants, whose one-value specular is their documented compromise), within 8 levels
-/// at all but 1% of the pixels; forward's image.
+/// `forward` and its mono references equal the CPU reference, which reads the textures and
+/// vertex colours at each sample itself (within one level, a fifth of the image at least,
+/// away from triangle and texture edges); every pipeline renders `scene` as its reference
+/// does (`forward`, or `forward_mono` for the mono variants, whose one-value specular is
+/// their documented compromise), within 8 levels at all but 1% of the pixels; forward's
+/// image.
 fn every_pipeline_as_forward(scene: &Scene, what: &str) -> image::RgbaImage {
     let ctx = common::gpu();
     let mut r = Renderer::new(&ctx, CARD.0, CARD.1, RenderSettings::default()).unwrap();
@@ -524,6 +528,17 @@ fn every_pipeline_as_forward(scene: &Scene, what: &str) -> image::RgbaImage {
         let image = r.render(scene, 0, info.id).unwrap().image;
         references.insert(info.id, image);
     }
+    let frame = common::shading::Frame::new(scene, 0, CARD);
+    let mut checked = common::shading::Checked::default();
+    for model in [Model::Full, Model::Mono, Model::MonoAlbedo] {
+        let image = &references[model.pipeline()];
+        common::shading::compare(&frame, image, model, 1, &mut checked);
+    }
+    assert!(
+        checked.pixels * 5 >= (CARD.0 * CARD.1) as usize,
+        "{what}: the reference checked only {} pixels",
+        checked.pixels
+    );
     for info in lightgrid::pipelines::PIPELINES {
         let reference = &references[info.reference];
         let over = common::pixels_over(reference, &references[info.id], 8);

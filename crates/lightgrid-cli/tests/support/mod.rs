@@ -85,3 +85,87 @@ pub fn run_limited(mut cmd: Command, limit: Duration) -> Result<(Option<i32>, St
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+/// `glb` with an animation added: its first light's node slides 3 m in x over one second,
+/// and its first mesh node turns half a turn (linear).
+pub fn with_animation(glb: &[u8]) -> Vec<u8> {
+    let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + len]).unwrap();
+    let mut bin = glb[20 + len + 8..].to_vec();
+    let nodes = doc["nodes"].as_array().unwrap();
+    let lit = nodes
+        .iter()
+        .position(|n| n.get("extensions").is_some())
+        .expect("a light node");
+    let meshed = nodes.iter().position(|n| n.get("mesh").is_some()).unwrap();
+    let from: Vec<f32> = match nodes[lit].get("translation") {
+        Some(t) => serde_json::from_value(t.clone()).unwrap(),
+        None => {
+            let m: Vec<f32> = serde_json::from_value(nodes[lit]["matrix"].clone()).unwrap();
+            m[12..15].to_vec()
+        }
+    };
+    let mut add = |values: &[f32], kind: &str, count: usize| {
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let offset = bin.len();
+        bin.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": values.len() * 4}),
+        );
+        let view = views.len() - 1;
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        let mut acc = serde_json::json!({"bufferView": view, "componentType": 5126, "count": count, "type": kind});
+        if kind == "SCALAR" {
+            acc["min"] = serde_json::json!([values[0]]);
+            acc["max"] = serde_json::json!([values[count - 1]]);
+        }
+        accessors.push(acc);
+        accessors.len() - 1
+    };
+    let times = add(&[0.0, 1.0], "SCALAR", 2);
+    let slide = add(
+        &[from[0], from[1], from[2], from[0] + 3.0, from[1], from[2]],
+        "VEC3",
+        2,
+    );
+    let turn = add(&[0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0], "VEC4", 2);
+    doc["animations"] = serde_json::json!([{
+        "channels": [
+            {"sampler": 0, "target": {"node": lit, "path": "translation"}},
+            {"sampler": 1, "target": {"node": meshed, "path": "rotation"}},
+        ],
+        "samplers": [{"input": times, "output": slide}, {"input": times, "output": turn}],
+    }]);
+    // Animated nodes hold TRS, not a matrix (§3.11).
+    for n in [lit, meshed] {
+        let node = doc["nodes"][n].as_object_mut().unwrap();
+        if let Some(m) = node.remove("matrix") {
+            let m: Vec<f32> = serde_json::from_value(m).unwrap();
+            node.insert(
+                "translation".into(),
+                serde_json::json!([m[12], m[13], m[14]]),
+            );
+        }
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    doc["buffers"][0]["byteLength"] = serde_json::json!(bin.len());
+    let mut json_bytes = serde_json::to_vec(&doc).unwrap();
+    while json_bytes.len() % 4 != 0 {
+        json_bytes.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&((12 + 8 + json_bytes.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json_bytes);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}

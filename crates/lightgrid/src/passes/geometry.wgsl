@@ -70,16 +70,17 @@ fn tex_coords(v: VertexOut) -> TexCoords {
 }
 
 // One coordinate wrapped as a glTF sampler says: the GPU sampler repeats; clamping keeps the
-// coordinate within half a texel of the edges (so the repeat never blends the far edge in),
-// mirroring folds every other repeat back.
+// coordinate within half a texel of the edges (so the repeat never blends the far edge in);
+// mirroring folds every other repeat back, and is then clamped the same way (at a fold an
+// edge texel meets its own mirror image, not the far edge).
 fn wrap_coordinate(x: f32, mode: u32, texels: f32) -> f32 {
+    let half = 0.5 / texels;
     if (mode == WRAP_CLAMP) {
-        let half = 0.5 / texels;
         return clamp(x, half, 1.0 - half);
     }
     if (mode == WRAP_MIRROR) {
         let t = fract(x * 0.5) * 2.0;
-        return select(t, 2.0 - t, t > 1.0);
+        return clamp(select(t, 2.0 - t, t > 1.0), half, 1.0 - half);
     }
     return x;
 }

@@ -3,9 +3,11 @@
 //! function written here from the papers' formulas and the shaders' documented contract, not
 //! generated from the WGSL.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3, Vec4};
 use lightgrid::consts::{
     EXPOSURE, MATERIAL_SHADER_CAR_PAINT, MATERIAL_SHADER_RIM, POINT_LIGHT_COS, SCENE_AMBIENT,
+    TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METAL_ROUGH, TEXTURE_SLOT_NORMAL,
+    TEXTURE_SLOT_OCCLUSION, WRAP_CLAMP, WRAP_MIRROR,
 };
 use lightgrid::scene::{Brdf, Light, LightUnits, Material, Scene, Spot};
 use lightgrid::{RenderSettings, Renderer};
@@ -38,8 +40,28 @@ struct Triangle {
     n: [Vec3; 3],
     material: usize,
     transparent: bool,
-    /// A vertex colour other than white (which the reference does not read).
-    coloured: bool,
+    /// Texture coordinate sets 0 and 1, vertex colour and tangent (xyz, bitangent sign) per
+    /// corner, as the vertex buffer holds them.
+    uv: [[Vec2; 3]; 2],
+    color: [Vec4; 3],
+    tangent: [Vec4; 3],
+}
+
+/// A material as one sample reads it: glTF's rules applied to its textures and vertex colour
+/// (the base colour multiplies the diffuse, ambient and alpha; metallic-roughness re-derives
+/// diffuse, F0 and the exponent; the normal texture bends the normal in the tangent frame;
+/// occlusion darkens the ambient term; the emissive texture multiplies the emissive colour).
+struct Sampled {
+    diffuse: Vec3,
+    specular: Vec3,
+    shininess: f32,
+    emissive: Vec3,
+    ambient: Vec3,
+    alpha: f32,
+    /// The shading normal, facing the ray's side.
+    normal: Vec3,
+    /// Every texel value read (linear), to find samples near a texture's edge.
+    texels: Vec<Vec4>,
 }
 
 /// A ray's meeting with a triangle: distance along the ray and the barycentric weights.
@@ -95,7 +117,10 @@ impl<'s> Frame<'s> {
                     n: v.map(|v| Vec3::from(v.normal)),
                     material: v[0].material as usize,
                     transparent: k * 3 >= g.opaque_indices,
-                    coloured: v.iter().any(|v| v.color != [255; 4]),
+                    uv: [v.map(|v| Vec2::from(v.uv)), v.map(|v| Vec2::from(v.uv1))],
+                    color: v.map(|v| Vec4::from(v.color.map(|c| f32::from(c) / 255.0))),
+                    tangent: v
+                        .map(|v| Vec4::from(v.tangent.map(|c| (f32::from(c) / 32767.0).max(-1.0)))),
                 }
             })
             .collect();
@@ -174,6 +199,194 @@ impl<'s> Frame<'s> {
             normal = -normal;
         }
         (position, normal)
+    }
+
+    /// Does the ray see the hit's triangle from its back (wound clockwise as seen)?
+    fn back_face(&self, hit: &Hit, ray: DVec3) -> bool {
+        let [a, b, c] = self.triangles[hit.triangle].p;
+        (b - a).cross(c - a).dot(ray) > 0.0
+    }
+
+    /// The material at `hit` as the sample reads it ([`Sampled`]).
+    fn sampled(&self, hit: &Hit, ray: DVec3) -> Sampled {
+        let tri = &self.triangles[hit.triangle];
+        let m = self.material(hit);
+        let w = hit.w.map(|x| x as f32);
+        let at2 = |c: [Vec2; 3]| c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
+        let at4 = |c: [Vec4; 3]| c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
+        let uv = [at2(tri.uv[0]), at2(tri.uv[1])];
+        let mut texels = Vec::new();
+        let mut read = |slot: u32, texture: Option<u32>| match texture {
+            None => Vec4::ONE,
+            Some(t) => {
+                let v = self.texel(m, slot, t, uv);
+                texels.push(v);
+                v
+            }
+        };
+        let base = read(TEXTURE_SLOT_BASE, m.texture) * at4(tri.color);
+        let n = (tri.n[0] * w[0] + tri.n[1] * w[1] + tri.n[2] * w[2]).normalize();
+        let mut normal = n;
+        if let Some((t, scale)) = m.normal_texture {
+            // glTF §3.9.3: the texel's x and y (times the scale) along the tangent and the
+            // bitangent, z along the normal.
+            let tn = (read(TEXTURE_SLOT_NORMAL, Some(t)).truncate() * 2.0 - 1.0)
+                * Vec3::new(scale, scale, 1.0);
+            let tg = at4(tri.tangent);
+            let tangent = tg.truncate() - n * n.dot(tg.truncate());
+            if tangent.length_squared() >= 1e-12 {
+                let u = tangent.normalize();
+                let v = n.cross(u) * if tg.w < 0.0 { -1.0 } else { 1.0 };
+                let mapped = u * tn.x + v * tn.y + n * tn.z;
+                if mapped.length_squared() > 1e-12 {
+                    normal = mapped.normalize();
+                }
+            }
+        }
+        if self.back_face(hit, ray) {
+            normal = -normal;
+        }
+        let colour = base.truncate();
+        let (mut diffuse, mut specular, mut shininess) =
+            (m.diffuse * colour, m.specular, m.shininess);
+        if let Some(mr) = m.metallic_roughness {
+            // glTF Appendix B: B metallic, G roughness; α = roughness², and the exponent whose
+            // Blinn-Phong lobe matches it, 2/α² − 2.
+            let t = read(TEXTURE_SLOT_METAL_ROUGH, mr.texture);
+            let metallic = (mr.metallic * t.z).clamp(0.0, 1.0);
+            let roughness = (mr.roughness * t.y).clamp(0.0, 1.0);
+            let c = mr.base * colour;
+            let alpha = (roughness * roughness).max(1e-3);
+            diffuse = c * (1.0 - metallic);
+            specular = Vec3::splat(0.04).lerp(c, metallic);
+            shininess = (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0);
+        }
+        let emissive = m.emissive * read(TEXTURE_SLOT_EMISSIVE, m.emissive_texture).truncate();
+        let mut ambient = m.ambient * colour;
+        if let Some((t, strength)) = m.occlusion_texture {
+            let o = read(TEXTURE_SLOT_OCCLUSION, Some(t)).x;
+            ambient *= 1.0 + strength * (o - 1.0);
+        }
+        Sampled {
+            diffuse,
+            specular,
+            shininess,
+            emissive,
+            ambient,
+            alpha: m.alpha * base.w,
+            normal,
+            texels,
+        }
+    }
+
+    /// Texture `texture` of `m`'s slot `slot` at the sample's coordinates, linear RGBA, as a
+    /// glTF sampler reads it at the base level: the slot's coordinate set and transform, its
+    /// wrapping (repeat, clamp to edge, mirrored repeat: on the texel indices) and bilinear
+    /// or nearest magnification, the sRGB-encoded texels decoded first.
+    fn texel(&self, m: &Material, slot: u32, texture: u32, uv: [Vec2; 2]) -> Vec4 {
+        let t = &self.scene.textures[texture as usize];
+        let p = self.texture_coordinates(m, slot, uv);
+        let wrap = (m.wraps >> (4 * slot)) & 15;
+        let index = |i: i64, n: u32, mode: u32| -> u32 {
+            let n = i64::from(n);
+            let i = match mode {
+                WRAP_CLAMP => i.clamp(0, n - 1),
+                WRAP_MIRROR => {
+                    let k = i.rem_euclid(2 * n);
+                    if k >= n {
+                        2 * n - 1 - k
+                    } else {
+                        k
+                    }
+                }
+                _ => i.rem_euclid(n),
+            };
+            i as u32
+        };
+        let fetch = |x: i64, y: i64| {
+            let (x, y) = (index(x, t.width, wrap & 3), index(y, t.height, wrap >> 2));
+            let o = 4 * (y * t.width + x) as usize;
+            let decode = |c: u8| {
+                let c = f32::from(c) / 255.0;
+                if c <= 0.04045 {
+                    c / 12.92
+                } else {
+                    ((c + 0.055) / 1.055).powf(2.4)
+                }
+            };
+            let px = &t.rgba[o..o + 4];
+            Vec4::new(
+                decode(px[0]),
+                decode(px[1]),
+                decode(px[2]),
+                f32::from(px[3]) / 255.0,
+            )
+        };
+        let x = f64::from(p.x) * f64::from(t.width);
+        let y = f64::from(p.y) * f64::from(t.height);
+        if (m.nearest >> slot) & 1 != 0 {
+            return fetch(x.floor() as i64, y.floor() as i64);
+        }
+        let (x, y) = (x - 0.5, y - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let top = fetch(x0, y0).lerp(fetch(x0 + 1, y0), fx);
+        let bottom = fetch(x0, y0 + 1).lerp(fetch(x0 + 1, y0 + 1), fx);
+        top.lerp(bottom, fy)
+    }
+
+    /// The coordinates slot `slot` of `m` reads: its set, through its `KHR_texture_transform`.
+    fn texture_coordinates(&self, m: &Material, slot: u32, uv: [Vec2; 2]) -> Vec2 {
+        let set = ((m.uv_sets >> slot) & 1) as usize;
+        m.uv_transforms[slot as usize].transform_point2(uv[set])
+    }
+
+    /// Is some texture of the hit's material minified at pixel (x, y) (a pixel step moves
+    /// its coordinates by more than a texel), so the GPU would read a smaller mip level than
+    /// the one the reference reads?
+    fn minified(&self, hit: &Hit, x: f64, y: f64) -> bool {
+        let m = self.material(hit);
+        let tri = &self.triangles[hit.triangle];
+        let uv_at = |x: f64, y: f64| {
+            let w = self
+                .plane_weights(hit.triangle, self.ray(x, y))
+                .map(|x| x as f32);
+            [0, 1].map(|s| tri.uv[s][0] * w[0] + tri.uv[s][1] * w[1] + tri.uv[s][2] * w[2])
+        };
+        let here = uv_at(x, y);
+        let slots = [
+            (TEXTURE_SLOT_BASE, m.texture),
+            (TEXTURE_SLOT_EMISSIVE, m.emissive_texture),
+            (
+                TEXTURE_SLOT_METAL_ROUGH,
+                m.metallic_roughness.and_then(|r| r.texture),
+            ),
+            (TEXTURE_SLOT_NORMAL, m.normal_texture.map(|t| t.0)),
+            (TEXTURE_SLOT_OCCLUSION, m.occlusion_texture.map(|t| t.0)),
+        ];
+        [uv_at(x + 1.0, y), uv_at(x, y + 1.0)].iter().any(|next| {
+            slots.iter().any(|&(slot, texture)| {
+                texture.is_some_and(|t| {
+                    let t = &self.scene.textures[t as usize];
+                    let step = self.texture_coordinates(m, slot, *next)
+                        - self.texture_coordinates(m, slot, here);
+                    let texels = step * Vec2::new(t.width as f32, t.height as f32);
+                    texels.abs().max_element() > 1.0
+                })
+            })
+        })
+    }
+
+    /// The barycentric weights of where the ray meets the triangle's plane (inside or not).
+    fn plane_weights(&self, triangle: usize, d: DVec3) -> [f64; 3] {
+        let [a, b, c] = self.triangles[triangle].p;
+        let (e1, e2) = (b - a, c - a);
+        let p = d.cross(e2);
+        let s = -a / e1.dot(p);
+        let u = s.dot(p);
+        let v = d.dot(s.cross(e1));
+        [1.0 - u - v, u, v]
     }
 
     /// The light's direction, squared distance, n·l and cone factor at the point, where it
@@ -263,18 +476,20 @@ impl<'s> Frame<'s> {
         &self.scene.materials[self.triangles[hit.triangle].material]
     }
 
-    /// Does the material's alpha test drop the fragment (glTF MASK)? Without a texture the
-    /// fragment's alpha is the material's.
-    fn discarded(&self, hit: &Hit) -> bool {
+    /// Does the material's alpha test drop the fragment (glTF MASK), its alpha the material's
+    /// times the base colour's texel and vertex colour?
+    fn discarded(&self, hit: &Hit, ray: DVec3) -> bool {
         let m = self.material(hit);
-        m.alpha_cutoff.is_some_and(|c| m.alpha < c)
+        m.alpha_cutoff
+            .is_some_and(|c| self.sampled(hit, ray).alpha < c)
     }
 
     /// What a pixel's centre ray sees: the nearest opaque surface and the glass in front of
     /// it, in drawing order. None where there is no opaque surface.
     pub fn seen(&self, x: f64, y: f64) -> Option<(Hit, Vec<Hit>, f64)> {
-        let mut hits = self.hits(self.ray(x, y));
-        hits.retain(|h| !self.discarded(h));
+        let ray = self.ray(x, y);
+        let mut hits = self.hits(ray);
+        hits.retain(|h| !self.discarded(h, ray));
         let opaque = hits
             .iter()
             .filter(|h| !self.triangles[h.triangle].transparent)
@@ -295,7 +510,9 @@ impl<'s> Frame<'s> {
 
     /// The pixel's reference colour, or None where its surface is ambiguous: an edge (a ray a
     /// third of a pixel off the centre meets other triangles), a second surface within 0.1 %
-    /// of the depth, a texture or a vertex colour (the reference reads neither).
+    /// of the depth, a texture's edge (a texel read a third of a pixel off differs by more
+    /// than 0.01) or a minified texture (the GPU reads a smaller mip level; the reference
+    /// reads the base level).
     pub fn reference(&self, px: u32, py: u32, model: Model) -> Option<(Vec3, bool)> {
         let (x, y) = (f64::from(px) + 0.5, f64::from(py) + 0.5);
         let (opaque, glass, second) = self.seen(x, y)?;
@@ -314,12 +531,26 @@ impl<'s> Frame<'s> {
                 return None;
             }
         }
-        if std::iter::once(&opaque).chain(&glass).any(|h| {
-            self.material(h).textures().next().is_some() || self.triangles[h.triangle].coloured
-        }) {
-            return None;
-        }
         let d = self.ray(x, y);
+        for h in std::iter::once(&opaque).chain(&glass) {
+            if self.material(h).textures().next().is_none() {
+                continue;
+            }
+            if self.minified(h, x, y) {
+                return None;
+            }
+            let centre = self.sampled(h, d).texels;
+            for (dx, dy) in [(-1.0, 0.0), (1.0, 0.0), (0.0, -1.0), (0.0, 1.0)] {
+                let (x, y) = (x + dx / 3.0, y + dy / 3.0);
+                let ray = self.ray(x, y);
+                let w = self.plane_weights(h.triangle, ray);
+                let near = self.sampled(&Hit { w, ..*h }, ray).texels;
+                let differ = |(a, b): (&Vec4, &Vec4)| (*a - *b).abs().max_element() > 0.01;
+                if centre.iter().zip(&near).any(differ) {
+                    return None;
+                }
+            }
+        }
         let keys = if self.shadows {
             let centre = self.shadow_key(x, y)?;
             for (dx, dy) in [(-1.0, 0.0), (1.0, 0.0), (0.0, -1.0), (0.0, 1.0)] {
@@ -335,7 +566,7 @@ impl<'s> Frame<'s> {
         let mut any_lit = lit;
         for (h, blocked) in glass.iter().zip(&keys[1..]) {
             let (c, lit) = self.shade(h, d, model, blocked);
-            let a = self.material(h).alpha;
+            let a = self.sampled(h, d).alpha;
             colour = c * a + colour * (1.0 - a);
             any_lit |= lit;
         }
@@ -345,19 +576,21 @@ impl<'s> Frame<'s> {
     /// The surface at `hit` lit by every light not `blocked` (linear HDR), and whether any
     /// light reached it.
     fn shade(&self, hit: &Hit, ray: DVec3, model: Model, blocked: &[bool]) -> (Vec3, bool) {
-        let (position, normal) = self.surface(hit, ray);
+        let (position, _) = self.surface(hit, ray);
         let m = self.material(hit);
+        let s = self.sampled(hit, ray);
+        let normal = s.normal;
         let view = -position.normalize();
         let (shader, paint, power) = m.shader.gpu();
         let grazing = (1.0 - normal.dot(view).clamp(0.0, 1.0)).powf(power);
         let diffuse = match shader {
-            MATERIAL_SHADER_CAR_PAINT => m.diffuse.lerp(paint, grazing),
-            MATERIAL_SHADER_RIM => m.diffuse + paint * grazing,
-            _ => m.diffuse,
+            MATERIAL_SHADER_CAR_PAINT => s.diffuse.lerp(paint, grazing),
+            MATERIAL_SHADER_RIM => s.diffuse + paint * grazing,
+            _ => s.diffuse,
         };
         let specular = match model {
-            Model::MonoAlbedo => Vec3::splat(luminance(m.specular)),
-            _ => m.specular,
+            Model::MonoAlbedo => Vec3::splat(luminance(s.specular)),
+            _ => s.specular,
         };
         let (mut e_diffuse, mut e_specular, mut e_specular_lum) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         let mut lit = false;
@@ -375,9 +608,9 @@ impl<'s> Frame<'s> {
             let (d, s) = match self.brdf {
                 Brdf::Phong => {
                     let h = (l + view).normalize();
-                    (e, e * normal.dot(h).max(0.0).powf(m.shininess))
+                    (e, e * normal.dot(h).max(0.0).powf(s.shininess))
                 }
-                Brdf::Ggx => ggx(normal, view, l, n_dot_l, m.shininess, specular, e),
+                Brdf::Ggx => ggx(normal, view, l, n_dot_l, s.shininess, specular, e),
             };
             e_diffuse += d;
             e_specular += s;
@@ -389,7 +622,7 @@ impl<'s> Frame<'s> {
             Model::Mono => e_diffuse * (e_specular_lum / luminance(e_diffuse)),
             _ => e_specular,
         };
-        let base = m.emissive + m.ambient * SCENE_AMBIENT;
+        let base = s.emissive + s.ambient * SCENE_AMBIENT;
         // GGX's Fresnel holds the specular colour; Blinn-Phong multiplies by it.
         let specular_albedo = match self.brdf {
             Brdf::Phong => specular,
