@@ -37,22 +37,26 @@ pub(crate) enum Preset {
     Transparency,
     /// MSAA (tiled-forward-shading Fig. 4.4 and 4.1(c)): random-fps (the paper's 1,024
     /// random lights) with and without its translucent blocks, frames 0..259 every 20,
-    /// tiled and clustered forward and deferred at every sample count the adapter offers.
+    /// tiled and clustered forward and deferred at every sample count the adapter offers,
+    /// the papers' tile count (as the paper preset).
     Msaa,
     /// Tiled against clustered forward shading (tiled-forward-shading Fig. 4.6): random-top
     /// and random-fps (1,024 random lights, top-down and first-person) without their
-    /// translucent blocks, 32-pixel tiles, frames 0..119 every 10: the top-down view favours
+    /// translucent blocks, the paper's tile count (32-pixel tiles at 1920x1080, 11 at
+    /// 640x360), frames 0..119 every 10: the top-down view favours
     /// tiles, the first-person view clusters, and clusters depend less on the view.
     Clustered,
     /// The Forward+ demo (forward-plus §5): `scattered` with its 3,072 moving lights at
-    /// 1280x720 (640x360 on a software adapter), 8x8 tiles, Forward+ (tiled forward with
+    /// 1280x720 (640x360 on a software adapter), the paper's 14,400 tiles (8x8 pixels at
+    /// 1280x720, 4x4 at 640x360), Forward+ (tiled forward with
     /// pre-Z) beside its baseline, compute-based deferred lighting (`tiled_light_prepass`),
     /// and tiled deferred, deferred and deferred lighting, frames 0..259 every 20,
     /// the lights-per-tile heatmap on Fig. 2(b)'s fixed 0 to 50 scale.
     ForwardPlus,
     /// Light ranges (tiled-forward-shading Fig. 4.2(a)): robots-many without its glass, every
     /// light's range scaled by 0.5 to 16, `forward`, `tiled_forward_prez` and `tiled_deferred`, frames
-    /// 0..259 every 65, at 320x180 on a software adapter: where tiling stops paying.
+    /// 0..259 every 65, at 320x180 on a software adapter, the papers' tile count (5-pixel
+    /// tiles there): where tiling stops paying.
     LightRange,
     /// Depth bounds (tiled-forward-shading §4.4, 22.4 → 15.6 → 10.9 ms): tiled forward
     /// without pre-Z, then tiled and clustered forward with pre-Z culling by no bounds, the
@@ -185,6 +189,12 @@ pub(crate) fn paper_tile(width: u32) -> u32 {
     ((f64::from(PAPER_TILE) * f64::from(width) / 1920.0).round() as u32).max(1)
 }
 
+/// The tile edge that gives a frame `width` wide Forward+'s tile count (forward-plus §5: 8x8
+/// tiles at 1280x720, 14,400 tiles): 8 pixels at 1280, 4 at 640.
+fn forward_plus_tile(width: u32) -> u32 {
+    (8 * width / 1280).max(1)
+}
+
 /// Forward+ Fig. 2(b)'s lights-per-tile scale (the forward-plus preset's heatmap).
 const FORWARD_PLUS_HEATMAP_MAX: u32 = 50;
 
@@ -308,8 +318,10 @@ pub(crate) fn bench_config(
                 ("msaa", supported.iter().map(u32::to_string).collect()),
                 measure(&[MsaaResolve::Separate, MsaaResolve::Kernel]),
             ],
-            // Fig. 4.4 measures the scene with and without its translucent blocks.
+            // Fig. 4.4 measures the scene with and without its translucent blocks, with the
+            // papers' tile count.
             opaque_variants: true,
+            tile: Some(paper_tile(papers_size(hardware).0)),
             ..study(hardware, |_| false)
         },
         Some(Preset::Paper) => BenchDefaults {
@@ -341,8 +353,9 @@ pub(crate) fn bench_config(
             ]
             .map(String::from)
             .to_vec(),
-            // forward-plus §5: 8x8 tiles, Fig. 2(b)'s fixed lights-per-tile scale.
-            tile: Some(8),
+            // forward-plus §5: 8x8 tiles at 1280x720 (their count: 4x4 at 640x360), Fig. 2(b)'s
+            // fixed lights-per-tile scale.
+            tile: Some(forward_plus_tile(if hardware { 1280 } else { 640 })),
             heatmap_max: Some(FORWARD_PLUS_HEATMAP_MAX),
             ..study(hardware, |_| false)
         },
@@ -352,6 +365,8 @@ pub(crate) fn bench_config(
                 .to_vec(),
             frames: "0..259:65",
             size: Some(if hardware { (1280, 720) } else { (320, 180) }),
+            // Fig. 4.2(a)'s 32-px tiles at 1920x1080: their count at this size.
+            tile: Some(paper_tile(if hardware { 1280 } else { 320 })),
             range_scales: LIGHT_RANGE_SCALES.to_vec(),
             transparency: false,
             ..study(hardware, |_| false)
@@ -448,7 +463,8 @@ pub(crate) fn bench_config(
                 .map(String::from)
                 .to_vec(),
             transparency: false,
-            tile: Some(32),
+            // Fig. 4.6's 32-px tiles at 1920x1080: their count at this size.
+            tile: Some(paper_tile(papers_size(hardware).0)),
             ..study(hardware, |_| false)
         },
     };

@@ -198,6 +198,11 @@ pub const EXPOSURE: f32 = 1.0;
 /// `FrameUniforms::brdf` (`scene::Brdf`): Blinn-Phong or glTF's GGX metallic-roughness.
 pub const BRDF_PHONG: u32 = 0;
 pub const BRDF_GGX: u32 = 1;
+
+/// A spot's angular window between its cones (`scene::SpotCone`): the papers' smoothstep, or
+/// KHR_lights_punctual's squared linear ramp.
+pub const SPOT_CONE_SMOOTHSTEP: u32 = 0;
+pub const SPOT_CONE_SQUARED: u32 = 1;
 /// `FrameUniforms::falloff` (`scene::LightUnits`): the papers' window `(1 − (d/r)²)²`, or
 /// KHR_lights_punctual's inverse square windowed by `clamp(1 − (d/r)⁴, 0, 1)²`.
 pub const FALLOFF_WINDOW: u32 = 0;
@@ -205,6 +210,13 @@ pub const FALLOFF_INVERSE_SQUARE: u32 = 1;
 /// The smallest squared distance the inverse-square falloff divides by (1 cm² in a glTF
 /// file's metres, as Filament clamps it): a light touching a surface stays finite there.
 pub const MIN_LIGHT_DISTANCE_SQ: f32 = 1e-4;
+
+/// The Blinn-Phong exponents a glTF material's roughness maps to (`2/α² − 2`, α =
+/// roughness²): from just above 0 (roughness 1, α = 1: GGX reads α back as 0.99975; 0 itself
+/// would make Blinn-Phong's `pow(0, 0)` undefined) to 2048 (roughness 0.18, the sharpest lobe
+/// a 16-bit G-buffer's exponent holds).
+pub const MIN_SHININESS: f32 = 1e-3;
+pub const MAX_SHININESS: f32 = 2048.0;
 
 /// `--shadow-atlas`'s default budget in MiB: a 4096² depth atlas.
 pub const DEFAULT_SHADOW_ATLAS_MIB: u32 = 64;
@@ -301,6 +313,8 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("EXPOSURE", WgslConst::F32(EXPOSURE)),
     ("BRDF_PHONG", WgslConst::U32(BRDF_PHONG)),
     ("BRDF_GGX", WgslConst::U32(BRDF_GGX)),
+    ("SPOT_CONE_SMOOTHSTEP", WgslConst::U32(SPOT_CONE_SMOOTHSTEP)),
+    ("SPOT_CONE_SQUARED", WgslConst::U32(SPOT_CONE_SQUARED)),
     ("FALLOFF_WINDOW", WgslConst::U32(FALLOFF_WINDOW)),
     (
         "FALLOFF_INVERSE_SQUARE",
@@ -310,6 +324,8 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
         "MIN_LIGHT_DISTANCE_SQ",
         WgslConst::F32(MIN_LIGHT_DISTANCE_SQ),
     ),
+    ("MIN_SHININESS", WgslConst::F32(MIN_SHININESS)),
+    ("MAX_SHININESS", WgslConst::F32(MAX_SHININESS)),
     ("SCREEN_WORKGROUP", WgslConst::U32(SCREEN_WORKGROUP)),
     ("SHADOWS_OFF", WgslConst::U32(SHADOWS_OFF)),
     ("SHADOWS_RAYS", WgslConst::U32(SHADOWS_RAYS)),

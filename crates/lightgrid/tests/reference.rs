@@ -2,7 +2,8 @@
 //!
 //! `LIGHTGRID_BLESS=1 cargo test --release -p lightgrid --test reference` rewrites the
 //! blessed images, each only after the frame matched the CPU shading reference
-//! (`common::shading`: every clean sampled pixel within one level), and never under `CI=true`.
+//! (`common::shading`: every clean sampled pixel within one level), and never under a
+//! non-empty `CI`. Every committed golden is itself checked against that reference.
 //! On failure the actual image and a diff image go to target/test-output/.
 
 mod common;
@@ -77,6 +78,44 @@ fn check_against_golden(scene: &str, frame: u32, size: (u32, u32)) {
             dir.display()
         );
     }
+}
+
+/// The goldens, by scene, frame and size.
+const GOLDENS: [(&str, u32, (u32, u32)); 2] = [
+    ("robots-many", 200, (192, 108)),
+    ("robots-few", 200, (160, 90)),
+];
+
+/// A golden cannot drift from the CPU shading reference: each committed image is within one
+/// level of it at every clean pixel sampled (as a bless requires of the render).
+#[test]
+fn every_golden_equals_the_shading_reference() {
+    for (scene, frame, size) in GOLDENS {
+        let name = golden_name(scene, frame, size);
+        let golden = load_golden(&name);
+        let s = catalog::build(scene, &SceneParams::default()).unwrap();
+        let f = common::shading::Frame::new(&s, frame, size);
+        let mut checked = common::shading::Checked::default();
+        common::shading::compare(&f, &golden, common::shading::Model::Full, 3, &mut checked);
+        assert!(
+            checked.pixels >= 100,
+            "{name}: {} pixels checked",
+            checked.pixels
+        );
+    }
+}
+
+/// Blessing is refused under any CI value a CI sets, and happens only when asked.
+#[test]
+fn blessing_is_refused_under_any_ci() {
+    for ci in ["true", "1", "yes", "github-actions"] {
+        let e = common::blessing_with(Some("1"), Some(ci)).unwrap_err();
+        assert!(e.contains(&format!("CI={ci}")), "{e}");
+    }
+    assert_eq!(common::blessing_with(Some("1"), None), Ok(true));
+    assert_eq!(common::blessing_with(Some("1"), Some("")), Ok(true));
+    assert_eq!(common::blessing_with(None, Some("true")), Ok(false));
+    assert_eq!(common::blessing_with(Some("0"), None), Ok(false));
 }
 
 #[test]

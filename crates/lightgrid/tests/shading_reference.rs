@@ -223,6 +223,7 @@ fn one_plane(
 const PHOTOMETRIC: Lighting = Lighting {
     units: LightUnits::Photometric,
     brdf: Brdf::Ggx,
+    spot_cone: lightgrid::scene::SpotCone::Squared,
     exposure: 1.0,
 };
 
@@ -284,6 +285,62 @@ fn a_plane_under_one_photometric_light_falls_off_with_the_inverse_square() {
         "{} points from {near} to {far} m",
         distances.len()
     );
+}
+
+/// KHR_lights_punctual's spot window, by hand: a 30 cd spot 2 m above a grey plane, pointing
+/// down (inner cone 0.3 rad, outer 0.7), with the specification's conventions. At every
+/// pixel whose ground point lies between the cones, `forward` shows
+/// `t² · I / d² · window(d)` through glTF's BRDF, `t = (cos θ − cos outer) / (cos inner − cos
+/// outer)`, within one level; points across the whole ramp are checked (the papers'
+/// smoothstep differs from `t²` by up to a quarter of the light there).
+#[test]
+fn a_spot_falls_off_between_its_cones_as_the_specification_writes() {
+    let ctx = common::gpu();
+    let (eye, size) = (Vec3::new(0.0, 3.5, 2.5), 96);
+    let (height, range, candela) = (2.0f32, 8.0f32, 30.0f32);
+    let (inner, outer) = (0.3f32, 0.7f32);
+    let mut material = Material::plain(Vec3::splat(0.6), 0.04, 30.0);
+    material.ambient = Vec3::ZERO;
+    let mut light = Light::point(Vec3::new(0.0, height, 0.0), Vec3::ONE, candela, range);
+    light.spot = Some(lightgrid::scene::Spot::new(-Vec3::Y, inner, outer));
+    let scene = one_plane(material, vec![light], eye, Vec3::ZERO, PHOTOMETRIC);
+    let f = Frame::new(&scene, 0, (size, size));
+    let mut r = Renderer::new(&ctx, size, size, RenderSettings::default()).unwrap();
+    let image = r.render(&scene, 0, "forward").unwrap().image;
+    let mut ramp = std::collections::BTreeSet::new();
+    for py in 0..size {
+        for px in 0..size {
+            if f.reference(px, py, Model::Full).is_none() {
+                continue;
+            }
+            let d = f.ray(f64::from(px) + 0.5, f64::from(py) + 0.5);
+            let t = f64::from(eye.y) / -d.y;
+            let p = eye + (d * t).as_vec3();
+            let to_light = Vec3::new(0.0, height, 0.0) - p;
+            let dist = to_light.length();
+            let (l, v) = (to_light / dist, (eye - p).normalize());
+            let cos_theta = l.y; // the angle from the downward axis
+            let ramp_t = ((cos_theta - outer.cos()) / (inner.cos() - outer.cos())).clamp(0.0, 1.0);
+            if ramp_t <= 0.02 || ramp_t >= 0.98 {
+                continue;
+            }
+            let window = (1.0 - (dist / range).powi(4)).clamp(0.0, 1.0).powi(2);
+            let e = Vec3::splat(candela / (dist * dist) * window * l.y * ramp_t * ramp_t);
+            let (diffuse, specular) =
+                common::shading::ggx(Vec3::Y, v, l, l.y, 30.0, material.specular, e);
+            let want = display(diffuse * material.diffuse + specular);
+            let got = image.get_pixel(px, py).0;
+            for c in 0..3 {
+                assert!(
+                    got[c].abs_diff(want[c]) <= 1,
+                    "({px}, {py}) at t = {ramp_t}: forward {:?}, the spec {want:?}",
+                    &got[..3]
+                );
+            }
+            ramp.insert((ramp_t * 10.0) as u32);
+        }
+    }
+    assert!(ramp.len() >= 9, "the ramp's tenths checked: {ramp:?}");
 }
 
 /// The directional albedo of glTF's BRDF as the reference writes it: `∫ f (n·l) dω` over the

@@ -182,7 +182,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
         let alpha_g = max(roughness * roughness, 1e-3);
         s.diffuse = colour * (1.0 - metallic);
         s.specular = mix(vec3<f32>(0.04), colour, metallic);
-        s.shininess = clamp(2.0 / (alpha_g * alpha_g) - 2.0, 1.0, 2048.0);
+        s.shininess = clamp(2.0 / (alpha_g * alpha_g) - 2.0, MIN_SHININESS, MAX_SHININESS);
     }
     s.emissive = emissive_colour(m, t);
     // Occlusion darkens the ambient term only (glTF: indirect light), by its strength.

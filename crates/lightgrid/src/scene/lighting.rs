@@ -45,6 +45,41 @@ impl Brdf {
     }
 }
 
+/// A spot's angular window between its inner and outer cones, with `t` the linear ramp
+/// `clamp((cos θ − cos outer) / (cos inner − cos outer), 0, 1)`. Both are 1 inside the inner
+/// cone and exactly 0 at the outer one, so culling by the outer cone is exact for either.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum SpotCone {
+    /// The papers' (and the catalog's): `t² (3 − 2t)`. Also what a lightgrid file's lighting
+    /// record without a spot field (an earlier lightgrid's) was rendered with.
+    #[default]
+    Smoothstep,
+    /// KHR_lights_punctual's (and its sample viewer's, Bevy's, three.js's): `t²`.
+    Squared,
+}
+
+impl SpotCone {
+    /// The shaders' value (`consts::SPOT_CONE_*`).
+    pub fn gpu(self) -> u32 {
+        match self {
+            SpotCone::Smoothstep => crate::consts::SPOT_CONE_SMOOTHSTEP,
+            SpotCone::Squared => crate::consts::SPOT_CONE_SQUARED,
+        }
+    }
+
+    /// The window at `cos_theta` (the angle from the spot's axis) between the cones.
+    pub fn window(self, cos_theta: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+        let t = ((cos_theta - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
+        match self {
+            SpotCone::Smoothstep => t * t * (3.0 - 2.0 * t),
+            SpotCone::Squared => t * t,
+        }
+    }
+}
+
 /// What a light's colour × intensity means.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -131,6 +166,8 @@ pub struct Shading {
     /// With shadow maps: the pipeline re-uses one light's maps (the classic deferred
     /// family's light volumes, `crate::shadows::maps`), so a face's tile is its cube face's.
     pub reuse_maps: bool,
+    /// The spots' window between their cones (the scene's [`Lighting::spot_cone`]).
+    pub spot_cone: SpotCone,
     /// Some material reads inputs per sample beyond its base colour
     /// ([`super::Material::reads_per_sample_inputs`]); without, the geometry stage is made
     /// without those reads (`passes/geometry.wgsl`'s `MATERIAL_INPUTS`).
@@ -145,6 +182,7 @@ impl Default for Shading {
             units: LightUnits::Papers,
             shadows: Shadows::Off,
             reuse_maps: false,
+            spot_cone: SpotCone::Smoothstep,
             material_inputs: false,
         }
     }
@@ -162,13 +200,16 @@ impl Shading {
                             continue;
                         }
                         for material_inputs in [false, true] {
-                            out.push(Shading {
-                                brdf,
-                                units,
-                                shadows,
-                                reuse_maps,
-                                material_inputs,
-                            });
+                            for spot_cone in [SpotCone::Smoothstep, SpotCone::Squared] {
+                                out.push(Shading {
+                                    brdf,
+                                    units,
+                                    shadows,
+                                    reuse_maps,
+                                    spot_cone,
+                                    material_inputs,
+                                });
+                            }
                         }
                     }
                 }
@@ -184,6 +225,7 @@ impl Shading {
             units: scene.lighting.units,
             shadows,
             reuse_maps: false,
+            spot_cone: scene.lighting.spot_cone,
             material_inputs: scene.materials.iter().any(|m| m.reads_per_sample_inputs()),
         }
     }
@@ -212,6 +254,9 @@ impl Shading {
 pub struct Lighting {
     pub units: LightUnits,
     pub brdf: Brdf,
+    /// The spots' window between their cones.
+    #[serde(default)]
+    pub spot_cone: SpotCone,
     /// Multiplies every light's radiance before shading (`--exposure`): for photometric
     /// scenes the display value of one lux on a white diffuse surface, times π.
     pub exposure: f32,
@@ -223,6 +268,7 @@ impl Default for Lighting {
         Lighting {
             units: LightUnits::Papers,
             brdf: Brdf::Phong,
+            spot_cone: SpotCone::Smoothstep,
             exposure: 1.0,
         }
     }
@@ -238,6 +284,7 @@ impl Lighting {
         Lighting {
             units: LightUnits::Photometric,
             brdf: Brdf::Ggx,
+            spot_cone: SpotCone::Squared,
             exposure: 1.0,
         }
     }
@@ -462,6 +509,7 @@ mod tests {
             let l = Lighting {
                 units,
                 brdf: Brdf::Phong,
+                spot_cone: SpotCone::Smoothstep,
                 exposure: 2.0,
             };
             // Phong's diffuse kd·E against GGX's kd/π·E.

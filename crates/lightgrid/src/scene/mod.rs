@@ -17,7 +17,7 @@ pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
 pub use lighting::{
     auto_exposure, derive_ranges, light_exposure, Brdf, DerivedRanges, LightUnits, Lighting,
-    Shading, Shadows, AUTO_EXPOSURE_DISTANCE, VISIBLE_RADIANCE,
+    Shading, Shadows, SpotCone, AUTO_EXPOSURE_DISTANCE, VISIBLE_RADIANCE,
 };
 pub use mesh::{bounds_of, Mesh};
 pub use raster::{rasterize, Fragment};

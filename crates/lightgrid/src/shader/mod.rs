@@ -349,6 +349,7 @@ const SHADING_BRDF_VALUE: &str = "SHADING_BRDF_VALUE";
 const SHADING_FALLOFF_VALUE: &str = "SHADING_FALLOFF_VALUE";
 const SHADING_SHADOWS_VALUE: &str = "SHADING_SHADOWS_VALUE";
 const SHADING_MATERIAL_INPUTS_VALUE: &str = "SHADING_MATERIAL_INPUTS_VALUE";
+const SHADING_SPOT_CONE_VALUE: &str = "SHADING_SPOT_CONE_VALUE";
 
 fn specialize(source: &str, shading: Shading) -> String {
     source
@@ -360,6 +361,10 @@ fn specialize(source: &str, shading: Shading) -> String {
         .replace(
             SHADING_SHADOWS_VALUE,
             &format!("{}u", shading.shadows_gpu()),
+        )
+        .replace(
+            SHADING_SPOT_CONE_VALUE,
+            &format!("{}u", shading.spot_cone.gpu()),
         )
         .replace(
             SHADING_MATERIAL_INPUTS_VALUE,

@@ -11,6 +11,8 @@ const SHADING_FALLOFF: u32 = SHADING_FALLOFF_VALUE;
 // How lights are shadowed (SHADOWS_OFF, SHADOWS_RAYS, SHADOWS_MAPS or SHADOWS_MAPS_REUSED),
 // written in the same way.
 const SHADING_SHADOWS: u32 = SHADING_SHADOWS_VALUE;
+// The spots' window between their cones (`SPOT_CONE_*`, `scene::SpotCone`).
+const SHADING_SPOT_CONE: u32 = SHADING_SPOT_CONE_VALUE;
 
 // A shading sample: everything the light function needs, wherever it came from
 // (interpolated vertex data or a G-buffer).
@@ -54,13 +56,20 @@ fn distance_falloff(dist_sq: f32, range: f32) -> f32 {
     return range_falloff(dist_sq, range);
 }
 
-// A spot's angular window: 1 inside the inner cone, a smoothstep to exactly 0 at the outer
-// cone, 0 outside; 1 for a point light. `l` is the unit vector from the surface to the light.
+// A spot's angular window: 1 inside the inner cone, falling to exactly 0 at the outer cone
+// (the papers' smoothstep, or KHR_lights_punctual's t² of the linear ramp t:
+// `SHADING_SPOT_CONE`), 0 outside; 1 for a point light. `l` is the unit vector from the
+// surface to the light.
 fn spot_falloff(light: Light, l: vec3<f32>) -> f32 {
     if (light.cos_outer <= POINT_LIGHT_COS) {
         return 1.0;
     }
-    return smoothstep(light.cos_outer, light.cos_inner, dot(-l, light.direction));
+    let cos_theta = dot(-l, light.direction);
+    if (SHADING_SPOT_CONE == SPOT_CONE_SQUARED) {
+        let t = saturate((cos_theta - light.cos_outer) / (light.cos_inner - light.cos_outer));
+        return t * t;
+    }
+    return smoothstep(light.cos_outer, light.cos_inner, cos_theta);
 }
 
 const INV_PI: f32 = 0.318309886;

@@ -9,7 +9,7 @@ use lightgrid::consts::{
     TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METAL_ROUGH, TEXTURE_SLOT_NORMAL,
     TEXTURE_SLOT_OCCLUSION, WRAP_CLAMP, WRAP_MIRROR,
 };
-use lightgrid::scene::{Brdf, Light, LightUnits, Material, Scene, Spot};
+use lightgrid::scene::{Brdf, Light, LightUnits, Material, Scene, Spot, SpotCone};
 use lightgrid::{RenderSettings, Renderer};
 
 /// The light model a `forward` variant implements.
@@ -259,7 +259,8 @@ impl<'s> Frame<'s> {
             let alpha = (roughness * roughness).max(1e-3);
             diffuse = c * (1.0 - metallic);
             specular = Vec3::splat(0.04).lerp(c, metallic);
-            shininess = (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0);
+            // README: the exponent from just above 0 (roughness 1) to 2048 (roughness 0.18).
+            shininess = (2.0 / (alpha * alpha) - 2.0).clamp(1e-3, 2048.0);
         }
         let emissive = m.emissive * read(TEXTURE_SLOT_EMISSIVE, m.emissive_texture).truncate();
         let mut ambient = m.ambient * colour;
@@ -413,7 +414,11 @@ impl<'s> Frame<'s> {
             }) => {
                 assert!(cos_outer > POINT_LIGHT_COS);
                 let t = ((-l.dot(direction) - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
-                t * t * (3.0 - 2.0 * t)
+                match self.scene.lighting.spot_cone {
+                    // The papers' smoothstep; KHR_lights_punctual's square of the ramp.
+                    SpotCone::Smoothstep => t * t * (3.0 - 2.0 * t),
+                    SpotCone::Squared => t * t,
+                }
             }
         };
         (n_dot_l > 0.0 && cone > 0.0).then_some((l, dist_sq, n_dot_l, cone))

@@ -184,7 +184,8 @@ const MAX_EMISSIVE: f32 = 1e12;
 /// glTF's metallic-roughness material (§3.9.2) to Blinn-Phong, by one documented rule:
 /// diffuse = base × (1 − metallic); specular = mix(0.04, base, metallic) (the dielectric F0
 /// of the specification's BRDF, metals tinted); shininess = 2/α² − 2 with α = roughness²
-/// (the Blinn-Phong exponent whose lobe matches GGX of that α), from 1 to 2048; ambient =
+/// (the Blinn-Phong exponent whose lobe matches GGX of that α), from `MIN_SHININESS` (just
+/// above 0, roughness 1) to `MAX_SHININESS` (2048, roughness 0.18); ambient =
 /// base; emissive = emissiveFactor × KHR_materials_emissive_strength, times the
 /// `emissiveTexture` where there is one. `BLEND` is drawn transparent with the base alpha.
 fn map_material(
@@ -211,8 +212,8 @@ fn map_material(
         Ok(Some(t.index))
     };
     use crate::consts::{
-        TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METAL_ROUGH, TEXTURE_SLOT_NORMAL,
-        TEXTURE_SLOT_OCCLUSION,
+        MAX_SHININESS, MIN_SHININESS, TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE,
+        TEXTURE_SLOT_METAL_ROUGH, TEXTURE_SLOT_NORMAL, TEXTURE_SLOT_OCCLUSION,
     };
     let texture = slot(
         pbr.and_then(|p| p.base_color_texture.as_ref()),
@@ -326,7 +327,7 @@ fn map_material(
     Ok(textured(Material {
         diffuse: colour * (1.0 - metallic),
         specular: Vec3::splat(0.04).lerp(colour, metallic),
-        shininess: (2.0 / (alpha_g * alpha_g) - 2.0).clamp(1.0, 2048.0),
+        shininess: (2.0 / (alpha_g * alpha_g) - 2.0).clamp(MIN_SHININESS, MAX_SHININESS),
         emissive: emissive.into(),
         ambient: colour,
         alpha: if transparent || alpha_tested {
@@ -1506,7 +1507,13 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         None => None,
     };
     if walk.objects.is_empty() {
-        return Err("the scene has no triangles to render".into());
+        // Say why where the file has primitives that are not drawn.
+        let skipped = walk.warned.iter().any(|w| w.contains("points and lines"));
+        return Err(if skipped {
+            "the scene has no triangles to render: its primitives are points and lines, which lightgrid does not draw".into()
+        } else {
+            "the scene has no triangles to render".into()
+        });
     }
     let defs = doc
         .root
