@@ -977,6 +977,9 @@ fn summary(results: &BenchResults) -> String {
             }
         );
     }
+    let mut sources: Vec<&str> = checked.iter().map(|c| c.source).collect();
+    sources.dedup();
+    s.push_str(&conditions_against_papers(results, &sources));
     // The claims this run's pipelines and settings cannot speak to, once each with the
     // scenes, so a focused run's table holds only what it measured.
     let mut missing: Vec<(&str, &str, &str, Vec<&str>)> = Vec::new();
@@ -1003,6 +1006,71 @@ fn summary(results: &BenchResults) -> String {
     }
     s.push_str("\nFiles: `results.json` (per-frame series and summaries), `results.csv` (one row per frame), `frame_time_*` (Fig. 2 style), `lighting_*` (Fig. 3 style, ideal dashed), `passes_*` (per-pass stacked bars), `heatmap_*` (lights per tile).\n");
     s
+}
+
+/// Where each paper measured its claims: the source's name, its GPU, frame size and tile edge
+/// (tiled-shading §8 and tiled-forward-shading §4: 32x32 tiles at 1920x1080; forward-plus
+/// §5: 8x8 tiles at 1280x720).
+const PAPER_CONDITIONS: [(&str, &str, (u32, u32), u32); 3] = [
+    (
+        "tiled-shading",
+        "an NVIDIA GTX 280 or GTX 480",
+        (1920, 1080),
+        32,
+    ),
+    (
+        "tiled-forward-shading",
+        "an NVIDIA GTX 480",
+        (1920, 1080),
+        32,
+    ),
+    ("forward-plus", "an AMD Radeon HD 6970", (1280, 720), 8),
+];
+
+/// For each paper among `sources` (the checked claims' sources), how this run's conditions
+/// differ from the paper's: the adapter, the frame size, the tile count.
+fn conditions_against_papers(results: &BenchResults, sources: &[&str]) -> String {
+    let (w, h) = results.runs.first().map_or((0, 0), |r| (r.width, r.height));
+    let tile = results.config.tile_size.max(1);
+    let tiles = |(w, h): (u32, u32), t: u32| w.div_ceil(t) * h.div_ceil(t);
+    let mut out = String::new();
+    for (paper, gpu, size, paper_tile) in PAPER_CONDITIONS {
+        if !sources.iter().any(|s| s.starts_with(paper)) {
+            continue;
+        }
+        let (ours, theirs) = (tiles((w, h), tile), tiles(size, paper_tile));
+        let mut differ = vec![format!("the adapter ({})", results.adapter)];
+        if (w, h) != size {
+            differ.push(format!("the frame size ({w}x{h})"));
+        }
+        // The tile count sets lights per tile and the culling ratios; within 10% is the
+        // paper's count.
+        if ours.abs_diff(theirs) * 10 > theirs {
+            differ.push(format!("the tile count ({ours} tiles of {tile} px)"));
+        }
+        let _ = writeln!(
+            out,
+            "- **{paper}** measured on {gpu} at {}x{} with {paper_tile}-px tiles ({theirs} tiles); this run differs in {}{}",
+            size.0,
+            size.1,
+            differ.join(", "),
+            if results.config.transparency {
+                " and draws transparent objects (the papers' opaque figures have none)"
+            } else {
+                ""
+            }
+        );
+    }
+    if out.is_empty() {
+        out
+    } else {
+        format!(
+            "
+The conditions each paper's claims were measured under, against this run's:
+
+{out}"
+        )
+    }
 }
 
 /// Read a results.json written by [`write_report`] (heatmaps are not part of it).

@@ -254,6 +254,13 @@ fn forward_plus_preset_draws_the_heatmap_on_the_papers_scale() {
     let tile = if v["software_adapter"] == true { 4 } else { 8 };
     assert_eq!(v["config"]["tile_size"], tile);
     assert_eq!(v["config"]["scenes"][0], "scattered");
+    // Its claims name the paper's conditions and how this small run differs from them.
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        summary.contains("- **forward-plus** measured on an AMD Radeon HD 6970 at 1280x720 with 8-px tiles (14400 tiles); this run differs in the adapter")
+            && summary.contains("the frame size (96x54)"),
+        "{summary}"
+    );
     let runs = v["runs"].as_array().unwrap();
     assert!(runs.iter().any(|r| r["pipeline"] == "tiled_forward_prez"));
     let heatmap = std::fs::read_dir(&out)
@@ -510,6 +517,11 @@ fn paper_preset_measures_every_pipeline_and_checks_the_papers_claims() {
     let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
     assert!(summary.contains("transparent objects off"), "{summary}");
     assert!(summary.contains("the papers': 2040 for 32-px tiles at 1920x1080"));
+    // Where the run's conditions differ from each paper's, said once per paper.
+    assert!(
+        summary.contains("- **tiled-shading** measured on an NVIDIA GTX 280 or GTX 480 at 1920x1080 with 32-px tiles (2040 tiles); this run differs in the adapter"),
+        "{summary}"
+    );
     // Each claim's paper wording, threshold and verdict; the model verdicts labelled.
     assert!(summary.contains(
         "| scene | claim (the paper's words) | source | threshold | measured | verdict |"

@@ -69,15 +69,6 @@ impl SpotCone {
             SpotCone::Squared => crate::consts::SPOT_CONE_SQUARED,
         }
     }
-
-    /// The window at `cos_theta` (the angle from the spot's axis) between the cones.
-    pub fn window(self, cos_theta: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-        let t = ((cos_theta - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
-        match self {
-            SpotCone::Smoothstep => t * t * (3.0 - 2.0 * t),
-            SpotCone::Squared => t * t,
-        }
-    }
 }
 
 /// What a light's colour × intensity means.

@@ -213,10 +213,12 @@ fn luminance(c: vec3<f32>) -> f32 {
 // The light pre-pass compromise (deferred-shading-vs-deferred-lighting): specular irradiance
 // stored as one luminance value and re-coloured with the diffuse irradiance's chromaticity.
 // Exact when all lights reaching a sample share one colour; otherwise the specular takes the
-// mixture's colour.
+// mixture's colour. Where the diffuse irradiance is next to nothing beside the specular (a
+// white metal, whose 1 − F rounds to a few ulps) its colour is rounding, so the specular
+// stays grey.
 fn mono_specular(diffuse_irradiance: vec3<f32>, specular_luminance: f32) -> vec3<f32> {
     let l = luminance(diffuse_irradiance);
-    if (l <= 1e-8) {
+    if (l <= max(1e-8, 1e-6 * specular_luminance)) {
         return vec3<f32>(specular_luminance);
     }
     return diffuse_irradiance * (specular_luminance / l);

@@ -623,7 +623,11 @@ impl<'s> Frame<'s> {
             lit |= d.max_element() > 1e-3;
         }
         let specular_light = match model {
-            Model::Mono if luminance(e_diffuse) <= 1e-8 => Vec3::splat(e_specular_lum),
+            // Grey where the diffuse irradiance is next to nothing beside the specular (its
+            // colour would be rounding: 1 − F of a white metal).
+            Model::Mono if luminance(e_diffuse) <= (1e-6 * e_specular_lum).max(1e-8) => {
+                Vec3::splat(e_specular_lum)
+            }
             Model::Mono => e_diffuse * (e_specular_lum / luminance(e_diffuse)),
             _ => e_specular,
         };
