@@ -219,6 +219,25 @@ fn one_plane(
     }
 }
 
+/// What pixel (px, py) of `f` shows on the ground (y = 0, seen from `eye`) under a light
+/// `height` above the origin: the unit vectors to the light and to the eye, the distance to
+/// the light and KHR_lights_punctual's range window `clamp(1 − (d/r)⁴, 0, 1)²` for `range`.
+fn toward_light(
+    f: &Frame,
+    eye: Vec3,
+    height: f32,
+    range: f32,
+    px: u32,
+    py: u32,
+) -> (Vec3, Vec3, f32, f32) {
+    let d = f.ray(f64::from(px) + 0.5, f64::from(py) + 0.5);
+    let p = eye + (d * (f64::from(eye.y) / -d.y)).as_vec3();
+    let to_light = Vec3::new(0.0, height, 0.0) - p;
+    let dist = to_light.length();
+    let window = (1.0 - (dist / range).powi(4)).clamp(0.0, 1.0).powi(2);
+    (to_light / dist, (eye - p).normalize(), dist, window)
+}
+
 /// Candela, inverse square and GGX, exposure 1: a glTF file's conventions, unscaled.
 const PHOTOMETRIC: Lighting = Lighting {
     units: LightUnits::Photometric,
@@ -254,13 +273,7 @@ fn a_plane_under_one_photometric_light_falls_off_with_the_inverse_square() {
             if f.reference(px, py, Model::Full).is_none() {
                 continue;
             }
-            let d = f.ray(f64::from(px) + 0.5, f64::from(py) + 0.5);
-            let t = f64::from(eye.y) / -d.y;
-            let p = eye + (d * t).as_vec3();
-            let to_light = Vec3::new(0.0, height, 0.0) - p;
-            let dist = to_light.length();
-            let (l, v) = (to_light / dist, (eye - p).normalize());
-            let window = (1.0 - (dist / range).powi(4)).clamp(0.0, 1.0).powi(2);
+            let (l, v, dist, window) = toward_light(&f, eye, height, range, px, py);
             let e = Vec3::splat(candela / (dist * dist) * window * l.y);
             let (diffuse, specular) =
                 common::shading::ggx(Vec3::Y, v, l, l.y, 30.0, material.specular, e);
@@ -313,18 +326,12 @@ fn a_spot_falls_off_between_its_cones_as_the_specification_writes() {
             if f.reference(px, py, Model::Full).is_none() {
                 continue;
             }
-            let d = f.ray(f64::from(px) + 0.5, f64::from(py) + 0.5);
-            let t = f64::from(eye.y) / -d.y;
-            let p = eye + (d * t).as_vec3();
-            let to_light = Vec3::new(0.0, height, 0.0) - p;
-            let dist = to_light.length();
-            let (l, v) = (to_light / dist, (eye - p).normalize());
+            let (l, v, dist, window) = toward_light(&f, eye, height, range, px, py);
             let cos_theta = l.y; // the angle from the downward axis
             let ramp_t = ((cos_theta - outer.cos()) / (inner.cos() - outer.cos())).clamp(0.0, 1.0);
             if ramp_t <= 0.02 || ramp_t >= 0.98 {
                 continue;
             }
-            let window = (1.0 - (dist / range).powi(4)).clamp(0.0, 1.0).powi(2);
             let e = Vec3::splat(candela / (dist * dist) * window * l.y * ramp_t * ramp_t);
             let (diffuse, specular) =
                 common::shading::ggx(Vec3::Y, v, l, l.y, 30.0, material.specular, e);
