@@ -33,10 +33,16 @@ fn forward(scene: &Scene, (w, h): (u32, u32)) -> image::RgbaImage {
 }
 
 /// A 20 m ground of `ground` (a material index; its diagonal off the origin, which the camera
-/// looks at), seen straight down from 5 m, a point light
-/// of `candela` (range 8) 1 m above the origin in a parent scaled 2 (so 2 m up), and the
-/// boxes `boxes` (material, position) on the ground.
-fn stage(w: &mut GltfWriter, ground: usize, candela: f32, boxes: &[(usize, [f32; 3])]) {
+/// looks at), seen straight down from 5 m, the light `light` pointing down 1 m above the
+/// origin in a parent scaled `lift` (so `lift` m up), and the boxes `boxes` (material,
+/// position) on the ground.
+fn stage(
+    w: &mut GltfWriter,
+    ground: usize,
+    light: serde_json::Value,
+    lift: f32,
+    boxes: &[(usize, [f32; 3])],
+) {
     let g = w.mesh(
         &[
             -10.0, 0.0, -9.0, 10.0, 0.0, -9.0, 10.0, 0.0, 11.0, -10.0, 0.0, 11.0,
@@ -52,36 +58,47 @@ fn stage(w: &mut GltfWriter, ground: usize, candela: f32, boxes: &[(usize, [f32;
         let mesh = w.mesh(&cp, Some(&cn), Some(&ci), Some(m), 4);
         roots.push(w.node(json!({"mesh": mesh, "translation": at, "scale": [0.8, 0.8, 0.8]})));
     }
-    let l = w.light(
-        json!({"type": "point", "color": [1.0, 1.0, 1.0], "intensity": candela, "range": 8.0}),
-    );
-    let light = w.node(json!({"translation": [0.0, 1.0, 0.0], "extensions": {"KHR_lights_punctual": {"light": l}}}));
-    roots.push(w.node(json!({"scale": [2.0, 2.0, 2.0], "children": [light]})));
+    let l = w.light(light);
+    let down = Quat::from_rotation_x(-90f32.to_radians()).to_array();
+    let light = w.node(json!({"translation": [0.0, 1.0, 0.0], "rotation": down,
+        "extensions": {"KHR_lights_punctual": {"light": l}}}));
+    roots.push(w.node(json!({"scale": [lift, lift, lift], "children": [light]})));
     w.cameras.push(
         json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 50.0}}),
     );
-    let down = Quat::from_rotation_x(-90f32.to_radians()).to_array();
     roots.push(w.node(json!({"camera": 0, "translation": [0.0, 5.0, 0.0], "rotation": down})));
     w.roots = roots;
+}
+
+/// A point light of `candela`, range 8.
+fn point(candela: f32) -> serde_json::Value {
+    json!({"type": "point", "color": [1.0, 1.0, 1.0], "intensity": candela, "range": 8.0})
 }
 
 #[test]
 fn the_files_reference_gives_the_values_worked_out_by_hand() {
     // Straight below the light and the camera, n = v = l = h: D = 1/(πα²), V = 1/4 and
-    // F = F0, so glTF's BRDF is (1 − F0) c_diff/π + F0/(4πα²); the light 2 m up (1 m under a
-    // parent scaled 2) gives I/4 windowed by (1 − (2/8)⁴)².
+    // F = F0, so glTF's BRDF is (1 − F0) c_diff/π + F0/(4πα²); the light `lift` m up (1 m
+    // under a parent scaled `lift`) gives I/lift² windowed by (1 − (lift/8)⁴)².
     let (candela, exposure) = (10.0, 0.5);
-    let window = (1.0 - (2.0f64 / 8.0).powi(4)).powi(2);
-    let e = f64::from(candela) / 4.0 * window;
     let pi = std::f64::consts::PI;
     let base = DVec3::new(0.9, 0.6, 0.3);
-    for (metallic, roughness) in [(1.0, 0.5), (1.0, 1.0), (0.0, 1.0), (0.0, 0.4)] {
+    for (metallic, roughness, lift) in [
+        (1.0, 0.5, 2.0),
+        (1.0, 1.0, 2.0),
+        (0.0, 1.0, 2.0),
+        (0.0, 0.4, 3.0),
+        (1.0, 0.3, 4.5),
+    ] {
+        let d = f64::from(lift);
+        let window = (1.0 - (d / 8.0).powi(4)).powi(2);
+        let e = f64::from(candela) / (d * d) * window;
         let mut w = GltfWriter::default();
         let m = w.material(
             json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.6, 0.3, 1.0],
             "metallicFactor": metallic, "roughnessFactor": roughness}}),
         );
-        stage(&mut w, m, candela, &[]);
+        stage(&mut w, m, point(candela), lift, &[]);
         let glb = w.glb();
         let alpha = roughness * roughness;
         let f0 = DVec3::splat(0.04).lerp(base, metallic);
@@ -108,6 +125,65 @@ fn the_files_reference_gives_the_values_worked_out_by_hand() {
     }
 }
 
+/// A spot is its point light inside the inner cone and dark outside the outer one: the
+/// reference's radiance with a spot (inner 0.3 rad, outer 0.5) equals the point light's at
+/// every ground pixel more than 0.02 rad inside the inner cone, and the ambient term alone
+/// more than 0.02 rad outside the outer one; `forward` equals the reference there too.
+#[test]
+fn the_files_reference_lights_a_spot_as_its_cones_say() {
+    let (size, exposure) = ((65, 65), 0.5);
+    let base = DVec3::new(0.9, 0.6, 0.3);
+    let scene = |light: serde_json::Value| {
+        let mut w = GltfWriter::default();
+        let m = w.material(
+            json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.6, 0.3, 1.0],
+            "metallicFactor": 0.0, "roughnessFactor": 0.7}}),
+        );
+        stage(&mut w, m, light, 2.0, &[]);
+        w.glb()
+    };
+    let mut spot = point(10.0);
+    spot["type"] = json!("spot");
+    spot["spot"] = json!({"innerConeAngle": 0.3, "outerConeAngle": 0.5});
+    let spot = scene(spot);
+    let (with_spot, with_point) = (
+        FileReference::new(&spot, size, exposure),
+        FileReference::new(&scene(point(10.0)), size, exposure),
+    );
+    let (mut inside, mut outside) = (0, 0);
+    for py in 0..size.1 {
+        for px in 0..size.0 {
+            let (Some(s), Some(p)) = (with_spot.radiance(px, py), with_point.radiance(px, py))
+            else {
+                continue;
+            };
+            // The ground point's angle from the spot's axis, 2 m above the origin.
+            let d = with_spot.ray(f64::from(px) + 0.5, f64::from(py) + 0.5);
+            let ground = DVec3::new(0.0, 5.0, 0.0) + d * (5.0 / -d.y);
+            let theta = (ground.x.hypot(ground.z) / 2.0).atan();
+            if theta < 0.28 {
+                assert!(
+                    (s - p).abs().max_element() < 1e-12,
+                    "({px}, {py}): {s} against {p}"
+                );
+                inside += 1;
+            } else if theta > 0.52 {
+                assert!(
+                    (s - base * 0.04).abs().max_element() < 1e-12,
+                    "({px}, {py}): {s}"
+                );
+                outside += 1;
+            }
+        }
+    }
+    assert!(
+        inside > 200 && outside > 200,
+        "{inside} inside, {outside} outside"
+    );
+    let image = forward(&open(&spot, exposure as f32), size);
+    assert!(file_reference::compare(&with_spot, &image, 1, 1) > 3000);
+}
+
 #[test]
 fn forward_equals_the_files_reference_on_metals_rough_and_smooth() {
     let mut w = GltfWriter::default();
@@ -125,7 +201,8 @@ fn forward_equals_the_files_reference_on_metals_rough_and_smooth() {
     stage(
         &mut w,
         ground,
-        12.0,
+        point(12.0),
+        2.0,
         &[
             (smooth, [-1.3, 0.4, 0.3]),
             (middle, [0.0, 0.4, -1.2]),
