@@ -9,10 +9,16 @@
 //! - α = roughness², F0 = mix(0.04, base, metallic), c_diff = base × (1 − metallic), and
 //!   Appendix B's BRDF `(1 − F) c_diff / π + F·D·V` (GGX D, height-correlated Smith V,
 //!   Schlick F);
-//! - a light's illuminance `colour × intensity / d²` (candela), windowed by
-//!   `clamp(1 − (d/r)⁴, 0, 1)²` where it has a range, a spot's `t²` between its cones;
+//! - a light's illuminance `colour × intensity / d²` (candela; README's `max(d², 10⁻⁴)`),
+//!   windowed by `clamp(1 − (d/r)⁴, 0, 1)²` where it has a range, a spot's `t²` between its
+//!   cones;
 //! - the node hierarchy (matrix, or translation × rotation × scale), the camera along its
-//!   node's −z with +y up and its `yfov`.
+//!   node's −z with +y up and its `yfov`; buffers in the GLB, as data URIs or as files;
+//!   points and lines are no surface; a normal that is zero is the face's.
+//!
+//! Lights, an exposure and a view that a renderer adds to a file (`--add-lights`, the
+//! automatic exposure, a camera fitted to a file without one) are handed over by the test:
+//! they are the renderer's choices, not the file's.
 //!
 //! What lightgrid states in its README and the reference writes out here: the ambient term
 //! (0.04 × the base colour, unscaled by the exposure), the tone curve `1 − e^(−x)` and the
@@ -96,9 +102,15 @@ fn vec3(a: &[f64]) -> DVec3 {
 }
 
 /// The bytes of an accessor's elements, each `size` bytes, in order.
-fn elements<'b>(doc: &Value, bin: &'b [u8], accessor: usize, size: usize) -> Vec<&'b [u8]> {
+fn elements<'b>(
+    doc: &Value,
+    buffers: &'b [Vec<u8>],
+    accessor: usize,
+    size: usize,
+) -> Vec<&'b [u8]> {
     let a = &doc["accessors"][accessor];
     let view = &doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let bin = &buffers[view["buffer"].as_u64().unwrap() as usize];
     let start = number(view, "byteOffset", 0.0) as usize + number(a, "byteOffset", 0.0) as usize;
     let stride = view
         .get("byteStride")
@@ -111,7 +123,7 @@ fn elements<'b>(doc: &Value, bin: &'b [u8], accessor: usize, size: usize) -> Vec
 }
 
 /// A float accessor of `n` components per element.
-fn read_floats(doc: &Value, bin: &[u8], accessor: usize, n: usize) -> Vec<Vec<f64>> {
+fn read_floats(doc: &Value, bin: &[Vec<u8>], accessor: usize, n: usize) -> Vec<Vec<f64>> {
     assert_eq!(
         doc["accessors"][accessor]["componentType"], 5126,
         "float data only"
@@ -127,7 +139,7 @@ fn read_floats(doc: &Value, bin: &[u8], accessor: usize, n: usize) -> Vec<Vec<f6
 }
 
 /// An index accessor (unsigned bytes, shorts or ints).
-fn read_indices(doc: &Value, bin: &[u8], accessor: usize) -> Vec<usize> {
+fn read_indices(doc: &Value, bin: &[Vec<u8>], accessor: usize) -> Vec<usize> {
     let size = match doc["accessors"][accessor]["componentType"]
         .as_u64()
         .unwrap()
@@ -161,12 +173,62 @@ fn local_transform(node: &Value) -> DMat4 {
 }
 
 impl FileReference {
-    /// The GLB `glb` rendered at `size` with the scene exposure `exposure`.
+    /// The GLB `glb` rendered at `size` with the scene exposure `exposure`, seen from its
+    /// first perspective camera.
     pub fn new(glb: &[u8], size: (u32, u32), exposure: f64) -> FileReference {
-        assert_eq!(&glb[..4], b"glTF", "a GLB");
-        let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
-        let doc: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
-        let bin = &glb[20 + json_len + 8..];
+        let out = Self::of_glb(glb, size, exposure, None);
+        assert!(out.near > 0.0, "the reference needs the file's camera");
+        out
+    }
+
+    /// The file at `path` (`.glb`, or `.gltf` with its buffers as files beside it or data
+    /// URIs), as [`new`](Self::new); without a perspective camera of its own the view is
+    /// unset until [`set_camera`](Self::set_camera).
+    pub fn open(path: &std::path::Path, size: (u32, u32), exposure: f64) -> FileReference {
+        let bytes = std::fs::read(path).unwrap();
+        if bytes.starts_with(b"glTF") {
+            return Self::of_glb(&bytes, size, exposure, None);
+        }
+        let dir = path.parent().unwrap();
+        Self::of_glb(
+            &[],
+            size,
+            exposure,
+            Some((serde_json::from_slice(&bytes).unwrap(), dir)),
+        )
+    }
+
+    fn of_glb(
+        glb: &[u8],
+        size: (u32, u32),
+        exposure: f64,
+        gltf: Option<(Value, &std::path::Path)>,
+    ) -> FileReference {
+        let dir = gltf.as_ref().map(|g| g.1.to_path_buf());
+        let (doc, bin): (Value, Vec<u8>) = match gltf {
+            Some((doc, _)) => (doc, Vec::new()),
+            None => {
+                assert_eq!(&glb[..4], b"glTF", "a GLB");
+                let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+                let bin = glb.get(20 + json_len + 8..).unwrap_or(&[]).to_vec();
+                (
+                    serde_json::from_slice(&glb[20..20 + json_len]).unwrap(),
+                    bin,
+                )
+            }
+        };
+        // Buffers: the GLB's own (no URI), a data URI, or a file beside the document.
+        let buffers: Vec<Vec<u8>> = doc["buffers"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|b| match b.get("uri").and_then(Value::as_str) {
+                None => bin.clone(),
+                Some(uri) if uri.starts_with("data:") => base64(&uri[uri.find(",").unwrap() + 1..]),
+                Some(uri) => std::fs::read(dir.as_ref().unwrap().join(uri)).unwrap(),
+            })
+            .collect();
+        let bin = &buffers;
         let mut out = FileReference {
             triangles: Vec::new(),
             materials: Vec::new(),
@@ -221,30 +283,63 @@ impl FileReference {
                     world,
                 );
             }
+            let perspective = |c: u64| doc["cameras"][c as usize]["type"] == "perspective";
             if let (Some(c), None) = (node.get("camera").and_then(Value::as_u64), &camera) {
-                camera = Some((c as usize, world));
+                if perspective(c) {
+                    camera = Some((c as usize, world));
+                }
             }
             for child in node["children"].as_array().into_iter().flatten().rev() {
                 stack.push((child.as_u64().unwrap() as usize, world));
             }
         }
-        let (c, world) = camera.expect("the reference needs the file's camera");
-        let perspective = &doc["cameras"][c]["perspective"];
-        out.tan_half_fov = (perspective["yfov"].as_f64().unwrap() * 0.5).tan();
-        out.near = perspective["znear"].as_f64().unwrap();
-        out.eye = world.transform_point3(DVec3::ZERO);
-        let forward = world.transform_vector3(DVec3::NEG_Z).normalize();
-        let up = world.transform_vector3(DVec3::Y).normalize();
-        let right = forward.cross(up).normalize();
-        out.basis = [right, right.cross(forward), forward];
+        if let Some((c, world)) = camera {
+            let perspective = &doc["cameras"][c]["perspective"];
+            let eye = world.transform_point3(DVec3::ZERO);
+            let forward = world.transform_vector3(DVec3::NEG_Z);
+            let up = world.transform_vector3(DVec3::Y);
+            let (yfov, near) = (perspective["yfov"].as_f64(), perspective["znear"].as_f64());
+            out.set_camera(eye, eye + forward, up, yfov.unwrap(), near.unwrap());
+        }
         out
     }
 
-    fn add_mesh(&mut self, doc: &Value, bin: &[u8], mesh: usize, world: DMat4) {
+    /// Has the view been set (the file's perspective camera, or [`set_camera`](Self::set_camera))?
+    pub fn has_camera(&self) -> bool {
+        self.near > 0.0
+    }
+
+    /// Look from `eye` toward `target` with `up` up, `fov_y` radians high, near plane `near`:
+    /// for a file without a camera, the view its renderer chose.
+    pub fn set_camera(&mut self, eye: DVec3, target: DVec3, up: DVec3, fov_y: f64, near: f64) {
+        let forward = (target - eye).normalize();
+        let right = forward.cross(up).normalize();
+        self.eye = eye;
+        self.basis = [right, right.cross(forward), forward];
+        self.tan_half_fov = (fov_y * 0.5).tan();
+        self.near = near;
+    }
+
+    /// A point light at `position` of `radiant` (colour × candela) and `range`: lights a
+    /// renderer adds to a file (`--add-lights`).
+    pub fn add_point_light(&mut self, position: DVec3, radiant: DVec3, range: f64) {
+        self.lights.push(Light {
+            position,
+            direction: DVec3::NEG_Y,
+            radiant,
+            range: Some(range),
+            cone: None,
+        });
+    }
+
+    fn add_mesh(&mut self, doc: &Value, bin: &[Vec<u8>], mesh: usize, world: DMat4) {
         let normal_matrix = world.inverse().transpose();
         for p in doc["meshes"][mesh]["primitives"].as_array().unwrap() {
             let mode = number(p, "mode", 4.0) as u32;
-            assert!((4..=6).contains(&mode), "triangles only, not mode {mode}");
+            if mode < 4 {
+                // Points and lines: not surfaces (renderers skip them, lightgrid warns).
+                continue;
+            }
             let attributes = &p["attributes"];
             let at = |name: &str| attributes[name].as_u64().map(|a| a as usize);
             let positions: Vec<DVec3> = read_floats(doc, bin, at("POSITION").unwrap(), 3)
@@ -369,10 +464,14 @@ impl FileReference {
         let position = self.eye + d * t;
         let [a, b, c] = tri.p;
         let mut face = (b - a).cross(c - a).normalize();
+        // A file's normal that is zero or not a number gives no direction: the face's.
         let mut normal = match tri.n {
             Some(n) => (n[0] * w[0] + n[1] * w[1] + n[2] * w[2]).normalize(),
             None => face,
         };
+        if !normal.is_finite() {
+            normal = face;
+        }
         // The face's outside is the side its normals point to (a mirroring node reverses
         // the winding, not the normals).
         if face.dot(normal) < 0.0 {
@@ -413,7 +512,8 @@ impl FileReference {
                     t * t
                 }
             };
-            let e = light.radiant * (window * cone / d2);
+            // README: `I / max(d², 10⁻⁴)`, a light within a centimetre stays finite.
+            let e = light.radiant * (window * cone / d2.max(1e-4));
             let h = (l + v).normalize();
             let n_dot_v = n.dot(v).clamp(0.0, 1.0);
             let n_dot_h = n.dot(h).clamp(0.0, 1.0);
@@ -427,6 +527,32 @@ impl FileReference {
         }
         sum * self.exposure + m.emissive + m.base * AMBIENT
     }
+}
+
+/// Standard base64 (RFC 4648), padding and whitespace ignored: a data URI's payload.
+fn base64(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base64: {c}"),
+    };
+    let digits: Vec<u8> = text
+        .bytes()
+        .filter(|c| !c.is_ascii_whitespace() && *c != b'=')
+        .map(value)
+        .collect();
+    let mut out = Vec::with_capacity(digits.len() * 3 / 4);
+    for chunk in digits.chunks(4) {
+        let n = chunk
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (i, &d)| n | u32::from(d) << (18 - 6 * i));
+        out.extend(&n.to_be_bytes()[1..chunk.len()]);
+    }
+    out
 }
 
 /// Linear radiance to 8-bit sRGB: the tone curve `1 − e^(−x)`, then the sRGB encoding.
