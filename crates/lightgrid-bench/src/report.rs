@@ -7,10 +7,10 @@ use crate::invalid;
 use crate::plot::{LineChart, Series, StackedBars};
 use lightgrid::culling::GridLists;
 use lightgrid::error::{Error, Result};
-use lightgrid::frame::{MaterialDraws, MsaaResolve};
+use lightgrid::frame::MaterialDraws;
 use lightgrid::image_io::{save_png, write_atomic};
 use lightgrid::passes::GBufferFormat;
-use lightgrid::pipelines::{ids, SettingValue, SpotCull};
+use lightgrid::pipelines::{ids, SpotCull};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -21,15 +21,6 @@ pub const REPORT_FILES: &[&str] = &["results.json", "results.csv", "summary.md"]
 /// Version of the results.json layout (documented in README).
 pub const SCHEMA_VERSION: u32 = 4;
 
-/// A run as the summary names it: the pipeline, the variant settings it was measured under
-/// and its G-buffer precision.
-pub(crate) fn run_name(r: &RunRecord) -> String {
-    match r.gbuffer_bits() {
-        Some(b) => format!("{} (g{b})", pipeline_label(r)),
-        None => pipeline_label(r),
-    }
-}
-
 /// A run's mean lighting computations as a multiple of the ideal, two decimals; `missing`
 /// where the run counted none.
 fn times_ideal(m: &super::RunSummary, missing: &str) -> String {
@@ -39,22 +30,6 @@ fn times_ideal(m: &super::RunSummary, missing: &str) -> String {
             x.mean / m.ideal_lighting_computations.mean.max(1.0)
         )
     })
-}
-
-/// The pipeline, with the spot culling and the transparent lists when the run measured more
-/// than one.
-fn pipeline_label(r: &RunRecord) -> String {
-    let mut label = r.pipeline.clone();
-    // Each setting that names the run, in the table's order, as its row says (the G-buffer
-    // is named by `run_name`); MSAA and where it resolves whenever MSAA is on.
-    for axis in lightgrid::pipelines::AXES {
-        let names = r.varied.iter().any(|f| f == axis.flag)
-            || (axis.flag == MsaaResolve::FLAG && r.msaa_resolve().is_some());
-        if names && axis.flag != GBufferFormat::FLAG {
-            label += &format!(" [{}]", (axis.label)(&(axis.get)(&r.settings)));
-        }
-    }
-    label
 }
 
 /// MSAA (tiled-forward-shading Fig. 4.4): time, memory and the edge-aware kernels' work at
@@ -175,7 +150,7 @@ ns per lighting computation: the slope of GPU frame time against lighting comput
         let _ = writeln!(
             s,
             "| {} | {} | {} | {ratio} | {} | {} | {pms:.2} / {gms:.2} |",
-            run_name(phong).replace(" [phong]", ""),
+            phong.name().replace(" [phong]", ""),
             show(pf),
             show(gf),
             show(pm),
@@ -231,7 +206,7 @@ Means over the frames. Maps: the depth texture the frame's maps were rendered in
         let _ = writeln!(
             s,
             "| {} | {:.2} | {unshadowed:.0} | {} | {} | {} | {} | {} |",
-            run_name(r),
+            r.name(),
             r.summary.as_ref().expect("filtered").gpu_ms.mean,
             bytes.map_or("-".into(), |b| format!("{:.2}", b / (1024.0 * 1024.0))),
             maps.map_or("-".into(), |m| format!("{}²", m.face)),
@@ -293,7 +268,7 @@ Means over the frames. Assignment: the GPU passes labelled `assign: ...` in the 
         let _ = writeln!(
             s,
             "| {} | {ratio} | {:.2} | {assign:.2} ({:.0}%) | {} | {} |",
-            run_name(r),
+            r.name(),
             m.gpu_ms.mean,
             100.0 * assign / m.gpu_ms.mean.max(1e-9),
             cpu.map_or("-".into(), |x| format!("{x:.2}")),
@@ -519,7 +494,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                 series: runs
                     .iter()
                     .map(|r| Series {
-                        name: pipeline_label(r),
+                        name: r.label(),
                         points: r
                             .frames
                             .iter()
@@ -547,7 +522,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                     .filter_map(|r| {
                         let s = r.summary.as_ref()?;
                         Some((
-                            pipeline_label(r),
+                            r.label(),
                             s.passes.iter().map(|p| (p.label.clone(), p.ms)).collect(),
                         ))
                     })
@@ -576,7 +551,7 @@ fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Resu
                     .all(|f| f.stats.lighting_computations.is_some())
             })
             .map(|r| Series {
-                name: pipeline_label(r),
+                name: r.label(),
                 points: r
                     .frames
                     .iter()
@@ -827,7 +802,7 @@ fn summary(results: &BenchResults) -> String {
             let _ = writeln!(
                 s,
                 "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} | {} |",
-                pipeline_label(r),
+                r.label(),
                 match (r.complete, r.times_from) {
                     (true, _) => "",
                     (false, super::run::TimesFrom::RealTime) => " (incomplete)",
@@ -894,7 +869,7 @@ fn summary(results: &BenchResults) -> String {
                         let _ = writeln!(
                             s,
                             "- {}: {avg:.0} ({:.2}×)",
-                            run_name(r),
+                            r.name(),
                             avg / (ideal / n).max(1.0)
                         );
                     }
@@ -945,7 +920,7 @@ fn summary(results: &BenchResults) -> String {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} |",
-                run_name(r),
+                r.name(),
                 passes.join(", "),
                 traffic,
                 table1

@@ -1020,6 +1020,29 @@ impl RunRecord {
         pipelines::find(&self.pipeline).is_ok_and(|p| (axis.applies)(p, &self.settings))
     }
 
+    /// The run as the summary names it: [`Self::label`] and its G-buffer precision.
+    pub(crate) fn name(&self) -> String {
+        match self.gbuffer_bits() {
+            Some(b) => format!("{} (g{b})", self.label()),
+            None => self.label(),
+        }
+    }
+
+    /// The pipeline, with each setting the run varied (in the settings table's order, as
+    /// its row labels it; the G-buffer is named by [`Self::name`]), and MSAA and where it
+    /// resolves whenever MSAA is on.
+    pub(crate) fn label(&self) -> String {
+        let mut label = self.pipeline.clone();
+        for axis in AXES {
+            let names = self.varied.iter().any(|f| f == axis.flag)
+                || (axis.flag == MsaaResolve::FLAG && self.msaa_resolve().is_some());
+            if names && axis.flag != GBufferFormat::FLAG {
+                label += &format!(" [{}]", (axis.label)(&(axis.get)(&self.settings)));
+            }
+        }
+        label
+    }
+
     /// The G-buffer's bits per channel, for pipelines with one.
     pub fn gbuffer_bits(&self) -> Option<u32> {
         self.reads(GBufferFormat::FLAG)

@@ -40,7 +40,7 @@ pub const ASSIGN_DEPTH_SLACK: f32 = 1e-4;
 /// result for a value beyond binary16's range WGSL leaves indeterminate.
 pub const HALF_MAX: f32 = 65504.0;
 
-/// The narrowest slicing range a clustered grid takes (`hi / lo`, `culling/depth_range.rs`):
+/// The narrowest slicing range a clustered grid takes (`hi / lo`, `culling/bounds/depth_range.rs`):
 /// a frame whose samples all lie at one view distance (a wall facing the camera) still gets
 /// slices of a finite scale.
 pub const SLICING_MIN_RATIO: f32 = 1.01;
@@ -227,6 +227,13 @@ pub const SHADOWS_MAPS: u32 = 2;
 /// Shadow maps re-used light by light (the light-volume pipelines): a face's tile is its cube
 /// face's.
 pub const SHADOWS_MAPS_REUSED: u32 = 3;
+/// A shadow map's slope-scaled normal offset, in texels of the map at the sample's distance
+/// (`shadows/maps.rs`): the sample moves along its normal by `SHADOW_NORMAL_OFFSET` +
+/// `SHADOW_SLOPE_OFFSET` × tan θ (θ between normal and light), tan θ capped at
+/// `SHADOW_MAX_SLOPE`.
+pub const SHADOW_NORMAL_OFFSET: f32 = 1.0;
+pub const SHADOW_SLOPE_OFFSET: f32 = 1.0;
+pub const SHADOW_MAX_SLOPE: f32 = 4.0;
 /// Entries of a shadow ray's traversal stack: a balanced tree of 2^31 triangles needs 30
 /// (`shadows/bvh.rs`); the renderer refuses a deeper one.
 pub const SHADOW_STACK_DEPTH: u32 = 32;
@@ -256,7 +263,7 @@ pub const DEPTH_BOUNDS_NONE: u32 = 3;
 
 /// 2.5D culling (`--depth-mask on`; Harada et al. 2012, "A 2.5D culling for Forward+"): each
 /// cell's depth bounds are cut into this many equal bins, one bit each of a 32-bit mask that
-/// says which bins hold samples (`culling/depth_mask.rs`).
+/// says which bins hold samples (`culling/bounds/depth_mask.rs`).
 pub const DEPTH_MASK_BINS: u32 = 32;
 /// A cell mask's bits when the cell has no mask (`--depth-mask off`, cells without depth
 /// bounds, transparent lists): every light that passes the other tests is listed.
@@ -331,18 +338,9 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ("SHADOWS_RAYS", WgslConst::U32(SHADOWS_RAYS)),
     ("SHADOWS_MAPS", WgslConst::U32(SHADOWS_MAPS)),
     ("SHADOWS_MAPS_REUSED", WgslConst::U32(SHADOWS_MAPS_REUSED)),
-    (
-        "SHADOW_NORMAL_OFFSET",
-        WgslConst::F32(crate::shadows::maps::NORMAL_OFFSET),
-    ),
-    (
-        "SHADOW_SLOPE_OFFSET",
-        WgslConst::F32(crate::shadows::maps::SLOPE_OFFSET),
-    ),
-    (
-        "SHADOW_MAX_SLOPE",
-        WgslConst::F32(crate::shadows::maps::MAX_SLOPE),
-    ),
+    ("SHADOW_NORMAL_OFFSET", WgslConst::F32(SHADOW_NORMAL_OFFSET)),
+    ("SHADOW_SLOPE_OFFSET", WgslConst::F32(SHADOW_SLOPE_OFFSET)),
+    ("SHADOW_MAX_SLOPE", WgslConst::F32(SHADOW_MAX_SLOPE)),
     ("SHADOW_STACK_DEPTH", WgslConst::U32(SHADOW_STACK_DEPTH)),
     ("SHADOW_MAX_STEPS", WgslConst::U32(SHADOW_MAX_STEPS)),
     (

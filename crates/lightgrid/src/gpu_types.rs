@@ -131,7 +131,7 @@ pub struct FrameUniforms {
     pub _pad2: u32,
 }
 
-/// The light grid's shape (`culling/light_grid.wgsl`). A tiled grid has one slice.
+/// The light grid's shape (`culling/grid/light_grid.wgsl`). A tiled grid has one slice.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GridParams {
@@ -146,7 +146,7 @@ pub struct GridParams {
     pub lists: u32,
     /// Cells of one layer (tiles × slices).
     pub layer_cells: u32,
-    /// A z-binned grid (`culling/zbin.rs`): 32-bit words of each tile's light mask; 0 for a
+    /// A z-binned grid (`culling/strategies/zbin.rs`): 32-bit words of each tile's light mask; 0 for a
     /// grid of per-cell lists.
     pub zbin_words: u32,
     /// A z-binned grid: where the tile masks start in the index buffer (after the sorted
@@ -174,7 +174,7 @@ pub struct BvhNode {
     pub count: u32,
 }
 
-/// One pass of the radix sort (`SortParams`, `culling/radix_sort.wgsl`).
+/// One pass of the radix sort (`SortParams`, `culling/strategies/radix_sort.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SortParams {
@@ -187,7 +187,7 @@ pub struct SortParams {
     pub _pad: u32,
 }
 
-/// One level of the GPU BVH build (`LevelParams`, `culling/bvh_build.wgsl`).
+/// One level of the GPU BVH build (`LevelParams`, `culling/strategies/bvh_build.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LevelParams {

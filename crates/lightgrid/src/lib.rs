@@ -26,7 +26,7 @@ pub mod shadows;
 pub mod stats;
 
 pub use analysis::FrameOutput;
-/// The light grid for any wgpu renderer (`culling/culler.rs`; README, "Embedding").
+/// The light grid for any wgpu renderer (`culling/embed/culler.rs`; README, "Embedding").
 pub use culling::{
     CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
     LightCuller,

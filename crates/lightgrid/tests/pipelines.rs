@@ -1724,7 +1724,7 @@ fn every_pipeline_picks_the_same_coplanar_surface_as_forward() {
     }
 }
 
-/// Clusters' depth slices follow the samples (`culling/depth_range.rs`): the grid's slicing
+/// Clusters' depth slices follow the samples (`culling/bounds/depth_range.rs`): the grid's slicing
 /// range is the frame's sample range (the CPU twin's, from the frame's depth) for the CPU
 /// and a GPU strategy alike, and a camera with znear 10⁻⁶ / zfar 10⁶ clusters as tightly as
 /// the scene's own planes (slices over near..far would leave nearly all of them empty and

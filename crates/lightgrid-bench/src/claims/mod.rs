@@ -13,7 +13,6 @@ mod shadows;
 mod tiled_forward_shading;
 mod tiled_shading;
 
-use crate::report::run_name;
 use culling::*;
 use deferred_lighting::*;
 use forward_plus::*;

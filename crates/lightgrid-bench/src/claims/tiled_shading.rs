@@ -49,7 +49,7 @@ pub(super) fn stencil_fewest(r: &BenchResults, scene: &str) -> (String, Verdict)
             let others: Vec<(String, f64)> = culled(r, scene)
                 .into_iter()
                 .filter(|x| x.pipeline != ids::DEFERRED_STENCIL)
-                .filter_map(|x| avg_count(x).map(|c| (run_name(x), c)))
+                .filter_map(|x| avg_count(x).map(|c| (x.name(), c)))
                 .collect();
             let best = others.iter().min_by(|a, b| a.1.total_cmp(&b.1));
             match best {
@@ -111,7 +111,7 @@ pub(super) fn time_follows_computations(r: &BenchResults, scene: &str) -> (Strin
                 .iter()
                 .map(|f| f.stats.lighting_computations.map(|n| n as f64))
                 .collect();
-            correlation(&t, &c?).map(|k| (run_name(x), k))
+            correlation(&t, &c?).map(|k| (x.name(), k))
         })
         .collect();
     corr.sort_by(|a, b| a.1.total_cmp(&b.1));

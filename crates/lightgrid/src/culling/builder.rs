@@ -13,12 +13,13 @@
 //! 3. the grid is left in [`GridBuffers`] (group 1 of the shading pass). Analysis downloads it
 //!    ([`GridBuilder::download`]); rendering alone never does.
 
-use super::cell_bounds::CellBoundsPass;
-use super::depth_range::DepthRangePass;
-use super::registry::find_strategy;
-pub use super::strategy::CellSource;
-use super::strategy::{AssignFrame, AssignStrategy, CullFrame, StrategyContext};
-use super::{GridBuffers, GridDims, GridLists, LightGrid};
+use crate::culling::bounds::cell_bounds::CellBoundsPass;
+use crate::culling::bounds::depth_range::DepthRangePass;
+pub use crate::culling::frame::CellSource;
+use crate::culling::frame::CullFrame;
+use crate::culling::grid::{GridBuffers, GridDims, GridLists, LightGrid};
+use crate::culling::strategies::registry::find_strategy;
+use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext};
 use crate::error::{Error, Result};
 use crate::frame::{Assign, FrameEncoder};
 use crate::gpu::CounterValues;
@@ -65,7 +66,7 @@ pub struct BuiltGrid {
     pub cell_bounds: Vec<[f32; 2]>,
     /// Each cell's 2.5D depth mask and tight box (`cell_box.rs`; neither unless
     /// `--depth-mask on` / `--cell-box on`).
-    pub cell_culls: Vec<super::CellCull>,
+    pub cell_culls: Vec<crate::culling::bounds::cell_box::CellCull>,
     /// The strategy that ran (`auto` resolved).
     pub assign: Assign,
     /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
@@ -79,7 +80,7 @@ struct LastFrame {
     cpu_ms: f64,
     cpu_grid: Option<LightGrid>,
     cell_bounds: Option<Vec<[f32; 2]>>,
-    cell_culls: Option<Vec<super::CellCull>>,
+    cell_culls: Option<Vec<crate::culling::bounds::cell_box::CellCull>>,
     /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
     near_far: [f32; 2],
 }
@@ -120,7 +121,7 @@ impl GridBuilder {
                 device,
                 cull_layout,
                 ctx.scene_layout,
-                super::cell_bounds::CellBoundsKey {
+                crate::culling::bounds::cell_bounds::CellBoundsKey {
                     samples: ctx.samples,
                     depth_bounds: ctx.depth_bounds,
                     reduction: ctx.depth_reduction,
@@ -143,7 +144,7 @@ impl GridBuilder {
         self.tiles = tiles;
     }
 
-    /// Group 1 of the shading pass (`culling/light_grid.wgsl`).
+    /// Group 1 of the shading pass (`culling/grid/light_grid.wgsl`).
     pub fn layout(&self) -> &wgpu::BindGroupLayout {
         &self.buffers.layout
     }
@@ -317,7 +318,9 @@ impl GridBuilder {
         };
         let cell_culls = match (&last.cell_culls, self.source) {
             (Some(m), _) => m.clone(),
-            (None, CellSource::NearFar) => vec![super::NO_CULL; last.dims.cell_count()],
+            (None, CellSource::NearFar) => {
+                vec![crate::culling::bounds::cell_box::NO_CULL; last.dims.cell_count()]
+            }
             (None, CellSource::Depth) => self.bounds.read_culls(device, queue)?,
         };
         Ok(BuiltGrid {

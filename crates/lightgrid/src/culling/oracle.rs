@@ -2,8 +2,9 @@
 //! grids must contain every light the oracle finds) and for the ideal lighting-computation
 //! count: for every visible sample, the lights whose range reaches it.
 
-use super::{GridDims, LightGrid, ViewLight, ViewSetup};
+use crate::culling::grid::{GridDims, LightGrid};
 use crate::scene::{Fragment, Light};
+use crate::scene::{ViewLight, ViewSetup};
 use glam::Vec3;
 use rayon::prelude::*;
 

@@ -5,9 +5,13 @@
 //! (`tests/culling.rs` measures how often), so `--spot-cull cone` ships instead; the benchmark
 //! counts what it would cost and miss over an animation ([`ray_test_count`]).
 
-use super::{assign_cpu, cell_bounds_cpu, oracle_tile_lights, DepthRange, GridDims, ViewSetup};
+use crate::culling::bounds::cell_bounds::cell_bounds_cpu;
+use crate::culling::grid::GridDims;
+use crate::culling::oracle::oracle_tile_lights;
+use crate::culling::strategies::assign_cpu::{assign_cpu, DepthRange};
 use crate::error::Result;
 use crate::scene::Light;
+use crate::scene::ViewSetup;
 use glam::Vec3;
 
 /// What test (b) would have listed for one frame's depth-bounded tile grid.

@@ -65,7 +65,7 @@ fn default_shadow_atlas() -> u32 {
     crate::consts::DEFAULT_SHADOW_ATLAS_MIB
 }
 
-/// How grid pipelines loop over a sample's lights (`--light-loop`; `culling/light_loop_*.wgsl`).
+/// How grid pipelines loop over a sample's lights (`--light-loop`; `culling/grid/light_loop_*.wgsl`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LightLoop {
@@ -90,7 +90,7 @@ impl LightLoop {
 
 /// Tight cells: each occupied cell of a grid built from the depth buffer keeps the view-space
 /// box of its samples' pixel footprints, and a light is listed only where its sphere reaches
-/// the box (the closest-point test; `culling/cell_box.rs`).
+/// the box (the closest-point test; `culling/bounds/cell_box.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum CellBox {
@@ -115,7 +115,7 @@ impl CellBox {
 /// 2.5D culling (Harada et al. 2012, "A 2.5D culling for Forward+"): each cell of a grid built
 /// from the depth buffer keeps a 32-bit mask of which of 32 equal bins of its depth bounds hold
 /// samples, and a light is listed only where the bins its view-depth span covers meet the
-/// mask (`culling/depth_mask.rs`).
+/// mask (`culling/bounds/depth_mask.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum DepthMask {
@@ -543,7 +543,7 @@ impl GridLists {
         self.layers() - 1
     }
 
-    /// The value of `GridParams::lists` (`culling/grid_cell.wgsl`).
+    /// The value of `GridParams::lists` (`culling/grid/grid_cell.wgsl`).
     pub fn gpu(self) -> u32 {
         use crate::consts::{GRID_LISTS_OPAQUE, GRID_LISTS_SEPARATE, GRID_LISTS_SHARED};
         match self {

@@ -61,7 +61,7 @@ impl ShadowAtlas {
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-    ) -> crate::Result<image::RgbaImage> {
+    ) -> crate::error::Result<image::RgbaImage> {
         let (w, h) = self.size;
         let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;

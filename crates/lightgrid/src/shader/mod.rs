@@ -25,21 +25,21 @@ pub mod src {
     );
     pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
     /// Cell addressing (`grid_slice`, `grid_cell`); needs a `grid` binding.
-    pub const GRID_CELL: &str = include_str!("../culling/grid_cell.wgsl");
+    pub const GRID_CELL: &str = include_str!("../culling/grid/grid_cell.wgsl");
     /// Group-1 grid bindings and the shading accessor (includes `GRID_CELL`).
     /// The grid's bindings, cell addressing and z-bin walk; one of the light loops below
     /// follows it.
     pub const LIGHT_GRID: &str = concat!(
-        include_str!("../culling/grid_cell.wgsl"),
-        include_str!("../culling/zbin_walk.wgsl"),
-        include_str!("../culling/light_grid.wgsl")
+        include_str!("../culling/grid/grid_cell.wgsl"),
+        include_str!("../culling/grid/zbin_walk.wgsl"),
+        include_str!("../culling/grid/light_grid.wgsl")
     );
     /// The walk over a z-binned grid (in `LIGHT_GRID`; renamed for a LightCuller's caller).
-    pub const ZBIN_WALK: &str = include_str!("../culling/zbin_walk.wgsl");
+    pub const ZBIN_WALK: &str = include_str!("../culling/grid/zbin_walk.wgsl");
     /// `grid_shade` and `grid_irradiance_mono`, one lane at a time (`--light-loop lane`).
-    pub const LIGHT_LOOP_LANE: &str = include_str!("../culling/light_loop_lane.wgsl");
+    pub const LIGHT_LOOP_LANE: &str = include_str!("../culling/grid/light_loop_lane.wgsl");
     /// The same, scalarized over the subgroup (`--light-loop subgroup`).
-    pub const LIGHT_LOOP_SUBGROUP: &str = include_str!("../culling/light_loop_subgroup.wgsl");
+    pub const LIGHT_LOOP_SUBGROUP: &str = include_str!("../culling/grid/light_loop_subgroup.wgsl");
     pub const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
     /// `tone(c)`: the tone curve.
     pub const TONE: &str = include_str!("../shading/tone.wgsl");

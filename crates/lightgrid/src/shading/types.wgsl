@@ -72,7 +72,7 @@ struct GridParams {
     _pad1: u32,
 }
 
-// The light BVH (culling/bvh.rs): built by bvh_build.wgsl, walked by bvh.wgsl.
+// The light BVH (culling/strategies/bvh.rs): built by bvh_build.wgsl, walked by bvh.wgsl.
 struct BvhNode {
     lo: vec3<f32>,
     first: u32,   // first child node, or for a leaf the first slot of the light order

@@ -22,8 +22,8 @@
 //! Depth is reversed (near / w, an infinite far plane), cleared to 0. The light function
 //! (`shading/shadows.wgsl`, `shadow_map_visibility`) picks the face by the major axis, moves
 //! the sample along its normal by a **slope-scaled normal offset** (one texel's world size at
-//! its distance × ([`NORMAL_OFFSET`] + [`SLOPE_OFFSET`] × tan θ, θ the angle between normal
-//! and light, tan θ capped at [`MAX_SLOPE`])), and filters with the comparison sampler's
+//! its distance × ([`SHADOW_NORMAL_OFFSET`](crate::consts::SHADOW_NORMAL_OFFSET) + `SHADOW_SLOPE_OFFSET` × tan θ, θ the angle
+//! between normal and light, tan θ capped at `SHADOW_MAX_SLOPE`)), and filters with the comparison sampler's
 //! bilinear 2×2 PCF, the footprint clamped a texel inside the tile.
 
 use crate::scene::Light;
@@ -37,10 +37,6 @@ pub const MAX_TILE: u32 = 1024;
 pub const NEAR_FRACTION: f32 = 1e-4;
 /// A spot of half-angle up to this many degrees gets one face; a wider one a cube.
 pub const SPOT_ONE_FACE_DEGREES: f32 = 60.0;
-/// The slope-scaled normal offset, in texels (module docs).
-pub const NORMAL_OFFSET: f32 = 1.0;
-pub const SLOPE_OFFSET: f32 = 1.0;
-pub const MAX_SLOPE: f32 = 4.0;
 /// The atlas pass's label in a frame's pass timings (the bench's summary reads it).
 pub const PASS_LABEL: &str = "shadow maps";
 /// Largest `--shadow-atlas` in MiB.

@@ -11,16 +11,16 @@
 //!
 //! The brute-force oracle in `oracle.rs` checks that nothing is ever missed.
 
-use super::strategy::check_index_capacity;
-use super::strategy::CellSource;
-use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{
-    box_overlap, cone_sphere, depth_mask_meets, CellCull, GridDims, LightGrid, ViewLight, ViewSetup,
-};
 use crate::consts::ASSIGN_DEPTH_SLACK as DEPTH_SLACK;
+use crate::culling::bounds::cell_box::{box_overlap, cone_sphere, CellCull};
+use crate::culling::bounds::depth_mask::depth_mask_meets;
+use crate::culling::frame::{check_index_capacity, CellSource};
+use crate::culling::grid::{GridDims, LightGrid};
+use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::scene::Light;
+use crate::scene::{ViewLight, ViewSetup};
 use glam::Vec3;
 use rayon::prelude::*;
 use web_time::Instant;
@@ -344,9 +344,11 @@ impl AssignStrategy for CpuStrategy {
             depth.then(|| bytemuck::pod_collect_to_vec(&bytes[0]));
         let culls: Option<Vec<CellCull>> = culled.then(|| bytemuck::pod_collect_to_vec(&bytes[1]));
         let dims = &match a.range {
-            Some(_) => {
-                super::depth_range::sliced(a.dims, &bytes[parts.len() - 2], &bytes[parts.len() - 1])
-            }
+            Some(_) => crate::culling::bounds::depth_range::sliced(
+                a.dims,
+                &bytes[parts.len() - 2],
+                &bytes[parts.len() - 1],
+            ),
             None => *a.dims,
         };
         let start = Instant::now();

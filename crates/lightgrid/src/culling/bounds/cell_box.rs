@@ -21,7 +21,9 @@
 //! [`cell_boxes_cpu`], and every strategy's twin applies [`sphere_box_gap`] and
 //! [`box_overlap`] as the WGSL does.
 
-use super::{CellMask, GridDims, GridLists, ViewSetup, NO_MASK};
+use crate::culling::bounds::depth_mask::{CellMask, NO_MASK};
+use crate::culling::grid::{GridDims, GridLists};
+use crate::scene::ViewSetup;
 use glam::Vec3;
 
 /// One cell's culling record beyond its depth bounds: its 2.5D depth mask (`depth_mask.rs`)
@@ -136,17 +138,22 @@ pub fn cell_boxes_cpu(
     slack: f32,
 ) -> Vec<Option<(Vec3, Vec3)>> {
     let mut boxes: Vec<Option<(Vec3, Vec3)>> = vec![None; dims.cell_count()];
-    super::cell_bounds::for_each_sample_cell(setup, dims, planes, |(x, y), w, cell| {
-        let (px, py) = (x as f32, y as f32);
-        let b = rect_box(
-            setup,
-            [px, px + 1.0],
-            [py, py + 1.0],
-            w * (1.0 - slack),
-            w * (1.0 + slack),
-        );
-        boxes[cell] = union(boxes[cell], b);
-    });
+    crate::culling::bounds::samples::for_each_sample_cell(
+        setup,
+        dims,
+        planes,
+        |(x, y), w, cell| {
+            let (px, py) = (x as f32, y as f32);
+            let b = rect_box(
+                setup,
+                [px, px + 1.0],
+                [py, py + 1.0],
+                w * (1.0 - slack),
+                w * (1.0 + slack),
+            );
+            boxes[cell] = union(boxes[cell], b);
+        },
+    );
     let layer = dims.layer_cells();
     for (cell, b) in boxes.iter_mut().enumerate().take(layer) {
         if let Some(r) = extra.map(|e| e[cell]).filter(|r| r[0] <= r[1]) {

@@ -1,6 +1,6 @@
 // A screen tile's frustum in view space: four side planes through the eye and a view-distance
 // range. Used by GPU light assignment (gather, BVH traversal) and the single-kernel tiled
-// deferred pipeline; `culling/gather.rs` has the CPU twin of both functions.
+// deferred pipeline; `culling/strategies/gather.rs` has the CPU twin of both functions.
 
 struct TileFrustum {
     planes: array<vec3<f32>, 4>,  // inward unit normals of the side planes

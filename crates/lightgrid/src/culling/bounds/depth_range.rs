@@ -11,9 +11,9 @@
 //! Steps (`depth_range.wgsl`): 1. `reduce`, 2. `finish`. CPU twins: [`depth_range_cpu`] and
 //! [`slicing_range`].
 
-use super::CullFrame;
-use super::GridDims;
 use crate::consts::SLICING_MIN_RATIO;
+use crate::culling::frame::CullFrame;
+use crate::culling::grid::GridDims;
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{bind_resources, download, storage_buffer};
@@ -132,7 +132,7 @@ impl DepthRangePass {
         );
         let (encoder, timer) = enc.parts();
         {
-            let mut pass = timer.begin_compute(encoder, super::labels::DEPTH_RANGE);
+            let mut pass = timer.begin_compute(encoder, crate::consts::pass_labels::DEPTH_RANGE);
             pass.set_bind_group(0, f.bind_group, &[]);
             pass.set_bind_group(1, &group, &[]);
             pass.set_pipeline(&self.reduce);

@@ -5,7 +5,7 @@
 //! fragments that will be shaded lie, and the cell-bounds kernel unions that with the samples'
 //! bounds. A fragment still outside is counted and its frame refused (`grid_shade_fragment`).
 
-use super::GridDims;
+use crate::culling::grid::GridDims;
 use crate::frame::{FrameEncoder, FrameInputs};
 use crate::gpu::{bind_resources, grow_storage, storage_buffer};
 use crate::passes::geometry::{draw_scene, geometry_pipeline, GeometryPipelineDesc};
@@ -114,7 +114,7 @@ impl FragmentBounds {
         if !self.forward_opaque && !f.has_transparency() {
             return;
         }
-        let label = super::labels::FRAGMENT_BOUNDS;
+        let label = crate::consts::pass_labels::FRAGMENT_BOUNDS;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],

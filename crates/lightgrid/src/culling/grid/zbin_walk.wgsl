@@ -1,4 +1,4 @@
-// The walk over a z-binned grid (culling/zbin.rs, Drobot 2017), shared by lightgrid's light
+// The walk over a z-binned grid (culling/strategies/zbin.rs, Drobot 2017), shared by lightgrid's light
 // loops (light_grid.wgsl and light_loop_*.wgsl) and, renamed into the `light_grid` prefix, a
 // LightCuller caller's (embed.wgsl). The index buffer holds the lights sorted by view depth,
 // then one bit mask over them per screen tile (`zbin_words` words each, from `zbin_masks`);

@@ -9,16 +9,17 @@
 //! spheres, padded for round-off), so the traversal never prunes a light the gather test
 //! would keep, and the lists it builds equal gather's.
 
-use super::gather::{box_margin, cell_frustum, light_margin, CpuFrustum};
-use super::gpu_assign::{bvh_shader, CellKernels};
-use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{GridDims, LightGrid, ViewLight, ViewSetup};
 use crate::consts::{BVH_LEAF, BVH_WIDTH};
+use crate::culling::grid::{GridDims, LightGrid};
+use crate::culling::strategies::gather::{box_margin, cell_frustum, light_margin, CpuFrustum};
+use crate::culling::strategies::gpu_assign::{bvh_shader, CellKernels};
+use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
 use crate::gpu::{bind_resources, buffer_layout, grow_storage, storage_buffer, STORAGE_READ};
 use crate::scene::Light;
+use crate::scene::{ViewLight, ViewSetup};
 use glam::Vec3;
 use rayon::prelude::*;
 use web_time::Instant;
@@ -184,14 +185,14 @@ fn box_in_cell(f: &CpuFrustum, n: &BvhNode) -> bool {
 
 /// CPU twin of the GPU traversal (`bvh.wgsl`): per cell, walk `bvh` pruning boxes outside the
 /// cell's frustum and keep the leaves' lights that pass the gather test. Lists in light
-/// order. Equal to [`super::assign_gather_cpu`] whenever the boxes are conservative, which is
+/// order. Equal to [`crate::culling::strategies::gather::assign_gather_cpu`] whenever the boxes are conservative, which is
 /// what the tests check.
 pub fn traverse_bvh_cpu(
     setup: &ViewSetup,
     dims: &GridDims,
     lights: &[Light],
     cell_bounds: &[[f32; 2]],
-    culls: Option<&[super::CellCull]>,
+    culls: Option<&[crate::culling::bounds::cell_box::CellCull]>,
     bvh: &LightBvh,
 ) -> LightGrid {
     let views: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();

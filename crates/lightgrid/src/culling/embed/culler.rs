@@ -16,10 +16,10 @@
 //! wait: overflow, truncated shader loops and refused lights come back a frame or two later
 //! from [`LightCuller::poll`], and the lists grow from them.
 
-use super::builder::{GridBuilder, GridSetup};
-use super::grid::GridDims;
-use super::strategy::{bind_cull_group, cull_layout, CellSource, CullFrame};
 use crate::consts::POINT_LIGHT_COS;
+use crate::culling::builder::{GridBuilder, GridSetup};
+use crate::culling::frame::{bind_cull_group, cull_layout, CellSource, CullFrame};
+use crate::culling::grid::GridDims;
 use crate::frame::{
     Assign, CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder, GridLists, SpotCull,
 };
@@ -190,7 +190,7 @@ impl Default for CullConfig {
             depth_bounds: DepthBounds::Both,
             samples: 1,
             max_lights: 1 << 16,
-            index_capacity: super::GridBuffers::INITIAL_INDEX_CAPACITY,
+            index_capacity: crate::culling::grid::GridBuffers::INITIAL_INDEX_CAPACITY,
             spot_cull: SpotCull::Cone,
             depth_mask: DepthMask::Off,
             cell_box: CellBox::Off,
@@ -621,7 +621,7 @@ impl LightCuller {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         values: &crate::gpu::CounterValues,
-    ) -> crate::error::Result<super::BuiltGrid> {
+    ) -> crate::error::Result<crate::culling::builder::BuiltGrid> {
         self.core.download(device, queue, values)
     }
 

@@ -4,17 +4,17 @@
 //! whose cone may reach the frustum's bounding sphere, computed as `tile_frustum` /
 //! `light_in_tile` in `tile_frustum.wgsl`, in the same f32 arithmetic.
 
-use super::gpu_assign::{gather_shader, CellKernels};
-use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::{
-    box_overlap, cone_sphere, depth_mask_meets, sphere_box_gap, CellCull, CellMask, GridDims,
-    LightGrid, ViewLight, ViewSetup, NO_MASK,
-};
 use crate::consts::ASSIGN_DEPTH_SLACK;
+use crate::culling::bounds::cell_box::{box_overlap, cone_sphere, sphere_box_gap, CellCull};
+use crate::culling::bounds::depth_mask::{depth_mask_meets, CellMask, NO_MASK};
+use crate::culling::grid::{GridDims, LightGrid};
+use crate::culling::strategies::gpu_assign::{gather_shader, CellKernels};
+use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
 use crate::scene::Light;
+use crate::scene::{ViewLight, ViewSetup};
 use glam::Vec3;
 use rayon::prelude::*;
 

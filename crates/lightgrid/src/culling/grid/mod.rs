@@ -1,11 +1,11 @@
 //! The light grid, exactly tiled-shading §6.2 / Figure 1: the global light list (the scene's
 //! light buffer), the per-cell `(offset, count)` grid, and the cell light index lists. A tiled
 //! grid is a clustered grid with one depth slice. Every builder produces a [`LightGrid`];
-//! every grid-reading shader reads it through `culling/light_grid.wgsl`.
+//! every grid-reading shader reads it through `culling/grid/light_grid.wgsl`.
 
 use crate::error::{Error, Result};
 pub use crate::frame::GridLists;
-use crate::gpu::{bind_resources, grow_storage, storage_buffer};
+use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::gpu_types::GridParams;
 
 /// The grid's shape: screen tiles, and for a clustered grid view-depth slices spaced
@@ -215,7 +215,7 @@ pub struct LightGrid {
     pub indices: Vec<u32>,
     /// A z-binned grid's compact form (what the GPU holds); `cells` and `indices` are then
     /// the lists it stands for.
-    pub zbins: Option<super::ZBins>,
+    pub zbins: Option<ZBins>,
 }
 
 impl LightGrid {
@@ -302,7 +302,7 @@ impl LightGrid {
     }
 }
 
-/// The grid on the GPU: group 1 of every grid-reading shader (`culling/light_grid.wgsl`).
+/// The grid on the GPU: group 1 of every grid-reading shader (`culling/grid/light_grid.wgsl`).
 pub struct GridBuffers {
     pub layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
@@ -454,6 +454,73 @@ impl GridBuffers {
 
     pub fn indices_buffer(&self) -> &wgpu::Buffer {
         &self.indices
+    }
+
+    /// The per-cell lists as the GPU left them, `total` index entries, read back (statistics,
+    /// heatmaps, the tests; waits).
+    pub fn read_lists(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        dims: &GridDims,
+        total: u32,
+    ) -> Result<LightGrid> {
+        let cells = download(device, queue, &self.cells, (dims.cell_count() * 8) as u64)?;
+        let indices = download(device, queue, &self.indices, u64::from(total) * 4)?;
+        Ok(LightGrid {
+            dims: *dims,
+            cells: bytemuck::pod_collect_to_vec(&cells),
+            indices: bytemuck::pod_collect_to_vec(&indices),
+            zbins: None,
+        })
+    }
+}
+
+/// A z-binned grid in its compact form, as the GPU holds it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ZBins {
+    /// Light indices sorted by view depth (the bounding sphere's centre; ties by index).
+    pub order: Vec<u32>,
+    /// Per depth bin, the sorted range `[first, end)` of the lights meeting it (`first >=
+    /// end`: none).
+    pub bins: Vec<[u32; 2]>,
+    /// 32-bit words of each tile's mask.
+    pub words: usize,
+    /// Per tile, `words` words: bit `i % 32` of word `i / 32` is sorted light `i`.
+    pub masks: Vec<u32>,
+}
+
+impl ZBins {
+    /// Bytes the GPU holds: the order, the masks and two words per bin.
+    pub fn bytes(&self) -> u64 {
+        ((self.order.len() + self.masks.len() + 2 * self.bins.len()) * 4) as u64
+    }
+
+    /// Does tile `t`'s mask hold sorted light `i`?
+    pub fn tile_has(&self, t: usize, i: usize) -> bool {
+        self.masks[t * self.words + i / 32] & (1 << (i % 32)) != 0
+    }
+
+    /// The lights a sample of cell `c` (any layer) shades, in sorted order.
+    pub fn cell_lights(&self, dims: &GridDims, c: usize) -> Vec<u32> {
+        let lc = c % dims.layer_cells();
+        let (t, k) = (lc % dims.tile_count(), lc / dims.tile_count());
+        let [first, end] = self.bins[k];
+        (first..end.max(first))
+            .filter(|&i| self.tile_has(t, i as usize))
+            .map(|i| self.order[i as usize])
+            .collect()
+    }
+
+    /// The per-cell lists this structure stands for (analysis, the heatmap, the oracle
+    /// tests), with the compact form kept beside them.
+    pub fn into_grid(self, dims: GridDims) -> LightGrid {
+        let lists: Vec<Vec<u32>> = (0..dims.cell_count())
+            .map(|c| self.cell_lights(&dims, c))
+            .collect();
+        let mut grid = LightGrid::from_lists(dims, &lists);
+        grid.zbins = Some(self);
+        grid
     }
 }
 

@@ -5,13 +5,17 @@
 //! loops over a whole screen of cells (llvmpipe ends loops after 65,536 iterations). Pairs
 //! are appended at an atomic cursor into a buffer sized from earlier frames' frame counters;
 //! pairs that do not fit are counted and the frame reported, never passed off as right. The
-//! lists hold what the CPU twin ([`super::assign_cpu`] with the same cell bounds) builds, in
+//! lists hold what the CPU twin ([`crate::culling::strategies::assign_cpu`] with the same cell bounds) builds, in
 //! the cursor's order (the tests compare them as sets).
 
-use super::gpu_assign::{copy_dispatch_args, indirect_args_buffer, AssignCommon};
-use super::radix_sort::RadixSort;
-use super::strategy::{AssignFrame, AssignStrategy, ListCapacity, StrategyContext, StrategyRun};
 use crate::consts::{ASSIGN_THREADS, COUNTER_ITEM_ARGS};
+use crate::culling::strategies::gpu_assign::{
+    copy_dispatch_args, indirect_args_buffer, AssignCommon,
+};
+use crate::culling::strategies::radix_sort::RadixSort;
+use crate::culling::strategies::{
+    AssignFrame, AssignStrategy, ListCapacity, StrategyContext, StrategyRun,
+};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
@@ -27,7 +31,7 @@ pub(crate) fn shader() -> ComposedShader {
             src::TYPES,
             src::SCENE_BINDINGS,
             src::GRID_CELL,
-            super::TILE_FRUSTUM_WGSL,
+            crate::culling::strategies::TILE_FRUSTUM_WGSL,
             include_str!("assign_bindings.wgsl"),
             include_str!("light_tiles.wgsl"),
             include_str!("scatter.wgsl"),

@@ -11,12 +11,14 @@
 //! `--depth-bounds` (`DepthBounds`) then opens one side of each occupied cell's bounds, or
 //! both sides of every cell, to the cell's slice: twin [`open_bounds`].
 
-use super::CullFrame;
-use super::{CellCull, GridDims, GridLists, ViewSetup};
 use crate::consts::ASSIGN_DEPTH_SLACK;
+use crate::culling::bounds::cell_box::{CellCull, NO_CULL};
+use crate::culling::frame::CullFrame;
+use crate::culling::grid::{GridDims, GridLists};
 use crate::error::{Error, Result};
 use crate::frame::{CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder};
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
+use crate::scene::ViewSetup;
 use crate::shader::{
     compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, src, Def,
     ShaderKey,
@@ -88,7 +90,7 @@ impl ShaderKey for CellBoundsKey {
             src::SCENE_BINDINGS,
             src::GRID_CELL,
             src::MSAA,
-            super::CELL_CULL_WGSL,
+            crate::culling::bounds::CELL_CULL_WGSL,
             include_str!("cell_bounds.wgsl"),
         ]
     }
@@ -120,51 +122,24 @@ pub fn open_bounds(
     }
 }
 
-/// The bounds of a cell without samples.
-/// Every sample of `planes` (per-sample depth planes, as `cell_bounds_cpu_samples` reads
-/// them) off the background, with its pixel, its view distance and each cell its distance
-/// lies in within the slack `ASSIGN_DEPTH_SLACK` (as the kernel's `include_depth`; the same
-/// cell twice when it lies in one): the walk the masks' and boxes' CPU twins share.
-pub(super) fn for_each_sample_cell(
-    setup: &ViewSetup,
-    dims: &GridDims,
-    planes: &[&[f32]],
-    mut f: impl FnMut((u32, u32), f32, usize),
-) {
-    for (y, x) in (0..dims.height).flat_map(|y| (0..dims.width).map(move |x| (y, x))) {
-        for plane in planes {
-            let d = plane[(y * dims.width + x) as usize];
-            if crate::depth::is_background(d) {
-                continue;
-            }
-            let w = setup.view_distance(d);
-            let tile = dims.tile_of(x, y);
-            let k0 = dims.slice_of(w * (1.0 - ASSIGN_DEPTH_SLACK));
-            let k1 = dims.slice_of(w * (1.0 + ASSIGN_DEPTH_SLACK));
-            for k in [k0, k1] {
-                f((x, y), w, k as usize * dims.tile_count() + tile);
-            }
-        }
-    }
-}
-
 /// Bytes of one cell's culling record (`CellCull`: mask and box).
 const CULL_BYTES: usize = std::mem::size_of::<CellCull>();
 
-/// The records of a grid without masks or boxes: one [`super::NO_CULL`], which every cell
+/// The records of a grid without masks or boxes: one [`NO_CULL`], which every cell
 /// reads (`cell_cull` in assign_bindings.wgsl clamps the index to the buffer), so such a grid
 /// spends 48 bytes on them, not 48 per cell.
 fn no_culls(device: &wgpu::Device) -> wgpu::Buffer {
     use wgpu::util::DeviceExt;
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("cell culls (none)"),
-        contents: bytemuck::bytes_of(&super::NO_CULL),
+        contents: bytemuck::bytes_of(&NO_CULL),
         usage: wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_DST
             | wgpu::BufferUsages::COPY_SRC,
     })
 }
 
+/// The bounds of a cell without samples.
 pub const EMPTY_CELL: [f32; 2] = [f32::INFINITY, 0.0];
 
 /// CPU twin of the kernel: the same inputs (depth-buffer values in [0, 1], 1 = no sample,
@@ -249,7 +224,7 @@ fn bounds_union(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
 /// The GPU kernel and the bounds buffer it fills.
 pub struct CellBoundsPass {
     /// With MSAA: the fragments' view distances folded into the bounds first.
-    fragments: Option<super::fragment_bounds::FragmentBounds>,
+    fragments: Option<crate::culling::bounds::fragment_bounds::FragmentBounds>,
     /// Binding 5 without MSAA (unread).
     no_fragments: wgpu::Buffer,
     /// `main` for tiles of `.0` pixels: a workgroup of one invocation per row (the override
@@ -287,7 +262,7 @@ impl CellBoundsPass {
     /// The kernel `key` names (over a depth target of `key.samples` samples per pixel).
     /// `forward_opaque`: a forward pass shades the opaque fragments from these bounds' grid.
     /// `scene_layout`: the renderer's group 0, with which an MSAA grid's fragment bounds draw
-    /// its geometry (none for a caller's depth buffer: [`super::LightCuller`]). `tile_size`:
+    /// its geometry (none for a caller's depth buffer: [`crate::culling::embed::culler::LightCuller`]). `tile_size`:
     /// the grid's tiles (another size later builds the kernel again).
     pub(crate) fn new(
         device: &wgpu::Device,
@@ -322,7 +297,7 @@ impl CellBoundsPass {
         });
         CellBoundsPass {
             fragments: scene_layout.filter(|_| samples > 1).map(|scene_layout| {
-                super::fragment_bounds::FragmentBounds::new(
+                crate::culling::bounds::fragment_bounds::FragmentBounds::new(
                     device,
                     scene_layout,
                     samples,
@@ -360,7 +335,7 @@ impl CellBoundsPass {
     pub fn check_capacity(&self, device: &wgpu::Device, dims: &GridDims) -> Result<()> {
         let per_cell = if self.culled { CULL_BYTES } else { 8 } as u64;
         let cells = dims.cell_count() as u64;
-        let max = super::strategy::max_index_entries(device) * 4;
+        let max = crate::culling::frame::max_index_entries(device) * 4;
         if cells * per_cell > max {
             return Err(Error::invalid(
                 "--slices",
@@ -436,7 +411,7 @@ impl CellBoundsPass {
             ],
         );
         encoder.clear_buffer(&self.occupancy, 0, None);
-        let mut pass = timer.begin_compute(encoder, super::labels::CELL_BOUNDS);
+        let mut pass = timer.begin_compute(encoder, crate::consts::pass_labels::CELL_BOUNDS);
         pass.set_pipeline(&self.pipeline.1);
         pass.set_bind_group(0, cull, &[]);
         pass.set_bind_group(1, &group, &[]);
@@ -457,7 +432,7 @@ impl CellBoundsPass {
         let all = vec![range; self.cells];
         queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&all));
         if self.culled {
-            let culls = vec![super::NO_CULL; self.cells];
+            let culls = vec![NO_CULL; self.cells];
             queue.write_buffer(&self.culls, 0, bytemuck::cast_slice(&culls));
         }
         let list: Vec<u32> = (0..self.cells as u32).collect();
@@ -506,10 +481,10 @@ impl CellBoundsPass {
     }
 
     /// The culling records of the last recorded frame (as [`CellBoundsPass::read`]; every
-    /// cell [`super::NO_CULL`] without masks or boxes).
+    /// cell [`NO_CULL`] without masks or boxes).
     pub fn read_culls(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<CellCull>> {
         if !self.culled {
-            return Ok(vec![super::NO_CULL; self.cells]);
+            return Ok(vec![NO_CULL; self.cells]);
         }
         let bytes = download(device, queue, &self.culls, (self.cells * CULL_BYTES) as u64)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))

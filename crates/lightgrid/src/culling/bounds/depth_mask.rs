@@ -22,8 +22,9 @@
 //! correctly rounded in WGSL, so from the same `(lo, inv)` the CPU bins a distance exactly as
 //! the GPU does.
 
-use super::{GridDims, GridLists, ViewSetup};
 use crate::consts::{DEPTH_MASK_ALL, DEPTH_MASK_BINS};
+use crate::culling::grid::{GridDims, GridLists};
+use crate::scene::ViewSetup;
 
 /// One cell's mask: `[bits, lo, inv, 0]` (`lo`, `inv`: f32 bits).
 pub type CellMask = [u32; 4];
@@ -84,7 +85,7 @@ pub fn cell_masks_cpu(
     slack: f32,
 ) -> Vec<CellMask> {
     let mut masks: Vec<CellMask> = scales.iter().map(|s| [0, s[1], s[2], 0]).collect();
-    super::cell_bounds::for_each_sample_cell(setup, dims, planes, |_, w, cell| {
+    crate::culling::bounds::samples::for_each_sample_cell(setup, dims, planes, |_, w, cell| {
         let m = masks[cell];
         masks[cell][0] |= inflated_span(w, w, slack, &m);
     });

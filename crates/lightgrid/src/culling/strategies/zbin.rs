@@ -12,15 +12,14 @@
 //! structure: no second list. GPU build: `zbin.wgsl` (keys, the radix sort shared with
 //! scatter and the GPU BVH, bins, masks); CPU twin: [`zbins_cpu`], in the same f32 arithmetic.
 
-use super::assign_cpu::project_sphere;
-use super::gather::{cpu_frustum, light_margin};
-use super::radix_sort::RadixSort;
-use super::scan::ScanPass;
-use super::strategy::{
-    check_index_capacity, AssignFrame, AssignStrategy, StrategyContext, StrategyRun,
-};
-use super::{GridBuffers, GridDims, LightGrid, ViewSetup};
 use crate::consts::{ASSIGN_DEPTH_SLACK, ASSIGN_THREADS};
+use crate::culling::frame::check_index_capacity;
+use crate::culling::grid::{GridBuffers, GridDims, LightGrid, ZBins};
+use crate::culling::strategies::assign_cpu::project_sphere;
+use crate::culling::strategies::gather::{cpu_frustum, light_margin};
+use crate::culling::strategies::radix_sort::RadixSort;
+use crate::culling::strategies::scan::ScanPass;
+use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
@@ -28,6 +27,7 @@ use crate::gpu::{
     UNIFORM,
 };
 use crate::scene::Light;
+use crate::scene::ViewSetup;
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
@@ -36,60 +36,12 @@ pub(crate) fn shader() -> ComposedShader {
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
-            super::TILE_FRUSTUM_WGSL,
+            crate::culling::strategies::TILE_FRUSTUM_WGSL,
             src::GRID_CELL,
             include_str!("light_tiles.wgsl"),
             include_str!("zbin.wgsl"),
         ],
     )
-}
-
-/// A z-binned grid in its compact form, as the GPU holds it.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ZBins {
-    /// Light indices sorted by view depth (the bounding sphere's centre; ties by index).
-    pub order: Vec<u32>,
-    /// Per depth bin, the sorted range `[first, end)` of the lights meeting it (`first >=
-    /// end`: none).
-    pub bins: Vec<[u32; 2]>,
-    /// 32-bit words of each tile's mask.
-    pub words: usize,
-    /// Per tile, `words` words: bit `i % 32` of word `i / 32` is sorted light `i`.
-    pub masks: Vec<u32>,
-}
-
-impl ZBins {
-    /// Bytes the GPU holds: the order, the masks and two words per bin.
-    pub fn bytes(&self) -> u64 {
-        ((self.order.len() + self.masks.len() + 2 * self.bins.len()) * 4) as u64
-    }
-
-    /// Does tile `t`'s mask hold sorted light `i`?
-    pub fn tile_has(&self, t: usize, i: usize) -> bool {
-        self.masks[t * self.words + i / 32] & (1 << (i % 32)) != 0
-    }
-
-    /// The lights a sample of cell `c` (any layer) shades, in sorted order.
-    pub fn cell_lights(&self, dims: &GridDims, c: usize) -> Vec<u32> {
-        let lc = c % dims.layer_cells();
-        let (t, k) = (lc % dims.tile_count(), lc / dims.tile_count());
-        let [first, end] = self.bins[k];
-        (first..end.max(first))
-            .filter(|&i| self.tile_has(t, i as usize))
-            .map(|i| self.order[i as usize])
-            .collect()
-    }
-
-    /// The per-cell lists this structure stands for (analysis, the heatmap, the oracle
-    /// tests), with the compact form kept beside them.
-    pub fn into_grid(self, dims: GridDims) -> LightGrid {
-        let lists: Vec<Vec<u32>> = (0..dims.cell_count())
-            .map(|c| self.cell_lights(&dims, c))
-            .collect();
-        let mut grid = LightGrid::from_lists(dims, &lists);
-        grid.zbins = Some(self);
-        grid
-    }
 }
 
 /// `ordered_bits` of `cell_box.wgsl`: the sort key of a float (order-preserving as u32).

@@ -1,9 +1,9 @@
 //! The light-assignment registry: one row per `--assign` strategy (`auto` resolves to one of
 //! them, `Assign::resolve`). Adding a strategy is one file implementing
-//! [`AssignStrategy`](super::strategy::AssignStrategy) and one row here; the tests iterate
+//! [`AssignStrategy`](crate::culling::strategies::AssignStrategy) and one row here; the tests iterate
 //! the rows.
 
-use super::strategy::{AssignStrategy, StrategyContext};
+use crate::culling::strategies::{AssignStrategy, StrategyContext};
 use crate::frame::Assign;
 
 /// One registry row.
@@ -26,42 +26,42 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         name: "cpu",
         description: "CPU: projected sphere rectangles, per-cell depth test (rayon); grid uploaded",
         reads_back: true,
-        create: super::assign_cpu::create_strategy,
+        create: crate::culling::strategies::assign_cpu::create_strategy,
     },
     StrategyInfo {
         assign: Assign::Gather,
         name: "gather",
         description: "GPU: one workgroup per occupied cell tests every light (forward-plus §4)",
         reads_back: false,
-        create: super::gather::create_strategy,
+        create: crate::culling::strategies::gather::create_strategy,
     },
     StrategyInfo {
         assign: Assign::Scatter,
         name: "scatter",
         description: "GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell (forward-plus §4)",
         reads_back: false,
-        create: super::scatter::create_strategy,
+        create: crate::culling::strategies::scatter::create_strategy,
     },
     StrategyInfo {
         assign: Assign::Bvh,
         name: "bvh",
         description: "light BVH built on the CPU each frame, walked per occupied cell on the GPU (tiled-forward-shading §4.4)",
         reads_back: false,
-        create: super::bvh::create_strategy,
+        create: crate::culling::strategies::bvh::create_strategy,
     },
     StrategyInfo {
         assign: Assign::BvhGpu,
         name: "bvh-gpu",
         description: "the same BVH built on the GPU (Morton codes, radix sort), walked the same way",
         reads_back: false,
-        create: super::bvh_gpu::create_strategy,
+        create: crate::culling::strategies::bvh_gpu::create_strategy,
     },
     StrategyInfo {
         assign: Assign::ZBin,
         name: "zbin",
         description: "GPU z-binning (Drobot 2017): lights sorted by depth, per-slice index ranges, per-tile light bit masks",
         reads_back: false,
-        create: super::zbin::create_strategy,
+        create: crate::culling::strategies::zbin::create_strategy,
     },
 ];
 

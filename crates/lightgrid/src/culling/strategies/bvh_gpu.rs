@@ -1,15 +1,15 @@
 //! The light BVH built on the GPU (`bvh_build.wgsl`): centre bounding box, Morton codes, the
 //! radix sort shared with scatter, then leaf and per-level node boxes. Produces the same
-//! layout as the CPU build ([`super::build_bvh`], its twin) and binds as the traversal's
+//! layout as the CPU build ([`crate::culling::strategies::bvh::build_bvh`], its twin) and binds as the traversal's
 //! group 2 (`bvh_order` is the sorted value array itself).
 
-use super::bvh::{bvh_levels, BvhBuffers, BvhNode};
-use super::gpu_assign::{bvh_shader, CellKernels};
-use super::radix_sort::RadixSort;
-use super::scan::ScanPass;
-use super::strategy::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
-use super::CullFrame;
 use crate::consts::ASSIGN_THREADS;
+use crate::culling::frame::CullFrame;
+use crate::culling::strategies::bvh::{bvh_levels, BvhBuffers, BvhNode};
+use crate::culling::strategies::gpu_assign::{bvh_shader, CellKernels};
+use crate::culling::strategies::radix_sort::RadixSort;
+use crate::culling::strategies::scan::ScanPass;
+use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext, StrategyRun};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::CounterValues;
@@ -26,7 +26,7 @@ pub(crate) fn shader() -> ComposedShader {
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
-            super::TILE_FRUSTUM_WGSL,
+            crate::culling::strategies::TILE_FRUSTUM_WGSL,
             include_str!("bvh_build.wgsl"),
         ],
     )

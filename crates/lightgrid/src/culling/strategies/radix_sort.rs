@@ -3,8 +3,8 @@
 //! ([`ScanPass`]) and a scatter to the global positions. Sorts `keys`/`vals` in place (with
 //! `tmp_*` as the other half of each pass). CPU twin: a stable sort by key.
 
-use super::scan::ScanPass;
 use crate::consts::ASSIGN_THREADS;
+use crate::culling::strategies::scan::ScanPass;
 use crate::gpu::{bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer};
 use crate::gpu::{PassTimer, UniformSlots, STORAGE_RW, UNIFORM};
 use crate::gpu_types::SortParams;

@@ -14,17 +14,16 @@
 //! buffer grows to the needed total for the next frame (an analysis run reruns the frame at
 //! once: `assign_reruns` in the stats). A frame missing a light is never passed off as right.
 
-use super::cell_bounds::CellBoundsPass;
-use super::scan::ScanPass;
-pub use super::strategy::check_index_capacity;
-use super::strategy::{AssignFrame, ListCapacity, StrategyContext};
-use super::{GridBuffers, GridDims, LightGrid};
 use crate::consts::COUNTER_SPILL_ARGS;
+use crate::culling::bounds::cell_bounds::CellBoundsPass;
+use crate::culling::grid::{GridBuffers, GridDims};
+use crate::culling::strategies::scan::ScanPass;
+use crate::culling::strategies::{AssignFrame, ListCapacity, StrategyContext};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
-    bind_resources, buffer_layout, download, grow_storage, storage_buffer, CounterValues,
-    PassTimer, STORAGE_READ, STORAGE_RW, UNIFORM,
+    bind_resources, buffer_layout, grow_storage, storage_buffer, CounterValues, PassTimer,
+    STORAGE_READ, STORAGE_RW, UNIFORM,
 };
 use crate::shader::{compose, compute_pipeline, src, ComposedShader};
 
@@ -36,7 +35,7 @@ fn cell_shader(name: &str, body: &'static str) -> ComposedShader {
         &[
             src::TYPES,
             src::SCENE_BINDINGS,
-            super::TILE_FRUSTUM_WGSL,
+            crate::culling::strategies::TILE_FRUSTUM_WGSL,
             ASSIGN_BINDINGS_WGSL,
             body,
         ],
@@ -132,29 +131,6 @@ pub fn copy_dispatch_args(
     dst: &wgpu::Buffer,
 ) {
     encoder.copy_buffer_to_buffer(counters, u64::from(slot) * 4, dst, 0, 12);
-}
-
-/// The grid as built on the GPU, read back (for statistics, heatmaps and the tests).
-pub fn read_grid(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    grid: &GridBuffers,
-    dims: &GridDims,
-    total: u32,
-) -> Result<LightGrid> {
-    let cells = download(
-        device,
-        queue,
-        grid.cells_buffer(),
-        (dims.cell_count() * 8) as u64,
-    )?;
-    let indices = download(device, queue, grid.indices_buffer(), u64::from(total) * 4)?;
-    Ok(LightGrid {
-        dims: *dims,
-        cells: bytemuck::pod_collect_to_vec(&cells),
-        indices: bytemuck::pod_collect_to_vec(&indices),
-        zbins: None,
-    })
 }
 
 /// A per-cell strategy's kernels (first pass, spill arguments, spill pass) and the index
