@@ -220,7 +220,10 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     let box_axis = lightgrid::pipelines::find_axis(CellBox::FLAG).expect("a row");
     for c in &top {
         let settings = RenderSettings {
-            assign: named_assign(c).unwrap_or_default(),
+            grid: lightgrid::CullConfig {
+                strategy: named_assign(c).unwrap_or_default(),
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         if c.depth_mask.is_none() && (mask_axis.applies)(info(c), &settings) {
@@ -392,7 +395,8 @@ pub fn advise(
     let start = Instant::now();
     let auto = plan
         .base
-        .assign
+        .grid
+        .strategy
         .resolve(plan.scene.lights.len(), ctx.is_software())
         .name();
     let n = plan.scene.frame_count();
@@ -468,11 +472,15 @@ pub fn advise(
 }
 
 fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
+    let base = plan.base.grid;
     RenderSettings {
-        tile_size: c.tile.unwrap_or(plan.base.tile_size),
-        assign: named_assign(c).unwrap_or(plan.base.assign),
-        depth_mask: c.depth_mask.unwrap_or(plan.base.depth_mask),
-        cell_box: c.cell_box.unwrap_or(plan.base.cell_box),
+        grid: lightgrid::CullConfig {
+            tile_size: c.tile.unwrap_or(base.tile_size),
+            strategy: named_assign(c).unwrap_or(base.strategy),
+            depth_mask: c.depth_mask.unwrap_or(base.depth_mask),
+            cell_box: c.cell_box.unwrap_or(base.cell_box),
+            ..base
+        },
         ..plan.base
     }
 }

@@ -286,7 +286,10 @@ impl BenchConfig {
             }
         }
         lightgrid::RenderSettings {
-            tile_size: self.tile_size,
+            grid: lightgrid::CullConfig {
+                tile_size: self.tile_size,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         }
         .validate()?;
@@ -565,7 +568,10 @@ struct Series {
 /// in the table's order, last setting fastest.
 fn variants(config: &BenchConfig, info: &pipelines::PipelineInfo) -> Vec<RenderSettings> {
     let mut out = vec![RenderSettings {
-        tile_size: config.tile_size,
+        grid: lightgrid::CullConfig {
+            tile_size: config.tile_size,
+            ..lightgrid::CullConfig::default()
+        },
         ..RenderSettings::default()
     }];
     for axis in AXES {
@@ -1051,7 +1057,7 @@ impl RunRecord {
 
     /// MSAA samples per pixel.
     pub fn msaa(&self) -> u32 {
-        self.settings.msaa
+        self.settings.grid.samples
     }
 
     /// Where the MSAA deferred kernel resolved (the deferred kernels above one sample).
@@ -1252,7 +1258,10 @@ impl PreparedBench {
                 let size = config.size.unwrap_or(scene.default_size);
                 // The first value of every setting (the thumbnails show the scene).
                 let mut settings = RenderSettings {
-                    tile_size: config.tile_size,
+                    grid: lightgrid::CullConfig {
+                        tile_size: config.tile_size,
+                        ..lightgrid::CullConfig::default()
+                    },
                     ..Default::default()
                 };
                 for axis in AXES {

@@ -228,9 +228,12 @@ fn measure_point(
     total: u64,
 ) -> (Vec<lightgrid::FrameOutput>, Result<bool>) {
     let settings = RenderSettings {
-        tile_size: config.tile_size,
-        slices: config.slices,
-        assign,
+        grid: lightgrid::CullConfig {
+            tile_size: config.tile_size,
+            slices: config.slices,
+            strategy: assign,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let mut outs = Vec::new();

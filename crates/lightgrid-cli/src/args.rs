@@ -305,13 +305,16 @@ impl RendererArgs {
     /// The renderer settings, validated (the message gives each option's range).
     pub(crate) fn settings(&self) -> Result<RenderSettings> {
         let mut settings = RenderSettings {
-            tile_size: self.tile,
+            grid: lightgrid::CullConfig {
+                tile_size: self.tile,
+                ..lightgrid::CullConfig::default()
+            },
             ..RenderSettings::default()
         };
         self.axes.apply(&mut settings)?;
         let resolve_given =
             (self.axes.axes().iter()).any(|a| a.flag == lightgrid::frame::MsaaResolve::FLAG);
-        check_msaa_resolve(resolve_given, &[settings.msaa])?;
+        check_msaa_resolve(resolve_given, &[settings.grid.samples])?;
         settings.validate()?;
         Ok(settings)
     }

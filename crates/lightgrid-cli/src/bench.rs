@@ -556,7 +556,10 @@ pub(crate) fn bench_config(
     let given: Vec<&'static Axis> = a.axes.given.iter().map(|(axis, _)| *axis).collect();
     // The MSAA-dependent options apply at the largest sample count measured.
     let settings = lightgrid::RenderSettings {
-        msaa: config.msaa_counts().into_iter().max().unwrap_or(1),
+        grid: lightgrid::CullConfig {
+            samples: config.msaa_counts().into_iter().max().unwrap_or(1),
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     check_applies(&given, &chosen, &settings)?;

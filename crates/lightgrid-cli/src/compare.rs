@@ -122,7 +122,9 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             outcome = Outcome::Interrupted(STOPPED_BY_SIGNAL.into());
             break;
         }
-        if let (true, lightgrid::pipelines::Msaa::Refused(why)) = (settings.msaa > 1, p.msaa) {
+        if let (true, lightgrid::pipelines::Msaa::Refused(why)) =
+            (settings.grid.samples > 1, p.msaa)
+        {
             outln!("{:<24} skipped: refuses MSAA ({why})", p.id);
             rows.push(Row {
                 pipeline: p.id,

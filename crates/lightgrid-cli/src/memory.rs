@@ -42,8 +42,11 @@ pub(crate) fn memory(a: &MemoryArgs) -> Result<()> {
 fn table(a: &MemoryArgs, samples: u32) -> Result<()> {
     let Size(w, h) = a.size;
     let settings = RenderSettings {
+        grid: lightgrid::CullConfig {
+            samples,
+            ..lightgrid::CullConfig::default()
+        },
         gbuffer: a.gbuffer,
-        msaa: samples,
         ..Default::default()
     };
     let msaa = if samples > 1 {
@@ -105,7 +108,7 @@ fn footer(a: &MemoryArgs) -> Result<()> {
     );
     // The grid's cell array (offset + count per cell); frames with transparent objects and
     // separate lists (the default) keep a second layer of cells for the transparent lists.
-    let (tile, slices) = (settings.tile_size, settings.slices);
+    let (tile, slices) = (settings.grid.tile_size, settings.grid.slices);
     let tiles = lightgrid::culling::GridDims::new(w, h, tile)?;
     let clusters = tiles.clustered(slices, 1.0, 2.0)?;
     let kib = |d: &lightgrid::culling::GridDims| (d.cell_count() * 8) as f64 / 1024.0;

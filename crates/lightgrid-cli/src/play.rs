@@ -112,7 +112,8 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
     let mut renderer = Renderer::new(&ctx, w, h, settings)?;
     let assign = info.assign.then(|| {
         settings
-            .assign
+            .grid
+            .strategy
             .resolve(scene.lights.len(), ctx.is_software())
             .name()
     });

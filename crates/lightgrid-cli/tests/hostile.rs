@@ -1402,7 +1402,7 @@ fn every_setting_of_the_table_is_refused_where_it_does_not_apply_and_accepted_wh
         } else {
             "1"
         };
-        settings.msaa = msaa.parse().unwrap();
+        settings.grid.samples = msaa.parse().unwrap();
         let taker = PIPELINES.iter().find(|p| (axis.applies)(p, &settings));
         let other = PIPELINES.iter().find(|p| !(axis.applies)(p, &settings));
         let taker = taker.unwrap_or_else(|| panic!("{} applies to no pipeline", axis.flag));

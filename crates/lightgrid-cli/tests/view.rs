@@ -226,7 +226,10 @@ fn a_dim_or_distant_missing_light_fails_the_flip_tolerance() {
     let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
     let (size, frame) = ((203, 117), 120);
     let settings = lightgrid::RenderSettings {
-        tile_size: 12,
+        grid: lightgrid::CullConfig {
+            tile_size: 12,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let mut r = lightgrid::Renderer::new(&ctx, size.0, size.1, settings).unwrap();

@@ -48,7 +48,7 @@ impl Controls {
 /// Why `info` cannot render with `settings`, or None when it can.
 pub fn refusal(info: &PipelineInfo, settings: &RenderSettings) -> Option<String> {
     match info.msaa {
-        Msaa::Refused(reason) if settings.msaa > 1 => {
+        Msaa::Refused(reason) if settings.grid.samples > 1 => {
             Some(format!("{} does not render with MSAA: {reason}", info.id))
         }
         _ => None,
@@ -92,7 +92,7 @@ mod tests {
         assert_eq!(a.rebuild_for(&b), Rebuild::Switch);
         b.view = DebugView::WastedWork;
         assert_eq!(a.rebuild_for(&b), Rebuild::Switch);
-        b.settings.tile_size = 32;
+        b.settings.grid.tile_size = 32;
         assert_eq!(a.rebuild_for(&b), Rebuild::Renderer);
         b.request.params.spot_fraction = 0.5;
         assert_eq!(a.rebuild_for(&b), Rebuild::Scene);
@@ -105,7 +105,10 @@ mod tests {
     fn msaa_greys_out_no_pipeline_since_every_one_renders_with_it() {
         for msaa in [1, 4] {
             let s = RenderSettings {
-                msaa,
+                grid: lightgrid::CullConfig {
+                    samples: msaa,
+                    ..lightgrid::CullConfig::default()
+                },
                 ..Default::default()
             };
             for (p, why) in pipeline_choices(&s) {

@@ -140,7 +140,7 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
     ui.add_enabled(
         grid,
         egui::Slider::new(
-            &mut draft.settings.tile_size,
+            &mut draft.settings.grid.tile_size,
             lightgrid::consts::MIN_TILE_SIZE..=lightgrid::consts::MAX_TILE_SIZE,
         )
         .text("tile px"),
@@ -148,7 +148,7 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
     ui.add_enabled(
         pipeline.is_some_and(|p| p.clustered),
         egui::Slider::new(
-            &mut draft.settings.slices,
+            &mut draft.settings.grid.slices,
             1..=lightgrid::consts::MAX_SLICES,
         )
         .logarithmic(true)
@@ -156,10 +156,10 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
     );
     ui.add_enabled_ui(pipeline.is_some_and(|p| p.assign), |ui| {
         egui::ComboBox::from_label("assignment")
-            .selected_text(draft.settings.assign.name())
+            .selected_text(draft.settings.grid.strategy.name())
             .show_ui(ui, |ui| {
                 for a in Assign::all() {
-                    ui.selectable_value(&mut draft.settings.assign, a, a.name())
+                    ui.selectable_value(&mut draft.settings.grid.strategy, a, a.name())
                         .on_hover_text(a.description());
                 }
             });
@@ -167,7 +167,7 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
     ui.horizontal(|ui| {
         ui.label("MSAA");
         for &n in info.msaa_counts {
-            ui.selectable_value(&mut draft.settings.msaa, n, format!("{n}x"));
+            ui.selectable_value(&mut draft.settings.grid.samples, n, format!("{n}x"));
         }
     });
     ui.horizontal(|ui| {

@@ -46,10 +46,24 @@ fn main() -> Result<()> {
         catalog::build(scene_name, &SceneParams::default()) // scenes without glass refuse the flag
     })?;
     let (w, h) = SIZE;
-    let mut tiled =
-        Renderer::new(&ctx, w, h, RenderSettings { tile_size: TILE, slices: 32, ..Default::default() })?;
-    let mut clustered =
-        Renderer::new(&ctx, w, h, RenderSettings { tile_size: TILE, slices: 32, ..Default::default() })?;
+    let mut tiled = Renderer::new(
+        &ctx,
+        w,
+        h,
+        RenderSettings {
+            grid: lightgrid::CullConfig { tile_size: TILE, slices: 32, ..lightgrid::CullConfig::default() },
+            ..Default::default()
+        },
+    )?;
+    let mut clustered = Renderer::new(
+        &ctx,
+        w,
+        h,
+        RenderSettings {
+            grid: lightgrid::CullConfig { tile_size: TILE, slices: 32, ..lightgrid::CullConfig::default() },
+            ..Default::default()
+        },
+    )?;
     // Per column: tiles, tiles with tight boxes, z-bins per BINS, clusters, clusters with boxes.
     let mut sums = vec![0.0f64; 4 + BINS.len()];
     let mut n = 0;

@@ -10,7 +10,7 @@
 //! levels). `cargo run --release -p lightgrid --example embed -- --out embed.png`
 
 use glam::{Mat4, Vec3, Vec4};
-use lightgrid::{CullConfig, CullGrid, CullInputs, CullLight, LightCuller};
+use lightgrid::{CullConfig, CullInputs, CullLight, LightCuller};
 use wgpu::util::DeviceExt;
 
 const W: u32 = 640;
@@ -138,8 +138,8 @@ pub fn run(out: Option<&str>) -> Result<(), Box<dyn std::error::Error>> {
     let cam_buf = init(bytemuck::cast_slice(&cam), wgpu::BufferUsages::UNIFORM);
 
     // lightgrid: the culler, and its WGSL in front of this program's shader.
-    let grid = CullGrid::Clusters { tile_size: 16, slices: 24 };
-    let mut culler = LightCuller::new(&device, &queue, CullConfig { grid, ..Default::default() })?;
+    let config = CullConfig { tile_size: 16, slices: 24, ..Default::default() };
+    let mut culler = LightCuller::new(&device, &queue, config)?;
     let source = format!("{}\n{}", LightCuller::wgsl(1), include_str!("embed.wgsl"));
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: None,

@@ -326,8 +326,8 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
         grid_is_pipelines.then_some(&grid),
         a.info.depth_bounds
             && a.info.assign
-            && (settings.depth_mask == crate::frame::DepthMask::On
-                || settings.cell_box == crate::frame::CellBox::On),
+            && (settings.grid.depth_mask == crate::frame::DepthMask::On
+                || settings.grid.cell_box == crate::frame::CellBox::On),
     );
     Ok(FrameOutput {
         image,
@@ -348,9 +348,9 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             readback_bytes: a.io.readback_bytes,
             truncated_loops: a.finished.truncated_loops,
             passes,
-            tile_size: settings.tile_size,
+            tile_size: settings.grid.tile_size,
             gbuffer_bits: settings.gbuffer.bits(),
-            msaa: settings.msaa,
+            msaa: settings.grid.samples,
             msaa_shading: a.finished.msaa_shading,
             fragments_off_bounds: a.finished.fragments_off_bounds,
             shadow_rays: (settings.shadows != crate::scene::Shadows::Off)

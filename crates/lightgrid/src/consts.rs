@@ -14,6 +14,8 @@ pub const DEFAULT_TILE_SIZE: u32 = 16;
 /// View-depth slices of the clustered grid (tiled-forward-shading §4.8), exponentially spaced
 /// between the camera's near and far planes.
 pub const DEFAULT_SLICES: u32 = 32;
+/// Index entries a new grid's lists start with; they grow (never shrink) to fit.
+pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 14;
 /// Most slices accepted by `--slices`.
 pub const MAX_SLICES: u32 = 256;
 

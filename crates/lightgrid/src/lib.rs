@@ -28,8 +28,7 @@ pub mod stats;
 pub use analysis::FrameOutput;
 /// The light grid for any wgpu renderer (`culling/embed/culler.rs`; README, "Embedding").
 pub use culling::{
-    CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
-    LightCuller,
+    Assign, CullConfig, CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller,
 };
 pub use error::{Error, Result};
 pub use frame::{CellBox, DepthBounds, DepthMask, SpotCull};

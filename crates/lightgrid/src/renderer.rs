@@ -231,11 +231,11 @@ impl Renderer {
     ) -> Result<Self> {
         validate_size(ctx, width, height)?;
         settings.validate()?;
-        crate::frame::check_msaa(ctx, settings.msaa, settings.gbuffer)?;
+        crate::frame::check_msaa(ctx, settings.grid.samples, settings.gbuffer)?;
         // The settings that need subgroup operations, and what to use without them.
         for (wants, what, instead) in [
             (
-                settings.depth_reduction == crate::frame::DepthReduction::Subgroup,
+                settings.grid.depth_reduction == crate::frame::DepthReduction::Subgroup,
                 "depth reduction",
                 "atomics",
             ),
@@ -255,10 +255,10 @@ impl Renderer {
                 ));
             }
         }
-        let dims = GridDims::new(width, height, settings.tile_size)?;
+        let dims = GridDims::new(width, height, settings.grid.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {
-            let targets = Targets::new(device, width, height, settings.msaa);
+            let targets = Targets::new(device, width, height, settings.grid.samples);
             let scene_layout = scene_layout(device);
             let cull_layout = crate::culling::cull_layout(device);
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
@@ -295,7 +295,7 @@ impl Renderer {
                 software_adapter: ctx.is_software() && cfg!(not(target_arch = "wasm32")),
                 adapter_label: ctx.adapter_label(),
                 targets,
-                tonemap: Tonemap::new(device, settings.msaa),
+                tonemap: Tonemap::new(device, settings.grid.samples),
                 timer: PassTimer::new(ctx, MAX_PASSES),
                 counters,
                 scene_layout,
@@ -319,7 +319,7 @@ impl Renderer {
                 transparent: None,
                 settings,
                 dims,
-                readbacks: AnalysisReadbacks::new(device, width, height, settings.msaa),
+                readbacks: AnalysisReadbacks::new(device, width, height, settings.grid.samples),
                 serial: 0,
                 in_flight: VecDeque::new(),
                 finished: Vec::new(),
@@ -330,7 +330,7 @@ impl Renderer {
                 stage,
                 message: format!(
                     "out of memory: the shared render targets of {width}x{height} alone need {} MiB",
-                    (Targets::bytes_per_pixel(settings.msaa) * u64::from(width) * u64::from(height)) >> 20
+                    (Targets::bytes_per_pixel(settings.grid.samples) * u64::from(width) * u64::from(height)) >> 20
                 ),
             },
             e => e,
@@ -389,12 +389,14 @@ impl Renderer {
     }
 
     fn prepare_technique(&mut self, info: &'static pipelines::PipelineInfo) -> Result<()> {
-        if let (true, pipelines::Msaa::Refused(reason)) = (self.settings.msaa > 1, info.msaa) {
+        if let (true, pipelines::Msaa::Refused(reason)) =
+            (self.settings.grid.samples > 1, info.msaa)
+        {
             return Err(Error::invalid(
                 "msaa",
                 format!(
                     "{} does not render with MSAA ({}x asked): {reason}",
-                    info.id, self.settings.msaa
+                    info.id, self.settings.grid.samples
                 ),
             ));
         }
@@ -542,7 +544,7 @@ impl Renderer {
             .collect();
         let (width, height) = self.size();
         let mut setup = ViewSetup::new(&state.camera, width, height);
-        setup.spot_cull = self.settings.spot_cull;
+        setup.spot_cull = self.settings.grid.spot_cull;
         Ok(Uploaded {
             setup,
             index_count: static_indices + frame_geometry.indices.len() as u32,
@@ -752,7 +754,7 @@ impl Renderer {
             viewport: [width as f32, height as f32],
             near: state.camera.near,
             far: state.camera.far,
-            spot_cull: u32::from(self.settings.spot_cull == SpotCull::Cone),
+            spot_cull: u32::from(self.settings.grid.spot_cull == SpotCull::Cone),
             standard_depth: 0,
             _pad1: 0,
             _pad2: 0,

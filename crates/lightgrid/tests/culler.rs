@@ -9,8 +9,8 @@
 
 use glam::{Mat4, Vec3};
 use lightgrid::{
-    CellBox, CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullStrategy,
-    DepthBounds, DepthMask, LightCuller,
+    Assign, CellBox, CullConfig, CullError, CullInput, CullInputs, CullLight, DepthBounds,
+    DepthMask, LightCuller,
 };
 use wgpu::util::DeviceExt;
 
@@ -615,14 +615,18 @@ fn check(caller: &Caller, config: CullConfig, what: &str) -> f64 {
     per_sample
 }
 
-const STRATEGIES: [CullStrategy; 4] = CullStrategy::ALL;
-const GRIDS: [CullGrid; 2] = [
-    CullGrid::Tiles { tile_size: 16 },
-    CullGrid::Clusters {
-        tile_size: 32,
-        slices: 16,
-    },
-];
+/// The strategies a caller's culler offers: the registry's rows that assign on the GPU
+/// (`cpu` and `bvh` need the lights on the CPU and are refused: see
+/// `strategies_that_need_the_lights_on_the_cpu_are_refused`).
+fn strategies() -> Vec<Assign> {
+    lightgrid::culling::STRATEGIES
+        .iter()
+        .filter(|s| !s.cpu_lights)
+        .map(|s| s.assign)
+        .collect()
+}
+/// (tile size, slices): tiles, and clusters.
+const GRIDS: [(u32, u32); 2] = [(16, 1), (32, 16)];
 
 #[test]
 fn every_strategy_grid_and_depth_bounds_mode_lists_every_reaching_light() {
@@ -630,7 +634,7 @@ fn every_strategy_grid_and_depth_bounds_mode_lists_every_reaching_light() {
     let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
     let lights = lights(&cam, 300, 7);
     let caller = Caller::new(&device, &queue, 1, cam, &lights);
-    for strategy in STRATEGIES {
+    for strategy in strategies() {
         for grid in GRIDS {
             for depth_bounds in [
                 DepthBounds::Both,
@@ -639,7 +643,8 @@ fn every_strategy_grid_and_depth_bounds_mode_lists_every_reaching_light() {
                 DepthBounds::None,
             ] {
                 let config = CullConfig {
-                    grid,
+                    tile_size: grid.0,
+                    slices: grid.1,
                     strategy,
                     depth_bounds,
                     ..CullConfig::default()
@@ -667,10 +672,11 @@ fn depth_masks_and_cell_boxes_list_every_reaching_light() {
     let lights = lights(&camera(eye, false), 300, 17);
     for samples in [1, 4] {
         let caller = Caller::new(&device, &queue, samples, camera(eye, false), &lights);
-        for strategy in STRATEGIES {
+        for strategy in strategies() {
             for grid in GRIDS {
                 let config = |depth_mask, cell_box| CullConfig {
-                    grid,
+                    tile_size: grid.0,
+                    slices: grid.1,
                     strategy,
                     samples,
                     depth_mask,
@@ -678,7 +684,7 @@ fn depth_masks_and_cell_boxes_list_every_reaching_light() {
                     ..CullConfig::default()
                 };
                 let what = format!("{strategy:?} {grid:?} MSAA {samples}");
-                if strategy == CullStrategy::ZBin {
+                if strategy == Assign::ZBin {
                     // No per-cell lists to cut: refused, with the setting named.
                     for (mask, cell_box) in
                         [(DepthMask::On, CellBox::Off), (DepthMask::Off, CellBox::On)]
@@ -721,10 +727,11 @@ fn msaa_depth_standard_depth_and_a_camera_far_from_the_origin() {
     let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
     let lights_near = lights(&cam, 300, 11);
     let msaa = Caller::new(&device, &queue, 4, cam, &lights_near);
-    for strategy in STRATEGIES {
+    for strategy in strategies() {
         for grid in GRIDS {
             let config = CullConfig {
-                grid,
+                tile_size: grid.0,
+                slices: grid.1,
                 strategy,
                 samples: 4,
                 ..CullConfig::default()
@@ -738,8 +745,9 @@ fn msaa_depth_standard_depth_and_a_camera_far_from_the_origin() {
     let far = Caller::new(&device, &queue, 1, cam, &far_lights);
     for grid in GRIDS {
         let config = CullConfig {
-            grid,
-            strategy: CullStrategy::Gather,
+            tile_size: grid.0,
+            slices: grid.1,
+            strategy: Assign::Gather,
             ..CullConfig::default()
         };
         check(
@@ -755,7 +763,7 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
     let (device, queue) = device();
     let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
     let mut lights = lights(&cam, 300, 17);
-    for strategy in STRATEGIES {
+    for strategy in strategies() {
         let config = CullConfig {
             strategy,
             index_capacity: 1,
@@ -764,7 +772,7 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
         let caller = Caller::new(&device, &queue, 1, camera(cam.eye, false), &lights);
         let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
         let (r, first) = caller.frame(&mut culler);
-        if strategy == CullStrategy::ZBin {
+        if strategy == Assign::ZBin {
             // Z-bins are sized from the light count each frame: nothing to grow.
             assert!(first.is_complete(), "{strategy:?}: {first:?}");
             // The sorted lights, then 10 mask words for each 16-pixel tile.
@@ -1057,25 +1065,19 @@ fn bad_use_is_a_typed_error_naming_the_input() {
     // Configurations: tile sizes, slices, sample counts and capacities out of range.
     for config in [
         CullConfig {
-            grid: CullGrid::Tiles { tile_size: 0 },
+            tile_size: 0,
             ..CullConfig::default()
         },
         CullConfig {
-            grid: CullGrid::Tiles { tile_size: 1 << 20 },
+            tile_size: 1 << 20,
             ..CullConfig::default()
         },
         CullConfig {
-            grid: CullGrid::Clusters {
-                tile_size: 16,
-                slices: 1,
-            },
+            slices: 0,
             ..CullConfig::default()
         },
         CullConfig {
-            grid: CullGrid::Clusters {
-                tile_size: 16,
-                slices: 100_000,
-            },
+            slices: 100_000,
             ..CullConfig::default()
         },
         CullConfig {
@@ -1110,8 +1112,26 @@ fn bad_use_is_a_typed_error_naming_the_input() {
             .unwrap_or_else(|| panic!("{config:?} accepted"));
         assert_eq!(e.input, CullInput::Config, "{e}");
     }
+    // The strategies that assign on the CPU: refused, naming why and what is offered.
+    for row in lightgrid::culling::STRATEGIES
+        .iter()
+        .filter(|s| s.cpu_lights)
+    {
+        let config = CullConfig {
+            strategy: row.assign,
+            ..CullConfig::default()
+        };
+        let e = LightCuller::new(&device, &queue, config)
+            .err()
+            .unwrap_or_else(|| panic!("{} accepted", row.name));
+        assert_eq!(e.input, CullInput::Config, "{e}");
+        assert!(
+            e.message.contains("on the CPU") && e.message.contains("gather"),
+            "{e}"
+        );
+    }
     // After all that, the good inputs still cull, with lights and without, every strategy.
-    for strategy in STRATEGIES {
+    for strategy in strategies() {
         let mut culler = LightCuller::new(
             &device,
             &queue,

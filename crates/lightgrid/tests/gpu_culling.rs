@@ -105,11 +105,14 @@ fn run(
             .iter()
             .map(|&assign| {
                 let settings = RenderSettings {
-                    tile_size: config.tile,
-                    slices: config.slices,
-                    assign,
-                    depth_mask: config.depth_mask,
-                    cell_box: config.cell_box,
+                    grid: lightgrid::CullConfig {
+                        tile_size: config.tile,
+                        slices: config.slices,
+                        strategy: assign,
+                        depth_mask: config.depth_mask,
+                        cell_box: config.cell_box,
+                        ..lightgrid::CullConfig::default()
+                    },
                     ..Default::default()
                 };
                 Renderer::new(ctx, w, h, settings).unwrap()

@@ -30,8 +30,11 @@ const SAMPLES: u32 = 4;
 
 fn msaa(tile_size: u32) -> RenderSettings {
     RenderSettings {
-        tile_size,
-        msaa: SAMPLES,
+        grid: lightgrid::CullConfig {
+            tile_size,
+            samples: SAMPLES,
+            ..Default::default()
+        },
         ..Default::default()
     }
 }
@@ -108,7 +111,7 @@ fn render_all(s: &Scene, frame: u32, (w, h): (u32, u32), settings: RenderSetting
     for p in PIPELINES.iter().filter(|p| p.reference != p.id) {
         let name = format!(
             "{}-f{frame}-{w}x{h}-t{}-{}",
-            s.name, settings.tile_size, p.id
+            s.name, settings.grid.tile_size, p.id
         );
         if p.msaa != Msaa::Supported {
             let e = r.render(s, frame, p.id).err().expect("refused");
@@ -674,7 +677,10 @@ fn sample_counts_the_adapter_lacks_are_refused_with_the_supported_list() {
             continue;
         }
         let settings = RenderSettings {
-            msaa: n,
+            grid: lightgrid::CullConfig {
+                samples: n,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         let e = Renderer::new(&ctx, 64, 64, settings)

@@ -240,7 +240,10 @@ fn check_images(
         let out = r.render(s, frame, p.id).unwrap();
         let expected = &references[p.reference];
         let cmp = common::compare_images(&expected.image, &out.image, tolerance(p.id));
-        let name = format!("{scene}-f{frame}-{w}x{h}-t{}-{}", settings.tile_size, p.id);
+        let name = format!(
+            "{scene}-f{frame}-{w}x{h}-t{}-{}",
+            settings.grid.tile_size, p.id
+        );
         if !cmp.passes() {
             let dir = common::output_dir();
             save_png(&out.image, &dir.join(format!("actual-{name}.png"))).unwrap();
@@ -263,7 +266,7 @@ fn check_images(
             "{name}: culling did more work than brute force"
         );
         if out.grid_is_pipelines {
-            assert_eq!(out.grid.dims.tile_size, settings.tile_size);
+            assert_eq!(out.grid.dims.tile_size, settings.grid.tile_size);
             assert_eq!(st.lights_per_tile_max, Some(out.grid.max_lights_per_cell()));
         }
         // tiled-shading Fig. 3's count (tile area × list length) for tiled grids: every
@@ -336,7 +339,10 @@ fn every_pipeline_renders_transparent_objects_like_forward() {
             frame,
             size,
             RenderSettings {
-                lists,
+                grid: lightgrid::CullConfig {
+                    lists,
+                    ..settings(tile).grid
+                },
                 ..settings(tile)
             },
         );
@@ -410,7 +416,10 @@ fn a_dim_or_distant_missing_light_fails_every_tolerance() {
 
 fn settings(tile_size: u32) -> RenderSettings {
     RenderSettings {
-        tile_size,
+        grid: lightgrid::CullConfig {
+            tile_size,
+            ..Default::default()
+        },
         ..Default::default()
     }
 }
@@ -537,7 +546,10 @@ fn spot_lights_render_the_same_in_every_pipeline() {
     let stress = catalog::build("stress", &params(Some(3000), 1.0)).unwrap();
     check(&stress, 3, (131, 77), settings(16));
     let spheres = RenderSettings {
-        spot_cull: lightgrid::pipelines::SpotCull::Sphere,
+        grid: lightgrid::CullConfig {
+            spot_cull: lightgrid::pipelines::SpotCull::Sphere,
+            ..settings(16).grid
+        },
         ..settings(16)
     };
     check(&stress, 3, (131, 77), spheres);
@@ -571,7 +583,10 @@ fn cone_culling_is_tighter_than_sphere_culling() {
     }
     let count = |scene: &lightgrid::scene::Scene, spot_cull| {
         let settings = RenderSettings {
-            spot_cull,
+            grid: lightgrid::CullConfig {
+                spot_cull,
+                ..settings(16).grid
+            },
             ..settings(16)
         };
         let mut r = Renderer::new(&ctx, 160, 90, settings).unwrap();
@@ -604,9 +619,12 @@ fn random_fps_tile_16_with_32_bit_gbuffer() {
         30,
         (160, 96),
         RenderSettings {
-            tile_size: 16,
+            grid: lightgrid::CullConfig {
+                tile_size: 16,
+                slices: 24,
+                ..lightgrid::CullConfig::default()
+            },
             gbuffer: GBufferFormat::F32,
-            slices: 24,
             ..Default::default()
         },
     );
@@ -630,7 +648,7 @@ fn check_assign(
     let out = r.render(s, frame, id).unwrap();
     let state = s.frame(frame);
     let setup = ViewSetup::new(&state.camera, w, h);
-    let assign = r.settings().assign;
+    let assign = r.settings().grid.strategy;
     assert_ne!(
         assign,
         Assign::Auto,
@@ -652,7 +670,7 @@ fn check_assign(
             &bounds,
             &out.depth,
             2,
-            r.settings().depth_bounds,
+            r.settings().grid.depth_bounds,
         );
     }
     let culls = out
@@ -668,10 +686,10 @@ fn check_assign(
         &bounds,
         &planes,
         (
-            r.settings().depth_mask == DepthMask::On && !near_far,
-            r.settings().cell_box == CellBox::On && !near_far,
+            r.settings().grid.depth_mask == DepthMask::On && !near_far,
+            r.settings().grid.cell_box == CellBox::On && !near_far,
         ),
-        r.settings().msaa == 1 || !lightgrid::pipelines::find(id).unwrap().forward_shading,
+        r.settings().grid.samples == 1 || !lightgrid::pipelines::find(id).unwrap().forward_shading,
     );
     common::check_grid_against_twin(
         &what,
@@ -728,9 +746,12 @@ fn check_strategies(
     }
     for assign in common::strategies() {
         let settings = RenderSettings {
-            tile_size: tile,
-            slices,
-            assign,
+            grid: lightgrid::CullConfig {
+                tile_size: tile,
+                slices,
+                strategy: assign,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
@@ -789,10 +810,13 @@ fn depth_bound_modes_open_the_bounds_and_keep_the_image() {
             .map(|&depth_bounds| {
                 for assign in [Assign::Cpu, Assign::Gather] {
                     let settings = RenderSettings {
-                        tile_size: 12,
-                        slices: 16,
-                        assign,
-                        depth_bounds,
+                        grid: lightgrid::CullConfig {
+                            tile_size: 12,
+                            slices: 16,
+                            strategy: assign,
+                            depth_bounds,
+                            ..lightgrid::CullConfig::default()
+                        },
                         ..Default::default()
                     };
                     let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
@@ -803,10 +827,13 @@ fn depth_bound_modes_open_the_bounds_and_keep_the_image() {
                     w,
                     h,
                     RenderSettings {
-                        tile_size: 12,
-                        slices: 16,
-                        assign: Assign::Cpu,
-                        depth_bounds,
+                        grid: lightgrid::CullConfig {
+                            tile_size: 12,
+                            slices: 16,
+                            strategy: Assign::Cpu,
+                            depth_bounds,
+                            ..lightgrid::CullConfig::default()
+                        },
                         ..Default::default()
                     },
                 )
@@ -839,7 +866,10 @@ fn depth_masks_keep_the_image_and_only_drop_lights() {
     sample_culling_keeps_the_image_and_only_drops_lights(
         "masks",
         |s| RenderSettings {
-            depth_mask: DepthMask::On,
+            grid: lightgrid::CullConfig {
+                depth_mask: DepthMask::On,
+                ..s.grid
+            },
             ..s
         },
         &["tiled_forward_prez", "tiled_deferred"],
@@ -856,7 +886,10 @@ fn cell_boxes_keep_the_image_and_only_drop_lights() {
     sample_culling_keeps_the_image_and_only_drops_lights(
         "boxes",
         |s| RenderSettings {
-            cell_box: CellBox::On,
+            grid: lightgrid::CullConfig {
+                cell_box: CellBox::On,
+                ..s.grid
+            },
             ..s
         },
         &[
@@ -896,9 +929,12 @@ fn sample_culling_keeps_the_image_and_only_drops_lights(
         });
     }
     let plain = |assign| RenderSettings {
-        tile_size: 12,
-        slices: 16,
-        assign,
+        grid: lightgrid::CullConfig {
+            tile_size: 12,
+            slices: 16,
+            strategy: assign,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let mut fewer = std::collections::HashMap::new();
@@ -955,13 +991,16 @@ fn depth_masks_and_cell_boxes_with_msaa_and_shared_lists() {
         }
         for assign in [Assign::Cpu, Assign::Gather, Assign::Scatter] {
             let with = |depth_mask, cell_box| RenderSettings {
-                tile_size: 16,
-                slices: 16,
-                assign,
-                msaa,
-                lists,
-                depth_mask,
-                cell_box,
+                grid: lightgrid::CullConfig {
+                    tile_size: 16,
+                    slices: 16,
+                    strategy: assign,
+                    samples: msaa,
+                    lists,
+                    depth_mask,
+                    cell_box,
+                    ..lightgrid::CullConfig::default()
+                },
                 ..Default::default()
             };
             let mut on = Renderer::new(&ctx, w, h, with(DepthMask::On, CellBox::On)).unwrap();
@@ -1029,11 +1068,14 @@ fn z_bins_equal_their_twin_and_keep_the_image_with_glass_and_msaa() {
             panic!("the adapter offers no {msaa}x MSAA");
         }
         let with = |assign| RenderSettings {
-            tile_size: 16,
-            slices: 24,
-            assign,
-            msaa,
-            lists,
+            grid: lightgrid::CullConfig {
+                tile_size: 16,
+                slices: 24,
+                strategy: assign,
+                samples: msaa,
+                lists,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         let mut zbin = Renderer::new(&ctx, w, h, with(Assign::ZBin)).unwrap();
@@ -1103,10 +1145,13 @@ fn the_subgroup_light_loop_evaluates_each_samples_own_lights() {
         (4, Assign::ZBin),
     ] {
         let with = |light_loop| RenderSettings {
-            tile_size: 16,
-            slices: 16,
-            assign,
-            msaa,
+            grid: lightgrid::CullConfig {
+                tile_size: 16,
+                slices: 16,
+                strategy: assign,
+                samples: msaa,
+                ..lightgrid::CullConfig::default()
+            },
             light_loop,
             ..Default::default()
         };
@@ -1145,10 +1190,13 @@ fn subgroup_depth_reduction_gives_the_twins_bounds() {
     let s = catalog::build("robots-many", &SceneParams::default()).unwrap();
     let (w, h, frame) = (203, 117, 60);
     let subgroup = |assign| RenderSettings {
-        tile_size: 12,
-        slices: 16,
-        assign,
-        depth_reduction: lightgrid::frame::DepthReduction::Subgroup,
+        grid: lightgrid::CullConfig {
+            tile_size: 12,
+            slices: 16,
+            strategy: assign,
+            depth_reduction: lightgrid::frame::DepthReduction::Subgroup,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     if !ctx.subgroups {
@@ -1168,7 +1216,10 @@ fn subgroup_depth_reduction_gives_the_twins_bounds() {
     for cell_box in CellBox::ALL {
         for assign in [Assign::Cpu, Assign::Gather] {
             let settings = RenderSettings {
-                cell_box,
+                grid: lightgrid::CullConfig {
+                    cell_box,
+                    ..subgroup(assign).grid
+                },
                 ..subgroup(assign)
             };
             let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
@@ -1205,7 +1256,10 @@ fn strategies_agree_with_each_other_and_pipelines_without_a_grid_ignore_them() {
     let mut lists = Vec::new();
     for assign in common::strategies() {
         let settings = RenderSettings {
-            assign,
+            grid: lightgrid::CullConfig {
+                strategy: assign,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         let mut r = Renderer::new(&ctx, 96, 64, settings).unwrap();
@@ -1301,8 +1355,11 @@ fn strategies_on_randomized_edge_case_lights() {
 fn light_loops_beyond_the_adapters_budget_are_refused() {
     let ctx = common::gpu();
     let settings = RenderSettings {
-        tile_size: 64,
-        assign: Assign::Cpu,
+        grid: lightgrid::CullConfig {
+            tile_size: 64,
+            strategy: Assign::Cpu,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let scene = |n| {
@@ -1739,8 +1796,11 @@ fn cluster_slices_follow_the_samples_depth_range() {
     let mut counts = Vec::new();
     for assign in [Assign::Cpu, Assign::Gather] {
         let settings = RenderSettings {
-            assign,
-            slices: 32,
+            grid: lightgrid::CullConfig {
+                strategy: assign,
+                slices: 32,
+                ..settings(16).grid
+            },
             ..settings(16)
         };
         let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
@@ -1806,16 +1866,25 @@ fn depth_masks_and_cell_boxes_on_a_gltf_file_far_from_the_origin_with_a_tiny_nea
         1.0e6,
     );
     let base = RenderSettings {
-        slices: 24,
+        grid: lightgrid::CullConfig {
+            slices: 24,
+            ..settings(9).grid
+        },
         ..settings(9)
     };
     for culled in [
         RenderSettings {
-            depth_mask: DepthMask::On,
+            grid: lightgrid::CullConfig {
+                depth_mask: DepthMask::On,
+                ..base.grid
+            },
             ..base
         },
         RenderSettings {
-            cell_box: CellBox::On,
+            grid: lightgrid::CullConfig {
+                cell_box: CellBox::On,
+                ..base.grid
+            },
             ..base
         },
     ] {

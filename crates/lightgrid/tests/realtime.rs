@@ -77,7 +77,10 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     let mut checked = 0;
     for assign in gpu_strategies() {
         let settings = RenderSettings {
-            assign,
+            grid: lightgrid::CullConfig {
+                strategy: assign,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         let mut r = Renderer::new(&ctx, 96, 54, settings).unwrap();
@@ -115,8 +118,11 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
 
     // The papers' CPU pipeline is the one exception: with depth bounds it reads them back.
     let cpu = RenderSettings {
-        assign: Assign::Cpu,
-        tile_size: 16,
+        grid: lightgrid::CullConfig {
+            strategy: Assign::Cpu,
+            tile_size: 16,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let mut r = Renderer::new(&ctx, 96, 54, cpu).unwrap();
@@ -136,11 +142,17 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     let record = std::mem::size_of::<lightgrid::culling::CellCull>() as u64;
     for culled in [
         RenderSettings {
-            depth_mask: lightgrid::DepthMask::On,
+            grid: lightgrid::CullConfig {
+                depth_mask: lightgrid::DepthMask::On,
+                ..cpu.grid
+            },
             ..cpu
         },
         RenderSettings {
-            cell_box: lightgrid::CellBox::On,
+            grid: lightgrid::CullConfig {
+                cell_box: lightgrid::CellBox::On,
+                ..cpu.grid
+            },
             ..cpu
         },
     ] {
@@ -162,7 +174,7 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     // Clusters: the slicing range and the sliced parameters come back with the bounds, in
     // the same one wait.
     let (submitted, _) = play(&mut r, &scene, "clustered_forward", &frames[..2]);
-    let slices = u64::from(RenderSettings::default().slices);
+    let slices = u64::from(RenderSettings::default().grid.slices);
     for s in &submitted {
         assert_eq!(s.io.submits, 2, "one part-way submission");
         let params = std::mem::size_of::<lightgrid::gpu_types::GridParams>() as u64;
@@ -199,7 +211,10 @@ fn a_frame_whose_lists_did_not_fit_is_reported_and_later_frames_fit() {
     // checks that their first frame is complete).
     for assign in gpu_strategies().filter(|&a| a != Assign::ZBin) {
         let settings = RenderSettings {
-            assign,
+            grid: lightgrid::CullConfig {
+                strategy: assign,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         // What the grid needs (an analysis render grows and reruns until it fits).
@@ -378,7 +393,10 @@ fn scatter_at_1280x720_matches_cpu_assignment() {
     let scene = catalog::build("robots-many", &SceneParams::default()).unwrap();
     let render = |assign| {
         let settings = RenderSettings {
-            assign,
+            grid: lightgrid::CullConfig {
+                strategy: assign,
+                ..lightgrid::CullConfig::default()
+            },
             ..Default::default()
         };
         let mut r = Renderer::new(&ctx, 1280, 720, settings).unwrap();
@@ -410,8 +428,11 @@ fn scatter_with_4_pixel_tiles_matches_forward() {
     let ctx = common::gpu();
     let scene = catalog::build("robots-many", &SceneParams::default()).unwrap();
     let settings = RenderSettings {
-        assign: Assign::Scatter,
-        tile_size: 4,
+        grid: lightgrid::CullConfig {
+            strategy: Assign::Scatter,
+            tile_size: 4,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let mut r = Renderer::new(&ctx, 320, 180, settings).unwrap();
@@ -443,7 +464,10 @@ fn single_kernel_with_a_64_pixel_tile_and_8000_lights_matches_forward() {
     let ctx = common::gpu();
     let scene = stress(8000);
     let settings = RenderSettings {
-        tile_size: 64,
+        grid: lightgrid::CullConfig {
+            tile_size: 64,
+            ..lightgrid::CullConfig::default()
+        },
         ..Default::default()
     };
     let mut r = Renderer::new(&ctx, 64, 64, settings).unwrap();

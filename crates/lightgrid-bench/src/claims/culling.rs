@@ -107,8 +107,8 @@ fn pairs<T: SettingValue + PartialEq>(
 ) -> Vec<(&RunRecord, &RunRecord)> {
     // The other settings off: each claim compares one technique against the plain grid.
     let plain = |x: &RunRecord| {
-        let mask_off = T::FLAG == DepthMask::FLAG || x.settings.depth_mask == DepthMask::Off;
-        let box_off = T::FLAG == CellBox::FLAG || x.settings.cell_box == CellBox::Off;
+        let mask_off = T::FLAG == DepthMask::FLAG || x.settings.grid.depth_mask == DepthMask::Off;
+        let box_off = T::FLAG == CellBox::FLAG || x.settings.grid.cell_box == CellBox::Off;
         mask_off && box_off
     };
     r.runs

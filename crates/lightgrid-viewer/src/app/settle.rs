@@ -74,8 +74,8 @@ impl App {
     fn change_controls(next: &mut Controls, step: &Step) -> Result<bool> {
         match &step.action {
             Action::Pipeline(id) => next.pipeline = pipelines::find(id)?.id.to_string(),
-            Action::Tile(n) => next.settings.tile_size = *n,
-            Action::Msaa(n) => next.settings.msaa = *n,
+            Action::Tile(n) => next.settings.grid.tile_size = *n,
+            Action::Msaa(n) => next.settings.grid.samples = *n,
             Action::Brdf(b) => next.settings.brdf = *b,
             Action::Shadows(s) => next.settings.shadows = *s,
             Action::View(v) => next.view = *v,

@@ -68,9 +68,9 @@ impl PageOptions {
                     view.size = Some((w, h));
                 }
                 "tile" => {
-                    view.settings.tile_size = value.parse().map_err(|_| bad("not a tile size"))?
+                    view.settings.grid.tile_size = value.parse().map_err(|_| bad("not a tile size"))?
                 }
-                "msaa" => view.settings.msaa = value.parse().map_err(|_| bad("not 1 or 4"))?,
+                "msaa" => view.settings.grid.samples = value.parse().map_err(|_| bad("not 1 or 4"))?,
                 "paused" => view.paused = true,
                 "limits" => {
                     limits = match value.as_str() {

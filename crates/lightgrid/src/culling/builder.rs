@@ -21,42 +21,21 @@ use crate::culling::grid::{GridBuffers, GridDims, GridLists, LightGrid};
 use crate::culling::strategies::registry::find_strategy;
 use crate::culling::strategies::{AssignFrame, AssignStrategy, StrategyContext};
 use crate::error::{Error, Result};
-use crate::frame::{Assign, FrameEncoder};
+use crate::frame::{Assign, CullConfig, FrameEncoder};
 use crate::gpu::CounterValues;
 
-/// What a [`GridBuilder`] is created from.
-pub struct GridSetup<'a> {
-    pub device: &'a wgpu::Device,
-    /// Group 0 of the culling kernels (`strategy::cull_layout`).
-    pub cull_layout: &'a wgpu::BindGroupLayout,
-    /// The renderer's group 0: an MSAA forward grid's fragment bounds draw its geometry with
-    /// it. `None` for a caller's depth buffer.
-    pub scene_layout: Option<&'a wgpu::BindGroupLayout>,
-    /// The frame's tile grid (one slice).
-    pub tiles: GridDims,
-    /// `--assign` (`auto` resolved per frame).
-    pub assign: Assign,
-    /// A CPU-emulated adapter (`auto` picks `cpu` there).
-    pub software_adapter: bool,
-    /// The lists of a frame with transparent geometry (`--lists`); a frame without any
-    /// builds opaque lists only.
-    pub lists: GridLists,
-    /// Samples per pixel of the depth target the cell bounds read (`--msaa`).
-    pub samples: u32,
+/// How a grid's frames reach it, beyond its [`CullConfig`]: where its bounds come from, who
+/// shades from it, and what `auto` may resolve to.
+#[derive(Clone, Copy, Debug)]
+pub struct GridUse {
+    /// Cell bounds from the frame's depth buffer, or near..far (a pipeline without a depth
+    /// pre-pass).
+    pub source: CellSource,
     /// A forward pass shades the opaque geometry from this grid (with MSAA its fragments'
     /// distances go into the bounds: `fragment_bounds.rs`); deferred kernels shade samples.
     pub forward_opaque: bool,
-    /// Which side of the depth bounds assignment culls by (`--depth-bounds`).
-    pub depth_bounds: crate::frame::DepthBounds,
-    /// How the cell-bounds kernel reduces depths (`--depth-reduction`).
-    pub depth_reduction: crate::frame::DepthReduction,
-    /// 2.5D culling (`--depth-mask`).
-    pub depth_mask: crate::frame::DepthMask,
-    /// Tight cells (`--cell-box`).
-    pub cell_box: crate::frame::CellBox,
-    /// Index entries the lists start with (`GridBuffers::INITIAL_INDEX_CAPACITY`); they grow
-    /// from the frame counters.
-    pub index_capacity: u64,
+    /// A CPU-emulated adapter whose frames bring their lights on the CPU: `auto` picks `cpu`.
+    pub software_adapter: bool,
 }
 
 /// A built grid and what went into it (analysis).
@@ -104,36 +83,46 @@ pub struct GridBuilder {
 }
 
 impl GridBuilder {
-    /// `slices` 1 builds a tiled grid, more a clustered one (slices spread each frame over
-    /// the samples' depth range, or between the camera's near and far planes without depth).
-    pub fn new(ctx: &GridSetup, slices: u32, source: CellSource) -> Self {
-        let (device, cull_layout) = (ctx.device, ctx.cull_layout);
+    /// The grid `config` describes over `tiles` (the frame's tile grid, one slice; a caller's
+    /// culler sets it per frame): `config.slices` 1 builds a tiled grid, more a clustered one
+    /// (slices spread each frame over the samples' depth range, or between the camera's near
+    /// and far planes without depth). `scene_layout`: the renderer's group 0, with which an
+    /// MSAA forward grid's fragment bounds draw its geometry.
+    pub fn new(
+        device: &wgpu::Device,
+        cull_layout: &wgpu::BindGroupLayout,
+        scene_layout: Option<&wgpu::BindGroupLayout>,
+        config: &CullConfig,
+        tiles: GridDims,
+        usage: GridUse,
+    ) -> Self {
+        let index_capacity = u64::from(config.index_capacity);
         GridBuilder {
-            tiles: ctx.tiles,
-            slices,
-            source,
-            assign: ctx.assign,
-            lists: ctx.lists,
-            software_adapter: ctx.software_adapter,
-            index_capacity: ctx.index_capacity,
+            tiles,
+            slices: config.slices,
+            source: usage.source,
+            assign: config.strategy,
+            lists: config.lists,
+            software_adapter: usage.software_adapter,
+            index_capacity,
             cull_layout: cull_layout.clone(),
             bounds: CellBoundsPass::new(
                 device,
                 cull_layout,
-                ctx.scene_layout,
+                scene_layout,
                 crate::culling::bounds::cell_bounds::CellBoundsKey {
-                    samples: ctx.samples,
-                    depth_bounds: ctx.depth_bounds,
-                    reduction: ctx.depth_reduction,
-                    depth_mask: ctx.depth_mask,
-                    cell_box: ctx.cell_box,
+                    samples: config.samples,
+                    depth_bounds: config.depth_bounds,
+                    reduction: config.depth_reduction,
+                    depth_mask: config.depth_mask,
+                    cell_box: config.cell_box,
                 },
-                ctx.forward_opaque,
-                ctx.tiles.tile_size,
+                usage.forward_opaque,
+                tiles.tile_size,
             ),
-            range: (slices > 1 && source == CellSource::Depth)
-                .then(|| DepthRangePass::new(device, cull_layout, ctx.samples)),
-            buffers: GridBuffers::new(device, ctx.index_capacity),
+            range: (config.slices > 1 && usage.source == CellSource::Depth)
+                .then(|| DepthRangePass::new(device, cull_layout, config.samples)),
+            buffers: GridBuffers::new(device, index_capacity),
             strategies: Vec::new(),
             last: None,
         }

@@ -12,7 +12,7 @@ mod oracle;
 mod spot_ray;
 mod strategies;
 
-pub use crate::frame::{Assign, AUTO_GATHER_MAX_LIGHTS};
+pub use crate::frame::{Assign, CullConfig, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
 pub use bounds::cell_bounds::{
     cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
@@ -26,11 +26,8 @@ pub use bounds::depth_mask::{
 };
 pub use bounds::depth_range::{depth_range_cpu, slicing_range, DepthRangePass};
 pub use builder::BuiltGrid;
-pub(crate) use builder::GridSetup;
-pub use embed::culler::{
-    CullConfig, CullError, CullGrid, CullInput, CullInputs, CullLight, CullReport, CullStrategy,
-    LightCuller,
-};
+pub(crate) use builder::GridUse;
+pub use embed::culler::{CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller};
 pub use frame::check_index_capacity;
 pub(crate) use frame::CellSource;
 pub(crate) use frame::{bind_cull_group, cull_layout, CullFrame};

@@ -13,8 +13,9 @@ pub mod targets;
 pub use settings::{
     validate_msaa, validate_sample_culling, validate_shadow_atlas, validate_shadow_lights,
     validate_shadow_map_size, validate_slices, validate_tile_size, validate_zbin_culling, Assign,
-    Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists, LightLoop,
-    MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull, AUTO_GATHER_MAX_LIGHTS,
+    Brdf, CellBox, CullConfig, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
+    LightLoop, MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull,
+    AUTO_GATHER_MAX_LIGHTS,
 };
 pub use targets::{check_msaa, msaa_counts, Targets};
 

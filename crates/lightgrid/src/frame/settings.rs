@@ -1,40 +1,21 @@
 //! The settings every pipeline of a renderer shares (`--tile`, `--gbuffer`, `--slices`,
 //! `--assign`): plain values, below everything that reads them.
 
-/// Settings every pipeline of a renderer shares.
+/// Settings every pipeline of a renderer shares: the light grid's description
+/// ([`CullConfig`], its fields flattened into the same records) and the rest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct RenderSettings {
-    /// Screen tile edge in pixels (`--tile`).
-    pub tile_size: u32,
+    /// The light grid every grid pipeline builds, and the frame's MSAA samples
+    /// (`--tile`, `--slices`, `--assign`, `--spot-cull`, `--lists`, `--msaa`,
+    /// `--depth-bounds`, `--depth-reduction`, `--depth-mask`, `--cell-box`).
+    #[serde(flatten)]
+    pub grid: CullConfig,
     /// G-buffer channel precision (`--gbuffer 16|32`).
     pub gbuffer: GBufferFormat,
-    /// View-depth slices of clustered grids (`--slices`).
-    pub slices: u32,
-    /// Who builds the grid (`--assign`).
-    pub assign: Assign,
-    /// What spot lights are culled by (`--spot-cull`), in every strategy.
-    pub spot_cull: SpotCull,
-    /// Lists for frames with transparent geometry (`--lists`): separate opaque and
-    /// transparent lists, or one shared list.
-    pub lists: GridLists,
     /// How forward pipelines draw the material shaders (`--material-draws`).
     pub material_draws: MaterialDraws,
-    /// MSAA samples per pixel of every target (`--msaa`): 1 (none) or a count the adapter
-    /// offers for every format (`frame::msaa_counts`).
-    pub msaa: u32,
     /// Where the MSAA deferred kernels resolve (`--msaa-resolve`).
     pub msaa_resolve: MsaaResolve,
-    /// Which cell depth bounds light assignment uses (`--depth-bounds`), for grids built
-    /// from the depth buffer.
-    pub depth_bounds: DepthBounds,
-    /// How the cell-bounds kernel reduces a tile's depths (`--depth-reduction`).
-    pub depth_reduction: DepthReduction,
-    /// 2.5D culling of grids built from the depth buffer (`--depth-mask`).
-    #[serde(default)]
-    pub depth_mask: DepthMask,
-    /// Tight cells of grids built from the depth buffer (`--cell-box`).
-    #[serde(default)]
-    pub cell_box: CellBox,
     /// The light loop of grid pipelines (`--light-loop`).
     #[serde(default)]
     pub light_loop: LightLoop,
@@ -55,6 +36,112 @@ pub struct RenderSettings {
     /// The largest shadow-map face in texels (`--shadow-map-size`, `--shadows maps`).
     #[serde(default = "default_shadow_map_size")]
     pub shadow_map_size: u32,
+}
+
+/// **The light grid's description**: every grid lightgrid builds is made from one, its own
+/// renderer's ([`RenderSettings::grid`]) and any other renderer's
+/// [`LightCuller`](crate::LightCuller).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct CullConfig {
+    /// Screen tile edge in pixels, 4 to 64 (`--tile`).
+    pub tile_size: u32,
+    /// View-depth slices per tile: 1 builds tiles (tiled shading), 2 to 256 clusters spread
+    /// exponentially over the frame's samples' depth range (clustered shading). `--slices`;
+    /// lightgrid's tiled pipelines build their grids with 1.
+    pub slices: u32,
+    /// Who assigns lights to cells (`--assign`; a row of `culling::STRATEGIES`, or `Auto`).
+    #[serde(rename = "assign")]
+    pub strategy: Assign,
+    /// What spot lights are culled by (`--spot-cull`), in every strategy.
+    pub spot_cull: SpotCull,
+    /// Lists for frames with transparent surfaces (`--lists`): separate opaque and
+    /// transparent lists, or one shared list; a frame without any builds opaque lists only.
+    pub lists: GridLists,
+    /// Samples per pixel of the depth the grid is built over (`--msaa`: every target of a
+    /// lightgrid frame): 1, or an MSAA count. With MSAA the bounds cover every sample.
+    #[serde(rename = "msaa")]
+    pub samples: u32,
+    /// Which side of each cell's depth range culls lights (`--depth-bounds`;
+    /// [`DepthBounds::Both`]: a light must reach between the cell's nearest and farthest
+    /// sample).
+    pub depth_bounds: DepthBounds,
+    /// How the cell-bounds kernel reduces a tile's depths (`--depth-reduction`).
+    pub depth_reduction: DepthReduction,
+    /// 2.5D culling (`--depth-mask on`): each cell also keeps a mask of which of 32 bins of
+    /// its depth bounds hold samples; needs [`DepthBounds::Both`].
+    #[serde(default)]
+    pub depth_mask: DepthMask,
+    /// Tight cells (`--cell-box on`): each occupied cell also keeps the view-space box of its
+    /// samples, and lights are kept by the closest-point test against it; needs
+    /// [`DepthBounds::Both`].
+    #[serde(default)]
+    pub cell_box: CellBox,
+    /// The most lights one frame may have; more is an error. Not a setting of the records.
+    #[serde(skip, default = "default_max_lights")]
+    pub max_lights: u32,
+    /// Index entries the lists start with; they grow from the frames' counters. Not a
+    /// setting of the records.
+    #[serde(skip, default = "default_index_capacity")]
+    pub index_capacity: u32,
+}
+
+fn default_max_lights() -> u32 {
+    crate::consts::MAX_LIGHTS
+}
+
+fn default_index_capacity() -> u32 {
+    crate::consts::INITIAL_INDEX_CAPACITY
+}
+
+impl Default for CullConfig {
+    /// 16-pixel tiles cut into 32 slices, `auto` assignment, both depth bounds, separate
+    /// transparent lists, no MSAA, up to `MAX_LIGHTS` lights.
+    fn default() -> Self {
+        CullConfig {
+            tile_size: crate::consts::DEFAULT_TILE_SIZE,
+            slices: crate::consts::DEFAULT_SLICES,
+            strategy: Assign::default(),
+            spot_cull: SpotCull::default(),
+            lists: GridLists::Separate,
+            samples: 1,
+            depth_bounds: DepthBounds::Both,
+            depth_reduction: DepthReduction::Atomics,
+            depth_mask: DepthMask::Off,
+            cell_box: CellBox::Off,
+            max_lights: default_max_lights(),
+            index_capacity: default_index_capacity(),
+        }
+    }
+}
+
+impl CullConfig {
+    /// Refuse a description no grid can be built from, naming the setting and the accepted
+    /// range.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        validate_tile_size(self.tile_size)?;
+        validate_slices(self.slices)?;
+        validate_msaa(self.samples)?;
+        validate_sample_culling(self.depth_mask, self.cell_box, self.depth_bounds)?;
+        validate_zbin_culling(self.strategy, self.depth_mask, self.cell_box)?;
+        if self.max_lights == 0 {
+            return Err(crate::error::Error::invalid(
+                "max_lights",
+                "must be at least 1",
+            ));
+        }
+        if self.index_capacity == 0 {
+            return Err(crate::error::Error::invalid(
+                "index_capacity",
+                "must be at least 1",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The same grid as tiles (one slice).
+    pub fn tiled(self) -> Self {
+        CullConfig { slices: 1, ..self }
+    }
 }
 
 fn default_shadow_map_size() -> u32 {
@@ -259,19 +346,10 @@ pub use crate::scene::{Brdf, Shadows, SpotCull};
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
-            tile_size: crate::consts::DEFAULT_TILE_SIZE,
+            grid: CullConfig::default(),
             gbuffer: GBufferFormat::F16,
-            slices: crate::consts::DEFAULT_SLICES,
-            assign: Assign::default(),
-            spot_cull: SpotCull::default(),
-            lists: GridLists::Separate,
             material_draws: MaterialDraws::PerMaterial,
-            msaa: 1,
             msaa_resolve: MsaaResolve::Separate,
-            depth_bounds: DepthBounds::Both,
-            depth_reduction: DepthReduction::Atomics,
-            depth_mask: DepthMask::Off,
-            cell_box: CellBox::Off,
             light_loop: LightLoop::Lane,
             brdf: None,
             shadows: Shadows::Off,
@@ -286,20 +364,16 @@ impl RenderSettings {
     /// Refuse settings no renderer can use, with the accepted range (`--slices 0` would
     /// otherwise silently build a tiled grid for the clustered pipelines).
     pub fn validate(&self) -> crate::error::Result<()> {
-        validate_tile_size(self.tile_size)?;
-        if self.lists == GridLists::Opaque {
+        self.grid.validate()?;
+        if self.grid.lists == GridLists::Opaque {
             return Err(crate::error::Error::invalid(
                 "lists",
                 "frames with transparent objects need transparent lists: separate or shared",
             ));
         }
-        validate_msaa(self.msaa)?;
-        validate_sample_culling(self.depth_mask, self.cell_box, self.depth_bounds)?;
-        validate_zbin_culling(self.assign, self.depth_mask, self.cell_box)?;
         validate_shadow_lights(self.shadow_lights)?;
         validate_shadow_atlas(self.shadow_atlas)?;
-        validate_shadow_map_size(self.shadow_map_size)?;
-        validate_slices(self.slices)
+        validate_shadow_map_size(self.shadow_map_size)
     }
 }
 
@@ -551,5 +625,67 @@ impl GridLists {
             GridLists::Shared => GRID_LISTS_SHARED,
             GridLists::Separate => GRID_LISTS_SEPARATE,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The records (the benchmark's results.json, the viewer's scripts) keep one flat object
+    /// per run: the grid's description is flattened into it under the settings' own names,
+    /// and the culler's limits are not records at all.
+    #[test]
+    fn the_grid_description_is_recorded_flat_under_the_settings_names() {
+        let s = RenderSettings {
+            grid: CullConfig {
+                tile_size: 8,
+                strategy: Assign::ZBin,
+                samples: 4,
+                max_lights: 7,
+                ..CullConfig::default()
+            },
+            ..RenderSettings::default()
+        };
+        let json = serde_json::to_value(s).unwrap();
+        let object = json.as_object().unwrap();
+        for key in [
+            "tile_size",
+            "slices",
+            "assign",
+            "spot_cull",
+            "lists",
+            "msaa",
+            "depth_bounds",
+            "depth_reduction",
+            "depth_mask",
+            "cell_box",
+            "gbuffer",
+        ] {
+            assert!(object.contains_key(key), "{key} missing: {json}");
+        }
+        assert!(!object.contains_key("grid") && !object.contains_key("max_lights"));
+        assert_eq!(json["assign"], "zbin");
+        assert_eq!(json["msaa"], 4);
+        // Read back: the limits come back as their defaults, everything else as written.
+        let back: RenderSettings = serde_json::from_value(json).unwrap();
+        assert_eq!(back.grid.max_lights, CullConfig::default().max_lights);
+        assert_eq!(
+            back,
+            RenderSettings {
+                grid: CullConfig {
+                    max_lights: CullConfig::default().max_lights,
+                    ..s.grid
+                },
+                ..s
+            }
+        );
+        // A record written before 2.5D culling and tight cells existed.
+        let mut old = serde_json::to_value(RenderSettings::default()).unwrap();
+        let o = old.as_object_mut().unwrap();
+        o.remove("depth_mask");
+        o.remove("cell_box");
+        let back: RenderSettings = serde_json::from_value(old).unwrap();
+        assert_eq!(back, RenderSettings::default());
     }
 }

@@ -8,6 +8,7 @@
 //! [`PIPELINES`]: super::PIPELINES
 
 use super::PipelineInfo;
+use crate::frame::CullConfig;
 use crate::frame::{
     Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
     LightLoop, MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull,
@@ -310,10 +311,10 @@ pub const AXES: &[Axis] = &[
         help: "view-depth slices of clustered pipelines (exponential spacing, 1 to 256)",
         values: Vec::new,
         applies: |p, _| p.clustered,
-        get: |s| s.slices.to_string(),
+        get: |s| s.grid.slices.to_string(),
         set: |s, v| {
-            s.slices = number(v)?;
-            crate::frame::validate_slices(s.slices).map_err(|e| e.to_string())
+            s.grid.slices = number(v)?;
+            crate::frame::validate_slices(s.grid.slices).map_err(|e| e.to_string())
         },
         label: |v| format!("{v} slices"),
     },
@@ -336,9 +337,9 @@ pub const AXES: &[Axis] = &[
         help: "who builds the light grid of grid pipelines (not tiled_deferred_single, which culls inside its kernel)",
         values: values::<Assign>,
         applies: |p, _| p.assign,
-        get: |s| s.assign.name().to_string(),
+        get: |s| s.grid.strategy.name().to_string(),
         set: |s, v| {
-            s.assign = Assign::parse(v)?;
+            s.grid.strategy = Assign::parse(v)?;
             Ok(())
         },
         label: |v| v.to_string(),
@@ -349,9 +350,9 @@ pub const AXES: &[Axis] = &[
         help: "what grid pipelines cull spot lights by",
         values: values::<SpotCull>,
         applies: |p, _| p.uses_grid,
-        get: |s| s.spot_cull.name().to_string(),
+        get: |s| s.grid.spot_cull.name().to_string(),
         set: |s, v| {
-            s.spot_cull = SpotCull::parse(v)?;
+            s.grid.spot_cull = SpotCull::parse(v)?;
             Ok(())
         },
         label: |v| v.to_string(),
@@ -362,9 +363,9 @@ pub const AXES: &[Axis] = &[
         help: "the light lists of grid pipelines with an --assign grid, for frames with transparent objects",
         values: values::<GridLists>,
         applies: |p, _| p.assign,
-        get: |s| SettingValue::name(s.lists).to_string(),
+        get: |s| SettingValue::name(s.grid.lists).to_string(),
         set: |s, v| {
-            s.lists = GridLists::parse(v)?;
+            s.grid.lists = GridLists::parse(v)?;
             Ok(())
         },
         label: |v| format!("{v} lists"),
@@ -388,10 +389,10 @@ pub const AXES: &[Axis] = &[
         help: "MSAA samples per pixel: 1 (off) or a count the adapter supports for every target (lavapipe: 4; real GPUs also 2 and 8)",
         values: Vec::new,
         applies: |p, _| p.msaa == super::Msaa::Supported,
-        get: |s| s.msaa.to_string(),
+        get: |s| s.grid.samples.to_string(),
         set: |s, v| {
-            s.msaa = number(v)?;
-            crate::frame::validate_msaa(s.msaa).map_err(|e| e.to_string())
+            s.grid.samples = number(v)?;
+            crate::frame::validate_msaa(s.grid.samples).map_err(|e| e.to_string())
         },
         label: |v| format!("{v}x msaa"),
     },
@@ -400,7 +401,7 @@ pub const AXES: &[Axis] = &[
         column: "msaa_resolve",
         help: "where tiled and clustered deferred and tiled_deferred_single resolve MSAA (with --msaa above 1)",
         values: values::<MsaaResolve>,
-        applies: |p, s| p.kernel_resolve && s.msaa > 1,
+        applies: |p, s| p.kernel_resolve && s.grid.samples > 1,
         get: |s| s.msaa_resolve.name().to_string(),
         set: |s, v| {
             s.msaa_resolve = MsaaResolve::parse(v)?;
@@ -414,9 +415,9 @@ pub const AXES: &[Axis] = &[
         help: "which cell depth bounds grids built from the depth buffer cull lights by (tiled-forward-shading §4.4)",
         values: values::<DepthBounds>,
         applies: |p, _| p.depth_bounds,
-        get: |s| s.depth_bounds.name().to_string(),
+        get: |s| s.grid.depth_bounds.name().to_string(),
         set: |s, v| {
-            s.depth_bounds = DepthBounds::parse(v)?;
+            s.grid.depth_bounds = DepthBounds::parse(v)?;
             Ok(())
         },
         label: |v| format!("bounds {v}"),
@@ -427,9 +428,9 @@ pub const AXES: &[Axis] = &[
         help: "how the cell-bounds kernel of tiled grids built from depth reduces a tile's samples (clustered grids always use atomics)",
         values: values::<DepthReduction>,
         applies: |p, _| reduces_tile_depth(p),
-        get: |s| s.depth_reduction.name().to_string(),
+        get: |s| s.grid.depth_reduction.name().to_string(),
         set: |s, v| {
-            s.depth_reduction = DepthReduction::parse(v)?;
+            s.grid.depth_reduction = DepthReduction::parse(v)?;
             Ok(())
         },
         label: |v| format!("{v} reduction"),
@@ -439,10 +440,10 @@ pub const AXES: &[Axis] = &[
         column: "depth_mask",
         help: "2.5D culling of the grids --assign builds from the depth buffer (needs --depth-bounds both)",
         values: values::<DepthMask>,
-        applies: |p, s| p.depth_bounds && p.assign && s.assign != Assign::ZBin,
-        get: |s| s.depth_mask.name().to_string(),
+        applies: |p, s| p.depth_bounds && p.assign && s.grid.strategy != Assign::ZBin,
+        get: |s| s.grid.depth_mask.name().to_string(),
         set: |s, v| {
-            s.depth_mask = DepthMask::parse(v)?;
+            s.grid.depth_mask = DepthMask::parse(v)?;
             Ok(())
         },
         label: |v| format!("mask {v}"),
@@ -452,10 +453,10 @@ pub const AXES: &[Axis] = &[
         column: "cell_box",
         help: "tight cells of the grids --assign builds from the depth buffer: each cell's samples' view-space box (needs --depth-bounds both)",
         values: values::<CellBox>,
-        applies: |p, s| p.depth_bounds && p.assign && s.assign != Assign::ZBin,
-        get: |s| s.cell_box.name().to_string(),
+        applies: |p, s| p.depth_bounds && p.assign && s.grid.strategy != Assign::ZBin,
+        get: |s| s.grid.cell_box.name().to_string(),
         set: |s, v| {
-            s.cell_box = CellBox::parse(v)?;
+            s.grid.cell_box = CellBox::parse(v)?;
             Ok(())
         },
         label: |v| format!("box {v}"),
@@ -571,7 +572,10 @@ pub fn check_axes_apply(
                 (
                     "--msaa 4",
                     RenderSettings {
-                        msaa: 4,
+                        grid: CullConfig {
+                            samples: 4,
+                            ..settings.grid
+                        },
                         ..*settings
                     },
                 ),
@@ -684,7 +688,13 @@ mod tests {
         assert!(!(reduction.applies)(find("clustered_forward"), &s));
         assert!(!(reduction.applies)(find("clustered_deferred"), &s));
         let resolve = find_axis("msaa-resolve").unwrap();
-        let msaa = RenderSettings { msaa: 4, ..s };
+        let msaa = RenderSettings {
+            grid: CullConfig {
+                samples: 4,
+                ..s.grid
+            },
+            ..s
+        };
         let takers = resolve.takers(&msaa);
         assert_eq!(
             takers,

@@ -134,7 +134,7 @@ enum Cull {
 fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn Technique> {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let samples = ctx.settings.msaa;
+    let samples = ctx.settings.grid.samples;
     let gbuffer = GBuffer::new(
         device,
         ctx.scene_layout,

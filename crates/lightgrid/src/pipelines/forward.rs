@@ -45,10 +45,10 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
             module: &module,
             fragment_entry: Some(fragment_entry),
             layouts: &[Some(ctx.scene_layout)],
-            color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
+            color_targets: &lighting_targets(ctx.count_blend, ctx.settings.grid.samples),
             depth_write: true,
             depth_compare: crate::depth::SURFACE,
-            samples: ctx.settings.msaa,
+            samples: ctx.settings.grid.samples,
         },
         ctx.settings.material_draws,
     );

@@ -232,7 +232,7 @@ impl TiledMsaa {
     ) -> (wgpu::BindGroupLayout, Self) {
         use crate::gpu::{bind_resources, buffer_entry, STORAGE_READ, STORAGE_RW};
         let device = ctx.device;
-        let (w, h, samples) = (ctx.dims.width, ctx.dims.height, ctx.settings.msaa);
+        let (w, h, samples) = (ctx.dims.width, ctx.dims.height, ctx.settings.grid.samples);
         let buffer = crate::gpu::storage_buffer(
             device,
             "msaa sample irradiance",
@@ -363,7 +363,7 @@ fn volume_irradiance(
 ) -> Irradiance {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let samples = ctx.settings.msaa;
+    let samples = ctx.settings.grid.samples;
     let volumes = Box::new(LightVolumes::new(device, w, h, samples));
     let irr_targets = [
         Some(additive(TARGET_FORMAT)),
@@ -435,12 +435,8 @@ fn tiled_irradiance(
     module: &wgpu::ShaderModule,
     attr_layout: &wgpu::BindGroupLayout,
 ) -> Irradiance {
-    let setup = crate::culling::GridSetup {
-        forward_opaque: false,
-        ..ctx.grid_setup()
-    };
-    let builder = LightCuller::for_renderer(&setup, 1, CellSource::Depth);
-    let samples = ctx.settings.msaa;
+    let builder = ctx.culler(&ctx.settings.grid.tiled(), CellSource::Depth, false);
+    let samples = ctx.settings.grid.samples;
     let (outputs_layout, msaa) = if samples > 1 {
         let (layout, msaa) = TiledMsaa::new(ctx, module, attr_layout);
         (layout, Some(Box::new(msaa)))
@@ -487,7 +483,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let mono = mode != Mode::Full;
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
-    let samples = ctx.settings.msaa;
+    let samples = ctx.settings.grid.samples;
     // The volume variants shade one light at a time and re-use one light's shadow maps.
     let shading = match mode {
         Mode::Tiled => ctx.shading,
@@ -922,7 +918,7 @@ pub(super) fn memory_tiled(settings: &RenderSettings) -> MemoryModel {
         ("irradiance (diffuse, mono specular)", TARGET_BYTES),
         ("hdr", HDR_BYTES),
     ];
-    if settings.msaa > 1 {
+    if settings.grid.samples > 1 {
         targets.extend([
             ("msaa sample irradiance", TARGET_BYTES),
             ("volume depth-stencil", VOLUME_DEPTH_BYTES),

@@ -10,7 +10,7 @@ mod tiled_deferred;
 mod tiled_forward;
 mod transparent;
 
-use crate::culling::{GridDims, GridSetup, LightCuller};
+use crate::culling::{CellSource, CullConfig, GridDims, GridUse, LightCuller};
 use crate::error::Error;
 use crate::error::Result;
 use crate::memory::MemoryModel;
@@ -41,24 +41,26 @@ pub struct PipelineContext<'a> {
 }
 
 impl PipelineContext<'_> {
-    /// What a grid pipeline's [`LightCuller`] is created from.
-    pub fn grid_setup(&self) -> GridSetup<'_> {
-        GridSetup {
-            device: self.device,
-            cull_layout: self.cull_layout,
-            scene_layout: Some(self.scene_layout),
-            tiles: self.dims,
-            assign: self.settings.assign,
-            software_adapter: self.software_adapter,
-            lists: self.settings.lists,
-            samples: self.settings.msaa,
-            forward_opaque: true,
-            depth_bounds: self.settings.depth_bounds,
-            depth_reduction: self.settings.depth_reduction,
-            depth_mask: self.settings.depth_mask,
-            cell_box: self.settings.cell_box,
-            index_capacity: u64::from(crate::culling::GridBuffers::INITIAL_INDEX_CAPACITY),
-        }
+    /// A grid pipeline's [`LightCuller`] for the grid `config` describes (the settings' own,
+    /// [`RenderSettings::grid`], or a variant of it), over the frame's tiles.
+    pub fn culler(
+        &self,
+        config: &CullConfig,
+        source: CellSource,
+        forward_opaque: bool,
+    ) -> LightCuller {
+        LightCuller::for_renderer(
+            self.device,
+            self.cull_layout,
+            self.scene_layout,
+            config,
+            self.dims,
+            GridUse {
+                source,
+                forward_opaque,
+                software_adapter: self.software_adapter,
+            },
+        )
     }
 }
 
@@ -156,7 +158,7 @@ pub struct PipelineInfo {
 impl PipelineInfo {
     /// The render targets and traffic model with `settings` (per sample with MSAA).
     pub fn memory_model(&self, settings: &RenderSettings) -> MemoryModel {
-        (self.memory)(settings).multisampled(settings.msaa)
+        (self.memory)(settings).multisampled(settings.grid.samples)
     }
 
     /// Whether the pipeline has a G-buffer (its memory depends on `--gbuffer`).

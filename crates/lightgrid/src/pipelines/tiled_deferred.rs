@@ -21,6 +21,7 @@ use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
 use crate::culling::{CellSource, GridDims, LightCuller};
 use crate::error::Result;
+use crate::frame::CullConfig;
 use crate::frame::MsaaResolve;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::passes::{
@@ -349,12 +350,12 @@ pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
 }
 
 pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
-    create_grid(ctx, ctx.settings.slices, "clustered deferred shading")
+    create_grid(ctx, ctx.settings.grid.slices, "clustered deferred shading")
 }
 
 fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let samples = ctx.settings.msaa;
+    let samples = ctx.settings.grid.samples;
     let gbuffer = GBuffer::new(
         ctx.device,
         ctx.scene_layout,
@@ -364,11 +365,14 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         samples,
         ctx.shading,
     );
-    let setup = crate::culling::GridSetup {
-        forward_opaque: false,
-        ..ctx.grid_setup()
-    };
-    let builder = LightCuller::for_renderer(&setup, slices, CellSource::Depth);
+    let builder = ctx.culler(
+        &CullConfig {
+            slices,
+            ..ctx.settings.grid
+        },
+        CellSource::Depth,
+        false,
+    );
     let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let layouts = [
         Some(ctx.scene_layout),
@@ -414,7 +418,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
 
 pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
-    let samples = ctx.settings.msaa;
+    let samples = ctx.settings.grid.samples;
     let gbuffer = GBuffer::new(
         ctx.device,
         ctx.scene_layout,
@@ -594,7 +598,7 @@ pub(super) fn memory_multi(settings: &RenderSettings) -> MemoryModel {
         ("gbuffer (4 targets)", 4 * g),
         ("hdr", HDR_BYTES),
     ];
-    if settings.msaa > 1 {
+    if settings.grid.samples > 1 {
         targets.push(("msaa sample colours", HDR_BYTES));
     }
     MemoryModel::new(

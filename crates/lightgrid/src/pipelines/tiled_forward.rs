@@ -54,19 +54,17 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
         &shader(ctx.settings.light_loop).specialized(ctx.shading),
     );
     let prepass = kind != Kind::Plain;
-    let builder = LightCuller::for_renderer(
-        &ctx.grid_setup(),
-        if kind == Kind::Clustered {
-            ctx.settings.slices
-        } else {
-            1
-        },
-        if prepass {
-            CellSource::Depth
-        } else {
-            CellSource::NearFar
-        },
-    );
+    let grid = if kind == Kind::Clustered {
+        ctx.settings.grid
+    } else {
+        ctx.settings.grid.tiled()
+    };
+    let source = if prepass {
+        CellSource::Depth
+    } else {
+        CellSource::NearFar
+    };
+    let builder = ctx.culler(&grid, source, true);
     let shading = MaterialPipelines::new(
         ctx.device,
         &GeometryPipelineDesc {
@@ -74,10 +72,10 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             module: &module,
             fragment_entry: Some("fs_main"),
             layouts: &[Some(ctx.scene_layout), Some(builder.bind_group_layout())],
-            color_targets: &lighting_targets(ctx.count_blend, ctx.settings.msaa),
+            color_targets: &lighting_targets(ctx.count_blend, ctx.settings.grid.samples),
             depth_write: !prepass,
             depth_compare: crate::depth::SURFACE,
-            samples: ctx.settings.msaa,
+            samples: ctx.settings.grid.samples,
         },
         ctx.settings.material_draws,
     );
@@ -92,7 +90,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
                 color_targets: &[],
                 depth_write: true,
                 depth_compare: crate::depth::SURFACE,
-                samples: ctx.settings.msaa,
+                samples: ctx.settings.grid.samples,
             },
         )
     });

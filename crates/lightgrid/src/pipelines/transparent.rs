@@ -15,6 +15,7 @@ use crate::culling::{CellSource, GridBuffers, GridLists, LightCuller};
 use crate::error::Result;
 use crate::frame::targets::counts_in_target;
 use crate::frame::Assign;
+use crate::frame::CullConfig;
 use crate::gpu::CounterValues;
 use crate::passes::geometry::{draw_transparent, MaterialPipelines};
 use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
@@ -76,23 +77,23 @@ impl TransparentPass {
         );
         // A GPU strategy (gather), so the frame still makes one submission and no readback,
         // over the opaque depth; one list per tile covering near..max.
-        let own_grid = LightCuller::for_renderer(
-            &crate::culling::GridSetup {
-                assign: Assign::Gather,
+        // Not the technique's grid: `--depth-bounds`, `--depth-mask` and `--cell-box` are
+        // about that one.
+        let own_grid = ctx.culler(
+            &CullConfig {
+                strategy: Assign::Gather,
                 lists: GridLists::Shared,
-                forward_opaque: false,
-                // Not the technique's grid: `--depth-bounds` is about that one.
                 depth_bounds: crate::frame::DepthBounds::Both,
                 depth_reduction: crate::frame::DepthReduction::Atomics,
                 depth_mask: crate::frame::DepthMask::Off,
                 cell_box: crate::frame::CellBox::Off,
-                ..ctx.grid_setup()
+                ..ctx.settings.grid.tiled()
             },
-            1,
             CellSource::Depth,
+            false,
         );
         let grid_layout = GridBuffers::layout(ctx.device);
-        let targets = blended_targets(counts_in_target(ctx.count_blend, ctx.settings.msaa));
+        let targets = blended_targets(counts_in_target(ctx.count_blend, ctx.settings.grid.samples));
         let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
             MaterialPipelines::new(
                 ctx.device,
@@ -104,7 +105,7 @@ impl TransparentPass {
                     color_targets: &targets,
                     depth_write: false,
                     depth_compare: crate::depth::NEARER,
-                    samples: ctx.settings.msaa,
+                    samples: ctx.settings.grid.samples,
                 },
                 ctx.settings.material_draws,
             )

@@ -17,12 +17,11 @@
 //! from [`LightCuller::poll`], and the lists grow from them.
 
 use crate::consts::POINT_LIGHT_COS;
-use crate::culling::builder::{GridBuilder, GridSetup};
+use crate::culling::builder::{GridBuilder, GridUse};
 use crate::culling::frame::{bind_cull_group, cull_layout, CellSource, CullFrame};
 use crate::culling::grid::GridDims;
-use crate::frame::{
-    Assign, CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder, GridLists, SpotCull,
-};
+use crate::culling::strategies::registry::{find_strategy, STRATEGIES};
+use crate::frame::{CullConfig, FrameEncoder, SpotCull};
 use crate::gpu::{
     buffer_entry, groups_1d, grow_storage, storage_buffer, FrameCounters, FrameTag, PassTimer,
     STORAGE_READ, STORAGE_RW, UNIFORM,
@@ -90,110 +89,6 @@ impl CullLight {
             payload,
             direction,
             cos_outer,
-        }
-    }
-}
-
-/// The cells of the grid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CullGrid {
-    /// Screen tiles of `tile_size` × `tile_size` pixels (4 to 64), each bounded by its
-    /// samples' depth range (tiled shading).
-    Tiles {
-        /// Tile edge in pixels.
-        tile_size: u32,
-    },
-    /// Tiles cut into `slices` depth slices (2 to 256), spread exponentially over the frame's
-    /// samples' depth range (clustered shading).
-    Clusters {
-        /// Tile edge in pixels.
-        tile_size: u32,
-        /// Depth slices per tile.
-        slices: u32,
-    },
-}
-
-/// How lights are assigned to cells (all on the GPU).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum CullStrategy {
-    /// One workgroup per occupied cell tests every light (forward-plus §4).
-    Gather,
-    /// One thread per light emits (cell, light) pairs, radix-sorted by cell.
-    Scatter,
-    /// A light BVH built on the GPU each frame, walked per occupied cell
-    /// (tiled-forward-shading §4.4).
-    BvhGpu,
-    /// Z-binning (Drobot 2017): lights sorted by view depth, per depth bin (the clusters'
-    /// slices; one bin for tiles) the range of sorted lights meeting it, per tile a bit mask
-    /// of the lights reaching it. Read it with `light_grid_walk` / `light_grid_next`; not
-    /// with [`CullConfig::depth_mask`] or [`CullConfig::cell_box`].
-    ZBin,
-    /// `Gather` up to 8192 lights, `BvhGpu` above.
-    #[default]
-    Auto,
-}
-
-impl CullStrategy {
-    /// The strategies `Auto` chooses between and the one it does not, each by name.
-    pub const ALL: [CullStrategy; 4] = [
-        CullStrategy::Gather,
-        CullStrategy::Scatter,
-        CullStrategy::BvhGpu,
-        CullStrategy::ZBin,
-    ];
-
-    fn assign(self) -> Assign {
-        match self {
-            CullStrategy::Gather => Assign::Gather,
-            CullStrategy::Scatter => Assign::Scatter,
-            CullStrategy::BvhGpu => Assign::BvhGpu,
-            CullStrategy::ZBin => Assign::ZBin,
-            CullStrategy::Auto => Assign::Auto,
-        }
-    }
-}
-
-/// What a [`LightCuller`] builds.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CullConfig {
-    /// Tiles or clusters.
-    pub grid: CullGrid,
-    /// How lights are assigned to cells.
-    pub strategy: CullStrategy,
-    /// Which side of each cell's depth range culls lights ([`DepthBounds::Both`]: a light
-    /// must reach between the cell's nearest and farthest sample).
-    pub depth_bounds: DepthBounds,
-    /// Samples per pixel of the caller's depth texture (1, or its MSAA count). With MSAA the
-    /// bounds cover every sample.
-    pub samples: u32,
-    /// The most lights one frame may have; more is an error of [`LightCuller::encode`].
-    pub max_lights: u32,
-    /// Index entries the lists start with; they grow from the frames' reports.
-    pub index_capacity: u32,
-    /// Spot lights culled by their cone as well as their bounding sphere.
-    pub spot_cull: SpotCull,
-    /// 2.5D culling ([`DepthMask::On`]): each cell also keeps a mask of which of 32 bins of
-    /// its depth bounds hold samples; needs [`DepthBounds::Both`].
-    pub depth_mask: DepthMask,
-    /// Tight cells ([`CellBox::On`]): each occupied cell also keeps the view-space box of its
-    /// samples, and lights are kept by the closest-point test against it; needs
-    /// [`DepthBounds::Both`].
-    pub cell_box: CellBox,
-}
-
-impl Default for CullConfig {
-    /// 16-pixel tiles, `Auto`, both depth bounds, no MSAA, up to 65,536 lights.
-    fn default() -> Self {
-        CullConfig {
-            grid: CullGrid::Tiles { tile_size: 16 },
-            strategy: CullStrategy::Auto,
-            depth_bounds: DepthBounds::Both,
-            samples: 1,
-            max_lights: 1 << 16,
-            index_capacity: crate::culling::grid::GridBuffers::INITIAL_INDEX_CAPACITY,
-            spot_cull: SpotCull::Cone,
-            depth_mask: DepthMask::Off,
-            cell_box: CellBox::Off,
         }
     }
 }
@@ -366,9 +261,10 @@ fn prefixed(text: &str) -> String {
 /// # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, depth: &wgpu::TextureView,
 /// #          lights: &wgpu::Buffer, view: glam::Mat4, proj: glam::Mat4)
 /// #          -> Result<(), lightgrid::CullError> {
-/// use lightgrid::{CullConfig, CullGrid, CullInputs, LightCuller};
+/// use lightgrid::{CullConfig, CullInputs, LightCuller};
 /// let mut culler = LightCuller::new(device, queue, CullConfig {
-///     grid: CullGrid::Clusters { tile_size: 16, slices: 24 },
+///     tile_size: 16,
+///     slices: 24,
 ///     ..CullConfig::default()
 /// })?;
 /// // The caller's shader: `LightCuller::wgsl(1)` declares the grid at group 1.
@@ -395,6 +291,8 @@ fn prefixed(text: &str) -> String {
 pub struct LightCuller {
     /// The stages every grid is built by (lightgrid's renderer's and a caller's).
     core: GridBuilder,
+    /// What the grid is.
+    config: CullConfig,
     /// A caller's culler: what turns its inputs into the culling kernels' group 0. `None` in
     /// lightgrid's renderer, whose frames bring their own ([`CullFrame::of`]).
     caller: Option<Box<Caller>>,
@@ -404,7 +302,6 @@ pub struct LightCuller {
 struct Caller {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    config: CullConfig,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     /// The camera-relative copy of the caller's lights and their bounding spheres.
@@ -451,37 +348,21 @@ impl LightCuller {
             input: CullInput::Config,
             message: e.to_string(),
         };
-        let (tile_size, slices) = match config.grid {
-            CullGrid::Tiles { tile_size } => (tile_size, 1),
-            CullGrid::Clusters { tile_size, slices } => {
-                if slices < 2 {
-                    return refuse(
-                        CullInput::Config,
-                        format!(
-                            "clusters need at least 2 slices, not {slices} (use CullGrid::Tiles)"
-                        ),
-                    );
-                }
-                (tile_size, slices)
-            }
-        };
-        crate::frame::validate_tile_size(tile_size).map_err(config_error)?;
-        crate::frame::validate_slices(slices).map_err(config_error)?;
-        crate::frame::validate_msaa(config.samples).map_err(config_error)?;
-        crate::frame::validate_sample_culling(
-            config.depth_mask,
-            config.cell_box,
-            config.depth_bounds,
-        )
-        .map_err(config_error)?;
-        crate::frame::validate_zbin_culling(
-            config.strategy.assign(),
-            config.depth_mask,
-            config.cell_box,
-        )
-        .map_err(config_error)?;
-        if config.max_lights == 0 {
-            return refuse(CullInput::Config, "max_lights must be at least 1");
+        config.validate().map_err(config_error)?;
+        if let Some(info) = find_strategy(config.strategy).filter(|s| s.cpu_lights) {
+            return refuse(
+                CullInput::Config,
+                format!(
+                    "strategy {} assigns on the CPU and needs the lights there; LightCuller reads them on the GPU only (auto, {})",
+                    info.name,
+                    STRATEGIES
+                        .iter()
+                        .filter(|s| !s.cpu_lights)
+                        .map(|s| s.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            );
         }
         let max_bytes = u64::from(config.max_lights) * std::mem::size_of::<GpuLight>() as u64;
         let limits = device.limits();
@@ -498,11 +379,9 @@ impl LightCuller {
                 ),
             );
         }
-        if config.index_capacity == 0 {
-            return refuse(CullInput::Config, "index_capacity must be at least 1");
-        }
         let layout = cull_layout(device);
-        let tiles = GridDims::new(tile_size, tile_size, tile_size).map_err(config_error)?;
+        let tiles = GridDims::new(config.tile_size, config.tile_size, config.tile_size)
+            .map_err(config_error)?;
         let need = STORAGE_BUFFERS_PER_STAGE;
         let have = device.limits().max_storage_buffers_per_shader_stage;
         if have < need {
@@ -515,25 +394,17 @@ impl LightCuller {
         }
         let mut core = crate::gpu::scoped(device, "creating the light culler", || {
             GridBuilder::new(
-                &GridSetup {
-                    device,
-                    cull_layout: &layout,
-                    scene_layout: None,
-                    tiles,
-                    assign: config.strategy.assign(),
+                device,
+                &layout,
+                None,
+                &config,
+                tiles,
+                GridUse {
+                    source: CellSource::Depth,
+                    forward_opaque: false,
                     // `Auto` stays on the GPU (`cpu` needs the lights on the CPU).
                     software_adapter: false,
-                    lists: GridLists::Opaque,
-                    samples: config.samples,
-                    forward_opaque: false,
-                    depth_bounds: config.depth_bounds,
-                    depth_reduction: DepthReduction::Atomics,
-                    depth_mask: config.depth_mask,
-                    cell_box: config.cell_box,
-                    index_capacity: u64::from(config.index_capacity),
                 },
-                slices,
-                CellSource::Depth,
             )
         })?;
         core.prepare(device)?;
@@ -570,10 +441,10 @@ impl LightCuller {
         );
         Ok(LightCuller {
             core,
+            config,
             caller: Some(Box::new(Caller {
                 device: device.clone(),
                 queue: queue.clone(),
-                config,
                 layout,
                 uniforms,
                 lights,
@@ -588,11 +459,28 @@ impl LightCuller {
         })
     }
 
-    /// lightgrid's renderer's culler: its frames bring the culling kernels' group 0 and the
-    /// depth ([`CullFrame::of`]), and `setup` says the rest (`--assign` may be `cpu`).
-    pub(crate) fn for_renderer(setup: &GridSetup, slices: u32, source: CellSource) -> Self {
+    /// lightgrid's renderer's culler for the grid `config` describes: its frames bring the
+    /// culling kernels' group 0 (over `cull_layout`) and the depth ([`CullFrame::of`]),
+    /// `usage` says the rest (`--assign` may be `cpu`). The one way in besides
+    /// [`Self::new`], until the renderer's frames go through [`Self::encode`].
+    pub(crate) fn for_renderer(
+        device: &wgpu::Device,
+        cull_layout: &wgpu::BindGroupLayout,
+        scene_layout: &wgpu::BindGroupLayout,
+        config: &CullConfig,
+        tiles: GridDims,
+        usage: GridUse,
+    ) -> Self {
         LightCuller {
-            core: GridBuilder::new(setup, slices, source),
+            core: GridBuilder::new(
+                device,
+                cull_layout,
+                Some(scene_layout),
+                config,
+                tiles,
+                usage,
+            ),
+            config: *config,
             caller: None,
         }
     }
@@ -657,7 +545,7 @@ impl LightCuller {
     /// - `light_grid_walk(cell: u32) -> LightGridWalk` and
     ///   `light_grid_next(walk: ptr<function, LightGridWalk>) -> bool`: the cell's lights one
     ///   at a time (`walk.light`, the index in the caller's light buffer), whatever the
-    ///   strategy built (lists, or [`CullStrategy::ZBin`]'s bins and masks);
+    ///   strategy built (lists, or `Assign::ZBin`'s bins and masks);
     /// - `light_grid_count(cell: u32) -> u32`: how many lights the cell has;
     /// - `light_grid_light(cell: u32, i: u32) -> u32`: the index, in the caller's light
     ///   buffer, of the cell's `i`-th light (a scan of the mask words on z-bins).
@@ -686,9 +574,9 @@ impl LightCuller {
         self.core.bind_group()
     }
 
-    /// The configuration the culler was made with (`None`: lightgrid's renderer's).
-    pub fn config(&self) -> Option<&CullConfig> {
-        self.caller.as_ref().map(|c| &c.config)
+    /// The description of the grid the culler builds.
+    pub fn config(&self) -> &CullConfig {
+        &self.config
     }
 
     /// Record one frame's culling into `encoder` after the caller's depth pre-pass. The
@@ -706,11 +594,9 @@ impl LightCuller {
                 "lightgrid's renderer's culler takes its frames from the renderer",
             );
         };
-        let camera = c.check(inputs)?;
+        let camera = c.check(inputs, &self.config)?;
         let (width, height) = (inputs.viewport[0], inputs.viewport[1]);
-        let tile_size = match c.config.grid {
-            CullGrid::Tiles { tile_size } | CullGrid::Clusters { tile_size, .. } => tile_size,
-        };
+        let tile_size = self.config.tile_size;
         core.set_tiles(
             GridDims::new(width, height, tile_size).map_err(|e| CullError {
                 input: CullInput::Viewport,
@@ -737,7 +623,7 @@ impl LightCuller {
                 [&c.uniforms, &c.lights, c.counters.buffer(), &c.bounds],
             );
         }
-        let uniforms = camera.uniforms(inputs, c.config.spot_cull);
+        let uniforms = camera.uniforms(inputs, self.config.spot_cull);
         c.queue
             .write_buffer(&c.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let depth_view = inputs
@@ -764,7 +650,7 @@ impl LightCuller {
         c.timer.reset();
         c.frames += 1;
         let frame = c.frames;
-        let setup = camera.setup(inputs, c.config.spot_cull);
+        let setup = camera.setup(inputs, self.config.spot_cull);
         let result = crate::gpu::scoped(&c.device, "recording the light culler", || {
             c.counters.clear(encoder);
             {
@@ -841,7 +727,7 @@ impl LightCuller {
 
 impl Caller {
     /// Refuse inputs the kernels cannot honour, each error naming its input.
-    fn check(&self, i: &CullInputs) -> Result<Camera, CullError> {
+    fn check(&self, i: &CullInputs, config: &CullConfig) -> Result<Camera, CullError> {
         use CullInput as I;
         let texture = i.depth.texture();
         let format = texture.format();
@@ -852,13 +738,13 @@ impl Caller {
         {
             return refuse(I::Depth, "the depth texture must be 2D with one layer");
         }
-        if texture.sample_count() != self.config.samples {
+        if texture.sample_count() != config.samples {
             return refuse(
                 I::Depth,
                 format!(
                     "the depth texture has {} samples per pixel; the culler was configured for {}",
                     texture.sample_count(),
-                    self.config.samples
+                    config.samples
                 ),
             );
         }
@@ -882,12 +768,12 @@ impl Caller {
                 ),
             );
         }
-        if i.light_count > self.config.max_lights {
+        if i.light_count > config.max_lights {
             return refuse(
                 I::LightCount,
                 format!(
                     "{} lights, more than the configured max_lights {}",
-                    i.light_count, self.config.max_lights
+                    i.light_count, config.max_lights
                 ),
             );
         }

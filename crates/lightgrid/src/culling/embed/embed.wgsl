@@ -11,7 +11,7 @@
 //     }
 //
 // The walk reads whatever the strategy built: per-cell lists, or z-binning's sorted lights,
-// per-bin ranges and per-tile masks (`CullStrategy::ZBin`). `light_grid_count` and
+// per-bin ranges and per-tile masks (`Assign::ZBin`). `light_grid_count` and
 // `light_grid_light(cell, i)` index a cell's lights directly: constant time on lists, a
 // scan of the tile's mask words on z-bins.
 

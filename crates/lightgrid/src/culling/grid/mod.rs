@@ -315,7 +315,7 @@ pub struct GridBuffers {
 
 impl GridBuffers {
     /// Index entries a new grid's buffer holds; it grows (never shrinks) to fit.
-    pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 14;
+    pub const INITIAL_INDEX_CAPACITY: u32 = crate::consts::INITIAL_INDEX_CAPACITY;
 
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {

@@ -16,6 +16,9 @@ pub struct StrategyInfo {
     /// The frame waits for the GPU part-way (the cell bounds read back: the papers' CPU
     /// pipeline); the others record into the frame's one submission.
     pub reads_back: bool,
+    /// It assigns on the CPU, from the lights there (a [`crate::LightCuller`] has them on the
+    /// GPU only).
+    pub cpu_lights: bool,
     pub create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
 }
 
@@ -25,6 +28,7 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         assign: Assign::Cpu,
         name: "cpu",
         description: "CPU: projected sphere rectangles, per-cell depth test (rayon); grid uploaded",
+        cpu_lights: true,
         reads_back: true,
         create: crate::culling::strategies::assign_cpu::create_strategy,
     },
@@ -32,6 +36,7 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         assign: Assign::Gather,
         name: "gather",
         description: "GPU: one workgroup per occupied cell tests every light (forward-plus §4)",
+        cpu_lights: false,
         reads_back: false,
         create: crate::culling::strategies::gather::create_strategy,
     },
@@ -39,6 +44,7 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         assign: Assign::Scatter,
         name: "scatter",
         description: "GPU: one thread per light emits (cell, light) pairs, radix-sorted by cell (forward-plus §4)",
+        cpu_lights: false,
         reads_back: false,
         create: crate::culling::strategies::scatter::create_strategy,
     },
@@ -46,6 +52,7 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         assign: Assign::Bvh,
         name: "bvh",
         description: "light BVH built on the CPU each frame, walked per occupied cell on the GPU (tiled-forward-shading §4.4)",
+        cpu_lights: true,
         reads_back: false,
         create: crate::culling::strategies::bvh::create_strategy,
     },
@@ -53,6 +60,7 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         assign: Assign::BvhGpu,
         name: "bvh-gpu",
         description: "the same BVH built on the GPU (Morton codes, radix sort), walked the same way",
+        cpu_lights: false,
         reads_back: false,
         create: crate::culling::strategies::bvh_gpu::create_strategy,
     },
@@ -60,6 +68,7 @@ pub const STRATEGIES: &[StrategyInfo] = &[
         assign: Assign::ZBin,
         name: "zbin",
         description: "GPU z-binning (Drobot 2017): lights sorted by depth, per-slice index ranges, per-tile light bit masks",
+        cpu_lights: false,
         reads_back: false,
         create: crate::culling::strategies::zbin::create_strategy,
     },
