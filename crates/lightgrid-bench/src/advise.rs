@@ -22,11 +22,12 @@
 use crate::run::Progress;
 use lightgrid::frame::{Assign, CellBox, DepthMask, RenderSettings};
 use lightgrid::gpu::GpuContext;
-use lightgrid::pipelines::{self, Msaa, PipelineInfo, SettingValue, REFERENCE};
+use lightgrid::pipelines::{self, Axis, Msaa, PipelineInfo, SettingValue, REFERENCE};
 use lightgrid::realtime::{play, PlayPlan};
 use lightgrid::scene::Scene;
 use lightgrid::Renderer;
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
@@ -38,35 +39,53 @@ pub const REFINE_TOP: usize = 3;
 /// Frames each candidate plays (spread over the animation).
 pub const FRAMES: usize = 4;
 
+/// Rows of the settings table the refinement tries, in this order, at each of their values
+/// but the default (where the row applies to the pipeline and the settings validate): 2.5D
+/// culling, tight cells, then the other strategies.
+pub const REFINED: [&str; 3] = [DepthMask::FLAG, CellBox::FLAG, Assign::FLAG];
+
 /// One configuration to measure.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct Candidate {
     pub pipeline: &'static str,
     /// The tile edge (grid pipelines only).
     pub tile: Option<u32>,
-    /// The strategy, `auto` resolved (pipelines with an `--assign` grid only).
-    pub assign: Option<&'static str>,
-    /// 2.5D culling (`--depth-mask on`), tried by the refinement where the setting applies;
-    /// None: as given.
-    pub depth_mask: Option<DepthMask>,
-    /// Tight cells (`--cell-box on`), tried as the masks are; None: as given.
-    pub cell_box: Option<CellBox>,
+    /// Rows of the settings table (`AXES`) the candidate sets, by the row's results column
+    /// (`assign`, `depth_mask`, ...), each to a value of the row by name (the survey's `auto`
+    /// resolved); the other settings as given.
+    #[serde(flatten)]
+    pub settings: BTreeMap<&'static str, &'static str>,
 }
 
 impl Candidate {
+    /// The candidate with row `flag` set to `value`.
+    fn with(&self, flag: &str, value: &'static str) -> Candidate {
+        let axis = pipelines::find_axis(flag).expect("a row of the table");
+        let mut c = self.clone();
+        c.settings.insert(axis.column, value);
+        c
+    }
+
+    /// The value it sets row `flag` to, if it sets it.
+    pub fn setting(&self, flag: &str) -> Option<&'static str> {
+        let axis = pipelines::find_axis(flag)?;
+        self.settings.get(axis.column).copied()
+    }
+
+    /// Its settings as (row, value), in the table's order.
+    fn rows(&self) -> impl Iterator<Item = (&'static Axis, &'static str)> + '_ {
+        pipelines::AXES
+            .iter()
+            .filter_map(|a| Some((a, *self.settings.get(a.column)?)))
+    }
+
     pub fn label(&self) -> String {
         let mut s = self.pipeline.to_string();
         if let Some(t) = self.tile {
             s += &format!(" tile {t}");
         }
-        if let Some(a) = self.assign {
-            s += &format!(" assign {a}");
-        }
-        if let Some(m) = self.depth_mask {
-            s += &format!(" depth-mask {}", m.name());
-        }
-        if let Some(b) = self.cell_box {
-            s += &format!(" cell-box {}", b.name());
+        for (axis, value) in self.rows() {
+            s += &format!(" {} {value}", axis.flag);
         }
         s
     }
@@ -161,34 +180,40 @@ pub fn survey(assign_auto: &'static str) -> Vec<Candidate> {
     considered()
         .into_iter()
         .filter(|p| p.id != REFERENCE)
-        .map(|p| Candidate {
-            pipeline: p.id,
-            tile: p.uses_grid.then_some(lightgrid::consts::DEFAULT_TILE_SIZE),
-            assign: p.assign.then_some(assign_auto),
-            depth_mask: None,
-            cell_box: None,
+        .map(|p| {
+            let c = Candidate {
+                pipeline: p.id,
+                tile: p.uses_grid.then_some(lightgrid::consts::DEFAULT_TILE_SIZE),
+                settings: BTreeMap::new(),
+            };
+            let assign = pipelines::find_axis(Assign::FLAG).expect("a row");
+            if (assign.applies)(p, &RenderSettings::default()) {
+                c.with(Assign::FLAG, assign_auto)
+            } else {
+                c
+            }
         })
         .collect()
 }
 
 /// Step 3: brute force, the baseline.
-pub const REFERENCE_CANDIDATE: Candidate = Candidate {
-    pipeline: REFERENCE,
-    tile: None,
-    assign: None,
-    depth_mask: None,
-    cell_box: None,
-};
+pub fn reference_candidate() -> Candidate {
+    Candidate {
+        pipeline: REFERENCE,
+        tile: None,
+        settings: BTreeMap::new(),
+    }
+}
 
 /// Step 2: for the fastest `REFINE_TOP` grid pipelines measured so far, the other tiles at
-/// their strategy, then the other strategies, then 2.5D culling (`--depth-mask on`, where the
-/// settings table says it applies). Candidates already in `done` are left out.
+/// their settings, then every other value of each row of [`REFINED`] where the settings
+/// table says it applies. Candidates already in `done` are left out.
 pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
     let ranked = rank(done.to_vec());
     let top: Vec<Candidate> = ranked
         .iter()
         .filter(|m| m.frame_ms().is_some() && m.candidate.tile.is_some())
-        .map(|m| m.candidate)
+        .map(|m| m.candidate.clone())
         .fold(Vec::new(), |mut seen: Vec<Candidate>, c| {
             if !seen.iter().any(|s| s.pipeline == c.pipeline) {
                 seen.push(c);
@@ -209,69 +234,26 @@ pub fn refine(done: &[Measurement]) -> Vec<Candidate> {
             push(
                 Candidate {
                     tile: Some(t),
-                    ..*c
+                    ..c.clone()
                 },
                 &mut out,
             );
         }
     }
-    // Per-sample culling where the settings table says it applies: 2.5D masks, tight boxes.
-    let mask_axis = lightgrid::pipelines::find_axis(DepthMask::FLAG).expect("a row");
-    let box_axis = lightgrid::pipelines::find_axis(CellBox::FLAG).expect("a row");
-    for c in &top {
-        let settings = RenderSettings {
-            grid: lightgrid::CullConfig {
-                strategy: named_assign(c).unwrap_or_default(),
-                ..lightgrid::CullConfig::default()
-            },
-            ..Default::default()
-        };
-        if c.depth_mask.is_none() && (mask_axis.applies)(info(c), &settings) {
-            push(
-                Candidate {
-                    depth_mask: Some(DepthMask::On),
-                    ..*c
-                },
-                &mut out,
-            );
-        }
-        if c.cell_box.is_none() && (box_axis.applies)(info(c), &settings) {
-            push(
-                Candidate {
-                    cell_box: Some(CellBox::On),
-                    ..*c
-                },
-                &mut out,
-            );
-        }
-    }
-    for c in &top {
-        if c.assign.is_some() {
-            // z-binning builds no per-cell lists for masks or boxes to cut.
-            let culling = (
-                c.depth_mask.unwrap_or_default(),
-                c.cell_box.unwrap_or_default(),
-            );
-            for a in Assign::all().filter(|a| {
-                *a != Assign::Auto
-                    && lightgrid::frame::validate_zbin_culling(*a, culling.0, culling.1).is_ok()
-            }) {
-                push(
-                    Candidate {
-                        assign: Some(a.name()),
-                        ..*c
-                    },
-                    &mut out,
-                );
+    for flag in REFINED {
+        let axis = pipelines::find_axis(flag).expect("a row of the table");
+        let default = (axis.get)(&RenderSettings::default());
+        for c in &top {
+            for v in (axis.values)().into_iter().filter(|v| v.name != default) {
+                let next = c.with(flag, v.name);
+                let settings = settings_of(&RenderSettings::default(), &next);
+                if (axis.applies)(info(c), &settings) && settings.validate().is_ok() {
+                    push(next, &mut out);
+                }
             }
         }
     }
     out
-}
-
-/// The strategy a candidate names, if it names one.
-fn named_assign(c: &Candidate) -> Option<Assign> {
-    c.assign.and_then(|a| Assign::all().find(|x| x.name() == a))
 }
 
 /// Fastest first; measured before unmeasured (kept in the order tried); equal times by
@@ -296,14 +278,8 @@ pub fn options(c: &Candidate) -> String {
     if let Some(t) = c.tile {
         s += &format!(" --tile {t}");
     }
-    if let Some(a) = c.assign {
-        s += &format!(" --assign {a}");
-    }
-    if let Some(m) = c.depth_mask {
-        s += &format!(" --depth-mask {}", m.name());
-    }
-    if let Some(b) = c.cell_box {
-        s += &format!(" --cell-box {}", b.name());
+    for (axis, value) in c.rows() {
+        s += &format!(" {} {value}", axis.option());
     }
     s
 }
@@ -370,7 +346,7 @@ pub fn recommend(ranking: &[Measurement]) -> Option<Recommendation> {
         "does not render with MSAA (choose the best MSAA-capable row for that)".into()
     });
     Some(Recommendation {
-        candidate: best.candidate,
+        candidate: best.candidate.clone(),
         options: options(&best.candidate),
         reasons,
     })
@@ -417,7 +393,7 @@ pub fn advise(
                     queue = refine(&done);
                     total += queue.len() as u64;
                 }
-                1 => queue = vec![REFERENCE_CANDIDATE],
+                1 => queue = vec![reference_candidate()],
                 _ => break,
             }
             next_steps -= 1;
@@ -471,18 +447,16 @@ pub fn advise(
     })
 }
 
-fn settings_of(plan: &AdvisePlan, c: &Candidate) -> RenderSettings {
-    let base = plan.base.grid;
-    RenderSettings {
-        grid: lightgrid::CullConfig {
-            tile_size: c.tile.unwrap_or(base.tile_size),
-            strategy: named_assign(c).unwrap_or(base.strategy),
-            depth_mask: c.depth_mask.unwrap_or(base.depth_mask),
-            cell_box: c.cell_box.unwrap_or(base.cell_box),
-            ..base
-        },
-        ..plan.base
+/// `base` with what `c` sets: its tile, and its rows of the settings table.
+fn settings_of(base: &RenderSettings, c: &Candidate) -> RenderSettings {
+    let mut s = *base;
+    if let Some(t) = c.tile {
+        s.grid.tile_size = t;
     }
+    for (axis, value) in c.rows() {
+        (axis.set)(&mut s, value).expect("a value of the row");
+    }
+    s
 }
 
 fn info(c: &Candidate) -> &'static PipelineInfo {
@@ -492,17 +466,18 @@ fn info(c: &Candidate) -> &'static PipelineInfo {
 /// `c` ending in `outcome`, with what is known without rendering it: its render targets'
 /// bytes and whether it renders with MSAA (a measurement fills in the rest).
 fn unmeasured(plan: &AdvisePlan, c: Candidate, outcome: Outcome) -> Measurement {
-    let settings = settings_of(plan, &c);
+    let settings = settings_of(&plan.base, &c);
+    let p = info(&c);
     Measurement {
         candidate: c,
         outcome,
-        memory_bytes: info(&c)
+        memory_bytes: p
             .memory_model(&settings)
             .target_bytes(plan.size.0, plan.size.1),
         lighting_computations: None,
         ideal_lighting_computations: None,
         efficiency: None,
-        msaa: !matches!(info(&c).msaa, Msaa::Refused(_)),
+        msaa: !matches!(p.msaa, Msaa::Refused(_)),
     }
 }
 
@@ -514,7 +489,7 @@ fn measure(
     left: Duration,
     stop: &AtomicBool,
 ) -> Measurement {
-    try_measure(ctx, plan, c, frames, left, stop).unwrap_or_else(|e| {
+    try_measure(ctx, plan, c.clone(), frames, left, stop).unwrap_or_else(|e| {
         let reason = e.to_string();
         unmeasured(plan, c, Outcome::Failed { reason })
     })
@@ -529,7 +504,7 @@ fn try_measure(
     left: Duration,
     stop: &AtomicBool,
 ) -> lightgrid::Result<Measurement> {
-    let settings = settings_of(plan, &c);
+    let settings = settings_of(&plan.base, &c);
     let mut renderer = Renderer::new(ctx, plan.size.0, plan.size.1, settings)?;
     // The warm-up frame (shader compilation included) bounds what one frame costs.
     let t = Instant::now();
@@ -585,12 +560,16 @@ mod tests {
 
     fn measured(pipeline: &'static str, tile: Option<u32>, ms: f64, mem: u64) -> Measurement {
         Measurement {
-            candidate: Candidate {
-                pipeline,
-                tile,
-                assign: tile.map(|_| "cpu"),
-                depth_mask: None,
-                cell_box: None,
+            candidate: {
+                let c = Candidate {
+                    pipeline,
+                    tile,
+                    settings: BTreeMap::new(),
+                };
+                match tile {
+                    Some(_) => c.with(Assign::FLAG, "cpu"),
+                    None => c,
+                }
             },
             outcome: Outcome::Measured {
                 frame_ms: ms,
@@ -614,7 +593,12 @@ mod tests {
         for c in &s {
             let p = pipelines::find(c.pipeline).unwrap();
             assert_eq!(c.tile.is_some(), p.uses_grid, "{}", c.pipeline);
-            assert_eq!(c.assign.is_some(), p.assign, "{}", c.pipeline);
+            assert_eq!(
+                c.setting(Assign::FLAG).is_some(),
+                p.assign,
+                "{}",
+                c.pipeline
+            );
         }
     }
 
@@ -693,26 +677,26 @@ mod tests {
             .into()
         );
         assert!(r.iter().all(|c| !done.iter().any(|d| d.candidate == *c)));
-        assert!(r.contains(&Candidate {
-            pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
-            tile: Some(32),
-            assign: Some("cpu"),
-            depth_mask: None,
-            cell_box: None,
-        }));
-        assert!(r.contains(&Candidate {
-            pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
-            tile: Some(16),
-            assign: Some("gather"),
-            depth_mask: None,
-            cell_box: None,
-        }));
-        assert!(!r.iter().any(|c| c.assign == Some("auto")));
+        let deferred = |tile, assign| {
+            Candidate {
+                pipeline: lightgrid::pipelines::ids::TILED_DEFERRED,
+                tile: Some(tile),
+                settings: BTreeMap::new(),
+            }
+            .with(Assign::FLAG, assign)
+        };
+        assert!(r.contains(&deferred(32, "cpu")));
+        assert!(r.contains(&deferred(16, "gather")));
+        assert!(!r.iter().any(|c| c.setting(Assign::FLAG) == Some("auto")));
+        // z-binning builds no per-cell lists: never with a mask or a box (the settings refuse
+        // it).
+        assert!(!r.iter().any(|c| c.setting(Assign::FLAG) == Some("zbin")
+            && (c.setting(DepthMask::FLAG).is_some() || c.setting(CellBox::FLAG).is_some())));
         // 2.5D culling for the top grid pipelines whose grids come from the depth buffer
         // (the settings table's rule), not for tiled_forward (no depth bounds).
         let masked: std::collections::BTreeSet<&str> = r
             .iter()
-            .filter(|c| c.depth_mask == Some(DepthMask::On))
+            .filter(|c| c.setting(DepthMask::FLAG) == Some("on"))
             .map(|c| c.pipeline)
             .collect();
         assert_eq!(
@@ -725,17 +709,20 @@ mod tests {
         );
         let c = r
             .iter()
-            .find(|c| c.depth_mask == Some(DepthMask::On))
+            .find(|c| c.setting(DepthMask::FLAG) == Some("on"))
             .unwrap();
         assert!(options(c).ends_with("--depth-mask on"), "{}", options(c));
         // Tight cells likewise.
         let boxed: std::collections::BTreeSet<&str> = r
             .iter()
-            .filter(|c| c.cell_box == Some(CellBox::On))
+            .filter(|c| c.setting(CellBox::FLAG) == Some("on"))
             .map(|c| c.pipeline)
             .collect();
         assert_eq!(boxed, masked);
-        let c = r.iter().find(|c| c.cell_box == Some(CellBox::On)).unwrap();
+        let c = r
+            .iter()
+            .find(|c| c.setting(CellBox::FLAG) == Some("on"))
+            .unwrap();
         assert!(options(c).ends_with("--cell-box on"), "{}", options(c));
     }
 
@@ -791,5 +778,37 @@ mod tests {
         let mut s = measured(lightgrid::pipelines::ids::FORWARD, None, 1.0, 1);
         s.outcome = Outcome::Failed { reason: "x".into() };
         assert!(recommend(&[s]).is_none());
+    }
+
+    /// Driven by the settings table: each refined row is a row with a value besides its
+    /// default, and every refined candidate's settings read back, row by row, what it names.
+    #[test]
+    fn the_refined_settings_are_rows_of_the_table_and_read_back() {
+        for flag in REFINED {
+            let axis = pipelines::find_axis(flag).expect("a row of the table");
+            assert!((axis.values)().len() >= 2, "{flag}");
+        }
+        let done = vec![measured(
+            lightgrid::pipelines::ids::TILED_DEFERRED,
+            Some(16),
+            10.0,
+            1,
+        )];
+        let r = refine(&done);
+        assert!(!r.is_empty());
+        for c in &r {
+            let s = settings_of(&RenderSettings::default(), c);
+            assert_eq!(Some(s.grid.tile_size), c.tile);
+            for (axis, value) in c.rows() {
+                assert_eq!((axis.get)(&s), value, "{}", c.label());
+                assert!(options(c).contains(&format!("{} {value}", axis.option())));
+            }
+        }
+        for flag in REFINED {
+            assert!(
+                r.iter().any(|c| c.setting(flag).is_some()),
+                "{flag} never tried"
+            );
+        }
     }
 }

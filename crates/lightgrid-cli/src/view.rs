@@ -54,7 +54,8 @@ pub(crate) struct ViewArgs {
     pub(crate) renderer: RendererArgs,
 }
 
-/// A script's steps, with what can be checked before a window opens checked.
+/// A script's steps, with what can be checked before a window opens checked (the settings
+/// table's steps by their rows, in `script::parse`).
 fn checked_script(text: &str, files: &mut Files) -> Result<Vec<Step>> {
     let steps = script::parse(text).map_err(|e| anyhow::anyhow!("--script: {e}"))?;
     for step in &steps {
@@ -65,9 +66,6 @@ fn checked_script(text: &str, files: &mut Files) -> Result<Vec<Step>> {
             }
             Action::Tile(n) => {
                 lightgrid::frame::validate_tile_size(*n).with_context(|| at.clone())?;
-            }
-            Action::Msaa(n) => {
-                lightgrid::frame::validate_msaa(*n).with_context(|| at.clone())?;
             }
             Action::Screenshot(path) => files.output(&at, Some(path), Kind::Png)?,
             _ => {}

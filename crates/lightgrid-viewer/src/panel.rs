@@ -7,8 +7,6 @@ use crate::controls::{pipeline_choices, Controls};
 use crate::live::LiveFigures;
 use egui::{Color32, RichText};
 use lightgrid::debug_view::DebugView;
-use lightgrid::frame::Assign;
-use lightgrid::frame::GBufferFormat;
 use lightgrid::scene::AddLights;
 
 /// What the panel shows but does not edit.
@@ -145,58 +143,72 @@ fn technique(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {
         )
         .text("tile px"),
     );
-    ui.add_enabled(
-        pipeline.is_some_and(|p| p.clustered),
-        egui::Slider::new(
-            &mut draft.settings.grid.slices,
-            1..=lightgrid::consts::MAX_SLICES,
-        )
-        .logarithmic(true)
-        .text("slices"),
-    );
-    ui.add_enabled_ui(pipeline.is_some_and(|p| p.assign), |ui| {
-        egui::ComboBox::from_label("assignment")
-            .selected_text(draft.settings.grid.strategy.name())
-            .show_ui(ui, |ui| {
-                for a in Assign::all() {
-                    ui.selectable_value(&mut draft.settings.grid.strategy, a, a.name())
-                        .on_hover_text(a.description());
-                }
-            });
-    });
-    ui.horizontal(|ui| {
-        ui.label("MSAA");
-        for &n in info.msaa_counts {
-            ui.selectable_value(&mut draft.settings.grid.samples, n, format!("{n}x"));
-        }
-    });
-    ui.horizontal(|ui| {
-        use lightgrid::pipelines::SettingValue;
-        ui.label("BRDF");
-        for &b in <Option<lightgrid::scene::Brdf>>::VALUES {
-            ui.selectable_value(&mut draft.settings.brdf, b, b.name())
-                .on_hover_text(b.help());
-        }
-    });
-    ui.horizontal(|ui| {
-        use lightgrid::pipelines::SettingValue;
-        ui.label("Shadows");
-        for &s in lightgrid::scene::Shadows::VALUES {
-            ui.selectable_value(&mut draft.settings.shadows, s, SettingValue::name(s))
-                .on_hover_text(s.help());
-        }
-    });
-    ui.add_enabled_ui(pipeline.is_some_and(|p| p.uses_gbuffer()), |ui| {
-        ui.horizontal(|ui| {
-            ui.label("G-buffer");
-            ui.selectable_value(&mut draft.settings.gbuffer, GBufferFormat::F16, "16-bit");
-            ui.selectable_value(&mut draft.settings.gbuffer, GBufferFormat::F32, "32-bit");
-        });
-    });
+    for axis in lightgrid::pipelines::AXES {
+        let applies = pipeline.is_some_and(|p| (axis.applies)(p, &draft.settings));
+        setting(ui, axis, &mut draft.settings, applies, info);
+    }
     ui.label(format!(
         "rendering {}x{}",
         info.render_size.0, info.render_size.1
     ));
+}
+
+/// One row of the settings table (`AXES`): its values by name, or a number the row checks
+/// (MSAA: the counts the adapter offers), greyed out where the pipeline does not read it.
+fn setting(
+    ui: &mut egui::Ui,
+    axis: &lightgrid::pipelines::Axis,
+    settings: &mut lightgrid::RenderSettings,
+    applies: bool,
+    info: &PanelInfo,
+) {
+    let current = (axis.get)(settings);
+    let mut names: Vec<(String, &str)> = (axis.values)()
+        .into_iter()
+        .map(|v| (v.name.to_string(), v.help))
+        .collect();
+    if axis.flag == "msaa" {
+        names = info
+            .msaa_counts
+            .iter()
+            .map(|n| (n.to_string(), ""))
+            .collect();
+    }
+    ui.add_enabled_ui(applies, |ui| {
+        let row = ui.horizontal(|ui| {
+            if names.is_empty() {
+                let mut n: u32 = current.parse().unwrap_or(0);
+                let r = ui.add(egui::DragValue::new(&mut n));
+                if r.changed() {
+                    let mut next = *settings;
+                    if (axis.set)(&mut next, &n.to_string()).is_ok() {
+                        *settings = next;
+                    }
+                }
+                ui.label(axis.flag);
+            } else {
+                egui::ComboBox::from_label(axis.flag)
+                    .selected_text(current.as_str())
+                    .show_ui(ui, |ui| {
+                        for (name, help) in &names {
+                            let r = ui.selectable_label(current == *name, name.as_str());
+                            let r = if help.is_empty() {
+                                r
+                            } else {
+                                r.on_hover_text(*help)
+                            };
+                            if r.clicked() {
+                                let mut next = *settings;
+                                if (axis.set)(&mut next, name).is_ok() {
+                                    *settings = next;
+                                }
+                            }
+                        }
+                    });
+            }
+        });
+        row.response.on_hover_text(axis.help);
+    });
 }
 
 fn scene(ui: &mut egui::Ui, draft: &mut Controls, info: &PanelInfo) {

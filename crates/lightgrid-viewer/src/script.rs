@@ -18,7 +18,9 @@ use std::path::PathBuf;
 pub enum Action {
     Pipeline(String),
     Tile(u32),
-    Msaa(u32),
+    /// A row of the settings table (`lightgrid::pipelines::AXES`): its flag and the value's
+    /// name (`msaa 4`, `brdf ggx`, `shadows maps`, `depth-mask on`, ...), checked by the row.
+    Setting(&'static str, String),
     View(DebugView),
     Resize(u32, u32),
     Frame(u32),
@@ -29,10 +31,6 @@ pub enum Action {
     Spots(f32),
     Transparency(bool),
     AddLights(u32),
-    /// `brdf auto|phong|ggx` (`--brdf`).
-    Brdf(Option<lightgrid::scene::Brdf>),
-    /// `shadows off|rays|maps` (`--shadows`).
-    Shadows(lightgrid::scene::Shadows),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -54,6 +52,25 @@ fn number(word: Option<&str>, what: &str, step: &str) -> Result<u32, String> {
     let w = word.ok_or_else(|| format!("'{step}': {what} needs a number"))?;
     w.parse::<u32>()
         .map_err(|_| format!("'{step}': '{w}' is not a whole number ({what})"))
+}
+
+/// A settings-table step, its value checked by the row's own `set` (the values and ranges
+/// the options accept).
+fn setting(
+    axis: &'static lightgrid::pipelines::Axis,
+    value: Option<&str>,
+    step: &str,
+) -> Result<Action, String> {
+    let names: Vec<&str> = (axis.values)().iter().map(|v| v.name).collect();
+    let expected = if names.is_empty() {
+        "a number".to_string()
+    } else {
+        names.join(", ")
+    };
+    let value = value.ok_or_else(|| format!("'{step}': {} needs {expected}", axis.flag))?;
+    (axis.set)(&mut lightgrid::RenderSettings::default(), value)
+        .map_err(|e| format!("'{step}': {e}"))?;
+    Ok(Action::Setting(axis.flag, value.to_string()))
 }
 
 /// Parse a script; steps come back in frame order (steps of one frame in their written order).
@@ -85,7 +102,6 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                     .to_string(),
             ),
             "tile" => Action::Tile(number(arg, "tile", step)?),
-            "msaa" => Action::Msaa(number(arg, "msaa", step)?),
             "view" => Action::View(arg.and_then(DebugView::parse).ok_or_else(|| {
                 format!("'{step}': view is one of shaded, lights, bounds, wasted")
             })?),
@@ -131,22 +147,6 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                 }
                 Action::AddLights(n)
             }
-            "brdf" => {
-                use lightgrid::pipelines::SettingValue;
-                let name = arg.ok_or_else(|| format!("'{step}': brdf needs auto, phong or ggx"))?;
-                Action::Brdf(
-                    <Option<lightgrid::scene::Brdf>>::parse(name)
-                        .map_err(|e| format!("'{step}': {e}"))?,
-                )
-            }
-            "shadows" => {
-                use lightgrid::pipelines::SettingValue;
-                let name =
-                    arg.ok_or_else(|| format!("'{step}': shadows needs off, rays or maps"))?;
-                Action::Shadows(
-                    lightgrid::scene::Shadows::parse(name).map_err(|e| format!("'{step}': {e}"))?,
-                )
-            }
             "pause" => Action::Pause,
             "play" => Action::Play,
             "panel" => match arg {
@@ -158,7 +158,10 @@ pub fn parse(script: &str) -> Result<Vec<Step>, String> {
                 let p = arg.ok_or_else(|| format!("'{step}': screenshot needs a file"))?;
                 Action::Screenshot(PathBuf::from(p))
             }
-            other => return Err(format!("'{step}': unknown action '{other}'")),
+            other => match lightgrid::pipelines::find_axis(other) {
+                Some(axis) => setting(axis, arg, step)?,
+                None => return Err(format!("'{step}': unknown action '{other}'")),
+            },
         };
         let takes_arg = !matches!(action, Action::Pause | Action::Play);
         if words.next().is_some() || (!takes_arg && arg.is_some()) {
@@ -199,13 +202,15 @@ mod tests {
                 Action::AddLights(300)
             ]
         );
-        let s = parse("brdf ggx; brdf auto; shadows maps").unwrap();
-        assert_eq!(s[0].action, Action::Brdf(Some(lightgrid::scene::Brdf::Ggx)));
-        assert_eq!(s[1].action, Action::Brdf(None));
-        assert_eq!(
-            s[2].action,
-            Action::Shadows(lightgrid::scene::Shadows::Maps)
-        );
+        // Every row of the settings table is a step, with its default value.
+        for axis in lightgrid::pipelines::AXES {
+            let value = (axis.get)(&lightgrid::RenderSettings::default());
+            let s = parse(&format!("{} {value}", axis.flag)).unwrap();
+            assert_eq!(s[0].action, Action::Setting(axis.flag, value));
+        }
+        let s = parse("brdf ggx; shadows maps; depth-mask on").unwrap();
+        assert_eq!(s[0].action, Action::Setting("brdf", "ggx".into()));
+        assert_eq!(s[2].action, Action::Setting("depth-mask", "on".into()));
     }
 
     #[test]
@@ -220,6 +225,11 @@ mod tests {
             "brdf lambert",
             "shadows",
             "shadows soft",
+            "msaa",
+            "msaa 3",
+            "slices 0",
+            "depth-mask maybe",
+            "assign",
             "tile -4",
             "tile NaN",
             "resize 300",

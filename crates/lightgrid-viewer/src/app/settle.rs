@@ -75,9 +75,10 @@ impl App {
         match &step.action {
             Action::Pipeline(id) => next.pipeline = pipelines::find(id)?.id.to_string(),
             Action::Tile(n) => next.settings.grid.tile_size = *n,
-            Action::Msaa(n) => next.settings.grid.samples = *n,
-            Action::Brdf(b) => next.settings.brdf = *b,
-            Action::Shadows(s) => next.settings.shadows = *s,
+            Action::Setting(flag, value) => {
+                let axis = pipelines::find_axis(flag).context("a row of the settings table")?;
+                (axis.set)(&mut next.settings, value).map_err(|e| anyhow!(e))?;
+            }
             Action::View(v) => next.view = *v,
             Action::Spots(f) => next.request.params.spot_fraction = *f,
             Action::Transparency(on) => next.request.params.transparency = *on,
@@ -245,5 +246,50 @@ impl App {
         let renderer = Renderer::new(&self.ctx, wanted.0, wanted.1, self.applied.settings)?;
         self.replace_renderer(renderer);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::script::parse;
+
+    /// Driven by the settings table: every value of every row, written as a script step, is
+    /// what the next settings read back; a value the row refuses never reaches them.
+    #[test]
+    fn every_value_of_every_setting_is_a_script_step_the_settings_read_back() {
+        let base = Controls {
+            pipeline: "forward".into(),
+            settings: lightgrid::RenderSettings::default(),
+            request: lightgrid::scene::SceneRequest::new("robots-many"),
+            view: DebugView::Shaded,
+        };
+        for axis in pipelines::AXES {
+            let mut values: Vec<String> =
+                (axis.values)().iter().map(|v| v.name.to_string()).collect();
+            if values.is_empty() {
+                // A number: the default and one more the row accepts.
+                let default = (axis.get)(&lightgrid::RenderSettings::default());
+                let other = if axis.flag == "msaa" { "4" } else { "16" };
+                values = vec![default, other.to_string()];
+            }
+            for v in values {
+                let steps = parse(&format!("{} {v}", axis.flag)).unwrap();
+                let mut next = base.clone();
+                assert!(App::change_controls(&mut next, &steps[0]).unwrap());
+                assert_eq!((axis.get)(&next.settings), v, "{}", axis.flag);
+            }
+            let mut next = base.clone();
+            let bad = Step {
+                at: 0,
+                action: Action::Setting(axis.flag, "no-such-value".into()),
+            };
+            assert!(
+                App::change_controls(&mut next, &bad).is_err(),
+                "{}",
+                axis.flag
+            );
+            assert_eq!(next.settings, base.settings);
+        }
     }
 }
