@@ -14,8 +14,12 @@ pub const DEFAULT_TILE_SIZE: u32 = 16;
 /// View-depth slices of the clustered grid (tiled-forward-shading §4.8), exponentially spaced
 /// between the camera's near and far planes.
 pub const DEFAULT_SLICES: u32 = 32;
-/// Index entries a new grid's lists start with; they grow (never shrink) to fit.
+/// Index entries a new grid's lists start with (`--index-capacity`); they grow (never
+/// shrink) to fit.
 pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 14;
+/// The most index entries `--index-capacity` may start with: what one storage binding holds
+/// within WebGPU's default limits (128 MiB of u32).
+pub const MAX_INDEX_CAPACITY: u32 = 1 << 25;
 /// Most slices accepted by `--slices`.
 pub const MAX_SLICES: u32 = 256;
 

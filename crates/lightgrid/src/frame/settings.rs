@@ -79,9 +79,10 @@ pub struct CullConfig {
     /// The most lights one frame may have; more is an error. Not a setting of the records.
     #[serde(skip, default = "default_max_lights")]
     pub max_lights: u32,
-    /// Index entries the lists start with; they grow from the frames' counters. Not a
-    /// setting of the records.
-    #[serde(skip, default = "default_index_capacity")]
+    /// Index entries the lists start with, 1 to `MAX_INDEX_CAPACITY` (`--index-capacity`);
+    /// they grow from the frames' counters, so a frame whose lists did not fit is counted
+    /// and the next ones fit. A scene known to need long lists starts with them.
+    #[serde(default = "default_index_capacity")]
     pub index_capacity: u32,
 }
 
@@ -129,12 +130,7 @@ impl CullConfig {
                 "must be at least 1",
             ));
         }
-        if self.index_capacity == 0 {
-            return Err(crate::error::Error::invalid(
-                "index_capacity",
-                "must be at least 1",
-            ));
-        }
+        validate_index_capacity(self.index_capacity)?;
         Ok(())
     }
 
@@ -455,6 +451,18 @@ pub fn validate_sample_culling(
     Ok(())
 }
 
+/// Refuse a starting list capacity outside `1..=MAX_INDEX_CAPACITY` entries.
+fn validate_index_capacity(entries: u32) -> crate::error::Result<()> {
+    use crate::consts::MAX_INDEX_CAPACITY;
+    if !(1..=MAX_INDEX_CAPACITY).contains(&entries) {
+        return Err(crate::error::Error::invalid(
+            "index-capacity",
+            format!("{entries}: must be between 1 and {MAX_INDEX_CAPACITY} index entries"),
+        ));
+    }
+    Ok(())
+}
+
 /// Refuse a view-depth slice count outside `1..=MAX_SLICES`.
 pub fn validate_slices(slices: u32) -> crate::error::Result<()> {
     use crate::consts::MAX_SLICES;
@@ -665,6 +673,10 @@ mod tests {
             assert!(object.contains_key(key), "{key} missing: {json}");
         }
         assert!(!object.contains_key("grid") && !object.contains_key("max_lights"));
+        assert_eq!(
+            json["index_capacity"],
+            crate::consts::INITIAL_INDEX_CAPACITY
+        );
         assert_eq!(json["assign"], "zbin");
         assert_eq!(json["msaa"], 4);
         // Read back: the limits come back as their defaults, everything else as written.
@@ -685,6 +697,7 @@ mod tests {
         let o = old.as_object_mut().unwrap();
         o.remove("depth_mask");
         o.remove("cell_box");
+        o.remove("index_capacity");
         let back: RenderSettings = serde_json::from_value(old).unwrap();
         assert_eq!(back, RenderSettings::default());
     }

@@ -345,6 +345,19 @@ pub const AXES: &[Axis] = &[
         label: |v| v.to_string(),
     },
     Axis {
+        flag: "index-capacity",
+        column: "index_capacity",
+        help: "index entries the light lists of --assign grids start with (1 to 33554432; they grow from the frames' counters, a frame whose lists did not fit is counted)",
+        values: Vec::new,
+        applies: |p, _| p.assign,
+        get: |s| s.grid.index_capacity.to_string(),
+        set: |s, v| {
+            s.grid.index_capacity = number(v)?;
+            s.grid.validate().map_err(|e| e.to_string())
+        },
+        label: |v| format!("{v} entries"),
+    },
+    Axis {
         flag: "spot-cull",
         column: "spot_cull",
         help: "what grid pipelines cull spot lights by",
