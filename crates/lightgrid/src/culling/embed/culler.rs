@@ -313,6 +313,8 @@ struct Caller {
     prep_layout: wgpu::BindGroupLayout,
     timer: PassTimer,
     frames: u64,
+    /// The newest finished frame's number and counters ([`LightCuller::read_grid`]).
+    last_report: Option<(u64, crate::gpu::CounterValues)>,
 }
 
 pub(crate) fn prep_shader() -> ComposedShader {
@@ -455,6 +457,7 @@ impl LightCuller {
                 prep_layout,
                 timer: PassTimer::disabled(),
                 frames: 0,
+                last_report: None,
             })),
         })
     }
@@ -689,6 +692,32 @@ impl LightCuller {
         Ok(frame)
     }
 
+    /// The grid the last encoded frame built, read back (tests and tools; waits for the
+    /// GPU): per cell its `(offset, count)` and the light indices, in the caller's light
+    /// buffer's numbering (a z-binned grid as the per-cell lists it stands for). Its report
+    /// must have been collected first ([`Self::wait`]). The offsets and the order of a cell's
+    /// lights follow the order the GPU's workgroups finished in; the lists themselves do not.
+    pub fn read_grid(&self) -> Result<crate::culling::LightGrid, CullError> {
+        let Some(c) = self.caller.as_deref() else {
+            return refuse(
+                CullInput::Config,
+                "lightgrid's renderer's culler takes its frames from the renderer",
+            );
+        };
+        match c.last_report {
+            Some((frame, values)) if frame == c.frames => {
+                Ok(self.core.download(&c.device, &c.queue, &values)?.grid)
+            }
+            _ => refuse(
+                CullInput::Config,
+                format!(
+                    "frame {} has not been reported yet: call wait (or poll until it is) before read_grid",
+                    c.frames
+                ),
+            ),
+        }
+    }
+
     /// The reports of the frames the GPU has finished since the last call, oldest first,
     /// without waiting (the caller's event loop polls the device, or this does). The lists
     /// grow from them.
@@ -713,6 +742,7 @@ impl LightCuller {
         let mut out = Vec::with_capacity(readbacks.len());
         for r in readbacks {
             self.core.observe(&device, &r.values)?;
+            self.caller()?.last_report = Some((r.tag.serial, r.values));
             out.push(CullReport {
                 frame: r.tag.serial,
                 index_entries: r.values.index_needed().max(r.values.pairs_needed()),
