@@ -114,104 +114,110 @@ fn main() {
     }
 }
 
-/// Render the frame both ways, compare, and write the grid's image to `out`.
-pub fn run(out: Option<&str>) -> Result<(), Box<dyn std::error::Error>> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-        required_limits: LightCuller::required_limits(&adapter),
-        ..Default::default()
-    }))?;
-    println!("adapter: {}", adapter.get_info().name);
-    let (view, proj) = camera();
-    let (vertices, indices) = mesh();
-    let lights = lights();
-    let init = |contents: &[u8], usage| {
-        device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage })
-    };
-    let vbuf = init(bytemuck::cast_slice(&vertices), wgpu::BufferUsages::VERTEX);
-    let ibuf = init(bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX);
-    let light_buf = init(bytemuck::cast_slice(&lights), wgpu::BufferUsages::STORAGE);
-    let eye = view.inverse().w_axis;
-    let mut cam = [(proj * view).to_cols_array(), view.to_cols_array()].concat();
-    cam.extend([eye.x, eye.y, eye.z, f32::from_bits(LIGHTS)]);
-    let cam_buf = init(bytemuck::cast_slice(&cam), wgpu::BufferUsages::UNIFORM);
+type Error = Box<dyn std::error::Error>;
 
-    // lightgrid: the culler, and its WGSL in front of this program's shader.
+/// Render the frame both ways, compare, and write the grid's image to `out`.
+pub fn run(out: Option<&str>) -> Result<(), Error> {
+    // Setup: this program's device (with the limits the culler asks for), the culler, and
+    // this program's buffers and pipelines around the culler's WGSL and bind group layout.
+    let (device, queue) = open_device()?;
     let config = CullConfig { tile_size: 16, slices: 24, ..Default::default() };
     let mut culler = LightCuller::new(&device, &queue, config)?;
-    let source = format!("{}\n{}", LightCuller::wgsl(1), include_str!("embed.wgsl"));
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: None,
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    };
-    let storage = wgpu::BufferBindingType::Storage { read_only: true };
-    let own = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: None,
-        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, storage)],
-    });
-    let group0 = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &own,
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: cam_buf.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: light_buf.as_entire_binding() },
-        ],
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: None,
-        bind_group_layouts: &[Some(&own), Some(culler.bind_group_layout())],
-        immediate_size: 0,
-    });
-    let color = wgpu::TextureFormat::Rgba8Unorm;
-    let targets = [Some(color.into()), Some(color.into())];
-    let pipeline = |fs: Option<&str>| {
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: fs,
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 24,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
-                })],
-            },
-            fragment: fs.map(|fs| wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(fs),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(fs.is_none()),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        })
-    };
-    let depth = texture(&device, wgpu::TextureFormat::Depth32Float).create_view(&Default::default());
-    let images = [texture(&device, color), texture(&device, color)];
-    let views = images.each_ref().map(|t| t.create_view(&Default::default()));
+    let program = Program::new(&device, culler.bind_group_layout());
+    // One frame: the depth pre-pass, the culling, the shading (twice: from the grid and from
+    // every light), read back.
+    let bytes = program.frame(&device, &queue, &mut culler)?;
+    let report = culler.wait()?.pop().ok_or("no culling report")?;
+    // Check: the two images agree.
+    check(&bytes, &report, out)
+}
 
-    // 1. This program's depth pre-pass, 2. lightgrid culls, 3. shading from the grid (and
-    // from every light, for comparison).
-    let mut encoder = device.create_command_encoder(&Default::default());
-    let draw = |encoder: &mut wgpu::CommandEncoder, fs: Option<&str>, grid: &wgpu::BindGroup| {
+/// The first adapter, with the limits `LightCuller` asks for.
+fn open_device() -> Result<(wgpu::Device, wgpu::Queue), Error> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+    println!("adapter: {}", adapter.get_info().name);
+    Ok(pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_limits: LightCuller::required_limits(&adapter),
+        ..Default::default()
+    }))?)
+}
+
+/// This program's GPU objects: the mesh, the lights, the camera, the pipelines of its depth
+/// pre-pass and its shading (its group 0 and the culler's grid at group 1), and its targets.
+struct Program {
+    vertices: wgpu::Buffer,
+    indices: (wgpu::Buffer, u32),
+    lights: wgpu::Buffer,
+    group0: wgpu::BindGroup,
+    depth_only: wgpu::RenderPipeline,
+    shade: wgpu::RenderPipeline,
+    depth: wgpu::TextureView,
+    images: [wgpu::Texture; 2],
+    camera: (Mat4, Mat4),
+}
+
+const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+impl Program {
+    fn new(device: &wgpu::Device, grid_layout: &wgpu::BindGroupLayout) -> Program {
+        let (view, proj) = camera();
+        let (vertices, indices) = mesh();
+        let init = |contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage })
+        };
+        let lights = init(bytemuck::cast_slice(&lights()), wgpu::BufferUsages::STORAGE);
+        let eye = view.inverse().w_axis;
+        let mut cam = [(proj * view).to_cols_array(), view.to_cols_array()].concat();
+        cam.extend([eye.x, eye.y, eye.z, f32::from_bits(LIGHTS)]);
+        let cam_buf = init(bytemuck::cast_slice(&cam), wgpu::BufferUsages::UNIFORM);
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let storage = wgpu::BufferBindingType::Storage { read_only: true };
+        let own = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: None,
+            entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, storage)],
+        });
+        let group0 = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &own,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: cam_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: lights.as_entire_binding() },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[Some(&own), Some(grid_layout)],
+            immediate_size: 0,
+        });
+        // lightgrid's WGSL in front of this program's shader (the grid at group 1).
+        let source = format!("{}\n{}", LightCuller::wgsl(1), include_str!("embed.wgsl"));
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: None,
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        Program {
+            vertices: init(bytemuck::cast_slice(&vertices), wgpu::BufferUsages::VERTEX),
+            indices: (init(bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX), indices.len() as u32),
+            lights,
+            group0,
+            depth_only: pipeline(device, &layout, &module, None),
+            shade: pipeline(device, &layout, &module, Some("fs")),
+            depth: texture(device, wgpu::TextureFormat::Depth32Float).create_view(&Default::default()),
+            images: [texture(device, COLOR), texture(device, COLOR)],
+            camera: (view, proj),
+        }
+    }
+
+    /// Record the depth pre-pass (`shade` false) or the shading pass into both images, with
+    /// `grid` at group 1.
+    fn draw(&self, encoder: &mut wgpu::CommandEncoder, shade: bool, grid: &wgpu::BindGroup) {
+        let views = self.images.each_ref().map(|t| t.create_view(&Default::default()));
         let attachment = |view| {
             let ops = wgpu::Operations {
                 load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
@@ -219,13 +225,13 @@ pub fn run(out: Option<&str>) -> Result<(), Box<dyn std::error::Error>> {
             };
             Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops })
         };
-        let load = if fs.is_none() { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load };
-        let colors = if fs.is_some() { views.each_ref().map(attachment).to_vec() } else { vec![] };
+        let load = if shade { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(1.0) };
+        let colors = if shade { views.each_ref().map(attachment).to_vec() } else { vec![] };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: fs,
+            label: None,
             color_attachments: &colors,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth,
+                view: &self.depth,
                 depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
@@ -233,46 +239,105 @@ pub fn run(out: Option<&str>) -> Result<(), Box<dyn std::error::Error>> {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&pipeline(fs));
-        pass.set_bind_group(0, &group0, &[]);
+        pass.set_pipeline(if shade { &self.shade } else { &self.depth_only });
+        pass.set_bind_group(0, &self.group0, &[]);
         pass.set_bind_group(1, grid, &[]);
-        pass.set_vertex_buffer(0, vbuf.slice(..));
-        pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..indices.len() as u32, 0, 0..1);
-    };
-    draw(&mut encoder, None, culler.bind_group());
-    let inputs = CullInputs {
-        depth: &depth,
-        lights: &light_buf,
-        light_count: LIGHTS,
-        view: view.to_cols_array_2d(),
-        proj: proj.to_cols_array_2d(),
-        near: NEAR,
-        far: FAR,
-        viewport: [W, H],
-    };
-    culler.encode(&mut encoder, &inputs)?;
-    // The grid's bind group after `encode` (it is replaced when the lists grow).
-    draw(&mut encoder, Some("fs"), culler.bind_group());
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size: u64::from(W * H * 8),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    for (i, image) in images.iter().enumerate() {
-        let offset = u64::from(W * H * 4) * i as u64;
-        let layout = wgpu::TexelCopyBufferLayout { offset, bytes_per_row: Some(W * 4), rows_per_image: None };
-        let buffer = wgpu::TexelCopyBufferInfo { buffer: &readback, layout };
-        encoder.copy_texture_to_buffer(image.as_image_copy(), buffer, image.size());
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.0.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.indices.1, 0, 0..1);
     }
-    queue.submit([encoder.finish()]);
-    readback.map_async(wgpu::MapMode::Read, .., |r| r.expect("map"));
-    device.poll(wgpu::PollType::wait_indefinitely())?;
-    let bytes = readback.get_mapped_range(..)?.to_vec();
-    let report = culler.wait()?.pop().ok_or("no culling report")?;
 
-    // The grid against every light: per pixel the largest channel difference, in levels.
+    /// One frame: the depth pre-pass, lightgrid's culling, the shading from the grid; both
+    /// images read back (the grid's, then every light's).
+    fn frame(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        culler: &mut LightCuller,
+    ) -> Result<Vec<u8>, Error> {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.draw(&mut encoder, false, culler.bind_group());
+        let (view, proj) = self.camera;
+        culler.encode(
+            &mut encoder,
+            &CullInputs {
+                depth: &self.depth,
+                lights: &self.lights,
+                light_count: LIGHTS,
+                view: view.to_cols_array_2d(),
+                proj: proj.to_cols_array_2d(),
+                near: NEAR,
+                far: FAR,
+                viewport: [W, H],
+            },
+        )?;
+        // The grid's bind group after `encode` (it is replaced when the lists grow).
+        self.draw(&mut encoder, true, culler.bind_group());
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: u64::from(W * H * 8),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        for (i, image) in self.images.iter().enumerate() {
+            let offset = u64::from(W * H * 4) * i as u64;
+            let layout =
+                wgpu::TexelCopyBufferLayout { offset, bytes_per_row: Some(W * 4), rows_per_image: None };
+            let buffer = wgpu::TexelCopyBufferInfo { buffer: &readback, layout };
+            encoder.copy_texture_to_buffer(image.as_image_copy(), buffer, image.size());
+        }
+        queue.submit([encoder.finish()]);
+        readback.map_async(wgpu::MapMode::Read, .., |r| r.expect("map"));
+        device.poll(wgpu::PollType::wait_indefinitely())?;
+        let bytes = readback.get_mapped_range(..)?.to_vec();
+        Ok(bytes)
+    }
+}
+
+/// The depth pre-pass's pipeline (`fs` None) or the shading pipeline (`fs`, into two images).
+fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    fs: Option<&str>,
+) -> wgpu::RenderPipeline {
+    let targets = [Some(COLOR.into()), Some(COLOR.into())];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: fs,
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 24,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+            })],
+        },
+        fragment: fs.map(|fs| wgpu::FragmentState {
+            module,
+            entry_point: Some(fs),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(fs.is_none()),
+            depth_compare: Some(wgpu::CompareFunction::LessEqual),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The grid's image against every light's: per pixel the largest channel difference, in
+/// levels, within `tiled_forward`'s tolerance; the grid's image written to `out`.
+fn check(bytes: &[u8], report: &lightgrid::CullReport, out: Option<&str>) -> Result<(), Error> {
     let (grid_image, all_image) = bytes.split_at(bytes.len() / 2);
     let pixel_diff = |(p, q): (&[u8], &[u8])| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap();
     let mut diffs: Vec<u8> = grid_image.chunks(4).zip(all_image.chunks(4)).map(pixel_diff).collect();

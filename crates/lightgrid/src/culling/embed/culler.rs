@@ -317,42 +317,15 @@ struct Caller {
     last_report: Option<(u64, crate::gpu::CounterValues)>,
 }
 
-pub(crate) fn prep_shader() -> ComposedShader {
-    compose(
-        "cull lights",
-        &[src::TYPES, include_str!("cull_lights.wgsl")],
-    )
-}
-
-/// The caller-facing module at every group a default wgpu device has, for the validation
-/// test. Not a [`crate::shader::ShaderKey`]: the group is the caller's, and its WGSL is
-/// pasted into the caller's shader rather than composed here.
-pub(crate) fn embed_shaders() -> Vec<ComposedShader> {
-    (0..wgpu::Limits::default().max_bind_groups)
-        .map(|group| {
-            compose(
-                &format!("light grid (embedded at group {group})"),
-                &[&LightCuller::wgsl(group)],
-            )
-        })
-        .collect()
-}
-
-impl LightCuller {
-    /// A culler on the caller's device and queue (clones of the handles). Refuses a
-    /// configuration outside lightgrid's limits.
-    pub fn new(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        config: CullConfig,
-    ) -> Result<Self, CullError> {
-        let config_error = |e: crate::error::Error| CullError {
-            input: CullInput::Config,
-            message: e.to_string(),
-        };
-        config.validate().map_err(config_error)?;
-        if let Some(info) = find_strategy(config.strategy).filter(|s| s.cpu_lights) {
-            return refuse(
+/// Refuse a configuration the culler cannot build on `device`, naming why.
+fn check_config(device: &wgpu::Device, config: &CullConfig) -> Result<(), CullError> {
+    let config_error = |e: crate::error::Error| CullError {
+        input: CullInput::Config,
+        message: e.to_string(),
+    };
+    config.validate().map_err(config_error)?;
+    if let Some(info) = find_strategy(config.strategy).filter(|s| s.cpu_lights) {
+        return refuse(
                 CullInput::Config,
                 format!(
                     "strategy {} assigns on the CPU and needs the lights there; LightCuller reads them on the GPU only (auto, {})",
@@ -365,51 +338,39 @@ impl LightCuller {
                         .join(", ")
                 ),
             );
-        }
-        let max_bytes = u64::from(config.max_lights) * std::mem::size_of::<GpuLight>() as u64;
-        let limits = device.limits();
-        if max_bytes
-            > limits
-                .max_storage_buffer_binding_size
-                .min(limits.max_buffer_size)
-        {
-            return refuse(
-                CullInput::Config,
-                format!(
-                    "max_lights {} needs {max_bytes} bytes of lights, more than this device binds",
-                    config.max_lights
-                ),
-            );
-        }
-        let layout = cull_layout(device);
-        let tiles = GridDims::new(config.tile_size, config.tile_size, config.tile_size)
-            .map_err(config_error)?;
-        let need = STORAGE_BUFFERS_PER_STAGE;
-        let have = device.limits().max_storage_buffers_per_shader_stage;
-        if have < need {
-            return refuse(
+    }
+    let max_bytes = u64::from(config.max_lights) * std::mem::size_of::<GpuLight>() as u64;
+    let limits = device.limits();
+    if max_bytes
+        > limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
+    {
+        return refuse(
+            CullInput::Config,
+            format!(
+                "max_lights {} needs {max_bytes} bytes of lights, more than this device binds",
+                config.max_lights
+            ),
+        );
+    }
+    let need = STORAGE_BUFFERS_PER_STAGE;
+    let have = device.limits().max_storage_buffers_per_shader_stage;
+    if have < need {
+        return refuse(
                 CullInput::Device,
                 format!(
                     "the culling kernels bind {need} storage buffers per stage; this device allows {have} (request LightCuller::required_limits)"
                 ),
             );
-        }
-        let mut core = crate::gpu::scoped(device, "creating the light culler", || {
-            GridBuilder::new(
-                device,
-                &layout,
-                None,
-                &config,
-                tiles,
-                GridUse {
-                    source: CellSource::Depth,
-                    forward_opaque: false,
-                    // `Auto` stays on the GPU (`cpu` needs the lights on the CPU).
-                    software_adapter: false,
-                },
-            )
-        })?;
-        core.prepare(device)?;
+    }
+    Ok(())
+}
+
+impl Caller {
+    /// The buffers and the light-preparing kernel of a caller's culler (group 0 of the
+    /// culling kernels over its own copies of the caller's lights).
+    fn new(device: &wgpu::Device, queue: &wgpu::Queue, layout: wgpu::BindGroupLayout) -> Caller {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("culler uniforms"),
             size: std::mem::size_of::<FrameUniforms>() as u64,
@@ -441,24 +402,140 @@ impl LightCuller {
             "main",
             &[Some(&prep_layout)],
         );
+        Caller {
+            device: device.clone(),
+            queue: queue.clone(),
+            layout,
+            uniforms,
+            lights,
+            bounds,
+            counters,
+            group,
+            prep,
+            prep_layout,
+            timer: PassTimer::disabled(),
+            frames: 0,
+            last_report: None,
+        }
+    }
+
+    /// Make room for `n` lights (a new group 0 when the buffers grow), write the frame's
+    /// uniforms, and record the kernel that copies the caller's lights camera-relative with
+    /// their bounding spheres.
+    fn prepare_lights(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &CullInputs,
+        uniforms: &FrameUniforms,
+    ) {
+        let n = inputs.light_count;
+        let grown_lights = grow_storage(
+            &self.device,
+            &mut self.lights,
+            "culler lights",
+            u64::from(n.max(1)) * 48,
+        );
+        let grown_bounds = grow_storage(
+            &self.device,
+            &mut self.bounds,
+            "culler light bounds",
+            u64::from(n.max(1)) * 16,
+        );
+        if grown_lights || grown_bounds {
+            self.group = bind_cull_group(
+                &self.device,
+                &self.layout,
+                [
+                    &self.uniforms,
+                    &self.lights,
+                    self.counters.buffer(),
+                    &self.bounds,
+                ],
+            );
+        }
+        self.queue
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+        let prep_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cull lights"),
+            layout: &self.prep_layout,
+            entries: &[
+                entry(0, &self.uniforms),
+                entry(1, inputs.lights),
+                entry(2, &self.lights),
+                entry(3, &self.bounds),
+                entry(4, self.counters.buffer()),
+            ],
+        });
+        self.counters.clear(encoder);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("cull: lights"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.prep);
+        pass.set_bind_group(0, &prep_group, &[]);
+        let (x, y) = groups_1d(n.div_ceil(crate::consts::ASSIGN_THREADS));
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+pub(crate) fn prep_shader() -> ComposedShader {
+    compose(
+        "cull lights",
+        &[src::TYPES, include_str!("cull_lights.wgsl")],
+    )
+}
+
+/// The caller-facing module at every group a default wgpu device has, for the validation
+/// test. Not a [`crate::shader::ShaderKey`]: the group is the caller's, and its WGSL is
+/// pasted into the caller's shader rather than composed here.
+pub(crate) fn embed_shaders() -> Vec<ComposedShader> {
+    (0..wgpu::Limits::default().max_bind_groups)
+        .map(|group| {
+            compose(
+                &format!("light grid (embedded at group {group})"),
+                &[&LightCuller::wgsl(group)],
+            )
+        })
+        .collect()
+}
+
+impl LightCuller {
+    /// A culler on the caller's device and queue (clones of the handles). Refuses a
+    /// configuration outside lightgrid's limits.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: CullConfig,
+    ) -> Result<Self, CullError> {
+        check_config(device, &config)?;
+        let layout = cull_layout(device);
+        let tiles =
+            GridDims::new(config.tile_size, config.tile_size, config.tile_size).map_err(|e| {
+                CullError {
+                    input: CullInput::Config,
+                    message: e.to_string(),
+                }
+            })?;
+        let mut core = crate::gpu::scoped(device, "creating the light culler", || {
+            GridBuilder::new(
+                device,
+                &layout,
+                None,
+                &config,
+                tiles,
+                GridUse {
+                    source: CellSource::Depth,
+                    forward_opaque: false,
+                    // `Auto` stays on the GPU (`cpu` needs the lights on the CPU).
+                    software_adapter: false,
+                },
+            )
+        })?;
+        core.prepare(device)?;
         Ok(LightCuller {
             core,
             config,
-            caller: Some(Box::new(Caller {
-                device: device.clone(),
-                queue: queue.clone(),
-                layout,
-                uniforms,
-                lights,
-                bounds,
-                counters,
-                group,
-                prep,
-                prep_layout,
-                timer: PassTimer::disabled(),
-                frames: 0,
-                last_report: None,
-            })),
+            caller: Some(Box::new(Caller::new(device, queue, layout))),
         })
     }
 
@@ -607,28 +684,6 @@ impl LightCuller {
             })?,
         );
         let n = inputs.light_count;
-        let grown_lights = grow_storage(
-            &c.device,
-            &mut c.lights,
-            "culler lights",
-            u64::from(n.max(1)) * 48,
-        );
-        let grown_bounds = grow_storage(
-            &c.device,
-            &mut c.bounds,
-            "culler light bounds",
-            u64::from(n.max(1)) * 16,
-        );
-        if grown_lights || grown_bounds {
-            c.group = bind_cull_group(
-                &c.device,
-                &c.layout,
-                [&c.uniforms, &c.lights, c.counters.buffer(), &c.bounds],
-            );
-        }
-        let uniforms = camera.uniforms(inputs, self.config.spot_cull);
-        c.queue
-            .write_buffer(&c.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let depth_view = inputs
             .depth
             .texture()
@@ -639,33 +694,14 @@ impl LightCuller {
                 mip_level_count: Some(1),
                 ..Default::default()
             });
-        let prep_group = c.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("cull lights"),
-            layout: &c.prep_layout,
-            entries: &[
-                entry(0, &c.uniforms),
-                entry(1, inputs.lights),
-                entry(2, &c.lights),
-                entry(3, &c.bounds),
-                entry(4, c.counters.buffer()),
-            ],
-        });
         c.timer.reset();
         c.frames += 1;
         let frame = c.frames;
         let setup = camera.setup(inputs, self.config.spot_cull);
-        let result = crate::gpu::scoped(&c.device, "recording the light culler", || {
-            c.counters.clear(encoder);
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("cull: lights"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&c.prep);
-                pass.set_bind_group(0, &prep_group, &[]);
-                let (x, y) = groups_1d(n.div_ceil(crate::consts::ASSIGN_THREADS));
-                pass.dispatch_workgroups(x, y, 1);
-            }
+        let uniforms = camera.uniforms(inputs, self.config.spot_cull);
+        let device = c.device.clone();
+        let result = crate::gpu::scoped(&device, "recording the light culler", || {
+            c.prepare_lights(encoder, inputs, &uniforms);
             let f = CullFrame {
                 device: &c.device,
                 queue: &c.queue,
@@ -869,76 +905,7 @@ impl Camera {
             return refuse(I::View, "the view matrix's last row must be (0, 0, 0, 1)");
         }
         let eye: DVec3 = -(r.transpose() * v.w_axis.truncate());
-        // The projection: symmetric perspective, w = -z.
-        let p = &i.proj;
-        let zero = |x: f32| x == 0.0;
-        let perspective = p[2][3] == -1.0
-            && zero(p[3][3])
-            && zero(p[0][3])
-            && zero(p[1][3])
-            && p[0][0] > 0.0
-            && p[1][1] > 0.0;
-        if !perspective {
-            return refuse(
-                I::Projection,
-                "a perspective projection with w = -z (right-handed, looking down -z) is needed",
-            );
-        }
-        if !(zero(p[2][0])
-            && zero(p[2][1])
-            && zero(p[1][0])
-            && zero(p[0][1])
-            && zero(p[3][0])
-            && zero(p[3][1]))
-        {
-            return refuse(
-                I::Projection,
-                "an off-centre or skewed projection (jitter, VR) is not supported: tiles assume a symmetric frustum",
-            );
-        }
-        let (near, far) = (i.near, i.far);
-        // The renderer's own check of a camera's planes (finite, 0 < near < far, a ratio the
-        // depth buffer holds).
-        crate::depth::check_planes(near, far).map_err(|e| CullError {
-            input: I::Planes,
-            message: e.to_string(),
-        })?;
-        // depth = A / w - B (A = proj[3][2], B = proj[2][2]): reversed when A > 0.
-        let (a, b) = (f64::from(p[3][2]), f64::from(p[2][2]));
-        if a == 0.0 {
-            return refuse(
-                I::Projection,
-                "the projection's depth does not vary with distance",
-            );
-        }
-        let standard_depth = a < 0.0;
-        let w_at = |d: f64| a / (d + b);
-        let (near_depth, far_depth) = if standard_depth {
-            (0.0, 1.0)
-        } else {
-            (1.0, 0.0)
-        };
-        let proj_near = w_at(near_depth);
-        let agrees = |x: f64, y: f32| (x - f64::from(y)).abs() <= 1e-3 * f64::from(y);
-        if !agrees(proj_near, near) {
-            return refuse(
-                I::Planes,
-                format!("near {near} is not the projection's near plane ({proj_near})"),
-            );
-        }
-        let proj_far = w_at(far_depth);
-        if proj_far.is_finite() && proj_far > 0.0 && !agrees(proj_far, far) {
-            return refuse(
-                I::Planes,
-                format!("far {far} is not the projection's far plane ({proj_far})"),
-            );
-        }
-        if standard_depth && !(proj_far.is_finite() && proj_far > 0.0) {
-            return refuse(
-                I::Projection,
-                "a standard-depth projection needs a finite far plane",
-            );
-        }
+        let standard_depth = projection_depth(i)?;
         Ok(Camera {
             rotation: Mat4::from_mat3(r.as_mat3()),
             eye: eye.as_vec3(),
@@ -978,6 +945,84 @@ impl Camera {
             spot_cull,
         }
     }
+}
+
+/// Check the projection against the planes: a symmetric perspective with w = -z whose near
+/// (and finite far) plane are `i.near` and `i.far`; true for standard depth (0 at near),
+/// false for reversed.
+fn projection_depth(i: &CullInputs) -> Result<bool, CullError> {
+    use CullInput as I;
+    // The projection: symmetric perspective, w = -z.
+    let p = &i.proj;
+    let zero = |x: f32| x == 0.0;
+    let perspective = p[2][3] == -1.0
+        && zero(p[3][3])
+        && zero(p[0][3])
+        && zero(p[1][3])
+        && p[0][0] > 0.0
+        && p[1][1] > 0.0;
+    if !perspective {
+        return refuse(
+            I::Projection,
+            "a perspective projection with w = -z (right-handed, looking down -z) is needed",
+        );
+    }
+    if !(zero(p[2][0])
+        && zero(p[2][1])
+        && zero(p[1][0])
+        && zero(p[0][1])
+        && zero(p[3][0])
+        && zero(p[3][1]))
+    {
+        return refuse(
+                I::Projection,
+                "an off-centre or skewed projection (jitter, VR) is not supported: tiles assume a symmetric frustum",
+            );
+    }
+    let (near, far) = (i.near, i.far);
+    // The renderer's own check of a camera's planes (finite, 0 < near < far, a ratio the
+    // depth buffer holds).
+    crate::depth::check_planes(near, far).map_err(|e| CullError {
+        input: I::Planes,
+        message: e.to_string(),
+    })?;
+    // depth = A / w - B (A = proj[3][2], B = proj[2][2]): reversed when A > 0.
+    let (a, b) = (f64::from(p[3][2]), f64::from(p[2][2]));
+    if a == 0.0 {
+        return refuse(
+            I::Projection,
+            "the projection's depth does not vary with distance",
+        );
+    }
+    let standard_depth = a < 0.0;
+    let w_at = |d: f64| a / (d + b);
+    let (near_depth, far_depth) = if standard_depth {
+        (0.0, 1.0)
+    } else {
+        (1.0, 0.0)
+    };
+    let proj_near = w_at(near_depth);
+    let agrees = |x: f64, y: f32| (x - f64::from(y)).abs() <= 1e-3 * f64::from(y);
+    if !agrees(proj_near, near) {
+        return refuse(
+            I::Planes,
+            format!("near {near} is not the projection's near plane ({proj_near})"),
+        );
+    }
+    let proj_far = w_at(far_depth);
+    if proj_far.is_finite() && proj_far > 0.0 && !agrees(proj_far, far) {
+        return refuse(
+            I::Planes,
+            format!("far {far} is not the projection's far plane ({proj_far})"),
+        );
+    }
+    if standard_depth && !(proj_far.is_finite() && proj_far > 0.0) {
+        return refuse(
+            I::Projection,
+            "a standard-depth projection needs a finite far plane",
+        );
+    }
+    Ok(standard_depth)
 }
 
 #[cfg(test)]
