@@ -222,6 +222,43 @@ pub fn validate_size(ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
+/// Refuse a size or settings the adapter cannot render: the frame's edges, the settings'
+/// own ranges, MSAA for every target, and what needs subgroup operations.
+fn check_settings(
+    ctx: &GpuContext,
+    width: u32,
+    height: u32,
+    settings: &RenderSettings,
+) -> Result<()> {
+    validate_size(ctx, width, height)?;
+    settings.validate()?;
+    crate::frame::check_msaa(ctx, settings.grid.samples, settings.gbuffer)?;
+    // The settings that need subgroup operations, and what to use without them.
+    for (wants, what, instead) in [
+        (
+            settings.grid.depth_reduction == crate::frame::DepthReduction::Subgroup,
+            "depth reduction",
+            "atomics",
+        ),
+        (
+            settings.light_loop == crate::frame::LightLoop::Subgroup,
+            "light loop",
+            "lane",
+        ),
+    ] {
+        if wants && !ctx.subgroups {
+            return Err(Error::invalid(
+                what,
+                format!(
+                    "subgroup: {} has no subgroup operations; use {instead}",
+                    ctx.adapter_label()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Renderer {
     pub fn new(
         ctx: &GpuContext,
@@ -229,32 +266,7 @@ impl Renderer {
         height: u32,
         settings: RenderSettings,
     ) -> Result<Self> {
-        validate_size(ctx, width, height)?;
-        settings.validate()?;
-        crate::frame::check_msaa(ctx, settings.grid.samples, settings.gbuffer)?;
-        // The settings that need subgroup operations, and what to use without them.
-        for (wants, what, instead) in [
-            (
-                settings.grid.depth_reduction == crate::frame::DepthReduction::Subgroup,
-                "depth reduction",
-                "atomics",
-            ),
-            (
-                settings.light_loop == crate::frame::LightLoop::Subgroup,
-                "light loop",
-                "lane",
-            ),
-        ] {
-            if wants && !ctx.subgroups {
-                return Err(Error::invalid(
-                    what,
-                    format!(
-                        "subgroup: {} has no subgroup operations; use {instead}",
-                        ctx.adapter_label()
-                    ),
-                ));
-            }
-        }
+        check_settings(ctx, width, height, &settings)?;
         let dims = GridDims::new(width, height, settings.grid.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {

@@ -131,6 +131,76 @@ enum Cull {
     Stencil,
 }
 
+/// What every light-volume and full-screen pipeline of one deferred technique shares.
+struct Volumes<'a> {
+    device: &'a wgpu::Device,
+    volumes: &'a LightVolumes,
+    module: &'a wgpu::ShaderModule,
+    layouts: [Option<&'a wgpu::BindGroupLayout>; 3],
+    targets: &'a [Option<wgpu::ColorTargetState>],
+}
+
+impl Volumes<'_> {
+    fn volume(
+        &self,
+        label: &str,
+        fragment_entry: &str,
+        draw: VolumeDraw,
+        shading: Shading,
+    ) -> wgpu::RenderPipeline {
+        self.volumes.pipeline(
+            self.device,
+            &VolumePipelineDesc {
+                label,
+                module: self.module,
+                fragment_entry,
+                layouts: &self.layouts,
+                color_targets: self.targets,
+                draw,
+                shading,
+            },
+        )
+    }
+
+    fn fullscreen(
+        &self,
+        label: &str,
+        fragment_entry: &str,
+        kind: Fullscreen,
+    ) -> wgpu::RenderPipeline {
+        self.volumes.fullscreen_pipeline(
+            self.device,
+            &FullscreenVolumeDesc {
+                label,
+                module: self.module,
+                fragment_entry,
+                layouts: &self.layouts,
+                color_targets: self.targets,
+                kind,
+            },
+        )
+    }
+
+    /// The base pass and the volume classes shaded per pixel or per sample.
+    fn shaders(&self, shading: Shading, cull: Cull) -> Shaders {
+        let (suffix, light, base) = match shading {
+            Shading::PerPixel => ("", "fs_light", "fs_base"),
+            Shading::PerSample => (" per sample", "fs_light_sample", "fs_base_sample"),
+        };
+        let label = |what: &str| format!("{what}{suffix}");
+        let volume = |what: &str, draw| self.volume(&label(what), light, draw, shading);
+        Shaders {
+            shading,
+            base: self.fullscreen(&label("deferred base"), base, Fullscreen::Shade(shading)),
+            front: volume("light volumes (front faces)", VolumeDraw::Front),
+            back: volume("light volumes (back faces)", VolumeDraw::Back),
+            full: volume("light volumes (full screen)", VolumeDraw::Full),
+            stencil_light: (cull == Cull::Stencil)
+                .then(|| volume("stencil light", VolumeDraw::StencilLight)),
+        }
+    }
+}
+
 fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn Technique> {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
@@ -152,86 +222,31 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
             .specialized(ctx.shading.reusing_maps()),
     );
     let targets = volume_targets(ctx.count_blend, samples);
-    let layouts = [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)];
-    let volume = |label: &str, fragment_entry, draw, shading| {
-        volumes.pipeline(
-            device,
-            &VolumePipelineDesc {
-                label,
-                module: &module,
-                fragment_entry,
-                layouts: &layouts,
-                color_targets: &targets,
-                draw,
-                shading,
-            },
-        )
-    };
-    let fullscreen = |label: &str, fragment_entry, kind| {
-        volumes.fullscreen_pipeline(
-            device,
-            &FullscreenVolumeDesc {
-                label,
-                module: &module,
-                fragment_entry,
-                layouts: &layouts,
-                color_targets: &targets,
-                kind,
-            },
-        )
+    let pipelines = Volumes {
+        device,
+        volumes: &volumes,
+        module: &module,
+        layouts: [Some(ctx.scene_layout), None, Some(&gbuffer.read_layout)],
+        targets: &targets,
     };
     let shaders = Shading::of(samples)
         .iter()
-        .map(|&shading| {
-            let (suffix, light, base) = match shading {
-                Shading::PerPixel => ("", "fs_light", "fs_base"),
-                Shading::PerSample => (" per sample", "fs_light_sample", "fs_base_sample"),
-            };
-            let label = |what: &str| format!("{what}{suffix}");
-            Shaders {
-                shading,
-                base: fullscreen(&label("deferred base"), base, Fullscreen::Shade(shading)),
-                front: volume(
-                    &label("light volumes (front faces)"),
-                    light,
-                    VolumeDraw::Front,
-                    shading,
-                ),
-                back: volume(
-                    &label("light volumes (back faces)"),
-                    light,
-                    VolumeDraw::Back,
-                    shading,
-                ),
-                full: volume(
-                    &label("light volumes (full screen)"),
-                    light,
-                    VolumeDraw::Full,
-                    shading,
-                ),
-                stencil_light: (cull == Cull::Stencil).then(|| {
-                    volume(
-                        &label("stencil light"),
-                        light,
-                        VolumeDraw::StencilLight,
-                        shading,
-                    )
-                }),
-            }
-        })
+        .map(|&shading| pipelines.shaders(shading, cull))
         .collect();
+    let mark_edges = (samples > 1)
+        .then(|| pipelines.fullscreen("msaa edge marking", "fs_mark_edges", Fullscreen::MarkEdges));
+    let stencil_mark = (cull == Cull::Stencil).then(|| {
+        pipelines.volume(
+            "stencil mark",
+            "fs_stencil_only",
+            VolumeDraw::StencilMark,
+            Shading::PerPixel,
+        )
+    });
     Box::new(Deferred {
         copy: volumes.copy_pipeline(device, &module, ctx.scene_layout, &targets),
-        mark_edges: (samples > 1)
-            .then(|| fullscreen("msaa edge marking", "fs_mark_edges", Fullscreen::MarkEdges)),
-        stencil_mark: (cull == Cull::Stencil).then(|| {
-            volume(
-                "stencil mark",
-                "fs_stencil_only",
-                VolumeDraw::StencilMark,
-                Shading::PerPixel,
-            )
-        }),
+        mark_edges,
+        stencil_mark,
         shaders,
         gbuffer,
         volumes,

@@ -479,6 +479,44 @@ impl Irradiance {
     }
 }
 
+/// The second geometry pass's pipelines, per pixel and (with MSAA) per sample: the material
+/// lit by the irradiance targets, drawn where the copy of the volume depth-stencil says.
+fn shade_pipelines(
+    ctx: &PipelineContext,
+    module: &wgpu::ShaderModule,
+    irr_layout: &wgpu::BindGroupLayout,
+    irradiance: &Irradiance,
+    mono: bool,
+) -> Vec<(Shading, wgpu::RenderPipeline)> {
+    let samples = ctx.settings.grid.samples;
+    Shading::of(samples)
+        .iter()
+        .map(|&shading| {
+            let entry = match (shading, mono) {
+                (Shading::PerPixel, false) => "fs_shade",
+                (Shading::PerPixel, true) => "fs_shade_mono",
+                (Shading::PerSample, false) => "fs_shade_sample",
+                (Shading::PerSample, true) => "fs_shade_mono_sample",
+            };
+            let desc = GeometryPipelineDesc {
+                label: "light pre-pass shading",
+                module,
+                fragment_entry: Some(entry),
+                layouts: &[Some(ctx.scene_layout), Some(irr_layout)],
+                color_targets: &[Some(HDR_FORMAT.into())],
+                depth_write: false,
+                depth_compare: crate::depth::SURFACE,
+                samples,
+            };
+            let pipeline = match irradiance.copy() {
+                Some(copy) => geometry_pipeline_on(ctx.device, &desc, copy.surface_test()),
+                None => geometry_pipeline(ctx.device, &desc),
+            };
+            (shading, pipeline)
+        })
+        .collect()
+}
+
 fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     let mono = mode != Mode::Full;
     let device = ctx.device;
@@ -529,32 +567,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     } else {
         wgpu::TextureUsages::RENDER_ATTACHMENT
     };
-    let shade = Shading::of(samples)
-        .iter()
-        .map(|&shading| {
-            let entry = match (shading, mono) {
-                (Shading::PerPixel, false) => "fs_shade",
-                (Shading::PerPixel, true) => "fs_shade_mono",
-                (Shading::PerSample, false) => "fs_shade_sample",
-                (Shading::PerSample, true) => "fs_shade_mono_sample",
-            };
-            let desc = GeometryPipelineDesc {
-                label: "light pre-pass shading",
-                module: &module,
-                fragment_entry: Some(entry),
-                layouts: &[Some(ctx.scene_layout), Some(&irr_layout)],
-                color_targets: &[Some(HDR_FORMAT.into())],
-                depth_write: false,
-                depth_compare: crate::depth::SURFACE,
-                samples,
-            };
-            let pipeline = match irradiance.copy() {
-                Some(copy) => geometry_pipeline_on(device, &desc, copy.surface_test()),
-                None => geometry_pipeline(device, &desc),
-            };
-            (shading, pipeline)
-        })
-        .collect();
+    let shade = shade_pipelines(ctx, &module, &irr_layout, &irradiance, mono);
     let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
     Box::new(LightPrepass {
         mono,
@@ -619,6 +632,75 @@ fn bind_views(
 }
 
 impl LightPrepass {
+    /// Pass 2 of the tiled variant: the grid, the irradiance kernel, and with MSAA the pass
+    /// expanding its samples (and marking the edges) into the multisampled target.
+    fn encode_tiled(
+        &mut self,
+        f: &FrameInputs,
+        enc: &mut FrameEncoder,
+        attr_group: &wgpu::BindGroup,
+    ) -> Result<()> {
+        let Irradiance::Tiled {
+            builder,
+            kernel,
+            outputs_layout,
+            msaa,
+        } = &mut self.irradiance
+        else {
+            unreachable!("the tiled variant's irradiance")
+        };
+        builder.build(&crate::culling::CullFrame::of(f), enc)?;
+        let outputs = match msaa {
+            Some(_) => None,
+            None => Some(crate::passes::compute_outputs_to(
+                f.device,
+                outputs_layout,
+                &self.diffuse_view,
+                &f.targets.counts,
+            )),
+        };
+        let (encoder, timer) = enc.parts();
+        {
+            let label = "tiled irradiance (mono specular)";
+            let mut pass = timer.begin_compute(encoder, label);
+            pass.set_pipeline(kernel);
+            pass.set_bind_group(0, f.scene_bind_group, &[]);
+            pass.set_bind_group(1, builder.bind_group(), &[]);
+            pass.set_bind_group(2, attr_group, &[]);
+            let group3 = match (&outputs, msaa.as_deref()) {
+                (Some(outputs), _) => outputs,
+                (None, Some(m)) => &m.kernel_group,
+                (None, None) => unreachable!("outputs without MSAA"),
+            };
+            pass.set_bind_group(3, group3, &[]);
+            pass.dispatch_workgroups(
+                f.targets.width.div_ceil(SCREEN_WORKGROUP),
+                f.targets.height.div_ceil(SCREEN_WORKGROUP),
+                1,
+            );
+        }
+        if let Some(m) = msaa.as_deref() {
+            let copy_group = m.volumes.copy_bind_group(f.device, &f.targets.depth);
+            let label = "msaa irradiance expand";
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(label),
+                color_attachments: &[Some(cleared(&self.diffuse_view, wgpu::Color::TRANSPARENT))],
+                depth_stencil_attachment: Some(m.volumes.kept_attachment()),
+                timestamp_writes: timer.render_pass(label),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            m.volumes
+                .draw_depth_copy(&mut pass, f.scene_bind_group, &m.copy, &copy_group);
+            pass.set_bind_group(1, &m.expand_group, &[]);
+            pass.set_bind_group(2, attr_group, &[]);
+            m.volumes
+                .draw_fullscreen(&mut pass, &m.expand, Shading::PerPixel);
+            m.volumes.mark_edges(&mut pass, &m.mark_edges);
+        }
+        Ok(())
+    }
+
     /// Pass 2 with light volumes: the depth copy, (MSAA) the edge marks, then per shading the
     /// counting draw and each volume class blending in.
     fn encode_volumes(
@@ -752,65 +834,7 @@ impl Technique for LightPrepass {
         }
         match &mut self.irradiance {
             Irradiance::Volumes { .. } => self.encode_volumes(f, enc, &attr_group)?,
-            Irradiance::Tiled {
-                builder,
-                kernel,
-                outputs_layout,
-                msaa,
-            } => {
-                builder.build(&crate::culling::CullFrame::of(f), enc)?;
-                let outputs = match msaa {
-                    Some(_) => None,
-                    None => Some(crate::passes::compute_outputs_to(
-                        f.device,
-                        outputs_layout,
-                        &self.diffuse_view,
-                        &f.targets.counts,
-                    )),
-                };
-                let (encoder, timer) = enc.parts();
-                {
-                    let label = "tiled irradiance (mono specular)";
-                    let mut pass = timer.begin_compute(encoder, label);
-                    pass.set_pipeline(kernel);
-                    pass.set_bind_group(0, f.scene_bind_group, &[]);
-                    pass.set_bind_group(1, builder.bind_group(), &[]);
-                    pass.set_bind_group(2, &attr_group, &[]);
-                    let group3 = match (&outputs, msaa.as_deref()) {
-                        (Some(outputs), _) => outputs,
-                        (None, Some(m)) => &m.kernel_group,
-                        (None, None) => unreachable!("outputs without MSAA"),
-                    };
-                    pass.set_bind_group(3, group3, &[]);
-                    pass.dispatch_workgroups(
-                        f.targets.width.div_ceil(SCREEN_WORKGROUP),
-                        f.targets.height.div_ceil(SCREEN_WORKGROUP),
-                        1,
-                    );
-                }
-                if let Some(m) = msaa.as_deref() {
-                    let copy_group = m.volumes.copy_bind_group(f.device, &f.targets.depth);
-                    let label = "msaa irradiance expand";
-                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some(label),
-                        color_attachments: &[Some(cleared(
-                            &self.diffuse_view,
-                            wgpu::Color::TRANSPARENT,
-                        ))],
-                        depth_stencil_attachment: Some(m.volumes.kept_attachment()),
-                        timestamp_writes: timer.render_pass(label),
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
-                    m.volumes
-                        .draw_depth_copy(&mut pass, f.scene_bind_group, &m.copy, &copy_group);
-                    pass.set_bind_group(1, &m.expand_group, &[]);
-                    pass.set_bind_group(2, &attr_group, &[]);
-                    m.volumes
-                        .draw_fullscreen(&mut pass, &m.expand, Shading::PerPixel);
-                    m.volumes.mark_edges(&mut pass, &m.mark_edges);
-                }
-            }
+            Irradiance::Tiled { .. } => self.encode_tiled(f, enc, &attr_group)?,
         }
         // Pass 3 tests the kept copy where there is one (its stencil holds the edge bits),
         // else the scene depth.
