@@ -373,6 +373,49 @@ fn instance_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
     })
 }
 
+/// The stencil state of a volume class: the stencil-shadow-style marking (back faces
+/// behind the scene incremented, front faces decremented), the light draw over what was
+/// marked (clearing it), or for the others the MSAA edge bit's test (`edge_test`).
+fn volume_stencil(draw: VolumeDraw) -> wgpu::StencilState {
+    use wgpu::{CompareFunction as C, StencilFaceState, StencilOperation as Op};
+    let both = |face: StencilFaceState, read_mask: u32, write_mask: u32| wgpu::StencilState {
+        front: face,
+        back: face,
+        read_mask,
+        write_mask,
+    };
+    let stencil = match draw {
+        VolumeDraw::StencilMark => wgpu::StencilState {
+            front: StencilFaceState {
+                compare: C::Always,
+                fail_op: Op::Keep,
+                depth_fail_op: Op::DecrementWrap,
+                pass_op: Op::Keep,
+            },
+            back: StencilFaceState {
+                compare: C::Always,
+                fail_op: Op::Keep,
+                depth_fail_op: Op::IncrementWrap,
+                pass_op: Op::Keep,
+            },
+            read_mask: COUNT_STENCIL_MASK,
+            write_mask: COUNT_STENCIL_MASK,
+        },
+        VolumeDraw::StencilLight => both(
+            StencilFaceState {
+                compare: C::Equal,
+                fail_op: Op::Keep,
+                depth_fail_op: Op::Keep,
+                pass_op: Op::Zero,
+            },
+            EDGE_STENCIL | 1,
+            COUNT_STENCIL_MASK,
+        ),
+        _ => both(edge_test(), EDGE_STENCIL, 0),
+    };
+    stencil
+}
+
 impl LightVolumes {
     /// Volumes for a `width` x `height` frame of `samples` samples per pixel.
     pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
@@ -541,7 +584,7 @@ impl LightVolumes {
     /// surface adds one, a front face behind it takes one, and the front face lies before
     /// the back face on every ray), so the low bit is "inside".
     pub fn pipeline(&self, device: &wgpu::Device, d: &VolumePipelineDesc) -> wgpu::RenderPipeline {
-        use wgpu::{CompareFunction as C, Face, StencilFaceState, StencilOperation as Op};
+        use wgpu::{CompareFunction as C, Face};
         assert!(
             d.shading == Shading::PerPixel || self.samples > 1,
             "per-sample volume pipelines need MSAA"
@@ -559,41 +602,7 @@ impl LightVolumes {
             VolumeDraw::StencilMark => (None, crate::depth::NEARER_OR_EQUAL, "vs_volume"),
             VolumeDraw::StencilLight => (Some(Face::Front), C::Always, "vs_volume"),
         };
-        let both = |face: StencilFaceState, read_mask: u32, write_mask: u32| wgpu::StencilState {
-            front: face,
-            back: face,
-            read_mask,
-            write_mask,
-        };
-        let stencil = match d.draw {
-            VolumeDraw::StencilMark => wgpu::StencilState {
-                front: StencilFaceState {
-                    compare: C::Always,
-                    fail_op: Op::Keep,
-                    depth_fail_op: Op::DecrementWrap,
-                    pass_op: Op::Keep,
-                },
-                back: StencilFaceState {
-                    compare: C::Always,
-                    fail_op: Op::Keep,
-                    depth_fail_op: Op::IncrementWrap,
-                    pass_op: Op::Keep,
-                },
-                read_mask: COUNT_STENCIL_MASK,
-                write_mask: COUNT_STENCIL_MASK,
-            },
-            VolumeDraw::StencilLight => both(
-                StencilFaceState {
-                    compare: C::Equal,
-                    fail_op: Op::Keep,
-                    depth_fail_op: Op::Keep,
-                    pass_op: Op::Zero,
-                },
-                EDGE_STENCIL | 1,
-                COUNT_STENCIL_MASK,
-            ),
-            _ => both(edge_test(), EDGE_STENCIL, 0),
-        };
+        let stencil = volume_stencil(d.draw);
         let targets = if d.draw == VolumeDraw::StencilMark {
             no_color(d.color_targets)
         } else {

@@ -175,25 +175,23 @@ pub fn cell_spheres(
     Some(spheres)
 }
 
-/// Build the tile grid on the CPU.
-pub fn assign_cpu(
-    setup: &ViewSetup,
-    dims: &GridDims,
-    lights: &[Light],
-    depth: DepthRange,
-) -> LightGrid {
-    struct Placed {
-        tx0: u32,
-        tx1: u32,
-        ty0: u32,
-        ty1: u32,
-        w_min: f32,
-        w_max: f32,
-        view: ViewLight,
-        /// A spot's sector box (`ViewLight::reach_box`), tested against cells' tight boxes.
-        sector: Option<(Vec3, Vec3)>,
-    }
-    let placed: Vec<Option<Placed>> = lights
+/// A light placed on the screen: the tiles its projected sphere covers, its view-distance
+/// extent, and the light in view space.
+struct Placed {
+    tx0: u32,
+    tx1: u32,
+    ty0: u32,
+    ty1: u32,
+    w_min: f32,
+    w_max: f32,
+    view: ViewLight,
+    /// A spot's sector box (`ViewLight::reach_box`), tested against cells' tight boxes.
+    sector: Option<(Vec3, Vec3)>,
+}
+
+/// Every light's [`Placed`], or None for a light in no tile.
+fn place(setup: &ViewSetup, dims: &GridDims, lights: &[Light]) -> Vec<Option<Placed>> {
+    lights
         .par_iter()
         .map(|l| {
             let v = setup.to_view(l);
@@ -210,7 +208,44 @@ pub fn assign_cpu(
                 view: v,
             })
         })
-        .collect();
+        .collect()
+}
+
+/// The grid of (cell, light) pairs: per cell its offset and count, the lists in the order
+/// the pairs come.
+fn grid_from_pairs(dims: &GridDims, pairs: &[Vec<(u32, u32)>]) -> LightGrid {
+    let mut counts = vec![0u32; dims.cell_count()];
+    for &(c, _) in pairs.iter().flatten() {
+        counts[c as usize] += 1;
+    }
+    let mut cells = Vec::with_capacity(counts.len());
+    let mut offset = 0u32;
+    for &n in &counts {
+        cells.push([offset, n]);
+        offset += n;
+    }
+    let mut indices = vec![0u32; offset as usize];
+    let mut cursor: Vec<u32> = cells.iter().map(|c| c[0]).collect();
+    for &(c, l) in pairs.iter().flatten() {
+        indices[cursor[c as usize] as usize] = l;
+        cursor[c as usize] += 1;
+    }
+    LightGrid {
+        dims: *dims,
+        cells,
+        indices,
+        zbins: None,
+    }
+}
+
+/// Build the tile grid on the CPU.
+pub fn assign_cpu(
+    setup: &ViewSetup,
+    dims: &GridDims,
+    lights: &[Light],
+    depth: DepthRange,
+) -> LightGrid {
+    let placed = place(setup, dims, lights);
     let mut rows: Vec<Vec<u32>> = vec![Vec::new(); dims.tiles_y as usize];
     for (i, p) in placed.iter().enumerate() {
         if let Some(p) = p {
@@ -286,28 +321,7 @@ pub fn assign_cpu(
             out
         })
         .collect();
-    let mut counts = vec![0u32; dims.cell_count()];
-    for &(c, _) in pairs.iter().flatten() {
-        counts[c as usize] += 1;
-    }
-    let mut cells = Vec::with_capacity(counts.len());
-    let mut offset = 0u32;
-    for &n in &counts {
-        cells.push([offset, n]);
-        offset += n;
-    }
-    let mut indices = vec![0u32; offset as usize];
-    let mut cursor: Vec<u32> = cells.iter().map(|c| c[0]).collect();
-    for &(c, l) in pairs.iter().flatten() {
-        indices[cursor[c as usize] as usize] = l;
-        cursor[c as usize] += 1;
-    }
-    LightGrid {
-        dims: *dims,
-        cells,
-        indices,
-        zbins: None,
-    }
+    grid_from_pairs(dims, &pairs)
 }
 
 /// `--assign cpu`: the papers' CPU pipeline (tiled-shading §6.3: a CPU-built grid "cannot be
