@@ -13,7 +13,7 @@ use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel};
 use crate::passes::{BufferReadback, DepthSamples, Readback, Targets};
 use crate::pipelines::PipelineInfo;
-use crate::scene::{rasterize, FrameState};
+use crate::scene::{rasterize, FrameState, Light};
 use crate::stats::{FrameStats, TimingSource};
 use glam::Vec3;
 use image::RgbaImage;
@@ -222,88 +222,58 @@ pub(crate) struct AnalysisInput<'r> {
     pub shadow_maps: Option<crate::stats::ShadowMapStats>,
 }
 
-/// Read the frame's copies back and compute its statistics.
-pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
-    let device = a.device;
-    let (width, height) = a.size;
-    let (dims, settings) = (a.dims, a.settings);
-    let lights = &a.up_state.lights;
-    let image =
-        RgbaImage::from_raw(width, height, a.readbacks.image.read(device)?).expect("size matches");
-    let depth_samples = a.readbacks.read_depth(device)?;
-    let depth = depth_samples[0].clone();
-    let samples = depth_samples.len() as u64;
-    let sum = |counts: &[u32]| counts.iter().map(|&c| u64::from(c)).sum::<u64>();
-    // Counted by the count target where it can blend, always with MSAA (`pixel_counts`).
-    let countable = a.count_blend || samples > 1;
-    let counts = if countable {
-        Some(a.readbacks.counts.read(device)?)
-    } else {
-        None
-    };
-    let lighting_computations = counts.as_deref().map(sum);
-    // The opaque passes' share (the counts before the transparent pass) and the transparent
-    // pass's (the rest). The traffic models describe the opaque pipeline (a lit pixel is a
-    // lighting computation of its deferred or forward pass); the transparent pass,
-    // forward-shaded by every pipeline, is outside them.
-    let opaque_lighting_computations = match lighting_computations {
-        Some(all) if !a.transparent.is_empty() => {
-            Some(sum(&a.readbacks.opaque_counts.read(device)?).min(all))
-        }
-        all => all,
-    };
-    let transparent_lighting_computations = lighting_computations
-        .zip(opaque_lighting_computations)
-        .map(|(all, opaque)| all - opaque);
-
-    // The ideal: for each visible sample and each transparent fragment in front of it, the
-    // lights reaching it. The depth-bounded CPU grid (with transparent lists when there are
-    // transparent fragments) narrows the search: it provably contains every such light.
-    // With MSAA the ideal is still one computation per light per pixel (MSAA shades once per
-    // pixel and surface): the average over the pixel's samples of the lights reaching each
-    // (at the pixel's centre ray, the sample's depth).
-    let setup = a.setup;
-    // Per sample plane, each pixel's view distance (plane 0: the pixel's visible sample).
-    let distances: Vec<Vec<f32>> = depth_samples
-        .iter()
-        .map(|plane| setup.view_distances(plane))
-        .collect();
-    let fragments = rasterize(&setup, &a.transparent, &distances[0]);
-    let ideal_dims = if fragments.is_empty() {
-        dims
-    } else {
-        dims.with_lists(GridLists::Separate)
-    };
-    let planes: Vec<&[f32]> = depth_samples.iter().map(Vec::as_slice).collect();
-    let bounds = cell_bounds_cpu_samples(&setup, &ideal_dims, &planes);
-    let bounded = assign_cpu(&setup, &ideal_dims, lights, DepthRange::Cells(&bounds));
-    let fragment_ideal = ideal_fragment_counts(&setup, &bounded, lights, &fragments);
-    let ideal_transparent: u64 = fragment_ideal.iter().map(|&n| u64::from(n)).sum();
-    // Per pixel: the opaque ideal averaged over the samples, plus the transparent fragments'.
-    let mut ideal_counts = vec![0f32; (width * height) as usize];
-    let mut ideal_opaque = 0u64;
-    for d in &distances {
-        for (acc, n) in ideal_counts
-            .iter_mut()
-            .zip(ideal_pixel_counts(&setup, &bounded, lights, d))
-        {
-            ideal_opaque += u64::from(n);
-            *acc += n as f32 / samples as f32;
+impl AnalysisInput<'_> {
+    /// The frame's GPU time: its timestamps, or the wall clock where there are none.
+    fn timing(&self) -> (f64, TimingSource) {
+        match self.finished.gpu_ms {
+            Some(ms) => (ms, TimingSource::GpuTimestamps),
+            None => (self.wall_ms, TimingSource::WallClock),
         }
     }
-    for (f, &n) in fragments.iter().zip(&fragment_ideal) {
-        ideal_counts[(f.y * width + f.x) as usize] += n as f32;
-    }
-    let ideal = (ideal_opaque + samples / 2) / samples + ideal_transparent;
 
-    let passes = a.finished.passes;
-    let (gpu_ms, timing) = match a.finished.gpu_ms {
-        Some(ms) => (ms, TimingSource::GpuTimestamps),
-        None => (a.wall_ms, TimingSource::WallClock),
-    };
-    let grid_is_pipelines = a.grid.is_some();
-    let assign_gpu_ms = a.finished.assign_gpu_ms.filter(|_| grid_is_pipelines);
-    let (grid, cell_bounds, cell_culls, assign, assign_cpu_ms) = match a.grid {
+    /// Where an MSAA deferred kernel resolved, for frames shaded per sample.
+    fn msaa_resolve(&self) -> Option<crate::frame::MsaaResolve> {
+        self.finished.msaa_shading.map(|_| {
+            if self.resolved_in_kernel {
+                crate::frame::MsaaResolve::Kernel
+            } else {
+                crate::frame::MsaaResolve::Separate
+            }
+        })
+    }
+
+    /// The frame's memory: the targets, the traffic of `opaque` lighting computations, the
+    /// pipeline's own grid (and its cells' culling records where 2.5D masks or boxes are on).
+    fn memory(&self, opaque: Option<u64>, grid: Option<&LightGrid>) -> FrameMemory {
+        let grid_settings = self.settings.grid;
+        frame_memory(
+            self.info.memory_model(&self.settings),
+            self.size,
+            opaque,
+            grid,
+            self.info.depth_bounds
+                && self.info.assign
+                && (grid_settings.depth_mask == crate::frame::DepthMask::On
+                    || grid_settings.cell_box == crate::frame::CellBox::On),
+        )
+    }
+}
+
+/// What the frame's grid statistics describe: the pipeline's own grid, its cell bounds and
+/// culling records, the strategy that ran and its CPU time; or, for a pipeline without a
+/// grid, the depth-bounded CPU grid of the ideal count.
+#[allow(clippy::type_complexity)]
+fn shaded_grid(
+    built: Option<BuiltGrid>,
+    bounded: LightGrid,
+) -> (
+    LightGrid,
+    Option<Vec<[f32; 2]>>,
+    Option<Vec<crate::culling::CellCull>>,
+    Option<String>,
+    Option<f64>,
+) {
+    match built {
         Some(b) => (
             b.grid,
             Some(b.cell_bounds),
@@ -312,22 +282,161 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             Some(b.cpu_ms),
         ),
         None => (bounded, None, None, None, None),
-    };
+    }
+}
+
+/// Per pixel, the lighting computations of every pass (None where not countable), their
+/// sum, and the opaque passes' and the transparent pass's shares.
+struct Counts {
+    counts: Option<Vec<u32>>,
+    all: Option<u64>,
+    opaque: Option<u64>,
+    transparent: Option<u64>,
+}
+
+impl Counts {
+    fn read(a: &AnalysisInput, samples: u64) -> Result<Counts> {
+        let sum = |counts: &[u32]| counts.iter().map(|&c| u64::from(c)).sum::<u64>();
+        // Counted by the count target where it can blend, always with MSAA (`pixel_counts`).
+        let countable = a.count_blend || samples > 1;
+        let counts = if countable {
+            Some(a.readbacks.counts.read(a.device)?)
+        } else {
+            None
+        };
+        let lighting_computations = counts.as_deref().map(sum);
+        // The opaque passes' share (the counts before the transparent pass) and the transparent
+        // pass's (the rest). The traffic models describe the opaque pipeline (a lit pixel is a
+        // lighting computation of its deferred or forward pass); the transparent pass,
+        // forward-shaded by every pipeline, is outside them.
+        let opaque_lighting_computations = match lighting_computations {
+            Some(all) if !a.transparent.is_empty() => {
+                Some(sum(&a.readbacks.opaque_counts.read(a.device)?).min(all))
+            }
+            all => all,
+        };
+        let transparent_lighting_computations = lighting_computations
+            .zip(opaque_lighting_computations)
+            .map(|(all, opaque)| all - opaque);
+        Ok(Counts {
+            counts,
+            all: lighting_computations,
+            opaque: opaque_lighting_computations,
+            transparent: transparent_lighting_computations,
+        })
+    }
+}
+
+/// The ideal of a frame: for each visible sample and each transparent fragment in front of
+/// it, the lights reaching it. The depth-bounded CPU grid (with transparent lists when there
+/// are transparent fragments) narrows the search: it provably contains every such light.
+/// With MSAA the ideal is still one computation per light per pixel (MSAA shades once per
+/// pixel and surface): the average over the pixel's samples of the lights reaching each (at
+/// the pixel's centre ray, the sample's depth).
+struct Ideal {
+    /// The depth-bounded CPU grid the search went through.
+    bounded: LightGrid,
+    /// The transparent fragments, rasterized on the CPU.
+    fragments: Vec<crate::scene::Fragment>,
+    /// Per pixel: the opaque ideal averaged over the samples, plus the transparent fragments'.
+    counts: Vec<f32>,
+    /// The frame's ideal lighting computations, and the transparent fragments' share.
+    total: u64,
+    transparent: u64,
+}
+
+impl Ideal {
+    fn of(
+        setup: &ViewSetup,
+        dims: GridDims,
+        lights: &[Light],
+        transparent: &[[Vec3; 3]],
+        depth_samples: &[Vec<f32>],
+    ) -> Ideal {
+        let samples = depth_samples.len() as u64;
+        // The ideal: for each visible sample and each transparent fragment in front of it, the
+        // lights reaching it. The depth-bounded CPU grid (with transparent lists when there are
+        // transparent fragments) narrows the search: it provably contains every such light.
+        // With MSAA the ideal is still one computation per light per pixel (MSAA shades once per
+        // pixel and surface): the average over the pixel's samples of the lights reaching each
+        // (at the pixel's centre ray, the sample's depth).
+        // Per sample plane, each pixel's view distance (plane 0: the pixel's visible sample).
+        let distances: Vec<Vec<f32>> = depth_samples
+            .iter()
+            .map(|plane| setup.view_distances(plane))
+            .collect();
+        let fragments = rasterize(setup, transparent, &distances[0]);
+        let ideal_dims = if fragments.is_empty() {
+            dims
+        } else {
+            dims.with_lists(GridLists::Separate)
+        };
+        let planes: Vec<&[f32]> = depth_samples.iter().map(Vec::as_slice).collect();
+        let bounds = cell_bounds_cpu_samples(setup, &ideal_dims, &planes);
+        let bounded = assign_cpu(setup, &ideal_dims, lights, DepthRange::Cells(&bounds));
+        let fragment_ideal = ideal_fragment_counts(setup, &bounded, lights, &fragments);
+        let ideal_transparent: u64 = fragment_ideal.iter().map(|&n| u64::from(n)).sum();
+        // Per pixel: the opaque ideal averaged over the samples, plus the transparent fragments'.
+        let mut ideal_counts = vec![0f32; (setup.width * setup.height) as usize];
+        let mut ideal_opaque = 0u64;
+        for d in &distances {
+            for (acc, n) in ideal_counts
+                .iter_mut()
+                .zip(ideal_pixel_counts(setup, &bounded, lights, d))
+            {
+                ideal_opaque += u64::from(n);
+                *acc += n as f32 / samples as f32;
+            }
+        }
+        for (f, &n) in fragments.iter().zip(&fragment_ideal) {
+            ideal_counts[(f.y * setup.width + f.x) as usize] += n as f32;
+        }
+        Ideal {
+            bounded,
+            fragments,
+            counts: ideal_counts,
+            total: (ideal_opaque + samples / 2) / samples + ideal_transparent,
+            transparent: ideal_transparent,
+        }
+    }
+}
+
+/// Read the frame's copies back and compute its statistics.
+pub(crate) fn analyze(mut a: AnalysisInput) -> Result<FrameOutput> {
+    let (device, (width, height)) = (a.device, a.size);
+    let (dims, settings) = (a.dims, a.settings);
+    let lights = &a.up_state.lights;
+    let image = a.readbacks.image.read(device)?;
+    let image = RgbaImage::from_raw(width, height, image).expect("size matches");
+    let depth_samples = a.readbacks.read_depth(device)?;
+    let depth = depth_samples[0].clone();
+    let samples = depth_samples.len() as u64;
+    let Counts {
+        counts,
+        all: lighting_computations,
+        opaque: opaque_lighting_computations,
+        transparent: transparent_lighting_computations,
+    } = Counts::read(&a, samples)?;
+    let setup = a.setup;
+    let Ideal {
+        bounded,
+        fragments,
+        counts: ideal_counts,
+        total: ideal,
+        transparent: ideal_transparent,
+    } = Ideal::of(&setup, dims, lights, &a.transparent, &depth_samples);
+    let passes = std::mem::take(&mut a.finished.passes);
+    let (gpu_ms, timing) = a.timing();
+    let grid_is_pipelines = a.grid.is_some();
+    let assign_gpu_ms = a.finished.assign_gpu_ms.filter(|_| grid_is_pipelines);
+    let (grid, cell_bounds, cell_culls, assign, assign_cpu_ms) =
+        shaded_grid(a.grid.take(), bounded);
     // The strategy's cost: its GPU passes and its CPU work (a wait for the GPU, which `cpu`
     // with depth bounds makes, is the frame's `cpu_wait_ms`: it also covers the passes before).
     let assign_ms = assign_cpu_ms.map(|cpu| cpu + assign_gpu_ms.unwrap_or(0.0));
-    let occupied = cell_bounds
-        .as_ref()
-        .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64);
-    let memory = frame_memory(
-        a.info.memory_model(&settings),
-        (width, height),
+    let memory = a.memory(
         opaque_lighting_computations,
         grid_is_pipelines.then_some(&grid),
-        a.info.depth_bounds
-            && a.info.assign
-            && (settings.grid.depth_mask == crate::frame::DepthMask::On
-                || settings.grid.cell_box == crate::frame::CellBox::On),
     );
     Ok(FrameOutput {
         image,
@@ -358,13 +467,7 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             unshadowed_lights: (settings.shadows != crate::scene::Shadows::Off)
                 .then_some(a.unshadowed),
             shadow_maps: a.shadow_maps,
-            msaa_resolve: a.finished.msaa_shading.map(|_| {
-                if a.resolved_in_kernel {
-                    crate::frame::MsaaResolve::Kernel
-                } else {
-                    crate::frame::MsaaResolve::Separate
-                }
-            }),
+            msaa_resolve: a.msaa_resolve(),
             lighting_computations,
             ideal_lighting_computations: ideal,
             transparent_fragments: fragments.len() as u64,
@@ -378,7 +481,9 @@ pub(crate) fn analyze(a: AnalysisInput) -> Result<FrameOutput> {
             tile_area_computations: grid.tile_area_computations().filter(|_| grid_is_pipelines),
             grid_indices: grid_is_pipelines.then_some(grid.indices.len() as u64),
             grid_cells: grid_is_pipelines.then_some(grid.cells.len() as u64),
-            grid_cells_occupied: occupied,
+            grid_cells_occupied: cell_bounds
+                .as_ref()
+                .map(|b| b.iter().filter(|[lo, hi]| lo <= hi).count() as u64),
             assign,
             assign_gpu_ms,
             assign_cpu_ms,

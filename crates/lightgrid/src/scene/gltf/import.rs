@@ -573,6 +573,135 @@ fn vec3s(flat: &[f32]) -> Vec<Vec3> {
 }
 
 /// The mesh of one triangle primitive, or `None` (with a warning) for points and lines.
+/// The primitive's positions (accessor `pos_acc`), all finite; counted against the file's
+/// vertex limit.
+fn file_positions(doc: &Document, pos_acc: usize, what: &str, walk: &mut Walk) -> Res<Vec<Vec3>> {
+    let count = doc.root.accessors.get(pos_acc).map_or(0, |a| a.count);
+    walk.read_vertices = walk.read_vertices.saturating_add(count);
+    if walk.read_vertices > MAX_VERTICES as u64 {
+        return Err(format!(
+            "{what}: the file's meshes have more than {MAX_VERTICES} vertices"
+        ));
+    }
+    let positions = vec3s(&doc.read_floats(pos_acc, 3, &format!("{what} POSITION"))?);
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(format!(
+            "{what}: POSITION (accessor {pos_acc}) has a NaN or infinite coordinate"
+        ));
+    }
+    Ok(positions)
+}
+
+/// The texture coordinate sets (0 and 1) the primitive's material reads, a warning for each
+/// the primitive lacks.
+fn texture_sets(
+    material: Option<&MaterialDef>,
+    prim: &Primitive,
+    what: &str,
+    walk: &mut Walk,
+) -> Vec<u32> {
+    let mut sets = material.map_or(Vec::new(), material_sets);
+    sets.retain(|&s| s <= 1);
+    for set in sets.iter().map(|s| format!("TEXCOORD_{s}")) {
+        if !prim.attributes.contains_key(&set) {
+            walk.warn(format!(
+                "{what}: textured without {set}; its texture is sampled at one texel"
+            ));
+        }
+    }
+    sets
+}
+
+/// The primitive's index sequence (its accessor's, or every vertex in order), each index
+/// within `vertices`; counted against the file's triangle limit.
+fn index_sequence(
+    doc: &Document,
+    prim: &Primitive,
+    what: &str,
+    walk: &mut Walk,
+    vertices: usize,
+) -> Res<Vec<u32>> {
+    let Some(i) = prim.indices else {
+        return Ok((0..vertices as u32).collect());
+    };
+    let n = doc.root.accessors.get(i).map_or(0, |a| a.count);
+    walk.read_indices = walk.read_indices.saturating_add(n);
+    if walk.read_indices > 3 * MAX_TRIANGLES as u64 {
+        return Err(format!(
+            "{what}: the file's meshes have more than {MAX_TRIANGLES} triangles"
+        ));
+    }
+    let seq = doc.read_indices(i, &format!("{what} indices"))?;
+    if let Some(bad) = seq.iter().find(|&&v| v as usize >= vertices) {
+        return Err(format!(
+            "{what}: index {bad} (accessor {i}) is out of range for {vertices} vertices"
+        ));
+    }
+    Ok(seq)
+}
+
+/// The primitive's `TEXCOORD_k`, one finite UV per vertex, or None without it.
+fn uv_set(
+    doc: &Document,
+    prim: &Primitive,
+    k: u32,
+    vertices: usize,
+    what: &str,
+) -> Res<Option<Vec<Vec2>>> {
+    let set = format!("TEXCOORD_{k}");
+    let Some(&a) = prim.attributes.get(&set) else {
+        return Ok(None);
+    };
+    let uv: Vec<Vec2> = doc
+        .read_floats(a, 2, &format!("{what} {set}"))?
+        .chunks_exact(2)
+        .map(|c| Vec2::new(c[0], c[1]))
+        .collect();
+    if uv.len() != vertices || uv.iter().any(|v| !v.is_finite()) {
+        return Err(format!(
+            "{what}: {set} (accessor {a}) needs one finite UV per vertex"
+        ));
+    }
+    Ok(Some(uv))
+}
+
+/// The file's tangents (accessor `a`), one finite tangent per vertex.
+fn file_tangents(doc: &Document, a: usize, vertices: usize, what: &str) -> Res<Vec<Vec4>> {
+    let t: Vec<Vec4> = doc
+        .read_floats(a, 4, &format!("{what} TANGENT"))?
+        .chunks_exact(4)
+        .map(Vec4::from_slice)
+        .collect();
+    if t.len() != vertices || t.iter().any(|v| !v.is_finite()) {
+        return Err(format!(
+            "{what}: TANGENT (accessor {a}) needs one finite tangent per vertex"
+        ));
+    }
+    Ok(t)
+}
+
+/// The file's normals (accessor `a`), one finite normal per vertex; a zero normal, which
+/// cannot be normalized, is the faces' around it.
+fn file_normals(
+    doc: &Document,
+    a: usize,
+    positions: &[Vec3],
+    indices: &[u32],
+    what: &str,
+) -> Res<Vec<Vec3>> {
+    let n = vec3s(&doc.read_floats(a, 3, &format!("{what} NORMAL"))?);
+    if n.len() != positions.len() || n.iter().any(|v| !v.is_finite()) {
+        return Err(format!(
+            "{what}: NORMAL (accessor {a}) needs one finite normal per vertex"
+        ));
+    }
+    let around = computed_normals(positions, indices);
+    Ok(n.iter()
+        .zip(&around)
+        .map(|(v, c)| v.try_normalize().unwrap_or(*c))
+        .collect())
+}
+
 fn primitive_mesh(
     doc: &Document,
     (mi, pi): (usize, usize),
@@ -596,39 +725,8 @@ fn primitive_mesh(
         walk.warn(format!("{what}: no POSITION attribute; skipped"));
         return Ok(None);
     };
-    let count = doc.root.accessors.get(pos_acc).map_or(0, |a| a.count);
-    walk.read_vertices = walk.read_vertices.saturating_add(count);
-    if walk.read_vertices > MAX_VERTICES as u64 {
-        return Err(format!(
-            "{what}: the file's meshes have more than {MAX_VERTICES} vertices"
-        ));
-    }
-    let positions = vec3s(&doc.read_floats(pos_acc, 3, &format!("{what} POSITION"))?);
-    if positions.iter().any(|p| !p.is_finite()) {
-        return Err(format!(
-            "{what}: POSITION (accessor {pos_acc}) has a NaN or infinite coordinate"
-        ));
-    }
-    let seq = match prim.indices {
-        Some(i) => {
-            let n = doc.root.accessors.get(i).map_or(0, |a| a.count);
-            walk.read_indices = walk.read_indices.saturating_add(n);
-            if walk.read_indices > 3 * MAX_TRIANGLES as u64 {
-                return Err(format!(
-                    "{what}: the file's meshes have more than {MAX_TRIANGLES} triangles"
-                ));
-            }
-            let seq = doc.read_indices(i, &format!("{what} indices"))?;
-            if let Some(bad) = seq.iter().find(|&&v| v as usize >= positions.len()) {
-                return Err(format!(
-                    "{what}: index {bad} (accessor {i}) is out of range for {} vertices",
-                    positions.len()
-                ));
-            }
-            seq
-        }
-        None => (0..positions.len() as u32).collect(),
-    };
+    let positions = file_positions(doc, pos_acc, &what, walk)?;
+    let seq = index_sequence(doc, prim, &what, walk, positions.len())?;
     let indices = triangulate(mode, &seq);
     if indices.is_empty() {
         walk.warn(format!("{what}: no triangles; skipped"));
@@ -636,35 +734,11 @@ fn primitive_mesh(
     }
     // The texture coordinate sets the primitive's material reads, each checked for.
     let material = prim.material.and_then(|m| doc.root.materials.get(m));
-    let mut sets = material.map_or(Vec::new(), material_sets);
-    sets.retain(|&s| s <= 1);
-    for set in sets.iter().map(|s| format!("TEXCOORD_{s}")) {
-        if !prim.attributes.contains_key(&set) {
-            walk.warn(format!(
-                "{what}: textured without {set}; its texture is sampled at one texel"
-            ));
-        }
-    }
-    let uv_set = |k: u32| -> Res<Option<Vec<Vec2>>> {
-        let set = format!("TEXCOORD_{k}");
-        let Some(&a) = prim.attributes.get(&set) else {
-            return Ok(None);
-        };
-        let uv: Vec<Vec2> = doc
-            .read_floats(a, 2, &format!("{what} {set}"))?
-            .chunks_exact(2)
-            .map(|c| Vec2::new(c[0], c[1]))
-            .collect();
-        if uv.len() != positions.len() || uv.iter().any(|v| !v.is_finite()) {
-            return Err(format!(
-                "{what}: {set} (accessor {a}) needs one finite UV per vertex"
-            ));
-        }
-        Ok(Some(uv))
-    };
-    let uvs = uv_set(0)?.unwrap_or_else(|| vec![Vec2::ZERO; positions.len()]);
+    let sets = texture_sets(material, prim, &what, walk);
+    let uvs = uv_set(doc, prim, 0, positions.len(), &what)?
+        .unwrap_or_else(|| vec![Vec2::ZERO; positions.len()]);
     let uvs1 = match sets.contains(&1) {
-        true => uv_set(1)?.unwrap_or_default(),
+        true => uv_set(doc, prim, 1, positions.len(), &what)?.unwrap_or_default(),
         false => Vec::new(),
     };
     let colors = match prim.attributes.get("COLOR_0") {
@@ -673,36 +747,12 @@ fn primitive_mesh(
     };
     let normal_texture = material.and_then(|m| m.normal_texture.as_ref());
     let tangents = match (normal_texture, prim.attributes.get("TANGENT")) {
-        (Some(_), Some(&a)) => {
-            let t: Vec<Vec4> = doc
-                .read_floats(a, 4, &format!("{what} TANGENT"))?
-                .chunks_exact(4)
-                .map(Vec4::from_slice)
-                .collect();
-            if t.len() != positions.len() || t.iter().any(|v| !v.is_finite()) {
-                return Err(format!(
-                    "{what}: TANGENT (accessor {a}) needs one finite tangent per vertex"
-                ));
-            }
-            t
-        }
+        (Some(_), Some(&a)) => file_tangents(doc, a, positions.len(), &what)?,
         _ => Vec::new(),
     };
     let mut mesh = match prim.attributes.get("NORMAL") {
         Some(&a) => {
-            let n = vec3s(&doc.read_floats(a, 3, &format!("{what} NORMAL"))?);
-            if n.len() != positions.len() || n.iter().any(|v| !v.is_finite()) {
-                return Err(format!(
-                    "{what}: NORMAL (accessor {a}) needs one finite normal per vertex"
-                ));
-            }
-            // A zero normal cannot be normalized: the faces around it give one.
-            let around = computed_normals(&positions, &indices);
-            let normals = n
-                .iter()
-                .zip(&around)
-                .map(|(v, c)| v.try_normalize().unwrap_or(*c))
-                .collect();
+            let normals = file_normals(doc, a, &positions, &indices, &what)?;
             Mesh {
                 positions,
                 normals,
