@@ -1485,8 +1485,9 @@ fn sample(doc: &Document, anim: &animation::Animation, walk: &mut Walk) -> Res<O
 }
 
 /// The scene a document describes.
-pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Scene, Vec<String>)> {
-    let mut walk = Walk::default();
+/// Refuse a file that requires an extension lightgrid does not read, or more materials than
+/// it renders; warn of every extension used and part not applied.
+fn check_extensions(doc: &Document, walk: &mut Walk) -> Res<()> {
     for ext in &doc.root.extensions_required {
         if !EXTENSIONS_READ.contains(&ext.as_str()) {
             return Err(format!(
@@ -1510,6 +1511,15 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
             crate::consts::MAX_MATERIALS - 1
         ));
     }
+    Ok(())
+}
+
+/// Every material the file's primitives may use (the specification's default last, where a
+/// primitive names none), how the file's indices map to them, and their textures.
+fn read_materials(
+    doc: &Document,
+    walk: &mut Walk,
+) -> Res<(Vec<Material>, MaterialMap, Vec<Texture>)> {
     let mut materials = Vec::new();
     let mut by_gltf = Vec::new();
     let mut textures = TextureLoader {
@@ -1522,7 +1532,7 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
             by_gltf.push(None);
             continue;
         }
-        materials.push(map_material(def, i, &mut textures, &mut walk)?);
+        materials.push(map_material(def, i, &mut textures, walk)?);
         by_gltf.push(Some(materials.len() - 1));
     }
     // The specification's default material, for primitives without one (only if any).
@@ -1534,17 +1544,75 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         .any(|p| p.material.is_none());
     if needs_default {
         let default = MaterialDef::default();
-        materials.push(map_material(
-            &default,
-            usize::MAX,
-            &mut textures,
-            &mut walk,
-        )?);
+        materials.push(map_material(&default, usize::MAX, &mut textures, walk)?);
     }
     let map = MaterialMap {
         by_gltf,
         default: materials.len().saturating_sub(1),
     };
+    Ok((materials, map, textures.textures))
+}
+
+/// The lights the file's nodes place (world space), each with the animation track of its
+/// node, if any.
+#[allow(clippy::type_complexity)]
+fn read_lights(
+    doc: &Document,
+    walk: &mut Walk,
+    sampled: Option<&Sampled>,
+) -> Res<(Vec<MappedLight>, Vec<Option<usize>>)> {
+    let defs = doc
+        .root
+        .extensions
+        .as_ref()
+        .and_then(|e| e.lights.as_ref())
+        .map_or(&[][..], |l| &l.lights[..]);
+    let mut lights = Vec::new();
+    let mut light_tracks = Vec::new();
+    for (li, world, node) in walk.lights.clone() {
+        let def = defs
+            .get(li)
+            .ok_or_else(|| format!("a node names light {li}, which does not exist"))?;
+        if let Some(light) = map_light(def, li, world, walk)? {
+            lights.push(light);
+            light_tracks.push(sampled.and_then(|s| s.track_of.get(&node).copied()));
+        }
+        if lights.len() > crate::consts::MAX_LIGHTS as usize {
+            return Err(format!("more than {} lights", crate::consts::MAX_LIGHTS));
+        }
+    }
+    Ok((lights, light_tracks))
+}
+
+/// Say which lights had no range and what they were given, and when no light shows.
+fn warn_derived(scene: &Scene, derived: &crate::scene::DerivedRanges, walk: &mut Walk) {
+    if let (Some(lo), Some(hi)) = (
+        derived.ranges.iter().map(|r| r.1).reduce(f32::min),
+        derived.ranges.iter().map(|r| r.1).reduce(f32::max),
+    ) {
+        let between = match lo == hi {
+            true => crate::scene::show(lo),
+            false => format!("{} to {}", crate::scene::show(lo), crate::scene::show(hi)),
+        };
+        walk.warn(format!(
+            "{} light(s) have no range (infinite in KHR_lights_punctual): each ends where it shows half a display level on a white surface at exposure {}, at {between} ({} capped by the scene's bounds; --stats lists each)",
+            derived.ranges.len(),
+            crate::scene::show(scene.lighting.exposure),
+            derived.capped
+        ));
+    }
+    if !derived.visible && !scene.lights.is_empty() {
+        walk.warn(format!(
+            "no light shows half a display level on any surface at exposure {}: the image holds ambient and emissive light only",
+            crate::scene::show(scene.lighting.exposure)
+        ));
+    }
+}
+
+pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Scene, Vec<String>)> {
+    let mut walk = Walk::default();
+    check_extensions(doc, &mut walk)?;
+    let (materials, map, textures) = read_materials(doc, &mut walk)?;
     walk_nodes(doc, &map, &mut walk)?;
     // The file's own animation, sampled per frame for what it moves.
     let mut notes = Vec::new();
@@ -1565,30 +1633,7 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
             "the scene has no triangles to render".into()
         });
     }
-    let defs = doc
-        .root
-        .extensions
-        .as_ref()
-        .and_then(|e| e.lights.as_ref())
-        .map_or(&[][..], |l| &l.lights[..]);
-    let mut lights = Vec::new();
-    let mut light_tracks = Vec::new();
-    for (li, world, node) in walk.lights.clone() {
-        let def = defs
-            .get(li)
-            .ok_or_else(|| format!("a node names light {li}, which does not exist"))?;
-        if let Some(light) = map_light(def, li, world, &mut walk)? {
-            lights.push(light);
-            light_tracks.push(
-                sampled
-                    .as_ref()
-                    .and_then(|s| s.track_of.get(&node).copied()),
-            );
-        }
-        if lights.len() > crate::consts::MAX_LIGHTS as usize {
-            return Err(format!("more than {} lights", crate::consts::MAX_LIGHTS));
-        }
-    }
+    let (lights, light_tracks) = read_lights(doc, &mut walk, sampled.as_ref())?;
     let mut exported = exported_lighting(doc, &mut walk);
     // A file an earlier lightgrid exported records no lighting, but every light carries
     // lightgrid's own intensity: the papers' units and Blinn-Phong, as it was made.
@@ -1622,7 +1667,7 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         objects: std::mem::take(&mut walk.objects),
         paths: Vec::new(),
         lights,
-        textures: textures.textures,
+        textures,
         camera_path,
         default_size,
         lighting: exported.unwrap_or_else(Lighting::photometric),
@@ -1630,27 +1675,7 @@ pub(super) fn import(doc: &Document, name: &str, opts: &LoadOptions) -> Res<(Sce
         tracks: sampled.map_or_else(Vec::new, |s| s.tracks),
     };
     let derived = crate::scene::derive_ranges(&mut scene, &ranged, exported.is_none());
-    if let (Some(lo), Some(hi)) = (
-        derived.ranges.iter().map(|r| r.1).reduce(f32::min),
-        derived.ranges.iter().map(|r| r.1).reduce(f32::max),
-    ) {
-        let between = match lo == hi {
-            true => crate::scene::show(lo),
-            false => format!("{} to {}", crate::scene::show(lo), crate::scene::show(hi)),
-        };
-        walk.warn(format!(
-            "{} light(s) have no range (infinite in KHR_lights_punctual): each ends where it shows half a display level on a white surface at exposure {}, at {between} ({} capped by the scene's bounds; --stats lists each)",
-            derived.ranges.len(),
-            crate::scene::show(scene.lighting.exposure),
-            derived.capped
-        ));
-    }
-    if !derived.visible && !scene.lights.is_empty() {
-        walk.warn(format!(
-            "no light shows half a display level on any surface at exposure {}: the image holds ambient and emissive light only",
-            crate::scene::show(scene.lighting.exposure)
-        ));
-    }
+    warn_derived(&scene, &derived, &mut walk);
     scene.derived_ranges = derived.ranges;
     Ok((scene, walk.finish_warnings()))
 }
