@@ -188,70 +188,15 @@ const MAX_EMISSIVE: f32 = 1e12;
 /// above 0, roughness 1) to `MAX_SHININESS` (2048, roughness 0.18); ambient =
 /// base; emissive = emissiveFactor × KHR_materials_emissive_strength, times the
 /// `emissiveTexture` where there is one. `BLEND` is drawn transparent with the base alpha.
-fn map_material(
+/// The material lightgrid exported into `extras.lightgrid` (its own Blinn-Phong material,
+/// exactly), with the file's metallic-roughness texture where it has the factors; None (a
+/// warning if it was malformed) for the glTF material.
+fn exact_material(
     def: &MaterialDef,
     index: usize,
-    textures: &mut TextureLoader,
+    mr_texture: Option<u32>,
     walk: &mut Walk,
-) -> Res<Material> {
-    let pbr = def.pbr_metallic_roughness.as_ref();
-    // Each texture a material reads, in its slot: ours, its coordinate set and wrapping.
-    let mut uv_sets = 0;
-    let mut wraps = 0;
-    let mut nearest = 0;
-    let mut uv_transforms = [glam::Affine2::IDENTITY; 5];
-    let mut slot = |r: Option<&TextureRef>, slot: u32, linear: bool| -> Res<Option<u32>> {
-        let Some(r) = r else { return Ok(None) };
-        let t = textures.load(r.index, index, linear)?;
-        let (transform, set) = texture_transform(r)
-            .map_err(|e| format!("material {index}: KHR_texture_transform: {e}"))?;
-        uv_transforms[slot as usize] = transform;
-        uv_sets |= u32::from(set == 1) << slot;
-        wraps |= t.wrap << (4 * slot);
-        nearest |= u32::from(t.nearest) << slot;
-        Ok(Some(t.index))
-    };
-    use crate::consts::{
-        MAX_SHININESS, MIN_SHININESS, TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE,
-        TEXTURE_SLOT_METAL_ROUGH, TEXTURE_SLOT_NORMAL, TEXTURE_SLOT_OCCLUSION,
-    };
-    let texture = slot(
-        pbr.and_then(|p| p.base_color_texture.as_ref()),
-        TEXTURE_SLOT_BASE,
-        false,
-    )?;
-    let emissive_texture = slot(def.emissive_texture.as_ref(), TEXTURE_SLOT_EMISSIVE, false)?;
-    let mr_texture = slot(
-        pbr.and_then(|p| p.metallic_roughness_texture.as_ref()),
-        TEXTURE_SLOT_METAL_ROUGH,
-        true,
-    )?;
-    let normal = slot(def.normal_texture.as_ref(), TEXTURE_SLOT_NORMAL, true)?;
-    let occlusion = slot(def.occlusion_texture.as_ref(), TEXTURE_SLOT_OCCLUSION, true)?;
-    let scale = def
-        .normal_texture
-        .as_ref()
-        .and_then(|t| t.scale)
-        .unwrap_or(1.0);
-    let strength = (def.occlusion_texture.as_ref())
-        .and_then(|t| t.strength)
-        .unwrap_or(1.0);
-    if !scale.is_finite() || !(0.0..=1.0).contains(&strength) {
-        return Err(format!(
-            "material {index}: normalTexture.scale must be finite and occlusionTexture.strength 0 to 1 (found {scale}, {strength})"
-        ));
-    }
-    let textured = |m: Material| Material {
-        texture,
-        emissive_texture,
-        normal_texture: normal.map(|t| (t, scale)),
-        occlusion_texture: occlusion.map(|t| (t, strength)),
-        uv_sets,
-        wraps,
-        nearest,
-        uv_transforms,
-        ..m
-    };
+) -> Option<Material> {
     if let Some(exact) = def
         .extras
         .as_ref()
@@ -268,15 +213,124 @@ fn map_material(
                     }
                     (None, None) => None,
                 };
-                return Ok(textured(Material {
+                return Some(Material {
                     metallic_roughness: mr,
                     ..m
-                }));
+                });
             }
             None => walk.warn(format!(
                 "material {index}: its extras.lightgrid is malformed; the glTF material is used"
             )),
         }
+    }
+    None
+}
+
+/// The textures a glTF material reads, each in its slot (`TEXTURE_SLOT_*`: ours, its
+/// coordinate set, wrapping, filtering and `KHR_texture_transform`), with the normal
+/// texture's scale and the occlusion texture's strength.
+struct TextureSlots {
+    texture: Option<u32>,
+    emissive: Option<u32>,
+    metal_rough: Option<u32>,
+    normal: Option<(u32, f32)>,
+    occlusion: Option<(u32, f32)>,
+    uv_sets: u32,
+    wraps: u32,
+    nearest: u32,
+    uv_transforms: [glam::Affine2; 5],
+}
+
+impl TextureSlots {
+    fn load(def: &MaterialDef, index: usize, textures: &mut TextureLoader) -> Res<TextureSlots> {
+        let pbr = def.pbr_metallic_roughness.as_ref();
+        // Each texture a material reads, in its slot: ours, its coordinate set and wrapping.
+        let mut uv_sets = 0;
+        let mut wraps = 0;
+        let mut nearest = 0;
+        let mut uv_transforms = [glam::Affine2::IDENTITY; 5];
+        let mut slot = |r: Option<&TextureRef>, slot: u32, linear: bool| -> Res<Option<u32>> {
+            let Some(r) = r else { return Ok(None) };
+            let t = textures.load(r.index, index, linear)?;
+            let (transform, set) = texture_transform(r)
+                .map_err(|e| format!("material {index}: KHR_texture_transform: {e}"))?;
+            uv_transforms[slot as usize] = transform;
+            uv_sets |= u32::from(set == 1) << slot;
+            wraps |= t.wrap << (4 * slot);
+            nearest |= u32::from(t.nearest) << slot;
+            Ok(Some(t.index))
+        };
+        use crate::consts::{
+            TEXTURE_SLOT_BASE, TEXTURE_SLOT_EMISSIVE, TEXTURE_SLOT_METAL_ROUGH,
+            TEXTURE_SLOT_NORMAL, TEXTURE_SLOT_OCCLUSION,
+        };
+        let texture = slot(
+            pbr.and_then(|p| p.base_color_texture.as_ref()),
+            TEXTURE_SLOT_BASE,
+            false,
+        )?;
+        let emissive_texture = slot(def.emissive_texture.as_ref(), TEXTURE_SLOT_EMISSIVE, false)?;
+        let mr_texture = slot(
+            pbr.and_then(|p| p.metallic_roughness_texture.as_ref()),
+            TEXTURE_SLOT_METAL_ROUGH,
+            true,
+        )?;
+        let normal = slot(def.normal_texture.as_ref(), TEXTURE_SLOT_NORMAL, true)?;
+        let occlusion = slot(def.occlusion_texture.as_ref(), TEXTURE_SLOT_OCCLUSION, true)?;
+        let scale = def
+            .normal_texture
+            .as_ref()
+            .and_then(|t| t.scale)
+            .unwrap_or(1.0);
+        let strength = (def.occlusion_texture.as_ref())
+            .and_then(|t| t.strength)
+            .unwrap_or(1.0);
+        if !scale.is_finite() || !(0.0..=1.0).contains(&strength) {
+            return Err(format!(
+                "material {index}: normalTexture.scale must be finite and occlusionTexture.strength 0 to 1 (found {scale}, {strength})"
+            ));
+        }
+        Ok(TextureSlots {
+            texture,
+            emissive: emissive_texture,
+            metal_rough: mr_texture,
+            normal: normal.map(|t| (t, scale)),
+            occlusion: occlusion.map(|t| (t, strength)),
+            uv_sets,
+            wraps,
+            nearest,
+            uv_transforms,
+        })
+    }
+
+    /// `m` reading these textures.
+    fn apply(&self, m: Material) -> Material {
+        Material {
+            texture: self.texture,
+            emissive_texture: self.emissive,
+            normal_texture: self.normal,
+            occlusion_texture: self.occlusion,
+            uv_sets: self.uv_sets,
+            wraps: self.wraps,
+            nearest: self.nearest,
+            uv_transforms: self.uv_transforms,
+            ..m
+        }
+    }
+}
+
+fn map_material(
+    def: &MaterialDef,
+    index: usize,
+    textures: &mut TextureLoader,
+    walk: &mut Walk,
+) -> Res<Material> {
+    let pbr = def.pbr_metallic_roughness.as_ref();
+    let slots = TextureSlots::load(def, index, textures)?;
+    let (texture, mr_texture) = (slots.texture, slots.metal_rough);
+    let textured = |m: Material| slots.apply(m);
+    if let Some(m) = exact_material(def, index, mr_texture, walk) {
+        return Ok(textured(m));
     }
     let base = pbr.and_then(|p| p.base_color_factor).unwrap_or([1.0; 4]);
     let metallic = pbr.and_then(|p| p.metallic_factor).unwrap_or(1.0);
@@ -327,7 +381,8 @@ fn map_material(
     Ok(textured(Material {
         diffuse: colour * (1.0 - metallic),
         specular: Vec3::splat(0.04).lerp(colour, metallic),
-        shininess: (2.0 / (alpha_g * alpha_g) - 2.0).clamp(MIN_SHININESS, MAX_SHININESS),
+        shininess: (2.0 / (alpha_g * alpha_g) - 2.0)
+            .clamp(crate::consts::MIN_SHININESS, crate::consts::MAX_SHININESS),
         emissive: emissive.into(),
         ambient: colour,
         alpha: if transparent || alpha_tested {
@@ -1078,6 +1133,37 @@ struct MappedLight {
     exact: bool,
 }
 
+/// A spot light's cone at its node's `world` transform (pointing down its −z): glTF's
+/// angles, checked, or the exact cosines a file lightgrid exported carries.
+fn spot_of(
+    what: &str,
+    world: Mat4,
+    (inner, outer): (f32, f32),
+    exact_cone: Option<(f32, f32)>,
+) -> Res<Spot> {
+    let ok = inner.is_finite()
+        && outer.is_finite()
+        && inner >= 0.0
+        && inner < outer
+        && outer <= std::f32::consts::FRAC_PI_2;
+    if !ok {
+        return Err(format!(
+            "{what}: cone angles need 0 ≤ inner < outer ≤ π/2 (found {inner}, {outer})"
+        ));
+    }
+    let dir = world.transform_vector3(Vec3::NEG_Z);
+    let dir = dir
+        .try_normalize()
+        .ok_or_else(|| format!("{what}: its node's transform has no direction"))?;
+    let mut spot = Spot::new(dir, inner, outer);
+    if let Some((ci, co)) = exact_cone {
+        if (-1.0..=1.0).contains(&co) && ci <= 1.0 && ci > co {
+            (spot.cos_inner, spot.cos_outer) = (ci, co);
+        }
+    }
+    Ok(spot)
+}
+
 /// A file's light as lightgrid's. Its intensity stays in candela (the scene's lights are
 /// photometric: `Lighting::photometric`), unless the file lightgrid exported carries the
 /// exact intensity in its own units.
@@ -1149,31 +1235,10 @@ fn map_light(
         .filter(|c| c.is_finite() && c.min_element() >= 0.0)
         .unwrap_or(colour);
     let position = world.transform_point3(Vec3::ZERO);
+    let exact_cone = number("cos_inner").zip(number("cos_outer"));
     let spot = match spot {
         None => None,
-        Some((inner, outer)) => {
-            let ok = inner.is_finite()
-                && outer.is_finite()
-                && inner >= 0.0
-                && inner < outer
-                && outer <= std::f32::consts::FRAC_PI_2;
-            if !ok {
-                return Err(format!(
-                    "{what}: cone angles need 0 ≤ inner < outer ≤ π/2 (found {inner}, {outer})"
-                ));
-            }
-            let dir = world.transform_vector3(Vec3::NEG_Z);
-            let dir = dir
-                .try_normalize()
-                .ok_or_else(|| format!("{what}: its node's transform has no direction"))?;
-            let mut spot = Spot::new(dir, inner, outer);
-            if let (Some(ci), Some(co)) = (number("cos_inner"), number("cos_outer")) {
-                if (-1.0..=1.0).contains(&co) && ci <= 1.0 && ci > co {
-                    (spot.cos_inner, spot.cos_outer) = (ci, co);
-                }
-            }
-            Some(spot)
-        }
+        Some(angles) => Some(spot_of(&what, world, angles, exact_cone)?),
     };
     let light = Light {
         position,
