@@ -698,6 +698,19 @@ fn mib(b: f64) -> f64 {
 }
 
 fn summary(results: &BenchResults) -> String {
+    let mut s = header(results);
+    let (scenes, _) = scenes_and_bits(results);
+    for scene in &scenes {
+        scene_section(&mut s, results, scene);
+        model_section(&mut s, results, scene);
+    }
+    claims_section(&mut s, results);
+    s
+}
+
+/// The run: its command, adapter, size, lights, settings and how it ended, and how to read
+/// the times and counts.
+fn header(results: &BenchResults) -> String {
     let c = &results.config;
     let mut s = String::from("# lightgrid benchmark\n\n");
     let (w, h) = results.runs.first().map_or((0, 0), |r| (r.width, r.height));
@@ -770,163 +783,179 @@ fn summary(results: &BenchResults) -> String {
         );
     }
     s.push_str("\nTimes come from the real-time path (`lightgrid play`: the frames rendered back to back, one queue submission each, no analysis): each frame's GPU time from timestamp queries where the adapter has them (first pass start to last pass end per submission, summed), else the wall time from one frame to the next (column `timing`); *real-time fps* is frames per second of that path. Counts come from an analysis render of each frame (results.json `sources`). *× ideal* = lighting computations ÷ the ideal (every light reaching every visible sample once); *efficiency* = ideal ÷ actual.\n");
-    let (scenes, _) = scenes_and_bits(results);
-    for scene in &scenes {
-        let _ = writeln!(s, "\n## {scene}\n");
-        if results.thumbnails.iter().any(|t| &t.0 == scene) {
-            let frames: Vec<String> = super::run::THUMBNAIL_FRAMES
-                .iter()
-                .map(u32::to_string)
-                .collect();
+    s
+}
+
+/// One scene's table: per run the time, fps, lighting computations against the ideal,
+/// memory and grid figures, then its sections.
+fn scene_section(s: &mut String, results: &BenchResults, scene: &str) {
+    let _ = writeln!(s, "\n## {scene}\n");
+    if results.thumbnails.iter().any(|t| &t.0 == scene) {
+        let frames: Vec<String> = super::run::THUMBNAIL_FRAMES
+            .iter()
+            .map(u32::to_string)
+            .collect();
+        let _ = writeln!(
+            s,
+            "![{scene}: frames {} (those the animation has)](thumbnails_{scene}.png)\n\n*Frames {} of the animation, as tiled-shading Fig. 2 shows them.*\n",
+            frames.join(", "),
+            frames.join(", ")
+        );
+    }
+    s.push_str("| pipeline | G-buffer | avg ms | min / max ms | real-time fps | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for r in results.runs.iter().filter(|r| &r.scene == scene) {
+        let Some(m) = &r.summary else { continue };
+        let lc = m
+            .lighting_computations
+            .map_or("n/a".into(), |x| format!("{:.0}", x.mean));
+        let ratio = times_ideal(m, "n/a");
+        let eff = m
+            .efficiency
+            .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0));
+        let tiles = match (m.lights_per_tile_avg, m.lights_per_tile_max) {
+            (Some(a), Some(x)) => format!("{a:.1} / {x}"),
+            _ => "-".into(),
+        };
+        let _ = writeln!(
+            s,
+            "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} | {} |",
+            r.label(),
+            match (r.complete, r.times_from) {
+                (true, _) => "",
+                (false, super::run::TimesFrom::RealTime) => " (incomplete)",
+                (false, super::run::TimesFrom::Analysis) => " (incomplete; analysis times)",
+            },
+            r.gbuffer_bits().map_or("-".into(), |b| format!("{b}-bit")),
+            m.gpu_ms.mean,
+            m.gpu_ms.min,
+            m.gpu_ms.max,
+            fps(r),
+            lc,
+            ratio,
+            eff,
+            tiles,
+            m.bytes_per_pixel,
+            r.timing.label()
+        );
+    }
+    let ideal = results
+        .runs
+        .iter()
+        .find(|r| &r.scene == scene)
+        .and_then(|r| r.summary.as_ref())
+        .map(|m| m.ideal_lighting_computations.mean);
+    if let Some(i) = ideal {
+        let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
+    }
+    fig3_counts(s, results, scene);
+    transparent_section(s, results, scene);
+    spot_ray_section(s, results, scene);
+    msaa_section(s, results, scene);
+    brdf_section(s, results, scene);
+    shadows_section(s, results, scene);
+    culling_section(s, results, scene);
+}
+
+/// The transparent overdraw: the same for every run of the scene (the analysis rasterizes
+/// the frame's transparent objects), and each run's transparent pass against its ideal.
+fn transparent_section(s: &mut String, results: &BenchResults, scene: &str) {
+    if let Some(r) = results
+        .runs
+        .iter()
+        .find(|r| &r.scene == scene && !r.frames.is_empty())
+    {
+        let n = r.frames.len() as f64;
+        let fragments: f64 = r
+            .frames
+            .iter()
+            .map(|f| f.stats.transparent_fragments as f64)
+            .sum();
+        let ideal: f64 = r
+            .frames
+            .iter()
+            .map(|f| f.stats.ideal_transparent_computations as f64)
+            .sum();
+        if fragments > 0.0 {
+            let pixels = f64::from(r.width) * f64::from(r.height);
             let _ = writeln!(
                 s,
-                "![{scene}: frames {} (those the animation has)](thumbnails_{scene}.png)\n\n*Frames {} of the animation, as tiled-shading Fig. 2 shows them.*\n",
-                frames.join(", "),
-                frames.join(", ")
+                "Transparent fragments per frame (avg): {:.0} ({:.3} per pixel), lit {:.0} times in the ideal (included above). The transparent pass's lighting computations per frame (avg, × that ideal):\n",
+                fragments / n,
+                fragments / n / pixels,
+                ideal / n
             );
-        }
-        s.push_str("| pipeline | G-buffer | avg ms | min / max ms | real-time fps | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
-        for r in results.runs.iter().filter(|r| &r.scene == scene) {
-            let Some(m) = &r.summary else { continue };
-            let lc = m
-                .lighting_computations
-                .map_or("n/a".into(), |x| format!("{:.0}", x.mean));
-            let ratio = times_ideal(m, "n/a");
-            let eff = m
-                .efficiency
-                .map_or("n/a".into(), |e| format!("{:.1}%", e * 100.0));
-            let tiles = match (m.lights_per_tile_avg, m.lights_per_tile_max) {
-                (Some(a), Some(x)) => format!("{a:.1} / {x}"),
-                _ => "-".into(),
-            };
-            let _ = writeln!(
-                s,
-                "| {}{} | {} | {:.2} | {:.2} / {:.2} | {} | {} | {} | {} | {} | {} | {} |",
-                r.label(),
-                match (r.complete, r.times_from) {
-                    (true, _) => "",
-                    (false, super::run::TimesFrom::RealTime) => " (incomplete)",
-                    (false, super::run::TimesFrom::Analysis) => " (incomplete; analysis times)",
-                },
-                r.gbuffer_bits().map_or("-".into(), |b| format!("{b}-bit")),
-                m.gpu_ms.mean,
-                m.gpu_ms.min,
-                m.gpu_ms.max,
-                fps(r),
-                lc,
-                ratio,
-                eff,
-                tiles,
-                m.bytes_per_pixel,
-                r.timing.label()
-            );
-        }
-        let ideal = results
-            .runs
-            .iter()
-            .find(|r| &r.scene == scene)
-            .and_then(|r| r.summary.as_ref())
-            .map(|m| m.ideal_lighting_computations.mean);
-        if let Some(i) = ideal {
-            let _ = writeln!(s, "\nIdeal lighting computations per frame (avg): {i:.0}.");
-        }
-        fig3_counts(&mut s, results, scene);
-        // The transparent overdraw: the same for every run of the scene (the analysis
-        // rasterizes the frame's transparent objects).
-        if let Some(r) = results
-            .runs
-            .iter()
-            .find(|r| &r.scene == scene && !r.frames.is_empty())
-        {
-            let n = r.frames.len() as f64;
-            let fragments: f64 = r
-                .frames
-                .iter()
-                .map(|f| f.stats.transparent_fragments as f64)
-                .sum();
-            let ideal: f64 = r
-                .frames
-                .iter()
-                .map(|f| f.stats.ideal_transparent_computations as f64)
-                .sum();
-            if fragments > 0.0 {
-                let pixels = f64::from(r.width) * f64::from(r.height);
-                let _ = writeln!(
-                    s,
-                    "Transparent fragments per frame (avg): {:.0} ({:.3} per pixel), lit {:.0} times in the ideal (included above). The transparent pass's lighting computations per frame (avg, × that ideal):\n",
-                    fragments / n,
-                    fragments / n / pixels,
-                    ideal / n
-                );
-                for r in results.runs.iter().filter(|r| &r.scene == scene) {
-                    let counts: Option<Vec<u64>> = r
-                        .frames
-                        .iter()
-                        .map(|f| f.stats.transparent_lighting_computations)
-                        .collect();
-                    if let Some(c) = counts.filter(|c| !c.is_empty()) {
-                        let avg = c.iter().sum::<u64>() as f64 / c.len() as f64;
-                        let _ = writeln!(
-                            s,
-                            "- {}: {avg:.0} ({:.2}×)",
-                            r.name(),
-                            avg / (ideal / n).max(1.0)
-                        );
-                    }
+            for r in results.runs.iter().filter(|r| &r.scene == scene) {
+                let counts: Option<Vec<u64>> = r
+                    .frames
+                    .iter()
+                    .map(|f| f.stats.transparent_lighting_computations)
+                    .collect();
+                if let Some(c) = counts.filter(|c| !c.is_empty()) {
+                    let avg = c.iter().sum::<u64>() as f64 / c.len() as f64;
+                    let _ = writeln!(
+                        s,
+                        "- {}: {avg:.0} ({:.2}×)",
+                        r.name(),
+                        avg / (ideal / n).max(1.0)
+                    );
                 }
             }
         }
-        spot_ray_section(&mut s, results, scene);
-        msaa_section(&mut s, results, scene);
-        brdf_section(&mut s, results, scene);
-        shadows_section(&mut s, results, scene);
-        culling_section(&mut s, results, scene);
-        s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
-        for r in results.runs.iter().filter(|r| &r.scene == scene) {
-            let Some(m) = &r.summary else { continue };
-            let passes: Vec<String> = m
-                .passes
-                .iter()
-                .map(|p| format!("{} {:.2}", p.label, p.ms))
-                .collect();
-            let n = r.frames.len().max(1) as f64;
-            let avg = |f: &dyn Fn(&super::FrameRecord) -> Option<u64>| {
-                let v: Vec<u64> = r.frames.iter().filter_map(f).collect();
-                (v.len() == r.frames.len()).then(|| v.iter().sum::<u64>() as f64 / n)
-            };
-            let traffic = match (
-                avg(&|f| f.stats.memory.modelled_write_bytes),
-                avg(&|f| f.stats.memory.modelled_read_bytes),
-            ) {
-                (Some(wb), Some(rb)) => format!("{:.1} / {:.1}", mib(wb), mib(rb)),
-                _ => "n/a".into(),
-            };
-            let t1: Vec<_> = r
-                .frames
-                .iter()
-                .filter_map(|f| f.stats.memory.forward_plus_table1)
-                .collect();
-            let table1 = if t1.is_empty() {
-                "-".into()
-            } else {
-                let k = t1.len() as f64;
-                format!(
-                    "{:.1} / {:.1} (M {:.1})",
-                    mib(t1.iter().map(|t| t.forward_plus_bytes).sum::<f64>() / k),
-                    mib(t1.iter().map(|t| t.deferred_bytes).sum::<f64>() / k),
-                    t1.iter().map(|t| t.m).sum::<f64>() / k
-                )
-            };
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} |",
-                r.name(),
-                passes.join(", "),
-                traffic,
-                table1
-            );
-        }
     }
+}
+
+/// Average measured GPU time per pass next to the traffic models.
+fn model_section(s: &mut String, results: &BenchResults, scene: &str) {
+    s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
+    for r in results.runs.iter().filter(|r| &r.scene == scene) {
+        let Some(m) = &r.summary else { continue };
+        let passes: Vec<String> = m
+            .passes
+            .iter()
+            .map(|p| format!("{} {:.2}", p.label, p.ms))
+            .collect();
+        let n = r.frames.len().max(1) as f64;
+        let avg = |f: &dyn Fn(&super::FrameRecord) -> Option<u64>| {
+            let v: Vec<u64> = r.frames.iter().filter_map(f).collect();
+            (v.len() == r.frames.len()).then(|| v.iter().sum::<u64>() as f64 / n)
+        };
+        let traffic = match (
+            avg(&|f| f.stats.memory.modelled_write_bytes),
+            avg(&|f| f.stats.memory.modelled_read_bytes),
+        ) {
+            (Some(wb), Some(rb)) => format!("{:.1} / {:.1}", mib(wb), mib(rb)),
+            _ => "n/a".into(),
+        };
+        let t1: Vec<_> = r
+            .frames
+            .iter()
+            .filter_map(|f| f.stats.memory.forward_plus_table1)
+            .collect();
+        let table1 = if t1.is_empty() {
+            "-".into()
+        } else {
+            let k = t1.len() as f64;
+            format!(
+                "{:.1} / {:.1} (M {:.1})",
+                mib(t1.iter().map(|t| t.forward_plus_bytes).sum::<f64>() / k),
+                mib(t1.iter().map(|t| t.deferred_bytes).sum::<f64>() / k),
+                t1.iter().map(|t| t.m).sum::<f64>() / k
+            )
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} |",
+            r.name(),
+            passes.join(", "),
+            traffic,
+            table1
+        );
+    }
+}
+
+/// The papers' claims on this adapter: each checked with its evidence and verdict, the
+/// conditions against the papers', and the claims these runs cannot speak to.
+fn claims_section(s: &mut String, results: &BenchResults) {
     s.push_str("\n## The papers' claims on this adapter\n\n");
     let (checked, unchecked): (Vec<_>, Vec<_>) = evaluate_claims(results)
         .into_iter()
@@ -980,7 +1009,6 @@ fn summary(results: &BenchResults) -> String {
         }
     }
     s.push_str("\nFiles: `results.json` (per-frame series and summaries), `results.csv` (one row per frame), `frame_time_*` (Fig. 2 style), `lighting_*` (Fig. 3 style, ideal dashed), `passes_*` (per-pass stacked bars), `heatmap_*` (lights per tile).\n");
-    s
 }
 
 /// Where each paper measured its claims: the source's name, its GPU, frame size and tile edge
