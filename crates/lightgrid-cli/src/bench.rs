@@ -282,29 +282,24 @@ fn measure<T: SettingValue>(values: &[T]) -> (&'static str, Vec<String>) {
 }
 
 /// `supported`: the MSAA sample counts the adapter offers (the msaa preset measures them all).
-pub(crate) fn bench_config(
-    a: &BenchArgs,
-    hardware: bool,
-    supported: &[u32],
-) -> Result<BenchConfig> {
-    let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
-    let d = match a.preset {
-        None => everything(),
-        Some(Preset::Quick) => BenchDefaults {
-            frames: "0..259:86",
-            size: Some((160, 90)),
-            ..everything()
-        },
-        Some(Preset::Spots) => BenchDefaults {
-            spot_fractions: vec![1.0],
-            settings: vec![measure(&[SpotCull::Sphere, SpotCull::Cone])],
-            ..study(hardware, |p| p.uses_grid)
-        },
-        Some(Preset::Transparency) => BenchDefaults {
-            settings: vec![measure(&[GridLists::Separate, GridLists::Shared])],
-            ..study(hardware, |p| p.assign)
-        },
-        Some(Preset::Msaa) => BenchDefaults {
+/// What a preset measures: the papers' figures at their conditions, or one setting studied.
+fn preset_defaults(preset: Preset, hardware: bool, supported: &[u32]) -> BenchDefaults {
+    match preset {
+        Preset::Msaa
+        | Preset::Paper
+        | Preset::ForwardPlus
+        | Preset::LightRange
+        | Preset::DepthBounds
+        | Preset::Clustered => paper_preset(preset, hardware, supported),
+        _ => study_preset(preset, hardware),
+    }
+}
+
+/// The presets that reproduce a paper's figure at its conditions (its tile count, size and
+/// scenes).
+fn paper_preset(preset: Preset, hardware: bool, supported: &[u32]) -> BenchDefaults {
+    match preset {
+        Preset::Msaa => BenchDefaults {
             scenes: vec!["random-fps"],
             pipelines: [
                 ids::TILED_FORWARD_PREZ,
@@ -324,7 +319,7 @@ pub(crate) fn bench_config(
             tile: Some(paper_tile(papers_size(hardware).0)),
             ..study(hardware, |_| false)
         },
-        Some(Preset::Paper) => BenchDefaults {
+        Preset::Paper => BenchDefaults {
             scenes: vec!["robots-many", "robots-few"],
             size: Some(papers_size(hardware)),
             settings: vec![measure(&[GBufferFormat::F16, GBufferFormat::F32])],
@@ -341,7 +336,7 @@ pub(crate) fn bench_config(
             transparency: false,
             ..everything()
         },
-        Some(Preset::ForwardPlus) => BenchDefaults {
+        Preset::ForwardPlus => BenchDefaults {
             scenes: vec!["scattered"],
             size: Some(if hardware { (1280, 720) } else { (640, 360) }),
             pipelines: [
@@ -359,7 +354,7 @@ pub(crate) fn bench_config(
             heatmap_max: Some(FORWARD_PLUS_HEATMAP_MAX),
             ..study(hardware, |_| false)
         },
-        Some(Preset::LightRange) => BenchDefaults {
+        Preset::LightRange => BenchDefaults {
             pipelines: [ids::FORWARD, ids::TILED_FORWARD_PREZ, ids::TILED_DEFERRED]
                 .map(String::from)
                 .to_vec(),
@@ -371,7 +366,7 @@ pub(crate) fn bench_config(
             transparency: false,
             ..study(hardware, |_| false)
         },
-        Some(Preset::DepthBounds) => BenchDefaults {
+        Preset::DepthBounds => BenchDefaults {
             pipelines: [
                 ids::TILED_FORWARD,
                 ids::TILED_FORWARD_PREZ,
@@ -385,7 +380,39 @@ pub(crate) fn bench_config(
             transparency: false,
             ..study(hardware, |_| false)
         },
-        Some(Preset::Culling) => BenchDefaults {
+        Preset::Clustered => BenchDefaults {
+            scenes: vec!["random-top", "random-fps"],
+            frames: "0..119:10",
+            pipelines: [ids::TILED_FORWARD_PREZ, ids::CLUSTERED_FORWARD]
+                .map(String::from)
+                .to_vec(),
+            transparency: false,
+            // Fig. 4.6's 32-px tiles at 1920x1080: their count at this size.
+            tile: Some(paper_tile(papers_size(hardware).0)),
+            ..study(hardware, |_| false)
+        },
+        _ => unreachable!("not a paper's preset"),
+    }
+}
+
+/// The presets that study one setting (or a quick look at everything).
+fn study_preset(preset: Preset, hardware: bool) -> BenchDefaults {
+    match preset {
+        Preset::Quick => BenchDefaults {
+            frames: "0..259:86",
+            size: Some((160, 90)),
+            ..everything()
+        },
+        Preset::Spots => BenchDefaults {
+            spot_fractions: vec![1.0],
+            settings: vec![measure(&[SpotCull::Sphere, SpotCull::Cone])],
+            ..study(hardware, |p| p.uses_grid)
+        },
+        Preset::Transparency => BenchDefaults {
+            settings: vec![measure(&[GridLists::Separate, GridLists::Shared])],
+            ..study(hardware, |p| p.assign)
+        },
+        Preset::Culling => BenchDefaults {
             scenes: vec!["robots-many", "robots-few", "scattered", "stress"],
             // Each scene as it is and with every light a spot (the spots preset's scene is
             // `robots-many-spots-1`).
@@ -415,7 +442,7 @@ pub(crate) fn bench_config(
             transparency: false,
             ..study(hardware, |_| false)
         },
-        Some(Preset::Brdf) => BenchDefaults {
+        Preset::Brdf => BenchDefaults {
             pipelines: [
                 ids::FORWARD,
                 ids::TILED_FORWARD_PREZ,
@@ -431,7 +458,7 @@ pub(crate) fn bench_config(
             transparency: false,
             ..study(hardware, |_| false)
         },
-        Some(Preset::Shadows) => BenchDefaults {
+        Preset::Shadows => BenchDefaults {
             pipelines: [
                 ids::FORWARD,
                 ids::TILED_DEFERRED,
@@ -456,17 +483,19 @@ pub(crate) fn bench_config(
             transparency: false,
             ..study(hardware, |_| false)
         },
-        Some(Preset::Clustered) => BenchDefaults {
-            scenes: vec!["random-top", "random-fps"],
-            frames: "0..119:10",
-            pipelines: [ids::TILED_FORWARD_PREZ, ids::CLUSTERED_FORWARD]
-                .map(String::from)
-                .to_vec(),
-            transparency: false,
-            // Fig. 4.6's 32-px tiles at 1920x1080: their count at this size.
-            tile: Some(paper_tile(papers_size(hardware).0)),
-            ..study(hardware, |_| false)
-        },
+        _ => unreachable!("not a study preset"),
+    }
+}
+
+pub(crate) fn bench_config(
+    a: &BenchArgs,
+    hardware: bool,
+    supported: &[u32],
+) -> Result<BenchConfig> {
+    let all: Vec<String> = PIPELINES.iter().map(|p| p.id.to_string()).collect();
+    let d = match a.preset {
+        None => everything(),
+        Some(p) => preset_defaults(p, hardware, supported),
     };
     let (scenes, frames, size, repeat, pipelines) =
         (d.scenes, d.frames, d.size, d.repeat, d.pipelines);
@@ -541,6 +570,13 @@ pub(crate) fn bench_config(
         material_shaders: a.material_shaders.is_none_or(OnOff::on),
         add_lights: crate::args::added_lights(a.add_lights, a.light_range)?,
     };
+    check_config(a, &config)?;
+    Ok(config)
+}
+
+/// Refuse a configuration no run can measure: its own checks, `--msaa-resolve` without
+/// MSAA, and an option given for pipelines that do not read it.
+fn check_config(a: &BenchArgs, config: &BenchConfig) -> Result<()> {
     let resolve_given = a
         .axes
         .given
@@ -562,8 +598,7 @@ pub(crate) fn bench_config(
         },
         ..Default::default()
     };
-    check_applies(&given, &chosen, &settings)?;
-    Ok(config)
+    check_applies(&given, &chosen, &settings)
 }
 
 pub(crate) fn bench(adapter: Option<&str>, a: &BenchArgs) -> Result<()> {
