@@ -79,6 +79,151 @@ fn diff_cell(
     }
 }
 
+impl Row {
+    /// A pipeline that produced no image: it `failed`, or was skipped with `note`.
+    fn without_image(pipeline: &'static str, failed: Option<String>, note: Option<String>) -> Row {
+        Row {
+            pipeline,
+            failed,
+            gpu_ms: None,
+            diff: None,
+            diff_note: note,
+            lighting_computations: None,
+            ideal_lighting_computations: None,
+        }
+    }
+}
+
+/// The run's first line and the table's head.
+fn print_header(
+    scene: &lightgrid::scene::Scene,
+    frame: u32,
+    (w, h): (u32, u32),
+    adapter: &str,
+) -> Result<()> {
+    outln!(
+        "{} frame {} at {w}x{h}, {} lights, on {}",
+        scene.name,
+        frame,
+        scene.lights.len(),
+        adapter
+    );
+    outln!(
+        "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
+        "pipeline",
+        "time ms",
+        "diff mean",
+        "p99",
+        "max",
+        "lighting comp",
+        "x ideal",
+        "lights/tile"
+    );
+    Ok(())
+}
+
+/// Write compare.json beside the images and move the run's files into place (an
+/// interrupted run is set aside rather than replacing an earlier whole one); the run's
+/// outcome as the command's.
+fn commit_table(
+    a: &CompareArgs,
+    files: &mut Files,
+    dir: OutDir,
+    mut written: Vec<std::path::PathBuf>,
+    summary: &CompareJson,
+    outcome: Outcome,
+) -> Result<()> {
+    let path = dir.staging().join(COMPARE_JSON);
+    write_atomic(&path, &serde_json::to_vec_pretty(summary)?)?;
+    written.push(path);
+    // Images of pipelines that failed this time must not stay from an earlier run. A table
+    // with failed pipelines is a whole answer (every pipeline was tried); an interrupted one
+    // is not, and does not replace an earlier run's.
+    files.placed("--out-dir", &a.out_dir, &written)?;
+    let whole = !matches!(outcome, Outcome::Interrupted(_));
+    let committed = dir.commit(&written, Earlier::Remove, whole)?;
+    let place = committed.set_aside.as_deref().unwrap_or(&a.out_dir);
+    outln!(
+        "images and stats in {} ({COMPARE_JSON}: the table)",
+        place.display()
+    );
+    match outcome {
+        Outcome::Complete => Ok(()),
+        Outcome::Failed(reason) => match committed.note(&a.out_dir) {
+            Some(note) => bail!("{reason}\n{note}"),
+            None => bail!("{reason}"),
+        },
+        o => run_outcome(&o, &a.out_dir, &committed),
+    }
+}
+
+/// The pipeline's image and its stats, written into the staging directory.
+fn write_outputs(
+    staging: &std::path::Path,
+    id: &str,
+    out: &lightgrid::FrameOutput,
+) -> Result<Vec<std::path::PathBuf>> {
+    let png = staging.join(format!("{id}.png"));
+    let stats = staging.join(format!("{id}.json"));
+    let mut written = Vec::new();
+    for (path, bytes) in [
+        (png.clone(), encode_png(&out.image, &png)?),
+        (stats, serde_json::to_vec_pretty(&out.stats)?),
+    ] {
+        write_atomic(&path, &bytes)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// One pipeline's line of the printed table: time, difference (or why there is none),
+/// lighting computations against the ideal, lights per cell.
+fn table_line(
+    id: &str,
+    s: &lightgrid::FrameStats,
+    d: Option<&DiffSummary>,
+    note: Option<&str>,
+) -> String {
+    let time = format!(
+        "{:.2}{}",
+        s.gpu_ms,
+        if s.timing == lightgrid::TimingSource::WallClock {
+            "*"
+        } else {
+            ""
+        }
+    );
+    let (mean, p99, max) = match (d, note) {
+        (Some(d), _) => (
+            format!("{:.3}", d.mean),
+            d.p99.to_string(),
+            d.max.to_string(),
+        ),
+        (None, n) => (
+            n.unwrap_or_default().to_string(),
+            String::new(),
+            String::new(),
+        ),
+    };
+    let comps = s
+        .lighting_computations
+        .map_or("n/a".into(), |n| n.to_string());
+    let ratio = s
+        .lighting_computations
+        .filter(|_| s.ideal_lighting_computations > 0)
+        .map_or("n/a".into(), |n| {
+            format!("{:.2}", n as f64 / s.ideal_lighting_computations as f64)
+        });
+    let per_tile = match (s.lights_per_tile_avg, s.lights_per_tile_max) {
+        (Some(avg), Some(max)) => format!("{avg:.1}/{max}"),
+        _ => "-".into(),
+    };
+    format!(
+        "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
+        id, time, mean, p99, max, comps, ratio, per_tile
+    )
+}
+
 pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let settings = a.scene.renderer.settings()?;
     // Only whether it can be written, here: what the directory holds is checked by the claim
@@ -92,24 +237,7 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
     let mut renderer = Renderer::new(&ctx, w, h, settings)?;
     let dir = OutDir::claim(&a.out_dir, "compare", a.force)?;
     let stop = stop_on_ctrl_c()?;
-    outln!(
-        "{} frame {} at {w}x{h}, {} lights, on {}",
-        scene.name,
-        a.scene.frame,
-        scene.lights.len(),
-        ctx.adapter_label()
-    );
-    outln!(
-        "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
-        "pipeline",
-        "time ms",
-        "diff mean",
-        "p99",
-        "max",
-        "lighting comp",
-        "x ideal",
-        "lights/tile"
-    );
+    print_header(&scene, a.scene.frame, (w, h), &ctx.adapter_label())?;
     // Reference images by id; `forward` is rendered first (registry order).
     let mut references: HashMap<&str, image::RgbaImage> = Default::default();
     let mut notes = Vec::new();
@@ -126,15 +254,11 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             (settings.grid.samples > 1, p.msaa)
         {
             outln!("{:<24} skipped: refuses MSAA ({why})", p.id);
-            rows.push(Row {
-                pipeline: p.id,
-                failed: None,
-                gpu_ms: None,
-                diff: None,
-                diff_note: Some(format!("skipped: refuses MSAA ({why})")),
-                lighting_computations: None,
-                ideal_lighting_computations: None,
-            });
+            rows.push(Row::without_image(
+                p.id,
+                None,
+                Some(format!("skipped: refuses MSAA ({why})")),
+            ));
             continue;
         }
         let warm = (0..a.scene.warmup)
@@ -143,30 +267,17 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
             Ok(o) => o,
             Err(e) => {
                 outln!("{:<24} failed: {e}", p.id);
-                rows.push(Row {
-                    pipeline: p.id,
-                    failed: Some(e.to_string()),
-                    gpu_ms: None,
-                    diff: None,
-                    diff_note: None,
-                    lighting_computations: None,
-                    ideal_lighting_computations: None,
-                });
+                rows.push(Row::without_image(p.id, Some(e.to_string()), None));
                 continue;
             }
         };
-        let png = dir.staging().join(format!("{}.png", p.id));
-        let stats = dir.staging().join(format!("{}.json", p.id));
-        for (path, bytes) in [
-            (png.clone(), encode_png(&out.image, &png)?),
-            (stats, serde_json::to_vec_pretty(&out.stats)?),
-        ] {
-            write_atomic(&path, &bytes)?;
-            written.push(path);
-        }
+        written.extend(write_outputs(dir.staging(), p.id, &out)?);
         let (d, note) = diff_cell(p.id, &out.image, &references, &rows)?;
-        if p.reference != REFERENCE && p.reference != p.id {
-            if let Some(r) = references.get(p.reference) {
+        if let Some(r) = references
+            .get(p.reference)
+            .filter(|_| p.reference != REFERENCE)
+        {
+            if p.reference != p.id {
                 let own = diff(r, &out.image)?.0;
                 notes.push(format!(
                     "{} vs its own reference {}: mean {:.3}, p99 {}, max {}",
@@ -174,51 +285,11 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
                 ));
             }
         }
-        let time = format!(
-            "{:.2}{}",
-            out.stats.gpu_ms,
-            if out.stats.timing == lightgrid::TimingSource::WallClock {
-                "*"
-            } else {
-                ""
-            }
-        );
         let s = &out.stats;
-        let (mean, p99, max) = match (&d, &note) {
-            (Some(d), _) => (
-                format!("{:.3}", d.mean),
-                d.p99.to_string(),
-                d.max.to_string(),
-            ),
-            (None, n) => (n.clone().unwrap_or_default(), String::new(), String::new()),
-        };
-        let comps = s
-            .lighting_computations
-            .map_or("n/a".into(), |n| n.to_string());
-        let ratio = s
-            .lighting_computations
-            .filter(|_| s.ideal_lighting_computations > 0)
-            .map_or("n/a".into(), |n| {
-                format!("{:.2}", n as f64 / s.ideal_lighting_computations as f64)
-            });
-        let per_tile = match (s.lights_per_tile_avg, s.lights_per_tile_max) {
-            (Some(avg), Some(max)) => format!("{avg:.1}/{max}"),
-            _ => "-".into(),
-        };
         if let Some(assign) = &s.assign {
             assigned_by.get_or_insert_with(|| assign.clone());
         }
-        outln!(
-            "{:<22} {:>9}  {:>9} {:>5} {:>5}  {:>14} {:>7}  {:>11}",
-            p.id,
-            time,
-            mean,
-            p99,
-            max,
-            comps,
-            ratio,
-            per_tile
-        );
+        outln!("{}", table_line(p.id, s, d.as_ref(), note.as_deref()));
         rows.push(Row {
             pipeline: p.id,
             failed: None,
@@ -262,28 +333,8 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         rows: &rows,
         notes: &notes,
     };
-    let path = dir.staging().join(COMPARE_JSON);
-    write_atomic(&path, &serde_json::to_vec_pretty(&summary)?)?;
-    written.push(path);
-    // Images of pipelines that failed this time must not stay from an earlier run. A table
-    // with failed pipelines is a whole answer (every pipeline was tried); an interrupted one
-    // is not, and does not replace an earlier run's.
-    files.placed("--out-dir", &a.out_dir, &written)?;
-    let whole = !matches!(outcome, Outcome::Interrupted(_));
-    let committed = dir.commit(&written, Earlier::Remove, whole)?;
-    let place = committed.set_aside.as_deref().unwrap_or(&a.out_dir);
-    outln!(
-        "images and stats in {} ({COMPARE_JSON}: the table)",
-        place.display()
-    );
-    match outcome {
-        Outcome::Complete => Ok(()),
-        Outcome::Failed(reason) => match committed.note(&a.out_dir) {
-            Some(note) => bail!("{reason}\n{note}"),
-            None => bail!("{reason}"),
-        },
-        o => run_outcome(&o, &a.out_dir, &committed),
-    }
+    let outcome = outcome.clone();
+    commit_table(a, &mut files, dir, written, &summary, outcome)
 }
 
 /// The table's file in the output directory.
