@@ -81,15 +81,9 @@ struct PlayJson<'a> {
     per_frame: &'a [lightgrid::realtime::PlayedFrame],
 }
 
-pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
-    let info = pipelines::find(&a.pipeline)?;
-    let settings = a.renderer.settings()?;
-    check_applies(&a.renderer.given(), &[info], &settings)?;
-    let mut files = Files::default();
-    files.output("--json", a.json.as_deref(), Kind::Data)?;
-    a.scene.claim(&mut files)?;
-    let scene = a.scene.build()?;
-    let range = match &a.frames {
+/// `--frames` (every frame of the animation without it), within the scene's animation.
+fn frame_range(frames: Option<&str>, scene: &lightgrid::scene::Scene) -> Result<FrameRange> {
+    let range = match frames {
         Some(s) => FrameRange::parse(s)?,
         None => FrameRange {
             start: 0,
@@ -106,6 +100,18 @@ pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
             scene.frame_count() - 1
         );
     }
+    Ok(range)
+}
+
+pub(crate) fn play(adapter: Option<&str>, a: &PlayArgs) -> Result<()> {
+    let info = pipelines::find(&a.pipeline)?;
+    let settings = a.renderer.settings()?;
+    check_applies(&a.renderer.given(), &[info], &settings)?;
+    let mut files = Files::default();
+    files.output("--json", a.json.as_deref(), Kind::Data)?;
+    a.scene.claim(&mut files)?;
+    let scene = a.scene.build()?;
+    let range = frame_range(a.frames.as_deref(), &scene)?;
     let frames = range.frames(scene.frame_count());
     let ctx = GpuContext::new(adapter)?;
     let (w, h) = Size::or_scene(a.size, &scene);

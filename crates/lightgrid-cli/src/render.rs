@@ -117,7 +117,11 @@ pub(crate) fn render(adapter: Option<&str>, a: &RenderArgs) -> Result<()> {
     for (path, bytes) in writes {
         write_atomic(path, &bytes)?;
     }
-    let s = &out.stats;
+    print_stats(&out.stats)
+}
+
+/// What the frame cost and counted, for the terminal.
+fn print_stats(s: &lightgrid::FrameStats) -> Result<()> {
     outln!(
         "{} / {} frame {} at {}x{}: {} lights, {:.2} ms ({}) on {}",
         s.scene,
