@@ -9,7 +9,7 @@ use super::LIGHT_MATCH_FRACTION;
 use super::{MAX_FILE_BYTES, MAX_JSON_BYTES, MAX_TRIANGLES, MAX_VERTICES};
 use crate::error::{Error, Result};
 use crate::scene::LightUnits;
-use crate::scene::{bounds_of, Material, Mesh, Scene};
+use crate::scene::{bounds_of, FrameState, Light, Material, Mesh, Scene};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};
 use std::collections::HashMap;
@@ -212,12 +212,14 @@ pub fn export_losses(scene: &Scene) -> Vec<String> {
     out
 }
 
-/// The GLB bytes of `scene` at `frame`, for frames of `size` (the camera's aspect ratio).
-pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
-    scene.validate()?;
-    scene.check_frame(frame)?;
-    let state = scene.frame(frame);
-    let mut bin = Bin::default();
+/// Each object's node and its mesh (shared by the objects drawing one mesh with one
+/// material at a translation-rotation-scale matrix; baked into world space otherwise), and
+/// what was written.
+fn object_nodes(
+    scene: &Scene,
+    state: &FrameState,
+    bin: &mut Bin,
+) -> (Vec<Value>, Vec<Value>, Counts) {
     let mut meshes = Vec::new();
     let mut mesh_of: HashMap<(usize, usize, bool), usize> = HashMap::new();
     let mut nodes = Vec::new();
@@ -248,7 +250,7 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
                     baked = world;
                     &baked
                 };
-                meshes.push(mesh_json(&mut bin, mesh, o.material, flip));
+                meshes.push(mesh_json(bin, mesh, o.material, flip));
                 counts.read_vertices += mesh.positions.len() as u64;
                 counts.read_indices += mesh.indices.len() as u64;
                 if trs {
@@ -267,55 +269,46 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         }
         nodes.push(node);
     }
-    if meshes.is_empty() {
-        return Err(Error::invalid(
-            "export",
-            format!("{} has no triangles to export", scene.name),
-        ));
-    }
-    let mut lights = Vec::new();
-    for (i, l) in state.lights.iter().enumerate() {
-        let mut def = json!({
-            "type": if l.spot.is_some() { "spot" } else { "point" },
-            "color": unit(l.color),
-            "intensity": candela(scene.lighting.units, l),
-            "range": l.range,
-            "extras": {"lightgrid": {"intensity": l.intensity, "color": l.color.to_array()}},
-        });
-        let mut node = json!({
-            "name": format!("light {i}"),
-            "translation": l.position.to_array(),
-            "extensions": {"KHR_lights_punctual": {"light": i}},
-        });
-        if let Some(s) = l.spot {
-            // glTF's widest cone is π/2 from the axis (a rounding below 0 is that cone).
-            if s.cos_outer < -1e-6 {
-                return Err(Error::invalid(
-                    "export",
-                    format!("spot light {i} is wider than glTF's largest cone (90° from its axis)"),
-                ));
-            }
-            def["spot"] = json!({
-                "innerConeAngle": s.cos_inner.clamp(0.0, 1.0).acos(),
-                "outerConeAngle": s.cos_outer.clamp(0.0, 1.0).acos(),
-            });
-            def["extras"]["lightgrid"]["cos_inner"] = json!(s.cos_inner);
-            def["extras"]["lightgrid"]["cos_outer"] = json!(s.cos_outer);
-            let q = Quat::from_rotation_arc(Vec3::NEG_Z, s.direction);
-            node["rotation"] = json!(q.to_array());
+    (meshes, nodes, counts)
+}
+
+/// A light's KHR_lights_punctual definition (glTF's candela and cone angles, lightgrid's
+/// exact numbers in `extras.lightgrid`) and its node.
+fn light_json(scene: &Scene, i: usize, l: &Light) -> Result<(Value, Value)> {
+    let mut def = json!({
+        "type": if l.spot.is_some() { "spot" } else { "point" },
+        "color": unit(l.color),
+        "intensity": candela(scene.lighting.units, l),
+        "range": l.range,
+        "extras": {"lightgrid": {"intensity": l.intensity, "color": l.color.to_array()}},
+    });
+    let mut node = json!({
+        "name": format!("light {i}"),
+        "translation": l.position.to_array(),
+        "extensions": {"KHR_lights_punctual": {"light": i}},
+    });
+    if let Some(s) = l.spot {
+        // glTF's widest cone is π/2 from the axis (a rounding below 0 is that cone).
+        if s.cos_outer < -1e-6 {
+            return Err(Error::invalid(
+                "export",
+                format!("spot light {i} is wider than glTF's largest cone (90° from its axis)"),
+            ));
         }
-        lights.push(def);
-        nodes.push(node);
+        def["spot"] = json!({
+            "innerConeAngle": s.cos_inner.clamp(0.0, 1.0).acos(),
+            "outerConeAngle": s.cos_outer.clamp(0.0, 1.0).acos(),
+        });
+        def["extras"]["lightgrid"]["cos_inner"] = json!(s.cos_inner);
+        def["extras"]["lightgrid"]["cos_outer"] = json!(s.cos_outer);
+        let q = Quat::from_rotation_arc(Vec3::NEG_Z, s.direction);
+        node["rotation"] = json!(q.to_array());
     }
-    let cam = state.camera;
-    let aspect = size.0 as f32 / size.1.max(1) as f32;
-    nodes.push(json!({
-        "name": "camera",
-        "camera": 0,
-        "matrix": cam.view().inverse().to_cols_array(),
-    }));
-    let materials: Vec<Value> = scene.materials.iter().map(material_json).collect();
-    // Textures as PNG images in the binary chunk, one glTF texture each (repeating).
+    Ok((def, node))
+}
+
+/// Every scene texture as a PNG image in the binary chunk.
+fn images_json(scene: &Scene, bin: &mut Bin) -> Result<Vec<Value>> {
     let mut images = Vec::new();
     for (i, t) in scene.textures.iter().enumerate() {
         let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba.clone())
@@ -331,6 +324,38 @@ pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         bin.bytes.extend_from_slice(&png);
         images.push(json!({"bufferView": bin.views.len() - 1, "mimeType": "image/png"}));
     }
+    Ok(images)
+}
+
+/// The GLB bytes of `scene` at `frame`, for frames of `size` (the camera's aspect ratio).
+pub fn export(scene: &Scene, frame: u32, size: (u32, u32)) -> Result<Vec<u8>> {
+    scene.validate()?;
+    scene.check_frame(frame)?;
+    let state = scene.frame(frame);
+    let mut bin = Bin::default();
+    let (meshes, mut nodes, counts) = object_nodes(scene, &state, &mut bin);
+    if meshes.is_empty() {
+        return Err(Error::invalid(
+            "export",
+            format!("{} has no triangles to export", scene.name),
+        ));
+    }
+    let mut lights = Vec::new();
+    for (i, l) in state.lights.iter().enumerate() {
+        let (def, node) = light_json(scene, i, l)?;
+        lights.push(def);
+        nodes.push(node);
+    }
+    let cam = state.camera;
+    let aspect = size.0 as f32 / size.1.max(1) as f32;
+    nodes.push(json!({
+        "name": "camera",
+        "camera": 0,
+        "matrix": cam.view().inverse().to_cols_array(),
+    }));
+    let materials: Vec<Value> = scene.materials.iter().map(material_json).collect();
+    // Textures as PNG images in the binary chunk, one glTF texture each (repeating).
+    let images = images_json(scene, &mut bin)?;
     let textures: Vec<Value> = (0..images.len())
         .map(|i| json!({"source": i, "sampler": 0}))
         .collect();
