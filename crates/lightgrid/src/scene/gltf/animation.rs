@@ -171,6 +171,68 @@ impl Animation {
     }
 }
 
+/// A sampler's interpolation and keys, checked: times finite, non-negative and increasing,
+/// one finite value (three with cubic-spline tangents) per key, rotations quaternions.
+fn sampler_keys(
+    doc: &Document,
+    sampler: &SamplerDef,
+    property: Property,
+    what: &str,
+) -> Res<(Interpolation, Vec<f32>, Vec<Vec4>)> {
+    let interpolation = match sampler.interpolation.as_deref().unwrap_or("LINEAR") {
+        "LINEAR" => Interpolation::Linear,
+        "STEP" => Interpolation::Step,
+        "CUBICSPLINE" => Interpolation::CubicSpline,
+        other => {
+            return Err(format!(
+                "{what}: interpolation '{other}' is not LINEAR, STEP or CUBICSPLINE"
+            ))
+        }
+    };
+    let times = doc.read_floats(sampler.input, 1, &format!("{what} input"))?;
+    if times.is_empty() {
+        return Err(format!("{what}: no key times"));
+    }
+    let increasing = times.windows(2).all(|w| w[1] > w[0]);
+    if !times.iter().all(|t| t.is_finite() && *t >= 0.0) || !increasing {
+        return Err(format!(
+            "{what}: key times must be finite, at least 0 and increasing"
+        ));
+    }
+    let comps = if property == Property::Rotation { 4 } else { 3 };
+    let flat = doc.read_floats(sampler.output, comps, &format!("{what} output"))?;
+    let per_key = if interpolation == Interpolation::CubicSpline {
+        3
+    } else {
+        1
+    };
+    if flat.len() != times.len() * per_key * comps {
+        return Err(format!(
+            "{what}: {} output values for {} keys (needs {})",
+            flat.len() / comps,
+            times.len(),
+            times.len() * per_key
+        ));
+    }
+    if !flat.iter().all(|v| v.is_finite()) {
+        return Err(format!("{what}: an output value is NaN or infinite"));
+    }
+    let values = flat
+        .chunks_exact(comps)
+        .map(|v| match comps {
+            4 => Vec4::new(v[0], v[1], v[2], v[3]),
+            _ => Vec4::new(v[0], v[1], v[2], 0.0),
+        })
+        .collect::<Vec<_>>();
+    if property == Property::Rotation {
+        let key_values = values.iter().skip(per_key / 2).step_by(per_key);
+        if key_values.clone().any(|q| q.length_squared() < 1e-12) {
+            return Err(format!("{what}: a rotation key is not a quaternion"));
+        }
+    }
+    Ok((interpolation, times, values))
+}
+
 /// The first animation of the file, read and checked, or None when it has none (or none
 /// that moves a node). `warn` takes what is not applied: other animations, weight channels,
 /// and an animation cut at [`MAX_FRAMES`].
@@ -213,57 +275,7 @@ pub(super) fn read(doc: &Document, warn: &mut dyn FnMut(String)) -> Res<Option<A
             .samplers
             .get(c.sampler)
             .ok_or_else(|| format!("{what}: sampler {} does not exist", c.sampler))?;
-        let interpolation = match sampler.interpolation.as_deref().unwrap_or("LINEAR") {
-            "LINEAR" => Interpolation::Linear,
-            "STEP" => Interpolation::Step,
-            "CUBICSPLINE" => Interpolation::CubicSpline,
-            other => {
-                return Err(format!(
-                    "{what}: interpolation '{other}' is not LINEAR, STEP or CUBICSPLINE"
-                ))
-            }
-        };
-        let times = doc.read_floats(sampler.input, 1, &format!("{what} input"))?;
-        if times.is_empty() {
-            return Err(format!("{what}: no key times"));
-        }
-        let increasing = times.windows(2).all(|w| w[1] > w[0]);
-        if !times.iter().all(|t| t.is_finite() && *t >= 0.0) || !increasing {
-            return Err(format!(
-                "{what}: key times must be finite, at least 0 and increasing"
-            ));
-        }
-        let comps = if property == Property::Rotation { 4 } else { 3 };
-        let flat = doc.read_floats(sampler.output, comps, &format!("{what} output"))?;
-        let per_key = if interpolation == Interpolation::CubicSpline {
-            3
-        } else {
-            1
-        };
-        if flat.len() != times.len() * per_key * comps {
-            return Err(format!(
-                "{what}: {} output values for {} keys (needs {})",
-                flat.len() / comps,
-                times.len(),
-                times.len() * per_key
-            ));
-        }
-        if !flat.iter().all(|v| v.is_finite()) {
-            return Err(format!("{what}: an output value is NaN or infinite"));
-        }
-        let values = flat
-            .chunks_exact(comps)
-            .map(|v| match comps {
-                4 => Vec4::new(v[0], v[1], v[2], v[3]),
-                _ => Vec4::new(v[0], v[1], v[2], 0.0),
-            })
-            .collect::<Vec<_>>();
-        if property == Property::Rotation {
-            let key_values = values.iter().skip(per_key / 2).step_by(per_key);
-            if key_values.clone().any(|q| q.length_squared() < 1e-12) {
-                return Err(format!("{what}: a rotation key is not a quaternion"));
-            }
-        }
+        let (interpolation, times, values) = sampler_keys(doc, sampler, property, &what)?;
         channels.push(Channel {
             node,
             property,
