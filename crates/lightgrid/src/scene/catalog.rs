@@ -408,6 +408,108 @@ fn in_street(x0: f32, x1: f32, z0: f32, z1: f32) -> bool {
     overlaps_main || overlaps_cross
 }
 
+/// The asphalt, and the sidewalks along both sides of the main street and the cross
+/// streets.
+fn street(b: &mut Builder, asphalt: usize, pavement: usize) {
+    let extent = STREET_HALF_LENGTH + 40.0;
+    b.object(
+        Mesh::ground(-extent, -extent, extent, extent, 0.0),
+        asphalt,
+        Motion::Static,
+    );
+
+    // Sidewalks along both sides of the main street and the cross streets.
+    let mut walks = Mesh::default();
+    let m = MAIN_STREET_WIDTH * 0.5;
+    for side in [-1.0f32, 1.0] {
+        let (x0, x1) = if side < 0.0 {
+            (-m - SIDEWALK, -m)
+        } else {
+            (m, m + SIDEWALK)
+        };
+        walks.append(
+            &Mesh::block(
+                Vec3::new(x0, 0.0, -STREET_HALF_LENGTH),
+                Vec3::new(x1, 0.2, STREET_HALF_LENGTH),
+            ),
+            Mat4::IDENTITY,
+        );
+    }
+    for c in CROSS_STREETS_Z {
+        let h = CROSS_STREET_WIDTH * 0.5;
+        for (z0, z1) in [(c - h - SIDEWALK, c - h), (c + h, c + h + SIDEWALK)] {
+            walks.append(
+                &Mesh::block(
+                    Vec3::new(-STREET_HALF_LENGTH, 0.0, z0),
+                    Vec3::new(STREET_HALF_LENGTH, 0.2, z1),
+                ),
+                Mat4::IDENTITY,
+            );
+        }
+    }
+    b.object(walks, pavement, Motion::Static);
+}
+
+/// Buildings: rows of boxes along every block's street fronts, two rows deep, each block of
+/// one of the `facades` materials (drawn from the scene's stream).
+fn buildings(b: &mut Builder, facades: Vec<usize>) {
+    let mut buildings: Vec<Mesh> = vec![Mesh::default(); facades.len()];
+    let inner = MAIN_STREET_WIDTH * 0.5 + SIDEWALK + 0.5;
+    for side in [-1.0f32, 1.0] {
+        for row in 0..2 {
+            let mut z = -STREET_HALF_LENGTH;
+            while z < STREET_HALF_LENGTH {
+                let width = b.rng.range(9.0, 22.0);
+                let depth = b.rng.range(14.0, 26.0);
+                let height = b.rng.range(10.0, 55.0) * if row == 0 { 1.0 } else { 1.4 };
+                let near = inner + row as f32 * 30.0;
+                let (x0, x1) = if side > 0.0 {
+                    (near, near + depth)
+                } else {
+                    (-near - depth, -near)
+                };
+                let (z0, z1) = (z, (z + width).min(STREET_HALF_LENGTH));
+                // Fronts facing the main street stop at the cross streets.
+                if !in_street(x0, x1, z0, z1) {
+                    let f = b.rng.below(facades.len() as u32) as usize;
+                    buildings[f].append(
+                        &Mesh::block(Vec3::new(x0, 0.0, z0), Vec3::new(x1, height, z1)),
+                        Mat4::IDENTITY,
+                    );
+                }
+                z += width + b.rng.range(0.5, 3.0);
+            }
+        }
+    }
+    for (mesh, f) in buildings.into_iter().zip(facades) {
+        b.object(mesh, f, Motion::Static);
+    }
+}
+
+/// A robot (a 2x scale humanoid made of boxes, facing +z in object space) and its eyes.
+fn robot_meshes() -> (Mesh, Mesh) {
+    let mut body = Mesh::default();
+    let parts = [
+        (Vec3::new(-1.8, 0.0, -0.7), Vec3::new(-0.4, 4.4, 0.7)), // left leg
+        (Vec3::new(0.4, 0.0, -0.7), Vec3::new(1.8, 4.4, 0.7)),   // right leg
+        (Vec3::new(-2.2, 4.4, -1.2), Vec3::new(2.2, 9.2, 1.2)),  // torso
+        (Vec3::new(-3.2, 5.0, -0.6), Vec3::new(-2.3, 9.0, 0.6)), // left arm
+        (Vec3::new(2.3, 5.0, -0.6), Vec3::new(3.2, 9.0, 0.6)),   // right arm
+        (Vec3::new(-1.2, 9.4, -1.0), Vec3::new(1.2, 11.4, 1.0)), // head
+    ];
+    for (lo, hi) in parts {
+        body.append(&Mesh::block(lo, hi), Mat4::IDENTITY);
+    }
+    let mut eye_mesh = Mesh::default();
+    for x in [-0.7, 0.3] {
+        eye_mesh.append(
+            &Mesh::cuboid(Vec3::new(x, 10.4, 1.02), Vec3::new(x + 0.4, 10.8, 1.15)),
+            Mat4::IDENTITY,
+        );
+    }
+    (body, eye_mesh)
+}
+
 /// The street, its buildings and the 11 robots. Returns the builder and the object index of
 /// each robot's body (lights of `robots-few` ride on it).
 fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
@@ -451,97 +553,10 @@ fn robots_street(name: &str, seed: u64) -> (Builder, Vec<usize>) {
         ..Material::plain(Vec3::new(0.2, 0.05, 0.05), 0.5, 32.0)
     });
 
-    let extent = STREET_HALF_LENGTH + 40.0;
-    b.object(
-        Mesh::ground(-extent, -extent, extent, extent, 0.0),
-        asphalt,
-        Motion::Static,
-    );
+    street(&mut b, asphalt, pavement);
+    buildings(&mut b, facades);
 
-    // Sidewalks along both sides of the main street and the cross streets.
-    let mut walks = Mesh::default();
-    let m = MAIN_STREET_WIDTH * 0.5;
-    for side in [-1.0f32, 1.0] {
-        let (x0, x1) = if side < 0.0 {
-            (-m - SIDEWALK, -m)
-        } else {
-            (m, m + SIDEWALK)
-        };
-        walks.append(
-            &Mesh::block(
-                Vec3::new(x0, 0.0, -STREET_HALF_LENGTH),
-                Vec3::new(x1, 0.2, STREET_HALF_LENGTH),
-            ),
-            Mat4::IDENTITY,
-        );
-    }
-    for c in CROSS_STREETS_Z {
-        let h = CROSS_STREET_WIDTH * 0.5;
-        for (z0, z1) in [(c - h - SIDEWALK, c - h), (c + h, c + h + SIDEWALK)] {
-            walks.append(
-                &Mesh::block(
-                    Vec3::new(-STREET_HALF_LENGTH, 0.0, z0),
-                    Vec3::new(STREET_HALF_LENGTH, 0.2, z1),
-                ),
-                Mat4::IDENTITY,
-            );
-        }
-    }
-    b.object(walks, pavement, Motion::Static);
-
-    // Buildings: rows of boxes along every block's street fronts, two rows deep.
-    let mut buildings: Vec<Mesh> = vec![Mesh::default(); facades.len()];
-    let inner = MAIN_STREET_WIDTH * 0.5 + SIDEWALK + 0.5;
-    for side in [-1.0f32, 1.0] {
-        for row in 0..2 {
-            let mut z = -STREET_HALF_LENGTH;
-            while z < STREET_HALF_LENGTH {
-                let width = b.rng.range(9.0, 22.0);
-                let depth = b.rng.range(14.0, 26.0);
-                let height = b.rng.range(10.0, 55.0) * if row == 0 { 1.0 } else { 1.4 };
-                let near = inner + row as f32 * 30.0;
-                let (x0, x1) = if side > 0.0 {
-                    (near, near + depth)
-                } else {
-                    (-near - depth, -near)
-                };
-                let (z0, z1) = (z, (z + width).min(STREET_HALF_LENGTH));
-                // Fronts facing the main street stop at the cross streets.
-                if !in_street(x0, x1, z0, z1) {
-                    let f = b.rng.below(facades.len() as u32) as usize;
-                    buildings[f].append(
-                        &Mesh::block(Vec3::new(x0, 0.0, z0), Vec3::new(x1, height, z1)),
-                        Mat4::IDENTITY,
-                    );
-                }
-                z += width + b.rng.range(0.5, 3.0);
-            }
-        }
-    }
-    for (mesh, f) in buildings.into_iter().zip(facades) {
-        b.object(mesh, f, Motion::Static);
-    }
-
-    // The robots: 2x scale humanoids made of boxes, facing +z in object space.
-    let mut body = Mesh::default();
-    let parts = [
-        (Vec3::new(-1.8, 0.0, -0.7), Vec3::new(-0.4, 4.4, 0.7)), // left leg
-        (Vec3::new(0.4, 0.0, -0.7), Vec3::new(1.8, 4.4, 0.7)),   // right leg
-        (Vec3::new(-2.2, 4.4, -1.2), Vec3::new(2.2, 9.2, 1.2)),  // torso
-        (Vec3::new(-3.2, 5.0, -0.6), Vec3::new(-2.3, 9.0, 0.6)), // left arm
-        (Vec3::new(2.3, 5.0, -0.6), Vec3::new(3.2, 9.0, 0.6)),   // right arm
-        (Vec3::new(-1.2, 9.4, -1.0), Vec3::new(1.2, 11.4, 1.0)), // head
-    ];
-    for (lo, hi) in parts {
-        body.append(&Mesh::block(lo, hi), Mat4::IDENTITY);
-    }
-    let mut eye_mesh = Mesh::default();
-    for x in [-0.7, 0.3] {
-        eye_mesh.append(
-            &Mesh::cuboid(Vec3::new(x, 10.4, 1.02), Vec3::new(x + 0.4, 10.8, 1.15)),
-            Mat4::IDENTITY,
-        );
-    }
+    let (body, eye_mesh) = robot_meshes();
     b.scene.paths = robot_paths();
     let mut robots = Vec::new();
     for p in 0..ROBOT_COUNT {
