@@ -465,135 +465,166 @@ fn scenes_and_bits(results: &BenchResults) -> (Vec<String>, Vec<u32>) {
     (scenes, bits)
 }
 
-fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Result<()> {
-    let (scenes, bits) = scenes_and_bits(results);
+/// A scene's frame time over the animation and its average GPU time per pass, at G-buffer
+/// precision `b`.
+fn time_charts(
+    dir: &Path,
+    results: &BenchResults,
+    scene: &str,
+    b: u32,
+    written: &mut Vec<PathBuf>,
+) -> Result<()> {
     let (w, h) = results.runs.first().map_or((0, 0), |r| (r.width, r.height));
-    for scene in &scenes {
-        for &b in &bits {
-            let runs: Vec<&RunRecord> = results
-                .runs
-                .iter()
-                .filter(|r| &r.scene == scene && r.gbuffer_bits().unwrap_or(b) == b)
-                .collect();
-            let timing = if runs
-                .iter()
-                .all(|r| r.timing == lightgrid::TimingSource::GpuTimestamps)
-            {
-                "GPU timestamps"
-            } else {
-                "wall clock"
-            };
-            let chart = LineChart {
-                title: format!(
-                    "{scene}: frame time over the animation ({w}x{h}, {b}-bit G-buffer)"
-                ),
-                x_label: "frame".into(),
-                y_label: format!("ms ({timing}, log scale)"),
-                log_x: false,
-                log_y: true,
-                series: runs
-                    .iter()
-                    .map(|r| Series {
-                        name: r.label(),
-                        points: r
-                            .frames
-                            .iter()
-                            .map(|f| (f.stats.frame as f64, f.stats.gpu_ms))
-                            .collect(),
-                        emphasis: false,
-                    })
-                    .collect(),
-            };
-            write_chart(
-                dir,
-                &format!("frame_time_{scene}_g{b}"),
-                chart.svg(),
-                chart.png(),
-                written,
-            )?;
-            // The brute-force references would flatten every other bar; their time is in the
-            // frame-time chart.
-            let bars = StackedBars {
-                title: format!("{scene}: average GPU time per pass ({b}-bit G-buffer; brute-force forward omitted)"),
-                y_label: "ms".into(),
-                bars: runs
-                    .iter()
-                    .filter(|r| !lightgrid::pipelines::find(&r.pipeline).is_ok_and(|p| p.reference == p.id))
-                    .filter_map(|r| {
-                        let s = r.summary.as_ref()?;
-                        Some((
-                            r.label(),
-                            s.passes.iter().map(|p| (p.label.clone(), p.ms)).collect(),
-                        ))
-                    })
-                    .collect(),
-            };
-            write_chart(
-                dir,
-                &format!("passes_{scene}_g{b}"),
-                bars.svg(),
-                bars.png(),
-                written,
-            )?;
-        }
-        // Lighting computations do not depend on the G-buffer precision: one chart per scene.
-        let first = bits.first().copied().unwrap_or(16);
-        let runs: Vec<&RunRecord> = results
-            .runs
+    let runs: Vec<&RunRecord> = results
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.gbuffer_bits().unwrap_or(b) == b)
+        .collect();
+    let timing = if runs
+        .iter()
+        .all(|r| r.timing == lightgrid::TimingSource::GpuTimestamps)
+    {
+        "GPU timestamps"
+    } else {
+        "wall clock"
+    };
+    let chart = LineChart {
+        title: format!("{scene}: frame time over the animation ({w}x{h}, {b}-bit G-buffer)"),
+        x_label: "frame".into(),
+        y_label: format!("ms ({timing}, log scale)"),
+        log_x: false,
+        log_y: true,
+        series: runs
             .iter()
-            .filter(|r| &r.scene == scene && r.gbuffer_bits().unwrap_or(first) == first)
-            .collect();
-        let mut series: Vec<Series> = runs
-            .iter()
-            .filter(|r| {
-                r.frames
-                    .iter()
-                    .all(|f| f.stats.lighting_computations.is_some())
-            })
             .map(|r| Series {
                 name: r.label(),
                 points: r
                     .frames
                     .iter()
-                    .map(|f| {
-                        (
-                            f.stats.frame as f64,
-                            f.stats.lighting_computations.unwrap_or(0) as f64,
-                        )
-                    })
+                    .map(|f| (f.stats.frame as f64, f.stats.gpu_ms))
                     .collect(),
                 emphasis: false,
             })
-            .collect();
-        if let Some(r) = runs.first() {
-            series.push(Series {
-                name: "ideal".into(),
-                points: r
-                    .frames
-                    .iter()
-                    .map(|f| {
-                        (
-                            f.stats.frame as f64,
-                            f.stats.ideal_lighting_computations as f64,
-                        )
-                    })
-                    .collect(),
-                emphasis: true,
-            });
+            .collect(),
+    };
+    write_chart(
+        dir,
+        &format!("frame_time_{scene}_g{b}"),
+        chart.svg(),
+        chart.png(),
+        written,
+    )?;
+    // The brute-force references would flatten every other bar; their time is in the
+    // frame-time chart.
+    let bars = StackedBars {
+        title: format!(
+            "{scene}: average GPU time per pass ({b}-bit G-buffer; brute-force forward omitted)"
+        ),
+        y_label: "ms".into(),
+        bars: runs
+            .iter()
+            .filter(|r| !lightgrid::pipelines::find(&r.pipeline).is_ok_and(|p| p.reference == p.id))
+            .filter_map(|r| {
+                let s = r.summary.as_ref()?;
+                Some((
+                    r.label(),
+                    s.passes.iter().map(|p| (p.label.clone(), p.ms)).collect(),
+                ))
+            })
+            .collect(),
+    };
+    write_chart(
+        dir,
+        &format!("passes_{scene}_g{b}"),
+        bars.svg(),
+        bars.png(),
+        written,
+    )?;
+    Ok(())
+}
+
+/// A scene's lighting computations per frame and the ideal (they do not depend on the
+/// G-buffer precision: the runs at precision `first`).
+fn lighting_chart(
+    dir: &Path,
+    results: &BenchResults,
+    scene: &str,
+    first: u32,
+    written: &mut Vec<PathBuf>,
+) -> Result<()> {
+    let (w, h) = results.runs.first().map_or((0, 0), |r| (r.width, r.height));
+    let runs: Vec<&RunRecord> = results
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.gbuffer_bits().unwrap_or(first) == first)
+        .collect();
+    let mut series: Vec<Series> = runs
+        .iter()
+        .filter(|r| {
+            r.frames
+                .iter()
+                .all(|f| f.stats.lighting_computations.is_some())
+        })
+        .map(|r| Series {
+            name: r.label(),
+            points: r
+                .frames
+                .iter()
+                .map(|f| {
+                    (
+                        f.stats.frame as f64,
+                        f.stats.lighting_computations.unwrap_or(0) as f64,
+                    )
+                })
+                .collect(),
+            emphasis: false,
+        })
+        .collect();
+    if let Some(r) = runs.first() {
+        series.push(Series {
+            name: "ideal".into(),
+            points: r
+                .frames
+                .iter()
+                .map(|f| {
+                    (
+                        f.stats.frame as f64,
+                        f.stats.ideal_lighting_computations as f64,
+                    )
+                })
+                .collect(),
+            emphasis: true,
+        });
+    }
+    let chart = LineChart {
+        title: format!("{scene}: lighting computations per frame ({w}x{h})"),
+        x_label: "frame".into(),
+        y_label: "lighting computations (log scale)".into(),
+        log_x: false,
+        log_y: true,
+        series,
+    };
+    write_chart(
+        dir,
+        &format!("lighting_{scene}"),
+        chart.svg(),
+        chart.png(),
+        written,
+    )?;
+    Ok(())
+}
+
+fn plots(dir: &Path, results: &BenchResults, written: &mut Vec<PathBuf>) -> Result<()> {
+    let (scenes, bits) = scenes_and_bits(results);
+    for scene in &scenes {
+        for &b in &bits {
+            time_charts(dir, results, scene, b, written)?;
         }
-        let chart = LineChart {
-            title: format!("{scene}: lighting computations per frame ({w}x{h})"),
-            x_label: "frame".into(),
-            y_label: "lighting computations (log scale)".into(),
-            log_x: false,
-            log_y: true,
-            series,
-        };
-        write_chart(
+        lighting_chart(
             dir,
-            &format!("lighting_{scene}"),
-            chart.svg(),
-            chart.png(),
+            results,
+            scene,
+            bits.first().copied().unwrap_or(16),
             written,
         )?;
     }
