@@ -29,6 +29,70 @@ fn sphere_meets_box(c: Vec3, r: f32, lo: Vec3, hi: Vec3) -> bool {
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
+/// Per cell the view-space box of its samples' pixel footprints, and every sample off the
+/// background: (cell, view distance, x, y).
+#[allow(clippy::type_complexity)]
+fn sample_boxes(out: &lightgrid::FrameOutput) -> (Vec<Vec3>, Vec<Vec3>, Vec<(usize, f32, u32, u32)>) {
+    let (setup, dims, (w, h)) = (&out.setup, out.grid.dims, SIZE);
+    let mut lo = vec![Vec3::INFINITY; dims.cell_count()];
+    let mut hi = vec![Vec3::NEG_INFINITY; dims.cell_count()];
+    let mut samples = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let d = out.depth[(y * w + x) as usize];
+            if lightgrid::depth::is_background(d) {
+                continue;
+            }
+            let wd = setup.view_distance(d);
+            let c = dims.cell_of(x, y, wd);
+            for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                for ww in [wd * 0.9999, wd * 1.0001] {
+                    let nx = (x as f32 + dx) / w as f32 * 2.0 - 1.0;
+                    let ny = 1.0 - (y as f32 + dy) / h as f32 * 2.0;
+                    let p = Vec3::new(nx / setup.p00 * ww, ny / setup.p11 * ww, -ww);
+                    lo[c] = lo[c].min(p);
+                    hi[c] = hi[c].max(p);
+                }
+            }
+            samples.push((c, wd, x, y));
+        }
+    }
+    (lo, hi, samples)
+}
+
+/// Z-binning's lighting computations per ideal, one per bin count of `BINS`: the tiles'
+/// near..far lists, a light kept where its depth bins meet the sample's.
+fn zbin_columns(
+    setup: &lightgrid::scene::ViewSetup,
+    lights: &[lightgrid::scene::Light],
+    views: &[lightgrid::scene::ViewLight],
+    samples: &[(usize, f32, u32, u32)],
+    ideal: f64,
+) -> Result<Vec<f64>> {
+    let (w, h) = SIZE;
+    let mut row = Vec::new();
+    let tiles = GridDims::new(w, h, TILE)?;
+    let flat = assign_cpu(setup, &tiles, lights, DepthRange::NearFar);
+    let (wmin, wmax) = samples.iter().fold((f32::INFINITY, 0f32), |a, s| (a.0.min(s.1), a.1.max(s.1)));
+    for bins in BINS {
+        let bin =
+            |x: f32| ((x - wmin) / (wmax - wmin) * bins as f32).floor().clamp(0.0, (bins - 1) as f32) as u32;
+        let mut count = 0u64;
+        for &(_, wd, x, y) in samples {
+            let b = bin(wd);
+            for &l in flat.cell(tiles.tile_of(x, y)) {
+                let v = &views[l as usize];
+                let wc = -v.center.z;
+                if bin(wc - v.radius) <= b && b <= bin(wc + v.radius) {
+                    count += 1;
+                }
+            }
+        }
+        row.push(count as f64 / ideal);
+    }
+    Ok(row)
+}
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let scene_name = args.first().map_or("robots-many", String::as_str);
@@ -79,29 +143,7 @@ fn main() -> Result<()> {
                 break;
             }
             let views: Vec<_> = lights.iter().map(|l| setup.to_view(l)).collect();
-            let mut lo = vec![Vec3::INFINITY; dims.cell_count()];
-            let mut hi = vec![Vec3::NEG_INFINITY; dims.cell_count()];
-            let mut samples = Vec::new();
-            for y in 0..h {
-                for x in 0..w {
-                    let d = out.depth[(y * w + x) as usize];
-                    if lightgrid::depth::is_background(d) {
-                        continue;
-                    }
-                    let wd = setup.view_distance(d);
-                    let c = dims.cell_of(x, y, wd);
-                    for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
-                        for ww in [wd * 0.9999, wd * 1.0001] {
-                            let nx = (x as f32 + dx) / w as f32 * 2.0 - 1.0;
-                            let ny = 1.0 - (y as f32 + dy) / h as f32 * 2.0;
-                            let p = Vec3::new(nx / setup.p00 * ww, ny / setup.p11 * ww, -ww);
-                            lo[c] = lo[c].min(p);
-                            hi[c] = hi[c].max(p);
-                        }
-                    }
-                    samples.push((c, wd, x, y));
-                }
-            }
+            let (lo, hi, samples) = sample_boxes(&out);
             let kept: Vec<u64> = (0..dims.cell_count())
                 .map(|c| {
                     let in_box = |l: &&u32| {
@@ -116,28 +158,7 @@ fn main() -> Result<()> {
             row.push(listed as f64 / ideal);
             row.push(boxed as f64 / ideal);
             if id == "tiled_forward_prez" {
-                let tiles = GridDims::new(w, h, TILE)?;
-                let flat = assign_cpu(setup, &tiles, &lights, DepthRange::NearFar);
-                let (wmin, wmax) =
-                    samples.iter().fold((f32::INFINITY, 0f32), |a, s| (a.0.min(s.1), a.1.max(s.1)));
-                for bins in BINS {
-                    let bin = |x: f32| {
-                        ((x - wmin) / (wmax - wmin) * bins as f32).floor().clamp(0.0, (bins - 1) as f32)
-                            as u32
-                    };
-                    let mut count = 0u64;
-                    for &(_, wd, x, y) in &samples {
-                        let b = bin(wd);
-                        for &l in flat.cell(tiles.tile_of(x, y)) {
-                            let v = &views[l as usize];
-                            let wc = -v.center.z;
-                            if bin(wc - v.radius) <= b && b <= bin(wc + v.radius) {
-                                count += 1;
-                            }
-                        }
-                    }
-                    row.push(count as f64 / ideal);
-                }
+                row.extend(zbin_columns(setup, &lights, &views, &samples, ideal)?);
             }
         }
         if row.len() < sums.len() {
