@@ -242,7 +242,7 @@ impl App {
         let panel_on = self.panel && sw >= MIN_PANEL_WINDOW.0 && sh >= MIN_PANEL_WINDOW.1;
         let draft = &mut self.draft;
         let mut actions = Vec::new();
-        let output = win.egui.ctx.run_pass(input, |ctx| {
+        let mut output = win.egui.ctx.run_pass(input, |ctx| {
             if panel_on {
                 actions = panel::draw(ctx, draft, &info);
             } else {
@@ -261,53 +261,16 @@ impl App {
         }
         win.egui
             .state
-            .handle_platform_output(&win.window, output.platform_output);
-        let primitives = win
-            .egui
-            .ctx
-            .tessellate(output.shapes, output.pixels_per_point);
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [win.surface.size().0, win.surface.size().1],
-            pixels_per_point: output.pixels_per_point,
-        };
-        let device = &self.ctx.device;
-        let queue = &self.ctx.queue;
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                win.egui.renderer.update_texture(device, queue, *id, delta);
-            }
-        }
-        let extra = win
-            .egui
-            .renderer
-            .update_buffers(device, queue, encoder, &primitives, &screen);
-        if !extra.is_empty() {
-            queue.submit(extra);
-        }
-        {
-            let mut pass = encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("viewer panel"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: target,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                })
-                .forget_lifetime();
-            win.egui.renderer.render(&mut pass, &primitives, &screen);
-        }
-        for id in &output.textures_delta.free {
-            win.egui.renderer.free_texture(id);
-        }
+            .handle_platform_output(&win.window, std::mem::take(&mut output.platform_output));
+        let size = win.surface.size();
+        win.egui.paint(
+            &self.ctx.device,
+            &self.ctx.queue,
+            encoder,
+            target,
+            output,
+            size,
+        );
         Ok(actions)
     }
 
@@ -352,5 +315,60 @@ impl App {
         );
         self.screenshots
             .push_back(after::free_name(Path::new("."), &stem));
+    }
+}
+
+impl EguiLayer {
+    /// Draw the pass's shapes over `target` (a window of `size` pixels), with its texture
+    /// changes.
+    fn paint(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        output: egui::FullOutput,
+        size: (u32, u32),
+    ) {
+        let primitives = self.ctx.tessellate(output.shapes, output.pixels_per_point);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [size.0, size.1],
+            pixels_per_point: output.pixels_per_point,
+        };
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                self.renderer.update_texture(device, queue, *id, delta);
+            }
+        }
+        let extra = self
+            .renderer
+            .update_buffers(device, queue, encoder, &primitives, &screen);
+        if !extra.is_empty() {
+            queue.submit(extra);
+        }
+        {
+            let mut pass = encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("viewer panel"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: target,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                })
+                .forget_lifetime();
+            self.renderer.render(&mut pass, &primitives, &screen);
+        }
+        for id in &output.textures_delta.free {
+            self.renderer.free_texture(id);
+        }
     }
 }
