@@ -207,10 +207,9 @@ impl BenchConfig {
         });
     }
 
-    pub fn validate(&self) -> Result<()> {
-        check_range_scales(&self.range_scales)?;
-        // Every list names series: a value given twice, or two values that are one, would
-        // measure one series twice under one name.
+    /// Every list names series: a value given twice, or two values that are one, would
+    /// measure one series twice under one name.
+    fn check_distinct_lists(&self) -> Result<()> {
         crate::check_distinct("--scene", &self.scenes, |s| scene_key(s))?;
         crate::check_distinct("--pipelines", &self.pipelines, |p| {
             pipelines::find(p).map_or(p.trim().to_string(), |i| i.id.to_string())
@@ -231,6 +230,12 @@ impl BenchConfig {
             };
             crate::check_distinct(&format!("--{}", a.flag), &a.values, canonical)?;
         }
+        Ok(())
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        check_range_scales(&self.range_scales)?;
+        self.check_distinct_lists()?;
         if self.scenes.is_empty() || self.pipelines.is_empty() {
             return Err(invalid("bench", "needs at least one scene and pipeline"));
         }
@@ -882,6 +887,39 @@ impl<'a> Measuring<'a> {
             .2)
     }
 
+    /// Once per scene and frame with spots: how many lights the spot test's rays take per
+    /// tile (`culling::ray_test_count`) against the frame's ideal.
+    fn spot_ray_test(
+        &self,
+        scene: &lightgrid::scene::Scene,
+        f: u32,
+        record: &RunRecord,
+        out: &lightgrid::FrameOutput,
+        results: &mut BenchResults,
+    ) -> Result<()> {
+        let tested = |t: &SpotRayTest| t.scene == scene.name && t.frame == f;
+        let spots = self.config.has_spots() && scene.lights.iter().any(|l| l.light.spot.is_some());
+        if spots && !results.spot_ray_tests.iter().any(tested) {
+            let state = scene.frame(f);
+            let setup =
+                lightgrid::scene::ViewSetup::new(&state.camera, record.width, record.height);
+            let count = lightgrid::culling::ray_test_count(
+                &setup,
+                self.config.tile_size,
+                &state.lights,
+                &out.depth,
+            )?;
+            results.spot_ray_tests.push(SpotRayTest {
+                scene: scene.name.clone(),
+                frame: f,
+                tile_size: self.config.tile_size,
+                ideal_lighting_computations: out.stats.ideal_lighting_computations,
+                count,
+            });
+        }
+        Ok(())
+    }
+
     /// Measure one series into `record` (and the render-target bytes per pixel and in all
     /// into `bytes`): warm-up, one analysis render per frame (counts), then `repeat` real-time
     /// passes (times). What it measured stays in `record` whatever the outcome.
@@ -934,27 +972,7 @@ impl<'a> Measuring<'a> {
                 );
                 heatmaps.push((scene.name.clone(), info.id.to_string(), f, map));
             }
-            let tested = |t: &SpotRayTest| t.scene == scene.name && t.frame == f;
-            let spots =
-                self.config.has_spots() && scene.lights.iter().any(|l| l.light.spot.is_some());
-            if spots && !results.spot_ray_tests.iter().any(tested) {
-                let state = scene.frame(f);
-                let setup =
-                    lightgrid::scene::ViewSetup::new(&state.camera, record.width, record.height);
-                let count = lightgrid::culling::ray_test_count(
-                    &setup,
-                    self.config.tile_size,
-                    &state.lights,
-                    &out.depth,
-                )?;
-                results.spot_ray_tests.push(SpotRayTest {
-                    scene: scene.name.clone(),
-                    frame: f,
-                    tile_size: self.config.tile_size,
-                    ideal_lighting_computations: s.ideal_lighting_computations,
-                    count,
-                });
-            }
+            self.spot_ray_test(scene, f, record, &out, results)?;
             record.frames.push(FrameRecord::from_analysis(f, s));
             if self.stopped() {
                 return Ok(SeriesEnd::Stopped);
