@@ -1169,6 +1169,38 @@ pub fn prepare(config: &BenchConfig) -> Result<PreparedBench> {
     })
 }
 
+/// Each scene's strip of frames (`THUMBNAIL_FRAMES`) with `pipeline` at the first value of
+/// every setting; a strip that fails is said, not a failed run.
+fn add_thumbnails(
+    ctx: &GpuContext,
+    config: &BenchConfig,
+    scenes: &[lightgrid::scene::Scene],
+    pipeline: &str,
+    results: &mut BenchResults,
+) {
+    for scene in scenes {
+        let size = config.size.unwrap_or(scene.default_size);
+        // The first value of every setting (the thumbnails show the scene).
+        let mut settings = RenderSettings {
+            grid: lightgrid::CullConfig {
+                tile_size: config.tile_size,
+                ..lightgrid::CullConfig::default()
+            },
+            ..Default::default()
+        };
+        for axis in AXES {
+            (axis.set)(&mut settings, &config.values(axis)[0]).expect("validated");
+        }
+        let strip = Renderer::new(ctx, size.0, size.1, settings)
+            .and_then(|mut r| thumbnails(&mut r, scene, pipeline));
+        match strip {
+            Ok(img) => results.thumbnails.push((scene.name.clone(), img)),
+            // A picture is not worth failing a finished run for: the report says.
+            Err(e) => eprintln!("thumbnails of {}: {e}", scene.name),
+        }
+    }
+}
+
 /// Run the benchmark: [`prepare`], then [`PreparedBench::run`].
 pub fn run(
     ctx: &GpuContext,
@@ -1272,28 +1304,7 @@ impl PreparedBench {
                 .heatmap_pipeline
                 .clone()
                 .unwrap_or_else(|| config.pipelines[0].clone());
-            for scene in scenes {
-                let size = config.size.unwrap_or(scene.default_size);
-                // The first value of every setting (the thumbnails show the scene).
-                let mut settings = RenderSettings {
-                    grid: lightgrid::CullConfig {
-                        tile_size: config.tile_size,
-                        ..lightgrid::CullConfig::default()
-                    },
-                    ..Default::default()
-                };
-                for axis in AXES {
-                    (axis.set)(&mut settings, &config.values(axis)[0]).expect("validated");
-                }
-                let settings = RenderSettings { ..settings };
-                let strip = Renderer::new(ctx, size.0, size.1, settings)
-                    .and_then(|mut r| thumbnails(&mut r, scene, &pipeline));
-                match strip {
-                    Ok(img) => results.thumbnails.push((scene.name.clone(), img)),
-                    // A picture is not worth failing a finished run for: the report says.
-                    Err(e) => eprintln!("thumbnails of {}: {e}", scene.name),
-                }
-            }
+            add_thumbnails(ctx, config, scenes, &pipeline, &mut results);
         }
         m.tick("done".into());
         Ok(results)
