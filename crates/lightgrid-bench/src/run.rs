@@ -617,6 +617,38 @@ fn varied(
 /// The suffix of a scene measured without its transparent objects (`opaque_variants`).
 pub const OPAQUE_SUFFIX: &str = "-opaque";
 
+/// A scene variant's name in the results: the scene's, with its light count and spot
+/// fraction where the run measures several.
+fn variant_name(
+    scene: &str,
+    config: &BenchConfig,
+    lights: Option<u32>,
+    spot_fraction: f32,
+) -> String {
+    let mut base = match lights {
+        Some(n) if config.lights.len() > 1 => format!("{scene}-{n}-lights"),
+        _ => scene.to_string(),
+    };
+    if config.spot_fractions().len() > 1 && spot_fraction > 0.0 {
+        base = format!("{base}{SPOTS_SUFFIX}{spot_fraction}");
+    }
+    base
+}
+
+/// Where a scene variant came from, in the options' words.
+fn variant_source(
+    name: &str,
+    config: &BenchConfig,
+    lights: Option<u32>,
+    spot_fraction: f32,
+) -> String {
+    match (lights, config.spot_fractions().len() > 1) {
+        (Some(n), _) if config.lights.len() > 1 => format!("--scene {name} with {n} lights"),
+        (_, true) => format!("--scene {name} at spot fraction {spot_fraction}"),
+        _ => format!("--scene {name}"),
+    }
+}
+
 fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
     let mut scenes = Vec::new();
     // Scene ids: two files with one file name (a/model.glb, b/model.glb) would be one scene
@@ -666,13 +698,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
             for w in &opened.warnings {
                 eprintln!("warning: {name}: {w}");
             }
-            let mut base = match lights {
-                Some(n) if config.lights.len() > 1 => format!("{}-{n}-lights", opened.scene.name),
-                _ => opened.scene.name.clone(),
-            };
-            if fractions.len() > 1 && spot_fraction > 0.0 {
-                base = format!("{base}{SPOTS_SUFFIX}{spot_fraction}");
-            }
+            let base = variant_name(&opened.scene.name, config, lights, spot_fraction);
             let id = unique_id(&base, &ids);
             if id != base {
                 eprintln!(
@@ -693,13 +719,7 @@ fn build_scenes(config: &BenchConfig) -> Result<Vec<lightgrid::scene::Scene>> {
                 true => open(false)?.scene,
                 false => opened.scene,
             };
-            let source = match (lights, fractions.len() > 1) {
-                (Some(n), _) if config.lights.len() > 1 => {
-                    format!("--scene {name} with {n} lights")
-                }
-                (_, true) => format!("--scene {name} at spot fraction {spot_fraction}"),
-                _ => format!("--scene {name}"),
-            };
+            let source = variant_source(name, config, lights, spot_fraction);
             if !config.range_scales.is_empty() {
                 for &f in &config.range_scales {
                     scenes.push(range_scaled(&scene, f));
