@@ -254,6 +254,52 @@ impl OutDir {
             .collect()
     }
 
+    /// Other commands' manifests and what each lists: their files are not replaced, and the
+    /// names a forced run took are handed over.
+    fn other_manifests(&self, own: &str) -> Result<Vec<(String, Vec<String>)>> {
+        let mut others = Vec::new();
+        for e in std::fs::read_dir(&self.dir)
+            .map_err(io(&self.dir))?
+            .flatten()
+        {
+            let m = e.file_name().to_string_lossy().into_owned();
+            if m.starts_with(MANIFEST_FILE) && m != own {
+                let list = self.listed(&m);
+                others.push((m, list));
+            }
+        }
+        Ok(others)
+    }
+
+    /// The refusal of a run whose files would replace `taken` (another command's, or not
+    /// lightgrid's): a few named with their owner, this run's files set aside.
+    fn refuse_taken(&self, taken: &[&String], others: &[(String, Vec<String>)]) -> Error {
+        let owner = |n: &String| {
+            others
+                .iter()
+                .find(|(_, l)| l.contains(n))
+                .and_then(|(m, _)| m.strip_prefix(MANIFEST_FILE)?.strip_prefix('-'))
+                .map_or("not written by lightgrid".to_string(), |c| {
+                    format!("written by `lightgrid {c}`")
+                })
+        };
+        let list: Vec<String> = taken
+            .iter()
+            .take(3)
+            .map(|n| format!("{n} ({})", owner(n)))
+            .collect();
+        let kept_note = match self.set_aside("refused") {
+            Ok(kept) => format!("this run's files are in {}", kept.display()),
+            Err(e) => format!("this run's files could not be kept: {e}"),
+        };
+        invalid(format!(
+            "{} already holds {}{}; nothing there was replaced ({kept_note}); give --force to replace them, or choose another directory",
+            self.dir.display(),
+            list.join(", "),
+            if taken.len() > 3 { ", ..." } else { "" }
+        ))
+    }
+
     /// After every file of the run is written into [`OutDir::staging`] (`written`): move them
     /// into the directory, then deal with the command's earlier files as `earlier` says, and
     /// list this run's files in the command's manifest. A file that another command's run
@@ -292,17 +338,7 @@ impl OutDir {
         }
         // Other commands' manifests, to refuse replacing their files and to hand over the
         // names a forced run took.
-        let mut others: Vec<(String, Vec<String>)> = Vec::new();
-        for e in std::fs::read_dir(&self.dir)
-            .map_err(io(&self.dir))?
-            .flatten()
-        {
-            let m = e.file_name().to_string_lossy().into_owned();
-            if m.starts_with(MANIFEST_FILE) && m != own {
-                let list = self.listed(&m);
-                others.push((m, list));
-            }
-        }
+        let others = self.other_manifests(&own)?;
         // Files an earlier version listed in its one shared manifest are anyone's to replace.
         let legacy = self.listed(MANIFEST_FILE);
         let taken: Vec<&String> = names
@@ -311,30 +347,7 @@ impl OutDir {
             .filter(|n| std::fs::symlink_metadata(self.dir.join(n)).is_ok())
             .collect();
         if !self.force && !taken.is_empty() {
-            let owner = |n: &String| {
-                others
-                    .iter()
-                    .find(|(_, l)| l.contains(n))
-                    .and_then(|(m, _)| m.strip_prefix(MANIFEST_FILE)?.strip_prefix('-'))
-                    .map_or("not written by lightgrid".to_string(), |c| {
-                        format!("written by `lightgrid {c}`")
-                    })
-            };
-            let list: Vec<String> = taken
-                .iter()
-                .take(3)
-                .map(|n| format!("{n} ({})", owner(n)))
-                .collect();
-            let kept_note = match self.set_aside("refused") {
-                Ok(kept) => format!("this run's files are in {}", kept.display()),
-                Err(e) => format!("this run's files could not be kept: {e}"),
-            };
-            return Err(invalid(format!(
-                "{} already holds {}{}; nothing there was replaced ({kept_note}); give --force to replace them, or choose another directory",
-                self.dir.display(),
-                list.join(", "),
-                if taken.len() > 3 { ", ..." } else { "" }
-            )));
+            return Err(self.refuse_taken(&taken, &others));
         }
         // Listed first with the old files too: a run stopped while files move leaves them all
         // listed, and the next run of the command removes what it does not write again.
