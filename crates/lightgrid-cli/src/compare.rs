@@ -80,6 +80,24 @@ fn diff_cell(
 }
 
 impl Row {
+    /// A pipeline's image: its time, difference and counts.
+    fn measured(
+        pipeline: &'static str,
+        s: &lightgrid::FrameStats,
+        diff: Option<DiffSummary>,
+        note: Option<String>,
+    ) -> Row {
+        Row {
+            pipeline,
+            failed: None,
+            gpu_ms: Some(s.gpu_ms),
+            diff,
+            diff_note: note,
+            lighting_computations: s.lighting_computations,
+            ideal_lighting_computations: Some(s.ideal_lighting_computations),
+        }
+    }
+
     /// A pipeline that produced no image: it `failed`, or was skipped with `note`.
     fn without_image(pipeline: &'static str, failed: Option<String>, note: Option<String>) -> Row {
         Row {
@@ -174,6 +192,26 @@ fn write_outputs(
         written.push(path);
     }
     Ok(written)
+}
+
+/// How a pipeline compared with its own reference, where that is not `forward` (the
+/// mono-specular variants).
+fn own_reference_note(
+    p: &lightgrid::pipelines::PipelineInfo,
+    references: &HashMap<&str, image::RgbaImage>,
+    image: &image::RgbaImage,
+) -> Result<Option<String>> {
+    if p.reference == REFERENCE || p.reference == p.id {
+        return Ok(None);
+    }
+    let Some(r) = references.get(p.reference) else {
+        return Ok(None);
+    };
+    let own = diff(r, image)?.0;
+    Ok(Some(format!(
+        "{} vs its own reference {}: mean {:.3}, p99 {}, max {}",
+        p.id, p.reference, own.mean, own.p99, own.max
+    )))
 }
 
 /// One pipeline's line of the printed table: time, difference (or why there is none),
@@ -273,32 +311,13 @@ pub(crate) fn compare(adapter: Option<&str>, a: &CompareArgs) -> Result<()> {
         };
         written.extend(write_outputs(dir.staging(), p.id, &out)?);
         let (d, note) = diff_cell(p.id, &out.image, &references, &rows)?;
-        if let Some(r) = references
-            .get(p.reference)
-            .filter(|_| p.reference != REFERENCE)
-        {
-            if p.reference != p.id {
-                let own = diff(r, &out.image)?.0;
-                notes.push(format!(
-                    "{} vs its own reference {}: mean {:.3}, p99 {}, max {}",
-                    p.id, p.reference, own.mean, own.p99, own.max
-                ));
-            }
-        }
+        notes.extend(own_reference_note(p, &references, &out.image)?);
         let s = &out.stats;
         if let Some(assign) = &s.assign {
             assigned_by.get_or_insert_with(|| assign.clone());
         }
         outln!("{}", table_line(p.id, s, d.as_ref(), note.as_deref()));
-        rows.push(Row {
-            pipeline: p.id,
-            failed: None,
-            gpu_ms: Some(s.gpu_ms),
-            diff: d,
-            diff_note: note,
-            lighting_computations: s.lighting_computations,
-            ideal_lighting_computations: Some(s.ideal_lighting_computations),
-        });
+        rows.push(Row::measured(p.id, s, d, note));
         if p.reference == p.id {
             references.insert(p.id, out.image);
         }
