@@ -821,7 +821,7 @@ fn header(results: &BenchResults) -> String {
 /// memory and grid figures, then its sections.
 fn scene_section(s: &mut String, results: &BenchResults, scene: &str) {
     let _ = writeln!(s, "\n## {scene}\n");
-    if results.thumbnails.iter().any(|t| &t.0 == scene) {
+    if results.thumbnails.iter().any(|t| t.0 == scene) {
         let frames: Vec<String> = super::run::THUMBNAIL_FRAMES
             .iter()
             .map(u32::to_string)
@@ -834,7 +834,7 @@ fn scene_section(s: &mut String, results: &BenchResults, scene: &str) {
         );
     }
     s.push_str("| pipeline | G-buffer | avg ms | min / max ms | real-time fps | lighting computations (avg) | × ideal | efficiency | lights/tile avg / max | target B/px | timing |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for r in results.runs.iter().filter(|r| &r.scene == scene) {
+    for r in results.runs.iter().filter(|r| r.scene == scene) {
         let Some(m) = &r.summary else { continue };
         let lc = m
             .lighting_computations
@@ -872,7 +872,7 @@ fn scene_section(s: &mut String, results: &BenchResults, scene: &str) {
     let ideal = results
         .runs
         .iter()
-        .find(|r| &r.scene == scene)
+        .find(|r| r.scene == scene)
         .and_then(|r| r.summary.as_ref())
         .map(|m| m.ideal_lighting_computations.mean);
     if let Some(i) = ideal {
@@ -893,7 +893,7 @@ fn transparent_section(s: &mut String, results: &BenchResults, scene: &str) {
     if let Some(r) = results
         .runs
         .iter()
-        .find(|r| &r.scene == scene && !r.frames.is_empty())
+        .find(|r| r.scene == scene && !r.frames.is_empty())
     {
         let n = r.frames.len() as f64;
         let fragments: f64 = r
@@ -915,7 +915,7 @@ fn transparent_section(s: &mut String, results: &BenchResults, scene: &str) {
                 fragments / n / pixels,
                 ideal / n
             );
-            for r in results.runs.iter().filter(|r| &r.scene == scene) {
+            for r in results.runs.iter().filter(|r| r.scene == scene) {
                 let counts: Option<Vec<u64>> = r
                     .frames
                     .iter()
@@ -938,7 +938,7 @@ fn transparent_section(s: &mut String, results: &BenchResults, scene: &str) {
 /// Average measured GPU time per pass next to the traffic models.
 fn model_section(s: &mut String, results: &BenchResults, scene: &str) {
     s.push_str("\n### Model vs measurement\n\nAverage measured GPU time per pass next to the traffic models: the blog's per-pixel / per-lit-pixel byte budget applied to the frame (`lightgrid memory` lists the budgets), and for grid pipelines the Forward+ paper's Table 1 evaluated with the measured lights per tile M.\n\n| pipeline | passes (avg ms) | modelled traffic per frame, MiB written / read | Forward+ Table 1: Forward+ / deferred MiB (M) |\n|---|---|---|---|\n");
-    for r in results.runs.iter().filter(|r| &r.scene == scene) {
+    for r in results.runs.iter().filter(|r| r.scene == scene) {
         let Some(m) = &r.summary else { continue };
         let passes: Vec<String> = m
             .passes

@@ -384,7 +384,8 @@ fn volume_stencil(draw: VolumeDraw) -> wgpu::StencilState {
         read_mask,
         write_mask,
     };
-    let stencil = match draw {
+
+    match draw {
         VolumeDraw::StencilMark => wgpu::StencilState {
             front: StencilFaceState {
                 compare: C::Always,
@@ -412,8 +413,7 @@ fn volume_stencil(draw: VolumeDraw) -> wgpu::StencilState {
             COUNT_STENCIL_MASK,
         ),
         _ => both(edge_test(), EDGE_STENCIL, 0),
-    };
-    stencil
+    }
 }
 
 impl LightVolumes {
