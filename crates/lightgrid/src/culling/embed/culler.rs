@@ -596,10 +596,7 @@ impl LightCuller {
     fn caller(&mut self) -> Result<&mut Caller, CullError> {
         match self.caller.as_deref_mut() {
             Some(c) => Ok(c),
-            None => refuse(
-                CullInput::Config,
-                "lightgrid's renderer's culler takes its frames from the renderer",
-            ),
+            None => not_a_callers(),
         }
     }
 
@@ -669,10 +666,7 @@ impl LightCuller {
     ) -> Result<u64, CullError> {
         let core = &mut self.core;
         let Some(c) = self.caller.as_deref_mut() else {
-            return refuse(
-                CullInput::Config,
-                "lightgrid's renderer's culler takes its frames from the renderer",
-            );
+            return not_a_callers();
         };
         let camera = c.check(inputs, &self.config)?;
         let (width, height) = (inputs.viewport[0], inputs.viewport[1]);
@@ -735,10 +729,7 @@ impl LightCuller {
     /// lights follow the order the GPU's workgroups finished in; the lists themselves do not.
     pub fn read_grid(&self) -> Result<crate::culling::LightGrid, CullError> {
         let Some(c) = self.caller.as_deref() else {
-            return refuse(
-                CullInput::Config,
-                "lightgrid's renderer's culler takes its frames from the renderer",
-            );
+            return not_a_callers();
         };
         match c.last_report {
             Some((frame, values)) if frame == c.frames => {
@@ -860,6 +851,15 @@ impl Caller {
         }
         Camera::new(i)
     }
+}
+
+/// The refusal of a caller's method on lightgrid's renderer's culler, whose frames come
+/// from the renderer.
+fn not_a_callers<T>() -> Result<T, CullError> {
+    refuse(
+        CullInput::Config,
+        "lightgrid's renderer's culler takes its frames from the renderer",
+    )
 }
 
 fn entry(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
