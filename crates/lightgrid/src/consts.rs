@@ -111,7 +111,7 @@ pub const COUNTER_SHADED_SAMPLES: u32 = 17;
 /// Samples with geometry the MSAA shading kernels saw (what per-sample shading would shade).
 pub const COUNTER_GEOMETRY_SAMPLES: u32 = 18;
 /// MSAA forward fragments whose shading point lay outside their cell's bounds, so their list
-/// may miss lights (`grid_shade_fragment` in `light_grid.wgsl`): the frame is wrong when
+/// may miss lights (`light_grid_shade_fragment` in `light_grid.wgsl`): the frame is wrong when
 /// non-zero (the fragment-bounds pass keeps it zero).
 pub const COUNTER_OFF_BOUNDS_FRAGMENTS: u32 = 19;
 /// Shadow rays the light function cast (`--shadows rays`: one per shadow-casting light that
@@ -415,7 +415,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ),
     ("EDGE_NORMAL_COS", WgslConst::F32(EDGE_NORMAL_COS)),
     ("EDGE_PLANE_SIN", WgslConst::F32(EDGE_PLANE_SIN)),
-    ("GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
+    ("LIGHT_GRID_LISTS_OPAQUE", WgslConst::U32(GRID_LISTS_OPAQUE)),
     ("DEPTH_BOUNDS_BOTH", WgslConst::U32(DEPTH_BOUNDS_BOTH)),
     ("DEPTH_BOUNDS_MIN", WgslConst::U32(DEPTH_BOUNDS_MIN)),
     ("DEPTH_BOUNDS_MAX", WgslConst::U32(DEPTH_BOUNDS_MAX)),
@@ -430,8 +430,11 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ),
     ("MATERIAL_SHADER_RIM", WgslConst::U32(MATERIAL_SHADER_RIM)),
     ("MATERIAL_SHADER_ANY", WgslConst::U32(MATERIAL_SHADER_ANY)),
-    ("GRID_LISTS_SHARED", WgslConst::U32(GRID_LISTS_SHARED)),
-    ("GRID_LISTS_SEPARATE", WgslConst::U32(GRID_LISTS_SEPARATE)),
+    ("LIGHT_GRID_LISTS_SHARED", WgslConst::U32(GRID_LISTS_SHARED)),
+    (
+        "LIGHT_GRID_LISTS_SEPARATE",
+        WgslConst::U32(GRID_LISTS_SEPARATE),
+    ),
     (
         "MATERIAL_FLAG_TRANSPARENT",
         WgslConst::U32(MATERIAL_FLAG_TRANSPARENT),

@@ -87,7 +87,7 @@ pub struct FrameStats {
     #[serde(default)]
     pub msaa_shading: Option<crate::frame::MsaaShading>,
     /// MSAA grid-forward fragments whose pixel centre (extrapolated off their triangle) lay
-    /// outside their cell's bounds (`grid_shade_fragment`). An analysis frame refuses a
+    /// outside their cell's bounds (`light_grid_shade_fragment`). An analysis frame refuses a
     /// non-zero count, so a written file always says 0.
     #[serde(default)]
     pub fragments_off_bounds: u64,

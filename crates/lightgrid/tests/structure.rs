@@ -1,6 +1,9 @@
-//! The house rule on function length: no function outside tests is longer than
-//! `MAX_LINES` lines (from its `fn` line to its closing brace), in any crate of the
-//! workspace, examples included. A long function is split where it reads as steps.
+//! House rules read from the sources:
+//! - function length: no function outside tests is longer than `MAX_LINES` lines (from its
+//!   `fn` line to its closing brace), in any crate of the workspace, examples included. A
+//!   long function is split where it reads as steps;
+//! - one way to compose shaders: the library's WGSL is put together only by `shader`'s keys
+//!   and defs, never by `concat!` of files or `.replace` of placeholders in its text.
 
 use std::path::{Path, PathBuf};
 
@@ -129,4 +132,54 @@ fn the_measure_counts_a_function_from_its_fn_line_to_its_closing_brace() {
     );
     let in_tests = format!("#[cfg(test)]\nmod tests {{\n{long}}}\n");
     assert!(long_functions(&in_tests).is_empty());
+}
+
+/// Shaders have one composition path (`shader::ShaderKey`, `Def`, `parts!`): no `concat!` and
+/// no `.replace` in the library's sources (neither has another use there), and no WGSL file
+/// carries a placeholder to be replaced (`*_VALUE`) or a `#` directive but `#if` / `#else` /
+/// `#endif`.
+#[test]
+fn shaders_are_composed_one_way() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    wgsl_files(&src, &mut files);
+    assert!(files.len() > 50, "the library's sources were not found");
+    let mut found = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let wgsl = f.extension().is_some_and(|e| e == "wgsl");
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            let directive = line.trim_start();
+            let bad = if wgsl {
+                code.contains("_VALUE")
+                    || (directive.starts_with('#')
+                        && !["#if ", "#else", "#endif"]
+                            .iter()
+                            .any(|d| directive.starts_with(d)))
+            } else {
+                code.contains("concat!(") || code.contains(".replace(")
+            };
+            if bad {
+                found.push(format!("{}:{}: {line}", f.display(), i + 1));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "compose shaders through shader::ShaderKey / Def / parts!:\n{}",
+        found.join("\n")
+    );
+}
+
+fn wgsl_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = entry.path();
+        if p.is_dir() {
+            wgsl_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "wgsl") {
+            out.push(p);
+        }
+    }
 }

@@ -18,17 +18,15 @@ pub(crate) fn shader() -> ComposedShader {
     compose("gbuffer", &parts)
 }
 
+/// The G-buffer's bindings and the reads both layouts share.
+const GBUFFER_READ: &str = include_str!("gbuffer_read.wgsl");
+
 /// WGSL a deferred pass includes to read the full G-buffer ([`GBufferLayout::Full`]).
-pub const GBUFFER_READ_WGSL: &str = concat!(
-    include_str!("gbuffer_read.wgsl"),
-    include_str!("gbuffer_specular.wgsl")
-);
+pub const GBUFFER_READ_WGSL: &[&str] = &[GBUFFER_READ, include_str!("gbuffer_specular.wgsl")];
 
 /// WGSL a deferred pass includes to read the mono-specular G-buffer.
-pub const GBUFFER_READ_MONO_WGSL: &str = concat!(
-    include_str!("gbuffer_read.wgsl"),
-    include_str!("gbuffer_specular_mono.wgsl")
-);
+pub const GBUFFER_READ_MONO_WGSL: &[&str] =
+    &[GBUFFER_READ, include_str!("gbuffer_specular_mono.wgsl")];
 
 /// The targets by location (and group-2 binding): normal + material, diffuse, specular +
 /// exponent, the light-independent term.
@@ -68,7 +66,7 @@ impl GBufferLayout {
     }
 
     /// The WGSL that reads this layout (group 2).
-    pub fn read_wgsl(self) -> &'static str {
+    pub fn read_wgsl(self) -> &'static [&'static str] {
         match self {
             GBufferLayout::Full => GBUFFER_READ_WGSL,
             GBufferLayout::MonoSpecular => GBUFFER_READ_MONO_WGSL,

@@ -41,9 +41,10 @@ fn vs_main(v: VertexIn) -> VertexOut {
 
 // Does any material of the scene read inputs per sample beyond its base colour (a
 // metallic-roughness model, normal, occlusion or emissive textures: `Shading::material_inputs`)?
-// Without them the shader is made without those reads: a software rasterizer runs both sides
-// of a branch, so an untaken one still costs (a third of lavapipe's G-buffer pass).
-const MATERIAL_INPUTS: bool = SHADING_MATERIAL_INPUTS_VALUE;
+// `SHADING_MATERIAL_INPUTS`, a `const` declared when the module is made (as lighting.wgsl's
+// `SHADING_*`). Without them the shader is made without those reads: a software rasterizer
+// runs both sides of a branch, so an untaken one still costs (a third of lavapipe's G-buffer
+// pass).
 
 // The scene's base-colour textures (group 0; `passes/base_textures.rs`): one array, a layer
 // per texture, sRGB-decoded when sampled, mipmapped, repeating.
@@ -129,7 +130,7 @@ fn base_colour(m: Material, v: VertexOut, t: TexCoords) -> vec4<f32> {
 // A material's emissive colour at the sample: its emissive factor times its emissive
 // texture's texel (glTF's emissiveTexture), or the factor alone.
 fn emissive_colour(m: Material, t: TexCoords) -> vec3<f32> {
-    if (!MATERIAL_INPUTS) {
+    if (!SHADING_MATERIAL_INPUTS) {
         return m.emissive;
     }
     let one = vec4<f32>(1.0);
@@ -171,7 +172,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     s.alpha = m.alpha * base.a;
     s.specular = m.specular;
     s.shininess = m.shininess;
-    if (MATERIAL_INPUTS && (m.flags & MATERIAL_FLAG_METALLIC_ROUGHNESS) != 0u) {
+    if (SHADING_MATERIAL_INPUTS && (m.flags & MATERIAL_FLAG_METALLIC_ROUGHNESS) != 0u) {
         // glTF's metallic-roughness per sample, by the import's rule (map_material):
         // the texture's B is metallic, G roughness.
         let one = vec4<f32>(1.0);
@@ -187,7 +188,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
     s.emissive = emissive_colour(m, t);
     // Occlusion darkens the ambient term only (glTF: indirect light), by its strength.
     s.ambient = m.ambient * base.rgb;
-    if (MATERIAL_INPUTS) {
+    if (SHADING_MATERIAL_INPUTS) {
         let occlusion = material_texel(m, t, TEXTURE_SLOT_OCCLUSION, m.occlusion_texture, vec4<f32>(1.0)).r;
         s.ambient *= 1.0 + m.occlusion_strength * (occlusion - 1.0);
     }
@@ -199,7 +200,7 @@ fn raw_surface_from_vertex(v: VertexOut, front_facing: bool) -> Surface {
 // x and y times the scale) through the vertex's tangent frame (glTF §3.9.3).
 fn mapped_normal(m: Material, v: VertexOut, t: TexCoords) -> vec3<f32> {
     let n = normalize(v.normal);
-    if (!MATERIAL_INPUTS || m.normal_texture == 0u) {
+    if (!SHADING_MATERIAL_INPUTS || m.normal_texture == 0u) {
         return n;
     }
     let texel = material_texel(m, t, TEXTURE_SLOT_NORMAL, m.normal_texture, vec4<f32>(0.5, 0.5, 1.0, 1.0));

@@ -136,10 +136,7 @@ pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
 /// The MSAA edge test (`differs`) over a per-sample G-buffer: the edge-aware deferred kernel
 /// and the light volumes' edge marking both compose it, so they shade the same pixels per
 /// sample. Needs `GBUFFER_READ_WGSL` and `shader::src::MSAA` with `shader::msaa_defs`.
-pub const MSAA_EDGES_WGSL: &str = concat!(
-    include_str!("msaa_surfaces.wgsl"),
-    include_str!("msaa_edges.wgsl")
-);
+pub const MSAA_EDGES_WGSL: &[&str] = &[MSAA_SURFACES_WGSL, include_str!("msaa_edges.wgsl")];
 
 /// The edge test's core (`surfaces_differ`: normals and planes of two samples with geometry),
 /// for readers of other per-sample attributes than the G-buffer (the light pre-pass). Needs

@@ -34,7 +34,7 @@ use crate::passes::{
 };
 use crate::passes::{GBuffer, GBufferLayout, COUNT_FORMAT, FULLSCREEN_WGSL, HDR_FORMAT};
 use crate::shader::{
-    create_module, every_sample_count, msaa_defs, src, ComposedShader, Def, ShaderKey,
+    create_module, every_sample_count, msaa_defs, parts, src, ComposedShader, Def, ShaderKey,
 };
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
@@ -76,8 +76,9 @@ impl ShaderKey for DeferredKey {
     }
 
     fn parts(self) -> Vec<&'static str> {
-        vec![
+        parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             src::LIGHTING,
             src::LIT_OUT,

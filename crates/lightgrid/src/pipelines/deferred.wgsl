@@ -22,7 +22,10 @@
 
 // One fragment per pixel (no edge; every pixel without MSAA): sample 0's attributes at the
 // pixel centre.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_light(v: VolumeOut, @builtin(sample_mask) mask: u32) -> LitOut {
     let p = vec2<u32>(v.clip.xy);
     if (is_background(textureLoad(gb_depth, p, 0))) {
@@ -35,7 +38,10 @@ fn fs_light(v: VolumeOut, @builtin(sample_mask) mask: u32) -> LitOut {
 }
 
 // One fragment per sample of an edge pixel: the sample's own surface where it lies.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_light_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> LitOut {
     let p = vec2<u32>(v.clip.xy);
     let depth = textureLoad(gb_depth, p, i);
@@ -50,7 +56,10 @@ fn fs_light_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> LitOut {
 // The light-independent term of every pixel that is no edge, written before the lights add
 // up (every sample holds the same surface: sample 0's). With MSAA it counts the pixel as one
 // sample shaded, and its covered samples with geometry.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_base(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -> LitOut {
     let p = vec2<u32>(pos.xy);
     var color = vec3<f32>(0.0);
@@ -65,7 +74,10 @@ fn fs_base(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -
 
 // The light-independent term of each sample of an edge pixel (MSAA only), counting the edge
 // pixel once (at sample 0) and the sample as shaded and with geometry.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_base_sample(@builtin(position) pos: vec4<f32>, @builtin(sample_index) i: u32) -> LitOut {
     let p = vec2<u32>(pos.xy);
     var color = vec3<f32>(0.0);

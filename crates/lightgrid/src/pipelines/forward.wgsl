@@ -4,7 +4,10 @@
 // a fragment shader with side effects would otherwise be depth-tested after shading, losing
 // early-Z (measured on lavapipe: tiled_forward_prez 2-3x slower). Sound here: the shader
 // neither discards nor writes depth, so early and late tests keep the same fragments.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let color = surface_base(s) + shade_all_lights(s, view_dir_to(s.position));
@@ -14,7 +17,10 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
 // forward_mono: the reference for light_prepass_mono: every light for every fragment, with
 // the same monochrome-specular model.
 // Early depth test forced, as fs_main.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let view_dir = view_dir_to(s.position);
@@ -34,7 +40,10 @@ fn fs_mono(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
 // forward_mono_albedo: the reference for deferred_mono: every light for every fragment, with
 // the specular albedo reduced to one value as deferred_mono's G-buffer stores it.
 // Early depth test forced, as fs_main.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_mono_albedo(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     var s = surface_from_vertex(v, front);
     s.specular = mono_albedo(s.specular);

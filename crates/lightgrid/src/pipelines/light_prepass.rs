@@ -58,8 +58,8 @@ use crate::passes::{
     cleared, loaded, multisampled_texture, sampled_texture_entry, VOLUME_DEPTH_BYTES,
 };
 use crate::shader::{
-    compute_pipeline, create_module, src, ComposedShader, SampleStage, SamplesKey, ShaderKey,
-    SCENE_PARTS,
+    compute_pipeline, create_module, parts, src, ComposedShader, SampleStage, SamplesKey,
+    ShaderKey, SCENE_PARTS,
 };
 
 /// Attributes and irradiance targets are RGBA16F, as the blog's X16R16G16B16 / A8R8G8B8 layout
@@ -152,8 +152,9 @@ impl crate::shader::ShaderKey for TiledKernelKey {
                 include_str!("tiled_light_prepass.wgsl"),
             )
         };
-        vec![
+        parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             src::LIGHTING,
             src::MSAA,

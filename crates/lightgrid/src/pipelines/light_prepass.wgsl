@@ -80,22 +80,34 @@ fn irradiance_sample(v: VolumeOut, i: u32) -> IrradianceOut {
     return irradiance_out(p, attributes_sample_surface(p, i, depth), v.light, 1u);
 }
 
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_irradiance(v: VolumeOut, @builtin(sample_mask) mask: u32) -> IrradianceOut {
     return irradiance_pixel(v, mask);
 }
 
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_irradiance_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> IrradianceOut {
     return irradiance_sample(v, i);
 }
 
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_irradiance_mono(v: VolumeOut, @builtin(sample_mask) mask: u32) -> IrradianceOut {
     return mono(irradiance_pixel(v, mask));
 }
 
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_irradiance_mono_sample(v: VolumeOut, @builtin(sample_index) i: u32) -> IrradianceOut {
     return mono(irradiance_sample(v, i));
 }
@@ -114,7 +126,10 @@ fn fs_mark_edges(@builtin(position) pos: vec4<f32>) -> IrradianceOut {
 
 // MSAA, per pixel that is no edge: one irradiance sample computed (counted by the fragment
 // covering sample 0), and its covered samples with geometry. Adds nothing to the targets.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_count(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) -> IrradianceOut {
     let p = vec2<u32>(pos.xy);
     if (!is_background(textureLoad(attr_depth, p, 0))) {
@@ -126,7 +141,10 @@ fn fs_count(@builtin(position) pos: vec4<f32>, @builtin(sample_mask) mask: u32) 
 
 // MSAA, per sample of an edge pixel: the edge pixel once (at sample 0), the sample as
 // computed and with geometry. Adds nothing to the targets.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_count_sample(@builtin(position) pos: vec4<f32>, @builtin(sample_index) i: u32) -> IrradianceOut {
     count_edge_sample(attr_depth, vec2<u32>(pos.xy), i);
     var out: IrradianceOut;

@@ -435,7 +435,7 @@ pub fn all_shaders() -> Vec<ComposedShader> {
     for p in PIPELINES {
         for s in (p.shaders)() {
             match out.iter().find(|o| o.name == s.name) {
-                Some(o) => assert_eq!(o.source, s.source, "two shaders named {}", s.name),
+                Some(o) => assert_eq!(o.source(), s.source(), "two shaders named {}", s.name),
                 None => out.push(s),
             }
         }

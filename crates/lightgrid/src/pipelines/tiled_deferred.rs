@@ -29,7 +29,7 @@ use crate::passes::{
     GBUFFER_READ_WGSL,
 };
 use crate::shader::{
-    compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, src,
+    compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, parts, src,
     ComposedShader, Def, SampleStage, SamplesKey, ShaderKey,
 };
 
@@ -81,18 +81,22 @@ impl ShaderKey for KernelKey {
     }
 
     fn parts(self) -> Vec<&'static str> {
-        let mut parts = vec![
+        let mut parts = parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             src::LIGHTING,
             src::MSAA,
             GBUFFER_READ_WGSL,
         ];
         match self.kernel {
-            Kernel::Grid => {
-                parts.extend([src::LIGHT_GRID, super::light_loop_wgsl(self.light_loop)])
+            Kernel::Grid => parts.extend(parts![
+                src::LIGHT_GRID,
+                super::light_loop_wgsl(self.light_loop)
+            ]),
+            Kernel::Single => {
+                parts.extend(parts![TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL])
             }
-            Kernel::Single => parts.extend([TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL]),
         }
         if self.samples == 1 {
             parts.push(COMPUTE_OUTPUTS_WGSL);
@@ -101,7 +105,7 @@ impl ShaderKey for KernelKey {
                 Kernel::Single => include_str!("tiled_deferred_single.wgsl"),
             });
         } else {
-            parts.extend([
+            parts.extend(parts![
                 crate::passes::MSAA_EDGES_WGSL,
                 src::TONE,
                 MSAA_EDGE_QUEUE_WGSL,

@@ -14,7 +14,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = surface_from_gbuffer(p, depth);
-    let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
-    let color = surface_base(s) + grid_shade(s, view_dir_to(s.position), cell);
-    write_sample(p, color, grid_cell_count(cell));
+    let cell = light_grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
+    let color = surface_base(s) + light_grid_shade(s, view_dir_to(s.position), cell);
+    write_sample(p, color, light_grid_cell_count(cell));
 }

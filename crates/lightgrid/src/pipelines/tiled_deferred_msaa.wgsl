@@ -34,9 +34,9 @@ fn background_sample(p: vec2<u32>, l: u32, s: u32) {
 // from its cell's lights, counted into the pixel.
 fn shade_at(p: vec2<u32>, s: u32, xy: vec2<f32>, depth: f32) -> vec3<f32> {
     let surface = apply_material(raw_surface_from_gbuffer(p, s, position_from_screen(xy, depth)));
-    let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
-    count_pixel(p, grid_cell_count(cell));
-    return surface_base(surface) + grid_shade(surface, view_dir_to(surface.position), cell);
+    let cell = light_grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
+    count_pixel(p, light_grid_cell_count(cell));
+    return surface_base(surface) + light_grid_shade(surface, view_dir_to(surface.position), cell);
 }
 
 // `differs(p, s, d0, n0)`, the edge test, is in passes/msaa_edges.wgsl.

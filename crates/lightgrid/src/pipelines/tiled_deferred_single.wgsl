@@ -11,7 +11,7 @@
 // in a single larger workgroup: a 64-pixel tile with 8,000 lights ran 16 x 8,000 iterations
 // per invocation, past llvmpipe's loop guard, and came out black.
 
-@group(1) @binding(0) var<uniform> tile: GridParams;
+@group(1) @binding(0) var<uniform> tile: LightGridParams;
 
 var<workgroup> batch: array<u32, TILE_LIGHT_BATCH>;
 var<workgroup> batch_count: atomic<u32>;

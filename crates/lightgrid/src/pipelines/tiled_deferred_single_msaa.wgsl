@@ -25,7 +25,7 @@
 // `pixel_counts`; the frame counters get edge pixels, samples shaded and samples with geometry,
 // as the grid kernel's.
 
-@group(1) @binding(0) var<uniform> tile: GridParams;
+@group(1) @binding(0) var<uniform> tile: LightGridParams;
 
 // The queue of edge samples and the counts: msaa_edge_queue.wgsl.
 const GROUP_WIDTH: u32 = TILE_THREADS;

@@ -18,7 +18,7 @@ use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, Tr
 use crate::culling::{CellSource, LightCuller};
 use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
-use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
+use crate::shader::{compose, create_module, parts, ComposedShader, SCENE_PARTS};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
     crate::frame::LightLoop::ALL.map(shader).to_vec()
@@ -26,10 +26,12 @@ pub(super) fn shaders() -> Vec<ComposedShader> {
 
 /// The forward shading pass with the light loop `l`.
 fn shader(l: crate::frame::LightLoop) -> ComposedShader {
-    let mut parts = SCENE_PARTS.to_vec();
-    parts.push(crate::shader::src::LIGHT_GRID);
-    parts.push(super::light_loop_wgsl(l));
-    parts.push(include_str!("tiled_forward.wgsl"));
+    let parts = parts![
+        SCENE_PARTS,
+        crate::shader::src::LIGHT_GRID,
+        super::light_loop_wgsl(l),
+        include_str!("tiled_forward.wgsl"),
+    ];
     compose(&format!("tiled_forward ({} loop)", l.name()), &parts)
 }
 

@@ -5,12 +5,15 @@
 // a fragment shader with side effects would otherwise be depth-tested after shading, losing
 // early-Z (measured on lavapipe: tiled_forward_prez 2-3x slower). Sound here: the shader
 // neither discards nor writes depth, so early and late tests keep the same fragments.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> LitOut {
     let s = surface_from_vertex(v, front);
     let w = view_distance_from_depth(v.clip.z);
-    let cell = grid_cell(v.clip.xy, w);
-    let color = surface_base(s) + grid_shade_fragment(s, view_dir_to(s.position), cell, w);
-    return lit(v.clip, color, grid_cell_count(cell));
+    let cell = light_grid_cell(v.clip.xy, w);
+    let color = surface_base(s) + light_grid_shade_fragment(s, view_dir_to(s.position), cell, w);
+    return lit(v.clip, color, light_grid_cell_count(cell));
 }
 

@@ -20,6 +20,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = attributes_pixel_surface(p);
-    let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
-    write_output(p, grid_irradiance_mono(s, view_dir_to(s.position), cell), grid_cell_count(cell));
+    let cell = light_grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
+    write_output(p, light_grid_irradiance_mono(s, view_dir_to(s.position), cell), light_grid_cell_count(cell));
 }

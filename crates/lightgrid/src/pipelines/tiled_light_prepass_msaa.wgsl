@@ -40,9 +40,9 @@ fn store_irradiance(p: vec2<u32>, s: u32, value: vec4<f32>) {
 
 // The tile's lights on `surface` at depth-buffer value `depth`, counted into pixel `p`.
 fn irradiance_at(p: vec2<u32>, surface: Surface, depth: f32) -> vec4<f32> {
-    let cell = grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
-    count_pixel(p, grid_cell_count(cell));
-    return grid_irradiance_mono(surface, view_dir_to(surface.position), cell);
+    let cell = light_grid_cell(vec2<f32>(p), view_distance_from_depth(depth));
+    count_pixel(p, light_grid_cell_count(cell));
+    return light_grid_irradiance_mono(surface, view_dir_to(surface.position), cell);
 }
 
 @compute @workgroup_size(SCREEN_WORKGROUP, SCREEN_WORKGROUP)

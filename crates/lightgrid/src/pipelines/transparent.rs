@@ -18,14 +18,16 @@ use crate::frame::Assign;
 use crate::frame::CullConfig;
 use crate::gpu::CounterValues;
 use crate::passes::geometry::{draw_transparent, MaterialPipelines};
-use crate::shader::{compose, create_module, ComposedShader, SCENE_PARTS};
+use crate::shader::{compose, create_module, parts, ComposedShader, SCENE_PARTS};
 
 /// The transparent pass with the light loop `l`.
 pub(super) fn shader(l: crate::frame::LightLoop) -> ComposedShader {
-    let mut parts = SCENE_PARTS.to_vec();
-    parts.push(crate::shader::src::LIGHT_GRID);
-    parts.push(super::light_loop_wgsl(l));
-    parts.push(include_str!("transparent.wgsl"));
+    let parts = parts![
+        SCENE_PARTS,
+        crate::shader::src::LIGHT_GRID,
+        super::light_loop_wgsl(l),
+        include_str!("transparent.wgsl"),
+    ];
     compose(&format!("transparent ({} loop)", l.name()), &parts)
 }
 

@@ -1,12 +1,20 @@
 //! Shader composition, one way for every shader: a shader stage with variants has a **key**
 //! type (a small `Copy` value: sample count, G-buffer layout, depth bounds, ...) implementing
-//! [`ShaderKey`]. The key names the stage's parts (its imports: shared WGSL modules then the
-//! stage file, in a fixed order, as WGSL has no includes) and its [`Def`]s; [`compose_defs`]
-//! declares every def as a WGSL `const` after the constants prelude, and a bool def is also
-//! the condition of `#if NAME` / `#if !NAME` ... `#else` ... `#endif` lines in the parts, for
-//! what a `const` cannot select (types, or code an adapter may lack, such as subgroup
-//! operations). Every value of every key ([`ShaderKey::all`]) is validated by naga in the
-//! tests (no GPU needed), with and without the adapter-dependent early depth test.
+//! [`ShaderKey`]. The key names the stage's parts (shared WGSL files then the stage's own, in
+//! a fixed order, as WGSL has no includes; a group of files always used together is a slice,
+//! and [`parts!`](crate::shader::parts) splices groups and single files into one list) and
+//! its [`Def`]s. A [`ComposedShader`] is the key's name, defs and parts; its text is made when
+//! a module is: the constants prelude, then a WGSL `const` per def that some part names, then
+//! the parts, a bool def also being the condition of `#if NAME` / `#if !NAME` ... `#else` ...
+//! `#endif` lines, for what a `const` cannot select (types, attributes, or code an adapter
+//! may lack, such as subgroup operations).
+//!
+//! Two more sets of defs join the key's when a module is made, through the same path: the
+//! light function's ([`ComposedShader::specialized`], from a frame's [`Shading`]) and the
+//! device's (`EARLY_DEPTH_TEST`, [`ComposedShader::source_for`]). The caller's WGSL of
+//! `LightCuller::wgsl` is a key too, composed without the prelude. Every value of every key
+//! ([`ShaderKey::all`]) is validated by naga in the tests (no GPU needed), in every shading
+//! and with and without the early depth test.
 //!
 //! WGSL `override`s remain only where one module is specialised per pipeline at pipeline
 //! creation (`constants`); their names come from [`overrides`].
@@ -14,29 +22,31 @@
 use crate::consts::wgsl_prelude;
 use crate::scene::Shading;
 
-/// Shared WGSL sources, in the order a shader lists them.
+/// Shared WGSL sources, in the order a shader lists them. A slice is a group of files a
+/// shader always takes together, in that order.
 pub mod src {
     pub const TYPES: &str = include_str!("../shading/types.wgsl");
+    /// `LightGridParams`, the grid's uniform (lightgrid's shaders and the caller's).
+    pub const GRID_PARAMS: &str = include_str!("../culling/grid/grid_params.wgsl");
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
-    /// The light function and the shadow rays it casts.
-    pub const LIGHTING: &str = concat!(
-        include_str!("../shading/lighting.wgsl"),
-        include_str!("../shading/shadows.wgsl")
-    );
+    /// The light function; needs the shading defs (`ComposedShader::specialized`).
+    pub const LIGHT_FUNCTION: &str = include_str!("../shading/lighting.wgsl");
+    /// The shadow rays and maps the light function casts and reads.
+    pub const SHADOWS: &str = include_str!("../shading/shadows.wgsl");
+    /// The light function and the shadows it casts.
+    pub const LIGHTING: &[&str] = &[LIGHT_FUNCTION, SHADOWS];
     pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
-    /// Cell addressing (`grid_slice`, `grid_cell`); needs a `grid` binding.
+    /// Cell addressing (`light_grid_slice`, `light_grid_cell`); needs a `light_grid` binding.
     pub const GRID_CELL: &str = include_str!("../culling/grid/grid_cell.wgsl");
-    /// Group-1 grid bindings and the shading accessor (includes `GRID_CELL`).
+    /// The walk over a z-binned grid's masks.
+    pub const ZBIN_WALK: &str = include_str!("../culling/grid/zbin_walk.wgsl");
+    /// The group-1 grid bindings and the shading accessors.
+    pub const GRID_BINDINGS: &str = include_str!("../culling/grid/light_grid.wgsl");
     /// The grid's bindings, cell addressing and z-bin walk; one of the light loops below
     /// follows it.
-    pub const LIGHT_GRID: &str = concat!(
-        include_str!("../culling/grid/grid_cell.wgsl"),
-        include_str!("../culling/grid/zbin_walk.wgsl"),
-        include_str!("../culling/grid/light_grid.wgsl")
-    );
-    /// The walk over a z-binned grid (in `LIGHT_GRID`; renamed for a LightCuller's caller).
-    pub const ZBIN_WALK: &str = include_str!("../culling/grid/zbin_walk.wgsl");
-    /// `grid_shade` and `grid_irradiance_mono`, one lane at a time (`--light-loop lane`).
+    pub const LIGHT_GRID: &[&str] = &[GRID_CELL, ZBIN_WALK, GRID_BINDINGS];
+    /// `light_grid_shade` and `light_grid_irradiance_mono`, one lane at a time
+    /// (`--light-loop lane`).
     pub const LIGHT_LOOP_LANE: &str = include_str!("../culling/grid/light_loop_lane.wgsl");
     /// The same, scalarized over the subgroup (`--light-loop subgroup`).
     pub const LIGHT_LOOP_SUBGROUP: &str = include_str!("../culling/grid/light_loop_subgroup.wgsl");
@@ -51,17 +61,51 @@ pub mod src {
 /// function and the shared vertex stage.
 pub const SCENE_PARTS: &[&str] = &[
     src::TYPES,
+    src::GRID_PARAMS,
     src::SCENE_BINDINGS,
-    src::LIGHTING,
+    src::LIGHT_FUNCTION,
+    src::SHADOWS,
     src::GEOMETRY,
     src::LIT_OUT,
 ];
 
-/// A named, composed WGSL shader.
+/// One WGSL part of a shader, or a group of parts in order: what [`parts!`] splices.
+pub trait Part {
+    /// Append this part (or each of the group's) to `parts`.
+    fn add_to(self, parts: &mut Vec<&'static str>);
+}
+
+impl Part for &'static str {
+    fn add_to(self, parts: &mut Vec<&'static str>) {
+        parts.push(self);
+    }
+}
+
+impl Part for &'static [&'static str] {
+    fn add_to(self, parts: &mut Vec<&'static str>) {
+        parts.extend_from_slice(self);
+    }
+}
+
+/// A shader's parts in order, from single files (`&str`) and groups (`&[&str]`).
+macro_rules! parts {
+    ($($part:expr),* $(,)?) => {{
+        let mut parts: Vec<&'static str> = Vec::new();
+        $($crate::shader::Part::add_to($part, &mut parts);)*
+        parts
+    }};
+}
+pub(crate) use parts;
+
+/// A named shader: its key's defs and parts, composed into WGSL text when a module is made
+/// ([`Self::source_for`]).
 #[derive(Clone, Debug)]
 pub struct ComposedShader {
     pub name: String,
-    pub source: String,
+    /// Starts with the constants prelude (every shader but the caller's).
+    prelude: bool,
+    defs: Vec<Def>,
+    parts: Vec<&'static str>,
 }
 
 /// A value a shader's key gives it: declared as a WGSL `const` before every part, and for a
@@ -104,13 +148,18 @@ pub trait ShaderKey: Copy + std::fmt::Debug + 'static {
     /// The WGSL parts after the prelude and the defs, in order.
     fn parts(self) -> Vec<&'static str>;
 
+    /// Does the shader start with the constants prelude? Every stage of lightgrid's does; the
+    /// caller's WGSL does not (it declares only `light_grid` names).
+    const PRELUDE: bool = true;
+
     /// The composed shader of this value.
     fn shader(self) -> ComposedShader {
-        compose_defs(
-            &format!("{} {self:?}", Self::STAGE),
-            &self.defs(),
-            &self.parts(),
-        )
+        ComposedShader {
+            name: format!("{} {self:?}", Self::STAGE),
+            prelude: Self::PRELUDE,
+            defs: self.defs(),
+            parts: self.parts(),
+        }
     }
 
     /// The shaders of every value, for validation.
@@ -184,16 +233,31 @@ impl<S: SampleStage> ShaderKey for SamplesKey<S> {
     }
 }
 
-/// Prelude + the given parts, in order (a shader without variants).
-pub fn compose(name: &str, parts: &[&str]) -> ComposedShader {
+/// A shader without variants: the prelude, then the given parts in order.
+pub fn compose(name: &str, parts: &[&'static str]) -> ComposedShader {
     compose_defs(name, &[], parts)
 }
 
-/// Prelude, one `const` per def, then the parts, their `#if` lines resolved against the bool
-/// defs. A condition naming no bool def, or an unbalanced `#if`, is a bug in the shader's key
-/// or its WGSL: it panics, and the validation test composes every key's every value.
-pub fn compose_defs(name: &str, defs: &[Def], parts: &[&str]) -> ComposedShader {
-    let mut source = wgsl_prelude();
+/// A shader with the given defs and parts (what a [`ShaderKey`] value composes).
+pub fn compose_defs(name: &str, defs: &[Def], parts: &[&'static str]) -> ComposedShader {
+    ComposedShader {
+        name: name.to_string(),
+        prelude: true,
+        defs: defs.to_vec(),
+        parts: parts.to_vec(),
+    }
+}
+
+/// The text of a shader: the prelude (if asked), one `const` per def some part names, then the
+/// parts, their `#if` lines resolved against the bool defs. A def defined twice, a condition
+/// naming no bool def or an unbalanced `#if` is a bug in the shader's key or its WGSL: it
+/// panics, and the validation test composes every key's every value.
+fn compose_text(name: &str, prelude: bool, defs: &[Def], parts: &[&str]) -> String {
+    let mut source = if prelude {
+        wgsl_prelude()
+    } else {
+        String::new()
+    };
     source.push_str("// from the shader's key\n");
     for (i, def) in defs.iter().enumerate() {
         assert!(
@@ -201,16 +265,15 @@ pub fn compose_defs(name: &str, defs: &[Def], parts: &[&str]) -> ComposedShader 
             "{name}: {} defined twice",
             def.name()
         );
-        source.push_str(&def.declaration());
+        if parts.iter().any(|p| p.contains(def.name())) {
+            source.push_str(&def.declaration());
+        }
     }
     for part in parts {
         source.push('\n');
         preprocess(name, part, defs, &mut source);
     }
-    ComposedShader {
-        name: name.to_string(),
-        source,
-    }
+    source
 }
 
 /// Append `part` to `out`, keeping the lines whose `#if` conditions hold. A directive line
@@ -302,31 +365,27 @@ pub mod overrides {
     ];
 }
 
-/// Parse and validate with naga; the error message carries naga's annotated source span.
+/// Parse and validate with naga, in every [`Shading`], as a device with the early depth test
+/// gets it; the error message carries naga's annotated source span.
 pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
-    validate_source(&shader.name, &shader.source)
+    validate_for(shader, true)
 }
 
 /// As [`validate`], the shader as [`create_module`] gives it to a device with or without
-/// `SHADER_EARLY_DEPTH_TEST`.
+/// `SHADER_EARLY_DEPTH_TEST`: in every [`Shading`] (each makes other code live; one text that
+/// two shadings make alike is validated once); the module of the first.
 pub fn validate_for(
     shader: &ComposedShader,
     early_depth_test: bool,
 ) -> Result<naga::Module, String> {
-    validate_source(&shader.name, &shader.source_for(early_depth_test))
-}
-
-/// Parse and validate, the shader in every [`Shading`] (each makes other code live; one
-/// source that two shadings make alike is validated once); the module of the first.
-fn validate_source(name: &str, source: &str) -> Result<naga::Module, String> {
     let mut first = None;
     let mut seen = std::collections::HashSet::new();
     for shading in Shading::all() {
-        let specialized = specialize(source, shading);
-        if !seen.insert(specialized.clone()) {
+        let source = shader.specialized(shading).source_for(early_depth_test);
+        if !seen.insert(source.clone()) {
             continue;
         }
-        let module = validate_one(name, &specialized)?;
+        let module = validate_one(&shader.name, &source)?;
         first.get_or_insert(module);
     }
     Ok(first.expect("one at least"))
@@ -344,66 +403,55 @@ fn validate_one(name: &str, source: &str) -> Result<naga::Module, String> {
     Ok(module)
 }
 
-/// The placeholders `lighting.wgsl` declares its BRDF and falloff with.
-const SHADING_BRDF_VALUE: &str = "SHADING_BRDF_VALUE";
-const SHADING_FALLOFF_VALUE: &str = "SHADING_FALLOFF_VALUE";
-const SHADING_SHADOWS_VALUE: &str = "SHADING_SHADOWS_VALUE";
-const SHADING_MATERIAL_INPUTS_VALUE: &str = "SHADING_MATERIAL_INPUTS_VALUE";
-const SHADING_SPOT_CONE_VALUE: &str = "SHADING_SPOT_CONE_VALUE";
-
-fn specialize(source: &str, shading: Shading) -> String {
-    source
-        .replace(SHADING_BRDF_VALUE, &format!("{}u", shading.brdf.gpu()))
-        .replace(
-            SHADING_FALLOFF_VALUE,
-            &format!("{}u", shading.units.falloff()),
-        )
-        .replace(
-            SHADING_SHADOWS_VALUE,
-            &format!("{}u", shading.shadows_gpu()),
-        )
-        .replace(
-            SHADING_SPOT_CONE_VALUE,
-            &format!("{}u", shading.spot_cone.gpu()),
-        )
-        .replace(
-            SHADING_MATERIAL_INPUTS_VALUE,
-            if shading.material_inputs {
-                "true"
-            } else {
-                "false"
-            },
-        )
+/// The light function's defs of a shading: its BRDF, falloff, shadows, spot cone
+/// (`lighting.wgsl`) and whether materials read per-sample inputs (`geometry.wgsl`).
+pub fn shading_defs(shading: Shading) -> Vec<Def> {
+    vec![
+        Def::U32("SHADING_BRDF", shading.brdf.gpu()),
+        Def::U32("SHADING_FALLOFF", shading.units.falloff()),
+        Def::U32("SHADING_SHADOWS", shading.shadows_gpu()),
+        Def::U32("SHADING_SPOT_CONE", shading.spot_cone.gpu()),
+        Def::Bool("SHADING_MATERIAL_INPUTS", shading.material_inputs),
+    ]
 }
 
-/// The attribute forward fragment shaders carry to keep early-Z although they may write the
-/// frame counters (a side effect that would otherwise move the depth test after shading).
+/// The device's def: does the device take `@early_depth_test(force)`
+/// (`SHADER_EARLY_DEPTH_TEST`, native only: Vulkan, GLES 3.1+)?
+pub const EARLY_DEPTH_TEST_DEF: &str = "EARLY_DEPTH_TEST";
+
+/// The attribute forward fragment shaders carry, under `#if EARLY_DEPTH_TEST`, to keep early-Z
+/// although they may write the frame counters (a side effect that would otherwise move the
+/// depth test after shading).
 pub const EARLY_DEPTH_TEST: &str = "@early_depth_test(force)";
 
 impl ComposedShader {
-    /// The shader with the light function's BRDF and falloff written in (`lighting.wgsl`'s
-    /// `SHADING_BRDF` and `SHADING_FALLOFF`): every module holding the light function is made
-    /// from this, and one made without it does not compile. A shader without the light
-    /// function is unchanged.
-    pub fn specialized(&self, shading: Shading) -> ComposedShader {
-        ComposedShader {
-            name: self.name.clone(),
-            source: specialize(&self.source, shading),
-        }
+    /// The same shader with more defs.
+    fn with(&self, defs: Vec<Def>) -> ComposedShader {
+        let mut out = self.clone();
+        out.defs.extend(defs);
+        out
     }
 
-    /// The source a device gets. The one edit that depends on the adapter rather than on a
-    /// key: without `SHADER_EARLY_DEPTH_TEST` (a native-only feature: Vulkan, GLES 3.1+) the
-    /// forced early depth test is dropped. The image is the same (no shader carrying it
-    /// discards or writes depth), only early-Z may be lost. It stays a text edit, not a def,
-    /// because WGSL has no conditional attribute and an `#if` around each of the entry points
-    /// carrying it would double them; [`validate_for`] checks both forms of every shader.
-    pub fn source_for(&self, early_depth_test: bool) -> std::borrow::Cow<'_, str> {
-        if early_depth_test {
-            std::borrow::Cow::Borrowed(self.source.as_str())
-        } else {
-            std::borrow::Cow::Owned(self.source.replace(EARLY_DEPTH_TEST, ""))
-        }
+    /// The shader with the light function's defs of `shading` ([`shading_defs`]): every
+    /// module holding the light function is made from this, and one made without them does
+    /// not compile. A shader naming none of them is unchanged.
+    pub fn specialized(&self, shading: Shading) -> ComposedShader {
+        self.with(shading_defs(shading))
+    }
+
+    /// The text a device with `SHADER_EARLY_DEPTH_TEST` gets.
+    pub fn source(&self) -> String {
+        self.source_for(true)
+    }
+
+    /// The text a device gets, with the one def that depends on the adapter rather than on
+    /// a key: without `SHADER_EARLY_DEPTH_TEST` the forced early depth test is left out. The
+    /// image is the same (no shader carrying it discards or writes depth), only early-Z may be
+    /// lost; [`validate_for`] checks both forms of every shader.
+    pub fn source_for(&self, early_depth_test: bool) -> String {
+        let device = Def::Bool(EARLY_DEPTH_TEST_DEF, early_depth_test);
+        let shader = self.with(vec![device]);
+        compose_text(&shader.name, shader.prelude, &shader.defs, &shader.parts)
     }
 }
 
@@ -415,7 +463,7 @@ pub fn create_module(device: &wgpu::Device, shader: &ComposedShader) -> wgpu::Sh
         .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(&shader.name),
-        source: wgpu::ShaderSource::Wgsl(shader.source_for(early_depth_test)),
+        source: wgpu::ShaderSource::Wgsl(shader.source_for(early_depth_test).into()),
     })
 }
 
@@ -462,35 +510,38 @@ pub fn compute_pipeline_with(
 mod tests {
     use super::*;
 
-    fn body(shader: &ComposedShader) -> &str {
+    fn body(source: &str) -> &str {
         let key = "// from the shader's key\n";
-        &shader.source[shader.source.find(key).unwrap() + key.len()..]
+        &source[source.find(key).unwrap() + key.len()..]
     }
 
     #[test]
     fn defs_are_consts_and_select_the_if_branches() {
-        let part = "a\n#if ON\nb\n#if !OFF\nc\n#else\nd\n#endif\n#else\ne\n#endif\nf\n";
+        let part = "a N\n#if ON\nb\n#if !OFF\nc\n#else\nd\n#endif\n#else\ne\n#endif\nf\n";
         let defs = [
             Def::Bool("ON", true),
             Def::Bool("OFF", false),
             Def::U32("N", 3),
+            Def::U32("UNNAMED", 4),
         ];
-        let s = compose_defs("t", &defs, &[part]);
+        let s = compose_defs("t", &defs, &[part]).source();
         let body = body(&s);
-        assert!(body
-            .starts_with("const ON: bool = true;\nconst OFF: bool = false;\nconst N: u32 = 3u;\n"));
-        assert_eq!(body_lines(&s), ["a", "b", "c", "f"]);
+        // A def no part names is not declared.
+        assert!(body.starts_with(
+            "const ON: bool = true;\nconst OFF: bool = false;\nconst N: u32 = 3u;\n\n"
+        ));
+        assert_eq!(body_lines(&s), ["a N", "b", "c", "f"]);
         // Directives leave empty lines: naga's spans keep the part's line numbers.
-        assert_eq!(body.lines().count(), defs.len() + 1 + part.lines().count());
+        assert_eq!(body.lines().count(), 3 + 1 + part.lines().count());
         let off = compose_defs(
             "t",
             &[Def::Bool("ON", false), Def::Bool("OFF", true)],
             &[part],
         );
-        assert_eq!(body_lines(&off), ["a", "e", "f"]);
+        assert_eq!(body_lines(&off.source()), ["a N", "e", "f"]);
     }
 
-    fn body_lines(s: &ComposedShader) -> Vec<&str> {
+    fn body_lines(s: &str) -> Vec<&str> {
         body(s)
             .lines()
             .filter(|l| !l.is_empty() && !l.starts_with("const "))
@@ -498,32 +549,47 @@ mod tests {
     }
 
     #[test]
+    fn the_device_and_the_shading_add_their_defs() {
+        let part = "@fragment\n#if EARLY_DEPTH_TEST\n@early_depth_test(force)\n#endif\nfn f() -> u32 { return SHADING_BRDF; }\n";
+        let s = compose("t", &[part]);
+        assert!(s.source_for(true).contains(EARLY_DEPTH_TEST));
+        assert!(!s.source_for(false).contains(EARLY_DEPTH_TEST));
+        assert!(!s.source().contains("const SHADING_BRDF"));
+        for shading in Shading::all() {
+            let text = s.specialized(shading).source();
+            let decl = format!("const SHADING_BRDF: u32 = {}u;", shading.brdf.gpu());
+            assert!(text.contains(&decl), "{shading:?}");
+            // Only the defs the parts name.
+            assert!(!text.contains("SHADING_FALLOFF"));
+        }
+    }
+
+    #[test]
     #[should_panic(expected = "names no bool def")]
     fn a_condition_without_a_def_is_refused() {
-        compose_defs("t", &[Def::U32("N", 1)], &["#if N\n#endif\n"]);
+        compose_defs("t", &[Def::U32("N", 1)], &["#if N\n#endif\n"]).source();
     }
 
     #[test]
     #[should_panic(expected = "without `#endif`")]
     fn an_unclosed_if_is_refused() {
-        compose_defs("t", &[Def::Bool("ON", true)], &["#if ON\n"]);
+        compose_defs("t", &[Def::Bool("ON", true)], &["#if ON\n"]).source();
     }
 
     #[test]
     #[should_panic(expected = "defined twice")]
     fn a_def_twice_is_refused() {
-        compose_defs("t", &[Def::U32("N", 1), Def::U32("N", 2)], &[]);
+        compose_defs("t", &[Def::U32("N", 1), Def::U32("N", 2)], &[]).source();
     }
 
     #[test]
     fn the_msaa_defs_select_the_texture_types() {
         for samples in every_sample_count() {
             let s = compose_defs("t", &msaa_defs(samples), &[src::MSAA]);
-            let multisampled = s.source.contains("texture_depth_multisampled_2d");
+            let text = s.source();
+            let multisampled = text.contains("texture_depth_multisampled_2d");
             assert_eq!(multisampled, samples > 1, "{samples}");
-            assert!(s
-                .source
-                .contains(&format!("const SAMPLES: u32 = {samples}u;")));
+            assert!(text.contains(&format!("const SAMPLES: u32 = {samples}u;")));
             validate(&s).unwrap();
         }
     }

@@ -1,18 +1,14 @@
 // The one light function. Every pipeline shades through `light_terms` / `shade_light`;
 // none has its own attenuation or BRDF.
 
-// The BRDF (BRDF_PHONG or BRDF_GGX) and the distance falloff (FALLOFF_WINDOW, the papers'
-// units, or FALLOFF_INVERSE_SQUARE, photometric) every light is shaded with, written in when a
-// pipeline's module is made (`ComposedShader::specialized`, from the renderer's resolved
-// `scene::Shading`): constants, so the light loop carries no branch, and no registers, for
-// the model a frame does not use. A module made without them does not compile.
-const SHADING_BRDF: u32 = SHADING_BRDF_VALUE;
-const SHADING_FALLOFF: u32 = SHADING_FALLOFF_VALUE;
-// How lights are shadowed (SHADOWS_OFF, SHADOWS_RAYS, SHADOWS_MAPS or SHADOWS_MAPS_REUSED),
-// written in the same way.
-const SHADING_SHADOWS: u32 = SHADING_SHADOWS_VALUE;
-// The spots' window between their cones (`SPOT_CONE_*`, `scene::SpotCone`).
-const SHADING_SPOT_CONE: u32 = SHADING_SPOT_CONE_VALUE;
+// The BRDF (`SHADING_BRDF`: BRDF_PHONG or BRDF_GGX), the distance falloff
+// (`SHADING_FALLOFF`: FALLOFF_WINDOW, the papers' units, or FALLOFF_INVERSE_SQUARE,
+// photometric), how lights are shadowed (`SHADING_SHADOWS`: SHADOWS_OFF, SHADOWS_RAYS,
+// SHADOWS_MAPS or SHADOWS_MAPS_REUSED) and the spots' window between their cones
+// (`SHADING_SPOT_CONE`: `scene::SpotCone`) are `const`s declared when a pipeline's module is
+// made (`ComposedShader::specialized`, from the renderer's resolved `scene::Shading`), so
+// the light loop carries no branch, and no registers, for the model a frame does not use. A
+// module made without them does not compile.
 
 // A shading sample: everything the light function needs, wherever it came from
 // (interpolated vertex data or a G-buffer).

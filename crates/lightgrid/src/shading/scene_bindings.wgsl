@@ -16,7 +16,7 @@
 
 // Set for pipelines drawing into multisampled targets (MSAA): the count goes to the pixel's
 // entry of `pixel_counts` instead of the count target (which such a pipeline does not have),
-// and a grid fragment checks that its cell holds it (`grid_shade_fragment`).
+// and a grid fragment checks that its cell holds it (`light_grid_shade_fragment`).
 override MULTISAMPLED: bool = false;
 
 // Add `count` lighting computations to pixel `p`'s count (MSAA frames).

@@ -57,21 +57,6 @@ struct FrameUniforms {
     _pad2: u32,
 }
 
-struct GridParams {
-    tile_size: u32,
-    tiles_x: u32,
-    tiles_y: u32,
-    slices: u32,
-    slice_scale: f32,
-    slice_bias: f32,
-    lists: u32,
-    layer_cells: u32,
-    zbin_words: u32,   // a z-binned grid's words per tile mask (0: per-cell lists)
-    zbin_masks: u32,   // where its tile masks start in the index buffer
-    _pad0: u32,
-    _pad1: u32,
-}
-
 // The light BVH (culling/strategies/bvh.rs): built by bvh_build.wgsl, walked by bvh.wgsl.
 struct BvhNode {
     lo: vec3<f32>,

@@ -20,8 +20,8 @@ use crate::frame::{CellBox, DepthBounds, DepthMask, DepthReduction, FrameEncoder
 use crate::gpu::{bind_resources, download, grow_storage, storage_buffer};
 use crate::scene::ViewSetup;
 use crate::shader::{
-    compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, src, Def,
-    ShaderKey,
+    compute_pipeline, compute_pipeline_with, every_sample_count, msaa_defs, overrides, parts, src,
+    Def, ShaderKey,
 };
 
 /// The cell-bounds kernel's variants: the depth target's samples, `--depth-bounds`
@@ -85,8 +85,9 @@ impl ShaderKey for CellBoundsKey {
     }
 
     fn parts(self) -> Vec<&'static str> {
-        vec![
+        parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             src::GRID_CELL,
             src::MSAA,

@@ -12,7 +12,7 @@
 // With MSAA every sample of every pixel (tiled-forward-shading §4.6: the bounds cover every
 // sample a fragment may shade).
 @group(1) @binding(0) var depth_tex: DepthTexture;
-@group(1) @binding(1) var<uniform> grid: GridParams;
+@group(1) @binding(1) var<uniform> light_grid: LightGridParams;
 @group(1) @binding(2) var<storage, read_write> bounds_out: array<vec2<f32>>;
 @group(1) @binding(3) var<storage, read_write> occupied_cells: array<u32>;
 // [0]: occupied cells; [1..4]: workgroup counts for dispatch_workgroups_indirect.
@@ -63,7 +63,7 @@ fn slice_box(k: u32, b: vec2<f32>, extra: vec2<f32>, origin: vec2<u32>) -> array
     var e = vec4<f32>(from_ordered_bits(x0), from_ordered_bits(x1), from_ordered_bits(atomicLoad(&box_y0[k])), from_ordered_bits(atomicLoad(&box_y1[k])));
     if (extra.x <= extra.y) {
         let lo = vec2<f32>(origin);
-        let hi = min(lo + vec2<f32>(f32(grid.tile_size)), frame.viewport);
+        let hi = min(lo + vec2<f32>(f32(light_grid.tile_size)), frame.viewport);
         let t = rect_extent(vec2<f32>(lo.x, hi.x), vec2<f32>(lo.y, hi.y), extra.x * (1.0 - ASSIGN_DEPTH_SLACK), extra.y * (1.0 + ASSIGN_DEPTH_SLACK));
         let u = vec4<f32>(min(e.x, t.x), max(e.y, t.y), min(e.z, t.z), max(e.w, t.w));
         e = select(t, u, has);
@@ -107,8 +107,8 @@ fn mask_row(origin: vec2<u32>, row: u32, width: u32) {
             let d = textureLoad(depth_tex, p, s);
             if (!is_background(d)) {
                 let w = view_distance_from_depth(d);
-                let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
-                let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+                let k0 = light_grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+                let k1 = light_grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
                 if (k0 != k) {
                     if (k != NO_SLICE) {
                         atomicOr(&mask_bits[k], bits);
@@ -216,8 +216,8 @@ fn bounds_row(origin: vec2<u32>, row: u32, width: u32) -> u32 {
             row_hi = max(row_hi, bitcast<u32>(select(frame.far, w, !is_background(d))));
             if (!is_background(d)) {
                 let bits = bitcast<u32>(w);
-                let k0 = grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
-                let k1 = grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
+                let k0 = light_grid_slice(w * (1.0 - ASSIGN_DEPTH_SLACK));
+                let k1 = light_grid_slice(w * (1.0 + ASSIGN_DEPTH_SLACK));
                 var e = vec4<u32>(0u);
 #if CELL_BOX
                 e = sample_box(w, p);
@@ -256,7 +256,7 @@ override CELL_THREADS: u32 = MAX_TILE_SIZE;
 @compute @workgroup_size(CELL_THREADS)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k0 = li;
-    for (; k0 < grid.slices; k0 = k0 + CELL_THREADS) {
+    for (; k0 < light_grid.slices; k0 = k0 + CELL_THREADS) {
         atomicStore(&slice_lo[k0], W_INFINITY);
         atomicStore(&slice_hi[k0], 0u);
 #if CELL_BOX
@@ -266,18 +266,18 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
         atomicStore(&box_y1[k0], 0u);
 #endif
     }
-    check_loop(k0, grid.slices);
+    check_loop(k0, light_grid.slices);
     if (li == 0u) {
         atomicStore(&tile_hi, 0u);
     }
     workgroupBarrier();
     let size = textureDimensions(depth_tex);
-    let origin = wg.xy * grid.tile_size;
+    let origin = wg.xy * light_grid.tile_size;
     // The tile's pixels that are on the screen.
-    let extent = min(vec2<u32>(grid.tile_size), size - min(origin, size));
+    let extent = min(vec2<u32>(light_grid.tile_size), size - min(origin, size));
     // `--depth-reduction subgroup` on a tiled grid: this invocation's samples in registers
     // (bit patterns, ordered as the distances are), reduced across the subgroup below.
-    let registers = SUBGROUP_REDUCTION && grid.slices == 1u;
+    let registers = SUBGROUP_REDUCTION && light_grid.slices == 1u;
     if (registers) {
         var lo = W_INFINITY;
         var hi = 0u;
@@ -311,21 +311,21 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
         atomicMax(&tile_hi, bounds_row(origin, li, extent.x));
     }
     workgroupBarrier();
-    let tile = wg.y * grid.tiles_x + wg.x;
-    let tiles = grid.tiles_x * grid.tiles_y;
+    let tile = wg.y * light_grid.tiles_x + wg.x;
+    let tiles = light_grid.tiles_x * light_grid.tiles_y;
     var k = li;
-    for (; k < grid.slices; k = k + CELL_THREADS) {
+    for (; k < light_grid.slices; k = k + CELL_THREADS) {
         let cell = k * tiles + tile;
         // What the cell's list serves besides its samples: MSAA forward fragments' range and,
         // with one shared list, the range transparent fragments may lie in.
         let fragments = fragment_range(cell);
         var shared_transparent = no_range();
-        if (grid.lists != GRID_LISTS_OPAQUE) {
+        if (light_grid.lists != LIGHT_GRID_LISTS_OPAQUE) {
             let t = transparent_bounds(k, bitcast<f32>(atomicLoad(&tile_hi)));
-            if (grid.lists == GRID_LISTS_SHARED) {
+            if (light_grid.lists == LIGHT_GRID_LISTS_SHARED) {
                 shared_transparent = t;
             } else {
-                write_bounds(grid.layer_cells + cell, bounds_union(t, fragment_range(grid.layer_cells + cell)));
+                write_bounds(light_grid.layer_cells + cell, bounds_union(t, fragment_range(light_grid.layer_cells + cell)));
             }
         }
         var b = vec2<f32>(bitcast<f32>(atomicLoad(&slice_lo[k])), bitcast<f32>(atomicLoad(&slice_hi[k])));
@@ -355,12 +355,12 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
 #endif
 #endif
 #if CELL_CULLS
-        if (grid.lists == GRID_LISTS_SEPARATE) {
-            cell_culls[grid.layer_cells + cell] = cell_cull_none();
+        if (light_grid.lists == LIGHT_GRID_LISTS_SEPARATE) {
+            cell_culls[light_grid.layer_cells + cell] = cell_cull_none();
         }
 #endif
     }
-    check_loop(k, grid.slices);
+    check_loop(k, light_grid.slices);
 #if DEPTH_MASK
     workgroupBarrier();
     if (li < extent.y) {
@@ -369,11 +369,11 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     workgroupBarrier();
     // 3. The masks.
     var mk = li;
-    for (; mk < grid.slices; mk = mk + CELL_THREADS) {
+    for (; mk < light_grid.slices; mk = mk + CELL_THREADS) {
         let sc = mask_scale[mk];
         cell_culls[mk * tiles + tile].mask = vec4<u32>(atomicLoad(&mask_bits[mk]), sc.x, sc.y, 0u);
     }
-    check_loop(mk, grid.slices);
+    check_loop(mk, light_grid.slices);
 #endif
 }
 
@@ -408,12 +408,12 @@ fn open_bounds(k: u32, b: vec2<f32>) -> vec2<f32> {
 fn slice_span(k: u32) -> vec2<f32> {
     var lo = frame.near;
     var hi = frame.far;
-    if (grid.slices > 1u) {
+    if (light_grid.slices > 1u) {
         if (k > 0u) {
-            lo = max(lo, exp((f32(k) - grid.slice_bias) / grid.slice_scale));
+            lo = max(lo, exp((f32(k) - light_grid.slice_bias) / light_grid.slice_scale));
         }
-        if (k + 1u < grid.slices) {
-            hi = min(hi, exp((f32(k + 1u) - grid.slice_bias) / grid.slice_scale));
+        if (k + 1u < light_grid.slices) {
+            hi = min(hi, exp((f32(k + 1u) - light_grid.slice_bias) / light_grid.slice_scale));
         }
     }
     return vec2<f32>(lo, hi);

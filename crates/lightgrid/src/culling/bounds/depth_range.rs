@@ -32,6 +32,7 @@ impl SampleStage for DepthRangeStage {
     fn parts(_samples: u32) -> Vec<&'static str> {
         vec![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             src::MSAA,
             include_str!("depth_range.wgsl"),

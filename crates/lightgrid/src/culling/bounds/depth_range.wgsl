@@ -15,9 +15,9 @@
 // CPU twins: `depth_range_cpu` and `slicing_range` (depth_range.rs).
 
 @group(1) @binding(0) var depth_tex: DepthTexture;
-@group(1) @binding(1) var<uniform> grid: GridParams;
+@group(1) @binding(1) var<uniform> light_grid: LightGridParams;
 @group(1) @binding(2) var<storage, read_write> range: array<atomic<u32>, 2>;
-@group(1) @binding(3) var<storage, read_write> params_out: GridParams;
+@group(1) @binding(3) var<storage, read_write> params_out: LightGridParams;
 
 const W_INFINITY: u32 = 0x7f800000u;
 
@@ -72,8 +72,8 @@ fn finish() {
     atomicStore(&range[0], bitcast<u32>(lo));
     atomicStore(&range[1], bitcast<u32>(hi));
     // GridDims::slice_params' formula over [lo, hi].
-    var p = grid;
-    let s = f32(grid.slices);
+    var p = light_grid;
+    let s = f32(light_grid.slices);
     let span = log(hi / lo);
     p.slice_scale = s / span;
     p.slice_bias = -s * log(lo) / span;

@@ -3,7 +3,7 @@
 //! the pixel centre, which may lie off its triangle, so its depth can lie outside the bounds
 //! of every sample of its cell; a pass with the shading passes' depth tests records where the
 //! fragments that will be shaded lie, and the cell-bounds kernel unions that with the samples'
-//! bounds. A fragment still outside is counted and its frame refused (`grid_shade_fragment`).
+//! bounds. A fragment still outside is counted and its frame refused (`light_grid_shade_fragment`).
 
 use crate::culling::grid::GridDims;
 use crate::frame::{FrameEncoder, FrameInputs};

@@ -10,7 +10,7 @@
 // minimum, bits of the maximum), both reduced with atomicMax, so a buffer cleared to zero is
 // empty everywhere (positive floats order like their bit patterns).
 
-@group(1) @binding(0) var<uniform> grid: GridParams;
+@group(1) @binding(0) var<uniform> light_grid: LightGridParams;
 @group(1) @binding(1) var<storage, read_write> fragment_bounds: array<atomic<u32>>;
 
 fn include_fragment(cell: u32, w: f32) {
@@ -21,25 +21,28 @@ fn include_fragment(cell: u32, w: f32) {
 
 // A fragment within ASSIGN_DEPTH_SLACK of a slice boundary counts for both slices, as a
 // sample does in the cell-bounds kernel. A centre extrapolated out of the view volume (past
-// the near or far plane, or behind the camera) is in no cell (`grid_shade_fragment`).
+// the near or far plane, or behind the camera) is in no cell (`light_grid_shade_fragment`).
 fn include_fragment_cells(pixel: vec2<f32>, w: f32, layer_offset: u32) {
     if (w < frame.near || w > frame.far) {
         return;
     }
-    let c0 = grid_cell(pixel, w * (1.0 - ASSIGN_DEPTH_SLACK)) + layer_offset;
-    let c1 = grid_cell(pixel, w * (1.0 + ASSIGN_DEPTH_SLACK)) + layer_offset;
+    let c0 = light_grid_cell(pixel, w * (1.0 - ASSIGN_DEPTH_SLACK)) + layer_offset;
+    let c1 = light_grid_cell(pixel, w * (1.0 + ASSIGN_DEPTH_SLACK)) + layer_offset;
     include_fragment(c0, w);
     if (c1 != c0) {
         include_fragment(c1, w);
     }
-    let c = grid_cell(pixel, w) + layer_offset;
+    let c = light_grid_cell(pixel, w) + layer_offset;
     if (c != c0 && c != c1) {
         include_fragment(c, w);
     }
 }
 
 // Opaque fragments: their cells in the first layer.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_opaque(v: VertexOut) {
     let m = materials[v.material];
     alpha_test(m, m.alpha * base_colour(m, v, tex_coords(v)).a);
@@ -47,8 +50,11 @@ fn fs_opaque(v: VertexOut) {
 }
 
 // Transparent fragments: the second layer with separate lists, else the one list.
-@fragment @early_depth_test(force)
+@fragment
+#if EARLY_DEPTH_TEST
+@early_depth_test(force)
+#endif
 fn fs_transparent(v: VertexOut) {
-    let layer = select(0u, grid.layer_cells, grid.lists == GRID_LISTS_SEPARATE);
+    let layer = select(0u, light_grid.layer_cells, light_grid.lists == LIGHT_GRID_LISTS_SEPARATE);
     include_fragment_cells(v.clip.xy, view_distance_from_depth(v.clip.z), layer);
 }

@@ -12,8 +12,9 @@ pub(crate) mod samples;
 
 /// Per-tile depth min/max inside a workgroup (the single-kernel tiled deferred pipeline).
 pub(crate) const TILE_DEPTH_WGSL: &str = include_str!("tile_depth.wgsl");
-/// The 2.5D depth mask's bins (`depth_mask.rs`) and the tight cells' record (`cell_box.rs`).
-pub(crate) const CELL_CULL_WGSL: &str = concat!(
-    include_str!("depth_mask.wgsl"),
-    include_str!("cell_box.wgsl")
-);
+/// The 2.5D depth mask's bins (`depth_mask.rs`).
+pub(crate) const DEPTH_MASK_WGSL: &str = include_str!("depth_mask.wgsl");
+/// The tight cells' record (`cell_box.rs`).
+pub(crate) const CELL_BOX_WGSL: &str = include_str!("cell_box.wgsl");
+/// Both, in order: what a cell's culling record reads and writes.
+pub(crate) const CELL_CULL_WGSL: &[&str] = &[DEPTH_MASK_WGSL, CELL_BOX_WGSL];

@@ -28,7 +28,7 @@ use crate::gpu::{
 };
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::scene::ViewSetup;
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, src, ComposedShader, Def, ShaderKey};
 use glam::{DMat3, DVec3, Mat4};
 
 /// One light as [`LightCuller`] reads it from the caller's buffer: 48 bytes, `#[repr(C)]`,
@@ -202,57 +202,42 @@ impl CullReport {
 /// three groups; `tests/culler.rs` creates every strategy on a device with exactly this).
 pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 16;
 
-/// The caller-facing WGSL: the grid's bindings (declared at group `GROUP`) and the accessors,
-/// the cell addressing shared with lightgrid's own shaders (`grid_cell.wgsl`) renamed into
-/// the `light_grid` prefix so nothing collides with the caller's names.
+/// The caller-facing WGSL's own part: the grid's bindings (at group `LIGHT_GRID_GROUP`) and
+/// the accessors. The cell addressing and z-bin walk are lightgrid's own parts, whose names
+/// already carry the `light_grid` prefix, so nothing collides with the caller's names.
 const EMBED_WGSL: &str = include_str!("embed.wgsl");
 
-/// lightgrid's `GridParams` struct (`shading/types.wgsl`), the one definition of the grid's
-/// uniform layout.
-fn grid_params_struct() -> &'static str {
-    let start = src::TYPES
-        .find("struct GridParams {")
-        .expect("types.wgsl defines GridParams");
-    let end = start + src::TYPES[start..].find('}').expect("its closing brace") + 1;
-    &src::TYPES[start..end]
+/// The caller's WGSL at bind group `group` ([`LightCuller::wgsl`]): a shader key like every
+/// other, composed without the constants prelude (it declares only `light_grid` names).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CallerGridKey {
+    pub group: u32,
 }
 
-/// WGSL `text` with its names prefixed (`grid` → `light_grid`, `grid_cell` →
-/// `light_grid_cell`, `GridParams` → `LightGridParams`, `GRID_LISTS_SEPARATE` →
-/// `LIGHT_GRID_LISTS_SEPARATE`).
-fn prefixed(text: &str) -> String {
-    let mut out = String::new();
-    let mut ident = String::new();
-    let flush = |ident: &mut String, out: &mut String| {
-        let renamed = match ident.as_str() {
-            "grid" => "light_grid".to_string(),
-            "GRID_LISTS_SEPARATE" => "LIGHT_GRID_LISTS_SEPARATE".to_string(),
-            s if s.starts_with("grid_") => format!("light_{s}"),
-            s if s.starts_with("Grid") => format!("Light{s}"),
-            s => s.to_string(),
-        };
-        out.push_str(&renamed);
-        ident.clear();
-    };
-    let mut comment = false;
-    for c in text.chars() {
-        if comment {
-            out.push(c);
-            comment = c != '\n';
-            continue;
-        }
-        if c.is_ascii_alphanumeric() || c == '_' {
-            ident.push(c);
-            continue;
-        }
-        flush(&mut ident, &mut out);
-        if c == '/' && out.ends_with('/') {
-            comment = true;
-        }
-        out.push(c);
+impl ShaderKey for CallerGridKey {
+    const STAGE: &'static str = "light grid (caller)";
+    const PRELUDE: bool = false;
+
+    /// Every group a default wgpu device has.
+    fn all() -> Vec<Self> {
+        (0..wgpu::Limits::default().max_bind_groups)
+            .map(|group| CallerGridKey { group })
+            .collect()
     }
-    flush(&mut ident, &mut out);
-    out
+
+    fn defs(self) -> Vec<Def> {
+        vec![
+            Def::U32("LIGHT_GRID_GROUP", self.group),
+            Def::U32(
+                "LIGHT_GRID_LISTS_SEPARATE",
+                crate::consts::GRID_LISTS_SEPARATE,
+            ),
+        ]
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![src::GRID_PARAMS, EMBED_WGSL, src::GRID_CELL, src::ZBIN_WALK]
+    }
 }
 
 /// Culls a caller's lights into lightgrid's light grid, in the caller's encoder.
@@ -486,17 +471,9 @@ pub(crate) fn prep_shader() -> ComposedShader {
 }
 
 /// The caller-facing module at every group a default wgpu device has, for the validation
-/// test. Not a [`crate::shader::ShaderKey`]: the group is the caller's, and its WGSL is
-/// pasted into the caller's shader rather than composed here.
+/// test.
 pub(crate) fn embed_shaders() -> Vec<ComposedShader> {
-    (0..wgpu::Limits::default().max_bind_groups)
-        .map(|group| {
-            compose(
-                &format!("light grid (embedded at group {group})"),
-                &[&LightCuller::wgsl(group)],
-            )
-        })
-        .collect()
+    CallerGridKey::all_shaders()
 }
 
 impl LightCuller {
@@ -629,14 +606,7 @@ impl LightCuller {
     ///
     /// Every name it declares starts with `light_grid` or `LightGrid`.
     pub fn wgsl(group: u32) -> String {
-        format!(
-            "{}\n{}\nconst LIGHT_GRID_LISTS_SEPARATE: u32 = {}u;\n\n{}\n{}",
-            prefixed(grid_params_struct()),
-            EMBED_WGSL.replace("LIGHT_GRID_GROUP", &group.to_string()),
-            crate::consts::GRID_LISTS_SEPARATE,
-            prefixed(src::GRID_CELL),
-            prefixed(src::ZBIN_WALK)
-        )
+        CallerGridKey { group }.shader().source()
     }
 
     /// The layout of [`Self::bind_group`], for the caller's pipeline layout (visible to
@@ -1046,5 +1016,13 @@ mod tests {
                 assert!(name.starts_with("LightGrid"), "{name}");
             }
         }
+        for (_, c) in module.constants.iter() {
+            let name = c.name.as_deref().unwrap_or("");
+            assert!(name.starts_with("LIGHT_GRID"), "{name}");
+        }
+        assert!(
+            module.constants.iter().count() >= 2,
+            "the group and the lists' value"
+        );
     }
 }

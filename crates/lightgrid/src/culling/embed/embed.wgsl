@@ -15,7 +15,7 @@
 // `light_grid_light(cell, i)` index a cell's lights directly: constant time on lists, a
 // scan of the tile's mask words on z-bins.
 
-// LightGridParams: lightgrid's GridParams (shading/types.wgsl), renamed.
+// LightGridParams: culling/grid/grid_params.wgsl, composed before this part.
 
 @group(LIGHT_GRID_GROUP) @binding(0) var<uniform> light_grid: LightGridParams;
 @group(LIGHT_GRID_GROUP) @binding(1) var<storage, read> light_grid_cells: array<vec2<u32>>;  // (offset, count)
@@ -33,7 +33,7 @@ struct LightGridWalk {
     end: u32,
     // Lists: the cell's offset.
     base: u32,
-    // Z-bins: the cell's tile and bin (zbin_walk.wgsl, renamed) and the current word's bits
+    // Z-bins: the cell's tile and bin (zbin_walk.wgsl) and the current word's bits
     // left.
     zbin: LightGridZBinWalk,
     bits: u32,
@@ -107,4 +107,5 @@ fn light_grid_light(cell: u32, i: u32) -> u32 {
     return 0u;
 }
 
-// Cell addressing, the same as lightgrid's own shaders (grid_cell.wgsl, renamed):
+// Cell addressing and the z-bin walk follow: lightgrid's own grid_cell.wgsl and zbin_walk.wgsl,
+// whose names carry the `light_grid` prefix everywhere.

@@ -1,27 +1,27 @@
 // The one light-grid accessor (tiled-shading Listing 1): find the sample's cell (grid_cell.wgsl),
 // loop the lights listed for it, call the one light function. Every grid-reading pipeline
-// (forward fragment shaders and deferred compute shaders) shades through `grid_shade`.
+// (forward fragment shaders and deferred compute shaders) shades through `light_grid_shade`.
 
-@group(1) @binding(0) var<uniform> grid: GridParams;
-@group(1) @binding(1) var<storage, read> grid_cells: array<vec2<u32>>;  // (offset, count)
-@group(1) @binding(2) var<storage, read> grid_indices: array<u32>;
+@group(1) @binding(0) var<uniform> light_grid: LightGridParams;
+@group(1) @binding(1) var<storage, read> light_grid_cells: array<vec2<u32>>;  // (offset, count)
+@group(1) @binding(2) var<storage, read> light_grid_indices: array<u32>;
 // The view-distance bounds each cell's list was built for ([min, max], min > max: empty).
-@group(1) @binding(3) var<storage, read> grid_bounds: array<vec2<f32>>;
+@group(1) @binding(3) var<storage, read> light_grid_bounds: array<vec2<f32>>;
 
 // Does cell `cell`'s volume hold a point at view distance `w` (its screen position inside
 // the cell's tile)? Then its list holds every light reaching the point.
-fn grid_cell_holds(cell: u32, w: f32) -> bool {
-    let b = grid_bounds[cell];
+fn light_grid_cell_holds(cell: u32, w: f32) -> bool {
+    let b = light_grid_bounds[cell];
     return w >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
 }
 
 // The lights a sample of `cell` evaluates: its list's length, or for a z-binned grid the set
 // bits of its tile's mask inside its bin's range.
-fn grid_cell_count(cell: u32) -> u32 {
-    if (grid.zbin_words != 0u) {
+fn light_grid_cell_count(cell: u32) -> u32 {
+    if (light_grid.zbin_words != 0u) {
         return zbin_count(cell);
     }
-    return grid_cells[cell].y;
+    return light_grid_cells[cell].y;
 }
 
 // The cell `zbin_shade` shaded last and how many lights it evaluated: the pipelines ask for
@@ -32,19 +32,19 @@ fn zbin_count(cell: u32) -> u32 {
     if (zbin_shaded.x == cell) {
         return zbin_shaded.y;
     }
-    let z = grid_zbin_walk(cell);
+    let z = light_grid_zbin_walk(cell);
     var n = 0u;
     var k = z.word0;
     for (; k < z.word_end; k = k + 1u) {
-        n += countOneBits(grid_zbin_word(z, k));
+        n += countOneBits(light_grid_zbin_word(z, k));
     }
     check_loop(k, z.word_end);
     return n;
 }
 
 // The index (into `lights`) of the light at position `i` of the cell's list.
-fn grid_light(cell: u32, i: u32) -> u32 {
-    return grid_indices[grid_cells[cell].x + i];
+fn light_grid_light(cell: u32, i: u32) -> u32 {
+    return light_grid_indices[light_grid_cells[cell].x + i];
 }
 
 // A forward fragment: its surface lit by the lights of `cell` (found at the fragment's pixel
@@ -59,12 +59,12 @@ fn grid_light(cell: u32, i: u32) -> u32 {
 // scene, forward's colour there included; it is lit from its pixel's cell and not counted.
 // (Looping over every light instead is no option: lavapipe runs helper lanes, whose
 // extrapolated depths leave the bounds, to the end of such a loop, 15x slower: measured.)
-fn grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> vec3<f32> {
+fn light_grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> vec3<f32> {
     let in_view = w >= frame.near && w <= frame.far;
-    if (MULTISAMPLED && in_view && !grid_cell_holds(cell, w)) {
+    if (MULTISAMPLED && in_view && !light_grid_cell_holds(cell, w)) {
         atomicAdd(&frame_counters[COUNTER_OFF_BOUNDS_FRAGMENTS], 1u);
     }
-    return grid_shade(s, view_dir, cell);
+    return light_grid_shade(s, view_dir, cell);
 }
 
 // One light's term in a loop's sum: the colour (rgb), or for the light pre-pass's monochrome
@@ -77,5 +77,5 @@ fn light_sum(s: Surface, view_dir: vec3<f32>, light: u32, mono: bool) -> vec4<f3
     return vec4<f32>(shade_light(s, view_dir, light), 0.0);
 }
 
-// The light loop itself, `grid_shade`, `grid_irradiance_mono` and `zbin_shade`, is in
+// The light loop itself, `light_grid_shade`, `light_grid_irradiance_mono` and `zbin_shade`, is in
 // light_loop_lane.wgsl (one lane at a time) or light_loop_subgroup.wgsl (`--light-loop`).

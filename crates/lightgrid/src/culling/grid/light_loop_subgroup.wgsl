@@ -14,14 +14,14 @@
 const NO_LIGHT: u32 = 0xffffffffu;
 
 fn list_sum(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
-    let count = grid_cell_count(cell);
-    let offset = grid_cells[cell].x;
+    let count = light_grid_cell_count(cell);
+    let offset = light_grid_cells[cell].x;
     var acc = vec4<f32>(0.0);
     var i = 0u;
     loop {
         var mine = NO_LIGHT;
         if (i < count) {
-            mine = grid_indices[offset + i];
+            mine = light_grid_indices[offset + i];
         }
         let l = subgroupMin(mine);
         if (l == NO_LIGHT) {
@@ -37,7 +37,7 @@ fn list_sum(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32>
 }
 
 fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
-    let z = grid_zbin_walk(cell);
+    let z = light_grid_zbin_walk(cell);
     let has = z.word0 < z.word_end;
     // The union of the lanes' word ranges, [lo, hi).
     let lo = subgroupMin(select(NO_LIGHT, z.word0, has));
@@ -52,13 +52,13 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
     for (; k < hi; k = k + 1u) {
         var mine = 0u;
         if (k >= z.word0 && k < z.word_end) {
-            mine = grid_zbin_word(z, k);
+            mine = light_grid_zbin_word(z, k);
         }
         listed += countOneBits(mine);
         for (var any = subgroupOr(mine); any != 0u; any = any & (any - 1u)) {
             let b = firstTrailingBit(any);
             if (((mine >> b) & 1u) != 0u) {
-                acc += light_sum(s, view_dir, grid_indices[k * 32u + b], mono);
+                acc += light_sum(s, view_dir, light_grid_indices[k * 32u + b], mono);
                 shaded += 1u;
             }
         }
@@ -69,15 +69,15 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
     return acc;
 }
 
-fn grid_irradiance_mono(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec4<f32> {
-    if (grid.zbin_words != 0u) {
+fn light_grid_irradiance_mono(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec4<f32> {
+    if (light_grid.zbin_words != 0u) {
         return zbin_shade(s, view_dir, cell, true);
     }
     return list_sum(s, view_dir, cell, true);
 }
 
-fn grid_shade(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec3<f32> {
-    if (grid.zbin_words != 0u) {
+fn light_grid_shade(s: Surface, view_dir: vec3<f32>, cell: u32) -> vec3<f32> {
+    if (light_grid.zbin_words != 0u) {
         return zbin_shade(s, view_dir, cell, false).rgb;
     }
     return list_sum(s, view_dir, cell, false).rgb;

@@ -137,7 +137,7 @@ impl GridDims {
         (self.slice_scale, self.slice_bias)
     }
 
-    /// Slice of view distance `w` (the same formula as `grid_slice` in light_grid.wgsl).
+    /// Slice of view distance `w` (the same formula as `light_grid_slice` in light_grid.wgsl).
     pub fn slice_of(&self, w: f32) -> u32 {
         if self.slices <= 1 {
             return 0;
@@ -171,7 +171,7 @@ impl GridDims {
     }
 
     /// Cell of a transparent fragment at pixel (x, y) with view distance `w`
-    /// (`grid_cell_transparent` in grid_cell.wgsl).
+    /// (`light_grid_cell_transparent` in grid_cell.wgsl).
     pub fn transparent_cell_of(&self, x: u32, y: u32, w: f32) -> usize {
         self.lists.transparent_layer() as usize * self.layer_cells() + self.cell_of(x, y, w)
     }
@@ -423,7 +423,7 @@ impl GridBuffers {
     }
 
     /// Record the copy of the frame's cell bounds (`cells` of them) next to the lists, for
-    /// the shading passes' check that a fragment lies in its cell (`grid_cell_holds`).
+    /// the shading passes' check that a fragment lies in its cell (`light_grid_cell_holds`).
     pub fn encode_bounds(
         &mut self,
         device: &wgpu::Device,

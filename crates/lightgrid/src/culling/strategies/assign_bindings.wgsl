@@ -10,7 +10,7 @@
 // lists did not fit (an analysis run grows and reruns it at once). The counters are group 0's
 // `frame_counters` (slots COUNTER_* from consts.rs).
 
-@group(1) @binding(0) var<uniform> grid: GridParams;
+@group(1) @binding(0) var<uniform> light_grid: LightGridParams;
 @group(1) @binding(1) var<storage, read> cell_bounds: array<vec2<f32>>;
 @group(1) @binding(2) var<storage, read_write> cells: array<vec2<u32>>;   // (offset, count)
 @group(1) @binding(3) var<storage, read_write> indices: array<u32>;
@@ -50,11 +50,11 @@ fn cell_of_group(wg: vec3<u32>, nwg: vec3<u32>, spill: bool) -> u32 {
 // frustum for NO_CELL).
 fn cell_frustum(c: u32) -> TileFrustum {
     if (c == NO_CELL) {
-        return tile_frustum(vec2<u32>(0u), grid.tile_size, vec2<f32>(1.0, 0.0));
+        return tile_frustum(vec2<u32>(0u), light_grid.tile_size, vec2<f32>(1.0, 0.0));
     }
-    let tile = c % (grid.tiles_x * grid.tiles_y);
-    let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);
-    var f = tile_frustum(xy, grid.tile_size, cell_bounds[c]);
+    let tile = c % (light_grid.tiles_x * light_grid.tiles_y);
+    let xy = vec2<u32>(tile % light_grid.tiles_x, tile / light_grid.tiles_x);
+    var f = tile_frustum(xy, light_grid.tile_size, cell_bounds[c]);
     let cull = cell_cull(c);
     f.mask = cull.mask;
     f.box_lo = cull.lo;

@@ -18,13 +18,14 @@ use crate::gpu::{
     STORAGE_RW, UNIFORM,
 };
 use crate::gpu_types::LevelParams;
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
     compose(
         "bvh build",
-        &[
+        &parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             include_str!("bvh_build.wgsl"),

@@ -25,15 +25,16 @@ use crate::gpu::{
     bind_resources, buffer_layout, grow_storage, storage_buffer, CounterValues, PassTimer,
     STORAGE_READ, STORAGE_RW, UNIFORM,
 };
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
 const ASSIGN_BINDINGS_WGSL: &str = include_str!("assign_bindings.wgsl");
 
 fn cell_shader(name: &str, body: &'static str) -> ComposedShader {
     compose(
         name,
-        &[
+        &parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             ASSIGN_BINDINGS_WGSL,

@@ -1,5 +1,5 @@
 // A light's bounding sphere projected to the screen: the tiles it may cover (scatter's
-// rectangles, z-binning's tile pre-filter). Needs `frame` (scene bindings) and `grid`. CPU
+// rectangles, z-binning's tile pre-filter). Needs `frame` (scene bindings) and `light_grid`. CPU
 // twin: `project_sphere` in assign_cpu.rs.
 
 const NO_RANGE: vec3<f32> = vec3<f32>(0.0, 0.0, 0.0);
@@ -69,7 +69,7 @@ fn light_tiles(c: vec3<f32>, r: f32) -> vec4<i32> {
     let px1 = min(max(floor(x_hi), 0.0), max_px.x);
     let py0 = min(max(floor(y_lo), 0.0), max_px.y);
     let py1 = min(max(floor(y_hi), 0.0), max_px.y);
-    let t = i32(grid.tile_size);
+    let t = i32(light_grid.tile_size);
     return vec4<i32>(i32(px0) / t, i32(py0) / t, i32(px1) / t, i32(py1) / t);
 }
 

@@ -20,11 +20,11 @@ pub(crate) mod zbin;
 
 /// `tile_frustum` / `light_in_tile` (needs the scene bindings), with the 2.5D depth mask and
 /// tight-cell box tests.
-pub(crate) const TILE_FRUSTUM_WGSL: &str = concat!(
-    include_str!("../bounds/depth_mask.wgsl"),
-    include_str!("../bounds/cell_box.wgsl"),
-    include_str!("tile_frustum.wgsl")
-);
+pub(crate) const TILE_FRUSTUM_WGSL: &[&str] = &[
+    crate::culling::bounds::DEPTH_MASK_WGSL,
+    crate::culling::bounds::CELL_BOX_WGSL,
+    include_str!("tile_frustum.wgsl"),
+];
 
 use crate::culling::bounds::cell_bounds::CellBoundsPass;
 use crate::culling::bounds::depth_range::DepthRangePass;

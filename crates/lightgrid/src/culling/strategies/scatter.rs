@@ -22,13 +22,14 @@ use crate::gpu::{
     bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, CounterValues,
     PassTimer, STORAGE_RW,
 };
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
     compose(
         "scatter",
-        &[
+        &parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             src::GRID_CELL,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,

@@ -87,7 +87,7 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let rect = light_rects[l];
     let k = i - item_offsets[l];
     let width = u32(rect.z - rect.x + 1);
-    let tile = u32(rect.y + i32(k / width)) * grid.tiles_x + u32(rect.x + i32(k % width));
+    let tile = u32(rect.y + i32(k / width)) * light_grid.tiles_x + u32(rect.x + i32(k % width));
 
     let light = lights[l];
     let b = light_bounds[l];
@@ -100,23 +100,23 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     // A spot's sector box must overlap a cell's tight box too (the sphere's box otherwise,
     // which the sphere test already implies), as assign_cpu tests.
     let sector = reach_box(l, c, radius);
-    let xy = vec2<u32>(tile % grid.tiles_x, tile / grid.tiles_x);
-    let k0 = grid_slice(w_min * (1.0 - ASSIGN_DEPTH_SLACK));
-    let k1 = grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
-    let tiles = grid.tiles_x * grid.tiles_y;
+    let xy = vec2<u32>(tile % light_grid.tiles_x, tile / light_grid.tiles_x);
+    let k0 = light_grid_slice(w_min * (1.0 - ASSIGN_DEPTH_SLACK));
+    let k1 = light_grid_slice(w_max * (1.0 + ASSIGN_DEPTH_SLACK));
+    let tiles = light_grid.tiles_x * light_grid.tiles_y;
     let capacity = arrayLength(&pair_keys);
     // With separate transparent lists the second layer's cells are walked after the first:
     // item s of the loop is slice k0 + s % n of layer s / n.
     let n = k1 - k0 + 1u;
-    let steps = n * select(1u, 2u, grid.lists == GRID_LISTS_SEPARATE);
+    let steps = n * select(1u, 2u, light_grid.lists == LIGHT_GRID_LISTS_SEPARATE);
     var s = 0u;
     for (; s < steps; s = s + 1u) {
-        let cell = (s / n) * grid.layer_cells + (k0 + s % n) * tiles + tile;
+        let cell = (s / n) * light_grid.layer_cells + (k0 + s % n) * tiles + tile;
         let b = cell_bounds[cell];
         let in_depth = b.x <= b.y && w_max >= b.x * (1.0 - ASSIGN_DEPTH_SLACK) && w_min <= b.y * (1.0 + ASSIGN_DEPTH_SLACK);
         let cull = cell_cull(cell);
         let in_cull = depth_mask_meets(cull.mask, w_min, w_max) && sphere_meets_box(cull.lo, cull.hi, c, radius) && box_meets_box(cull.lo, cull.hi, sector[0], sector[1]);
-        if (in_depth && in_cull && (!by_cone || cone_margin(light, cone_sphere(tile_frustum(xy, grid.tile_size, b).sphere, cull.lo, cull.hi)) >= 0.0)) {
+        if (in_depth && in_cull && (!by_cone || cone_margin(light, cone_sphere(tile_frustum(xy, light_grid.tile_size, b).sphere, cull.lo, cull.hi)) >= 0.0)) {
             let slot = atomicAdd(&frame_counters[COUNTER_PAIRS_NEEDED], 1u);
             if (slot < capacity) {
                 pair_keys[slot] = cell;
@@ -164,7 +164,7 @@ fn bounds_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 @compute @workgroup_size(ASSIGN_THREADS)
 fn counts_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let c = flat_index(gid, nwg);
-    if (c < grid_cell_total()) {
+    if (c < light_grid_cell_total()) {
         cells[c].y = cells[c].y - cells[c].x;
     }
 }

@@ -28,13 +28,14 @@ use crate::gpu::{
 };
 use crate::scene::Light;
 use crate::scene::ViewSetup;
-use crate::shader::{compose, compute_pipeline, src, ComposedShader};
+use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
 pub(crate) fn shader() -> ComposedShader {
     compose(
         "zbin",
-        &[
+        &parts![
             src::TYPES,
+            src::GRID_PARAMS,
             src::SCENE_BINDINGS,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             src::GRID_CELL,

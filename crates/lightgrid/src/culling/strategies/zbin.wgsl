@@ -13,7 +13,7 @@
 //    MSAA fragment centres alike).
 // A sample shades the set bits of its tile's mask inside its bin's range (light_grid.wgsl).
 
-@group(1) @binding(0) var<uniform> grid: GridParams;
+@group(1) @binding(0) var<uniform> light_grid: LightGridParams;
 @group(1) @binding(1) var<storage, read> cell_bounds: array<vec2<f32>>;
 // The grid's cell buffer: per bin (~first, end) while building.
 @group(1) @binding(2) var<storage, read_write> bins: array<atomic<u32>>;
@@ -41,7 +41,7 @@ fn keys_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     vals[l] = l;
     if (l == 0u) {
         // The grid's index entries, reported as every strategy's are.
-        let entries = frame.light_count + grid.tiles_x * grid.tiles_y * grid.zbin_words;
+        let entries = frame.light_count + light_grid.tiles_x * light_grid.tiles_y * light_grid.zbin_words;
         atomicMax(&frame_counters[COUNTER_INDEX_NEEDED], entries);
     }
 }
@@ -68,8 +68,8 @@ fn bins_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         keys[i] = u32(rect.x) | (u32(rect.z) << 16u);
         vals[i] = u32(rect.y) | (u32(rect.w) << 16u);
     }
-    let k1 = grid_slice(hi);
-    var k = grid_slice(lo);
+    let k1 = light_grid_slice(hi);
+    var k = light_grid_slice(lo);
     for (; k <= k1; k = k + 1u) {
         atomicMax(&bins[2u * k], ~i);
         atomicMax(&bins[2u * k + 1u], i + 1u);
@@ -84,15 +84,15 @@ fn bins_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
 @compute @workgroup_size(ASSIGN_THREADS)
 fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let g = item(gid, nwg);
-    let tiles = grid.tiles_x * grid.tiles_y;
-    let words = grid.zbin_words;
+    let tiles = light_grid.tiles_x * light_grid.tiles_y;
+    let words = light_grid.zbin_words;
     if (g >= tiles * words) {
         return;
     }
     let t = g % tiles;
     let word = g / tiles;
     var range = vec2<f32>(3.4e38, -3.4e38);
-    let layers = grid_cell_total() / tiles;
+    let layers = light_grid_cell_total() / tiles;
     var k = 0u;
     for (; k < layers; k = k + 1u) {
         let b = cell_bounds[k * tiles + t];
@@ -103,8 +103,8 @@ fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     check_loop(k, layers);
     var bits = 0u;
     if (range.x <= range.y) {
-        let xy = vec2<u32>(t % grid.tiles_x, t / grid.tiles_x);
-        let f = tile_frustum(xy, grid.tile_size, range);
+        let xy = vec2<u32>(t % light_grid.tiles_x, t / light_grid.tiles_x);
+        let f = tile_frustum(xy, light_grid.tile_size, range);
         let first = word * 32u;
         let n = min(32u, frame.light_count - first);
         var j = 0u;
@@ -119,5 +119,5 @@ fn masks_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         }
         check_loop(j, n);
     }
-    zbin_out[grid.zbin_masks + t * words + word] = bits;
+    zbin_out[light_grid.zbin_masks + t * words + word] = bits;
 }
