@@ -1,6 +1,6 @@
 //! Analysis: what only a measuring run asks for (`render --stats`, `compare`, `bench`, the
 //! tests), never the real-time path. The frame's image, depth and lighting counts are copied
-//! out in the frame's own submission ([`AnalysisReadbacks`]); after the wait the ideal count
+//! out in the frame's own submission (`AnalysisReadbacks`); after the wait the ideal count
 //! is computed on the CPU, the grid the pipeline shaded with is downloaded
 //! (`LightCuller::download`) and everything lands in [`FrameStats`].
 
@@ -92,7 +92,7 @@ enum DepthReadback {
 }
 
 /// The staging buffers an analysis frame copies its image, counts and depth into.
-pub struct AnalysisReadbacks {
+pub(crate) struct AnalysisReadbacks {
     image: Readback,
     counts: CountsReadback,
     /// The counts before the transparent pass (frames with transparent objects).

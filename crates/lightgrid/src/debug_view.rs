@@ -1,7 +1,7 @@
 //! The viewer's debug views of an analysis frame ([`FrameOutput`]), each an image of the
 //! frame's own size with the numbers its legend needs:
 //! - **lights per cell** (Forward+ Fig. 2(b)): each pixel tinted by the list length of the cell
-//!   it reads ([`heatmap::cell_counts`]);
+//!   it reads (`heatmap::cell_counts`);
 //! - **cell depth bounds**: each pixel tinted by the view-distance span `max - min` of its
 //!   cell's samples (tiled-shading §6.3: long spans are where depth discontinuities make a
 //!   tile's lists long); cells without bounds (`brute-force` pipelines) show none;
@@ -161,7 +161,7 @@ fn wasted_work(out: &FrameOutput) -> DebugImage {
 
 /// Per pixel, the computations above the ideal (rounded; never below 0: a pipeline cannot
 /// do less than the ideal, and MSAA's averaged ideal may sit a fraction above a count).
-pub fn wasted_per_pixel(counts: &[u32], ideal: &[f32]) -> Vec<u32> {
+pub(crate) fn wasted_per_pixel(counts: &[u32], ideal: &[f32]) -> Vec<u32> {
     counts
         .iter()
         .zip(ideal)

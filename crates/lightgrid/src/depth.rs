@@ -20,7 +20,7 @@
 pub const CLEAR: f32 = 0.0;
 
 /// Nearer than, or as near as, what is there.
-pub const NEARER_OR_EQUAL: wgpu::CompareFunction = wgpu::CompareFunction::GreaterEqual;
+pub(crate) const NEARER_OR_EQUAL: wgpu::CompareFunction = wgpu::CompareFunction::GreaterEqual;
 
 /// The test of every pass that draws the scene's opaque surfaces (pre-passes, G-buffers,
 /// forward and post-pre-pass shading).
@@ -28,10 +28,10 @@ pub const SURFACE: wgpu::CompareFunction = NEARER_OR_EQUAL;
 
 /// Strictly nearer than what is there (the transparent pass over the opaque depth: a
 /// transparent surface coplanar with an opaque one is behind it, in every pipeline alike).
-pub const NEARER: wgpu::CompareFunction = wgpu::CompareFunction::Greater;
+pub(crate) const NEARER: wgpu::CompareFunction = wgpu::CompareFunction::Greater;
 
 /// Farther than, or as far as, what is there (a light volume's back faces).
-pub const FARTHER_OR_EQUAL: wgpu::CompareFunction = wgpu::CompareFunction::LessEqual;
+pub(crate) const FARTHER_OR_EQUAL: wgpu::CompareFunction = wgpu::CompareFunction::LessEqual;
 
 /// Does a depth-buffer value hold no geometry?
 pub fn is_background(depth: f32) -> bool {
@@ -58,12 +58,12 @@ pub fn view_distance(depth: f32, near: f32, far: f32) -> f32 {
 /// plane) nears f32's smallest normal number, which GPUs flush to zero, and a surface there
 /// would read as the background. Real files stop far above it (10⁻¹² for znear 10⁻⁶ and
 /// zfar 10⁶).
-pub const MIN_NEAR_FAR_RATIO: f32 = 1e-30;
+pub(crate) const MIN_NEAR_FAR_RATIO: f32 = 1e-30;
 
 /// Can the depth buffer hold a camera with these planes? `0 < near < far`, both finite, and
 /// `near / far` at least [`MIN_NEAR_FAR_RATIO`]: otherwise the frame is refused, never
 /// rendered with depths that lost the surfaces.
-pub fn check_planes(near: f32, far: f32) -> crate::error::Result<()> {
+pub(crate) fn check_planes(near: f32, far: f32) -> crate::error::Result<()> {
     if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
         return Err(crate::error::Error::invalid(
             "camera",
@@ -83,7 +83,7 @@ pub fn check_planes(near: f32, far: f32) -> crate::error::Result<()> {
 }
 
 /// `(A, B)` of `depth = A / w - B`, computed in f64 so a tiny near plane loses nothing.
-pub fn coefficients(near: f32, far: f32) -> (f32, f32) {
+pub(crate) fn coefficients(near: f32, far: f32) -> (f32, f32) {
     let (n, f) = (f64::from(near), f64::from(far));
     ((n * f / (f - n)) as f32, (n / (f - n)) as f32)
 }

@@ -94,12 +94,12 @@ pub struct GpuVertex {
 }
 
 /// A unit vector's component as a signed normalized 16-bit integer (`Snorm16`).
-pub fn snorm16(v: f32) -> i16 {
+pub(crate) fn snorm16(v: f32) -> i16 {
     (v.clamp(-1.0, 1.0) * 32767.0).round() as i16
 }
 
 /// A 0-to-1 value as a normalized byte (`Unorm8`).
-pub fn unorm8(v: f32) -> u8 {
+pub(crate) fn unorm8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0).round() as u8
 }
 

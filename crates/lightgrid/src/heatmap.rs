@@ -116,7 +116,7 @@ pub fn heatmap_scaled(
 /// Per pixel (row-major), the light count of the cell it reads: its tile's fullest list, or for
 /// a clustered grid with `view_distance` the cluster of its visible sample (the tile's fullest
 /// where it has none).
-pub fn cell_counts(grid: &LightGrid, view_distance: Option<&[f32]>) -> Vec<u32> {
+pub(crate) fn cell_counts(grid: &LightGrid, view_distance: Option<&[f32]>) -> Vec<u32> {
     let dims = grid.dims;
     let tile_max = grid.tile_max_counts();
     let (w, h) = (dims.width, dims.height);

@@ -88,13 +88,13 @@ pub fn diff(a: &RgbaImage, b: &RgbaImage) -> Result<(DiffSummary, RgbaImage)> {
 
 /// Most pixels [`load_image`] decodes: 8192 x 8192 (256 MiB as RGBA8), so comparing two images
 /// stays far below a gigabyte whatever their headers declare.
-pub const MAX_DECODED_PIXELS: u64 = 8192 * 8192;
+pub(crate) const MAX_DECODED_PIXELS: u64 = 8192 * 8192;
 
 /// Largest image file [`load_image`] reads.
-pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
 
 /// Read a PNG (or any format the image crate decodes) as RGBA8, refusing images larger than
-/// [`MAX_DECODED_PIXELS`] from their header, before anything is allocated.
+/// `MAX_DECODED_PIXELS` from their header, before anything is allocated.
 pub fn load_image(path: &Path) -> Result<RgbaImage> {
     let io = |cause| Error::Io {
         path: path.display().to_string(),
@@ -116,7 +116,7 @@ pub fn load_image(path: &Path) -> Result<RgbaImage> {
 }
 
 /// Decode image bytes (PNG, JPEG) as RGBA8 with [`load_image`]'s limits; errors name `name`.
-pub fn decode_image(bytes: &[u8], name: &str) -> Result<RgbaImage> {
+pub(crate) fn decode_image(bytes: &[u8], name: &str) -> Result<RgbaImage> {
     let bad = |reason: String| Error::Image {
         path: name.to_string(),
         reason,

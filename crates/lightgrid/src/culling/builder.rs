@@ -39,7 +39,7 @@ pub struct GridUse {
 }
 
 /// A built grid and what went into it (analysis).
-pub struct BuiltGrid {
+pub(crate) struct BuiltGrid {
     pub grid: LightGrid,
     /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
     pub cell_bounds: Vec<[f32; 2]>,

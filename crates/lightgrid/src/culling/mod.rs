@@ -14,37 +14,26 @@ mod strategies;
 
 pub use crate::frame::{Assign, CullConfig, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
-pub use bounds::cell_bounds::{
-    cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, CellBoundsPass, EMPTY_CELL,
-};
-pub use bounds::cell_box::{
-    box_overlap, cell_boxes_cpu, cone_sphere, rect_box, sphere_box_gap, view_extent, CellCull,
-    NO_CULL,
-};
-pub use bounds::depth_mask::{
-    cell_masks_cpu, depth_mask_meets, depth_mask_span, mask_scale, CellMask, NO_MASK,
-};
-pub use bounds::depth_range::{depth_range_cpu, slicing_range, DepthRangePass};
-pub use builder::BuiltGrid;
+pub use bounds::cell_bounds::{cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, EMPTY_CELL};
+pub use bounds::cell_box::{cell_boxes_cpu, CellCull};
+pub use bounds::depth_mask::{cell_masks_cpu, CellMask, NO_MASK};
+pub use bounds::depth_range::{depth_range_cpu, slicing_range};
+pub(crate) use builder::BuiltGrid;
 pub(crate) use builder::GridUse;
 pub use embed::culler::{CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller};
 pub use frame::check_index_capacity;
 pub(crate) use frame::CellSource;
 pub(crate) use frame::{bind_cull_group, cull_layout, CullFrame};
 pub use grid::{GridBuffers, GridDims, GridLists, LightGrid, ZBins};
-pub use oracle::{
-    ideal_fragment_computations, ideal_fragment_counts, ideal_lighting_computations,
-    ideal_pixel_counts, oracle_fragment_lights, oracle_tile_lights,
-};
+pub(crate) use oracle::{ideal_fragment_counts, ideal_pixel_counts};
+pub use oracle::{ideal_lighting_computations, oracle_fragment_lights, oracle_tile_lights};
 pub use spot_ray::{ray_test_count, RayTestCount};
 pub use strategies::assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
-pub use strategies::bvh::{
-    build_bvh, bvh_levels, morton_code, traverse_bvh_cpu, BvhNode, LightBvh,
-};
-pub use strategies::gather::{assign_gather_cpu, assign_gather_cpu_masked, gather_margins};
-pub use strategies::registry::{find_strategy, StrategyInfo, ASSIGN_VALUES, STRATEGIES};
-pub use strategies::zbin::{ordered_bits, zbins_cpu};
-pub use strategies::AssignStrategy;
+pub use strategies::bvh::{build_bvh, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
+pub use strategies::gather::{assign_gather_cpu, assign_gather_cpu_masked};
+pub(crate) use strategies::registry::ASSIGN_VALUES;
+pub use strategies::registry::{StrategyInfo, STRATEGIES};
+pub use strategies::zbin::zbins_cpu;
 
 pub use crate::consts::pass_labels as labels;
 

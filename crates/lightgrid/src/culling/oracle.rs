@@ -77,7 +77,7 @@ pub fn ideal_lighting_computations(
 
 /// [`ideal_lighting_computations`] per pixel (row-major; 0 where there is no sample): the
 /// viewer's wasted-work view subtracts it from the pipeline's counts.
-pub fn ideal_pixel_counts(
+pub(crate) fn ideal_pixel_counts(
     setup: &ViewSetup,
     grid: &LightGrid,
     lights: &[Light],
@@ -127,23 +127,8 @@ pub fn oracle_fragment_lights(
         .collect()
 }
 
-/// The ideal count of transparent fragments: for each, the lights that reach it. `grid` must
-/// list every such light in the fragment's transparent cell (the CPU assignment with
-/// transparent lists does).
-pub fn ideal_fragment_computations(
-    setup: &ViewSetup,
-    grid: &LightGrid,
-    lights: &[Light],
-    fragments: &[Fragment],
-) -> u64 {
-    ideal_fragment_counts(setup, grid, lights, fragments)
-        .iter()
-        .map(|&n| u64::from(n))
-        .sum()
-}
-
 /// [`ideal_fragment_computations`] per fragment, in the order of `fragments`.
-pub fn ideal_fragment_counts(
+pub(crate) fn ideal_fragment_counts(
     setup: &ViewSetup,
     grid: &LightGrid,
     lights: &[Light],

@@ -1,7 +1,7 @@
 //! What one frame carries, below `pipelines/`, `passes/` and `culling/` (which all use it):
 //! the settings every pipeline shares (`settings.rs`), the render targets (`targets.rs`),
-//! what a pipeline reads to record a frame ([`FrameInputs`]), the frame's command encoder
-//! ([`FrameEncoder`]), which counts the queue submissions, blocking readbacks and CPU waits
+//! what a pipeline reads to record a frame (`FrameInputs`), the frame's command encoder
+//! (`FrameEncoder`), which counts the queue submissions, blocking readbacks and CPU waits
 //! the frame makes ([`FrameIo`]), and what the renderer reports about a frame once submitted
 //! ([`SubmittedFrame`]) and once the GPU has finished it ([`FinishedFrame`]). A real-time
 //! frame makes one submission and no blocking readback; only the `cpu` strategy with depth
@@ -11,13 +11,15 @@ mod settings;
 pub mod targets;
 
 pub use settings::{
-    validate_msaa, validate_sample_culling, validate_shadow_atlas, validate_shadow_lights,
-    validate_shadow_map_size, validate_slices, validate_tile_size, validate_zbin_culling, Assign,
-    Brdf, CellBox, CullConfig, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
-    LightLoop, MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull,
-    AUTO_GATHER_MAX_LIGHTS,
+    validate_msaa, validate_tile_size, Assign, Brdf, CellBox, CullConfig, DepthBounds, DepthMask,
+    DepthReduction, GBufferFormat, GridLists, LightLoop, MaterialDraws, MsaaResolve,
+    RenderSettings, Shadows, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
-pub use targets::{check_msaa, msaa_counts, Targets};
+pub(crate) use settings::{
+    validate_shadow_atlas, validate_shadow_lights, validate_shadow_map_size, validate_slices,
+};
+pub(crate) use targets::Targets;
+pub use targets::{check_msaa, msaa_counts};
 
 use crate::error::Result;
 use crate::gpu::{read_buffer, scoped, PassTimer, PassTiming};
@@ -25,7 +27,7 @@ use crate::scene::{Draw, Light, ViewSetup};
 use web_time::Instant;
 
 /// What a pipeline reads to render one frame.
-pub struct FrameInputs<'a> {
+pub(crate) struct FrameInputs<'a> {
     pub device: &'a wgpu::Device,
     pub queue: &'a wgpu::Queue,
     pub scene_bind_group: &'a wgpu::BindGroup,
@@ -54,7 +56,7 @@ pub struct FrameInputs<'a> {
 
 /// Re-used shadow maps (`crate::shadows::maps`): the light-volume pipelines shade one light at
 /// a time and render a shadowed light's maps into the same six tiles just before it.
-pub trait ReusedShadowMaps {
+pub(crate) trait ReusedShadowMaps {
     /// Does light `i` cast shadows this frame?
     fn casts(&self, light: usize) -> bool;
     /// Record light `i`'s maps into the re-used tiles.
@@ -82,7 +84,7 @@ pub struct FrameIo {
 /// The frame's command encoder. A pipeline records into it; only the `cpu` strategy submits
 /// part-way (to read the cell bounds back). Every submission and blocking read goes through
 /// here, so [`FrameIo`] is the whole story of the frame's CPU-GPU traffic.
-pub struct FrameEncoder<'a> {
+pub(crate) struct FrameEncoder<'a> {
     device: &'a wgpu::Device,
     queue: &'a wgpu::Queue,
     encoder: Recording<'a>,
@@ -154,13 +156,6 @@ impl<'a> FrameEncoder<'a> {
         self.io.submits += 1;
         self.timer.next_submission();
         Ok(index)
-    }
-
-    /// Submit what was recorded, copy the first `bytes` of `buffer` to the CPU and wait for
-    /// them (the `cpu` strategy's cell bounds). Counted as a submission, a blocking readback
-    /// and CPU wait.
-    pub fn download(&mut self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
-        Ok(self.download_all(&[(buffer, bytes)])?.remove(0))
     }
 
     /// [`Self::download`] of several buffers (the first `bytes` of each, multiples of 4) in

@@ -375,7 +375,7 @@ impl RenderSettings {
 
 /// `--assign zbin` keeps no per-cell lists: its tile masks and depth bins are the culling, so
 /// the per-cell 2.5D masks and boxes have nothing to cut.
-pub fn validate_zbin_culling(
+pub(crate) fn validate_zbin_culling(
     assign: Assign,
     depth_mask: DepthMask,
     cell_box: CellBox,
@@ -422,7 +422,7 @@ pub fn validate_tile_size(tile_size: u32) -> crate::error::Result<()> {
 /// Refuse 2.5D culling or tight cells over bounds opened on a side: the mask's bins cut the
 /// samples' own bounds and the box is the samples' own (the renderer's settings and
 /// `LightCuller`'s config both ask this).
-pub fn validate_sample_culling(
+pub(crate) fn validate_sample_culling(
     depth_mask: DepthMask,
     cell_box: CellBox,
     depth_bounds: DepthBounds,
@@ -464,7 +464,7 @@ fn validate_index_capacity(entries: u32) -> crate::error::Result<()> {
 }
 
 /// Refuse a view-depth slice count outside `1..=MAX_SLICES`.
-pub fn validate_slices(slices: u32) -> crate::error::Result<()> {
+pub(crate) fn validate_slices(slices: u32) -> crate::error::Result<()> {
     use crate::consts::MAX_SLICES;
     if !(1..=MAX_SLICES).contains(&slices) {
         return Err(crate::error::Error::invalid(
@@ -477,7 +477,7 @@ pub fn validate_slices(slices: u32) -> crate::error::Result<()> {
 
 /// `--shadow-lights`: 1 to `MAX_LIGHTS` lights, or every light (`None`). Zero is refused:
 /// `--shadows off` says no light casts.
-pub fn validate_shadow_lights(n: Option<u32>) -> crate::error::Result<()> {
+pub(crate) fn validate_shadow_lights(n: Option<u32>) -> crate::error::Result<()> {
     use crate::consts::MAX_LIGHTS;
     match n {
         Some(n) if !(1..=MAX_LIGHTS).contains(&n) => Err(crate::error::Error::invalid(
@@ -489,7 +489,7 @@ pub fn validate_shadow_lights(n: Option<u32>) -> crate::error::Result<()> {
 }
 
 /// `--shadow-atlas`: 1 to `shadows::maps::MAX_ATLAS_MIB` MiB.
-pub fn validate_shadow_atlas(mib: u32) -> crate::error::Result<()> {
+pub(crate) fn validate_shadow_atlas(mib: u32) -> crate::error::Result<()> {
     use crate::shadows::maps::MAX_ATLAS_MIB;
     if !(1..=MAX_ATLAS_MIB).contains(&mib) {
         return Err(crate::error::Error::invalid(
@@ -501,7 +501,7 @@ pub fn validate_shadow_atlas(mib: u32) -> crate::error::Result<()> {
 }
 
 /// `--shadow-map-size`: a power of two from `MIN_TILE` to `MAX_TILE` texels.
-pub fn validate_shadow_map_size(texels: u32) -> crate::error::Result<()> {
+pub(crate) fn validate_shadow_map_size(texels: u32) -> crate::error::Result<()> {
     use crate::shadows::maps::{MAX_TILE, MIN_TILE};
     if !(MIN_TILE..=MAX_TILE).contains(&texels) || !texels.is_power_of_two() {
         return Err(crate::error::Error::invalid(

@@ -11,7 +11,7 @@ pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 /// Per-pixel lighting-computation counts: every lighting shader adds the number of times it
 /// ran the light function for the sample (additive blending or a storage write), and the
 /// renderer sums the target. 32-bit float holds integers exactly up to 2^24 per pixel.
-pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub(crate) const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// The MSAA sample counts the adapter offers for every multisampled target of a frame (HDR
 /// colour, depth, and the G-buffer in `gbuffer`'s format), ascending; always has 1.
@@ -44,12 +44,12 @@ pub fn check_msaa(
 /// Does a frame count its lighting computations in the count target (`COUNT_FORMAT`)? Where
 /// the adapter blends R32Float and without MSAA; with MSAA every pass adds into
 /// `Targets::pixel_counts` instead.
-pub fn counts_in_target(count_blend: bool, samples: u32) -> bool {
+pub(crate) fn counts_in_target(count_blend: bool, samples: u32) -> bool {
     count_blend && samples == 1
 }
 
 /// A single-sample 2D texture of the frame's size.
-pub fn render_texture(
+pub(crate) fn render_texture(
     device: &wgpu::Device,
     label: &str,
     format: wgpu::TextureFormat,
@@ -60,7 +60,7 @@ pub fn render_texture(
 }
 
 /// A 2D texture of the frame's size with `samples` samples per pixel.
-pub fn multisampled_texture(
+pub(crate) fn multisampled_texture(
     device: &wgpu::Device,
     label: &str,
     format: wgpu::TextureFormat,
@@ -101,7 +101,9 @@ pub fn cleared(
 }
 
 /// The scene depth attachment, cleared to the background (`depth::CLEAR`) and stored.
-pub fn cleared_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+pub(crate) fn cleared_depth(
+    view: &wgpu::TextureView,
+) -> wgpu::RenderPassDepthStencilAttachment<'_> {
     wgpu::RenderPassDepthStencilAttachment {
         view,
         depth_ops: Some(wgpu::Operations {
@@ -126,7 +128,7 @@ pub fn loaded(view: &wgpu::TextureView) -> wgpu::RenderPassColorAttachment<'_> {
 }
 
 /// The depth target as an earlier pass left it (tested against, not cleared).
-pub fn loaded_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+pub(crate) fn loaded_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
     wgpu::RenderPassDepthStencilAttachment {
         view,
         depth_ops: Some(wgpu::Operations {
@@ -142,7 +144,7 @@ pub fn loaded_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAtt
 /// lighting counts are added per pixel into `pixel_counts` (a count target per sample would
 /// count a fragment once per covered sample, or, blended, lose the samples failing the depth
 /// test: a fragment shader runs once per pixel and primitive).
-pub struct Targets {
+pub(crate) struct Targets {
     pub width: u32,
     pub height: u32,
     pub samples: u32,

@@ -21,7 +21,7 @@ pub const COUNTER_BYTES: u64 = COUNTER_SLOTS as u64 * 4;
 
 /// The frame counters' values after a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CounterValues(pub [u32; COUNTER_SLOTS as usize]);
+pub(crate) struct CounterValues(pub [u32; COUNTER_SLOTS as usize]);
 
 impl CounterValues {
     fn get(&self, slot: u32) -> u32 {
@@ -75,7 +75,7 @@ impl CounterValues {
 
 /// Who a slot's values belong to.
 #[derive(Clone, Debug)]
-pub struct FrameTag {
+pub(crate) struct FrameTag {
     /// The renderer's frame number (counts every submitted frame).
     pub serial: u64,
     /// The pipeline that rendered it.
@@ -86,7 +86,7 @@ pub struct FrameTag {
 
 /// A finished frame's counters and raw pass timestamps.
 #[derive(Clone, Debug)]
-pub struct FrameReadback {
+pub(crate) struct FrameReadback {
     pub tag: FrameTag,
     pub values: CounterValues,
     pub ticks: Vec<u64>,
@@ -104,7 +104,7 @@ struct Slot {
 }
 
 /// The counters buffer and a ring of staging slots (grown when every slot is in flight).
-pub struct FrameCounters {
+pub(crate) struct FrameCounters {
     buffer: wgpu::Buffer,
     slot_bytes: u64,
     slots: Vec<Slot>,

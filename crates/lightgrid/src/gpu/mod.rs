@@ -5,14 +5,16 @@ mod counters;
 mod timing;
 
 pub use context::{list_adapters, AdapterSummary, DeviceLimits, GpuContext};
-pub use counters::{CounterValues, FrameCounters, FrameReadback, FrameTag, COUNTER_BYTES};
-pub use timing::{FrameTimings, PassTimer, PassTiming, TimedPass};
+pub use counters::COUNTER_BYTES;
+pub(crate) use counters::{CounterValues, FrameCounters, FrameReadback, FrameTag};
+pub use timing::PassTiming;
+pub(crate) use timing::{PassTimer, TimedPass};
 
 use crate::error::{Error, Result};
 
 /// Run `f` inside a validation + out-of-memory error scope and turn a captured error into
 /// [`Error::Gpu`], so bad input becomes an error message instead of wgpu's default panic.
-pub fn scoped<T>(device: &wgpu::Device, stage: &str, f: impl FnOnce() -> T) -> Result<T> {
+pub(crate) fn scoped<T>(device: &wgpu::Device, stage: &str, f: impl FnOnce() -> T) -> Result<T> {
     let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let value = f();
@@ -67,7 +69,7 @@ pub(crate) fn report_late(stage: &str, message: String) {
     }
 }
 
-/// The GPU errors reported since the last call, oldest first (see [`scoped`]).
+/// The GPU errors reported since the last call, oldest first (see `scoped`).
 pub fn take_late_errors() -> Vec<Error> {
     LATE_ERRORS
         .lock()
@@ -85,7 +87,7 @@ fn native_only(stage: &str) -> Error {
 }
 
 /// Block until all submitted work is done.
-pub fn wait_idle(device: &wgpu::Device) -> Result<()> {
+pub(crate) fn wait_idle(device: &wgpu::Device) -> Result<()> {
     #[cfg(target_arch = "wasm32")]
     if cfg!(target_arch = "wasm32") {
         let _ = device;
@@ -101,7 +103,7 @@ pub fn wait_idle(device: &wgpu::Device) -> Result<()> {
 }
 
 /// Map a MAP_READ buffer, copy its bytes out and unmap it.
-pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+pub(crate) fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);
@@ -139,13 +141,13 @@ pub fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGrou
 
 /// `buffer_entry` shorthands.
 pub const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
-pub const STORAGE_READ: wgpu::BufferBindingType =
+pub(crate) const STORAGE_READ: wgpu::BufferBindingType =
     wgpu::BufferBindingType::Storage { read_only: true };
-pub const STORAGE_RW: wgpu::BufferBindingType =
+pub(crate) const STORAGE_RW: wgpu::BufferBindingType =
     wgpu::BufferBindingType::Storage { read_only: false };
 
 /// A compute layout whose bindings 0.. are buffers of the given types.
-pub fn buffer_layout(
+pub(crate) fn buffer_layout(
     device: &wgpu::Device,
     label: &str,
     types: &[wgpu::BufferBindingType],
@@ -184,7 +186,7 @@ pub fn bind_resources(
 }
 
 /// A storage buffer (also copy source and destination) of at least `size` bytes.
-pub fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+pub(crate) fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: size.max(16).next_multiple_of(4),
@@ -197,7 +199,7 @@ pub fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Bu
 
 /// Make `buffer` hold at least `size` bytes, replacing it (contents lost) with one of the
 /// next power-of-two size when it is smaller. Returns true when it was replaced.
-pub fn grow_storage(
+pub(crate) fn grow_storage(
     device: &wgpu::Device,
     buffer: &mut wgpu::Buffer,
     label: &str,
@@ -249,7 +251,7 @@ pub fn groups_1d(groups: u32) -> (u32, u32) {
 /// A uniform buffer of 16-byte parameter records, one per pass of a multi-pass stage, each at
 /// the minimum uniform offset alignment so a pass binds its own record (every record is
 /// written before the command buffer runs, so the passes cannot share one).
-pub struct UniformSlots {
+pub(crate) struct UniformSlots {
     buffer: wgpu::Buffer,
     slots: u64,
     /// Bytes of one record (the binding's size).

@@ -21,14 +21,14 @@ pub struct PassTiming {
 
 /// A pass the timer handed slots to: its label and the submission of the frame it is in.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct TimedPass {
+pub(crate) struct TimedPass {
     pub label: String,
     pub submission: u32,
 }
 
 /// What a frame's timestamps say.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct FrameTimings {
+pub(crate) struct FrameTimings {
     /// Each pass's begin-to-end time.
     pub passes: Vec<PassTiming>,
     /// The frame's GPU time: its submissions' spans, summed (None without timestamps).
@@ -40,7 +40,7 @@ pub struct FrameTimings {
 
 /// Hands out begin/end timestamp slots to passes; [`PassTimer::resolve_into`] copies the
 /// frame's timestamps into a buffer the frame counters read back (`gpu/counters.rs`).
-pub struct PassTimer {
+pub(crate) struct PassTimer {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     labels: Vec<TimedPass>,
     /// The frame's submissions so far (the passes recorded now go into this one).
@@ -90,11 +90,6 @@ impl PassTimer {
     /// Bytes of the timestamps of `passes` passes.
     pub fn bytes_for(passes: u32) -> u64 {
         u64::from(passes) * 16
-    }
-
-    /// Does this timer measure GPU time (false: wall time must be used)?
-    pub fn enabled(&self) -> bool {
-        self.queries.is_some()
     }
 
     /// Forget last frame's passes.

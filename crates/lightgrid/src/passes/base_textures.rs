@@ -10,9 +10,9 @@ use image::imageops::FilterType;
 use wgpu::util::DeviceExt;
 
 /// Budget of the whole array with its mips; the edge halves until it fits.
-pub const MAX_TEXTURE_BYTES: u64 = 256 << 20;
+pub(crate) const MAX_TEXTURE_BYTES: u64 = 256 << 20;
 
-pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub(crate) const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
 pub struct BaseTextures {
     pub view: wgpu::TextureView,
@@ -25,7 +25,7 @@ pub struct BaseTextures {
 
 /// The layer edge for these textures: the power of two at or above the largest, at most
 /// [`MAX_TEXTURE_EDGE`], halved until the array fits [`MAX_TEXTURE_BYTES`].
-pub fn layer_edge(textures: &[Texture]) -> u32 {
+pub(crate) fn layer_edge(textures: &[Texture]) -> u32 {
     let largest = textures
         .iter()
         .map(|t| t.width.max(t.height))
@@ -62,7 +62,7 @@ fn mips(t: &Texture, edge: u32) -> Vec<Vec<u8>> {
 
 impl BaseTextures {
     /// Upload `textures` (none: one white texel; `Scene::validate` bounds the count by
-    /// [`MAX_TEXTURES`]).
+    /// `MAX_TEXTURES`).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, textures: &[Texture]) -> Self {
         debug_assert!(textures.len() <= MAX_TEXTURES);
         let white = [Texture {
@@ -139,7 +139,7 @@ fn sampler_descriptor() -> wgpu::SamplerDescriptor<'static> {
 }
 
 /// The layout entry of binding 11, the nearest sampler, fragment stage.
-pub fn nearest_layout_entry() -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn nearest_layout_entry() -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding: 11,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -149,7 +149,7 @@ pub fn nearest_layout_entry() -> wgpu::BindGroupLayoutEntry {
 }
 
 /// The layout entries of bindings 6 (the array) and 7 (the sampler), fragment stage.
-pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+pub(crate) fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
     [
         wgpu::BindGroupLayoutEntry {
             binding: 6,

@@ -22,7 +22,8 @@ pub(crate) fn shader() -> ComposedShader {
 const GBUFFER_READ: &str = include_str!("gbuffer_read.wgsl");
 
 /// WGSL a deferred pass includes to read the full G-buffer ([`GBufferLayout::Full`]).
-pub const GBUFFER_READ_WGSL: &[&str] = &[GBUFFER_READ, include_str!("gbuffer_specular.wgsl")];
+pub(crate) const GBUFFER_READ_WGSL: &[&str] =
+    &[GBUFFER_READ, include_str!("gbuffer_specular.wgsl")];
 
 /// WGSL a deferred pass includes to read the mono-specular G-buffer.
 pub const GBUFFER_READ_MONO_WGSL: &[&str] =
@@ -85,8 +86,7 @@ impl GBufferLayout {
     }
 }
 
-pub struct GBuffer {
-    pub format: GBufferFormat,
+pub(crate) struct GBuffer {
     /// By location; `None` where the layout has no target.
     views: Vec<Option<wgpu::TextureView>>,
     pipeline: wgpu::RenderPipeline,
@@ -143,7 +143,6 @@ impl GBuffer {
             },
         );
         GBuffer {
-            format,
             read_layout: Self::read_layout(device, &views, samples),
             views,
             pipeline,

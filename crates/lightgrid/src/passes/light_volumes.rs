@@ -69,7 +69,7 @@ fn cone_volume_extent(l: &Light, center: Vec3) -> f32 {
 /// znear of 10⁻⁶ leaves everything beyond ~10 units within a few steps of 0. Adapters
 /// without `DEPTH32FLOAT_STENCIL8` (rare: every Vulkan, Metal and DX12 GPU in wgpu's tests
 /// has it, as has lavapipe) fall back to `Depth24PlusStencil8`.
-pub fn volume_depth_format(device: &wgpu::Device) -> wgpu::TextureFormat {
+pub(crate) fn volume_depth_format(device: &wgpu::Device) -> wgpu::TextureFormat {
     if device
         .features()
         .contains(wgpu::Features::DEPTH32FLOAT_STENCIL8)
@@ -81,9 +81,9 @@ pub fn volume_depth_format(device: &wgpu::Device) -> wgpu::TextureFormat {
 }
 
 /// The stencil bit marking an MSAA edge pixel: its samples are shaded one by one.
-pub const EDGE_STENCIL: u32 = 0x80;
+pub(crate) const EDGE_STENCIL: u32 = 0x80;
 /// The stencil bits of the z-fail volume marks (`VolumeDraw::StencilMark`): below the edge bit.
-pub const COUNT_STENCIL_MASK: u32 = 0x7f;
+pub(crate) const COUNT_STENCIL_MASK: u32 = 0x7f;
 
 /// How the fragments of a volume (or full-screen) draw are shaded with MSAA.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,9 +136,9 @@ fn edge_test() -> wgpu::StencilFaceState {
 }
 
 /// Bytes per pixel of the volume depth-stencil target in the memory model: 32-bit float
-/// depth + 8-bit stencil ([`volume_depth_format`]).
+/// depth + 8-bit stencil (`volume_depth_format`).
 pub const VOLUME_DEPTH_BYTES: u32 = 5;
-pub const VOLUME_WGSL: &str = include_str!("light_volume.wgsl");
+pub(crate) const VOLUME_WGSL: &str = include_str!("light_volume.wgsl");
 
 const RINGS: u32 = 8;
 const SEGMENTS: u32 = 16;
@@ -267,7 +267,7 @@ fn unit_cone(outward_ccw: bool) -> (Vec<[f32; 3]>, Vec<u32>) {
 
 /// Which light volumes a draw covers, and how they are rasterized.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum VolumeDraw {
+pub(crate) enum VolumeDraw {
     Front,
     Back,
     Full,
@@ -278,7 +278,7 @@ pub enum VolumeDraw {
 }
 
 /// What a volume pipeline shades with.
-pub struct VolumePipelineDesc<'a> {
+pub(crate) struct VolumePipelineDesc<'a> {
     pub label: &'a str,
     pub module: &'a wgpu::ShaderModule,
     pub fragment_entry: &'a str,
@@ -291,7 +291,7 @@ pub struct VolumePipelineDesc<'a> {
 }
 
 /// A full-screen draw of a volume pass (after the depth copy).
-pub struct FullscreenVolumeDesc<'a> {
+pub(crate) struct FullscreenVolumeDesc<'a> {
     pub label: &'a str,
     pub module: &'a wgpu::ShaderModule,
     pub fragment_entry: &'a str,
@@ -302,7 +302,7 @@ pub struct FullscreenVolumeDesc<'a> {
 
 /// What a full-screen volume-pass draw does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fullscreen {
+pub(crate) enum Fullscreen {
     /// Shades the pixels (or edge samples) of `Shading`.
     Shade(Shading),
     /// Sets [`EDGE_STENCIL`] on every sample of the pixels its fragment does not discard; no
@@ -328,7 +328,7 @@ pub fn additive(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
 }
 
 /// The sphere mesh, per-frame instance lists and the depth-stencil copy.
-pub struct LightVolumes {
+pub(crate) struct LightVolumes {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
     /// The sphere's and the unit cone's index ranges in `indices`, and the cone's first vertex.
@@ -484,11 +484,6 @@ impl LightVolumes {
             samples,
             copy_layout,
         }
-    }
-
-    /// Upload this frame's classes.
-    pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, c: &VolumeClasses) {
-        self.upload_split(device, queue, c, &VolumeClasses::default());
     }
 
     /// Upload this frame's classes: `c` drawn together, `shadowed` one light at a time

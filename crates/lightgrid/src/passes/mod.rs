@@ -9,18 +9,19 @@ mod readback;
 pub(crate) mod shadow_atlas;
 mod tonemap;
 
-pub use crate::frame::targets::{
-    cleared, cleared_depth, loaded, loaded_depth, multisampled_texture, render_texture, Targets,
-    COUNT_FORMAT, DEPTH_FORMAT, HDR_FORMAT, LDR_FORMAT,
+pub use crate::frame::targets::{cleared, loaded, DEPTH_FORMAT, HDR_FORMAT, LDR_FORMAT};
+pub(crate) use crate::frame::targets::{
+    cleared_depth, loaded_depth, multisampled_texture, render_texture, Targets, COUNT_FORMAT,
 };
-pub use gbuffer::{GBuffer, GBufferFormat, GBufferLayout, GBUFFER_READ_WGSL};
-pub use light_volumes::{
-    additive, classify_lights, volume_depth_format, Fullscreen, FullscreenVolumeDesc, LightVolumes,
-    Shading, VolumeClasses, VolumeDraw, VolumePipelineDesc, COUNT_STENCIL_MASK, EDGE_STENCIL,
-    VOLUME_DEPTH_BYTES, VOLUME_WGSL,
+pub(crate) use gbuffer::{GBuffer, GBUFFER_READ_WGSL};
+pub use gbuffer::{GBufferFormat, GBufferLayout};
+pub use light_volumes::{additive, classify_lights, Shading, VolumeClasses, VOLUME_DEPTH_BYTES};
+pub(crate) use light_volumes::{
+    Fullscreen, FullscreenVolumeDesc, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_WGSL,
 };
-pub use readback::{BufferReadback, DepthSamples, Readback};
-pub use tonemap::Tonemap;
+pub use readback::Readback;
+pub(crate) use readback::{BufferReadback, DepthSamples};
+pub(crate) use tonemap::Tonemap;
 
 use crate::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GpuVertex};
 use crate::shader::ComposedShader;
@@ -131,20 +132,20 @@ pub fn draw_fullscreen(
 }
 
 /// WGSL of a deferred compute pass's outputs (group 3).
-pub const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
+pub(crate) const COMPUTE_OUTPUTS_WGSL: &str = include_str!("compute_outputs.wgsl");
 
 /// The MSAA edge test (`differs`) over a per-sample G-buffer: the edge-aware deferred kernel
 /// and the light volumes' edge marking both compose it, so they shade the same pixels per
 /// sample. Needs `GBUFFER_READ_WGSL` and `shader::src::MSAA` with `shader::msaa_defs`.
-pub const MSAA_EDGES_WGSL: &[&str] = &[MSAA_SURFACES_WGSL, include_str!("msaa_edges.wgsl")];
+pub(crate) const MSAA_EDGES_WGSL: &[&str] = &[MSAA_SURFACES_WGSL, include_str!("msaa_edges.wgsl")];
 
 /// The edge test's core (`surfaces_differ`: normals and planes of two samples with geometry),
 /// for readers of other per-sample attributes than the G-buffer (the light pre-pass). Needs
 /// `shader::src::MSAA` with `shader::msaa_defs`.
-pub const MSAA_SURFACES_WGSL: &str = include_str!("msaa_surfaces.wgsl");
+pub(crate) const MSAA_SURFACES_WGSL: &str = include_str!("msaa_surfaces.wgsl");
 
 /// Layout of group 3 of deferred compute passes (`compute_outputs.wgsl`).
-pub fn compute_outputs_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+pub(crate) fn compute_outputs_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let storage = |binding, format| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -162,7 +163,7 @@ pub fn compute_outputs_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 /// Group 3 for a deferred compute pass: the HDR and count targets as storage textures.
-pub fn compute_outputs(
+pub(crate) fn compute_outputs(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     targets: &Targets,
@@ -172,7 +173,7 @@ pub fn compute_outputs(
 
 /// Group 3 with another RGBA16F target in the colour's place (the tiled light pre-pass's
 /// irradiance).
-pub fn compute_outputs_to(
+pub(crate) fn compute_outputs_to(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     color: &wgpu::TextureView,
@@ -196,7 +197,7 @@ pub fn compute_outputs_to(
 
 /// The count target of a fragment pipeline: additive blending where the adapter can blend
 /// R32Float, otherwise no target (the count is then not reported).
-pub fn count_target(count_blend: bool) -> Option<wgpu::ColorTargetState> {
+pub(crate) fn count_target(count_blend: bool) -> Option<wgpu::ColorTargetState> {
     count_blend.then_some(wgpu::ColorTargetState {
         format: COUNT_FORMAT,
         blend: Some(wgpu::BlendState {
@@ -321,7 +322,7 @@ pub fn texture_entry(
 }
 
 /// As [`texture_entry`], multisampled when `samples` > 1 (`shader::src::MSAA`'s types).
-pub fn sampled_texture_entry(
+pub(crate) fn sampled_texture_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
     samples: u32,

@@ -101,7 +101,7 @@ impl Readback {
 }
 
 /// A MAP_READ buffer for copies of a storage buffer's first `bytes`.
-pub struct BufferReadback {
+pub(crate) struct BufferReadback {
     staging: wgpu::Buffer,
     bytes: u64,
 }
@@ -146,7 +146,7 @@ impl SampleStage for DepthSamplesStage {
 
 /// Analysis of an MSAA frame: every sample of the depth target, one plane per sample
 /// (`depth_samples.wgsl`), read back.
-pub struct DepthSamples {
+pub(crate) struct DepthSamples {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     planes: wgpu::Buffer,

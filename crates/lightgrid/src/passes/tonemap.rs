@@ -23,7 +23,7 @@ impl SampleStage for TonemapStage {
     }
 }
 
-pub struct Tonemap {
+pub(crate) struct Tonemap {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }

@@ -18,9 +18,10 @@ use crate::shader::ComposedShader;
 
 pub use crate::culling::Assign;
 use crate::frame::GBufferFormat;
-pub use crate::frame::{FrameEncoder, FrameInputs, RenderSettings, SpotCull};
+pub(crate) use crate::frame::{FrameEncoder, FrameInputs};
+pub use crate::frame::{RenderSettings, SpotCull};
 pub use axes::{check_axes_apply, find_axis, value_of, Axis, AxisValue, SettingValue, AXES};
-pub use transparent::{TransparentLights, TransparentPass};
+pub(crate) use transparent::{TransparentLights, TransparentPass};
 
 /// What a pipeline needs to create its GPU objects.
 pub struct PipelineContext<'a> {
@@ -67,7 +68,7 @@ impl PipelineContext<'_> {
 /// A rendering technique: records a frame that fills `targets.hdr`, `targets.depth` and
 /// `targets.counts`, with no readback and no wait (the frame's one submission is the
 /// renderer's; only the `cpu` strategy with depth bounds reads the cell bounds back).
-pub trait Technique {
+pub(crate) trait Technique {
     /// Record the frame into `enc`.
     fn encode(&mut self, f: &FrameInputs, enc: &mut FrameEncoder) -> Result<()>;
     /// The grid builder of a grid pipeline with an `--assign` strategy: analysis downloads
@@ -105,12 +106,12 @@ pub enum Msaa {
 /// or removed pipeline is a compile error there, not a silently unmatched string.
 pub mod ids {
     pub const FORWARD: &str = "forward";
-    pub const FORWARD_MONO: &str = "forward_mono";
-    pub const FORWARD_MONO_ALBEDO: &str = "forward_mono_albedo";
+    pub(crate) const FORWARD_MONO: &str = "forward_mono";
+    pub(crate) const FORWARD_MONO_ALBEDO: &str = "forward_mono_albedo";
     pub const TILED_FORWARD: &str = "tiled_forward";
     pub const TILED_FORWARD_PREZ: &str = "tiled_forward_prez";
     pub const TILED_DEFERRED: &str = "tiled_deferred";
-    pub const TILED_DEFERRED_SINGLE: &str = "tiled_deferred_single";
+    pub(crate) const TILED_DEFERRED_SINGLE: &str = "tiled_deferred_single";
     pub const CLUSTERED_FORWARD: &str = "clustered_forward";
     pub const CLUSTERED_DEFERRED: &str = "clustered_deferred";
     pub const DEFERRED: &str = "deferred";
@@ -150,7 +151,7 @@ pub struct PipelineInfo {
     pub kernel_resolve: bool,
     /// Every composed shader the pipeline creates (validated by the tests without a GPU).
     pub shaders: fn() -> Vec<ComposedShader>,
-    pub create: fn(&PipelineContext) -> Box<dyn Technique>,
+    pub(crate) create: fn(&PipelineContext) -> Box<dyn Technique>,
     /// Render targets and the traffic model (`memory.rs`).
     pub memory: fn(&RenderSettings) -> MemoryModel,
 }

@@ -32,7 +32,7 @@ pub(super) fn shader(l: crate::frame::LightLoop) -> ComposedShader {
 }
 
 /// Where a technique's transparent fragments find their lights.
-pub enum TransparentLights<'a> {
+pub(crate) enum TransparentLights<'a> {
     /// Every light (`forward`).
     All,
     /// The technique's own grid, built this frame with transparent lists.
@@ -42,7 +42,7 @@ pub enum TransparentLights<'a> {
 }
 
 /// The pass's two pipelines and the grid it builds for techniques without one.
-pub struct TransparentPass {
+pub(crate) struct TransparentPass {
     all_lights: MaterialPipelines,
     grid: MaterialPipelines,
     own_grid: LightCuller,

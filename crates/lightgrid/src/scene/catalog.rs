@@ -15,18 +15,18 @@ use glam::{Mat4, Vec3};
 /// Width of the robots scene's main street (tiled-shading §8).
 pub const MAIN_STREET_WIDTH: f32 = 29.1;
 /// Robots walking the street (the BART Robots scene has 11).
-pub const ROBOT_COUNT: usize = 11;
+pub(crate) const ROBOT_COUNT: usize = 11;
 /// `robots-many`: static lights spread evenly along the robots' paths.
-pub const ROBOTS_MANY_LIGHTS: usize = 924;
-pub const ROBOTS_MANY_RANGE: f32 = 12.5;
+pub(crate) const ROBOTS_MANY_LIGHTS: usize = 924;
+pub(crate) const ROBOTS_MANY_RANGE: f32 = 12.5;
 /// `robots-few`: one light per robot.
-pub const ROBOTS_FEW_RANGE: f32 = 40.0;
+pub(crate) const ROBOTS_FEW_RANGE: f32 = 40.0;
 /// Frames of the robots camera path (the paper shows frames 0 to 259).
-pub const ROBOTS_FRAMES: u32 = 260;
-pub const SCATTERED_LIGHTS: usize = 3072;
-pub const RANDOM_LIGHTS: usize = 1024;
+pub(crate) const ROBOTS_FRAMES: u32 = 260;
+pub(crate) const SCATTERED_LIGHTS: usize = 3072;
+pub(crate) const RANDOM_LIGHTS: usize = 1024;
 /// `stress` without `--lights`.
-pub const STRESS_DEFAULT_LIGHTS: u32 = 10_000;
+pub(crate) const STRESS_DEFAULT_LIGHTS: u32 = 10_000;
 /// Largest `--lights` accepted by `stress`.
 pub const STRESS_MAX_LIGHTS: u32 = 1_000_000;
 
@@ -63,7 +63,7 @@ impl Default for SceneParams {
 
 /// Outer half-angles of the spots `--spot-fraction` makes, in degrees (street lamps to wide
 /// floods); the inner cone is 50% to 90% of the outer.
-pub const SPOT_OUTER_DEGREES: (f32, f32) = (15.0, 75.0);
+pub(crate) const SPOT_OUTER_DEGREES: (f32, f32) = (15.0, 75.0);
 
 /// A saturated random colour (random hue), as lights in the papers' scenes.
 pub(crate) fn random_light_color(rng: &mut Rng) -> Vec3 {
@@ -697,7 +697,7 @@ fn field_glass(scene: &mut Scene, seed: u64) {
 }
 
 /// Reach of a robot's headlight.
-pub const HEADLIGHT_RANGE: f32 = 35.0;
+pub(crate) const HEADLIGHT_RANGE: f32 = 35.0;
 
 fn robots_many(p: &SceneParams) -> Scene {
     let (mut b, robots) = robots_street("robots-many", p.seed);

@@ -79,10 +79,10 @@ pub enum LightUnits {
     /// show it under Blinn-Phong, windowed by `(1 − (d/r)²)²` with no inverse-square term.
     Papers,
     /// KHR_lights_punctual's: luminous intensity in candela, illuminance `I / d²` windowed by
-    /// `clamp(1 − (d/r)⁴, 0, 1)²` (distances below [`MIN_LIGHT_DISTANCE_SQ`]'s root count as
+    /// `clamp(1 − (d/r)⁴, 0, 1)²` (distances below `MIN_LIGHT_DISTANCE_SQ`'s root count as
     /// it: a light inside a surface does not make it infinite).
     ///
-    /// [`MIN_LIGHT_DISTANCE_SQ`]: crate::consts::MIN_LIGHT_DISTANCE_SQ
+    /// `MIN_LIGHT_DISTANCE_SQ`: crate::consts::MIN_LIGHT_DISTANCE_SQ
     Photometric,
 }
 
@@ -267,10 +267,10 @@ impl Default for Lighting {
 
 /// Distance at which the automatic exposure reads a light without a range of its own: a
 /// room-scale two metres.
-pub const AUTO_EXPOSURE_DISTANCE: f32 = 2.0;
+pub(crate) const AUTO_EXPOSURE_DISTANCE: f32 = 2.0;
 
 impl Lighting {
-    /// A glTF file's: photometric lights, GGX, and exposure 1 until [`auto_exposure`] sets it.
+    /// A glTF file's: photometric lights, GGX, and exposure 1 until `auto_exposure` sets it.
     pub fn photometric() -> Lighting {
         Lighting {
             units: LightUnits::Photometric,
@@ -308,7 +308,7 @@ const EXPOSURE_PROBES: usize = 256;
 /// keep room above and below, however many lights overlap. With no probe lit (lights away
 /// from every surface), [`light_exposure`] reads the lights alone. `ranged[i]`: whether
 /// light `i` had its own range in the file.
-pub fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
+pub(crate) fn auto_exposure(scene: &Scene, ranged: &[bool]) -> f32 {
     let lights: Vec<Light> = scene.lights.iter().map(|l| l.light).collect();
     let probes = surface_probes(scene, probe_count(lights.len()));
     let lit: Vec<f64> = probes
@@ -351,11 +351,11 @@ fn illuminance(lights: &[Light], p: Vec3, n: Vec3) -> f64 {
 /// Half the darkest step of an 8-bit sRGB display, as linear radiance (the sRGB curve's
 /// linear segment, 1/12.92; the tone curve `1 − e^−x` has slope 1 at black): a light
 /// without a range is cut where it shows less than this on a white surface facing it.
-pub const VISIBLE_RADIANCE: f64 = 0.5 / 255.0 / 12.92;
+pub(crate) const VISIBLE_RADIANCE: f64 = 0.5 / 255.0 / 12.92;
 
 /// The ranges [`derive_ranges`] gave.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct DerivedRanges {
+pub(crate) struct DerivedRanges {
     /// (light index, range) for each light the file gave no range.
     pub ranges: Vec<(usize, f32)>,
     /// How many of them the scene's bounds capped.
@@ -372,7 +372,7 @@ pub struct DerivedRanges {
 /// light (past that it lights nothing). With `auto` (the automatic exposure) the exposure is
 /// read with every such light reaching the whole scene, the ranges derived from it, and the
 /// exposure read again with them.
-pub fn derive_ranges(scene: &mut Scene, ranged: &[bool], auto: bool) -> DerivedRanges {
+pub(crate) fn derive_ranges(scene: &mut Scene, ranged: &[bool], auto: bool) -> DerivedRanges {
     let limits = &super::LIGHT_LIMITS;
     let clamp = |r: f64| (r as f32).clamp(limits.min_range, limits.max_range);
     let bounds = super::source::bounds(scene);
@@ -472,7 +472,7 @@ fn surface_probes(scene: &Scene, n: usize) -> Vec<(Vec3, Vec3)> {
 /// diffuse surface at half the range of the median light (by the illuminance it gives
 /// there; [`AUTO_EXPOSURE_DISTANCE`] for lights whose range was derived, not given) shows
 /// radiance 1/π: mid-grey, as [`auto_exposure`] puts its median probe.
-pub fn light_exposure(lights: &[(Light, bool)]) -> f32 {
+pub(crate) fn light_exposure(lights: &[(Light, bool)]) -> f32 {
     let e = lights
         .iter()
         .map(|(l, ranged)| {

@@ -3,7 +3,7 @@
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 /// The axis-aligned bounds (min, max) of `points`; `None` for no points.
-pub fn bounds_of(points: impl IntoIterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
+pub(crate) fn bounds_of(points: impl IntoIterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
     points.into_iter().fold(None, |b, p| match b {
         None => Some((p, p)),
         Some((lo, hi)) => Some((lo.min(p), hi.max(p))),

@@ -15,11 +15,10 @@ mod view;
 
 pub use camera::{Camera, CameraPath};
 pub use catalog::{SceneInfo, SceneParams, SCENES};
-pub use lighting::{
-    auto_exposure, derive_ranges, light_exposure, Brdf, DerivedRanges, LightUnits, Lighting,
-    Shading, Shadows, SpotCone, AUTO_EXPOSURE_DISTANCE, VISIBLE_RADIANCE,
-};
-pub use mesh::{bounds_of, Mesh};
+pub(crate) use lighting::{derive_ranges, DerivedRanges};
+pub use lighting::{Brdf, LightUnits, Lighting, Shading, Shadows, SpotCone};
+pub(crate) use mesh::bounds_of;
+pub use mesh::Mesh;
 pub use raster::{rasterize, Fragment};
 pub use rng::Rng;
 pub use source::{open, AddLights, FileContents, Opened, SceneRequest};
@@ -257,7 +256,7 @@ pub struct Spot {
 }
 
 /// Narrowest gap between a spot's inner and outer cosines (the falloff must have a width).
-pub const SPOT_MIN_FALLOFF: f32 = 1e-4;
+pub(crate) const SPOT_MIN_FALLOFF: f32 = 1e-4;
 
 impl Spot {
     /// A cone around `direction` (need not be unit length) with half-angles `inner` < `outer`
@@ -280,7 +279,7 @@ impl Spot {
 /// range the falloff divides by stays a normal f32 (1e-12 to 1e24), and so do squared
 /// distances between light positions within the coordinate bound. A tiny range is refused
 /// rather than turned into an infinite falloff or intensity.
-pub struct LightLimits {
+pub(crate) struct LightLimits {
     /// Largest radiance component (colour × intensity).
     pub max_radiance: f32,
     /// Smallest and largest range, in scene units.
@@ -311,11 +310,11 @@ fn show_f64(v: f64) -> String {
 }
 
 /// [`show`] for the three parts of a vector: `[x, y, z]`.
-pub fn show3(v: Vec3) -> String {
+pub(crate) fn show3(v: Vec3) -> String {
     format!("[{}, {}, {}]", show(v.x), show(v.y), show(v.z))
 }
 
-pub const LIGHT_LIMITS: LightLimits = LightLimits {
+pub(crate) const LIGHT_LIMITS: LightLimits = LightLimits {
     max_radiance: 1e12,
     min_range: 1e-6,
     max_range: 1e12,
@@ -324,7 +323,7 @@ pub const LIGHT_LIMITS: LightLimits = LightLimits {
 
 impl Light {
     /// What is wrong with the light's numbers, with the values, or nothing: a range and
-    /// position within [`LIGHT_LIMITS`], finite non-negative colour and intensity whose
+    /// position within `LIGHT_LIMITS`, finite non-negative colour and intensity whose
     /// product (the radiance) is within them. Shared by the scene's validation
     /// and the glTF import, which names the file and the light.
     pub fn check_values(&self) -> std::result::Result<(), String> {
@@ -459,7 +458,7 @@ impl Light {
         [c.x, c.y, c.z, r]
     }
 
-    /// Finite position, colour and intensity within [`LIGHT_LIMITS`]' bounds, a range within
+    /// Finite position, colour and intensity within `LIGHT_LIMITS`' bounds, a range within
     /// them, and for a spot a unit direction and cosines with -1 ≤ outer < inner ≤ 1.
     pub fn validate(&self, index: usize) -> Result<()> {
         self.check_values()

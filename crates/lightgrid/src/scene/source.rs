@@ -15,14 +15,14 @@ use std::path::PathBuf;
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AddLights {
     pub count: u32,
-    /// `None`: [`default_added_range`].
+    /// `None`: `default_added_range`.
     pub range: Option<f32>,
 }
 
 /// Intensity of an added light (the catalog's lights are 0.35 to 1).
-pub const ADDED_LIGHT_INTENSITY: f32 = 0.5;
+pub(crate) const ADDED_LIGHT_INTENSITY: f32 = 0.5;
 /// Lights an added light's default range makes reach a point of the bounds, on average.
-pub const ADDED_LIGHT_COVERAGE: f32 = 8.0;
+pub(crate) const ADDED_LIGHT_COVERAGE: f32 = 8.0;
 
 /// A scene to open: a catalog name or a `.gltf`/`.glb` path, with the options.
 #[derive(Clone, Debug, PartialEq)]
@@ -128,7 +128,7 @@ pub fn check(req: &SceneRequest) -> Result<()> {
 pub const MAX_EXPOSURE: f32 = 1e6;
 
 /// A positive finite exposure up to [`MAX_EXPOSURE`].
-pub fn check_exposure(e: f32) -> Result<()> {
+pub(crate) fn check_exposure(e: f32) -> Result<()> {
     if !(e.is_finite() && e > 0.0 && e <= MAX_EXPOSURE) {
         return Err(Error::invalid(
             "--exposure",
@@ -297,7 +297,7 @@ fn light_box(lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
 
 /// The range at which `count` lights uniform in the box reach [`ADDED_LIGHT_COVERAGE`]
 /// lights per point on average: count × (4/3)πr³ = coverage × volume.
-pub fn default_added_range(lo: Vec3, hi: Vec3, count: u32) -> f32 {
+pub(crate) fn default_added_range(lo: Vec3, hi: Vec3, count: u32) -> f32 {
     let (lo, hi) = light_box(lo, hi);
     let e = hi - lo;
     let volume = e.x * e.y * e.z;

@@ -2,7 +2,7 @@
 //! type (a small `Copy` value: sample count, G-buffer layout, depth bounds, ...) implementing
 //! [`ShaderKey`]. The key names the stage's parts (shared WGSL files then the stage's own, in
 //! a fixed order, as WGSL has no includes; a group of files always used together is a slice,
-//! and [`parts!`](crate::shader::parts) splices groups and single files into one list) and
+//! and `parts!` splices groups and single files into one list) and
 //! its [`Def`]s. A [`ComposedShader`] is the key's name, defs and parts; its text is made when
 //! a module is: the constants prelude, then a WGSL `const` per def that some part names, then
 //! the parts, a bool def also being the condition of `#if NAME` / `#if !NAME` ... `#else` ...
@@ -27,39 +27,40 @@ use crate::scene::Shading;
 pub mod src {
     pub const TYPES: &str = include_str!("../shading/types.wgsl");
     /// `LightGridParams`, the grid's uniform (lightgrid's shaders and the caller's).
-    pub const GRID_PARAMS: &str = include_str!("../culling/grid/grid_params.wgsl");
+    pub(crate) const GRID_PARAMS: &str = include_str!("../culling/grid/grid_params.wgsl");
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
     /// The light function; needs the shading defs (`ComposedShader::specialized`).
-    pub const LIGHT_FUNCTION: &str = include_str!("../shading/lighting.wgsl");
+    pub(crate) const LIGHT_FUNCTION: &str = include_str!("../shading/lighting.wgsl");
     /// The shadow rays and maps the light function casts and reads.
-    pub const SHADOWS: &str = include_str!("../shading/shadows.wgsl");
+    pub(crate) const SHADOWS: &str = include_str!("../shading/shadows.wgsl");
     /// The light function and the shadows it casts.
-    pub const LIGHTING: &[&str] = &[LIGHT_FUNCTION, SHADOWS];
-    pub const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
+    pub(crate) const LIGHTING: &[&str] = &[LIGHT_FUNCTION, SHADOWS];
+    pub(crate) const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
     /// Cell addressing (`light_grid_slice`, `light_grid_cell`); needs a `light_grid` binding.
-    pub const GRID_CELL: &str = include_str!("../culling/grid/grid_cell.wgsl");
+    pub(crate) const GRID_CELL: &str = include_str!("../culling/grid/grid_cell.wgsl");
     /// The walk over a z-binned grid's masks.
-    pub const ZBIN_WALK: &str = include_str!("../culling/grid/zbin_walk.wgsl");
+    pub(crate) const ZBIN_WALK: &str = include_str!("../culling/grid/zbin_walk.wgsl");
     /// The group-1 grid bindings and the shading accessors.
-    pub const GRID_BINDINGS: &str = include_str!("../culling/grid/light_grid.wgsl");
+    pub(crate) const GRID_BINDINGS: &str = include_str!("../culling/grid/light_grid.wgsl");
     /// The grid's bindings, cell addressing and z-bin walk; one of the light loops below
     /// follows it.
-    pub const LIGHT_GRID: &[&str] = &[GRID_CELL, ZBIN_WALK, GRID_BINDINGS];
+    pub(crate) const LIGHT_GRID: &[&str] = &[GRID_CELL, ZBIN_WALK, GRID_BINDINGS];
     /// `light_grid_shade` and `light_grid_irradiance_mono`, one lane at a time
     /// (`--light-loop lane`).
-    pub const LIGHT_LOOP_LANE: &str = include_str!("../culling/grid/light_loop_lane.wgsl");
+    pub(crate) const LIGHT_LOOP_LANE: &str = include_str!("../culling/grid/light_loop_lane.wgsl");
     /// The same, scalarized over the subgroup (`--light-loop subgroup`).
-    pub const LIGHT_LOOP_SUBGROUP: &str = include_str!("../culling/grid/light_loop_subgroup.wgsl");
-    pub const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
+    pub(crate) const LIGHT_LOOP_SUBGROUP: &str =
+        include_str!("../culling/grid/light_loop_subgroup.wgsl");
+    pub(crate) const LIT_OUT: &str = include_str!("../passes/lit_out.wgsl");
     /// `tone(c)`: the tone curve.
-    pub const TONE: &str = include_str!("../shading/tone.wgsl");
-    /// The MSAA texture types and `sample_position`; needs [`super::msaa_defs`].
+    pub(crate) const TONE: &str = include_str!("../shading/tone.wgsl");
+    /// The MSAA texture types and `sample_position`; needs `super::msaa_defs`.
     pub const MSAA: &str = include_str!("msaa.wgsl");
 }
 
 /// The modules every scene-geometry shader starts with: structs, group-0 bindings, the light
 /// function and the shared vertex stage.
-pub const SCENE_PARTS: &[&str] = &[
+pub(crate) const SCENE_PARTS: &[&str] = &[
     src::TYPES,
     src::GRID_PARAMS,
     src::SCENE_BINDINGS,
@@ -70,7 +71,7 @@ pub const SCENE_PARTS: &[&str] = &[
 ];
 
 /// One WGSL part of a shader, or a group of parts in order: what [`parts!`] splices.
-pub trait Part {
+pub(crate) trait Part {
     /// Append this part (or each of the group's) to `parts`.
     fn add_to(self, parts: &mut Vec<&'static str>);
 }
@@ -170,7 +171,7 @@ pub trait ShaderKey: Copy + std::fmt::Debug + 'static {
 
 /// A stage whose only variant is the sample count of the targets it reads or writes: its
 /// key is [`SamplesKey`], which defines the MSAA values ([`msaa_defs`]).
-pub trait SampleStage: 'static {
+pub(crate) trait SampleStage: 'static {
     /// The stage's name (the shader's label).
     const STAGE: &'static str;
 
@@ -186,7 +187,7 @@ pub trait SampleStage: 'static {
 }
 
 /// The key of a [`SampleStage`]: the sample count.
-pub struct SamplesKey<S> {
+pub(crate) struct SamplesKey<S> {
     pub samples: u32,
     stage: std::marker::PhantomData<fn() -> S>,
 }
@@ -239,7 +240,7 @@ pub fn compose(name: &str, parts: &[&'static str]) -> ComposedShader {
 }
 
 /// A shader with the given defs and parts (what a [`ShaderKey`] value composes).
-pub fn compose_defs(name: &str, defs: &[Def], parts: &[&'static str]) -> ComposedShader {
+pub(crate) fn compose_defs(name: &str, defs: &[Def], parts: &[&'static str]) -> ComposedShader {
     ComposedShader {
         name: name.to_string(),
         prelude: true,
@@ -320,7 +321,7 @@ fn preprocess(name: &str, part: &str, defs: &[Def], out: &mut String) {
 /// The defs of a frame's sample count, for shaders that read its multisampled targets (with
 /// [`src::MSAA`]): `SAMPLES`, `MULTISAMPLED_TARGETS` (the texture types) and
 /// `SAMPLE_POSITIONS`, the standard positions (`consts::msaa_sample_positions`).
-pub fn msaa_defs(samples: u32) -> Vec<Def> {
+pub(crate) fn msaa_defs(samples: u32) -> Vec<Def> {
     let positions: Vec<String> = crate::consts::msaa_sample_positions(samples)
         .iter()
         .map(|[x, y]| format!("vec2<f32>({x:?}, {y:?})"))
@@ -338,7 +339,7 @@ pub fn msaa_defs(samples: u32) -> Vec<Def> {
 }
 
 /// Every MSAA count the renderer can request (`consts::MSAA_COUNTS`), for the keys' `all()`.
-pub fn every_sample_count() -> impl Iterator<Item = u32> {
+pub(crate) fn every_sample_count() -> impl Iterator<Item = u32> {
     crate::consts::MSAA_COUNTS.into_iter()
 }
 
@@ -346,15 +347,15 @@ pub fn every_sample_count() -> impl Iterator<Item = u32> {
 /// (`constants`). The validation test checks that the shaders declare these and no others.
 pub mod overrides {
     /// `scene_bindings.wgsl`: a pipeline drawing into multisampled targets.
-    pub const MULTISAMPLED: &str = "MULTISAMPLED";
+    pub(crate) const MULTISAMPLED: &str = "MULTISAMPLED";
     /// `lighting.wgsl`: the material shader a forward pipeline draws.
-    pub const MATERIAL_SHADER: &str = "MATERIAL_SHADER";
+    pub(crate) const MATERIAL_SHADER: &str = "MATERIAL_SHADER";
     /// `msaa_sample_outputs.wgsl`: the deferred MSAA kernel resolving in workgroup memory.
-    pub const RESOLVE_IN_KERNEL: &str = "RESOLVE_IN_KERNEL";
+    pub(crate) const RESOLVE_IN_KERNEL: &str = "RESOLVE_IN_KERNEL";
     /// `sample_expand.wgsl`: the frame's width in pixels.
-    pub const WIDTH: &str = "WIDTH";
+    pub(crate) const WIDTH: &str = "WIDTH";
     /// `cell_bounds.wgsl`: invocations per workgroup, one per row of the grid's tiles.
-    pub const CELL_THREADS: &str = "CELL_THREADS";
+    pub(crate) const CELL_THREADS: &str = "CELL_THREADS";
     /// Every override of the library's shaders.
     pub const ALL: [&str; 5] = [
         MULTISAMPLED,
@@ -371,7 +372,7 @@ pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
     validate_for(shader, true)
 }
 
-/// As [`validate`], the shader as [`create_module`] gives it to a device with or without
+/// As [`validate`], the shader as `create_module` gives it to a device with or without
 /// `SHADER_EARLY_DEPTH_TEST`: in every [`Shading`] (each makes other code live; one text that
 /// two shadings make alike is validated once); the module of the first.
 pub fn validate_for(
@@ -405,7 +406,7 @@ fn validate_one(name: &str, source: &str) -> Result<naga::Module, String> {
 
 /// The light function's defs of a shading: its BRDF, falloff, shadows, spot cone
 /// (`lighting.wgsl`) and whether materials read per-sample inputs (`geometry.wgsl`).
-pub fn shading_defs(shading: Shading) -> Vec<Def> {
+pub(crate) fn shading_defs(shading: Shading) -> Vec<Def> {
     vec![
         Def::U32("SHADING_BRDF", shading.brdf.gpu()),
         Def::U32("SHADING_FALLOFF", shading.units.falloff()),
@@ -417,7 +418,7 @@ pub fn shading_defs(shading: Shading) -> Vec<Def> {
 
 /// The device's def: does the device take `@early_depth_test(force)`
 /// (`SHADER_EARLY_DEPTH_TEST`, native only: Vulkan, GLES 3.1+)?
-pub const EARLY_DEPTH_TEST_DEF: &str = "EARLY_DEPTH_TEST";
+pub(crate) const EARLY_DEPTH_TEST_DEF: &str = "EARLY_DEPTH_TEST";
 
 /// The attribute forward fragment shaders carry, under `#if EARLY_DEPTH_TEST`, to keep early-Z
 /// although they may write the frame counters (a side effect that would otherwise move the
@@ -432,7 +433,7 @@ impl ComposedShader {
         out
     }
 
-    /// The shader with the light function's defs of `shading` ([`shading_defs`]): every
+    /// The shader with the light function's defs of `shading` (`shading_defs`): every
     /// module holding the light function is made from this, and one made without them does
     /// not compile. A shader naming none of them is unchanged.
     pub fn specialized(&self, shading: Shading) -> ComposedShader {
@@ -457,7 +458,7 @@ impl ComposedShader {
 
 /// Create a wgpu shader module from a composed shader, as the device's features allow
 /// ([`ComposedShader::source_for`]).
-pub fn create_module(device: &wgpu::Device, shader: &ComposedShader) -> wgpu::ShaderModule {
+pub(crate) fn create_module(device: &wgpu::Device, shader: &ComposedShader) -> wgpu::ShaderModule {
     let early_depth_test = device
         .features()
         .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
@@ -479,7 +480,7 @@ pub fn compute_pipeline(
 }
 
 /// As [`compute_pipeline`], with values for the shader's `override` constants.
-pub fn compute_pipeline_with(
+pub(crate) fn compute_pipeline_with(
     device: &wgpu::Device,
     label: &str,
     shader: &ComposedShader,

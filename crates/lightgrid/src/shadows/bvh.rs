@@ -1,20 +1,20 @@
 //! A bounding-volume hierarchy over triangles for shadow rays (Forward+ §6's "local short ray
 //! casting to the lights"): built on the CPU, flattened into the layout `shading/shadows.wgsl`
-//! walks, and walked on the CPU by the same rules ([`TriangleBvh::occluded`]).
+//! walks, and walked on the CPU by the same rules (`TriangleBvh::occluded`).
 //!
 //! The build splits each node's triangles at the median centroid along the longest axis of
-//! their centroids' box, down to [`LEAF_TRIANGLES`]: a balanced tree, so its depth is
-//! ⌈log2(n / 4)⌉ + 1 and the shaders' fixed stack ([`SHADOW_STACK_DEPTH`]) holds any scene a
+//! their centroids' box, down to `LEAF_TRIANGLES`: a balanced tree, so its depth is
+//! ⌈log2(n / 4)⌉ + 1 and the shaders' fixed stack (`SHADOW_STACK_DEPTH`) holds any scene a
 //! buffer can (2^31 triangles need 30 levels). A median split costs O(n log n) and keeps the
 //! per-frame rebuild of the moving objects cheap; the surface-area heuristic would trace
 //! faster and build slower (not measured here).
 //!
-//! [`SHADOW_STACK_DEPTH`]: crate::consts::SHADOW_STACK_DEPTH
+//! `SHADOW_STACK_DEPTH`: crate::consts::SHADOW_STACK_DEPTH
 
 use glam::Vec3;
 
 /// Most triangles in a leaf.
-pub const LEAF_TRIANGLES: usize = crate::consts::SHADOW_LEAF_TRIANGLES as usize;
+pub(crate) const LEAF_TRIANGLES: usize = crate::consts::SHADOW_LEAF_TRIANGLES as usize;
 
 /// A triangle's three corners.
 pub type Triangle = [Vec3; 3];
@@ -22,7 +22,7 @@ pub type Triangle = [Vec3; 3];
 /// One node: its box, and either two children (`count` 0: the left child follows the node,
 /// `next` is the right child) or `count` triangles from `next`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Node {
+pub(crate) struct Node {
     pub min: Vec3,
     pub max: Vec3,
     pub next: u32,
@@ -31,14 +31,14 @@ pub struct Node {
 
 /// The hierarchy: nodes depth first (the root at 0), triangles in leaf order.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct TriangleBvh {
+pub(crate) struct TriangleBvh {
     pub nodes: Vec<Node>,
     pub triangles: Vec<Triangle>,
 }
 
 /// Vec4s per node and per triangle in the GPU layout.
-pub const NODE_VEC4S: u32 = 2;
-pub const TRIANGLE_VEC4S: u32 = 3;
+pub(crate) const NODE_VEC4S: u32 = 2;
+pub(crate) const TRIANGLE_VEC4S: u32 = 3;
 
 impl TriangleBvh {
     pub fn build(mut triangles: Vec<Triangle>) -> TriangleBvh {
@@ -107,6 +107,7 @@ impl TriangleBvh {
 
     /// Does a triangle cross the segment `origin + t·dir`, 0 < t < `t_max`? As the shader walks
     /// it: boxes by slabs, triangles by Möller–Trumbore, either side of a triangle.
+    #[cfg(test)]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
         if self.nodes.is_empty() {
             return false;
@@ -184,7 +185,8 @@ fn build_node(
 
 /// Does the segment `origin + t·dir`, 0 ≤ t ≤ `t_max`, meet the box? (`inv` = 1 / dir; the
 /// IEEE infinities of an axis-parallel ray do the right thing.)
-pub fn box_hit(min: Vec3, max: Vec3, origin: Vec3, inv: Vec3, t_max: f32) -> bool {
+#[cfg(test)]
+pub(crate) fn box_hit(min: Vec3, max: Vec3, origin: Vec3, inv: Vec3, t_max: f32) -> bool {
     let t0 = (min - origin) * inv;
     let t1 = (max - origin) * inv;
     let near = t0.min(t1).max_element().max(0.0);
@@ -194,7 +196,15 @@ pub fn box_hit(min: Vec3, max: Vec3, origin: Vec3, inv: Vec3, t_max: f32) -> boo
 
 /// Möller–Trumbore: does the segment cross the triangle `v0, v0 + e1, v0 + e2` at
 /// 0 < t < `t_max`?
-pub fn triangle_hit(v0: Vec3, e1: Vec3, e2: Vec3, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+#[cfg(test)]
+pub(crate) fn triangle_hit(
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    origin: Vec3,
+    dir: Vec3,
+    t_max: f32,
+) -> bool {
     let p = dir.cross(e2);
     let det = e1.dot(p);
     if det.abs() < 1e-12 {

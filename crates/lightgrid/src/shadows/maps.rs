@@ -13,16 +13,16 @@
 //! **The tile rule**: the budget `--shadow-atlas MiB` is a square of 4-byte texels, its side
 //! the largest power of two that fits (capped by the device). With T faces this frame, the
 //! tiles are laid in rows of ⌈√T⌉, and a tile's side is the largest power of two that fits
-//! `side / ⌈√T⌉`, at most `--shadow-map-size` (and [`MAX_TILE`]): more shadowed lights,
+//! `side / ⌈√T⌉`, at most `--shadow-map-size` (and `MAX_TILE`): more shadowed lights,
 //! smaller maps. The atlas texture is as large as its rows of tiles need (so at one map size
 //! its memory grows with the shadowed lights, up to the budget); the re-used maps are six
 //! tiles of the same size, so both forms shade the same image. A frame whose faces would need
-//! tiles under [`MIN_TILE`] texels is refused with the numbers.
+//! tiles under `MIN_TILE` texels is refused with the numbers.
 //!
 //! Depth is reversed (near / w, an infinite far plane), cleared to 0. The light function
 //! (`shading/shadows.wgsl`, `shadow_map_visibility`) picks the face by the major axis, moves
 //! the sample along its normal by a **slope-scaled normal offset** (one texel's world size at
-//! its distance × ([`SHADOW_NORMAL_OFFSET`](crate::consts::SHADOW_NORMAL_OFFSET) + `SHADOW_SLOPE_OFFSET` × tan θ, θ the angle
+//! its distance × (`SHADOW_NORMAL_OFFSET` + `SHADOW_SLOPE_OFFSET` × tan θ, θ the angle
 //! between normal and light, tan θ capped at `SHADOW_MAX_SLOPE`)), and filters with the comparison sampler's
 //! bilinear 2×2 PCF, the footprint clamped a texel inside the tile.
 
@@ -30,21 +30,21 @@ use crate::scene::Light;
 use glam::{Mat4, Vec3};
 
 /// Smallest and largest tile side in texels.
-pub const MIN_TILE: u32 = 16;
-pub const MAX_TILE: u32 = 1024;
+pub(crate) const MIN_TILE: u32 = 16;
+pub(crate) const MAX_TILE: u32 = 1024;
 /// The near plane of a face, as a fraction of the light's range: geometry nearer the light
 /// than this casts no shadow.
-pub const NEAR_FRACTION: f32 = 1e-4;
+pub(crate) const NEAR_FRACTION: f32 = 1e-4;
 /// A spot of half-angle up to this many degrees gets one face; a wider one a cube.
-pub const SPOT_ONE_FACE_DEGREES: f32 = 60.0;
+pub(crate) const SPOT_ONE_FACE_DEGREES: f32 = 60.0;
 /// The atlas pass's label in a frame's pass timings (the bench's summary reads it).
 pub const PASS_LABEL: &str = "shadow maps";
 /// Largest `--shadow-atlas` in MiB.
-pub const MAX_ATLAS_MIB: u32 = 4096;
+pub(crate) const MAX_ATLAS_MIB: u32 = 4096;
 
 /// The atlas side for a budget of `mib` MiB: the largest power of two whose square of 4-byte
 /// texels fits, at most `max_dimension`.
-pub fn atlas_side(mib: u32, max_dimension: u32) -> u32 {
+pub(crate) fn atlas_side(mib: u32, max_dimension: u32) -> u32 {
     let texels = (u64::from(mib) << 20) / 4;
     let mut side = 1u32;
     while u64::from(side * 2) * u64::from(side * 2) <= texels && side * 2 <= max_dimension {
@@ -55,7 +55,7 @@ pub fn atlas_side(mib: u32, max_dimension: u32) -> u32 {
 
 /// Where a frame's faces lie in the shadow texture, and how large it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct AtlasLayout {
+pub(crate) struct AtlasLayout {
     /// The texture's size in texels: all in flight, ⌈√T⌉ tiles a row and as many rows as
     /// the faces fill; re-used, one cube's six tiles (3 x 2).
     pub width: u32,
@@ -114,6 +114,7 @@ impl AtlasLayout {
     }
 
     /// Bytes of the texture.
+    #[cfg(test)]
     pub fn bytes(&self) -> u64 {
         Self::bytes_of(self.width, self.height)
     }
@@ -168,7 +169,7 @@ fn reversed_infinite(fov: f32, near: f32) -> Mat4 {
 
 /// The view-projection of each of the light's faces, for camera-relative positions (`light`
 /// camera-relative): clip = M · p, depth near / w.
-pub fn face_matrices(light: &Light) -> Vec<Mat4> {
+pub(crate) fn face_matrices(light: &Light) -> Vec<Mat4> {
     let near = light.range * NEAR_FRACTION;
     let eye = light.position;
     if faces(light) == 1 {
@@ -187,7 +188,8 @@ pub fn face_matrices(light: &Light) -> Vec<Mat4> {
 }
 
 /// The face of a cube a direction from the light falls on (the shader's rule).
-pub fn cube_face(v: Vec3) -> u32 {
+#[cfg(test)]
+pub(crate) fn cube_face(v: Vec3) -> u32 {
     let a = v.abs();
     if a.x >= a.y && a.x >= a.z {
         u32::from(v.x <= 0.0)
@@ -201,7 +203,7 @@ pub fn cube_face(v: Vec3) -> u32 {
 /// One frame's maps: each shadowed light's first face, every face's matrix, and where the
 /// faces lie (all in flight, or one light's at a time: `reused`).
 #[derive(Clone, Debug)]
-pub struct MapFrame {
+pub(crate) struct MapFrame {
     /// The atlas of every face (the grid pipelines', and the transparent pass's).
     pub atlas: AtlasLayout,
     /// The layout the shaders read: the atlas, or its [`AtlasLayout::reused`] six tiles.

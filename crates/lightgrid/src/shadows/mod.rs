@@ -5,7 +5,7 @@
 //! With `--shadows rays` the one light function (`shading/lighting.wgsl`) multiplies a
 //! shadow-casting light's terms by the visibility of one ray from the sample to the light
 //! (`shading/shadows.wgsl`), so every pipeline shadows alike. The rays walk two hierarchies
-//! over the opaque triangles ([`bvh::TriangleBvh`]): the static objects', built once per scene,
+//! over the opaque triangles (`bvh::TriangleBvh`): the static objects', built once per scene,
 //! and the moving objects', rebuilt every frame. Transparent objects and alpha-tested
 //! (cut-out) materials cast no shadow: a ray does not read textures.
 //!
@@ -17,7 +17,7 @@
 //! being the light's brightness (the luminance of colour × intensity) times its screen
 //! coverage (the square of its bounding sphere's radius over its distance from the eye,
 //! capped at 1 when the eye is inside it), 0 for a sphere outside the view frustum; ties go to
-//! the lower index. The others light unshadowed, counted as such ([`ShadowFrame::unshadowed`]).
+//! the lower index. The others light unshadowed, counted as such (`ShadowFrame::unshadowed`).
 
 pub mod bvh;
 pub mod maps;
@@ -29,9 +29,9 @@ use glam::{Vec3, Vec4Swizzles};
 /// Vec4s of the header at the start of the shadow buffer (`shadows.wgsl`):
 /// `[origin = eye − anchor, bias]`, `[bits(static root), bits(moving root),
 /// bits(caster words' first vec4), relative bias]`; a root of [`NO_TREE`] is an empty tree.
-pub const HEADER_VEC4S: u32 = 2;
+pub(crate) const HEADER_VEC4S: u32 = 2;
 /// The root of an empty hierarchy.
-pub const NO_TREE: u32 = crate::consts::SHADOW_NO_TREE;
+pub(crate) const NO_TREE: u32 = crate::consts::SHADOW_NO_TREE;
 
 /// The offset of a ray's origin along the surface normal, in world units: `BIAS_REL` × the
 /// sample's distance from the eye (what interpolating a position, or rebuilding it from a
@@ -42,12 +42,12 @@ pub const NO_TREE: u32 = crate::consts::SHADOW_NO_TREE;
 /// surface shadows itself on the catalog's scenes, near the origin or 1.4·10⁵ from it
 /// (tests/shadows.rs, tests/pipelines.rs). The ray ends at the light itself (a triangle counts
 /// strictly before it): a light is exact, and one just behind a wall is behind it.
-pub const BIAS_REL: f32 = 2e-5;
-pub const BIAS_EXTENT: f32 = 1e-6;
+pub(crate) const BIAS_REL: f32 = 2e-5;
+pub(crate) const BIAS_EXTENT: f32 = 1e-6;
 
 /// The triangles that cast shadows in `geometry` (whose index values start at vertex `base`):
 /// its opaque runs that are not alpha tested, relative to `anchor`.
-pub fn casting_triangles(geometry: &Geometry, base: u32, anchor: Vec3) -> Vec<Triangle> {
+pub(crate) fn casting_triangles(geometry: &Geometry, base: u32, anchor: Vec3) -> Vec<Triangle> {
     let mut out = Vec::new();
     let (opaque, _) = geometry.split_draws();
     for d in opaque.iter().filter(|d| !d.alpha_test) {
@@ -64,7 +64,7 @@ pub fn casting_triangles(geometry: &Geometry, base: u32, anchor: Vec3) -> Vec<Tr
 /// What the static part of a scene gives every frame's shadows: the anchor, the biases and
 /// the static objects' hierarchy.
 #[derive(Clone, Debug)]
-pub struct StaticShadows {
+pub(crate) struct StaticShadows {
     pub anchor: Vec3,
     pub bias: f32,
     pub bvh: TriangleBvh,
@@ -108,7 +108,7 @@ impl StaticShadows {
 
 /// One frame's shadow data: the moving objects' hierarchy and which lights cast.
 #[derive(Clone, Debug)]
-pub struct ShadowFrame {
+pub(crate) struct ShadowFrame {
     pub moving: TriangleBvh,
     /// Per light: does it cast shadows this frame?
     pub casters: Vec<bool>,
@@ -140,16 +140,10 @@ impl ShadowFrame {
         self.casters.iter().filter(|&&c| !c).count()
     }
 
-    /// Is the segment from camera-relative `from` to camera-relative `to` blocked (the CPU
-    /// walk of what the shader walks, with its bias rules)? `normal` is the surface's.
-    pub fn blocked(&self, statics: &StaticShadows, from: Vec3, normal: Vec3, to: Vec3) -> bool {
-        let (o, d) = ray(from, normal, to, self.origin, statics.bias);
-        statics.bvh.occluded(o, d, 1.0) || self.moving.occluded(o, d, 1.0)
-    }
-
     /// The whole buffer (`shadows.wgsl`'s layout): the header, the static hierarchy at
     /// [`HEADER_VEC4S`] ([`StaticShadows::gpu_data`]), then what changes between frames of one
     /// scene ([`Self::frame_data`], at [`StaticShadows::frame_start`]).
+    #[cfg(test)]
     pub fn gpu_data(&self, statics: &StaticShadows) -> Vec<[f32; 4]> {
         let mut out = self.header(statics).to_vec();
         out.extend(statics.gpu_data());

@@ -223,7 +223,7 @@ fn bounds_union(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
 }
 
 /// The GPU kernel and the bounds buffer it fills.
-pub struct CellBoundsPass {
+pub(crate) struct CellBoundsPass {
     /// With MSAA: the fragments' view distances folded into the bounds first.
     fragments: Option<crate::culling::bounds::fragment_bounds::FragmentBounds>,
     /// Binding 5 without MSAA (unread).

@@ -37,7 +37,7 @@ pub struct CellCull {
 }
 
 /// No mask and no box (cells of a grid without `--depth-mask on` or `--cell-box on`).
-pub const NO_CULL: CellCull = CellCull {
+pub(crate) const NO_CULL: CellCull = CellCull {
     mask: NO_MASK,
     lo: [0.0; 4],
     hi: [0.0; 4],
@@ -57,7 +57,7 @@ impl CellCull {
 
 /// The range of `n / scale * w` over `n` in `{n0, n1}` and `w` in `{w0, w1}`: one view-space
 /// axis of a screen rectangle's frustum piece (`view_extent` in WGSL, the same operations).
-pub fn view_extent(n0: f32, n1: f32, scale: f32, w0: f32, w1: f32) -> [f32; 2] {
+pub(crate) fn view_extent(n0: f32, n1: f32, scale: f32, w0: f32, w1: f32) -> [f32; 2] {
     let (a, b) = (n0 / scale, n1 / scale);
     let v = [a * w0, a * w1, b * w0, b * w1];
     [
@@ -68,7 +68,13 @@ pub fn view_extent(n0: f32, n1: f32, scale: f32, w0: f32, w1: f32) -> [f32; 2] {
 
 /// The view-space box of the pixel rectangle `[x0, x1] × [y0, y1]` (pixel edges) over view
 /// distances `[w0, w1]` (`rect_box` in WGSL).
-pub fn rect_box(setup: &ViewSetup, x: [f32; 2], y: [f32; 2], w0: f32, w1: f32) -> (Vec3, Vec3) {
+pub(crate) fn rect_box(
+    setup: &ViewSetup,
+    x: [f32; 2],
+    y: [f32; 2],
+    w0: f32,
+    w1: f32,
+) -> (Vec3, Vec3) {
     let (sx, sy) = (setup.width as f32, setup.height as f32);
     let ex = view_extent(
         x[0] / sx * 2.0 - 1.0,
@@ -89,14 +95,14 @@ pub fn rect_box(setup: &ViewSetup, x: [f32; 2], y: [f32; 2], w0: f32, w1: f32) -
 
 /// How far the sphere `(c, r)` is from the box (`> 0`: it misses; `sphere_meets_cell_box` in
 /// WGSL decides `|d|² <= r²` on the same `d`).
-pub fn sphere_box_gap(lo: Vec3, hi: Vec3, c: Vec3, r: f32) -> f32 {
+pub(crate) fn sphere_box_gap(lo: Vec3, hi: Vec3, c: Vec3, r: f32) -> f32 {
     let d = (lo - c).max(Vec3::ZERO).max(c - hi);
     d.length() - r
 }
 
 /// How far two boxes overlap on their least overlapping axis (`< 0`: they are apart;
 /// `box_meets_box` in WGSL decides `a.lo <= b.hi && a.hi >= b.lo` on every axis).
-pub fn box_overlap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> f32 {
+pub(crate) fn box_overlap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> f32 {
     (b.1 - a.0).min(a.1 - b.0).min_element()
 }
 
@@ -104,7 +110,7 @@ pub fn box_overlap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> f32 {
 /// of the cell's tight box where the cell has one and it is the smaller, else `frustum`, the
 /// frustum piece's. Either holds every point the cell shades, so the cone test stays
 /// conservative; the box's is smaller wherever the box is (a cell's samples on one surface).
-pub fn cone_sphere(frustum: (Vec3, f32), cell_box: Option<(Vec3, Vec3)>) -> (Vec3, f32) {
+pub(crate) fn cone_sphere(frustum: (Vec3, f32), cell_box: Option<(Vec3, Vec3)>) -> (Vec3, f32) {
     match cell_box {
         Some((lo, hi)) => {
             let r = (hi - lo).length() * 0.5;

@@ -38,20 +38,21 @@ fn bin(w: f32, m: &CellMask) -> u32 {
 }
 
 /// The bits of the bins `[w0, w1]` covers (none when `w0 > w1`); `depth_mask_span` in WGSL.
-pub fn depth_mask_span(w0: f32, w1: f32, m: &CellMask) -> u32 {
+pub(crate) fn depth_mask_span(w0: f32, w1: f32, m: &CellMask) -> u32 {
     let (b0, b1) = (bin(w0, m), bin(w1, m));
     (u32::MAX >> (31 - b1)) & (u32::MAX << b0)
 }
 
 /// Does the view-depth span `[w0, w1]` meet a bin of `m` that holds samples?
-pub fn depth_mask_meets(m: &CellMask, w0: f32, w1: f32) -> bool {
+pub(crate) fn depth_mask_meets(m: &CellMask, w0: f32, w1: f32) -> bool {
     m[0] == DEPTH_MASK_ALL || depth_mask_span(w0, w1, m) & m[0] != 0
 }
 
 /// A mask's bins over the bounds `[lo, hi]`, with no bit set yet (what the kernel computes
 /// from the cell's bounds; the division may round differently there, so tests take the
 /// GPU's scales).
-pub fn mask_scale(b: [f32; 2]) -> CellMask {
+#[cfg(test)]
+pub(crate) fn mask_scale(b: [f32; 2]) -> CellMask {
     let inv = if b[1] > b[0] {
         DEPTH_MASK_BINS as f32 / (b[1] - b[0])
     } else {
@@ -73,7 +74,7 @@ fn inflated_span(lo: f32, hi: f32, slack: f32, m: &CellMask) -> u32 {
 /// the samples of `planes` (as `cell_bounds_cpu_samples` reads them), each sample's distance
 /// inflated by `slack` (the kernel's `ASSIGN_DEPTH_SLACK`; tests bracket round-off with a
 /// smaller and a larger one), with the bins over `scales` (per cell `[_, lo, inv, _]`, from
-/// [`mask_scale`] or the GPU's own masks). With a shared list, `transparent[cell]` is the
+/// `mask_scale` or the GPU's own masks). With a shared list, `transparent[cell]` is the
 /// range the cell's transparent fragments may lie in (every bin of it is set); the
 /// transparent layer of separate lists gets [`NO_MASK`].
 pub fn cell_masks_cpu(

@@ -52,7 +52,7 @@ pub fn depth_range_cpu(setup: &ViewSetup, planes: &[&[f32]]) -> [f32; 2] {
 }
 
 /// The slicing range for samples spanning `samples` (`[+inf, 0]`: none): clamped to
-/// near..far, near..far without samples, and at least [`SLICING_MIN_RATIO`] wide. Twin of
+/// near..far, near..far without samples, and at least `SLICING_MIN_RATIO` wide. Twin of
 /// `finish`.
 pub fn slicing_range(samples: [f32; 2], near: f32, far: f32) -> [f32; 2] {
     let [lo, hi] = if samples[0] > samples[1] {
@@ -64,7 +64,7 @@ pub fn slicing_range(samples: [f32; 2], near: f32, far: f32) -> [f32; 2] {
     [lo, hi.clamp(near, far).max(lo * SLICING_MIN_RATIO)]
 }
 
-pub struct DepthRangePass {
+pub(crate) struct DepthRangePass {
     reduce: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,

@@ -78,7 +78,7 @@ fn union(nodes: &[BvhNode]) -> ([f32; 3], [f32; 3]) {
 /// The node layout for `lights` lights: per level, bottom-up (leaves first), the index of its
 /// first node and its node count. Nodes are stored root first, so the last level listed
 /// starts at 0.
-pub fn bvh_levels(lights: usize) -> Vec<(u32, u32)> {
+pub(crate) fn bvh_levels(lights: usize) -> Vec<(u32, u32)> {
     let mut counts = Vec::new();
     let mut n = lights.div_ceil(BVH_WIDTH as usize);
     while n > 0 {

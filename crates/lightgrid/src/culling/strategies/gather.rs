@@ -161,7 +161,7 @@ pub(super) fn box_margin(f: &CpuFrustum, lo: Vec3, hi: Vec3) -> f32 {
 /// Per cell and light, the gather test's margin (cells in grid order, lights in order).
 /// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`); `culls`: per
 /// cell its 2.5D depth mask and tight box, for a grid built with `--depth-mask on` or `--cell-box on`.
-pub fn gather_margins(
+pub(crate) fn gather_margins(
     setup: &ViewSetup,
     dims: &GridDims,
     lights: &[Light],

@@ -63,7 +63,7 @@ pub struct StrategyRun {
 }
 
 /// One light-assignment strategy.
-pub trait AssignStrategy {
+pub(crate) trait AssignStrategy {
     /// Record this frame's assignment into `enc` (after the cell bounds).
     fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun>;
     /// Size buffers from a finished frame's counters (an earlier frame's, read back without

@@ -19,7 +19,7 @@ pub struct StrategyInfo {
     /// It assigns on the CPU, from the lights there (a [`crate::LightCuller`] has them on the
     /// GPU only).
     pub cpu_lights: bool,
-    pub create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
+    pub(crate) create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
 }
 
 /// The registry: every strategy `--assign` can name (`auto` resolves to one of them).
@@ -82,7 +82,7 @@ const AUTO_DESCRIPTION: &str =
 
 /// Every `--assign` value as the settings table lists them: `auto` (the default), then the
 /// registry's rows, built from the registry at compile time.
-pub const ASSIGN_VALUES: [Assign; STRATEGIES.len() + 1] = {
+pub(crate) const ASSIGN_VALUES: [Assign; STRATEGIES.len() + 1] = {
     let mut out = [Assign::Auto; STRATEGIES.len() + 1];
     let mut i = 0;
     while i < STRATEGIES.len() {
@@ -93,7 +93,7 @@ pub const ASSIGN_VALUES: [Assign; STRATEGIES.len() + 1] = {
 };
 
 /// The registry row of a (resolved) strategy.
-pub fn find_strategy(assign: Assign) -> Option<&'static StrategyInfo> {
+pub(crate) fn find_strategy(assign: Assign) -> Option<&'static StrategyInfo> {
     STRATEGIES.iter().find(|s| s.assign == assign)
 }
 

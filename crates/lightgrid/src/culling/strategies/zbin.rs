@@ -46,7 +46,7 @@ pub(crate) fn shader() -> ComposedShader {
 }
 
 /// `ordered_bits` of `cell_box.wgsl`: the sort key of a float (order-preserving as u32).
-pub fn ordered_bits(x: f32) -> u32 {
+pub(crate) fn ordered_bits(x: f32) -> u32 {
     let b = x.to_bits();
     if b & 0x8000_0000 != 0 {
         !b

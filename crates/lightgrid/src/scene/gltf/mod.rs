@@ -2,7 +2,7 @@
 //!
 //! Reading (`read.rs`, `import.rs`) treats the file as hostile: every index, offset, length
 //! and count is checked before it is used or allocated for, totals are bounded
-//! ([`MAX_VERTICES`], [`MAX_TRIANGLES`], [`MAX_FILE_BYTES`]), the node graph is walked without
+//! (`MAX_VERTICES`, `MAX_TRIANGLES`, `MAX_FILE_BYTES`), the node graph is walked without
 //! recursion and refused if it is not a forest, and any problem is an [`Error::Gltf`] naming
 //! the file and the problem. What the renderer cannot show (points and lines, directional
 //! lights, orthographic cameras, extensions it does not know) is skipped with a warning,
@@ -21,7 +21,7 @@
 //! (`scene::derive_ranges`). Files written by [`export`] carry lightgrid's exact material and light
 //! intensity in `extras.lightgrid` and the scene's lighting conventions at the root, so they
 //! load back unchanged; a catalog scene's papers-unit lights are written in candela matched
-//! at [`LIGHT_MATCH_FRACTION`] of the range.
+//! at `LIGHT_MATCH_FRACTION` of the range.
 
 mod animation;
 mod export;
@@ -39,17 +39,17 @@ use crate::scene::Scene;
 use std::path::Path;
 
 /// Largest file (document, buffer or image) read.
-pub const MAX_FILE_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_FILE_BYTES: u64 = 1 << 30;
 /// Largest JSON document read.
-pub const MAX_JSON_BYTES: u64 = 64 << 20;
+pub(crate) const MAX_JSON_BYTES: u64 = 64 << 20;
 /// Most vertices read from a file's accessors, and baked into its instances.
-pub const MAX_VERTICES: u32 = 1 << 22;
+pub(crate) const MAX_VERTICES: u32 = 1 << 22;
 /// Most triangles read and baked.
-pub const MAX_TRIANGLES: u32 = 1 << 23;
+pub(crate) const MAX_TRIANGLES: u32 = 1 << 23;
 /// Where along its range an exported papers-unit light and its inverse-square candela agree.
-pub const LIGHT_MATCH_FRACTION: f32 = 0.25;
+pub(crate) const LIGHT_MATCH_FRACTION: f32 = 0.25;
 /// Extensions read (a file may require these).
-pub const EXTENSIONS_READ: &[&str] = &[
+pub(crate) const EXTENSIONS_READ: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_texture_transform",
