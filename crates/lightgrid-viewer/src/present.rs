@@ -56,7 +56,7 @@ impl Blit {
         // An sRGB surface encodes on write; a linear one gets the encoding from the shader,
         // so both show the display target's bytes.
         let constants = [("ENCODE_SRGB", if format.is_srgb() { 0.0 } else { 1.0 })];
-        let shader = lightgrid::shader::compose(
+        let shader = lightgrid::compose(
             "viewer blit",
             &[lightgrid::passes::FULLSCREEN_WGSL, BLIT_WGSL],
         );

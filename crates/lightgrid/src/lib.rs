@@ -12,7 +12,7 @@ pub mod depth;
 pub mod error;
 pub mod frame;
 pub mod gpu;
-pub mod gpu_types;
+mod gpu_types;
 pub mod heatmap;
 pub mod image_io;
 pub mod memory;
@@ -21,7 +21,12 @@ pub mod pipelines;
 pub mod realtime;
 mod renderer;
 pub mod scene;
+// Shader composition: public for lightgrid's own tests (the `testing` feature); a renderer
+// composes its own WGSL with `compose` into a `ComposedShader`.
+#[cfg(feature = "testing")]
 pub mod shader;
+#[cfg(not(feature = "testing"))]
+mod shader;
 pub mod shadows;
 pub mod stats;
 
@@ -34,4 +39,17 @@ pub use error::{Error, Result};
 pub use frame::{CellBox, DepthBounds, DepthMask, SpotCull};
 pub use frame::{FinishedFrame, RenderSettings, SubmittedFrame};
 pub use renderer::{max_frame_edge, validate_size, Renderer, MAX_FRAMES_IN_FLIGHT};
+pub use shader::{compose, ComposedShader};
 pub use stats::{Distribution, FrameStats, TimingSource};
+
+/// lightgrid's own tests' view of its internals (the `testing` feature, which only the
+/// crate's tests turn on; not an API): the CPU twin of every culling stage, the brute-force
+/// oracle, the strategies' registry and the GPU-side layouts (`gpu_types`).
+#[cfg(feature = "testing")]
+pub mod testing {
+    pub use crate::culling::testing::*;
+    /// The `#[repr(C)]` structs the shaders read, field for field.
+    pub mod gpu_types {
+        pub use crate::gpu_types::*;
+    }
+}

@@ -619,7 +619,7 @@ fn check(caller: &Caller, config: CullConfig, what: &str) -> f64 {
 /// (`cpu` and `bvh` need the lights on the CPU and are refused: see
 /// `strategies_that_need_the_lights_on_the_cpu_are_refused`).
 fn strategies() -> Vec<Assign> {
-    lightgrid::culling::STRATEGIES
+    lightgrid::testing::STRATEGIES
         .iter()
         .filter(|s| !s.cpu_lights)
         .map(|s| s.assign)
@@ -1113,7 +1113,7 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         assert_eq!(e.input, CullInput::Config, "{e}");
     }
     // The strategies that assign on the CPU: refused, naming why and what is offered.
-    for row in lightgrid::culling::STRATEGIES
+    for row in lightgrid::testing::STRATEGIES
         .iter()
         .filter(|s| s.cpu_lights)
     {

@@ -142,7 +142,7 @@ fn callers_grid(
     let depth = depth_texture(device, queue, &out.depth);
     let depth_view = depth.create_view(&Default::default());
     let state = scene.frame(FRAME);
-    let lights: Vec<lightgrid::gpu_types::GpuLight> = state
+    let lights: Vec<lightgrid::testing::gpu_types::GpuLight> = state
         .lights
         .iter()
         .map(|l| l.relative_to(setup.eye).to_gpu())
@@ -194,7 +194,7 @@ fn the_renderers_grid_is_a_callers_with_the_same_config() {
         ..SceneParams::default()
     };
     let scene = catalog::build("robots-many", &params).unwrap();
-    let offered: Vec<Assign> = lightgrid::culling::STRATEGIES
+    let offered: Vec<Assign> = lightgrid::testing::STRATEGIES
         .iter()
         .filter(|s| !s.cpu_lights)
         .map(|s| s.assign)

@@ -6,12 +6,12 @@
 mod common;
 
 use glam::Vec3;
-use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu, build_bvh, cell_bounds_cpu, oracle_fragment_lights,
-    oracle_tile_lights, project_sphere, traverse_bvh_cpu, DepthRange, GridDims, GridLists,
-    ViewSetup, EMPTY_CELL,
-};
+use lightgrid::culling::{assign_cpu, DepthRange, GridDims, GridLists, ViewSetup};
 use lightgrid::scene::{Camera, Fragment, Light, Rng};
+use lightgrid::testing::{
+    assign_gather_cpu, build_bvh, cell_bounds_cpu, oracle_fragment_lights, oracle_tile_lights,
+    project_sphere, traverse_bvh_cpu, EMPTY_CELL,
+};
 
 const TILES: [u32; 9] = [4, 5, 7, 8, 13, 16, 31, 32, 64];
 
@@ -445,7 +445,7 @@ fn light_bvh_is_well_formed() {
         let mut seen = vec![0u32; n];
         let mut visited = vec![false; bvh.nodes.len()];
         let mut stack = vec![0usize];
-        let contains = |outer: &lightgrid::culling::BvhNode, lo: Vec3, hi: Vec3| {
+        let contains = |outer: &lightgrid::testing::BvhNode, lo: Vec3, hi: Vec3| {
             Vec3::from(outer.lo).cmple(lo).all() && Vec3::from(outer.hi).cmpge(hi).all()
         };
         while let Some(i) = stack.pop() {
@@ -487,7 +487,7 @@ fn light_bvh_is_well_formed() {
 /// Lights near each other get nearby Morton codes; the code is monotone along each axis.
 #[test]
 fn morton_codes_interleave_axes() {
-    use lightgrid::culling::morton_code;
+    use lightgrid::testing::morton_code;
     let (lo, ext) = (Vec3::ZERO, Vec3::splat(1.0));
     assert_eq!(morton_code(Vec3::ZERO, lo, ext), 0);
     assert_eq!(morton_code(Vec3::ONE, lo, ext), (1 << 30) - 1);

@@ -1,9 +1,9 @@
 //! Rust structs in gpu_types.rs and their WGSL twins agree on size and every field offset.
 
-use lightgrid::gpu_types::{
+use lightgrid::shader::{compose, src, validate};
+use lightgrid::testing::gpu_types::{
     BvhNode, FrameUniforms, GpuLight, GpuMaterial, GridParams, LevelParams, SortParams,
 };
-use lightgrid::shader::{compose, src, validate};
 use std::mem::{offset_of, size_of};
 
 fn wgsl_layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
@@ -39,7 +39,11 @@ fn gpu_structs_match_wgsl() {
     // A throwaway entry point keeps the module non-empty for validation.
     let shader = compose(
         "layout",
-        &[src::TYPES, "@compute @workgroup_size(1) fn main() {}"],
+        &[
+            src::TYPES,
+            src::GRID_PARAMS,
+            "@compute @workgroup_size(1) fn main() {}",
+        ],
     );
     let module = validate(&shader).expect("types.wgsl validates");
     check_layout!(
@@ -50,7 +54,7 @@ fn gpu_structs_match_wgsl() {
     );
     check_layout!(
         &module,
-        "GridParams",
+        "LightGridParams",
         GridParams,
         [
             tile_size,
@@ -131,7 +135,7 @@ fn gpu_structs_match_wgsl() {
 
 #[test]
 fn vertex_layout_matches_gpu_vertex() {
-    use lightgrid::gpu_types::GpuVertex;
+    use lightgrid::testing::gpu_types::GpuVertex;
     let layout = lightgrid::passes::vertex_layout();
     assert_eq!(layout.array_stride as usize, size_of::<GpuVertex>());
     let offsets: Vec<u64> = layout.attributes.iter().map(|a| a.offset).collect();

@@ -17,13 +17,13 @@
 mod common;
 
 use glam::{Mat4, Vec3};
-use lightgrid::culling::cell_bounds_cpu_samples;
 use lightgrid::frame::MsaaResolve;
 use lightgrid::pipelines::{Msaa, PIPELINES, REFERENCE};
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::scene::{
     CameraPath, Light, LightAnchor, Material, Mesh, Motion, Object, Scene, SceneLight,
 };
+use lightgrid::testing::cell_bounds_cpu_samples;
 use lightgrid::{FrameOutput, RenderSettings, Renderer};
 
 const SAMPLES: u32 = 4;

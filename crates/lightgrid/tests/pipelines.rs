@@ -1096,7 +1096,7 @@ fn z_bins_equal_their_twin_and_keep_the_image_with_glass_and_msaa() {
                 .zbins
                 .as_ref()
                 .expect("a z-binned grid keeps its compact form");
-            let twin = lightgrid::culling::zbins_cpu(
+            let twin = lightgrid::testing::zbins_cpu(
                 &setup,
                 &a.grid.dims,
                 &state.lights,
@@ -1299,8 +1299,8 @@ fn index_lists_beyond_the_device_limit_are_refused() {
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size)
         / 4;
-    assert!(lightgrid::culling::check_index_capacity(&ctx.device, max, "test").is_ok());
-    let err = lightgrid::culling::check_index_capacity(&ctx.device, max + 1, "scatter")
+    assert!(lightgrid::testing::check_index_capacity(&ctx.device, max, "test").is_ok());
+    let err = lightgrid::testing::check_index_capacity(&ctx.device, max + 1, "scatter")
         .unwrap_err()
         .to_string();
     assert!(
@@ -1788,7 +1788,7 @@ fn every_pipeline_picks_the_same_coplanar_surface_as_forward() {
 /// the clusters no better than depth-bounded tiles).
 #[test]
 fn cluster_slices_follow_the_samples_depth_range() {
-    use lightgrid::culling::{depth_range_cpu, slicing_range};
+    use lightgrid::testing::{depth_range_cpu, slicing_range};
     let ctx = common::gpu();
     let own = catalog::build("robots-many", &SceneParams::default()).unwrap();
     let tiny = with_planes(&own, 1e-6, 1e6);

@@ -5,19 +5,20 @@
 
 mod common;
 
-use lightgrid::culling::{Assign, GridBuffers};
+use lightgrid::culling::Assign;
 use lightgrid::gpu::{bind_resources, download, GpuContext, COUNTER_BYTES};
-use lightgrid::gpu_types::{FrameUniforms, GpuLight, GpuMaterial};
 use lightgrid::image_io::diff;
 use lightgrid::passes::scene_layout;
 use lightgrid::pipelines::PIPELINES;
 use lightgrid::scene::catalog::{self, SceneParams};
 use lightgrid::shader::{compose, compute_pipeline, src};
+use lightgrid::testing::gpu_types::{FrameUniforms, GpuLight, GpuMaterial};
+use lightgrid::testing::GridBuffers;
 use lightgrid::{Error, RenderSettings, Renderer};
 
 /// The registry's strategies that record into the frame's one submission.
 fn gpu_strategies() -> impl Iterator<Item = Assign> {
-    lightgrid::culling::STRATEGIES
+    lightgrid::testing::STRATEGIES
         .iter()
         .filter(|s| !s.reads_back)
         .map(|s| s.assign)
@@ -139,7 +140,7 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     }
     // With 2.5D culling or tight cells the cells' records (mask and box) come back in the
     // same wait.
-    let record = std::mem::size_of::<lightgrid::culling::CellCull>() as u64;
+    let record = std::mem::size_of::<lightgrid::testing::CellCull>() as u64;
     for culled in [
         RenderSettings {
             grid: lightgrid::CullConfig {
@@ -177,7 +178,7 @@ fn one_submission_and_no_readback_per_frame_for_every_gpu_strategy() {
     let slices = u64::from(RenderSettings::default().grid.slices);
     for s in &submitted {
         assert_eq!(s.io.submits, 2, "one part-way submission");
-        let params = std::mem::size_of::<lightgrid::gpu_types::GridParams>() as u64;
+        let params = std::mem::size_of::<lightgrid::testing::gpu_types::GridParams>() as u64;
         assert_eq!(s.io.readback_bytes, cells * slices * 8 + 8 + params);
     }
 }

@@ -14,26 +14,40 @@ mod strategies;
 
 pub use crate::frame::{Assign, CullConfig, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
-pub use bounds::cell_bounds::{cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, EMPTY_CELL};
-pub use bounds::cell_box::{cell_boxes_cpu, CellCull};
-pub use bounds::depth_mask::{cell_masks_cpu, CellMask, NO_MASK};
-pub use bounds::depth_range::{depth_range_cpu, slicing_range};
+pub(crate) use bounds::cell_bounds::cell_bounds_cpu_samples;
+pub(crate) use bounds::cell_box::CellCull;
 pub(crate) use builder::BuiltGrid;
 pub(crate) use builder::GridUse;
 pub use embed::culler::{CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller};
-pub use frame::check_index_capacity;
 pub(crate) use frame::CellSource;
 pub(crate) use frame::{bind_cull_group, cull_layout, CullFrame};
-pub use grid::{GridBuffers, GridDims, GridLists, LightGrid, ZBins};
+pub(crate) use grid::GridBuffers;
+pub use grid::{GridDims, GridLists, LightGrid, ZBins};
+pub use oracle::ideal_lighting_computations;
 pub(crate) use oracle::{ideal_fragment_counts, ideal_pixel_counts};
-pub use oracle::{ideal_lighting_computations, oracle_fragment_lights, oracle_tile_lights};
 pub use spot_ray::{ray_test_count, RayTestCount};
-pub use strategies::assign_cpu::{assign_cpu, project_sphere, DepthRange, PixelRect};
-pub use strategies::bvh::{build_bvh, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
-pub use strategies::gather::{assign_gather_cpu, assign_gather_cpu_masked};
+pub use strategies::assign_cpu::{assign_cpu, DepthRange};
 pub(crate) use strategies::registry::ASSIGN_VALUES;
-pub use strategies::registry::{StrategyInfo, STRATEGIES};
-pub use strategies::zbin::zbins_cpu;
+
+/// The CPU twin of every culling stage, the brute-force oracle and the strategies' registry,
+/// for lightgrid's own tests: public as `lightgrid::testing` with the `testing` feature only.
+#[cfg(feature = "testing")]
+pub(crate) mod testing {
+    pub use super::bounds::cell_bounds::{
+        cell_bounds_cpu, cell_bounds_cpu_samples, open_bounds, EMPTY_CELL,
+    };
+    pub use super::bounds::cell_box::{cell_boxes_cpu, CellCull};
+    pub use super::bounds::depth_mask::{cell_masks_cpu, CellMask, NO_MASK};
+    pub use super::bounds::depth_range::{depth_range_cpu, slicing_range};
+    pub use super::frame::check_index_capacity;
+    pub use super::grid::GridBuffers;
+    pub use super::oracle::{oracle_fragment_lights, oracle_tile_lights};
+    pub use super::strategies::assign_cpu::{project_sphere, PixelRect};
+    pub use super::strategies::bvh::{build_bvh, morton_code, traverse_bvh_cpu, BvhNode, LightBvh};
+    pub use super::strategies::gather::{assign_gather_cpu, assign_gather_cpu_masked};
+    pub use super::strategies::registry::{StrategyInfo, STRATEGIES};
+    pub use super::strategies::zbin::zbins_cpu;
+}
 
 pub use crate::consts::pass_labels as labels;
 

@@ -109,6 +109,7 @@ pub(crate) fn ideal_pixel_counts(
 /// For every cell, the lights reaching at least one of the transparent fragments that read it
 /// (`GridDims::transparent_cell_of`); cells no fragment reads stay empty. Brute force over
 /// every light (tests only).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn oracle_fragment_lights(
     setup: &ViewSetup,
     dims: &GridDims,

@@ -27,7 +27,7 @@ use crate::scene::Shading;
 pub mod src {
     pub const TYPES: &str = include_str!("../shading/types.wgsl");
     /// `LightGridParams`, the grid's uniform (lightgrid's shaders and the caller's).
-    pub(crate) const GRID_PARAMS: &str = include_str!("../culling/grid/grid_params.wgsl");
+    pub const GRID_PARAMS: &str = include_str!("../culling/grid/grid_params.wgsl");
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
     /// The light function; needs the shading defs (`ComposedShader::specialized`).
     pub(crate) const LIGHT_FUNCTION: &str = include_str!("../shading/lighting.wgsl");
@@ -357,6 +357,7 @@ pub mod overrides {
     /// `cell_bounds.wgsl`: invocations per workgroup, one per row of the grid's tiles.
     pub(crate) const CELL_THREADS: &str = "CELL_THREADS";
     /// Every override of the library's shaders.
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub const ALL: [&str; 5] = [
         MULTISAMPLED,
         MATERIAL_SHADER,
@@ -368,6 +369,7 @@ pub mod overrides {
 
 /// Parse and validate with naga, in every [`Shading`], as a device with the early depth test
 /// gets it; the error message carries naga's annotated source span.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
     validate_for(shader, true)
 }
@@ -375,6 +377,7 @@ pub fn validate(shader: &ComposedShader) -> Result<naga::Module, String> {
 /// As [`validate`], the shader as `create_module` gives it to a device with or without
 /// `SHADER_EARLY_DEPTH_TEST`: in every [`Shading`] (each makes other code live; one text that
 /// two shadings make alike is validated once); the module of the first.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn validate_for(
     shader: &ComposedShader,
     early_depth_test: bool,
@@ -392,6 +395,7 @@ pub fn validate_for(
     Ok(first.expect("one at least"))
 }
 
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 fn validate_one(name: &str, source: &str) -> Result<naga::Module, String> {
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| format!("{name}: {}", e.emit_to_string(source)))?;
@@ -423,6 +427,7 @@ pub(crate) const EARLY_DEPTH_TEST_DEF: &str = "EARLY_DEPTH_TEST";
 /// The attribute forward fragment shaders carry, under `#if EARLY_DEPTH_TEST`, to keep early-Z
 /// although they may write the frame counters (a side effect that would otherwise move the
 /// depth test after shading).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub const EARLY_DEPTH_TEST: &str = "@early_depth_test(force)";
 
 impl ComposedShader {
@@ -448,7 +453,7 @@ impl ComposedShader {
     /// The text a device gets, with the one def that depends on the adapter rather than on
     /// a key: without `SHADER_EARLY_DEPTH_TEST` the forced early depth test is left out. The
     /// image is the same (no shader carrying it discards or writes depth), only early-Z may be
-    /// lost; [`validate_for`] checks both forms of every shader.
+    /// lost; `validate_for` checks both forms of every shader.
     pub fn source_for(&self, early_depth_test: bool) -> String {
         let device = Def::Bool(EARLY_DEPTH_TEST_DEF, early_depth_test);
         let shader = self.with(vec![device]);

@@ -7,14 +7,14 @@ pub mod gltf_fixture;
 pub mod shading;
 
 use glam::Vec3;
-use lightgrid::culling::{
-    assign_cpu, assign_gather_cpu_masked, cell_bounds_cpu, cell_boxes_cpu, cell_masks_cpu,
-    oracle_tile_lights, zbins_cpu, CellCull, CellMask, DepthRange, GridDims, GridLists, LightGrid,
-    ViewSetup, NO_MASK,
-};
+use lightgrid::culling::{assign_cpu, DepthRange, GridDims, GridLists, LightGrid, ViewSetup};
 use lightgrid::gpu::GpuContext;
 use lightgrid::pipelines::Assign;
 use lightgrid::scene::{Camera, Light, Rng, Spot};
+use lightgrid::testing::{
+    assign_gather_cpu_masked, cell_bounds_cpu, cell_boxes_cpu, cell_masks_cpu, oracle_tile_lights,
+    zbins_cpu, CellCull, CellMask, NO_MASK,
+};
 use std::path::PathBuf;
 
 /// Every pipeline whose grid `--assign` builds, from the registry.
@@ -28,7 +28,7 @@ pub fn grid_pipelines() -> Vec<&'static str> {
 
 /// Every strategy of the registry.
 pub fn strategies() -> Vec<Assign> {
-    lightgrid::culling::STRATEGIES
+    lightgrid::testing::STRATEGIES
         .iter()
         .map(|s| s.assign)
         .collect()
@@ -597,7 +597,7 @@ pub fn check_opened_cell_bounds(
     depth_bounds: lightgrid::frame::DepthBounds,
 ) {
     let mut cpu = cell_bounds_cpu(setup, dims, depth);
-    lightgrid::culling::open_bounds(setup, dims, depth_bounds, &mut cpu);
+    lightgrid::testing::open_bounds(setup, dims, depth_bounds, &mut cpu);
     assert_eq!(bounds.len(), cpu.len(), "{what}: cell count");
     let mut emptiness = 0;
     let near = |a: f32, b: f32, rel: f32| (a - b).abs() <= rel * b.abs();
@@ -967,7 +967,7 @@ pub fn check_grid_covers_transparent_fragments(
     triangles: &[[Vec3; 3]],
 ) -> usize {
     let fragments = lightgrid::scene::rasterize(setup, triangles, &setup.view_distances(depth));
-    let must = lightgrid::culling::oracle_fragment_lights(setup, &grid.dims, lights, &fragments);
+    let must = lightgrid::testing::oracle_fragment_lights(setup, &grid.dims, lights, &fragments);
     for (c, list) in must.iter().enumerate() {
         for l in list {
             assert!(

@@ -101,6 +101,7 @@ impl ShaderKey for CellBoundsKey {
 /// does): `Min` opens an occupied cell's far side to its slice's far end, `Max` its near
 /// side to the slice's near end, `None` gives every cell (occupied or not) its slice's
 /// whole range. Bounds only widen, so no light a cell's samples need is lost.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn open_bounds(
     setup: &ViewSetup,
     dims: &GridDims,

@@ -57,6 +57,7 @@ impl CellCull {
 
 /// The range of `n / scale * w` over `n` in `{n0, n1}` and `w` in `{w0, w1}`: one view-space
 /// axis of a screen rectangle's frustum piece (`view_extent` in WGSL, the same operations).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(crate) fn view_extent(n0: f32, n1: f32, scale: f32, w0: f32, w1: f32) -> [f32; 2] {
     let (a, b) = (n0 / scale, n1 / scale);
     let v = [a * w0, a * w1, b * w0, b * w1];
@@ -68,6 +69,7 @@ pub(crate) fn view_extent(n0: f32, n1: f32, scale: f32, w0: f32, w1: f32) -> [f3
 
 /// The view-space box of the pixel rectangle `[x0, x1] × [y0, y1]` (pixel edges) over view
 /// distances `[w0, w1]` (`rect_box` in WGSL).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(crate) fn rect_box(
     setup: &ViewSetup,
     x: [f32; 2],
@@ -95,6 +97,7 @@ pub(crate) fn rect_box(
 
 /// How far the sphere `(c, r)` is from the box (`> 0`: it misses; `sphere_meets_cell_box` in
 /// WGSL decides `|d|² <= r²` on the same `d`).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(crate) fn sphere_box_gap(lo: Vec3, hi: Vec3, c: Vec3, r: f32) -> f32 {
     let d = (lo - c).max(Vec3::ZERO).max(c - hi);
     d.length() - r
@@ -124,6 +127,7 @@ pub(crate) fn cone_sphere(frustum: (Vec3, f32), cell_box: Option<(Vec3, Vec3)>) 
     }
 }
 
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 fn union(a: Option<(Vec3, Vec3)>, b: (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
     Some(a.map_or(b, |a| (a.0.min(b.0), a.1.max(b.1))))
 }
@@ -135,6 +139,7 @@ fn union(a: Option<(Vec3, Vec3)>, b: (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
 /// widened by `slack`), and, where `extra[cell]` is a range (MSAA forward fragments, a shared
 /// list's transparent range), the cell's tile over that range. The transparent layer of
 /// separate lists has none.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn cell_boxes_cpu(
     setup: &ViewSetup,
     dims: &GridDims,

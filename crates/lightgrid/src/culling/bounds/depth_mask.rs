@@ -62,6 +62,7 @@ pub(crate) fn mask_scale(b: [f32; 2]) -> CellMask {
 }
 
 /// The bins of `[lo, hi]` inflated by `slack` on both sides (none for an empty range).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 fn inflated_span(lo: f32, hi: f32, slack: f32, m: &CellMask) -> u32 {
     if lo > hi {
         return 0;
@@ -77,6 +78,7 @@ fn inflated_span(lo: f32, hi: f32, slack: f32, m: &CellMask) -> u32 {
 /// `mask_scale` or the GPU's own masks). With a shared list, `transparent[cell]` is the
 /// range the cell's transparent fragments may lie in (every bin of it is set); the
 /// transparent layer of separate lists gets [`NO_MASK`].
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn cell_masks_cpu(
     setup: &ViewSetup,
     dims: &GridDims,

@@ -42,6 +42,7 @@ impl SampleStage for DepthRangeStage {
 
 /// The view-distance `[min, max]` of every sample that holds geometry (`planes[s]`: sample
 /// `s` of every pixel); `[+inf, 0]` when none does. Twin of `reduce`.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn depth_range_cpu(setup: &ViewSetup, planes: &[&[f32]]) -> [f32; 2] {
     planes
         .iter()
@@ -54,6 +55,7 @@ pub fn depth_range_cpu(setup: &ViewSetup, planes: &[&[f32]]) -> [f32; 2] {
 /// The slicing range for samples spanning `samples` (`[+inf, 0]`: none): clamped to
 /// near..far, near..far without samples, and at least `SLICING_MIN_RATIO` wide. Twin of
 /// `finish`.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn slicing_range(samples: [f32; 2], near: f32, far: f32) -> [f32; 2] {
     let [lo, hi] = if samples[0] > samples[1] {
         [near, far]

@@ -9,6 +9,7 @@ use crate::scene::ViewSetup;
 /// them) off the background, with its pixel, its view distance and each cell its distance
 /// lies in within the slack `ASSIGN_DEPTH_SLACK` (as the kernel's `include_depth`; the same
 /// cell twice when it lies in one): the walk the masks' and boxes' CPU twins share.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(crate) fn for_each_sample_cell(
     setup: &ViewSetup,
     dims: &GridDims,

@@ -313,8 +313,10 @@ pub struct GridBuffers {
     bind_group: wgpu::BindGroup,
 }
 
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 impl GridBuffers {
     /// Index entries a new grid's buffer holds; it grows (never shrinks) to fit.
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub const INITIAL_INDEX_CAPACITY: u32 = crate::consts::INITIAL_INDEX_CAPACITY;
 
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {

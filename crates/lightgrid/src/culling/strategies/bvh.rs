@@ -26,11 +26,14 @@ use web_time::Instant;
 
 pub use crate::gpu_types::BvhNode;
 
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 impl BvhNode {
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub fn is_leaf(&self) -> bool {
         self.count & BVH_LEAF != 0
     }
 
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub fn children(&self) -> std::ops::Range<u32> {
         self.first..self.first + (self.count & !BVH_LEAF)
     }
@@ -179,6 +182,7 @@ pub fn build_bvh(setup: &ViewSetup, lights: &[Light]) -> LightBvh {
 }
 
 /// `box_in_cell` of tile_frustum.wgsl: does the node's view-space box reach into the frustum?
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 fn box_in_cell(f: &CpuFrustum, n: &BvhNode) -> bool {
     box_margin(f, Vec3::from(n.lo), Vec3::from(n.hi)) >= 0.0
 }
@@ -187,6 +191,7 @@ fn box_in_cell(f: &CpuFrustum, n: &BvhNode) -> bool {
 /// cell's frustum and keep the leaves' lights that pass the gather test. Lists in light
 /// order. Equal to [`crate::culling::strategies::gather::assign_gather_cpu`] whenever the boxes are conservative, which is
 /// what the tests check.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn traverse_bvh_cpu(
     setup: &ViewSetup,
     dims: &GridDims,

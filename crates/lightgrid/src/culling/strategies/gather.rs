@@ -19,6 +19,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// A tile's frustum on the CPU, computed exactly as `tile_frustum` in WGSL.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(super) struct CpuFrustum {
     pub planes: [Vec3; 4],
     pub w_min: f32,
@@ -32,6 +33,7 @@ pub(super) struct CpuFrustum {
     pub cell_box: Option<(Vec3, Vec3)>,
 }
 
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(super) fn cpu_frustum(
     setup: &ViewSetup,
     dims: &GridDims,
@@ -66,6 +68,7 @@ pub(super) fn cpu_frustum(
 
 /// The frustum of cell `c` (`cell_frustum` in assign_bindings.wgsl): its tile's planes, its
 /// bounds and, when given, its depth mask and box.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(super) fn cell_frustum(
     setup: &ViewSetup,
     dims: &GridDims,
@@ -84,6 +87,7 @@ pub(super) fn cell_frustum(
 
 /// How far inside the cell's frustum the light is (≥ 0: inside, as `sphere_in_tile` decides);
 /// `-inf` for a cell without samples. Tests use its size to recognise round-off cases.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(super) fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
     if f.w_min > f.w_max {
         return f32::NEG_INFINITY;
@@ -107,6 +111,7 @@ pub(super) fn margin(f: &CpuFrustum, center: Vec3, r: f32) -> f32 {
 
 /// How far the span `[w0, w1]` is from the nearest bin of `m` holding samples, in view
 /// distance (positive when they do not meet).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 fn mask_gap(m: &CellMask, w0: f32, w1: f32) -> f32 {
     let (lo, inv) = (f32::from_bits(m[1]), f32::from_bits(m[2]));
     if inv <= 0.0 || m[0] == 0 {
@@ -125,6 +130,7 @@ fn mask_gap(m: &CellMask, w0: f32, w1: f32) -> f32 {
 
 /// `light_in_tile` in WGSL: the light's bounding sphere against the frustum, and a spot's
 /// cone against the frustum's bounding sphere; the smaller margin.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(super) fn light_margin(f: &CpuFrustum, v: &ViewLight) -> f32 {
     let m = margin(f, v.center, v.radius);
     if m < 0.0 || v.cone.is_none() {
@@ -139,6 +145,7 @@ pub(super) fn light_margin(f: &CpuFrustum, v: &ViewLight) -> f32 {
 
 /// `box_in_cell` of tile_frustum.wgsl as a margin: how far the view-space box reaches into
 /// the frustum (≥ 0: it does).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(super) fn box_margin(f: &CpuFrustum, lo: Vec3, hi: Vec3) -> f32 {
     if f.w_min > f.w_max {
         return f32::NEG_INFINITY;
@@ -161,6 +168,7 @@ pub(super) fn box_margin(f: &CpuFrustum, lo: Vec3, hi: Vec3) -> f32 {
 /// Per cell and light, the gather test's margin (cells in grid order, lights in order).
 /// `cell_bounds`: per cell the view-distance `[min, max]` (`cell_bounds.rs`); `culls`: per
 /// cell its 2.5D depth mask and tight box, for a grid built with `--depth-mask on` or `--cell-box on`.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(crate) fn gather_margins(
     setup: &ViewSetup,
     dims: &GridDims,
@@ -180,6 +188,7 @@ pub(crate) fn gather_margins(
 
 /// CPU twin of the GPU gather (and of the BVH traversal, which applies the same final test):
 /// the same inputs and the same grid (lists in light order; the GPU's order varies).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn assign_gather_cpu(
     setup: &ViewSetup,
     dims: &GridDims,
@@ -191,6 +200,7 @@ pub fn assign_gather_cpu(
 
 /// [`assign_gather_cpu`] of a grid built with `--depth-mask on` or `--cell-box on`: its
 /// cells' culling records.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn assign_gather_cpu_masked(
     setup: &ViewSetup,
     dims: &GridDims,

@@ -15,6 +15,7 @@ pub struct StrategyInfo {
     pub description: &'static str,
     /// The frame waits for the GPU part-way (the cell bounds read back: the papers' CPU
     /// pipeline); the others record into the frame's one submission.
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub reads_back: bool,
     /// It assigns on the CPU, from the lights there (a [`crate::LightCuller`] has them on the
     /// GPU only).

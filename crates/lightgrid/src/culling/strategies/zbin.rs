@@ -46,6 +46,7 @@ pub(crate) fn shader() -> ComposedShader {
 }
 
 /// `ordered_bits` of `cell_box.wgsl`: the sort key of a float (order-preserving as u32).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub(crate) fn ordered_bits(x: f32) -> u32 {
     let b = x.to_bits();
     if b & 0x8000_0000 != 0 {
@@ -57,6 +58,7 @@ pub(crate) fn ordered_bits(x: f32) -> u32 {
 
 /// The union of the bounds of tile `t`'s cells (every slice and layer); `[MAX, -MAX]` when
 /// none holds a sample (as `masks_main` starts from).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 fn tile_range(dims: &GridDims, cell_bounds: &[[f32; 2]], t: usize) -> [f32; 2] {
     let tiles = dims.tile_count();
     (0..dims.cell_count() / tiles)
@@ -69,6 +71,7 @@ fn tile_range(dims: &GridDims, cell_bounds: &[[f32; 2]], t: usize) -> [f32; 2] {
 
 /// CPU twin of the GPU build: the same sort, bins and masks. `dims` is the grid's shape
 /// (its slices are the bins), `cell_bounds` the bounds the cells were built with.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn zbins_cpu(
     setup: &ViewSetup,
     dims: &GridDims,
