@@ -20,11 +20,15 @@ use image::RgbaImage;
 
 /// An image, its statistics, and what the analysis saw.
 pub struct FrameOutput {
+    /// The rendered frame, tonemapped to 8-bit sRGB RGBA.
     pub image: RgbaImage,
+    /// The frame's statistics (what `render --stats` writes).
     pub stats: FrameStats,
     /// The grid the pipeline shaded with; for pipelines that build none, the depth-bounded
     /// CPU tile grid used for the ideal count (see `grid_is_pipelines`).
     pub grid: LightGrid,
+    /// True when `grid` is the pipeline's own; false when it is the CPU tile grid of the
+    /// ideal count (the pipeline builds no grid).
     pub grid_is_pipelines: bool,
     /// The cell bounds the pipeline's light assignment read (`culling::cell_bounds_cpu` is
     /// their CPU twin); None for pipelines without a grid.

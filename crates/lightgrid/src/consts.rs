@@ -27,6 +27,7 @@ pub(crate) const MAX_SLICES: u32 = 256;
 /// (tile / TILE_THREADS)^2 workgroups per tile, each reducing the tile's depth and culling its
 /// lights again, so large tiles repeat that work (16 times at 64).
 pub const MIN_TILE_SIZE: u32 = 4;
+/// Largest tile edge `--tile` accepts, in pixels.
 pub const MAX_TILE_SIZE: u32 = 64;
 
 /// Threads along one edge of a per-tile workgroup (depth bounds, single-kernel tiled deferred):
@@ -279,7 +280,9 @@ pub(crate) const DEPTH_MASK_ALL: u32 = u32::MAX;
 /// material carries, and the value of the WGSL override `MATERIAL_SHADER` that makes a
 /// pipeline branch on the material instead of being specialised to one shader.
 pub(crate) const MATERIAL_SHADER_STANDARD: u32 = 0;
+/// `MaterialShader::CarPaint`: the diffuse colour turns toward a flip colour at grazing angles.
 pub const MATERIAL_SHADER_CAR_PAINT: u32 = 1;
+/// `MaterialShader::Rim`: a rim colour times `(1 − n·v)^power` added to the diffuse colour.
 pub const MATERIAL_SHADER_RIM: u32 = 2;
 /// Number of material shaders (forward pipelines create one pipeline each).
 pub(crate) const MATERIAL_SHADERS: u32 = 3;
@@ -302,20 +305,29 @@ pub(crate) const MATERIAL_FLAG_TRANSPARENT: u32 = 1;
 pub(crate) const MATERIAL_FLAG_METALLIC_ROUGHNESS: u32 = 2;
 /// A material's texture slots (`GpuMaterial::uv_sets`, `wraps`).
 pub const TEXTURE_SLOT_BASE: u32 = 0;
+/// Emissive texture slot: its RGB scales the material's emissive colour.
 pub const TEXTURE_SLOT_EMISSIVE: u32 = 1;
+/// glTF metallic-roughness texture slot: B scales metallic, G scales roughness.
 pub const TEXTURE_SLOT_METAL_ROUGH: u32 = 2;
+/// Tangent-space normal map slot (glTF §3.9.3), its x and y scaled by the normal scale.
 pub const TEXTURE_SLOT_NORMAL: u32 = 3;
+/// Occlusion texture slot: its R darkens the ambient term only, by the occlusion strength.
 pub const TEXTURE_SLOT_OCCLUSION: u32 = 4;
 /// Texture wrapping (glTF samplers' `wrapS`/`wrapT`): the GPU sampler repeats, clamping and
 /// mirroring are applied to the coordinates.
 pub(crate) const WRAP_REPEAT: u32 = 0;
+/// glTF `CLAMP_TO_EDGE` (33071): the coordinate is clamped to within half a texel of the edges.
 pub const WRAP_CLAMP: u32 = 1;
+/// glTF `MIRRORED_REPEAT` (33648): every other repeat is folded back, then clamped like
+/// [`WRAP_CLAMP`].
 pub const WRAP_MIRROR: u32 = 2;
 
 /// A WGSL constant value: unsigned integer or float.
 #[derive(Clone, Copy, Debug)]
 pub enum WgslConst {
+    /// Written as a WGSL `u32` literal (`{v}u`).
     U32(u32),
+    /// Written as a WGSL `f32` literal (Rust's `{v:?}` form, so whole numbers keep their `.0`).
     F32(f32),
 }
 
@@ -480,7 +492,10 @@ pub(crate) fn wgsl_prelude() -> String {
 pub mod pass_labels {
     /// Every light-assignment pass's label starts with this (`FinishedFrame::assign_gpu_ms`).
     pub const ASSIGN_PREFIX: &str = "assign:";
+    /// The cell-bounds kernel's pass (`cell_bounds.wgsl`): each cell's sample depth range.
     pub const CELL_BOUNDS: &str = "assign: cell bounds";
+    /// The MSAA fragment-bounds render pass (`fragment_bounds.wgsl`) that widens cell bounds to
+    /// where forward fragments will look their cells up.
     pub const FRAGMENT_BOUNDS: &str = "assign: fragment bounds";
     pub(crate) const DEPTH_RANGE: &str = "assign: depth range";
 }

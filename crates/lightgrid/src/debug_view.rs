@@ -17,12 +17,16 @@ use image::RgbaImage;
 pub enum DebugView {
     /// The shaded frame itself (the real-time path; no analysis).
     Shaded,
+    /// Each pixel tinted by the length of its cell's light list.
     LightsPerCell,
+    /// Each pixel tinted by the view-distance span (`max - min`) of its cell's depth bounds.
     CellBounds,
+    /// Each pixel tinted by its lighting computations above the ideal.
     WastedWork,
 }
 
 impl DebugView {
+    /// Every view, in the order [`DebugView::next`] cycles through them.
     pub const ALL: [DebugView; 4] = [
         DebugView::Shaded,
         DebugView::LightsPerCell,
@@ -30,6 +34,7 @@ impl DebugView {
         DebugView::WastedWork,
     ];
 
+    /// The view's human-readable name, for legends and menus (e.g. "lights per cell").
     pub fn name(self) -> &'static str {
         match self {
             DebugView::Shaded => "shaded",
@@ -59,8 +64,11 @@ impl DebugView {
 
 /// A debug view's image and its legend: the ramp runs from 0 to `max` `unit`.
 pub struct DebugImage {
+    /// The frame tinted by the view's per-pixel values, at the frame's own size.
     pub image: RgbaImage,
+    /// The value at the top of the ramp: the largest in the frame, in `unit`s.
     pub max: f64,
+    /// The legend's unit (e.g. "lights"); empty where the view shows nothing.
     pub unit: &'static str,
     /// Why the view shows nothing where it cannot be drawn (no counts, no grid).
     pub note: Option<String>,

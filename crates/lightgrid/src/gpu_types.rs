@@ -1,5 +1,8 @@
 //! Every `#[repr(C)]` struct shared with WGSL. Sizes are asserted at compile time here; the
 //! `layout` test parses the WGSL with naga and compares every field offset with these.
+//! Not an API (public only as `lightgrid::testing::gpu_types`): each field is the WGSL
+//! struct's field of the same name, documented there.
+#![cfg_attr(feature = "testing", allow(missing_docs))]
 
 use bytemuck::{Pod, Zeroable};
 

@@ -10,9 +10,11 @@ use std::path::Path;
 /// largest absolute difference of its three colour channels.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DiffSummary {
+    /// Mean of the per-pixel differences over all pixels.
     pub mean: f64,
     /// 99th percentile (nearest rank) of the per-pixel differences.
     pub p99: f64,
+    /// The largest per-pixel difference.
     pub max: f64,
 }
 
@@ -262,6 +264,7 @@ impl Temporary {
         Temporary { path, keep: false }
     }
 
+    /// The temporary's path.
     pub fn path(&self) -> &Path {
         &self.path
     }
@@ -379,7 +382,12 @@ pub fn check_writable(path: &Path) -> Result<()> {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum FileIdentity {
     /// An existing file's device and inode.
-    Inode { device: u64, inode: u64 },
+    Inode {
+        /// The device (filesystem) the file lives on (`st_dev`).
+        device: u64,
+        /// The file's inode number on that device (`st_ino`).
+        inode: u64,
+    },
     /// A canonical path: of an existing file where there are no inodes, or where a new file
     /// would be created.
     Path(std::path::PathBuf),

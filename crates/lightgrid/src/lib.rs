@@ -4,6 +4,8 @@
 //! Start with [`gpu::GpuContext::new`], build a scene from [`scene::catalog`], and render it
 //! with a [`Renderer`] and a pipeline id from [`pipelines::PIPELINES`].
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod consts;
 pub mod culling;

@@ -26,13 +26,17 @@ pub struct PlayedFrame {
     /// GPU time of the frame (its submissions' timestamp spans, summed); None without
     /// timestamps.
     pub gpu_ms: Option<f64>,
+    /// Each timed pass's GPU time, in recording order (empty without timestamps).
     pub passes: Vec<PassTiming>,
     /// CPU time spent waiting for older frames (more than `MAX_FRAMES_IN_FLIGHT` in flight).
     pub throttle_ms: f64,
     /// CPU time the frame itself waited on the GPU (the `cpu` strategy's read-back).
     pub cpu_wait_ms: f64,
+    /// Queue submissions the frame made.
     pub submits: u32,
+    /// Bytes the frame read back with a wait for the GPU.
     pub readback_bytes: u64,
+    /// Bytes uploaded to the GPU for the frame (lights, uniforms, moving geometry).
     pub upload_bytes: u64,
     /// Some light list did not fit (the frame is missing lights; lists grew for later ones).
     pub overflowed: bool,
@@ -43,12 +47,14 @@ pub struct PlayedFrame {
 /// A whole real-time run.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PlayRun {
+    /// The recorded frames in play order (warm-up frames excluded).
     pub frames: Vec<PlayedFrame>,
     /// Stopped (Ctrl-C) before the end.
     pub interrupted: bool,
 }
 
 impl PlayRun {
+    /// The distribution of frame periods in milliseconds; None when no frame was played.
     pub fn frame_ms(&self) -> Option<Distribution> {
         Distribution::of(self.frames.iter().map(|f| f.frame_ms))
     }
@@ -77,22 +83,27 @@ impl PlayRun {
         self.frames.iter().map(f).sum::<f64>() / self.frames.len() as f64
     }
 
+    /// Mean queue submissions per frame (0 without frames).
     pub fn submits_per_frame(&self) -> f64 {
         self.per_frame(|f| f64::from(f.submits))
     }
 
+    /// Mean bytes read back with a wait per frame (0 without frames).
     pub fn readback_bytes_per_frame(&self) -> f64 {
         self.per_frame(|f| f.readback_bytes as f64)
     }
 
+    /// Mean bytes uploaded per frame (0 without frames).
     pub fn upload_bytes_per_frame(&self) -> f64 {
         self.per_frame(|f| f.upload_bytes as f64)
     }
 
+    /// Frames in which some light list did not fit.
     pub fn overflow_frames(&self) -> usize {
         self.frames.iter().filter(|f| f.overflowed).count()
     }
 
+    /// Frames with at least one shader loop cut short.
     pub fn truncated_frames(&self) -> usize {
         self.frames.iter().filter(|f| f.truncated_loops > 0).count()
     }
@@ -100,10 +111,13 @@ impl PlayRun {
 
 /// What to play.
 pub struct PlayPlan<'a> {
+    /// The scene whose animation is played.
     pub scene: &'a Scene,
+    /// Id of the pipeline to render with.
     pub pipeline: &'a str,
     /// Animation frames, in order; played `passes` times.
     pub frames: &'a [u32],
+    /// How many times `frames` is played through (at least 1).
     pub passes: u32,
     /// Frames played first and not recorded (cycling through `frames`): shader compilation,
     /// list growth, and a full queue of frames in flight when the measurement starts.

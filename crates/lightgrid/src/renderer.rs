@@ -260,6 +260,9 @@ fn check_settings(
 }
 
 impl Renderer {
+    /// A renderer for `width`×`height`-pixel frames: the shared render targets, buffers and
+    /// layouts (pipelines are created on first use). Refuses sizes and settings the adapter
+    /// cannot render.
     pub fn new(
         ctx: &GpuContext,
         width: u32,
@@ -385,10 +388,12 @@ impl Renderer {
         (scene, cull)
     }
 
+    /// The frame size, `(width, height)` in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.targets.width, self.targets.height)
     }
 
+    /// The settings the renderer was created with (fixed for its lifetime).
     pub fn settings(&self) -> RenderSettings {
         self.settings
     }

@@ -28,7 +28,6 @@ impl TimingSource {
     }
 }
 
-/// Statistics of one rendered frame.
 /// A frame's shadow maps (`crate::shadows::maps`).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ShadowMapStats {
@@ -43,18 +42,28 @@ pub struct ShadowMapStats {
     pub reused: bool,
 }
 
+/// Statistics of one analysis frame (what `lightgrid render --stats` writes).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameStats {
+    /// The scene's name.
     pub scene: String,
+    /// The pipeline's id.
     pub pipeline: String,
+    /// The adapter as `GpuContext::adapter_label` prints it: "name (backend)".
     pub adapter: String,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
+    /// The animation frame rendered.
     pub frame: u32,
+    /// Lights in the scene at this frame.
     pub lights: u32,
+    /// Triangles drawn (static and moving, opaque and transparent).
     pub triangles: u32,
     /// GPU time of the frame in milliseconds (see `timing`).
     pub gpu_ms: f64,
+    /// How `gpu_ms` was measured.
     pub timing: TimingSource,
     /// Wall time from the frame's first submission until the device was idle (analysis
     /// copies included).
@@ -127,6 +136,7 @@ pub struct FrameStats {
     /// Lights per cell (tile, or cluster) of the grid this pipeline shaded with (None: it
     /// builds no grid).
     pub lights_per_tile_avg: Option<f64>,
+    /// The longest light list of a cell in that grid (None: it builds no grid).
     pub lights_per_tile_max: Option<u32>,
     /// tiled-shading Fig. 3's count for tiled grids: tile area × list length, summed over the
     /// tiles (`LightGrid::tile_area_computations`; None for clustered grids and without one).
@@ -137,6 +147,7 @@ pub struct FrameStats {
     /// Cells of the grid (tiles × slices) and how many hold samples (non-empty bounds).
     #[serde(default)]
     pub grid_cells: Option<u64>,
+    /// Cells of the grid whose depth bounds are non-empty (None without a grid).
     #[serde(default)]
     pub grid_cells_occupied: Option<u64>,
     /// The light-assignment strategy that built the grid (`--assign`, `auto` resolved).
@@ -173,11 +184,15 @@ fn one() -> u32 {
 /// the middle two); [`Distribution::median_index`] finds which value that is.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Distribution {
+    /// The smallest value.
     pub min: f64,
     /// The arithmetic mean.
     pub mean: f64,
+    /// The value at rank `round((n - 1) 0.5)` (of an even count, the upper of the middle two).
     pub median: f64,
+    /// The 95th percentile: the value at rank `round((n - 1) 0.95)`.
     pub p95: f64,
+    /// The largest value.
     pub max: f64,
 }
 

@@ -74,6 +74,7 @@ impl FrameInputs<'_> {
 /// time it spent waiting for the GPU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FrameIo {
+    /// Queue submissions the frame made (more than one when it read data back part-way).
     pub submits: u32,
     /// Bytes read back with a wait for the GPU (not the asynchronous frame counters).
     pub readback_bytes: u64,
@@ -232,13 +233,17 @@ pub struct MsaaShading {
 /// What the GPU reported about a finished real-time frame (read back without waiting).
 #[derive(Clone, Debug)]
 pub struct FinishedFrame {
+    /// The frame's number, as [`SubmittedFrame::serial`] gave it when it was submitted.
     pub serial: u64,
+    /// Id of the pipeline that rendered it (`PipelineInfo::id`, as given to `--pipeline`).
     pub pipeline: &'static str,
     /// The frame's GPU time: the span of each of its submissions (first pass start to last
     /// pass end), summed, so CPU waits between them are left out; None without timestamps.
     pub gpu_ms: Option<f64>,
     /// The span of its light-assignment passes (`assign: ...`, cell bounds included).
     pub assign_gpu_ms: Option<f64>,
+    /// Each timed pass's label and begin-to-end GPU time, in recording order (empty without
+    /// timestamps).
     pub passes: Vec<PassTiming>,
     /// Shader loops that ended before their bound: the frame is wrong when non-zero.
     pub truncated_loops: u32,

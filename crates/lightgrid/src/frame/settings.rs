@@ -161,8 +161,10 @@ pub enum LightLoop {
 }
 
 impl LightLoop {
+    /// Every value `--light-loop` accepts, the default first.
     pub const ALL: [LightLoop; 2] = [LightLoop::Lane, LightLoop::Subgroup];
 
+    /// The value's name, as `--light-loop` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             LightLoop::Lane => "lane",
@@ -185,8 +187,10 @@ pub enum CellBox {
 }
 
 impl CellBox {
+    /// Every value `--cell-box` accepts, the default first.
     pub const ALL: [CellBox; 2] = [CellBox::Off, CellBox::On];
 
+    /// The value's name, as `--cell-box` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             CellBox::Off => "off",
@@ -210,8 +214,10 @@ pub enum DepthMask {
 }
 
 impl DepthMask {
+    /// Every value `--depth-mask` accepts, the default first.
     pub const ALL: [DepthMask; 2] = [DepthMask::Off, DepthMask::On];
 
+    /// The value's name, as `--depth-mask` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             DepthMask::Off => "off",
@@ -235,8 +241,10 @@ pub enum DepthReduction {
 }
 
 impl DepthReduction {
+    /// Every value `--depth-reduction` accepts, the default first.
     pub const ALL: [DepthReduction; 2] = [DepthReduction::Atomics, DepthReduction::Subgroup];
 
+    /// The value's name, as `--depth-reduction` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             DepthReduction::Atomics => "atomics",
@@ -265,6 +273,7 @@ pub enum DepthBounds {
 }
 
 impl DepthBounds {
+    /// Every value `--depth-bounds` accepts, the default first.
     pub const ALL: [DepthBounds; 4] = [
         DepthBounds::Both,
         DepthBounds::Min,
@@ -272,6 +281,7 @@ impl DepthBounds {
         DepthBounds::None,
     ];
 
+    /// The value's name, as `--depth-bounds` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             DepthBounds::Both => "both",
@@ -309,6 +319,7 @@ pub enum MsaaResolve {
 }
 
 impl MsaaResolve {
+    /// The value's name, as `--msaa-resolve` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             MsaaResolve::Separate => "separate",
@@ -329,6 +340,7 @@ pub enum MaterialDraws {
 }
 
 impl MaterialDraws {
+    /// The value's name, as `--material-draws` takes it and results show it.
     pub fn name(self) -> &'static str {
         match self {
             MaterialDraws::PerMaterial => "per-material",
@@ -515,12 +527,15 @@ pub(crate) fn validate_shadow_map_size(texels: u32) -> crate::error::Result<()> 
 /// Bits per G-buffer channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum GBufferFormat {
+    /// 16-bit float channels (`--gbuffer 16`), the default.
     #[default]
     F16,
+    /// 32-bit float channels (`--gbuffer 32`).
     F32,
 }
 
 impl GBufferFormat {
+    /// The texture format of each four-channel G-buffer target (`Rgba16Float` or `Rgba32Float`).
     pub fn texture_format(self) -> wgpu::TextureFormat {
         match self {
             GBufferFormat::F16 => wgpu::TextureFormat::Rgba16Float,
@@ -533,6 +548,7 @@ impl GBufferFormat {
         4 * self.bits() / 8
     }
 
+    /// Bits per channel: 16 or 32, as `--gbuffer` takes it.
     pub fn bits(self) -> u32 {
         match self {
             GBufferFormat::F16 => 16,
@@ -603,6 +619,7 @@ pub enum GridLists {
 }
 
 impl GridLists {
+    /// The value's name in results and messages (`--lists` takes `separate` and `shared`).
     pub fn name(self) -> &'static str {
         match self {
             GridLists::Opaque => "opaque",

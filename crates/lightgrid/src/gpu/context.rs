@@ -14,9 +14,13 @@ use crate::error::{Error, Result};
 pub struct GpuContext {
     /// The instance the adapter came from (a window's surface is created from it).
     pub instance: wgpu::Instance,
+    /// The adapter the device was created on.
     pub adapter: wgpu::Adapter,
+    /// The device every resource and pipeline is created on.
     pub device: wgpu::Device,
+    /// The device's queue: buffer writes and command submissions.
     pub queue: wgpu::Queue,
+    /// The adapter's name, backend, device type and driver (reports, software checks).
     pub info: wgpu::AdapterInfo,
     /// Timestamp queries at pass boundaries are available and enabled.
     pub timestamps: bool,
@@ -29,10 +33,15 @@ pub struct GpuContext {
 /// One line of `lightgrid list`.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct AdapterSummary {
+    /// Position in preference order; `--adapter <index>` selects it.
     pub index: usize,
+    /// The adapter's name as its driver reports it.
     pub name: String,
+    /// Backend as wgpu names it, lowercase (`vulkan`, `metal`, `dx12`, `gl`, ...).
     pub backend: String,
+    /// `wgpu::DeviceType` as Debug prints it (`DiscreteGpu`, `IntegratedGpu`, `Cpu`...).
     pub device_type: String,
+    /// Driver name and driver info, space-separated (empty if the adapter reports none).
     pub driver: String,
 }
 

@@ -15,7 +15,9 @@ use super::GpuContext;
 /// GPU time of one pass.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PassTiming {
+    /// The pass's label (light-assignment passes' labels start with `assign: `).
     pub label: String,
+    /// GPU time from the pass's begin timestamp to its end timestamp, in milliseconds.
     pub ms: f64,
 }
 

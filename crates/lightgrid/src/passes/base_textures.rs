@@ -14,8 +14,11 @@ pub(crate) const MAX_TEXTURE_BYTES: u64 = 256 << 20;
 
 pub(crate) const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
+/// The scene's base-colour texture array and its samplers (see the module docs).
 pub struct BaseTextures {
+    /// `D2Array` view: one layer per texture, full mip chain (group 0, binding 6).
     pub view: wgpu::TextureView,
+    /// Repeating trilinear sampler (group 0, binding 7).
     pub sampler: wgpu::Sampler,
     /// Nearest-texel magnification (a glTF sampler's `magFilter` NEAREST: pixel art).
     pub nearest: wgpu::Sampler,

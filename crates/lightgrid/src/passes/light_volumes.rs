@@ -152,9 +152,14 @@ const PLANE_SLACK: f32 = 1e-3;
 /// Light indices per draw class.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct VolumeClasses {
+    /// Volumes entirely beyond the near plane: front faces, depth test LessEqual.
     pub front: Vec<u32>,
+    /// Volumes reaching the near plane but not the far one: back faces, GreaterEqual.
     pub back: Vec<u32>,
+    /// Volumes reaching both planes: a full-screen triangle, no depth test.
     pub full: Vec<u32>,
+    /// Stencil-tested lights (only when asked): every volume not reaching the far plane,
+    /// marked by two-sided z-fail stencil then lit; empty otherwise.
     pub stencil: Vec<u32>,
     /// Per class (front, back, full, stencil), where its cone volumes start.
     pub cones_from: [u32; 4],

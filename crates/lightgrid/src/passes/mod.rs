@@ -42,10 +42,15 @@ pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
 
 /// What a full-screen pass (`vs_fullscreen` + one fragment entry, no depth) draws with.
 pub struct FullscreenDesc<'a> {
+    /// Label of the pipeline and its pipeline layout.
     pub label: &'a str,
+    /// The shader holding `vs_fullscreen` and the fragment entry point.
     pub shader: &'a ComposedShader,
+    /// Name of the fragment entry point in `shader`.
     pub fragment_entry: &'a str,
+    /// Layout of group 0, the pipeline's only bind group.
     pub layout: &'a wgpu::BindGroupLayout,
+    /// Format of the one colour target.
     pub target: wgpu::TextureFormat,
     /// Samples per pixel of the target.
     pub samples: u32,

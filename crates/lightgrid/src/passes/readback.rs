@@ -13,6 +13,7 @@ pub struct Readback {
 }
 
 impl Readback {
+    /// A readback (buffer labelled `label`) for one `width` × `height` texture, 4 bytes a texel.
     pub fn new(device: &wgpu::Device, label: &str, width: u32, height: u32) -> Self {
         let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;

@@ -20,6 +20,7 @@ pub trait SettingValue: Copy + PartialEq + Sized + 'static {
     const FLAG: &'static str;
     /// Every value the option accepts, the default first.
     const VALUES: &'static [Self];
+    /// The value's name: what the option takes on the command line and results show.
     fn name(self) -> &'static str;
     /// One line for `--help`.
     fn help(self) -> &'static str;
@@ -238,7 +239,9 @@ impl SettingValue for GBufferFormat {
 /// A named value of an axis, for `--help`.
 #[derive(Clone, Copy, Debug)]
 pub struct AxisValue {
+    /// The value as the option takes it ([`SettingValue::name`]).
     pub name: &'static str,
+    /// One line describing it ([`SettingValue::help`]).
     pub help: &'static str,
 }
 

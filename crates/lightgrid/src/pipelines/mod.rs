@@ -25,12 +25,16 @@ pub(crate) use transparent::{TransparentLights, TransparentPass};
 
 /// What a pipeline needs to create its GPU objects.
 pub struct PipelineContext<'a> {
+    /// The device the pipeline's GPU objects are created on.
     pub device: &'a wgpu::Device,
     /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
     pub scene_layout: &'a wgpu::BindGroupLayout,
     /// Group 0 of the culling kernels (`culling::cull_layout`).
     pub cull_layout: &'a wgpu::BindGroupLayout,
+    /// The frame's size and tiles in pixels (`--tile`), as a one-slice grid; a clustered grid
+    /// adds its view-depth slices each frame.
     pub dims: GridDims,
+    /// The renderer's settings, shared by every pipeline it creates.
     pub settings: RenderSettings,
     /// The BRDF and light units every module holding the light function is made for
     /// (`ComposedShader::specialized`).
@@ -105,20 +109,43 @@ pub enum Msaa {
 /// Every pipeline's id, as a constant: code that names a pipeline uses these, so a renamed
 /// or removed pipeline is a compile error there, not a silently unmatched string.
 pub mod ids {
+    /// Brute-force forward shading, every light for every fragment: the reference image.
     pub const FORWARD: &str = "forward";
     pub(crate) const FORWARD_MONO: &str = "forward_mono";
     pub(crate) const FORWARD_MONO_ALBEDO: &str = "forward_mono_albedo";
+    /// Tile grid without depth bounds (every tile spans near..far), read by forward shading
+    /// (tiled-shading §3).
     pub const TILED_FORWARD: &str = "tiled_forward";
+    /// Depth pre-pass, per-tile depth bounds, tile grid, forward shading with early-Z
+    /// (forward-plus; tiled-shading §6.3).
     pub const TILED_FORWARD_PREZ: &str = "tiled_forward_prez";
+    /// G-buffer, per-tile depth bounds, tile grid, one compute pass shading each sample
+    /// (tiled-shading §2, §6).
     pub const TILED_DEFERRED: &str = "tiled_deferred";
     pub(crate) const TILED_DEFERRED_SINGLE: &str = "tiled_deferred_single";
+    /// Depth pre-pass, grid of (tile, view-depth slice) clusters holding samples, forward
+    /// shading (tiled-forward-shading §4.8).
     pub const CLUSTERED_FORWARD: &str = "clustered_forward";
+    /// G-buffer, cluster grid, one compute pass shading each sample from its cluster
+    /// (tiled-forward-shading §4.8).
     pub const CLUSTERED_DEFERRED: &str = "clustered_deferred";
+    /// Classic deferred shading: G-buffer, then each light's volume rasterized with additive
+    /// blending.
     pub const DEFERRED: &str = "deferred";
+    /// As [`DEFERRED`], with a two-sided stencil pass per light so only samples inside its
+    /// volume are shaded.
     pub const DEFERRED_STENCIL: &str = "deferred_stencil";
+    /// As [`DEFERRED`], with a one-value specular albedo in the diffuse target's alpha (three
+    /// G-buffer targets); checked against `forward_mono_albedo`.
     pub const DEFERRED_MONO: &str = "deferred_mono";
+    /// Deferred lighting (light pre-pass): diffuse and specular irradiance per light volume,
+    /// then a second geometry pass applies the materials.
     pub const LIGHT_PREPASS: &str = "light_prepass";
+    /// Light pre-pass with monochrome specular irradiance in the diffuse target's alpha;
+    /// checked against `forward_mono`.
     pub const LIGHT_PREPASS_MONO: &str = "light_prepass_mono";
+    /// Compute-based deferred lighting (forward-plus §5's baseline): one compute pass per tile
+    /// accumulates its lights into one mono-specular irradiance target, then a geometry pass.
     pub const TILED_LIGHT_PREPASS: &str = "tiled_light_prepass";
 }
 
@@ -126,6 +153,7 @@ pub mod ids {
 pub struct PipelineInfo {
     /// The id used on the command line and in stats.
     pub id: &'static str,
+    /// One line on what the pipeline does, for `lightgrid list` and the viewer's tooltips.
     pub description: &'static str,
     /// Where the technique is described.
     pub paper: &'static str,
@@ -418,9 +446,6 @@ pub const PIPELINES: &[PipelineInfo] = &[
     },
 ];
 
-/// Every shader the library can create, for the validation test: the shared passes, the
-/// culling stages and the registry's pipelines, every value of each keyed stage
-/// (`shader::ShaderKey::all`), once each (pipelines sharing a stage list it each).
 /// The WGSL light loop a grid-reading shader composes after `shader::src::LIGHT_GRID`.
 pub(crate) fn light_loop_wgsl(l: crate::frame::LightLoop) -> &'static str {
     match l {
@@ -429,6 +454,9 @@ pub(crate) fn light_loop_wgsl(l: crate::frame::LightLoop) -> &'static str {
     }
 }
 
+/// Every shader the library can create, for the validation test: the shared passes, the
+/// culling stages and the registry's pipelines, every value of each keyed stage
+/// (`shader::ShaderKey::all`), once each (pipelines sharing a stage list it each).
 pub fn all_shaders() -> Vec<ComposedShader> {
     let mut out = crate::passes::shaders();
     out.extend(crate::culling::shaders());
@@ -455,6 +483,7 @@ fn pipeline_names() -> String {
         .join(", ")
 }
 
+/// The registry row with id `id`; an unknown id is an error listing every pipeline id.
 pub fn find(id: &str) -> Result<&'static PipelineInfo> {
     PIPELINES
         .iter()

@@ -5,14 +5,20 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+/// A perspective camera at one frame: where it is, what it looks at, and its frustum.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Position of the eye, in world space.
     pub eye: Vec3,
+    /// World-space point the camera looks at (the view direction is `target - eye`).
     pub target: Vec3,
+    /// World-space up direction; need not be unit length or orthogonal to the view direction.
     pub up: Vec3,
     /// Vertical field of view in radians.
     pub fov_y: f32,
+    /// Distance to the near plane along the view direction, in scene units; maps to depth 1.
     pub near: f32,
+    /// Distance to the far plane along the view direction, in scene units; maps to depth 0.
     pub far: f32,
 }
 
@@ -91,8 +97,11 @@ pub struct CameraPath {
     /// throughout (the catalog's cameras). A file's camera keeps its roll this way, and one
     /// looking straight up or down its orientation.
     pub ups: Vec<Vec3>,
+    /// Vertical field of view in radians, the same at every frame.
     pub fov_y: f32,
+    /// Near-plane distance in scene units, the same at every frame.
     pub near: f32,
+    /// Far-plane distance in scene units, the same at every frame.
     pub far: f32,
 }
 
@@ -122,6 +131,8 @@ impl CameraPath {
         self.keys.last().map_or(1, |k| k.0 + 1)
     }
 
+    /// The camera at `frame`: eye, target and up interpolated between the keys around it,
+    /// held at the first or last key outside them.
     pub fn at(&self, frame: u32) -> Camera {
         let n = self.keys.len();
         let seg = self

@@ -33,6 +33,7 @@ pub const STRESS_MAX_LIGHTS: u32 = 1_000_000;
 /// What the user can vary when building a catalog scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneParams {
+    /// Seed of the scene's random placement of lights, objects and colours (`--seed`).
     pub seed: u64,
     /// Light count; only scenes with `variable_lights` accept it.
     pub lights: Option<u32>,
@@ -110,7 +111,9 @@ pub(crate) fn make_spots(scene: &mut Scene, seed: u64, fraction: f32) {
 
 /// One catalog row.
 pub struct SceneInfo {
+    /// The name the scene is chosen by (`robots-many`, `stress`, ...).
     pub name: &'static str,
+    /// One line on what the scene holds, as `lightgrid list` prints it.
     pub description: &'static str,
     /// Accepts `--lights N`.
     pub variable_lights: bool,

@@ -29,6 +29,7 @@ pub enum Brdf {
 }
 
 impl Brdf {
+    /// The BRDF's `--brdf` value (and serialized name): `phong` or `ggx`.
     pub fn name(self) -> &'static str {
         match self {
             Brdf::Phong => "phong",
@@ -125,8 +126,10 @@ pub enum Shadows {
 }
 
 impl Shadows {
+    /// Every shadow mode, in the order `--shadows` lists them.
     pub const ALL: [Shadows; 3] = [Shadows::Off, Shadows::Rays, Shadows::Maps];
 
+    /// The mode's `--shadows` value: `off`, `rays` or `maps`.
     pub fn name(self) -> &'static str {
         match self {
             Shadows::Off => "off",
@@ -151,8 +154,11 @@ impl Shadows {
 /// scene, `--brdf` or `--shadows` changes them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Shading {
+    /// The BRDF the light function evaluates.
     pub brdf: Brdf,
+    /// The lights' units, which pick the distance falloff ([`LightUnits::falloff`]).
     pub units: LightUnits,
+    /// How lights cast shadows.
     pub shadows: Shadows,
     /// With shadow maps: the pipeline re-uses one light's maps (the classic deferred
     /// family's light volumes, `crate::shadows::maps`), so a face's tile is its cube face's.
@@ -243,7 +249,9 @@ impl Shading {
 /// (what `--brdf auto` renders), and the exposure that turns its light into display units.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Lighting {
+    /// What the lights' colour × intensity means (and so their falloff with distance).
     pub units: LightUnits,
+    /// The BRDF the materials were made for: what `--brdf auto` renders with.
     pub brdf: Brdf,
     /// The spots' window between their cones.
     #[serde(default)]

@@ -13,9 +13,13 @@ pub(crate) fn bounds_of(points: impl IntoIterator<Item = Vec3>) -> Option<(Vec3,
 /// An indexed triangle mesh (counter-clockwise front faces).
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
+    /// Vertex positions in the mesh's own (object) space.
     pub positions: Vec<Vec3>,
+    /// Unit vertex normals in object space, one per position.
     pub normals: Vec<Vec3>,
+    /// Texture coordinate set 0, one per position (UV (0, 0) is a texture's first texel).
     pub uvs: Vec<Vec2>,
+    /// Three vertex indices per triangle, counter-clockwise seen from the front.
     pub indices: Vec<u32>,
     /// Per vertex, or empty: tangents (xyz, and the bitangent's sign in w) for normal
     /// textures, from the file or generated (MikkTSpace).
@@ -27,6 +31,7 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Number of triangles (a third of the indices).
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }

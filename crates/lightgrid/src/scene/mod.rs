@@ -33,12 +33,22 @@ use glam::{Mat4, Quat, Vec3};
 /// back to front, blended with `alpha` (its fragments' coverage).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
+    /// Diffuse reflectance (linear RGB), the colour the lights' `n·l` term is multiplied by.
     pub diffuse: Vec3,
+    /// Specular colour (linear RGB): the Blinn-Phong highlight's weight, or `F0` under GGX.
     pub specular: Vec3,
+    /// Blinn-Phong exponent `s` of the highlight; GGX reads it as the roughness
+    /// `α = √(2 / (s + 2))`.
     pub shininess: f32,
+    /// Light the surface emits (linear RGB), added whatever the lights.
     pub emissive: Vec3,
+    /// Colour (linear RGB) the scene's constant ambient light (`consts::SCENE_AMBIENT`) is
+    /// multiplied by.
     pub ambient: Vec3,
+    /// Opacity from 0 to 1 (times the base-colour texture's): a transparent material's blend
+    /// coverage, and what `alpha_cutoff` tests.
     pub alpha: f32,
+    /// Drawn blended after the opaque geometry, back to front, instead of opaque.
     pub transparent: bool,
     /// How the material responds to the view (its shader).
     pub shader: MaterialShader,
@@ -75,7 +85,10 @@ pub struct Material {
 pub struct MetallicRoughness {
     /// The base colour factor (its alpha is the material's `alpha`).
     pub base: Vec3,
+    /// Metalness from 0 (dielectric) to 1 (metal), glTF's `metallicFactor`.
     pub metallic: f32,
+    /// Perceptual roughness from 0 (smooth) to 1 (rough), glTF's `roughnessFactor`; the GGX
+    /// `α` is its square.
     pub roughness: f32,
     /// A texture whose B channel scales `metallic` and G `roughness` (linear, in
     /// [`Scene::textures`]).
@@ -87,8 +100,11 @@ pub struct MetallicRoughness {
 /// the sampler's decode gives back the file's values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// `width × height` texels of 4 bytes (R, G, B, A), row by row from the top.
     pub rgba: Vec<u8>,
 }
 
@@ -102,9 +118,19 @@ pub enum MaterialShader {
     Standard,
     /// Two-colour car paint: the diffuse colour turns toward `flip` at grazing angles,
     /// `(1 - n·v)^power`.
-    CarPaint { flip: Vec3, power: f32 },
+    CarPaint {
+        /// The colour (linear RGB) the diffuse colour turns toward at grazing angles.
+        flip: Vec3,
+        /// Exponent on `1 - n·v`: larger keeps the flip closer to the silhouette.
+        power: f32,
+    },
     /// A rim: `color × (1 - n·v)^power` added to the diffuse colour, lit by the lights.
-    Rim { color: Vec3, power: f32 },
+    Rim {
+        /// The rim's colour (linear RGB), at full strength where the surface is seen edge-on.
+        color: Vec3,
+        /// Exponent on `1 - n·v`: larger makes the rim thinner.
+        power: f32,
+    },
 }
 
 impl MaterialShader {
@@ -179,6 +205,8 @@ impl Material {
         }
     }
 
+    /// The material as the shaders read it (texture indices plus one, 0 for none; UV
+    /// transforms as rows of a 2×3 matrix).
     pub fn to_gpu(&self) -> GpuMaterial {
         let (shader, paint, paint_power) = self.shader.gpu();
         let mr = self.metallic_roughness;
@@ -238,10 +266,17 @@ impl Material {
 /// shines in every direction; a spot light (`spot`) only inside its outer cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
+    /// Position in world space; in a [`SceneLight`] anchored to an object or a track, in that
+    /// anchor's frame; camera-relative after [`Light::relative_to`].
     pub position: Vec3,
+    /// Colour (linear RGB); colour × `intensity` is the light's radiance.
     pub color: Vec3,
+    /// Strength multiplying `color`, in the scene's [`LightUnits`] (candela for photometric
+    /// lights).
     pub intensity: f32,
+    /// Distance from `position`, in scene units, at and beyond which the light adds nothing.
     pub range: f32,
+    /// The cone of a spot light; `None` for a point light.
     pub spot: Option<Spot>,
 }
 
@@ -251,7 +286,9 @@ pub struct Light {
 pub struct Spot {
     /// Unit axis of the cone, from the light outwards.
     pub direction: Vec3,
+    /// Cosine of the inner cone's half-angle: full intensity at angles from `direction` within it.
     pub cos_inner: f32,
+    /// Cosine of the outer cone's half-angle (below `cos_inner`): no light at or beyond it.
     pub cos_outer: f32,
 }
 
@@ -484,10 +521,12 @@ impl Light {
 /// A closed polyline in the xz plane that something walks along.
 #[derive(Clone, Debug)]
 pub struct Path {
+    /// The corners in order, in world space; the last joins back to the first.
     pub points: Vec<Vec3>,
 }
 
 impl Path {
+    /// Length of the whole loop (the closing segment included), in scene units.
     pub fn length(&self) -> f32 {
         self.segments().map(|(a, b)| a.distance(b)).sum()
     }
@@ -517,12 +556,16 @@ impl Path {
 /// How an object moves over the animation.
 #[derive(Clone, Debug)]
 pub enum Motion {
+    /// Does not move: `Object::local` places it in the world.
     Static,
     /// Walks along `paths[path]` at `speed` units per frame, starting at arc length `start`,
     /// facing the direction of travel.
     Walk {
+        /// Index into [`Scene::paths`].
         path: usize,
+        /// Arc length travelled per frame, in scene units.
         speed: f32,
+        /// Arc length along the path at frame 0, in scene units.
         start: f32,
     },
     /// Moves as [`Scene::tracks`]`[track]` says: one transform per frame, applied to `local`
@@ -533,10 +576,13 @@ pub enum Motion {
 /// A mesh placed in the world with a material.
 #[derive(Clone, Debug)]
 pub struct Object {
+    /// Index into [`Scene::meshes`].
     pub mesh: usize,
+    /// Index into [`Scene::materials`].
     pub material: usize,
     /// Placement relative to the motion's frame (or the world, for static objects).
     pub local: Mat4,
+    /// How the object moves over the animation.
     pub motion: Motion,
 }
 
@@ -550,6 +596,7 @@ impl Object {
 /// Where a light sits: fixed in the world, or carried by an object.
 #[derive(Clone, Copy, Debug)]
 pub enum LightAnchor {
+    /// Fixed: `light.position` is in world space.
     World,
     /// Offset from the object's motion frame.
     Object(usize),
@@ -559,8 +606,12 @@ pub enum LightAnchor {
     /// circle of `radius` through it, a turn every `frames_per_turn` frames, the axis at
     /// angle `phase` from it (the Forward+ demo's moving lights).
     Circle {
+        /// Radius of the circle, in scene units.
         radius: f32,
+        /// Frames per full turn (at least 1 is used).
         frames_per_turn: f32,
+        /// Angle in radians, in the xz plane from +x toward +z, of the frame-0 position as
+        /// seen from the axis.
         phase: f32,
     },
 }
@@ -573,24 +624,33 @@ fn circle_position(start: Vec3, radius: f32, frames_per_turn: f32, phase: f32, f
     start + (at(phase + turn) - at(phase))
 }
 
+/// One of a scene's lights and what carries it through the animation.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneLight {
     /// For `LightAnchor::Object`, `light.position` is relative to the object.
     pub light: Light,
+    /// What moves the light from frame to frame (nothing, for [`LightAnchor::World`]).
     pub anchor: LightAnchor,
 }
 
 /// A complete scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The catalog scene's name, or the file's stem; messages name the scene by it.
     pub name: String,
+    /// The meshes objects place, each in its own object space.
     pub meshes: Vec<Mesh>,
+    /// The materials objects use (at most `consts::MAX_MATERIALS`).
     pub materials: Vec<Material>,
+    /// Every placed mesh.
     pub objects: Vec<Object>,
+    /// The loops [`Motion::Walk`] objects follow.
     pub paths: Vec<Path>,
+    /// Every light with its anchor (at least one, at most [`MAX_LIGHTS`]).
     pub lights: Vec<SceneLight>,
     /// Base-colour textures the materials name (loaded scenes; the catalog has none).
     pub textures: Vec<Texture>,
+    /// The camera over the animation; its last key sets the frame count.
     pub camera_path: CameraPath,
     /// Frame size used when the user gives none.
     pub default_size: (u32, u32),
@@ -609,7 +669,10 @@ pub struct Scene {
 /// nearest.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Geometry {
+    /// The baked objects' vertices, positions and normals in world space.
     pub vertices: Vec<GpuVertex>,
+    /// Three vertex indices per triangle; `vertices[0]` has index `base`, the vertex the
+    /// geometry was baked to start at (0 for [`Scene::geometry`]).
     pub indices: Vec<u32>,
     /// `indices[..opaque_indices]` are opaque, the rest transparent, back to front.
     pub opaque_indices: usize,
@@ -625,7 +688,9 @@ pub struct Draw {
     pub shader: u32,
     /// The run's materials are alpha tested (a depth-only pass needs a fragment stage).
     pub alpha_test: bool,
+    /// Position of the run's first index in [`Geometry::indices`].
     pub first: u32,
+    /// Number of indices in the run (three per triangle).
     pub count: u32,
 }
 
@@ -665,14 +730,18 @@ impl Geometry {
 /// The scene evaluated at one frame.
 #[derive(Clone, Debug)]
 pub struct FrameState {
+    /// The frame evaluated.
     pub frame: u32,
+    /// The camera at this frame.
     pub camera: Camera,
+    /// Every light at this frame in world space, in [`Scene::lights`]' order.
     pub lights: Vec<Light>,
     /// World transform of each object.
     pub transforms: Vec<Mat4>,
 }
 
 impl Scene {
+    /// Number of frames in the animation: the camera path's (last key frame + 1).
     pub fn frame_count(&self) -> u32 {
         self.camera_path.frame_count()
     }
@@ -1098,6 +1167,7 @@ impl Scene {
         Ok(())
     }
 
+    /// Every material as the shaders read it ([`Material::to_gpu`]), in index order.
     pub fn materials_gpu(&self) -> Vec<GpuMaterial> {
         self.materials.iter().map(Material::to_gpu).collect()
     }

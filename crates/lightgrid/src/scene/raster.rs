@@ -11,8 +11,11 @@ use glam::{Vec2, Vec3};
 /// A fragment: pixel (x, y) and its view distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Fragment {
+    /// Pixel column, from the left.
     pub x: u32,
+    /// Pixel row, from the top.
     pub y: u32,
+    /// View distance (view-space -z) of the fragment at the pixel centre, in scene units.
     pub w: f32,
 }
 

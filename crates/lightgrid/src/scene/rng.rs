@@ -1,14 +1,17 @@
 //! A small deterministic generator (SplitMix64), so catalog scenes depend only on their seed
 //! and never on a crate's stream changing between versions.
 
+/// A SplitMix64 stream: the same seed gives the same numbers on every platform and version.
 #[derive(Clone, Debug)]
 pub struct Rng(u64);
 
 impl Rng {
+    /// A stream determined by `seed` alone.
     pub fn new(seed: u64) -> Self {
         Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
     }
 
+    /// The next 64 uniformly distributed random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;

@@ -14,6 +14,7 @@ use std::path::PathBuf;
 /// scenes: uniform in the bounding box, random hues.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AddLights {
+    /// How many point lights to add: at least 1, and with the scene's own at most `MAX_LIGHTS`.
     pub count: u32,
     /// `None`: `default_added_range`.
     pub range: Option<f32>,
@@ -27,10 +28,15 @@ pub(crate) const ADDED_LIGHT_COVERAGE: f32 = 8.0;
 /// A scene to open: a catalog name or a `.gltf`/`.glb` path, with the options.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneRequest {
+    /// A catalog scene's name, or a `.gltf`/`.glb` file's path (its name alone with
+    /// `contents`).
     pub spec: String,
+    /// The catalog's options; for a file only the seed, `--spot-fraction` and
+    /// `--transparency` apply.
     pub params: SceneParams,
     /// `--camera N` (files only).
     pub camera: Option<usize>,
+    /// `--add-lights`: point lights to scatter over the scene's bounds.
     pub add_lights: Option<AddLights>,
     /// `--exposure`: replaces the scene's (`Lighting::exposure`; the catalog's is 1, a
     /// file's automatic).
@@ -79,7 +85,9 @@ impl SceneRequest {
 /// An opened scene and the warnings loading it gave (skipped parts of a file).
 #[derive(Debug)]
 pub struct Opened {
+    /// The scene, with its added lights and spots, validated.
     pub scene: Scene,
+    /// What loading a file skipped or approximated; empty for catalog scenes.
     pub warnings: Vec<String>,
 }
 

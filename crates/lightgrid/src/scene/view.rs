@@ -23,6 +23,8 @@ pub enum SpotCull {
     Cone,
 }
 
+/// One frame's camera as light assignment sees it: view rotation, projection scale, depth
+/// range and frame size in pixels.
 #[derive(Clone, Copy, Debug)]
 pub struct ViewSetup {
     /// Camera-relative space to view space: a rotation (`Camera::rotation`).
@@ -31,10 +33,15 @@ pub struct ViewSetup {
     pub eye: Vec3,
     /// `proj[0][0]` and `proj[1][1]`: x_ndc = p00 * x / w, y_ndc = p11 * y / w.
     pub p00: f32,
+    /// `proj[1][1]`: the vertical projection scale, 1 / tan(fov_y / 2).
     pub p11: f32,
+    /// Near-plane view distance (the camera's `near`), in scene units.
     pub near: f32,
+    /// Far-plane view distance (the camera's `far`), in scene units.
     pub far: f32,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
     /// What spot lights are culled by; `to_view` hands it to each light.
     pub spot_cull: SpotCull,
@@ -46,8 +53,11 @@ pub struct ViewSetup {
 pub struct ViewLight {
     /// Bounding sphere: everything the light reaches is inside it.
     pub center: Vec3,
+    /// Radius of the bounding sphere, in scene units.
     pub radius: f32,
+    /// The light's position in view space (a spot's cone apex).
     pub apex: Vec3,
+    /// The light's range: it reaches nothing at or beyond this distance from `apex`.
     pub range: f32,
     /// A spot's unit axis and outer cosine.
     pub cone: Option<(Vec3, f32)>,
@@ -144,6 +154,8 @@ impl ViewLight {
 }
 
 impl ViewSetup {
+    /// The setup for `camera` rendering a `width` × `height` pixel frame, culling spots by
+    /// [`SpotCull`]'s default.
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
         let proj = camera.proj(width as f32 / height as f32);
         ViewSetup {

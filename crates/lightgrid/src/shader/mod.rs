@@ -25,9 +25,12 @@ use crate::scene::Shading;
 /// Shared WGSL sources, in the order a shader lists them. A slice is a group of files a
 /// shader always takes together, in that order.
 pub mod src {
+    /// The structs every stage shares (light, material, frame uniforms, BVH node, ...).
     pub const TYPES: &str = include_str!("../shading/types.wgsl");
     /// `LightGridParams`, the grid's uniform (lightgrid's shaders and the caller's).
     pub const GRID_PARAMS: &str = include_str!("../culling/grid/grid_params.wgsl");
+    /// Group 0 of the scene passes: frame uniforms, lights, materials, light bounds, the frame's
+    /// counters and per-pixel counts.
     pub const SCENE_BINDINGS: &str = include_str!("../shading/scene_bindings.wgsl");
     /// The light function; needs the shading defs (`ComposedShader::specialized`).
     pub(crate) const LIGHT_FUNCTION: &str = include_str!("../shading/lighting.wgsl");
@@ -102,6 +105,7 @@ pub(crate) use parts;
 /// ([`Self::source_for`]).
 #[derive(Clone, Debug)]
 pub struct ComposedShader {
+    /// The label: the stage's name and key value; names the module and composition errors.
     pub name: String,
     /// Starts with the constants prelude (every shader but the caller's).
     prelude: bool,
@@ -113,7 +117,9 @@ pub struct ComposedShader {
 /// bool, the condition of `#if` lines.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Def {
+    /// A `const NAME: bool`, also the condition of `#if NAME` / `#if !NAME` lines.
     Bool(&'static str, bool),
+    /// A `const NAME: u32`.
     U32(&'static str, u32),
     /// A `const` of WGSL type `.1` and value `.2` (an array of sample positions).
     Wgsl(&'static str, String, String),

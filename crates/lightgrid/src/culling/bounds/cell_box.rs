@@ -31,8 +31,11 @@ use glam::Vec3;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CellCull {
+    /// The 2.5D depth mask: which of 32 bins of the cell's bounds hold samples.
     pub mask: CellMask,
+    /// The box's view-space minimum corner; `w` = 1 when the cell has a box.
     pub lo: [f32; 4],
+    /// The box's view-space maximum corner.
     pub hi: [f32; 4],
 }
 

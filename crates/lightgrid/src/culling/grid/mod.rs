@@ -13,19 +13,26 @@ use crate::gpu_types::GridParams;
 /// `depth_range.rs`). Cell index = (slice * tiles_y + ty) * tiles_x + tx.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridDims {
+    /// Tile edge in pixels (tiles are square).
     pub tile_size: u32,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
+    /// Tile columns: `width / tile_size` rounded up (the last column may be partial).
     pub tiles_x: u32,
+    /// Tile rows: `height / tile_size` rounded up (the last row may be partial).
     pub tiles_y: u32,
     /// 1 for a tiled grid.
     pub slices: u32,
     /// The view-distance range the slices are spread over.
     pub near: f32,
+    /// Far end of that range (`near` is the near end); unused by a tiled grid.
     pub far: f32,
     /// slice = floor(ln(w) * slice_scale + slice_bias): from `near` and `far`, or exactly the
     /// GPU's values when it spread the slices ([`GridDims::with_slicing`]).
     pub slice_scale: f32,
+    /// The additive term of the slice formula above; unused by a tiled grid.
     pub slice_bias: f32,
     /// Which samples the lists cover: opaque samples only, or transparent fragments too.
     pub lists: GridLists,
@@ -126,6 +133,7 @@ impl GridDims {
         (c / self.layer_cells()) as u32
     }
 
+    /// Screen tile of pixel (x, y): `ty * tiles_x + tx`, also its cell in slice 0.
     pub fn tile_of(&self, x: u32, y: u32) -> usize {
         ((y / self.tile_size) * self.tiles_x + x / self.tile_size) as usize
     }
@@ -188,6 +196,8 @@ impl GridDims {
         )
     }
 
+    /// The shape as the shaders' `LightGridParams` uniform (slicing zeroed for a tiled grid;
+    /// z-bin words and mask offset 0 unless z-binned).
     pub fn params(&self) -> GridParams {
         let (slice_scale, slice_bias) = self.slice_params();
         GridParams {
@@ -210,8 +220,11 @@ impl GridDims {
 /// The grid: `cells[c] = [offset, count]` into `indices`, which hold light indices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightGrid {
+    /// The shape: cell count and cell index convention ([`GridDims`]).
     pub dims: GridDims,
+    /// Per cell, `[offset, count]`: its list is `indices[offset..offset + count]`.
     pub cells: Vec<[u32; 2]>,
+    /// Every cell's list back to back: indices into the scene's light buffer.
     pub indices: Vec<u32>,
     /// A z-binned grid's compact form (what the GPU holds); `cells` and `indices` are then
     /// the lists it stands for.
@@ -251,6 +264,7 @@ impl LightGrid {
         }
     }
 
+    /// Mean list length: index entries over all cells (empty cells and every layer counted).
     pub fn average_lights_per_cell(&self) -> f64 {
         self.indices.len() as f64 / self.cells.len().max(1) as f64
     }
@@ -283,6 +297,7 @@ impl LightGrid {
         )
     }
 
+    /// Longest list of any cell (0 for a grid without cells).
     pub fn max_lights_per_cell(&self) -> u32 {
         self.cells.iter().map(|c| c[1]).max().unwrap_or(0)
     }
@@ -304,6 +319,7 @@ impl LightGrid {
 
 /// The grid on the GPU: group 1 of every grid-reading shader (`culling/grid/light_grid.wgsl`).
 pub struct GridBuffers {
+    /// The layout of group 1 ([`Self::layout`]'s), for the shading pipelines' layouts.
     pub layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     cells: wgpu::Buffer,
@@ -319,6 +335,8 @@ impl GridBuffers {
     #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub const INITIAL_INDEX_CAPACITY: u32 = crate::consts::INITIAL_INDEX_CAPACITY;
 
+    /// The grid's group layout: params (uniform), cells, indices and cell bounds (storage,
+    /// read), visible to fragment and compute stages.
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -395,6 +413,7 @@ impl GridBuffers {
         }
     }
 
+    /// Group 1 of the shading passes: the grid's four buffers.
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         &self.bind_group
     }
@@ -446,14 +465,17 @@ impl GridBuffers {
         }
     }
 
+    /// The `GridParams` uniform.
     pub fn params_buffer(&self) -> &wgpu::Buffer {
         &self.params
     }
 
+    /// Each cell's (offset, count) into the index list.
     pub fn cells_buffer(&self) -> &wgpu::Buffer {
         &self.cells
     }
 
+    /// The index list: light indices, each cell's run at its offset.
     pub fn indices_buffer(&self) -> &wgpu::Buffer {
         &self.indices
     }

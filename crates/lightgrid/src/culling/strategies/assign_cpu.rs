@@ -28,9 +28,13 @@ use web_time::Instant;
 /// Pixels covered by a projected light: inclusive pixel index ranges, clipped to the frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelRect {
+    /// First covered column.
     pub x0: u32,
+    /// Last covered column (inclusive).
     pub x1: u32,
+    /// First covered row (from the top).
     pub y0: u32,
+    /// Last covered row (inclusive).
     pub y1: u32,
 }
 

@@ -28,11 +28,13 @@ pub use crate::gpu_types::BvhNode;
 
 #[cfg_attr(not(feature = "testing"), allow(dead_code))]
 impl BvhNode {
+    /// Does the node hold lights (slots of [`LightBvh::order`]) rather than child nodes?
     #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub fn is_leaf(&self) -> bool {
         self.count & BVH_LEAF != 0
     }
 
+    /// The node's children: node indices, or for a leaf the slots of [`LightBvh::order`].
     #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub fn children(&self) -> std::ops::Range<u32> {
         self.first..self.first + (self.count & !BVH_LEAF)
@@ -42,7 +44,9 @@ impl BvhNode {
 /// The hierarchy: `nodes[0]` is the root; `order[slot]` is the light a leaf slot refers to.
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
+    /// The nodes, root first, each level after the one above.
     pub nodes: Vec<BvhNode>,
+    /// The light (its index in the scene's light list) of each leaf slot.
     pub order: Vec<u32>,
 }
 

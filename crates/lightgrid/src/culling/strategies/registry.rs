@@ -8,6 +8,7 @@ use crate::frame::Assign;
 
 /// One registry row.
 pub struct StrategyInfo {
+    /// The strategy this row describes.
     pub assign: Assign,
     /// The `--assign` value (and serde's, `Assign`'s attributes: a test checks they agree).
     pub name: &'static str,
@@ -106,6 +107,7 @@ impl Assign {
         STRATEGIES.iter().map(|s| s.assign).chain([Assign::Auto])
     }
 
+    /// The strategy's `--assign` value (also its serde name); `auto` for [`Assign::Auto`].
     pub fn name(self) -> &'static str {
         find_strategy(self).map_or(AUTO_NAME, |s| s.name)
     }

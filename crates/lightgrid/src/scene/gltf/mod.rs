@@ -66,7 +66,10 @@ pub struct LoadOptions {
 /// A loaded scene and what was skipped on the way.
 #[derive(Debug)]
 pub struct Loaded {
+    /// The imported scene.
     pub scene: Scene,
+    /// What the import skipped or approximated, one message each, without repeats (at most
+    /// 50; a last one then says how many more there were).
     pub warnings: Vec<String>,
 }
 
