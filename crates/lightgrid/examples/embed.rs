@@ -261,7 +261,8 @@ impl Program {
         culler.encode(
             &mut encoder,
             &CullInputs {
-                depth: &self.depth,
+                depth: Some(&self.depth),
+                transparent: false,
                 lights: &self.lights,
                 light_count: LIGHTS,
                 view: view.to_cols_array_2d(),

@@ -8,6 +8,7 @@
 //! input it names.
 
 use glam::{Mat4, Vec3};
+use lightgrid::culling::GridLists;
 use lightgrid::{
     Assign, CellBox, CullConfig, CullError, CullInput, CullInputs, CullLight, DepthBounds,
     DepthMask, LightCuller,
@@ -179,12 +180,15 @@ struct Check {
     near: f32,
     far: f32,
     standard: u32,
-    pad: [u32; 3],
+    /// 0: check the depth buffer's samples; 1: a transparent surface's fragment in front of
+    /// each sample, looked up with `light_grid_cell_transparent`.
+    mode: u32,
+    pad: [u32; 2],
 }
 
 const DEPTH_WGSL: &str = r#"
 struct Check { inv_rotation: mat4x4<f32>, eye: vec3<f32>, light_count: u32, a: f32, b: f32,
-    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, pad0: u32, pad1: u32, pad2: u32 }
+    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, mode: u32, pad1: u32, pad2: u32 }
 @group(0) @binding(0) var<uniform> c: Check;
 
 @vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
@@ -211,7 +215,7 @@ fn hash(p: vec2<f32>) -> f32 {
 
 const CHECK_WGSL: &str = r#"
 struct Check { inv_rotation: mat4x4<f32>, eye: vec3<f32>, light_count: u32, a: f32, b: f32,
-    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, pad0: u32, pad1: u32, pad2: u32 }
+    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, mode: u32, pad1: u32, pad2: u32 }
 struct MyLight { position: vec3<f32>, range: f32, payload: vec4<f32>, direction: vec3<f32>, cos_outer: f32 }
 @group(0) @binding(0) var<uniform> c: Check;
 @group(0) @binding(1) var<storage, read> my_lights: array<MyLight>;
@@ -233,6 +237,10 @@ fn reaches(l: MyLight, p: vec3<f32>) -> bool {
     return dot(d, l.direction) > (l.cos_outer + 1e-3) * dist;
 }
 
+fn noise(p: vec2<f32>) -> f32 {
+    return fract(sin(dot(p, vec2<f32>(12.9898, 78.233))) * 43758.547);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= u32(c.viewport.x) || gid.y >= u32(c.viewport.y)) {
@@ -244,13 +252,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (sky) {
             continue;
         }
-        let w = c.a / (d + c.b);
+        let opaque_w = c.a / (d + c.b);
         let xy = vec2<f32>(gid.xy) + 0.5;
+        // Mode 1: a transparent surface between the near plane and the sample.
+        let t = 0.02 + 0.96 * noise(xy + f32(s) * 0.37);
+        let w = select(opaque_w, c.near + (opaque_w - c.near) * t, c.mode == 1u);
         let ndc = vec2<f32>(xy.x / c.viewport.x * 2.0 - 1.0, 1.0 - xy.y / c.viewport.y * 2.0);
         let v = vec3<f32>(ndc.x * w / c.p00, ndc.y * w / c.p11, -w);
         // Camera-relative point; the lights are moved by the eye (world minus eye).
         let p = (c.inv_rotation * vec4<f32>(v, 0.0)).xyz;
-        let cell = light_grid_cell(xy, w);
+        let cell = select(light_grid_cell(xy, w), light_grid_cell_transparent(xy, w), c.mode == 1u);
         let n = light_grid_count(cell);
         atomicAdd(&result[2], n);
         atomicAdd(&result[3], 1u);
@@ -305,6 +316,8 @@ struct Caller {
     depth_pipeline: wgpu::RenderPipeline,
     check: wgpu::Buffer,
     lights: wgpu::Buffer,
+    /// The same lights with ranges 10% short: a culler fed these must fail the oracle.
+    shrunk_lights: wgpu::Buffer,
     light_count: u32,
     cam: Camera,
 }
@@ -380,16 +393,29 @@ impl Caller {
             near: NEAR,
             far: FAR,
             standard: u32::from(cam.standard),
-            pad: [0; 3],
+            mode: 0,
+            pad: [0; 2],
         };
         let check = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check"),
             contents: bytemuck::bytes_of(&check),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("caller lights"),
             contents: bytemuck::cast_slice(lights),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let shrunk: Vec<CullLight> = lights
+            .iter()
+            .map(|l| CullLight {
+                range: l.range * 0.9,
+                ..*l
+            })
+            .collect();
+        let shrunk_lights = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("caller lights, ranges 10% short"),
+            contents: bytemuck::cast_slice(&shrunk),
             usage: wgpu::BufferUsages::STORAGE,
         });
         Caller {
@@ -401,6 +427,7 @@ impl Caller {
             depth_pipeline,
             check,
             lights: light_buffer,
+            shrunk_lights,
             light_count: lights.len() as u32,
             cam,
         }
@@ -408,7 +435,8 @@ impl Caller {
 
     fn inputs(&self) -> CullInputs<'_> {
         CullInputs {
-            depth: &self.depth_view,
+            depth: Some(&self.depth_view),
+            transparent: false,
             lights: &self.lights,
             light_count: self.light_count,
             view: self.cam.view.to_cols_array_2d(),
@@ -422,7 +450,19 @@ impl Caller {
     /// Depth pre-pass, culling, and the oracle over every sample; returns the oracle's
     /// counts `[misses, reaching, listed, samples, x, y, light]` and the culler's report.
     fn frame(&self, culler: &mut LightCuller) -> ([u32; 7], lightgrid::CullReport) {
+        self.frame_as(culler, Mode::default())
+    }
+
+    /// [`Self::frame`], the culler given the depth or not and asked for transparent lists or
+    /// not, and the oracle checking the samples or transparent fragments in front of them.
+    fn frame_as(&self, culler: &mut LightCuller, mode: Mode) -> ([u32; 7], lightgrid::CullReport) {
         let device = &self.device;
+        // `mode` is the Check struct's word after `standard` (byte 120).
+        self.queue.write_buffer(
+            &self.check,
+            std::mem::offset_of!(Check, mode) as u64,
+            bytemuck::bytes_of(&u32::from(mode.check_transparent)),
+        );
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -452,9 +492,17 @@ impl Caller {
             pass.set_bind_group(0, &group, &[]);
             pass.draw(0..3, 0..1);
         }
-        let frame = culler
-            .encode(&mut encoder, &self.inputs())
-            .expect("culling");
+        let inputs = CullInputs {
+            depth: mode.depth.then_some(&self.depth_view),
+            transparent: mode.transparent_lists,
+            lights: if mode.shrunk {
+                &self.shrunk_lights
+            } else {
+                &self.lights
+            },
+            ..self.inputs()
+        };
+        let frame = culler.encode(&mut encoder, &inputs).expect("culling");
         let result = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("oracle result"),
             size: 32,
@@ -566,6 +614,30 @@ impl Caller {
     }
 }
 
+/// How a test frame is culled and checked.
+#[derive(Clone, Copy, Debug)]
+struct Mode {
+    /// The culler gets the depth buffer (`CullInputs::depth`).
+    depth: bool,
+    /// `CullInputs::transparent`.
+    transparent_lists: bool,
+    /// The oracle checks a transparent fragment in front of each sample instead of the sample.
+    check_transparent: bool,
+    /// The culler is given the lights with ranges 10% short (the oracle keeps the true ones).
+    shrunk: bool,
+}
+
+impl Default for Mode {
+    fn default() -> Self {
+        Mode {
+            depth: true,
+            transparent_lists: false,
+            check_transparent: false,
+            shrunk: false,
+        }
+    }
+}
+
 fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -582,10 +654,15 @@ fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLay
 /// Cull one frame with `config` and check it against the oracle; a frame whose lists did not
 /// fit is culled again (the lists grew from its report). Returns the lights listed per sample.
 fn check(caller: &Caller, config: CullConfig, what: &str) -> f64 {
+    check_as(caller, config, what, Mode::default())
+}
+
+/// [`check`], the frame culled and checked as `mode` says.
+fn check_as(caller: &Caller, config: CullConfig, what: &str, mode: Mode) -> f64 {
     let mut culler = LightCuller::new(&caller.device, &caller.queue, config).expect("culler");
-    let (mut r, mut report) = caller.frame(&mut culler);
+    let (mut r, mut report) = caller.frame_as(&mut culler, mode);
     if report.overflowed {
-        (r, report) = caller.frame(&mut culler);
+        (r, report) = caller.frame_as(&mut culler, mode);
     }
     assert!(report.is_complete(), "{what}: {report:?}");
     assert!(
@@ -806,6 +883,151 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
     assert!(!report.is_complete());
 }
 
+/// Froxels without a depth pre-pass (`CullInputs::depth: None`): every cell spans its slice of
+/// near..far, so a sample, or a transparent surface anywhere in front of it, finds every light
+/// reaching it in the cell its view distance names. On tiles the lists are never shorter than
+/// with the depth (the cells only grow), and they still cull.
+#[test]
+fn froxels_without_depth_list_every_light_reaching_any_surface() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 23);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in strategies() {
+        // Lights per sample without depth: on tiles, then on clusters.
+        let mut without_depth = Vec::new();
+        for grid in GRIDS {
+            let config = CullConfig {
+                tile_size: grid.0,
+                slices: grid.1,
+                strategy,
+                ..CullConfig::default()
+            };
+            let what = format!("{strategy:?} {grid:?}");
+            let with_depth =
+                (grid.1 == 1).then(|| check(&caller, config, &format!("{what} with depth")));
+            for check_transparent in [false, true] {
+                let mode = Mode {
+                    depth: false,
+                    transparent_lists: false,
+                    check_transparent,
+                    shrunk: false,
+                };
+                let what =
+                    format!("{what} without depth, transparent fragments {check_transparent}");
+                let without = check_as(&caller, config, &what, mode);
+                if let Some(with_depth) = with_depth.filter(|_| !check_transparent) {
+                    assert!(without >= with_depth, "{what}: {without} < {with_depth}");
+                }
+                if !check_transparent {
+                    without_depth.push(without);
+                }
+            }
+        }
+        // Froxels are bounded by their slices: the clusters cull far more than tiles over
+        // near..far (z-binning's bins are per slice range of the whole screen: less so).
+        // The oracle catches a culler that undersizes the lights, without depth too.
+        let mut culler = LightCuller::new(
+            &device,
+            &queue,
+            CullConfig {
+                strategy,
+                ..CullConfig::default()
+            },
+        )
+        .expect("culler");
+        let shrunk = Mode {
+            depth: false,
+            shrunk: true,
+            ..Mode::default()
+        };
+        let (mut r, mut report) = caller.frame_as(&mut culler, shrunk);
+        if report.overflowed {
+            (r, report) = caller.frame_as(&mut culler, shrunk);
+        }
+        assert!(report.is_complete(), "{strategy:?}: {report:?}");
+        assert!(
+            r[0] > 100,
+            "{strategy:?}: ranges 10% short must miss lights: {} misses",
+            r[0]
+        );
+        if strategy != Assign::ZBin {
+            assert!(
+                without_depth[1] < 0.5 * without_depth[0],
+                "{strategy:?}: clusters without depth list {:.1} per sample, tiles {:.1}",
+                without_depth[1],
+                without_depth[0]
+            );
+        }
+    }
+}
+
+/// Transparent surfaces in front of the depth (`CullInputs::transparent`): with separate lists
+/// (a second layer of cells, read with `light_grid_cell_transparent`) or shared ones (the
+/// opaque cells widened to the near plane), every light reaching a fragment between the near
+/// plane and the sample is listed, and the samples still find theirs. Without transparent
+/// lists the same fragments miss lights: the oracle catches it. Asking for transparent lists
+/// without a depth buffer is a typed error.
+#[test]
+fn transparent_lists_cover_surfaces_in_front_of_the_depth() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 29);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in strategies() {
+        for grid in GRIDS {
+            for lists in [GridLists::Separate, GridLists::Shared] {
+                let config = CullConfig {
+                    tile_size: grid.0,
+                    slices: grid.1,
+                    strategy,
+                    lists,
+                    ..CullConfig::default()
+                };
+                for check_transparent in [true, false] {
+                    let mode = Mode {
+                        depth: true,
+                        transparent_lists: true,
+                        check_transparent,
+                        shrunk: false,
+                    };
+                    let what = format!(
+                        "{strategy:?} {grid:?} {lists:?}, transparent fragments {check_transparent}"
+                    );
+                    check_as(&caller, config, &what, mode);
+                }
+            }
+        }
+    }
+    let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
+    let without_lists = Mode {
+        depth: true,
+        transparent_lists: false,
+        check_transparent: true,
+        shrunk: false,
+    };
+    let (mut r, mut report) = caller.frame_as(&mut culler, without_lists);
+    if report.overflowed {
+        (r, report) = caller.frame_as(&mut culler, without_lists);
+    }
+    assert!(report.is_complete(), "{report:?}");
+    assert!(
+        r[0] > 100,
+        "without transparent lists, fragments in front of the samples must miss lights: {} misses",
+        r[0]
+    );
+    let e = refused(
+        &mut culler,
+        &device,
+        &CullInputs {
+            depth: None,
+            transparent: true,
+            ..caller.inputs()
+        },
+    );
+    assert_eq!(e.input, CullInput::Depth, "{e}");
+}
+
 fn refused(culler: &mut LightCuller, device: &wgpu::Device, inputs: &CullInputs) -> CullError {
     let mut encoder = device.create_command_encoder(&Default::default());
     culler
@@ -858,7 +1080,7 @@ fn bad_use_is_a_typed_error_naming_the_input() {
     expect(
         &mut culler,
         &CullInputs {
-            depth: &colour,
+            depth: Some(&colour),
             ..caller.inputs()
         },
         CullInput::Depth,
@@ -872,7 +1094,7 @@ fn bad_use_is_a_typed_error_naming_the_input() {
     expect(
         &mut culler,
         &CullInputs {
-            depth: &msaa,
+            depth: Some(&msaa),
             ..caller.inputs()
         },
         CullInput::Depth,
@@ -882,7 +1104,7 @@ fn bad_use_is_a_typed_error_naming_the_input() {
     expect(
         &mut culler,
         &CullInputs {
-            depth: &unbound,
+            depth: Some(&unbound),
             ..caller.inputs()
         },
         CullInput::Depth,

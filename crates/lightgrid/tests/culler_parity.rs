@@ -167,7 +167,8 @@ fn callers_grid(
         .encode(
             &mut encoder,
             &CullInputs {
-                depth: &depth_view,
+                depth: Some(&depth_view),
+                transparent: false,
                 lights: &buffer,
                 light_count: lights.len() as u32,
                 view: setup.view.to_cols_array_2d(),

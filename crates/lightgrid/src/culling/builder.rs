@@ -62,6 +62,8 @@ struct LastFrame {
     cell_culls: Option<Vec<crate::culling::bounds::cell_box::CellCull>>,
     /// The camera's `[near, far]` (every cell's bounds without a depth pre-pass).
     near_far: [f32; 2],
+    /// Where the frame's cell bounds came from.
+    source: CellSource,
 }
 
 pub struct GridBuilder {
@@ -189,9 +191,14 @@ impl GridBuilder {
         Ok(self.strategies[i].1.as_mut())
     }
 
-    /// Record this frame's grid. With `CellSource::Depth`, `f.depth` must hold the frame's
-    /// depth in what `enc` has recorded so far.
+    /// Record this frame's grid. With `CellSource::Depth`, `f.depth` holds the frame's depth
+    /// in what `enc` has recorded so far; a frame without one (a caller without a depth
+    /// pre-pass) is bounded by near..far.
     pub fn build(&mut self, f: &CullFrame, enc: &mut FrameEncoder) -> Result<()> {
+        let source = match f.depth {
+            Some(_) => self.source,
+            None => CellSource::NearFar,
+        };
         let dims = if self.slices > 1 {
             self.tiles
                 .clustered(self.slices, f.setup.near, f.setup.far)?
@@ -199,14 +206,14 @@ impl GridBuilder {
             self.tiles
         };
         // Cells spanning near..far already cover every transparent fragment.
-        let dims = dims.with_lists(match self.source {
+        let dims = dims.with_lists(match source {
             CellSource::Depth if f.transparency => self.lists,
             _ => GridLists::Opaque,
         });
         let assign = self.assign.resolve(f.light_count, self.software_adapter);
         let dims = self.strategy(f.device, assign)?.shape(dims, f.light_count);
         self.bounds.check_capacity(f.device, &dims)?;
-        if let Some(range) = &self.range {
+        if let Some(range) = self.range.as_ref().filter(|_| source == CellSource::Depth) {
             range.encode(
                 f,
                 enc,
@@ -214,14 +221,13 @@ impl GridBuilder {
                 &[self.bounds.params_buffer(), self.buffers.params_buffer()],
             );
         }
-        match self.source {
+        match source {
             CellSource::Depth => self.bounds.encode(f, enc, &dims),
             CellSource::NearFar => {
                 self.bounds
                     .fill(f.device, f.queue, &dims, [f.setup.near, f.setup.far])
             }
         }
-        let source = self.source;
         // Disjoint borrows: the strategy list, the grid buffers and the bounds.
         let strategy = self
             .strategies
@@ -234,7 +240,7 @@ impl GridBuilder {
                 f,
                 grid: &mut self.buffers,
                 bounds: &self.bounds,
-                range: self.range.as_ref(),
+                range: self.range.as_ref().filter(|_| source == CellSource::Depth),
                 dims: &dims,
                 source,
             },
@@ -254,6 +260,7 @@ impl GridBuilder {
             cell_bounds: run.cell_bounds,
             cell_culls: run.cell_culls,
             near_far: [f.setup.near, f.setup.far],
+            source,
         });
         Ok(())
     }
@@ -286,8 +293,10 @@ impl GridBuilder {
             None => {
                 let dims = match &self.range {
                     // The GPU spread the slices: `last.dims` holds near..far.
-                    Some(range) => range.read(device, queue, &last.dims)?,
-                    None => last.dims,
+                    Some(range) if last.source == CellSource::Depth => {
+                        range.read(device, queue, &last.dims)?
+                    }
+                    _ => last.dims,
                 };
                 let strategy = self
                     .strategies
@@ -298,14 +307,14 @@ impl GridBuilder {
                 strategy.read_grid(device, queue, &self.buffers, &dims, values)?
             }
         };
-        let cell_bounds = match (&last.cell_bounds, self.source) {
+        let cell_bounds = match (&last.cell_bounds, last.source) {
             (Some(b), _) => b.clone(),
             (None, CellSource::NearFar) => {
-                vec![last.near_far; last.dims.cell_count()]
+                crate::culling::bounds::cell_bounds::slice_bounds(&last.dims, last.near_far)
             }
             (None, CellSource::Depth) => self.bounds.read(device, queue)?,
         };
-        let cell_culls = match (&last.cell_culls, self.source) {
+        let cell_culls = match (&last.cell_culls, last.source) {
             (Some(m), _) => m.clone(),
             (None, CellSource::NearFar) => {
                 vec![crate::culling::bounds::cell_box::NO_CULL; last.dims.cell_count()]

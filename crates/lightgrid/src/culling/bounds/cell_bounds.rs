@@ -199,6 +199,21 @@ pub fn cell_bounds_cpu_samples(
     bounds
 }
 
+/// Every cell's bounds without a depth buffer (froxels): its slice's view-distance range,
+/// widened by twice the slack as [`transparent_bounds`] widens it (the shaders' slice of a
+/// distance may round into the next), within near..far. A tiled grid's cells span near..far.
+pub(crate) fn slice_bounds(dims: &GridDims, [near, far]: [f32; 2]) -> Vec<[f32; 2]> {
+    (0..dims.cell_count())
+        .map(|c| {
+            let [lo, hi] = dims.slice_range(dims.slice_of_cell(c));
+            [
+                near.max(lo * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK)),
+                far.min(hi * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK)),
+            ]
+        })
+        .collect()
+}
+
 /// Where transparent fragments of slice `k` can lie in a tile whose opaque maximum is
 /// `tile_max` (an empty pixel counts as the far plane): in front of it, behind the near
 /// plane, inside the slice's range widened by twice the slack (tiled-forward-shading §4.5:
@@ -422,7 +437,8 @@ impl CellBoundsPass {
         pass.dispatch_workgroups(1, 1, 1);
     }
 
-    /// Without depth: every cell spans `[near, far]` (and counts as occupied).
+    /// Without depth: every cell spans its slice of `[near, far]` (`slice_bounds`) and counts
+    /// as occupied.
     pub fn fill(
         &mut self,
         device: &wgpu::Device,
@@ -431,7 +447,7 @@ impl CellBoundsPass {
         range: [f32; 2],
     ) {
         self.ensure(device, dims);
-        let all = vec![range; self.cells];
+        let all = slice_bounds(dims, range);
         queue.write_buffer(&self.bounds, 0, bytemuck::cast_slice(&all));
         if self.culled {
             let culls = vec![NO_CULL; self.cells];

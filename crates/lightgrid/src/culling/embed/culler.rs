@@ -98,8 +98,19 @@ impl CullLight {
 pub struct CullInputs<'a> {
     /// The caller's depth buffer after its depth pre-pass, recorded earlier in the same
     /// encoder (a view of a 2D depth texture with `TEXTURE_BINDING` usage and
-    /// [`CullConfig::samples`] samples; its depth aspect is read).
-    pub depth: &'a wgpu::TextureView,
+    /// [`CullConfig::samples`] samples; its depth aspect is read): each cell is bounded by the
+    /// samples in it. `None` for a renderer without a depth pre-pass: every cell spans its
+    /// whole slice of `near..far` (froxels: the slices follow the exponential spacing of
+    /// `light_grid_slice` over `near..far`, [`CullConfig::slices`] of them; one slice is
+    /// tiles spanning the whole range), so any surface at any depth, opaque or transparent,
+    /// finds its lights with `light_grid_cell`.
+    pub depth: Option<&'a wgpu::TextureView>,
+    /// With `depth`: the frame has transparent surfaces in front of it, so lists are also
+    /// built for them as [`CullConfig::lists`] says (`Separate`: a second layer of cells over
+    /// `near` to the tile's farthest sample, read with `light_grid_cell_transparent`;
+    /// `Shared`: the opaque cells widened to `near`). Without depth every cell already covers
+    /// them. `false`: lists cover the depth buffer's samples only.
+    pub transparent: bool,
     /// The caller's lights: [`CullLight`]s from byte 0, with `STORAGE` usage.
     pub lights: &'a wgpu::Buffer,
     /// Lights in the buffer this frame (at most [`CullConfig::max_lights`]).
@@ -123,7 +134,8 @@ pub struct CullInputs<'a> {
 pub enum CullInput {
     /// [`CullConfig`].
     Config,
-    /// [`CullInputs::depth`]: format, dimension, sample count, usage.
+    /// [`CullInputs::depth`]: format, dimension, sample count, usage; or asked to cover
+    /// transparent surfaces without it.
     Depth,
     /// [`CullInputs::lights`]: size, usage.
     Lights,
@@ -257,7 +269,8 @@ impl ShaderKey for CallerGridKey {
 /// let mut encoder = device.create_command_encoder(&Default::default());
 /// // ... the caller's depth pre-pass into `depth` ...
 /// culler.encode(&mut encoder, &CullInputs {
-///     depth,
+///     depth: Some(depth),
+///     transparent: false,
 ///     lights,
 ///     light_count: 300,
 ///     view: view.to_cols_array_2d(),
@@ -596,6 +609,9 @@ impl LightCuller {
     /// - `light_grid_cell(pixel: vec2<f32>, view_distance: f32) -> u32`: the cell of the sample
     ///   at framebuffer position `pixel` (`@builtin(position).xy`) and view distance
     ///   `view_distance` (−z in view space);
+    /// - `light_grid_cell_transparent(pixel: vec2<f32>, view_distance: f32) -> u32`: the cell
+    ///   of a transparent surface's fragment (the second layer with `GridLists::Separate`
+    ///   and [`CullInputs::transparent`]; otherwise the same as `light_grid_cell`);
     /// - `light_grid_walk(cell: u32) -> LightGridWalk` and
     ///   `light_grid_next(walk: ptr<function, LightGridWalk>) -> bool`: the cell's lights one
     ///   at a time (`walk.light`, the index in the caller's light buffer), whatever the
@@ -648,16 +664,15 @@ impl LightCuller {
             })?,
         );
         let n = inputs.light_count;
-        let depth_view = inputs
-            .depth
-            .texture()
-            .create_view(&wgpu::TextureViewDescriptor {
+        let depth_view = inputs.depth.map(|depth| {
+            depth.texture().create_view(&wgpu::TextureViewDescriptor {
                 label: Some("culler depth"),
                 aspect: wgpu::TextureAspect::DepthOnly,
                 base_mip_level: 0,
                 mip_level_count: Some(1),
                 ..Default::default()
-            });
+            })
+        });
         c.timer.reset();
         c.frames += 1;
         let frame = c.frames;
@@ -671,11 +686,11 @@ impl LightCuller {
                 queue: &c.queue,
                 bind_group: &c.group,
                 counters: c.counters.buffer(),
-                depth: Some(&depth_view),
+                depth: depth_view.as_ref(),
                 setup,
                 light_count: n as usize,
                 lights: &[],
-                transparency: false,
+                transparency: inputs.transparent,
                 scene: None,
             };
             let mut enc = FrameEncoder::borrowed(&c.device, &c.queue, encoder, &mut c.timer);
@@ -756,7 +771,32 @@ impl Caller {
     /// Refuse inputs the kernels cannot honour, each error naming its input.
     fn check(&self, i: &CullInputs, config: &CullConfig) -> Result<Camera, CullError> {
         use CullInput as I;
-        let texture = i.depth.texture();
+        let [w, h] = i.viewport;
+        if w == 0 || h == 0 {
+            return refuse(I::Viewport, format!("{w}x{h} has no pixels"));
+        }
+        match i.depth {
+            Some(depth) => Self::check_depth(depth.texture(), i, config)?,
+            None if i.transparent => {
+                return refuse(
+                    I::Depth,
+                    "transparent lists are built in front of a depth buffer; without one every cell already spans near..far",
+                )
+            }
+            None => {}
+        }
+        self.check_lights(i, config)?;
+        Camera::new(i)
+    }
+
+    /// The depth texture: a 2D depth format with the configured samples, readable, as large
+    /// as the viewport.
+    fn check_depth(
+        texture: &wgpu::Texture,
+        i: &CullInputs,
+        config: &CullConfig,
+    ) -> Result<(), CullError> {
+        use CullInput as I;
         let format = texture.format();
         if !format.is_depth_stencil_format() || !format.has_depth_aspect() {
             return refuse(I::Depth, format!("{format:?} is not a depth format"));
@@ -782,9 +822,6 @@ impl Caller {
             return refuse(I::Depth, "the depth texture lacks TEXTURE_BINDING usage");
         }
         let [w, h] = i.viewport;
-        if w == 0 || h == 0 {
-            return refuse(I::Viewport, format!("{w}x{h} has no pixels"));
-        }
         if w > texture.width() || h > texture.height() {
             return refuse(
                 I::Viewport,
@@ -795,6 +832,12 @@ impl Caller {
                 ),
             );
         }
+        Ok(())
+    }
+
+    /// The light buffer and count.
+    fn check_lights(&self, i: &CullInputs, config: &CullConfig) -> Result<(), CullError> {
+        use CullInput as I;
         if i.light_count > config.max_lights {
             return refuse(
                 I::LightCount,
@@ -819,7 +862,7 @@ impl Caller {
         if !i.lights.usage().contains(wgpu::BufferUsages::STORAGE) {
             return refuse(I::Lights, "the light buffer lacks STORAGE usage");
         }
-        Camera::new(i)
+        Ok(())
     }
 }
 

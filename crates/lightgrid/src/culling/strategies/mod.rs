@@ -45,7 +45,7 @@ pub struct AssignFrame<'a, 'f> {
     /// GPU spreads the slices: `dims` holds near..far until it is read back).
     pub range: Option<&'a DepthRangePass>,
     pub dims: &'a GridDims,
-    /// Where the bounds came from (`NearFar`: every cell spans near..far).
+    /// Where the bounds came from (`NearFar`: every cell spans its slice of near..far).
     pub source: CellSource,
 }
 
