@@ -263,6 +263,7 @@ impl Program {
             &CullInputs {
                 depth: Some(&self.depth),
                 transparent: false,
+                cpu_lights: None,
                 lights: &self.lights,
                 light_count: LIGHTS,
                 view: view.to_cols_array_2d(),

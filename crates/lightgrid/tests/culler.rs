@@ -318,6 +318,9 @@ struct Caller {
     lights: wgpu::Buffer,
     /// The same lights with ranges 10% short: a culler fed these must fail the oracle.
     shrunk_lights: wgpu::Buffer,
+    /// Both, on the CPU (`CullInputs::cpu_lights`, for `cpu` and `bvh`).
+    cpu_lights: Vec<CullLight>,
+    shrunk_cpu_lights: Vec<CullLight>,
     light_count: u32,
     cam: Camera,
 }
@@ -428,6 +431,8 @@ impl Caller {
             check,
             lights: light_buffer,
             shrunk_lights,
+            cpu_lights: lights.to_vec(),
+            shrunk_cpu_lights: shrunk,
             light_count: lights.len() as u32,
             cam,
         }
@@ -437,6 +442,7 @@ impl Caller {
         CullInputs {
             depth: Some(&self.depth_view),
             transparent: false,
+            cpu_lights: None,
             lights: &self.lights,
             light_count: self.light_count,
             view: self.cam.view.to_cols_array_2d(),
@@ -500,6 +506,11 @@ impl Caller {
             } else {
                 &self.lights
             },
+            cpu_lights: Some(if mode.shrunk {
+                &self.shrunk_cpu_lights
+            } else {
+                &self.cpu_lights
+            }),
             ..self.inputs()
         };
         let frame = culler.encode(&mut encoder, &inputs).expect("culling");
@@ -692,13 +703,11 @@ fn check_as(caller: &Caller, config: CullConfig, what: &str, mode: Mode) -> f64 
     per_sample
 }
 
-/// The strategies a caller's culler offers: the registry's rows that assign on the GPU
-/// (`cpu` and `bvh` need the lights on the CPU and are refused: see
-/// `strategies_that_need_the_lights_on_the_cpu_are_refused`).
+/// The strategies a caller's culler offers: every row of the registry (`cpu` and `bvh` are
+/// given the lights on the CPU as well, `CullInputs::cpu_lights`).
 fn strategies() -> Vec<Assign> {
     lightgrid::testing::STRATEGIES
         .iter()
-        .filter(|s| !s.cpu_lights)
         .map(|s| s.assign)
         .collect()
 }
@@ -849,6 +858,13 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
         let caller = Caller::new(&device, &queue, 1, camera(cam.eye, false), &lights);
         let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
         let (r, first) = caller.frame(&mut culler);
+        if strategy == Assign::Cpu {
+            // The CPU uploads its whole grid, whatever the capacity: nothing to grow.
+            assert!(first.is_complete(), "{strategy:?}: {first:?}");
+            assert!(first.index_entries > 1000, "{first:?}");
+            assert_eq!(r[0], 0, "{strategy:?}: misses");
+            continue;
+        }
         if strategy == Assign::ZBin {
             // Z-bins are sized from the light count each frame: nothing to grow.
             assert!(first.is_complete(), "{strategy:?}: {first:?}");
@@ -1334,23 +1350,43 @@ fn bad_use_is_a_typed_error_naming_the_input() {
             .unwrap_or_else(|| panic!("{config:?} accepted"));
         assert_eq!(e.input, CullInput::Config, "{e}");
     }
-    // The strategies that assign on the CPU: refused, naming why and what is offered.
+    // The strategies that assign on the CPU need the lights there too: one per light, each
+    // finite with a positive range.
     for row in lightgrid::testing::STRATEGIES
         .iter()
         .filter(|s| s.cpu_lights)
     {
         let config = CullConfig {
             strategy: row.assign,
+            max_lights: 40,
             ..CullConfig::default()
         };
-        let e = LightCuller::new(&device, &queue, config)
-            .err()
-            .unwrap_or_else(|| panic!("{} accepted", row.name));
-        assert_eq!(e.input, CullInput::Config, "{e}");
-        assert!(
-            e.message.contains("on the CPU") && e.message.contains("gather"),
-            "{e}"
+        let mut culler = LightCuller::new(&device, &queue, config).expect("a cpu strategy");
+        let e = refused(&mut culler, &device, &caller.inputs());
+        assert_eq!(e.input, CullInput::Lights, "{e}");
+        assert!(e.message.contains("cpu_lights"), "{e}");
+        let e = refused(
+            &mut culler,
+            &device,
+            &CullInputs {
+                cpu_lights: Some(&caller.cpu_lights[..39]),
+                ..caller.inputs()
+            },
         );
+        assert_eq!(e.input, CullInput::Lights, "{e}");
+        assert!(e.message.contains("39"), "{e}");
+        let mut nan = caller.cpu_lights.clone();
+        nan[3].position[0] = f32::NAN;
+        let e = refused(
+            &mut culler,
+            &device,
+            &CullInputs {
+                cpu_lights: Some(&nan),
+                ..caller.inputs()
+            },
+        );
+        assert_eq!(e.input, CullInput::Lights, "{e}");
+        assert!(e.message.contains("cpu_lights[3]"), "{e}");
     }
     // After all that, the good inputs still cull, with lights and without, every strategy.
     for strategy in strategies() {
@@ -1375,6 +1411,7 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         let mut encoder = device.create_command_encoder(&Default::default());
         let inputs = CullInputs {
             light_count: 0,
+            cpu_lights: Some(&[]),
             ..caller.inputs()
         };
         let frame = culler.encode(&mut encoder, &inputs).expect("no lights");

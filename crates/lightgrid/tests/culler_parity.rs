@@ -1,7 +1,8 @@
 //! One description, one grid: the renderer's grid for a `CullConfig` and a caller's
 //! `LightCuller::new` with the same config, handed the renderer's depth, lights and camera,
-//! hold the same lists, cell for cell, on robots-many, tiles and clusters, every strategy a
-//! caller is offered. Public API only: `Renderer`, `LightCuller`, `CullConfig`.
+//! hold the same lists, cell for cell, on robots-many with and without glass (transparent
+//! lists), tiles and clusters, every strategy (`cpu` and `bvh` given the lights on the CPU).
+//! Public API only: `Renderer`, `LightCuller`, `CullConfig`.
 //!
 //! The offsets into the index list and the order of a cell's lights follow the order the
 //! GPU's workgroups finish in (an atomic cursor), so two runs of the same grid differ there;
@@ -136,6 +137,7 @@ fn callers_grid(
     scene: &lightgrid::scene::Scene,
     out: &FrameOutput,
     config: CullConfig,
+    transparent: bool,
 ) -> LightGrid {
     let (device, queue) = (&ctx.device, &ctx.queue);
     let setup = out.setup;
@@ -162,25 +164,33 @@ fn callers_grid(
         "the renderer's projection"
     );
     let mut culler = LightCuller::new(device, queue, config).expect("the same config");
-    let mut encoder = device.create_command_encoder(&Default::default());
-    culler
-        .encode(
-            &mut encoder,
-            &CullInputs {
-                depth: Some(&depth_view),
-                transparent: false,
-                lights: &buffer,
-                light_count: lights.len() as u32,
-                view: setup.view.to_cols_array_2d(),
-                proj: proj.to_cols_array_2d(),
-                near: setup.near,
-                far: setup.far,
-                viewport: [SIZE.0, SIZE.1],
-            },
-        )
-        .expect("the renderer's frame is a caller's frame");
-    queue.submit([encoder.finish()]);
-    let reports = culler.wait().unwrap();
+    let inputs = CullInputs {
+        depth: Some(&depth_view),
+        transparent,
+        // The same lights on the CPU (`cpu` and `bvh` assign there).
+        cpu_lights: Some(bytemuck::cast_slice(&lights)),
+        lights: &buffer,
+        light_count: lights.len() as u32,
+        view: setup.view.to_cols_array_2d(),
+        proj: proj.to_cols_array_2d(),
+        near: setup.near,
+        far: setup.far,
+        viewport: [SIZE.0, SIZE.1],
+    };
+    // A frame whose lists did not fit is culled again (they grew from its report), as the
+    // renderer re-renders one.
+    let mut reports = Vec::new();
+    for _ in 0..2 {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        culler
+            .encode(&mut encoder, &inputs)
+            .expect("the renderer's frame is a caller's frame");
+        queue.submit([encoder.finish()]);
+        reports = culler.wait().unwrap();
+        if !reports.iter().any(|r| r.overflowed) {
+            break;
+        }
+    }
     assert!(reports.iter().all(|r| r.is_complete()), "{reports:?}");
     culler.read_grid().unwrap()
 }
@@ -188,20 +198,31 @@ fn callers_grid(
 #[test]
 fn the_renderers_grid_is_a_callers_with_the_same_config() {
     let ctx = common::gpu();
-    // Without glass: a caller's culler builds opaque lists only (transparent lists are not
-    // offered to callers yet).
-    let params = SceneParams {
-        transparency: false,
-        ..SceneParams::default()
-    };
-    let scene = catalog::build("robots-many", &params).unwrap();
+    // Every strategy (`cpu` and `bvh` given the lights on the CPU as well); with glass, the
+    // caller asks for transparent lists (`CullInputs::transparent`) as the renderer builds them.
     let offered: Vec<Assign> = lightgrid::testing::STRATEGIES
         .iter()
-        .filter(|s| !s.cpu_lights)
         .map(|s| s.assign)
         .collect();
+    for transparency in [false, true] {
+        let params = SceneParams {
+            transparency,
+            ..SceneParams::default()
+        };
+        let scene = catalog::build("robots-many", &params).unwrap();
+        parity(&ctx, &scene, &offered, transparency);
+    }
+}
+
+/// The renderer's grid and a caller's for every strategy in `offered`, tiles and clusters.
+fn parity(
+    ctx: &lightgrid::gpu::GpuContext,
+    scene: &lightgrid::scene::Scene,
+    offered: &[Assign],
+    transparency: bool,
+) {
     for (pipeline, slices) in [(ids::TILED_DEFERRED, 1), (ids::CLUSTERED_DEFERRED, 16)] {
-        for &strategy in &offered {
+        for &strategy in offered {
             let config = CullConfig {
                 strategy,
                 slices,
@@ -211,13 +232,13 @@ fn the_renderers_grid_is_a_callers_with_the_same_config() {
                 grid: config,
                 ..RenderSettings::default()
             };
-            let mut renderer = Renderer::new(&ctx, SIZE.0, SIZE.1, settings).unwrap();
-            let out = renderer.render(&scene, FRAME, pipeline).unwrap();
+            let mut renderer = Renderer::new(ctx, SIZE.0, SIZE.1, settings).unwrap();
+            let out = renderer.render(scene, FRAME, pipeline).unwrap();
             assert!(out.grid_is_pipelines, "{pipeline}");
-            let what = format!("{pipeline} {strategy:?}");
+            let what = format!("{pipeline} {strategy:?} transparency {transparency}");
             let ours = lists(&out.grid);
             assert!(ours.iter().any(|l| !l.is_empty()), "{what}: an empty grid");
-            let callers = callers_grid(&ctx, &scene, &out, config);
+            let callers = callers_grid(ctx, scene, &out, config, transparency);
             assert_eq!(callers.dims, out.grid.dims, "{what}: the cells");
             assert_eq!(lists(&callers), ours, "{what}: the lists");
             // The comparison can fail: a caller's grid with another description differs.
@@ -226,7 +247,7 @@ fn the_renderers_grid_is_a_callers_with_the_same_config() {
                     depth_bounds: DepthBounds::None,
                     ..config
                 };
-                let theirs = callers_grid(&ctx, &scene, &out, other);
+                let theirs = callers_grid(ctx, scene, &out, other, transparency);
                 assert_ne!(
                     lists(&theirs),
                     ours,

@@ -130,6 +130,13 @@ impl GridBuilder {
         }
     }
 
+    /// Index entries of the last frame's grid where the CPU built it (`cpu`); `None` where
+    /// the GPU counted them.
+    pub(crate) fn last_cpu_entries(&self) -> Option<u32> {
+        let grid = self.last.as_ref()?.cpu_grid.as_ref()?;
+        Some(grid.indices.len() as u32)
+    }
+
     /// The screen size changed (`LightCuller`: a caller's viewport).
     pub(crate) fn set_tiles(&mut self, tiles: GridDims) {
         self.tiles = tiles;

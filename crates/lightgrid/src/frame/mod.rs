@@ -94,7 +94,8 @@ pub(crate) struct FrameEncoder<'a> {
 }
 
 /// The encoder a frame records into: the renderer's own, or a caller's
-/// (`culling::LightCuller`), which is never submitted here.
+/// (`culling::LightCuller`), which the caller submits at the end of its frame; only a
+/// part-way readback (the `cpu` strategy's) submits what it holds so far and replaces it.
 enum Recording<'a> {
     Owned(wgpu::CommandEncoder),
     Borrowed(&'a mut wgpu::CommandEncoder),
@@ -116,8 +117,8 @@ impl<'a> FrameEncoder<'a> {
         }
     }
 
-    /// Record into a caller's encoder: the caller submits it; a part-way submission
-    /// ([`Self::download`]) is refused.
+    /// Record into a caller's encoder: the caller submits it. A part-way readback
+    /// (`download_all`) submits what it holds so far and leaves a new encoder in its place.
     pub(crate) fn borrowed(
         device: &'a wgpu::Device,
         queue: &'a wgpu::Queue,
@@ -142,12 +143,12 @@ impl<'a> FrameEncoder<'a> {
         (encoder, self.timer)
     }
 
+    /// Submit what is recorded so far and go on in a new encoder (a caller's is replaced in
+    /// its place: the rest of its frame records into the new one).
     fn submit_recorded(&mut self, stage: &str) -> Result<wgpu::SubmissionIndex> {
-        let Recording::Owned(encoder) = &mut self.encoder else {
-            return Err(crate::error::Error::Gpu {
-                stage: stage.into(),
-                message: "a caller's command encoder cannot be submitted part-way".into(),
-            });
+        let encoder = match &mut self.encoder {
+            Recording::Owned(e) => e,
+            Recording::Borrowed(e) => &mut **e,
         };
         let done = std::mem::replace(
             encoder,

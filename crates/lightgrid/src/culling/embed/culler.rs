@@ -20,16 +20,16 @@ use crate::consts::POINT_LIGHT_COS;
 use crate::culling::builder::{GridBuilder, GridUse};
 use crate::culling::frame::{bind_cull_group, cull_layout, CellSource, CullFrame};
 use crate::culling::grid::GridDims;
-use crate::culling::strategies::registry::{find_strategy, STRATEGIES};
+use crate::culling::strategies::registry::find_strategy;
 use crate::frame::{CullConfig, FrameEncoder, SpotCull};
 use crate::gpu::{
     buffer_entry, groups_1d, grow_storage, storage_buffer, FrameCounters, FrameTag, PassTimer,
     STORAGE_READ, STORAGE_RW, UNIFORM,
 };
 use crate::gpu_types::{FrameUniforms, GpuLight};
-use crate::scene::ViewSetup;
+use crate::scene::{Light, Spot, ViewSetup};
 use crate::shader::{compose, compute_pipeline, src, ComposedShader, Def, ShaderKey};
-use glam::{DMat3, DVec3, Mat4};
+use glam::{DMat3, DVec3, Mat4, Vec3};
 
 /// One light as [`LightCuller`] reads it from the caller's buffer: 48 bytes, `#[repr(C)]`,
 /// the layout of a WGSL `struct { position: vec3<f32>, range: f32, payload: vec4<f32>,
@@ -75,6 +75,22 @@ impl CullLight {
         }
     }
 
+    /// The light as the CPU strategies read it (a spot's inner cone just inside its outer).
+    fn into_light(self) -> Light {
+        let spot = (self.cos_outer >= -1.0).then(|| Spot {
+            direction: Vec3::from(self.direction),
+            cos_inner: (self.cos_outer + crate::scene::SPOT_MIN_FALLOFF).min(1.0),
+            cos_outer: self.cos_outer,
+        });
+        Light {
+            position: Vec3::from(self.position),
+            color: Vec3::ZERO,
+            intensity: 0.0,
+            range: self.range,
+            spot,
+        }
+    }
+
     /// A spot light: unit `direction`, outer half-angle cosine `cos_outer`.
     pub fn spot(
         position: [f32; 3],
@@ -113,6 +129,12 @@ pub struct CullInputs<'a> {
     pub transparent: bool,
     /// The caller's lights: [`CullLight`]s from byte 0, with `STORAGE` usage.
     pub lights: &'a wgpu::Buffer,
+    /// The same lights on the CPU, for the strategies that assign there (tiled-shading §6.1:
+    /// `cpu`, and `bvh`, which builds its hierarchy there); the others ignore it. `cpu` reads
+    /// the cells' depth bounds back part-way through the frame: what the encoder holds so far
+    /// (the depth pre-pass) is submitted, and the caller's encoder is replaced by a new one,
+    /// into which the rest of the frame records.
+    pub cpu_lights: Option<&'a [CullLight]>,
     /// Lights in the buffer this frame (at most [`CullConfig::max_lights`]).
     pub light_count: u32,
     /// World to view space (right-handed, the camera looking down −z): a rotation and a
@@ -271,6 +293,7 @@ impl ShaderKey for CallerGridKey {
 /// culler.encode(&mut encoder, &CullInputs {
 ///     depth: Some(depth),
 ///     transparent: false,
+///     cpu_lights: None,
 ///     lights,
 ///     light_count: 300,
 ///     view: view.to_cols_array_2d(),
@@ -313,6 +336,9 @@ struct Caller {
     frames: u64,
     /// The newest finished frame's number and counters ([`LightCuller::read_grid`]).
     last_report: Option<(u64, crate::gpu::CounterValues)>,
+    /// Frames whose grid the CPU built, and its index entries (their reports carry them: the
+    /// GPU counted none).
+    cpu_entries: Vec<(u64, u32)>,
 }
 
 /// Refuse a configuration the culler cannot build on `device`, naming why.
@@ -322,21 +348,6 @@ fn check_config(device: &wgpu::Device, config: &CullConfig) -> Result<(), CullEr
         message: e.to_string(),
     };
     config.validate().map_err(config_error)?;
-    if let Some(info) = find_strategy(config.strategy).filter(|s| s.cpu_lights) {
-        return refuse(
-                CullInput::Config,
-                format!(
-                    "strategy {} assigns on the CPU and needs the lights there; LightCuller reads them on the GPU only (auto, {})",
-                    info.name,
-                    STRATEGIES
-                        .iter()
-                        .filter(|s| !s.cpu_lights)
-                        .map(|s| s.name)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            );
-    }
     let max_bytes = u64::from(config.max_lights) * std::mem::size_of::<GpuLight>() as u64;
     let limits = device.limits();
     if max_bytes
@@ -414,6 +425,7 @@ impl Caller {
             timer: PassTimer::disabled(),
             frames: 0,
             last_report: None,
+            cpu_entries: Vec::new(),
         }
     }
 
@@ -673,6 +685,12 @@ impl LightCuller {
                 ..Default::default()
             })
         });
+        let cpu_lights: Vec<Light> = inputs
+            .cpu_lights
+            .unwrap_or_default()
+            .iter()
+            .map(|l| l.into_light())
+            .collect();
         c.timer.reset();
         c.frames += 1;
         let frame = c.frames;
@@ -689,7 +707,7 @@ impl LightCuller {
                 depth: depth_view.as_ref(),
                 setup,
                 light_count: n as usize,
-                lights: &[],
+                lights: &cpu_lights,
                 transparency: inputs.transparent,
                 scene: None,
             };
@@ -697,6 +715,9 @@ impl LightCuller {
             core.build(&f, &mut enc)
         });
         result??;
+        if let Some(entries) = core.last_cpu_entries() {
+            c.cpu_entries.push((frame, entries));
+        }
         let tag = FrameTag {
             serial: frame,
             pipeline: "LightCuller",
@@ -754,10 +775,21 @@ impl LightCuller {
         let mut out = Vec::with_capacity(readbacks.len());
         for r in readbacks {
             self.core.observe(&device, &r.values)?;
-            self.caller()?.last_report = Some((r.tag.serial, r.values));
+            let c = self.caller()?;
+            c.last_report = Some((r.tag.serial, r.values));
+            let cpu_entries = c
+                .cpu_entries
+                .iter()
+                .position(|&(frame, _)| frame == r.tag.serial)
+                .map_or(0, |i| c.cpu_entries.swap_remove(i).1);
+            c.cpu_entries.retain(|&(frame, _)| frame > r.tag.serial);
             out.push(CullReport {
                 frame: r.tag.serial,
-                index_entries: r.values.index_needed().max(r.values.pairs_needed()),
+                index_entries: r
+                    .values
+                    .index_needed()
+                    .max(r.values.pairs_needed())
+                    .max(cpu_entries),
                 overflowed: r.values.overflowed(),
                 truncated_loops: r.values.truncated_loops(),
                 invalid_lights: r.values.invalid_lights(),
@@ -861,6 +893,49 @@ impl Caller {
         }
         if !i.lights.usage().contains(wgpu::BufferUsages::STORAGE) {
             return refuse(I::Lights, "the light buffer lacks STORAGE usage");
+        }
+        Self::check_cpu_lights(i, config)
+    }
+
+    /// The lights on the CPU, for a strategy that assigns there: one per light, each finite
+    /// with a positive range (the GPU counts such lights and leaves them out; the CPU
+    /// strategies refuse them). Other strategies ignore them.
+    fn check_cpu_lights(i: &CullInputs, config: &CullConfig) -> Result<(), CullError> {
+        use CullInput as I;
+        if !find_strategy(config.strategy).is_some_and(|s| s.cpu_lights) {
+            return Ok(());
+        }
+        let Some(lights) = i.cpu_lights else {
+            return refuse(
+                I::Lights,
+                format!(
+                    "strategy {} assigns on the CPU: CullInputs::cpu_lights must hold the lights",
+                    config.strategy.name()
+                ),
+            );
+        };
+        if lights.len() != i.light_count as usize {
+            return refuse(
+                I::Lights,
+                format!(
+                    "cpu_lights holds {} lights; light_count is {}",
+                    lights.len(),
+                    i.light_count
+                ),
+            );
+        }
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        if let Some(k) = lights.iter().position(|l| {
+            !(finite(&l.position)
+                && finite(&l.direction)
+                && l.cos_outer.is_finite()
+                && l.range > 0.0
+                && l.range.is_finite())
+        }) {
+            return refuse(
+                I::Lights,
+                format!("cpu_lights[{k}] is not finite or has no positive range"),
+            );
         }
         Ok(())
     }

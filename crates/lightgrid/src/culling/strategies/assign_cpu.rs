@@ -369,10 +369,15 @@ impl AssignStrategy for CpuStrategy {
             ),
             None => *a.dims,
         };
+        // Clusters without depth (a caller's froxels): each cell spans its slice of
+        // near..far, as the GPU strategies' bounds do (`slice_bounds`).
+        let slices = (!depth && dims.slices > 1).then(|| {
+            crate::culling::bounds::cell_bounds::slice_bounds(dims, [a.f.setup.near, a.f.setup.far])
+        });
         let start = Instant::now();
-        let range = match (&cell_bounds, &culls) {
-            (Some(b), Some(m)) => DepthRange::Culled(b, m),
-            (Some(b), None) => DepthRange::Cells(b),
+        let range = match (&cell_bounds, &culls, &slices) {
+            (Some(b), Some(m), _) => DepthRange::Culled(b, m),
+            (Some(b), None, _) | (None, _, Some(b)) => DepthRange::Cells(b),
             _ => DepthRange::NearFar,
         };
         let grid = assign_cpu(&a.f.setup, dims, a.f.lights, range);

@@ -18,8 +18,8 @@ pub struct StrategyInfo {
     /// pipeline); the others record into the frame's one submission.
     #[cfg_attr(not(feature = "testing"), allow(dead_code))]
     pub reads_back: bool,
-    /// It assigns on the CPU, from the lights there (a [`crate::LightCuller`] has them on the
-    /// GPU only).
+    /// It assigns on the CPU, from the lights there (a [`crate::LightCuller`] is given them in
+    /// `CullInputs::cpu_lights`).
     pub cpu_lights: bool,
     pub(crate) create: fn(&StrategyContext) -> Box<dyn AssignStrategy>,
 }
