@@ -459,6 +459,20 @@ impl Caller {
         self.frame_as(culler, Mode::default())
     }
 
+    /// [`Self::frame_as`], once more if the frame's lists did not fit (they grew from its
+    /// report).
+    fn settled_frame(
+        &self,
+        culler: &mut LightCuller,
+        mode: Mode,
+    ) -> ([u32; 7], lightgrid::CullReport) {
+        let first = self.frame_as(culler, mode);
+        match first.1.overflowed {
+            true => self.frame_as(culler, mode),
+            false => first,
+        }
+    }
+
     /// [`Self::frame`], the culler given the depth or not and asked for transparent lists or
     /// not, and the oracle checking the samples or transparent fragments in front of them.
     fn frame_as(&self, culler: &mut LightCuller, mode: Mode) -> ([u32; 7], lightgrid::CullReport) {
@@ -671,10 +685,7 @@ fn check(caller: &Caller, config: CullConfig, what: &str) -> f64 {
 /// [`check`], the frame culled and checked as `mode` says.
 fn check_as(caller: &Caller, config: CullConfig, what: &str, mode: Mode) -> f64 {
     let mut culler = LightCuller::new(&caller.device, &caller.queue, config).expect("culler");
-    let (mut r, mut report) = caller.frame_as(&mut culler, mode);
-    if report.overflowed {
-        (r, report) = caller.frame_as(&mut culler, mode);
-    }
+    let (r, report) = caller.settled_frame(&mut culler, mode);
     assert!(report.is_complete(), "{what}: {report:?}");
     assert!(
         r[3] > W * H / 2,
@@ -957,10 +968,7 @@ fn froxels_without_depth_list_every_light_reaching_any_surface() {
             shrunk: true,
             ..Mode::default()
         };
-        let (mut r, mut report) = caller.frame_as(&mut culler, shrunk);
-        if report.overflowed {
-            (r, report) = caller.frame_as(&mut culler, shrunk);
-        }
+        let (r, report) = caller.settled_frame(&mut culler, shrunk);
         assert!(report.is_complete(), "{strategy:?}: {report:?}");
         assert!(
             r[0] > 100,
@@ -1022,10 +1030,7 @@ fn transparent_lists_cover_surfaces_in_front_of_the_depth() {
         check_transparent: true,
         shrunk: false,
     };
-    let (mut r, mut report) = caller.frame_as(&mut culler, without_lists);
-    if report.overflowed {
-        (r, report) = caller.frame_as(&mut culler, without_lists);
-    }
+    let (r, report) = caller.settled_frame(&mut culler, without_lists);
     assert!(report.is_complete(), "{report:?}");
     assert!(
         r[0] > 100,

@@ -10,15 +10,20 @@ use std::path::{Path, PathBuf};
 const MAX_LINES: usize = 100;
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    source_files(dir, "rs", out);
+}
+
+/// The files under `dir` whose extension is `ext`. Tests and their helpers are not held to
+/// the rules; build outputs are not sources.
+fn source_files(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap().flatten() {
         let p = entry.path();
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
         if p.is_dir() {
-            // Tests and their helpers are not held to it; build outputs are not sources.
             if name != "tests" && name != "target" && !name.starts_with('.') {
-                rust_files(&p, out);
+                source_files(&p, ext, out);
             }
-        } else if name.ends_with(".rs") {
+        } else if p.extension().is_some_and(|e| e == ext) {
             out.push(p);
         }
     }
@@ -143,7 +148,7 @@ fn shaders_are_composed_one_way() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
-    wgsl_files(&src, &mut files);
+    source_files(&src, "wgsl", &mut files);
     assert!(files.len() > 50, "the library's sources were not found");
     let mut found = Vec::new();
     for f in &files {
@@ -171,15 +176,4 @@ fn shaders_are_composed_one_way() {
         "compose shaders through shader::ShaderKey / Def / parts!:\n{}",
         found.join("\n")
     );
-}
-
-fn wgsl_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap().flatten() {
-        let p = entry.path();
-        if p.is_dir() {
-            wgsl_files(&p, out);
-        } else if p.extension().is_some_and(|e| e == "wgsl") {
-            out.push(p);
-        }
-    }
 }

@@ -220,7 +220,9 @@ impl GridBuilder {
         let assign = self.assign.resolve(f.light_count, self.software_adapter);
         let dims = self.strategy(f.device, assign)?.shape(dims, f.light_count);
         self.bounds.check_capacity(f.device, &dims)?;
-        if let Some(range) = self.range.as_ref().filter(|_| source == CellSource::Depth) {
+        // The slicing range only over a depth buffer.
+        let range = self.range.as_ref().filter(|_| source == CellSource::Depth);
+        if let Some(range) = range {
             range.encode(
                 f,
                 enc,
@@ -247,7 +249,7 @@ impl GridBuilder {
                 f,
                 grid: &mut self.buffers,
                 bounds: &self.bounds,
-                range: self.range.as_ref().filter(|_| source == CellSource::Depth),
+                range,
                 dims: &dims,
                 source,
             },

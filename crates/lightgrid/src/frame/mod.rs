@@ -143,17 +143,15 @@ impl<'a> FrameEncoder<'a> {
         (encoder, self.timer)
     }
 
+    fn encoder(&mut self) -> &mut wgpu::CommandEncoder {
+        self.parts().0
+    }
+
     /// Submit what is recorded so far and go on in a new encoder (a caller's is replaced in
     /// its place: the rest of its frame records into the new one).
     fn submit_recorded(&mut self, stage: &str) -> Result<wgpu::SubmissionIndex> {
-        let encoder = match &mut self.encoder {
-            Recording::Owned(e) => e,
-            Recording::Borrowed(e) => &mut **e,
-        };
-        let done = std::mem::replace(
-            encoder,
-            self.device.create_command_encoder(&Default::default()),
-        );
+        let next = self.device.create_command_encoder(&Default::default());
+        let done = std::mem::replace(self.encoder(), next);
         let index = scoped(self.device, stage, || self.queue.submit([done.finish()]))?;
         self.io.submits += 1;
         self.timer.next_submission();

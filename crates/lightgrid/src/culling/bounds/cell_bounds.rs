@@ -204,14 +204,21 @@ pub fn cell_bounds_cpu_samples(
 /// distance may round into the next), within near..far. A tiled grid's cells span near..far.
 pub(crate) fn slice_bounds(dims: &GridDims, [near, far]: [f32; 2]) -> Vec<[f32; 2]> {
     (0..dims.cell_count())
-        .map(|c| {
-            let [lo, hi] = dims.slice_range(dims.slice_of_cell(c));
-            [
-                near.max(lo * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK)),
-                far.min(hi * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK)),
-            ]
-        })
+        .map(|c| widened_slice(dims, dims.slice_of_cell(c), near, far))
         .collect()
+}
+
+/// Slice `k`'s view-distance range widened by twice the slack, within `near..hi`
+/// (`EMPTY_CELL` when nothing is left).
+fn widened_slice(dims: &GridDims, k: u32, near: f32, hi: f32) -> [f32; 2] {
+    let [slice_lo, slice_hi] = dims.slice_range(k);
+    let lo = near.max(slice_lo * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
+    let hi = hi.min(slice_hi * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
+    if lo > hi {
+        EMPTY_CELL
+    } else {
+        [lo, hi]
+    }
 }
 
 /// Where transparent fragments of slice `k` can lie in a tile whose opaque maximum is
@@ -219,14 +226,7 @@ pub(crate) fn slice_bounds(dims: &GridDims, [near, far]: [f32; 2]) -> Vec<[f32; 
 /// plane, inside the slice's range widened by twice the slack (tiled-forward-shading §4.5:
 /// the transparent list spans near..max). Twin of `transparent_bounds` in the kernel.
 fn transparent_bounds(setup: &ViewSetup, dims: &GridDims, k: u32, tile_max: f32) -> [f32; 2] {
-    let [slice_lo, slice_hi] = dims.slice_range(k);
-    let lo = setup.near.max(slice_lo * (1.0 - 2.0 * ASSIGN_DEPTH_SLACK));
-    let hi = tile_max.min(slice_hi * (1.0 + 2.0 * ASSIGN_DEPTH_SLACK));
-    if lo > hi {
-        EMPTY_CELL
-    } else {
-        [lo, hi]
-    }
+    widened_slice(dims, k, setup.near, tile_max)
 }
 
 /// The smallest range holding both (either may be empty: min > max).

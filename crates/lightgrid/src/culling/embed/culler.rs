@@ -685,12 +685,16 @@ impl LightCuller {
                 ..Default::default()
             })
         });
-        let cpu_lights: Vec<Light> = inputs
-            .cpu_lights
-            .unwrap_or_default()
-            .iter()
-            .map(|l| l.into_light())
-            .collect();
+        // Only a strategy that assigns on the CPU reads them (the others ignore them).
+        let cpu_lights: Vec<Light> = match needs_cpu_lights(&self.config) {
+            true => inputs
+                .cpu_lights
+                .unwrap_or_default()
+                .iter()
+                .map(|l| l.into_light())
+                .collect(),
+            false => Vec::new(),
+        };
         c.timer.reset();
         c.frames += 1;
         let frame = c.frames;
@@ -902,7 +906,7 @@ impl Caller {
     /// strategies refuse them). Other strategies ignore them.
     fn check_cpu_lights(i: &CullInputs, config: &CullConfig) -> Result<(), CullError> {
         use CullInput as I;
-        if !find_strategy(config.strategy).is_some_and(|s| s.cpu_lights) {
+        if !needs_cpu_lights(config) {
             return Ok(());
         }
         let Some(lights) = i.cpu_lights else {
@@ -939,6 +943,11 @@ impl Caller {
         }
         Ok(())
     }
+}
+
+/// Does `config`'s strategy assign on the CPU (`CullInputs::cpu_lights`)?
+fn needs_cpu_lights(config: &CullConfig) -> bool {
+    find_strategy(config.strategy).is_some_and(|s| s.cpu_lights)
 }
 
 /// The refusal of a caller's method on lightgrid's renderer's culler, whose frames come
