@@ -183,12 +183,14 @@ struct Check {
     /// 0: check the depth buffer's samples; 1: a transparent surface's fragment in front of
     /// each sample, looked up with `light_grid_cell_transparent`.
     mode: u32,
-    pad: [u32; 2],
+    /// The frame's projection's `proj[2][0]`, `proj[2][1]` (off-centre: x_ndc = p00 x / w - p20).
+    p20: f32,
+    p21: f32,
 }
 
 const DEPTH_WGSL: &str = r#"
 struct Check { inv_rotation: mat4x4<f32>, eye: vec3<f32>, light_count: u32, a: f32, b: f32,
-    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, mode: u32, pad1: u32, pad2: u32 }
+    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, mode: u32, p20: f32, p21: f32 }
 @group(0) @binding(0) var<uniform> c: Check;
 
 @vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
@@ -215,7 +217,7 @@ fn hash(p: vec2<f32>) -> f32 {
 
 const CHECK_WGSL: &str = r#"
 struct Check { inv_rotation: mat4x4<f32>, eye: vec3<f32>, light_count: u32, a: f32, b: f32,
-    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, mode: u32, pad1: u32, pad2: u32 }
+    p00: f32, p11: f32, viewport: vec2<f32>, near: f32, far: f32, standard: u32, mode: u32, p20: f32, p21: f32 }
 struct MyLight { position: vec3<f32>, range: f32, payload: vec4<f32>, direction: vec3<f32>, cos_outer: f32 }
 @group(0) @binding(0) var<uniform> c: Check;
 @group(0) @binding(1) var<storage, read> my_lights: array<MyLight>;
@@ -257,7 +259,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Mode 1: a transparent surface between the near plane and the sample.
         let t = 0.02 + 0.96 * noise(xy + f32(s) * 0.37);
         let w = select(opaque_w, c.near + (opaque_w - c.near) * t, c.mode == 1u);
-        let ndc = vec2<f32>(xy.x / c.viewport.x * 2.0 - 1.0, 1.0 - xy.y / c.viewport.y * 2.0);
+        // NDC shifted by an off-centre projection: ndc + (p20, p21) = (p00 x, p11 y) / w.
+        let ndc = vec2<f32>(xy.x / c.viewport.x * 2.0 - 1.0 + c.p20, 1.0 - xy.y / c.viewport.y * 2.0 + c.p21);
         let v = vec3<f32>(ndc.x * w / c.p00, ndc.y * w / c.p11, -w);
         // Camera-relative point; the lights are moved by the eye (world minus eye).
         let p = (c.inv_rotation * vec4<f32>(v, 0.0)).xyz;
@@ -397,7 +400,8 @@ impl Caller {
             far: FAR,
             standard: u32::from(cam.standard),
             mode: 0,
-            pad: [0; 2],
+            p20: 0.0,
+            p21: 0.0,
         };
         let check = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check"),
@@ -477,11 +481,19 @@ impl Caller {
     /// not, and the oracle checking the samples or transparent fragments in front of them.
     fn frame_as(&self, culler: &mut LightCuller, mode: Mode) -> ([u32; 7], lightgrid::CullReport) {
         let device = &self.device;
-        // `mode` is the Check struct's word after `standard` (byte 120).
         self.queue.write_buffer(
             &self.check,
             std::mem::offset_of!(Check, mode) as u64,
             bytemuck::bytes_of(&u32::from(mode.check_transparent)),
+        );
+        // The frame's projection: the camera's, shifted off centre as `mode` says.
+        let mut proj = self.cam.proj.to_cols_array_2d();
+        proj[2][0] += mode.shift[0];
+        proj[2][1] += mode.shift[1];
+        self.queue.write_buffer(
+            &self.check,
+            std::mem::offset_of!(Check, p20) as u64,
+            bytemuck::cast_slice(&[proj[2][0], proj[2][1]]),
         );
         let mut encoder = device.create_command_encoder(&Default::default());
         {
@@ -525,6 +537,7 @@ impl Caller {
             } else {
                 &self.cpu_lights
             }),
+            proj,
             ..self.inputs()
         };
         let frame = culler.encode(&mut encoder, &inputs).expect("culling");
@@ -650,6 +663,9 @@ struct Mode {
     check_transparent: bool,
     /// The culler is given the lights with ranges 10% short (the oracle keeps the true ones).
     shrunk: bool,
+    /// Added to the camera's `proj[2][0]`, `proj[2][1]` this frame: an off-centre projection
+    /// (TAA jitter, a VR eye). x_ndc = p00 x / w - proj[2][0].
+    shift: [f32; 2],
 }
 
 impl Default for Mode {
@@ -659,6 +675,7 @@ impl Default for Mode {
             transparent_lists: false,
             check_transparent: false,
             shrunk: false,
+            shift: [0.0; 2],
         }
     }
 }
@@ -938,7 +955,7 @@ fn froxels_without_depth_list_every_light_reaching_any_surface() {
                     depth: false,
                     transparent_lists: false,
                     check_transparent,
-                    shrunk: false,
+                    ..Mode::default()
                 };
                 let what =
                     format!("{what} without depth, transparent fragments {check_transparent}");
@@ -986,6 +1003,91 @@ fn froxels_without_depth_list_every_light_reaching_any_surface() {
     }
 }
 
+/// Off-centre projections (`CullInputs::proj` with `proj[2][0]`, `proj[2][1]`): TAA jitter of
+/// up to ±0.5 px that changes every frame (one culler, as an engine runs it), a VR eye whose
+/// principal point sits 20% of the width off centre, and an off-axis display shifted in both
+/// axes. Every strategy, tiles and clusters, with the depth and without (froxels): every light
+/// reaching a sample is in its cell. Each case with ranges 10% short must miss lights.
+#[test]
+fn jittered_and_off_centre_projections_list_every_reaching_light() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 31);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    // A sub-pixel jitter in NDC (2 / W per pixel), from a Halton-like sequence.
+    let jitter = |k: usize| {
+        let h = |base: usize| {
+            let (mut f, mut r, mut i) = (1.0f32, 0.0f32, k + 1);
+            while i > 0 {
+                f /= base as f32;
+                r += f * (i % base) as f32;
+                i /= base;
+            }
+            r - 0.5
+        };
+        [h(2) * 2.0 / W as f32, h(3) * 2.0 / H as f32]
+    };
+    // (name, shift per frame): the principal point at x = W/2 + 0.2 W is ndc 0.4, so
+    // proj[2][0] = -0.4; an off-axis window far from the axis in both directions.
+    let vr_eye = |_: usize| [-0.4, 0.0];
+    let off_axis = |_: usize| [0.6, -0.5];
+    // (name, shift of frame k, the frames: with the depth or without).
+    type Case<'a> = (&'a str, &'a dyn Fn(usize) -> [f32; 2], &'a [bool]);
+    let cases: [Case; 3] = [
+        ("TAA jitter", &jitter, &[true, true, false, true]),
+        ("VR eye", &vr_eye, &[true, false]),
+        ("off-axis", &off_axis, &[true, false]),
+    ];
+    for (name, shift, frames) in cases {
+        for strategy in strategies() {
+            for grid in GRIDS {
+                let config = CullConfig {
+                    tile_size: grid.0,
+                    slices: grid.1,
+                    strategy,
+                    ..CullConfig::default()
+                };
+                let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+                for (k, &depth) in frames.iter().enumerate() {
+                    let mode = Mode {
+                        depth,
+                        shift: shift(k),
+                        ..Mode::default()
+                    };
+                    let what = format!(
+                        "{name} {:?} {strategy:?} {grid:?} depth {depth}",
+                        mode.shift
+                    );
+                    let (r, report) = caller.settled_frame(&mut culler, mode);
+                    assert!(report.is_complete(), "{what}: {report:?}");
+                    assert!(r[1] > 5_000, "{what}: only {} light-sample pairs", r[1]);
+                    assert_eq!(
+                        r[0], 0,
+                        "{what}: {} lights reaching samples are missing from their cells (first: pixel ({}, {}), light {})",
+                        r[0], r[4], r[5], r[6]
+                    );
+                    assert!(
+                        f64::from(r[2]) / f64::from(r[3]) < f64::from(caller.light_count) * 0.6,
+                        "{what}: no culling"
+                    );
+                }
+            }
+        }
+        let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
+        let shrunk = Mode {
+            shrunk: true,
+            shift: shift(5),
+            ..Mode::default()
+        };
+        let (r, _) = caller.settled_frame(&mut culler, shrunk);
+        assert!(
+            r[0] > 100,
+            "{name}: ranges 10% short must miss lights: {} misses",
+            r[0]
+        );
+    }
+}
+
 /// Transparent surfaces in front of the depth (`CullInputs::transparent`): with separate lists
 /// (a second layer of cells, read with `light_grid_cell_transparent`) or shared ones (the
 /// opaque cells widened to the near plane), every light reaching a fragment between the near
@@ -1013,7 +1115,7 @@ fn transparent_lists_cover_surfaces_in_front_of_the_depth() {
                         depth: true,
                         transparent_lists: true,
                         check_transparent,
-                        shrunk: false,
+                        ..Mode::default()
                     };
                     let what = format!(
                         "{strategy:?} {grid:?} {lists:?}, transparent fragments {check_transparent}"
@@ -1028,7 +1130,7 @@ fn transparent_lists_cover_surfaces_in_front_of_the_depth() {
         depth: true,
         transparent_lists: false,
         check_transparent: true,
-        shrunk: false,
+        ..Mode::default()
     };
     let (r, report) = caller.settled_frame(&mut culler, without_lists);
     assert!(report.is_complete(), "{report:?}");
@@ -1256,17 +1358,25 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         CullInput::Projection,
         "perspective",
     );
-    let mut jittered = good.proj;
-    jittered[2][0] = 0.01;
-    expect(
-        &mut culler,
-        &CullInputs {
-            proj: jittered,
-            ..caller.inputs()
-        },
-        CullInput::Projection,
-        "off-centre",
-    );
+    // Off-centre is accepted (`jittered_and_off_centre_projections_...`); a skew, a constant
+    // shift and a depth that varies across the image are not a camera's.
+    for (col, row, why) in [
+        (1, 0, "skewed"),
+        (3, 1, "shifts"),
+        (0, 2, "varies with x or y"),
+    ] {
+        let mut odd = good.proj;
+        odd[col][row] = 0.01;
+        expect(
+            &mut culler,
+            &CullInputs {
+                proj: odd,
+                ..caller.inputs()
+            },
+            CullInput::Projection,
+            why,
+        );
+    }
     // Planes: near ≥ far, NaN, and planes the projection does not have.
     expect(
         &mut culler,

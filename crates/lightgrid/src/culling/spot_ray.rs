@@ -139,7 +139,11 @@ pub fn ray_test_count(
             .count() as u64;
         let cx = (x0 + x1) as f32 * 0.5 / setup.width as f32 * 2.0 - 1.0;
         let cy = 1.0 - (y0 + y1) as f32 * 0.5 / setup.height as f32 * 2.0;
-        let ray = Vec3::new(cx / setup.p00, cy / setup.p11, -1.0);
+        let ray = Vec3::new(
+            (cx + setup.p20) / setup.p00,
+            (cy + setup.p21) / setup.p11,
+            -1.0,
+        );
         // Lights without a thickened cone: as the CPU grid lists them.
         let others = grid
             .cell(t)

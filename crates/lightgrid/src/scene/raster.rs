@@ -60,7 +60,10 @@ fn raster_triangle(setup: &ViewSetup, t: [Vec3; 3], opaque_w: &[f32], out: &mut 
     // Screen position (pixels, y down) and 1/w, which is affine in screen space.
     let screen = t.map(|p| {
         let w = -p.z;
-        let ndc = Vec2::new(setup.p00 * p.x / w, setup.p11 * p.y / w);
+        let ndc = Vec2::new(
+            setup.p00 * p.x / w - setup.p20,
+            setup.p11 * p.y / w - setup.p21,
+        );
         (
             Vec2::new((ndc.x * 0.5 + 0.5) * wf, (0.5 - ndc.y * 0.5) * hf),
             1.0 / w,

@@ -35,6 +35,12 @@ pub struct ViewSetup {
     pub p00: f32,
     /// `proj[1][1]`: the vertical projection scale, 1 / tan(fov_y / 2).
     pub p11: f32,
+    /// `proj[2][0]` and `proj[2][1]`: an off-centre projection's shift (TAA jitter, a VR eye,
+    /// an off-axis display; 0 for a symmetric one): x_ndc = p00 * x / w - p20,
+    /// y_ndc = p11 * y / w - p21.
+    pub p20: f32,
+    /// `proj[2][1]`: see [`Self::p20`].
+    pub p21: f32,
     /// Near-plane view distance (the camera's `near`), in scene units.
     pub near: f32,
     /// Far-plane view distance (the camera's `far`), in scene units.
@@ -163,6 +169,8 @@ impl ViewSetup {
             eye: camera.eye,
             p00: proj.x_axis.x,
             p11: proj.y_axis.y,
+            p20: proj.z_axis.x,
+            p21: proj.z_axis.y,
             near: camera.near,
             far: camera.far,
             width,
@@ -217,8 +225,8 @@ impl ViewSetup {
         w_min: f32,
         w_max: f32,
     ) -> (Vec3, f32) {
-        let ndc_x = |x: u32| x as f32 / self.width as f32 * 2.0 - 1.0;
-        let ndc_y = |y: u32| 1.0 - y as f32 / self.height as f32 * 2.0;
+        let ndc_x = |x: u32| x as f32 / self.width as f32 * 2.0 - 1.0 + self.p20;
+        let ndc_y = |y: u32| 1.0 - y as f32 / self.height as f32 * 2.0 + self.p21;
         let mut corners = [Vec3::ZERO; 8];
         let mut i = 0;
         for w in [w_min, w_max] {
@@ -256,8 +264,8 @@ impl ViewSetup {
 
     /// View-space position of the sample at the centre of pixel (x, y) at view distance `w`.
     pub fn sample_position(&self, x: u32, y: u32, w: f32) -> Vec3 {
-        let ndc_x = (x as f32 + 0.5) / self.width as f32 * 2.0 - 1.0;
-        let ndc_y = 1.0 - (y as f32 + 0.5) / self.height as f32 * 2.0;
+        let ndc_x = (x as f32 + 0.5) / self.width as f32 * 2.0 - 1.0 + self.p20;
+        let ndc_y = 1.0 - (y as f32 + 0.5) / self.height as f32 * 2.0 + self.p21;
         Vec3::new(ndc_x / self.p00 * w, ndc_y / self.p11 * w, -w)
     }
 }

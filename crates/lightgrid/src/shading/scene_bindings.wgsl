@@ -63,7 +63,8 @@ fn position_from_depth(p: vec2<u32>, depth: f32) -> vec3<f32> {
 fn position_from_screen(xy: vec2<f32>, depth: f32) -> vec3<f32> {
     let uv = xy / frame.viewport;
     let w = view_distance_from_depth(depth);
-    let v = vec3<f32>((uv.x * 2.0 - 1.0) * w / frame.proj[0][0], (1.0 - uv.y * 2.0) * w / frame.proj[1][1], -w);
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0) + vec2<f32>(frame.proj[2][0], frame.proj[2][1]);
+    let v = vec3<f32>(ndc.x * w / frame.proj[0][0], ndc.y * w / frame.proj[1][1], -w);
     return (frame.inv_view * vec4<f32>(v, 0.0)).xyz;
 }
 

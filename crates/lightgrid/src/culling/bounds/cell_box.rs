@@ -82,15 +82,15 @@ pub(crate) fn rect_box(
 ) -> (Vec3, Vec3) {
     let (sx, sy) = (setup.width as f32, setup.height as f32);
     let ex = view_extent(
-        x[0] / sx * 2.0 - 1.0,
-        x[1] / sx * 2.0 - 1.0,
+        x[0] / sx * 2.0 - 1.0 + setup.p20,
+        x[1] / sx * 2.0 - 1.0 + setup.p20,
         setup.p00,
         w0,
         w1,
     );
     let ey = view_extent(
-        1.0 - y[0] / sy * 2.0,
-        1.0 - y[1] / sy * 2.0,
+        1.0 - y[0] / sy * 2.0 + setup.p21,
+        1.0 - y[1] / sy * 2.0 + setup.p21,
         setup.p11,
         w0,
         w1,

@@ -26,8 +26,11 @@ fn view_extent(n0: f32, n1: f32, scale: f32, w0: f32, w1: f32) -> vec2<f32> {
 // over view distances [w0, w1]: (x lo, x hi, y lo, y hi). CPU twin: `rect_box`.
 fn rect_extent(x: vec2<f32>, y: vec2<f32>, w0: f32, w1: f32) -> vec4<f32> {
     let size = frame.viewport;
-    let ex = view_extent(x.x / size.x * 2.0 - 1.0, x.y / size.x * 2.0 - 1.0, frame.proj[0][0], w0, w1);
-    let ey = view_extent(1.0 - y.x / size.y * 2.0, 1.0 - y.y / size.y * 2.0, frame.proj[1][1], w0, w1);
+    // NDC shifted by an off-centre projection's proj[2].xy (ndc + shift = p00 x / w).
+    let sx = frame.proj[2][0];
+    let sy = frame.proj[2][1];
+    let ex = view_extent(x.x / size.x * 2.0 - 1.0 + sx, x.y / size.x * 2.0 - 1.0 + sx, frame.proj[0][0], w0, w1);
+    let ey = view_extent(1.0 - y.x / size.y * 2.0 + sy, 1.0 - y.y / size.y * 2.0 + sy, frame.proj[1][1], w0, w1);
     return vec4<f32>(ex, ey);
 }
 

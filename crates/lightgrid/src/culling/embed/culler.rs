@@ -140,8 +140,11 @@ pub struct CullInputs<'a> {
     /// World to view space (right-handed, the camera looking down −z): a rotation and a
     /// translation, column-major (`glam::Mat4::to_cols_array_2d`).
     pub view: [[f32; 4]; 4],
-    /// View to clip space: a symmetric perspective projection with depth 0..1, standard
-    /// (0 at `near`, cleared to 1) or reversed (1 at `near`, cleared to 0; infinite allowed).
+    /// View to clip space: a perspective projection with depth 0..1, standard (0 at `near`,
+    /// cleared to 1) or reversed (1 at `near`, cleared to 0; infinite allowed). It may be
+    /// off-centre (`proj[2][0]`, `proj[2][1]` not 0: TAA jitter changing every frame, a VR
+    /// eye, an off-axis display): the cells follow its actual frustum. An orthographic
+    /// projection is refused (its cells would be boxes, not frusta).
     pub proj: [[f32; 4]; 4],
     /// The projection's near plane (a view distance).
     pub near: f32,
@@ -167,7 +170,7 @@ pub enum CullInput {
     Viewport,
     /// [`CullInputs::view`]: not finite, or not a rotation and a translation.
     View,
-    /// [`CullInputs::proj`]: not finite, not a symmetric perspective projection.
+    /// [`CullInputs::proj`]: not finite, not a perspective projection (orthographic, skewed).
     Projection,
     /// [`CullInputs::near`] / [`CullInputs::far`]: not 0 < near < far, or not the
     /// projection's.
@@ -1035,6 +1038,8 @@ impl Camera {
             eye: self.eye,
             p00: i.proj[0][0],
             p11: i.proj[1][1],
+            p20: i.proj[2][0],
+            p21: i.proj[2][1],
             near: i.near,
             far: i.far,
             width: i.viewport[0],
@@ -1044,12 +1049,12 @@ impl Camera {
     }
 }
 
-/// Check the projection against the planes: a symmetric perspective with w = -z whose near
-/// (and finite far) plane are `i.near` and `i.far`; true for standard depth (0 at near),
-/// false for reversed.
+/// Check the projection against the planes: a perspective (maybe off-centre) with w = -z
+/// whose near (and finite far) plane are `i.near` and `i.far`; true for standard depth (0 at
+/// near), false for reversed.
 fn projection_depth(i: &CullInputs) -> Result<bool, CullError> {
     use CullInput as I;
-    // The projection: symmetric perspective, w = -z.
+    // The projection: perspective, w = -z.
     let p = &i.proj;
     let zero = |x: f32| x == 0.0;
     let perspective = p[2][3] == -1.0
@@ -1064,17 +1069,20 @@ fn projection_depth(i: &CullInputs) -> Result<bool, CullError> {
             "a perspective projection with w = -z (right-handed, looking down -z) is needed",
         );
     }
-    if !(zero(p[2][0])
-        && zero(p[2][1])
-        && zero(p[1][0])
-        && zero(p[0][1])
-        && zero(p[3][0])
-        && zero(p[3][1]))
-    {
+    // Off-centre (TAA jitter, a VR eye, an off-axis display: p[2][0], p[2][1]) is any
+    // frustum the cells follow; a skew or a shift of the image that does not grow with depth
+    // is no pinhole camera.
+    if !(zero(p[1][0]) && zero(p[0][1]) && zero(p[3][0]) && zero(p[3][1])) {
         return refuse(
-                I::Projection,
-                "an off-centre or skewed projection (jitter, VR) is not supported: tiles assume a symmetric frustum",
-            );
+            I::Projection,
+            "a skewed projection (proj[1][0], proj[0][1]) or one that shifts x or y by a constant (proj[3][0], proj[3][1]) is not a perspective camera's",
+        );
+    }
+    if !(zero(p[0][2]) && zero(p[1][2])) {
+        return refuse(
+            I::Projection,
+            "the projection's depth varies with x or y (proj[0][2], proj[1][2]): depth must depend on the view distance alone",
+        );
     }
     let (near, far) = (i.near, i.far);
     // The renderer's own check of a camera's planes (finite, 0 < near < far, a ratio the

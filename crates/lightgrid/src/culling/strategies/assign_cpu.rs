@@ -117,8 +117,8 @@ pub fn project_sphere(setup: &ViewSetup, light: &ViewLight) -> Option<PixelRect>
     let (sy0, sy1) = axis_range(c.y, cw, r, setup.near)?;
     let (w, h) = (setup.width as f32, setup.height as f32);
     // NDC -> pixels (y down). A small widening absorbs round-off.
-    let px = |s: f32| ((setup.p00 * s) * 0.5 + 0.5) * w;
-    let py = |s: f32| (0.5 - (setup.p11 * s) * 0.5) * h;
+    let px = |s: f32| ((setup.p00 * s - setup.p20) * 0.5 + 0.5) * w;
+    let py = |s: f32| (0.5 - (setup.p11 * s - setup.p21) * 0.5) * h;
     let (x_lo, x_hi) = (px(sx0) - 0.01, px(sx1) + 0.01);
     let (y_lo, y_hi) = (py(sy1) - 0.01, py(sy0) + 0.01);
     if x_hi < 0.0 || y_hi < 0.0 || x_lo > w || y_lo > h {

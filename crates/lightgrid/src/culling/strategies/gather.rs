@@ -45,8 +45,15 @@ pub(super) fn cpu_frustum(
     let ts = dims.tile_size as f32;
     let lo = (x0 as f32, y0 as f32);
     let hi = ((lo.0 + ts).min(size.0), (lo.1 + ts).min(size.1));
-    let ndc_lo = (lo.0 / size.0 * 2.0 - 1.0, 1.0 - lo.1 / size.1 * 2.0);
-    let ndc_hi = (hi.0 / size.0 * 2.0 - 1.0, 1.0 - hi.1 / size.1 * 2.0);
+    // Shifted by an off-centre projection (`ViewSetup::p20`), as `tile_frustum.wgsl`.
+    let ndc_lo = (
+        lo.0 / size.0 * 2.0 - 1.0 + setup.p20,
+        1.0 - lo.1 / size.1 * 2.0 + setup.p21,
+    );
+    let ndc_hi = (
+        hi.0 / size.0 * 2.0 - 1.0 + setup.p20,
+        1.0 - hi.1 / size.1 * 2.0 + setup.p21,
+    );
     CpuFrustum {
         planes: [
             Vec3::new(1.0, 0.0, ndc_lo.0 / setup.p00).normalize(),

@@ -57,10 +57,13 @@ fn light_tiles(c: vec3<f32>, r: f32) -> vec4<i32> {
     let size = frame.viewport;
     let p00 = frame.proj[0][0];
     let p11 = frame.proj[1][1];
-    let x_lo = ((p00 * sx.x) * 0.5 + 0.5) * size.x - 0.01;
-    let x_hi = ((p00 * sx.y) * 0.5 + 0.5) * size.x + 0.01;
-    let y_lo = (0.5 - (p11 * sy.y) * 0.5) * size.y - 0.01;
-    let y_hi = (0.5 - (p11 * sy.x) * 0.5) * size.y + 0.01;
+    // An off-centre projection (jitter, a VR eye) shifts NDC by -proj[2].xy.
+    let p20 = frame.proj[2][0];
+    let p21 = frame.proj[2][1];
+    let x_lo = ((p00 * sx.x - p20) * 0.5 + 0.5) * size.x - 0.01;
+    let x_hi = ((p00 * sx.y - p20) * 0.5 + 0.5) * size.x + 0.01;
+    let y_lo = (0.5 - (p11 * sy.y - p21) * 0.5) * size.y - 0.01;
+    let y_hi = (0.5 - (p11 * sy.x - p21) * 0.5) * size.y + 0.01;
     if (x_hi < 0.0 || y_hi < 0.0 || x_lo > size.x || y_lo > size.y) {
         return none;
     }

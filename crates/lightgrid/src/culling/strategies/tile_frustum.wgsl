@@ -24,8 +24,10 @@ fn tile_frustum(tile: vec2<u32>, tile_size: u32, w_range: vec2<f32>) -> TileFrus
     let size = frame.viewport;
     let lo = vec2<f32>(tile * tile_size);
     let hi = min(lo + vec2<f32>(f32(tile_size)), size);
-    let ndc_lo = vec2<f32>(lo.x / size.x * 2.0 - 1.0, 1.0 - lo.y / size.y * 2.0);  // left, top
-    let ndc_hi = vec2<f32>(hi.x / size.x * 2.0 - 1.0, 1.0 - hi.y / size.y * 2.0);  // right, bottom
+    // Shifted by an off-centre projection's (jitter, a VR eye) proj[2].xy: ndc + shift = p00 x / w.
+    let shift = vec2<f32>(frame.proj[2][0], frame.proj[2][1]);
+    let ndc_lo = vec2<f32>(lo.x / size.x * 2.0 - 1.0, 1.0 - lo.y / size.y * 2.0) + shift;  // left, top
+    let ndc_hi = vec2<f32>(hi.x / size.x * 2.0 - 1.0, 1.0 - hi.y / size.y * 2.0) + shift;  // right, bottom
     let p00 = frame.proj[0][0];
     let p11 = frame.proj[1][1];
     var f: TileFrustum;
@@ -42,8 +44,9 @@ fn tile_frustum(tile: vec2<u32>, tile_size: u32, w_range: vec2<f32>) -> TileFrus
     return f;
 }
 
-// The centre of the eight corners of the frustum piece over NDC rectangle [lo, hi] between
-// view distances w0 and w1, and its farthest corner.
+// The centre of the eight corners of the frustum piece over NDC rectangle [lo, hi] (shifted by
+// the projection's centre: `tile_frustum`) between view distances w0 and w1, and its farthest
+// corner.
 fn frustum_sphere(ndc_lo: vec2<f32>, ndc_hi: vec2<f32>, w0: f32, w1: f32) -> vec4<f32> {
     var corners: array<vec3<f32>, 8>;
     var i = 0u;
