@@ -480,6 +480,18 @@ impl Caller {
     /// [`Self::frame`], the culler given the depth or not and asked for transparent lists or
     /// not, and the oracle checking the samples or transparent fragments in front of them.
     fn frame_as(&self, culler: &mut LightCuller, mode: Mode) -> ([u32; 7], lightgrid::CullReport) {
+        self.frame_with(culler, mode, None)
+    }
+
+    /// [`Self::frame_as`], the oracle binding the grid the way a caller that keeps the group
+    /// does: `held`'s, taken again only when the generation moved during `encode` (`follow`),
+    /// or never (a caller ignoring the rule). `None`: `bind_group()` after `encode`.
+    fn frame_with(
+        &self,
+        culler: &mut LightCuller,
+        mode: Mode,
+        held: Option<(&mut Held, bool)>,
+    ) -> ([u32; 7], lightgrid::CullReport) {
         let device = &self.device;
         self.queue.write_buffer(
             &self.check,
@@ -541,6 +553,17 @@ impl Caller {
             ..self.inputs()
         };
         let frame = culler.encode(&mut encoder, &inputs).expect("culling");
+        let grid_group = match held {
+            Some((held, follow)) => {
+                if follow && culler.bind_group_generation() != held.generation {
+                    held.group = culler.bind_group().clone();
+                    held.generation = culler.bind_group_generation();
+                    held.moves += 1;
+                }
+                held.group.clone()
+            }
+            None => culler.bind_group().clone(),
+        };
         let result = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("oracle result"),
             size: 32,
@@ -632,7 +655,7 @@ impl Caller {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &group, &[]);
-            pass.set_bind_group(1, culler.bind_group(), &[]);
+            pass.set_bind_group(1, &grid_group, &[]);
             pass.dispatch_workgroups(W.div_ceil(8), H.div_ceil(8), 1);
         }
         encoder.copy_buffer_to_buffer(&result, 0, &readback, 0, 32);
@@ -649,6 +672,24 @@ impl Caller {
             .find(|r| r.frame == frame)
             .expect("the frame's report");
         (values[..7].try_into().unwrap(), report)
+    }
+}
+
+/// A caller's copy of the culler's group, kept across frames.
+struct Held {
+    group: wgpu::BindGroup,
+    generation: u64,
+    /// Times it was taken again.
+    moves: u32,
+}
+
+impl Held {
+    fn take(culler: &LightCuller) -> Held {
+        Held {
+            group: culler.bind_group().clone(),
+            generation: culler.bind_group_generation(),
+            moves: 0,
+        }
     }
 }
 
@@ -925,6 +966,111 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
     let (_, report) = caller.frame(&mut culler);
     assert_eq!(report.invalid_lights, 2, "{report:?}");
     assert!(!report.is_complete());
+}
+
+/// A bind group that stays (`LightCuller::bind_group`'s rule): the group a caller takes before
+/// the first frame serves every frame until `bind_group_generation` moves, which happens only
+/// in `encode`. Growing from one index entry, the caller following the rule takes it again
+/// once and its frames then list every light; a caller ignoring the rule reads the stale group
+/// and misses lights (the oracle catches it). With `reserve` and an index capacity set up
+/// front, the group taken once serves every frame: with depth, transparent lists and froxels.
+#[test]
+fn the_bind_group_stays_until_its_generation_moves() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 37);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in strategies() {
+        let config = CullConfig {
+            strategy,
+            index_capacity: 1,
+            ..CullConfig::default()
+        };
+        // Following the rule.
+        let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+        let mut held = Held::take(&culler);
+        let mut reports = Vec::new();
+        for frame in 0..4 {
+            let (r, report) =
+                caller.frame_with(&mut culler, Mode::default(), Some((&mut held, true)));
+            // `frame_with` waited for the reports: the lists grew there, the group did not.
+            assert_eq!(
+                culler.bind_group_generation(),
+                held.generation,
+                "{strategy:?} frame {frame}: the group moved outside encode"
+            );
+            if frame >= 2 {
+                assert!(
+                    report.is_complete(),
+                    "{strategy:?} frame {frame}: {report:?}"
+                );
+                assert_eq!(r[0], 0, "{strategy:?} frame {frame}: misses");
+            }
+            reports.push((report, held.moves));
+        }
+        let grew = reports[0].0.overflowed;
+        assert!(
+            !grew || held.moves >= 1,
+            "{strategy:?}: the lists grew without a new group: {reports:?}"
+        );
+        assert_eq!(
+            reports[2].1, reports[3].1,
+            "{strategy:?}: the group moved once the lists fit: {reports:?}"
+        );
+        // Ignoring the rule: the group from before the first frame, after the lists grew.
+        if grew {
+            let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+            let mut stale = Held::take(&culler);
+            caller.frame_with(&mut culler, Mode::default(), Some((&mut stale, false)));
+            let (r, report) =
+                caller.frame_with(&mut culler, Mode::default(), Some((&mut stale, false)));
+            assert!(report.is_complete(), "{strategy:?}: {report:?}");
+            assert_ne!(culler.bind_group_generation(), stale.generation);
+            assert!(
+                r[0] > 100,
+                "{strategy:?}: a stale group must miss lights: {} misses",
+                r[0]
+            );
+        }
+        // Room set up front: the group taken once serves every frame.
+        let mut culler = LightCuller::new(
+            &device,
+            &queue,
+            CullConfig {
+                index_capacity: 1 << 18,
+                ..config
+            },
+        )
+        .expect("culler");
+        culler.reserve([W, H]).expect("reserve");
+        let mut once = Held::take(&culler);
+        let modes = [
+            Mode::default(),
+            Mode {
+                transparent_lists: true,
+                check_transparent: true,
+                ..Mode::default()
+            },
+            Mode {
+                depth: false,
+                ..Mode::default()
+            },
+            Mode::default(),
+        ];
+        for (k, mode) in modes.into_iter().enumerate() {
+            let (r, report) = caller.frame_with(&mut culler, mode, Some((&mut once, false)));
+            assert_eq!(
+                culler.bind_group_generation(),
+                once.generation,
+                "{strategy:?} reserved, frame {k}: the group moved"
+            );
+            assert!(
+                report.is_complete(),
+                "{strategy:?} reserved, frame {k}: {report:?}"
+            );
+            assert_eq!(r[0], 0, "{strategy:?} reserved, frame {k}: misses");
+        }
+    }
 }
 
 /// Froxels without a depth pre-pass (`CullInputs::depth: None`): every cell spans its slice of

@@ -151,6 +151,18 @@ impl GridBuilder {
         self.buffers.bind_group()
     }
 
+    /// How many times [`Self::bind_group`] has been replaced.
+    pub(crate) fn generation(&self) -> u64 {
+        self.buffers.generation()
+    }
+
+    /// Grow the grid's buffers now for `cells` cells and this grid's index capacity.
+    pub(crate) fn reserve(&mut self, device: &wgpu::Device, cells: usize) -> Result<()> {
+        crate::culling::frame::check_index_capacity(device, self.index_capacity, "reserve")?;
+        self.buffers.reserve(device, cells, self.index_capacity);
+        Ok(())
+    }
+
     /// Create `assign`'s strategy now (`auto`: both it may resolve to), so a device that
     /// cannot run it fails here rather than at the first frame.
     pub(crate) fn prepare(&mut self, device: &wgpu::Device) -> Result<()> {

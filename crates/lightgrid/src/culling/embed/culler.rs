@@ -646,10 +646,42 @@ impl LightCuller {
         self.core.layout()
     }
 
-    /// The grid the last encoded frame builds. Take it again after every
-    /// [`Self::encode`]: it is replaced when the lists grow.
+    /// The grid the frames build, for the caller's shading pass.
+    ///
+    /// **The rule:** the group stays the same object until [`Self::bind_group_generation`]
+    /// changes, and that happens only inside [`Self::encode`], when a frame needs more room
+    /// than the buffers have: longer lists (a finished frame's report said its lists
+    /// overflowed, so `poll`/`wait` raised the capacity) or more cells (a larger viewport, more
+    /// layers). `poll`, `wait` and `read_grid` never replace it. A caller that keeps the group
+    /// in its own bind groups compares the generation after each `encode` and rebuilds only
+    /// when it moved; one that wants it never to move calls [`Self::reserve`] and sets
+    /// [`CullConfig::index_capacity`] to what its frames need.
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         self.core.bind_group()
+    }
+
+    /// How many times [`Self::bind_group`] has been replaced (0 until a frame needs more room
+    /// than the culler was made or reserved with); see the rule there.
+    pub fn bind_group_generation(&self) -> u64 {
+        self.core.generation()
+    }
+
+    /// Make room now for frames of up to `viewport` pixels (every cell of the configured
+    /// slices, both layers with separate transparent lists) and
+    /// [`CullConfig::index_capacity`] index entries (for z-binning: its sorted lights and
+    /// every tile's mask words, `lights + tiles × ⌈lights / 32⌉`), so that such frames never
+    /// replace [`Self::bind_group`]. It may replace it once, now: take the group after this.
+    pub fn reserve(&mut self, viewport: [u32; 2]) -> Result<(), CullError> {
+        let [w, h] = viewport;
+        let tiles = GridDims::new(w, h, self.config.tile_size).map_err(|e| CullError {
+            input: CullInput::Viewport,
+            message: e.to_string(),
+        })?;
+        let cells =
+            tiles.tile_count() * self.config.slices as usize * self.config.lists.layers() as usize;
+        let device = self.caller()?.device.clone();
+        self.core.reserve(&device, cells)?;
+        Ok(())
     }
 
     /// The description of the grid the culler builds.

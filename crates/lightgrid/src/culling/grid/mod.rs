@@ -327,6 +327,8 @@ pub struct GridBuffers {
     /// The cell bounds the lists were built for (`light_grid.wgsl`'s `grid_bounds`).
     bounds: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
+    /// How many times `bind_group` was replaced (a buffer grew).
+    generation: u64,
 }
 
 #[cfg_attr(not(feature = "testing"), allow(dead_code))]
@@ -380,6 +382,39 @@ impl GridBuffers {
             indices,
             bounds,
             bind_group,
+            generation: 0,
+        }
+    }
+
+    /// A new group over the buffers (one grew): the generation moves on.
+    fn rebind(&mut self, device: &wgpu::Device) {
+        self.bind_group = Self::bind(
+            device,
+            &self.layout,
+            [&self.params, &self.cells, &self.indices, &self.bounds],
+        );
+        self.generation += 1;
+    }
+
+    /// How many times [`Self::bind_group`] has been replaced since the buffers were made.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Grow the buffers now to hold `cells` cells and `indices` index entries, so frames
+    /// within them replace no group.
+    pub fn reserve(&mut self, device: &wgpu::Device, cells: usize, indices: u64) {
+        let cb = (cells * 8) as u64;
+        let grown_cells = grow_storage(device, &mut self.cells, "grid cells", cb);
+        let grown_indices = grow_storage(
+            device,
+            &mut self.indices,
+            "grid indices",
+            indices.max(1) * 4,
+        );
+        let grown_bounds = grow_storage(device, &mut self.bounds, "grid cell bounds", cb);
+        if grown_cells || grown_indices || grown_bounds {
+            self.rebind(device);
         }
     }
 
@@ -434,11 +469,7 @@ impl GridBuffers {
         let grown_indices = grow_storage(device, &mut self.indices, "grid indices", ib);
         let grown_bounds = grow_storage(device, &mut self.bounds, "grid cell bounds", cb);
         if grown_cells || grown_indices || grown_bounds {
-            self.bind_group = Self::bind(
-                device,
-                &self.layout,
-                [&self.params, &self.cells, &self.indices, &self.bounds],
-            );
+            self.rebind(device);
         }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
     }
@@ -454,11 +485,7 @@ impl GridBuffers {
     ) {
         let bytes = (cells * 8) as u64;
         if grow_storage(device, &mut self.bounds, "grid cell bounds", bytes) {
-            self.bind_group = Self::bind(
-                device,
-                &self.layout,
-                [&self.params, &self.cells, &self.indices, &self.bounds],
-            );
+            self.rebind(device);
         }
         if bytes > 0 {
             encoder.copy_buffer_to_buffer(bounds, 0, &self.bounds, 0, bytes);
