@@ -11,7 +11,7 @@ use glam::{Mat4, Vec3};
 use lightgrid::culling::GridLists;
 use lightgrid::{
     Assign, CellBox, CullConfig, CullError, CullInput, CullInputs, CullLight, DepthBounds,
-    DepthMask, LightCuller,
+    DepthMask, LightCuller, LightLayout,
 };
 use wgpu::util::DeviceExt;
 
@@ -161,6 +161,48 @@ fn lights(cam: &Camera, n: usize, seed: u64) -> Vec<CullLight> {
             } else {
                 CullLight::point(p, range, payload)
             }
+        })
+        .collect()
+}
+
+/// An engine's own light: 64 bytes, the culler's fields shuffled among the engine's own.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct EngineLight {
+    color: [f32; 3],
+    intensity: f32,
+    cos_outer: f32,
+    direction: [f32; 3],
+    kind: u32,
+    range: f32,
+    /// Never read by the culler: NaN here must not matter.
+    shadow: [f32; 2],
+    position: [f32; 3],
+    pad: f32,
+}
+
+/// [`EngineLight`] as the culler reads it.
+const ENGINE_LAYOUT: LightLayout = LightLayout {
+    stride: 64,
+    position: 48,
+    range: 36,
+    direction: Some(20),
+    cos_outer: Some(16),
+};
+
+fn engine_lights(lights: &[CullLight]) -> Vec<EngineLight> {
+    lights
+        .iter()
+        .map(|l| EngineLight {
+            color: [l.payload[0], l.payload[1], l.payload[2]],
+            intensity: 100.0,
+            cos_outer: l.cos_outer,
+            direction: l.direction,
+            kind: u32::from(l.cos_outer >= -1.0),
+            range: l.range,
+            shadow: [f32::NAN, f32::INFINITY],
+            position: l.position,
+            pad: f32::NAN,
         })
         .collect()
 }
@@ -321,6 +363,9 @@ struct Caller {
     lights: wgpu::Buffer,
     /// The same lights with ranges 10% short: a culler fed these must fail the oracle.
     shrunk_lights: wgpu::Buffer,
+    /// Both as [`EngineLight`]s (`ENGINE_LAYOUT`).
+    engine_lights: wgpu::Buffer,
+    shrunk_engine_lights: wgpu::Buffer,
     /// Both, on the CPU (`CullInputs::cpu_lights`, for `cpu` and `bvh`).
     cpu_lights: Vec<CullLight>,
     shrunk_cpu_lights: Vec<CullLight>,
@@ -425,7 +470,16 @@ impl Caller {
             contents: bytemuck::cast_slice(&shrunk),
             usage: wgpu::BufferUsages::STORAGE,
         });
+        let engine_buffer = |label, lights: &[CullLight]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(&engine_lights(lights)),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
         Caller {
+            engine_lights: engine_buffer("engine lights", lights),
+            shrunk_engine_lights: engine_buffer("engine lights, ranges 10% short", &shrunk),
             device: device.clone(),
             queue: queue.clone(),
             samples,
@@ -539,10 +593,11 @@ impl Caller {
         let inputs = CullInputs {
             depth: mode.depth.then_some(&self.depth_view),
             transparent: mode.transparent_lists,
-            lights: if mode.shrunk {
-                &self.shrunk_lights
-            } else {
-                &self.lights
+            lights: match (mode.engine_layout, mode.shrunk) {
+                (false, false) => &self.lights,
+                (false, true) => &self.shrunk_lights,
+                (true, false) => &self.engine_lights,
+                (true, true) => &self.shrunk_engine_lights,
             },
             cpu_lights: Some(if mode.shrunk {
                 &self.shrunk_cpu_lights
@@ -707,6 +762,8 @@ struct Mode {
     /// Added to the camera's `proj[2][0]`, `proj[2][1]` this frame: an off-centre projection
     /// (TAA jitter, a VR eye). x_ndc = p00 x / w - proj[2][0].
     shift: [f32; 2],
+    /// The culler reads the lights as [`EngineLight`]s (its layout set to `ENGINE_LAYOUT`).
+    engine_layout: bool,
 }
 
 impl Default for Mode {
@@ -717,6 +774,7 @@ impl Default for Mode {
             check_transparent: false,
             shrunk: false,
             shift: [0.0; 2],
+            engine_layout: false,
         }
     }
 }
@@ -966,6 +1024,78 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
     let (_, report) = caller.frame(&mut culler);
     assert_eq!(report.invalid_lights, 2, "{report:?}");
     assert!(!report.is_complete());
+}
+
+/// The caller's own light struct (`LightCuller::set_light_layout`): a 64-byte stride with the
+/// fields shuffled among the engine's own (NaN in fields the culler must not read), read in
+/// place. Every strategy, tiles and clusters, with the depth and without: every reaching light
+/// listed, and the same lists as the `CullLight` buffer gives; ranges 10% short miss lights.
+#[test]
+fn the_callers_own_light_layout_is_read_in_place() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 41);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in strategies() {
+        for grid in GRIDS {
+            let config = CullConfig {
+                tile_size: grid.0,
+                slices: grid.1,
+                strategy,
+                ..CullConfig::default()
+            };
+            for depth in [true, false] {
+                let what = format!("{strategy:?} {grid:?} depth {depth}");
+                let plain = check_as(
+                    &caller,
+                    config,
+                    &what,
+                    Mode {
+                        depth,
+                        ..Mode::default()
+                    },
+                );
+                let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+                assert_eq!(culler.light_layout(), LightLayout::CULL_LIGHT);
+                culler.set_light_layout(ENGINE_LAYOUT).expect("layout");
+                let mode = Mode {
+                    depth,
+                    engine_layout: true,
+                    ..Mode::default()
+                };
+                let (r, report) = caller.settled_frame(&mut culler, mode);
+                assert!(report.is_complete(), "{what}: {report:?}");
+                assert_eq!(
+                    r[0], 0,
+                    "{what}: {} lights reaching samples are missing (first: pixel ({}, {}), light {})",
+                    r[0], r[4], r[5], r[6]
+                );
+                let listed = f64::from(r[2]) / f64::from(r[3]);
+                assert_eq!(listed, plain, "{what}: the engine's layout lists otherwise");
+            }
+        }
+        let mut culler = LightCuller::new(
+            &device,
+            &queue,
+            CullConfig {
+                strategy,
+                ..CullConfig::default()
+            },
+        )
+        .expect("culler");
+        culler.set_light_layout(ENGINE_LAYOUT).expect("layout");
+        let shrunk = Mode {
+            engine_layout: true,
+            shrunk: true,
+            ..Mode::default()
+        };
+        let (r, _) = caller.settled_frame(&mut culler, shrunk);
+        assert!(
+            r[0] > 100,
+            "{strategy:?}: ranges 10% short must miss lights: {} misses",
+            r[0]
+        );
+    }
 }
 
 /// A bind group that stays (`LightCuller::bind_group`'s rule): the group a caller takes before
@@ -1436,6 +1566,91 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         CullInput::Lights,
         "STORAGE",
     );
+    // The caller's light layout: refused by the field at fault, and the layout unchanged.
+    let layouts = [
+        (
+            LightLayout {
+                stride: 50,
+                ..ENGINE_LAYOUT
+            },
+            "multiple of 4",
+        ),
+        (
+            LightLayout {
+                stride: 0,
+                ..ENGINE_LAYOUT
+            },
+            "between 4 and 4096",
+        ),
+        (
+            LightLayout {
+                stride: 8192,
+                ..ENGINE_LAYOUT
+            },
+            "between 4 and 4096",
+        ),
+        (
+            LightLayout {
+                position: 2,
+                ..ENGINE_LAYOUT
+            },
+            "position at byte 2",
+        ),
+        (
+            LightLayout {
+                range: 64,
+                ..ENGINE_LAYOUT
+            },
+            "range (bytes 64..68) does not fit",
+        ),
+        (
+            LightLayout {
+                position: 56,
+                ..ENGINE_LAYOUT
+            },
+            "position (bytes 56..68)",
+        ),
+        (
+            LightLayout {
+                cos_outer: None,
+                ..ENGINE_LAYOUT
+            },
+            "come together",
+        ),
+        (
+            LightLayout {
+                range: 52,
+                ..ENGINE_LAYOUT
+            },
+            "position and range overlap",
+        ),
+        (
+            LightLayout {
+                cos_outer: Some(24),
+                ..ENGINE_LAYOUT
+            },
+            "direction and cos_outer overlap",
+        ),
+    ];
+    for (layout, words) in layouts {
+        let e = culler
+            .set_light_layout(layout)
+            .expect_err(&format!("{layout:?} accepted"));
+        assert_eq!(e.input, CullInput::Lights, "{e}");
+        assert!(e.to_string().contains(words), "{e} (expected '{words}')");
+        assert_eq!(culler.light_layout(), LightLayout::CULL_LIGHT);
+    }
+    // A buffer of 40 CullLights is too short for 40 lights of 64 bytes.
+    culler.set_light_layout(ENGINE_LAYOUT).expect("layout");
+    expect(
+        &mut culler,
+        &caller.inputs(),
+        CullInput::Lights,
+        "40 lights of 64 bytes need 2560 bytes; the buffer has 1920",
+    );
+    culler
+        .set_light_layout(LightLayout::default())
+        .expect("layout");
     // Viewport: empty, larger than the depth texture.
     expect(
         &mut culler,

@@ -18,7 +18,9 @@ pub(crate) use bounds::cell_bounds::cell_bounds_cpu_samples;
 pub(crate) use bounds::cell_box::CellCull;
 pub(crate) use builder::BuiltGrid;
 pub(crate) use builder::GridUse;
-pub use embed::culler::{CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller};
+pub use embed::culler::{
+    CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller, LightLayout,
+};
 pub(crate) use frame::CellSource;
 pub(crate) use frame::{bind_cull_group, cull_layout, CullFrame};
 pub(crate) use grid::GridBuffers;

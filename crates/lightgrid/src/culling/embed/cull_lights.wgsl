@@ -1,15 +1,55 @@
-// LightCuller's first pass: a caller's lights (world space, `CullLight`'s layout, which is
-// `Light`'s) into the camera-relative copy every culling kernel reads, and each light's
+// LightCuller's first pass: a caller's lights (world space, in the caller's own struct as
+// `LightLayout` describes it; `CullLight`'s by default) into the camera-relative copy every
+// culling kernel reads (`Light`), and each light's
 // bounding sphere (`Light::bounding_sphere`'s formula, in f32 as the CPU computes it). A
 // light whose position, range or spot cone is not finite, or whose range is not positive, is
 // counted (COUNTER_INVALID_LIGHTS) and given a sphere no cell holds: the report says the
 // frame lacks it, never a silently wrong grid.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
-@group(0) @binding(1) var<storage, read> caller_lights: array<Light>;
+// Where a light's fields lie in the caller's buffer, in 4-byte words (`LightLayout::words`).
+struct CallerLightLayout {
+    stride: u32,
+    position: u32,
+    range: u32,
+    direction: u32,
+    cos_outer: u32,
+    // 1: the buffer has spot lights (direction and cos_outer); 0: points only.
+    spot: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+@group(0) @binding(1) var<storage, read> caller_lights: array<u32>;
 @group(0) @binding(2) var<storage, read_write> lights_out: array<Light>;
 @group(0) @binding(3) var<storage, read_write> bounds_out: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;
+@group(0) @binding(5) var<uniform> caller_layout: CallerLightLayout;
+
+fn caller_f32(word: u32) -> f32 {
+    return bitcast<f32>(caller_lights[word]);
+}
+
+fn caller_vec3(word: u32) -> vec3<f32> {
+    return vec3<f32>(caller_f32(word), caller_f32(word + 1u), caller_f32(word + 2u));
+}
+
+// Light `i` of the caller's buffer: what culling reads of it (the rest is the caller's).
+fn caller_light(i: u32) -> Light {
+    let base = i * caller_layout.stride;
+    var l: Light;
+    l.position = caller_vec3(base + caller_layout.position);
+    l.range = caller_f32(base + caller_layout.range);
+    l.radiance = vec3<f32>(0.0);
+    l.cos_inner = 0.0;
+    l.direction = vec3<f32>(0.0, 0.0, -1.0);
+    l.cos_outer = POINT_LIGHT_COS;
+    if (caller_layout.spot != 0u) {
+        l.direction = caller_vec3(base + caller_layout.direction);
+        l.cos_outer = caller_f32(base + caller_layout.cos_outer);
+    }
+    return l;
+}
 
 // Infinity or NaN, by the exponent bits (comparisons with NaN may be folded away).
 fn not_finite(x: f32) -> bool {
@@ -51,7 +91,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (i >= frame.light_count) {
         return;
     }
-    var l = caller_lights[i];
+    var l = caller_light(i);
     l.position = l.position - frame.eye;
     if (!light_is_valid(l)) {
         atomicAdd(&frame_counters[COUNTER_INVALID_LIGHTS], 1u);

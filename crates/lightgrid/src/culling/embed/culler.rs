@@ -109,6 +109,105 @@ impl CullLight {
     }
 }
 
+/// Where the culler finds each light's fields in the caller's own light buffer
+/// ([`LightCuller::set_light_layout`]): the culler reads the buffer in place, whatever the
+/// caller's struct is. Byte offsets within a light, each a multiple of 4; f32 values.
+///
+/// - `position`: three f32s, world space; `range`: one f32 (> 0, the light reaches nothing
+///   farther);
+/// - `direction` (three f32s, a unit axis) and `cos_outer` (one f32, the cosine of the outer
+///   half-angle, −1..=1; exactly −2, [`CullLight::POINT`], for a point light): both, for a
+///   buffer with spot lights, or neither (every light a point light).
+///
+/// Everything else in a light (colour, intensity, type, shadows) is the caller's and never
+/// read. The default is [`CullLight`]'s layout.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightLayout {
+    /// Bytes from one light to the next (a multiple of 4, 4..=4096).
+    pub stride: u32,
+    /// Byte offset of the position (three f32s).
+    pub position: u32,
+    /// Byte offset of the range (one f32).
+    pub range: u32,
+    /// Byte offset of a spot's unit axis (three f32s), with `cos_outer`; `None`: no spots.
+    pub direction: Option<u32>,
+    /// Byte offset of a spot's outer half-angle cosine (one f32), with `direction`.
+    pub cos_outer: Option<u32>,
+}
+
+impl LightLayout {
+    /// [`CullLight`]'s layout: 48 bytes, position at 0, range 12, direction 32, cosine 44.
+    pub const CULL_LIGHT: LightLayout = LightLayout {
+        stride: 48,
+        position: 0,
+        range: 12,
+        direction: Some(32),
+        cos_outer: Some(44),
+    };
+
+    /// The layout as the light-preparing kernel reads it (in 4-byte words), after `check`.
+    fn words(&self) -> [u32; 8] {
+        let spot = self.direction.zip(self.cos_outer);
+        [
+            self.stride / 4,
+            self.position / 4,
+            self.range / 4,
+            spot.map_or(0, |(d, _)| d / 4),
+            spot.map_or(0, |(_, c)| c / 4),
+            u32::from(spot.is_some()),
+            0,
+            0,
+        ]
+    }
+
+    /// Refuse a layout whose fields are unaligned, outside the stride or overlapping.
+    fn check(&self) -> Result<(), CullError> {
+        let bad = |m: String| refuse(CullInput::Lights, format!("light layout: {m}"));
+        if self.stride % 4 != 0 || !(4..=4096).contains(&self.stride) {
+            return bad(format!(
+                "stride {} must be a multiple of 4 between 4 and 4096",
+                self.stride
+            ));
+        }
+        let mut fields = vec![("position", self.position, 12), ("range", self.range, 4)];
+        match (self.direction, self.cos_outer) {
+            (Some(d), Some(c)) => {
+                fields.push(("direction", d, 12));
+                fields.push(("cos_outer", c, 4));
+            }
+            (None, None) => {}
+            _ => return bad("direction and cos_outer come together (spots) or not at all".into()),
+        }
+        for &(name, at, len) in &fields {
+            if at % 4 != 0 {
+                return bad(format!("{name} at byte {at} is not a multiple of 4"));
+            }
+            if u64::from(at) + len > u64::from(self.stride) {
+                return bad(format!(
+                    "{name} (bytes {at}..{}) does not fit the stride {}",
+                    u64::from(at) + len,
+                    self.stride
+                ));
+            }
+        }
+        for (i, &(a, at_a, len_a)) in fields.iter().enumerate() {
+            for &(b, at_b, len_b) in &fields[i + 1..] {
+                let (a0, b0) = (u64::from(at_a), u64::from(at_b));
+                if a0 < b0 + len_b && b0 < a0 + len_a {
+                    return bad(format!("{a} and {b} overlap"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for LightLayout {
+    fn default() -> Self {
+        Self::CULL_LIGHT
+    }
+}
+
 /// One frame's inputs to [`LightCuller::encode`].
 #[derive(Clone, Copy)]
 pub struct CullInputs<'a> {
@@ -127,9 +226,11 @@ pub struct CullInputs<'a> {
     /// `Shared`: the opaque cells widened to `near`). Without depth every cell already covers
     /// them. `false`: lists cover the depth buffer's samples only.
     pub transparent: bool,
-    /// The caller's lights: [`CullLight`]s from byte 0, with `STORAGE` usage.
+    /// The caller's lights from byte 0, with `STORAGE` usage: [`CullLight`]s, or the
+    /// caller's own struct as [`LightCuller::set_light_layout`] describes it.
     pub lights: &'a wgpu::Buffer,
-    /// The same lights on the CPU, for the strategies that assign there (tiled-shading §6.1:
+    /// The same lights on the CPU as [`CullLight`]s (whatever the buffer's layout), for the
+    /// strategies that assign there (tiled-shading §6.1:
     /// `cpu`, and `bvh`, which builds its hierarchy there); the others ignore it. `cpu` reads
     /// the cells' depth bounds back part-way through the frame: what the encoder holds so far
     /// (the depth pre-pass) is submitted, and the caller's encoder is replaced by a new one,
@@ -162,7 +263,8 @@ pub enum CullInput {
     /// [`CullInputs::depth`]: format, dimension, sample count, usage; or asked to cover
     /// transparent surfaces without it.
     Depth,
-    /// [`CullInputs::lights`]: size, usage.
+    /// [`CullInputs::lights`]: size, usage; [`LightLayout`]: alignment, fit, overlap;
+    /// [`CullInputs::cpu_lights`].
     Lights,
     /// [`CullInputs::light_count`] beyond [`CullConfig::max_lights`].
     LightCount,
@@ -335,6 +437,9 @@ struct Caller {
     group: wgpu::BindGroup,
     prep: wgpu::ComputePipeline,
     prep_layout: wgpu::BindGroupLayout,
+    /// The caller's light layout, and its words for the light-preparing kernel.
+    light_layout: LightLayout,
+    light_layout_buffer: wgpu::Buffer,
     timer: PassTimer,
     frames: u64,
     /// The newest finished frame's number and counters ([`LightCuller::read_grid`]).
@@ -405,8 +510,21 @@ impl Caller {
                 buffer_entry(2, STORAGE_RW),
                 buffer_entry(3, STORAGE_RW),
                 buffer_entry(4, STORAGE_RW),
+                buffer_entry(5, UNIFORM),
             ],
         });
+        let light_layout = LightLayout::CULL_LIGHT;
+        let light_layout_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("culler light layout"),
+            size: 32,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(
+            &light_layout_buffer,
+            0,
+            bytemuck::cast_slice(&light_layout.words()),
+        );
         let prep = compute_pipeline(
             device,
             "cull lights",
@@ -425,6 +543,8 @@ impl Caller {
             group,
             prep,
             prep_layout,
+            light_layout,
+            light_layout_buffer,
             timer: PassTimer::disabled(),
             frames: 0,
             last_report: None,
@@ -477,6 +597,7 @@ impl Caller {
                 entry(2, &self.lights),
                 entry(3, &self.bounds),
                 entry(4, self.counters.buffer()),
+                entry(5, &self.light_layout_buffer),
             ],
         });
         self.counters.clear(encoder);
@@ -687,6 +808,29 @@ impl LightCuller {
     /// The description of the grid the culler builds.
     pub fn config(&self) -> &CullConfig {
         &self.config
+    }
+
+    /// Read the caller's lights in its own struct from now on ([`LightLayout`]; the default
+    /// is [`CullLight`]'s): [`CullInputs::lights`] is then the caller's buffer as it is, of
+    /// `light_count × stride` bytes or more. Refuses, naming the field, a layout whose fields
+    /// are unaligned, overlap or do not fit the stride.
+    pub fn set_light_layout(&mut self, layout: LightLayout) -> Result<(), CullError> {
+        layout.check()?;
+        let c = self.caller()?;
+        c.light_layout = layout;
+        c.queue.write_buffer(
+            &c.light_layout_buffer,
+            0,
+            bytemuck::cast_slice(&layout.words()),
+        );
+        Ok(())
+    }
+
+    /// The layout the culler reads the caller's lights with.
+    pub fn light_layout(&self) -> LightLayout {
+        self.caller
+            .as_deref()
+            .map_or(LightLayout::CULL_LIGHT, |c| c.light_layout)
     }
 
     /// Record one frame's culling into `encoder` after the caller's depth pre-pass. The
@@ -919,12 +1063,13 @@ impl Caller {
             );
         }
         // A storage binding holds at least one element, even for a frame without lights.
-        let needed = u64::from(i.light_count.max(1)) * std::mem::size_of::<CullLight>() as u64;
+        let stride = self.light_layout.stride;
+        let needed = u64::from(i.light_count.max(1)) * u64::from(stride);
         if i.lights.size() < needed {
             return refuse(
                 I::Lights,
                 format!(
-                    "{} lights need {needed} bytes; the buffer has {}",
+                    "{} lights of {stride} bytes need {needed} bytes; the buffer has {}",
                     i.light_count,
                     i.lights.size()
                 ),
