@@ -155,8 +155,11 @@ pub struct GridParams {
     /// A z-binned grid: where the tile masks start in the index buffer (after the sorted
     /// light indices).
     pub zbin_masks: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// Padding (named without a trailing digit or leading underscore: naga_oil imports the
+    /// WGSL struct by these names, `LightCuller::naga_oil_module`).
+    pub pad_a: u32,
+    /// Padding.
+    pub pad_b: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 48);

@@ -637,14 +637,17 @@ impl Caller {
             } else {
                 ("texture_depth_2d", "0")
             };
-            let src = format!(
-                "const SAMPLES: u32 = {}u;\n{}\n{}",
+            let check = format!(
+                "const SAMPLES: u32 = {}u;\n{}",
                 self.samples,
-                LightCuller::wgsl(1),
                 CHECK_WGSL
                     .replace("DEPTH_TYPE", ty)
                     .replace("LOAD_SAMPLE", sample)
             );
+            let src = match mode.naga_oil {
+                false => format!("{}\n{check}", LightCuller::wgsl(1)),
+                true => compose_with_naga_oil(&check),
+            };
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("oracle"),
                 source: wgpu::ShaderSource::Wgsl(src.into()),
@@ -764,6 +767,8 @@ struct Mode {
     shift: [f32; 2],
     /// The culler reads the lights as [`EngineLight`]s (its layout set to `ENGINE_LAYOUT`).
     engine_layout: bool,
+    /// The oracle imports the accessors from `LightCuller::naga_oil_module` with naga_oil.
+    naga_oil: bool,
 }
 
 impl Default for Mode {
@@ -775,8 +780,43 @@ impl Default for Mode {
             shrunk: false,
             shift: [0.0; 2],
             engine_layout: false,
+            naga_oil: false,
         }
     }
+}
+
+/// The oracle composed as a naga_oil user composes: the grid registered as the module
+/// `lightgrid::grid`, imported by name, the result written back as WGSL.
+fn compose_with_naga_oil(check: &str) -> String {
+    use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
+    let mut composer = Composer::default();
+    let added = composer.add_composable_module(ComposableModuleDescriptor {
+        source: &LightCuller::naga_oil_module(1),
+        file_path: "lightgrid/grid.wgsl",
+        ..Default::default()
+    });
+    if let Err(e) = added {
+        panic!("the grid module: {}", e.emit_to_string(&composer));
+    }
+    let source = format!(
+        "#import lightgrid::grid::{{light_grid_cell, light_grid_cell_transparent, light_grid_count, light_grid_light, light_grid_walk, light_grid_next}}\n{check}"
+    );
+    let module = match composer.make_naga_module(NagaModuleDescriptor {
+        source: &source,
+        file_path: "oracle.wgsl",
+        ..Default::default()
+    }) {
+        Ok(module) => module,
+        Err(e) => panic!("the oracle: {}", e.emit_to_string(&composer)),
+    };
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .expect("the composed oracle validates");
+    naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+        .expect("written as WGSL")
 }
 
 fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
@@ -1096,6 +1136,63 @@ fn the_callers_own_light_layout_is_read_in_place() {
             r[0]
         );
     }
+}
+
+/// The accessors as a naga_oil module (`LightCuller::naga_oil_module`): the oracle imports
+/// `lightgrid::grid`'s functions by name through naga_oil's composer, and checks tiles and
+/// clusters, z-bins and lists, samples and transparent fragments, as the text form does.
+#[test]
+fn the_naga_oil_module_serves_a_composed_shader() {
+    let (device, queue) = device();
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 43);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in [Assign::Gather, Assign::ZBin] {
+        for grid in GRIDS {
+            let config = CullConfig {
+                tile_size: grid.0,
+                slices: grid.1,
+                strategy,
+                ..CullConfig::default()
+            };
+            for (transparent, depth) in [(false, true), (true, true), (false, false)] {
+                let mode = Mode {
+                    depth,
+                    transparent_lists: transparent && depth,
+                    check_transparent: transparent,
+                    naga_oil: true,
+                    ..Mode::default()
+                };
+                let what = format!("naga_oil {strategy:?} {grid:?} transparent {transparent}");
+                let text = check_as(
+                    &caller,
+                    config,
+                    &what,
+                    Mode {
+                        naga_oil: false,
+                        ..mode
+                    },
+                );
+                let module = check_as(&caller, config, &what, mode);
+                assert_eq!(module, text, "{what}: the module lists otherwise");
+            }
+        }
+    }
+    // The shrunk lights still miss through the module (the oracle is the same oracle).
+    let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
+    let (r, _) = caller.settled_frame(
+        &mut culler,
+        Mode {
+            shrunk: true,
+            naga_oil: true,
+            ..Mode::default()
+        },
+    );
+    assert!(
+        r[0] > 100,
+        "ranges 10% short must miss lights: {} misses",
+        r[0]
+    );
 }
 
 /// A bind group that stays (`LightCuller::bind_group`'s rule): the group a caller takes before

@@ -67,8 +67,8 @@ fn gpu_structs_match_wgsl() {
             layer_cells,
             zbin_words,
             zbin_masks,
-            _pad0,
-            _pad1
+            pad_a,
+            pad_b
         ]
     );
     check_layout!(

@@ -346,6 +346,9 @@ pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 16;
 /// already carry the `light_grid` prefix, so nothing collides with the caller's names.
 const EMBED_WGSL: &str = include_str!("embed.wgsl");
 
+/// The import path of [`LightCuller::naga_oil_module`].
+const NAGA_OIL_IMPORT_PATH: &str = "lightgrid::grid";
+
 /// The caller's WGSL at bind group `group` ([`LightCuller::wgsl`]): a shader key like every
 /// other, composed without the constants prelude (it declares only `light_grid` names).
 #[derive(Clone, Copy, Debug)]
@@ -759,6 +762,28 @@ impl LightCuller {
     /// Every name it declares starts with `light_grid` or `LightGrid`.
     pub fn wgsl(group: u32) -> String {
         CallerGridKey { group }.shader().source()
+    }
+
+    /// [`Self::wgsl`] as a [naga_oil](https://crates.io/crates/naga_oil) module named
+    /// `lightgrid::grid` (the same text under a `#define_import_path` line), for a renderer
+    /// that composes its shaders with naga_oil (Bevy's composer):
+    ///
+    /// ```text
+    /// composer.add_composable_module(ComposableModuleDescriptor {
+    ///     source: &LightCuller::naga_oil_module(1),
+    ///     file_path: "lightgrid/grid.wgsl",
+    ///     ..Default::default()
+    /// })?;
+    /// // in the caller's shader:
+    /// #import lightgrid::grid::{light_grid_cell, light_grid_walk, light_grid_next}
+    /// ```
+    ///
+    /// `tests/culler.rs` composes its oracle this way with naga_oil 0.23 and culls through it.
+    pub fn naga_oil_module(group: u32) -> String {
+        format!(
+            "#define_import_path {NAGA_OIL_IMPORT_PATH}\n{}",
+            Self::wgsl(group)
+        )
     }
 
     /// The layout of [`Self::bind_group`], for the caller's pipeline layout (visible to

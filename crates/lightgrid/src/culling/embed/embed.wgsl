@@ -46,7 +46,7 @@ fn light_grid_walk(cell: u32) -> LightGridWalk {
         return LightGridWalk(0u, 0u, c.y, c.x, LightGridZBinWalk(0u, 0u, 0u, 0u, 0u), 0u);
     }
     let z = light_grid_zbin_walk(cell);
-    return LightGridWalk(0u, z.word0, z.word_end, 0u, z, 0u);
+    return LightGridWalk(0u, z.word_begin, z.word_end, 0u, z, 0u);
 }
 
 // The next light of the walk into `(*w).light`; false when there is none left.
@@ -79,7 +79,7 @@ fn light_grid_count(cell: u32) -> u32 {
     }
     let z = light_grid_zbin_walk(cell);
     var n = 0u;
-    for (var k = z.word0; k < z.word_end; k++) {
+    for (var k = z.word_begin; k < z.word_end; k++) {
         n += countOneBits(light_grid_zbin_word(z, k));
     }
     return n;
@@ -93,7 +93,7 @@ fn light_grid_light(cell: u32, i: u32) -> u32 {
     }
     let z = light_grid_zbin_walk(cell);
     var left = i;
-    for (var k = z.word0; k < z.word_end; k++) {
+    for (var k = z.word_begin; k < z.word_end; k++) {
         var bits = light_grid_zbin_word(z, k);
         let n = countOneBits(bits);
         if (left < n) {

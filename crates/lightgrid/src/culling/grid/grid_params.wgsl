@@ -12,6 +12,6 @@ struct LightGridParams {
     layer_cells: u32,
     zbin_words: u32,   // a z-binned grid's words per tile mask (0: per-cell lists)
     zbin_masks: u32,   // where its tile masks start in the index buffer
-    _pad0: u32,
-    _pad1: u32,
+    pad_a: u32,
+    pad_b: u32,
 }

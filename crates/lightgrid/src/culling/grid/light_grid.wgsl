@@ -34,7 +34,7 @@ fn zbin_count(cell: u32) -> u32 {
     }
     let z = light_grid_zbin_walk(cell);
     var n = 0u;
-    var k = z.word0;
+    var k = z.word_begin;
     for (; k < z.word_end; k = k + 1u) {
         n += countOneBits(light_grid_zbin_word(z, k));
     }

@@ -8,7 +8,7 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
     var acc = vec4<f32>(0.0);
     var shaded = 0u;
     var listed = 0u;
-    var k = z.word0;
+    var k = z.word_begin;
     for (; k < z.word_end; k = k + 1u) {
         var bits = light_grid_zbin_word(z, k);
         listed += countOneBits(bits);

@@ -38,9 +38,9 @@ fn list_sum(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32>
 
 fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f32> {
     let z = light_grid_zbin_walk(cell);
-    let has = z.word0 < z.word_end;
+    let has = z.word_begin < z.word_end;
     // The union of the lanes' word ranges, [lo, hi).
-    let lo = subgroupMin(select(NO_LIGHT, z.word0, has));
+    let lo = subgroupMin(select(NO_LIGHT, z.word_begin, has));
     let hi = subgroupMax(z.word_end);
     var acc = vec4<f32>(0.0);
     if (lo == NO_LIGHT) {
@@ -51,7 +51,7 @@ fn zbin_shade(s: Surface, view_dir: vec3<f32>, cell: u32, mono: bool) -> vec4<f3
     var k = lo;
     for (; k < hi; k = k + 1u) {
         var mine = 0u;
-        if (k >= z.word0 && k < z.word_end) {
+        if (k >= z.word_begin && k < z.word_end) {
             mine = light_grid_zbin_word(z, k);
         }
         listed += countOneBits(mine);

@@ -211,8 +211,8 @@ impl GridDims {
             layer_cells: self.layer_cells() as u32,
             zbin_words: self.zbin_lights.map_or(0, |n| n.div_ceil(32)),
             zbin_masks: self.zbin_lights.unwrap_or(0),
-            _pad0: 0,
-            _pad1: 0,
+            pad_a: 0,
+            pad_b: 0,
         }
     }
 }

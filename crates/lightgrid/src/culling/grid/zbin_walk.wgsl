@@ -12,7 +12,7 @@ struct LightGridZBinWalk {
     tile_mask: u32,  // index of the tile's first mask word
     first: u32,      // the bin's sorted range [first, end)
     end: u32,
-    word0: u32,      // the mask words the range touches, [word0, word_end) (empty: 0, 0)
+    word_begin: u32,      // the mask words the range touches, [word_begin, word_end) (empty: 0, 0)
     word_end: u32,
 }
 
@@ -32,7 +32,7 @@ fn light_grid_zbin_walk(cell: u32) -> LightGridZBinWalk {
     );
 }
 
-// The tile mask's word `k` (k * 32 .. k * 32 + 31 in sorted order, k in [word0, word_end))
+// The tile mask's word `k` (k * 32 .. k * 32 + 31 in sorted order, k in [word_begin, word_end))
 // limited to the bin's range.
 fn light_grid_zbin_word(z: LightGridZBinWalk, k: u32) -> u32 {
     let lo = max(z.first, k * 32u) - k * 32u;
