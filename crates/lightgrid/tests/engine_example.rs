@@ -1,8 +1,7 @@
 //! The `engine` example is the documentation of `LightCuller` as an engine uses it (its own
 //! light struct, a jittered off-centre eye, glass over an opaque scene, a mode without a depth
 //! pre-pass): this runs it both ways and fails when a frame's image from the grid differs from
-//! its brute-force loop's beyond the tolerance it states, or a frame after the first two lacks
-//! lights.
+//! its brute-force loop's beyond the tolerance it states, or a frame lacks lights.
 
 // Formatted as an example (`examples/rustfmt.toml`), not from here.
 #[rustfmt::skip]
