@@ -599,7 +599,7 @@ impl Caller {
                 (true, false) => &self.engine_lights,
                 (true, true) => &self.shrunk_engine_lights,
             },
-            cpu_lights: Some(if mode.shrunk {
+            cpu_lights: mode.cpu_lights.then_some(if mode.shrunk {
                 &self.shrunk_cpu_lights
             } else {
                 &self.cpu_lights
@@ -769,6 +769,8 @@ struct Mode {
     engine_layout: bool,
     /// The oracle imports the accessors from `LightCuller::naga_oil_module` with naga_oil.
     naga_oil: bool,
+    /// The lights are handed on the CPU as well (`CullInputs::cpu_lights`).
+    cpu_lights: bool,
 }
 
 impl Default for Mode {
@@ -781,6 +783,7 @@ impl Default for Mode {
             shift: [0.0; 2],
             engine_layout: false,
             naga_oil: false,
+            cpu_lights: true,
         }
     }
 }
@@ -842,6 +845,18 @@ fn check(caller: &Caller, config: CullConfig, what: &str) -> f64 {
 fn check_as(caller: &Caller, config: CullConfig, what: &str, mode: Mode) -> f64 {
     let mut culler = LightCuller::new(&caller.device, &caller.queue, config).expect("culler");
     let (r, report) = caller.settled_frame(&mut culler, mode);
+    assert_lists_every_light(caller, r, &report, what)
+}
+
+/// The oracle's counts `r` and the report of one frame: complete, a scene that tests
+/// something, no reaching light missing, and lists that cull. Returns the lights listed per
+/// sample.
+fn assert_lists_every_light(
+    caller: &Caller,
+    r: [u32; 7],
+    report: &lightgrid::CullReport,
+    what: &str,
+) -> f64 {
     assert!(report.is_complete(), "{what}: {report:?}");
     assert!(
         r[3] > W * H / 2,
@@ -868,6 +883,23 @@ fn check_as(caller: &Caller, config: CullConfig, what: &str, mode: Mode) -> f64 
         caller.light_count
     );
     per_sample
+}
+
+/// A frame culled as `mode` says but with the lights' ranges 10% short must miss lights: the
+/// oracle catches a culler that undersizes them.
+fn assert_shrunk_misses(caller: &Caller, culler: &mut LightCuller, mode: Mode, what: &str) {
+    let (r, _) = caller.settled_frame(
+        culler,
+        Mode {
+            shrunk: true,
+            ..mode
+        },
+    );
+    assert!(
+        r[0] > 100,
+        "{what}: ranges 10% short must miss lights: {} misses",
+        r[0]
+    );
 }
 
 /// The strategies a caller's culler offers: every row of the registry (`cpu` and `bvh` are
@@ -1056,12 +1088,17 @@ fn lists_grow_from_the_reports_and_refused_lights_are_reported() {
         );
         assert_eq!(r[0], 0, "{strategy:?}: misses after growing");
     }
-    // A NaN position and a zero range: refused, counted, and in no list.
+    // A NaN position and a zero range: refused on the GPU, counted, and in no list (handed on
+    // the CPU as well, `auto` would assign there and refuse the frame: the test above).
     lights[5].position[1] = f32::NAN;
     lights[9].range = 0.0;
     let caller = Caller::new(&device, &queue, 1, camera(cam.eye, false), &lights);
     let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
-    let (_, report) = caller.frame(&mut culler);
+    let gpu_only = Mode {
+        cpu_lights: false,
+        ..Mode::default()
+    };
+    let (_, report) = caller.frame_as(&mut culler, gpu_only);
     assert_eq!(report.invalid_lights, 2, "{report:?}");
     assert!(!report.is_complete());
 }
@@ -1104,13 +1141,7 @@ fn the_callers_own_light_layout_is_read_in_place() {
                     ..Mode::default()
                 };
                 let (r, report) = caller.settled_frame(&mut culler, mode);
-                assert!(report.is_complete(), "{what}: {report:?}");
-                assert_eq!(
-                    r[0], 0,
-                    "{what}: {} lights reaching samples are missing (first: pixel ({}, {}), light {})",
-                    r[0], r[4], r[5], r[6]
-                );
-                let listed = f64::from(r[2]) / f64::from(r[3]);
+                let listed = assert_lists_every_light(&caller, r, &report, &what);
                 assert_eq!(listed, plain, "{what}: the engine's layout lists otherwise");
             }
         }
@@ -1124,17 +1155,11 @@ fn the_callers_own_light_layout_is_read_in_place() {
         )
         .expect("culler");
         culler.set_light_layout(ENGINE_LAYOUT).expect("layout");
-        let shrunk = Mode {
+        let engine = Mode {
             engine_layout: true,
-            shrunk: true,
             ..Mode::default()
         };
-        let (r, _) = caller.settled_frame(&mut culler, shrunk);
-        assert!(
-            r[0] > 100,
-            "{strategy:?}: ranges 10% short must miss lights: {} misses",
-            r[0]
-        );
+        assert_shrunk_misses(&caller, &mut culler, engine, &format!("{strategy:?}"));
     }
 }
 
@@ -1180,19 +1205,11 @@ fn the_naga_oil_module_serves_a_composed_shader() {
     }
     // The shrunk lights still miss through the module (the oracle is the same oracle).
     let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
-    let (r, _) = caller.settled_frame(
-        &mut culler,
-        Mode {
-            shrunk: true,
-            naga_oil: true,
-            ..Mode::default()
-        },
-    );
-    assert!(
-        r[0] > 100,
-        "ranges 10% short must miss lights: {} misses",
-        r[0]
-    );
+    let module = Mode {
+        naga_oil: true,
+        ..Mode::default()
+    };
+    assert_shrunk_misses(&caller, &mut culler, module, "naga_oil");
 }
 
 /// A bind group that stays (`LightCuller::bind_group`'s rule): the group a caller takes before
@@ -1227,11 +1244,8 @@ fn the_bind_group_stays_until_its_generation_moves() {
                 "{strategy:?} frame {frame}: the group moved outside encode"
             );
             if frame >= 2 {
-                assert!(
-                    report.is_complete(),
-                    "{strategy:?} frame {frame}: {report:?}"
-                );
-                assert_eq!(r[0], 0, "{strategy:?} frame {frame}: misses");
+                let what = format!("{strategy:?} frame {frame}");
+                assert_lists_every_light(&caller, r, &report, &what);
             }
             reports.push((report, held.moves));
         }
@@ -1291,12 +1305,65 @@ fn the_bind_group_stays_until_its_generation_moves() {
                 once.generation,
                 "{strategy:?} reserved, frame {k}: the group moved"
             );
-            assert!(
-                report.is_complete(),
-                "{strategy:?} reserved, frame {k}: {report:?}"
-            );
-            assert_eq!(r[0], 0, "{strategy:?} reserved, frame {k}: misses");
+            let what = format!("{strategy:?} reserved, frame {k}");
+            assert_lists_every_light(&caller, r, &report, &what);
         }
+    }
+}
+
+/// `auto` resolves as lightgrid's renderer resolves it: on a CPU adapter (lavapipe here) a
+/// frame that hands its lights on the CPU is assigned there (`cpu` uploads its whole grid, so
+/// even one index entry of capacity fits its first frame), one that does not stays on the GPU
+/// (`gather` overflows one entry); on a GPU both stay there.
+#[test]
+fn auto_assigns_on_a_software_adapters_cpu_when_given_the_lights() {
+    let (device, queue) = device();
+    let software = device.adapter_info().device_type == wgpu::DeviceType::Cpu;
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 47);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    let config = CullConfig {
+        strategy: Assign::Auto,
+        index_capacity: 1,
+        ..CullConfig::default()
+    };
+    for cpu_lights in [true, false] {
+        let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+        let mode = Mode {
+            cpu_lights,
+            ..Mode::default()
+        };
+        let (r, first) = caller.frame_as(&mut culler, mode);
+        let on_cpu = software && cpu_lights;
+        assert_eq!(
+            first.overflowed, !on_cpu,
+            "software adapter {software}, cpu_lights {cpu_lights}: {first:?}"
+        );
+        if on_cpu {
+            assert_lists_every_light(&caller, r, &first, "auto on the CPU");
+        }
+        let (r, second) = caller.frame_as(&mut culler, mode);
+        assert_lists_every_light(
+            &caller,
+            r,
+            &second,
+            &format!("auto, cpu_lights {cpu_lights}"),
+        );
+    }
+    // Handed lights that are not finite, `auto` on the CPU refuses them (as `cpu` does).
+    if software {
+        let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+        let mut bad = lights.clone();
+        bad[3].range = f32::NAN;
+        let e = refused(
+            &mut culler,
+            &device,
+            &CullInputs {
+                cpu_lights: Some(&bad),
+                ..caller.inputs()
+            },
+        );
+        assert_eq!(e.input, CullInput::Lights, "{e}");
     }
 }
 
@@ -1353,18 +1420,11 @@ fn froxels_without_depth_list_every_light_reaching_any_surface() {
             },
         )
         .expect("culler");
-        let shrunk = Mode {
+        let froxels = Mode {
             depth: false,
-            shrunk: true,
             ..Mode::default()
         };
-        let (r, report) = caller.settled_frame(&mut culler, shrunk);
-        assert!(report.is_complete(), "{strategy:?}: {report:?}");
-        assert!(
-            r[0] > 100,
-            "{strategy:?}: ranges 10% short must miss lights: {} misses",
-            r[0]
-        );
+        assert_shrunk_misses(&caller, &mut culler, froxels, &format!("{strategy:?}"));
         if strategy != Assign::ZBin {
             assert!(
                 without_depth[1] < 0.5 * without_depth[0],
@@ -1432,32 +1492,16 @@ fn jittered_and_off_centre_projections_list_every_reaching_light() {
                         mode.shift
                     );
                     let (r, report) = caller.settled_frame(&mut culler, mode);
-                    assert!(report.is_complete(), "{what}: {report:?}");
-                    assert!(r[1] > 5_000, "{what}: only {} light-sample pairs", r[1]);
-                    assert_eq!(
-                        r[0], 0,
-                        "{what}: {} lights reaching samples are missing from their cells (first: pixel ({}, {}), light {})",
-                        r[0], r[4], r[5], r[6]
-                    );
-                    assert!(
-                        f64::from(r[2]) / f64::from(r[3]) < f64::from(caller.light_count) * 0.6,
-                        "{what}: no culling"
-                    );
+                    assert_lists_every_light(&caller, r, &report, &what);
                 }
             }
         }
         let mut culler = LightCuller::new(&device, &queue, CullConfig::default()).expect("culler");
-        let shrunk = Mode {
-            shrunk: true,
+        let shifted = Mode {
             shift: shift(5),
             ..Mode::default()
         };
-        let (r, _) = caller.settled_frame(&mut culler, shrunk);
-        assert!(
-            r[0] > 100,
-            "{name}: ranges 10% short must miss lights: {} misses",
-            r[0]
-        );
+        assert_shrunk_misses(&caller, &mut culler, shifted, name);
     }
 }
 
@@ -1737,6 +1781,41 @@ fn bad_use_is_a_typed_error_naming_the_input() {
         assert!(e.to_string().contains(words), "{e} (expected '{words}')");
         assert_eq!(culler.light_layout(), LightLayout::CULL_LIGHT);
     }
+    // Room reserved for no pixels, beyond any texture, or for more cells than a device binds
+    // (4-px tiles, 256 slices, two layers over the largest texture).
+    let huge = [1 << 30, 1 << 30];
+    let largest = device.limits().max_texture_dimension_2d;
+    let mut fine = LightCuller::new(
+        &device,
+        &queue,
+        CullConfig {
+            tile_size: 4,
+            slices: 256,
+            ..CullConfig::default()
+        },
+    )
+    .expect("culler");
+    for (fine_grid, viewport, words) in [
+        (false, [0, H], "no pixels"),
+        (false, huge, "largest 2D texture"),
+        (true, [largest, largest], "cells, more than"),
+    ] {
+        let target = if fine_grid { &mut fine } else { &mut culler };
+        let e = target.reserve(viewport).expect_err("reserved");
+        assert_eq!(e.input, CullInput::Viewport, "{e}");
+        assert!(e.to_string().contains(words), "{e} (expected '{words}')");
+    }
+    // A frame without depth cannot be larger than a texture either.
+    expect(
+        &mut culler,
+        &CullInputs {
+            depth: None,
+            viewport: huge,
+            ..caller.inputs()
+        },
+        CullInput::Viewport,
+        "largest 2D texture",
+    );
     // A buffer of 40 CullLights is too short for 40 lights of 64 bytes.
     culler.set_light_layout(ENGINE_LAYOUT).expect("layout");
     expect(

@@ -34,7 +34,8 @@ pub struct GridUse {
     /// A forward pass shades the opaque geometry from this grid (with MSAA its fragments'
     /// distances go into the bounds: `fragment_bounds.rs`); deferred kernels shade samples.
     pub forward_opaque: bool,
-    /// A CPU-emulated adapter whose frames bring their lights on the CPU: `auto` picks `cpu`.
+    /// A CPU-emulated adapter: `auto` picks `cpu` for frames that bring their lights on the
+    /// CPU (`CullFrame::lights_on_cpu`).
     pub software_adapter: bool,
 }
 
@@ -229,7 +230,9 @@ impl GridBuilder {
             CellSource::Depth if f.transparency => self.lists,
             _ => GridLists::Opaque,
         });
-        let assign = self.assign.resolve(f.light_count, self.software_adapter);
+        let assign = self
+            .assign
+            .resolve(f.light_count, self.software_adapter && f.lights_on_cpu);
         let dims = self.strategy(f.device, assign)?.shape(dims, f.light_count);
         self.bounds.check_capacity(f.device, &dims)?;
         // The slicing range only over a depth buffer.

@@ -25,6 +25,9 @@ pub struct CullFrame<'a> {
     /// The lights on the CPU (world space), for the strategies that work there (`cpu`,
     /// `bvh`); empty where only the GPU has them ([`crate::culling::embed::culler::LightCuller`]).
     pub lights: &'a [Light],
+    /// `lights` holds the frame's lights (the renderer's frames always; a caller's when it
+    /// hands them): `auto` may resolve to `cpu` on a software adapter.
+    pub lights_on_cpu: bool,
     /// The frame draws transparent geometry (the grid's transparent lists are built).
     pub transparency: bool,
     /// The renderer's frame: with MSAA its forward fragments' distances widen the cell bounds
@@ -44,6 +47,7 @@ impl<'a> CullFrame<'a> {
             setup: f.setup,
             light_count: f.lights.len(),
             lights: f.lights,
+            lights_on_cpu: true,
             transparency: f.has_transparency(),
             scene: Some(f),
         }

@@ -268,7 +268,8 @@ pub enum CullInput {
     Lights,
     /// [`CullInputs::light_count`] beyond [`CullConfig::max_lights`].
     LightCount,
-    /// [`CullInputs::viewport`]: empty, or larger than the depth texture.
+    /// [`CullInputs::viewport`] (or [`LightCuller::reserve`]'s): empty, larger than the depth
+    /// texture or than any texture the device makes, or more cells than it binds.
     Viewport,
     /// [`CullInputs::view`]: not finite, or not a rotation and a translation.
     View,
@@ -440,6 +441,8 @@ struct Caller {
     group: wgpu::BindGroup,
     prep: wgpu::ComputePipeline,
     prep_layout: wgpu::BindGroupLayout,
+    /// [`software_adapter`]: `auto` assigns on the CPU when a frame brings `cpu_lights`.
+    software_adapter: bool,
     /// The caller's light layout, and its words for the light-preparing kernel.
     light_layout: LightLayout,
     light_layout_buffer: wgpu::Buffer,
@@ -548,6 +551,7 @@ impl Caller {
             prep_layout,
             light_layout,
             light_layout_buffer,
+            software_adapter: software_adapter(device),
             timer: PassTimer::disabled(),
             frames: 0,
             last_report: None,
@@ -655,8 +659,9 @@ impl LightCuller {
                 GridUse {
                     source: CellSource::Depth,
                     forward_opaque: false,
-                    // `Auto` stays on the GPU (`cpu` needs the lights on the CPU).
-                    software_adapter: false,
+                    // `Auto` picks `cpu` on a CPU adapter for frames that bring their lights
+                    // on the CPU (`CullFrame::lights_on_cpu`).
+                    software_adapter: software_adapter(device),
                 },
             )
         })?;
@@ -818,15 +823,26 @@ impl LightCuller {
     /// every tile's mask words, `lights + tiles × ⌈lights / 32⌉`), so that such frames never
     /// replace [`Self::bind_group`]. It may replace it once, now: take the group after this.
     pub fn reserve(&mut self, viewport: [u32; 2]) -> Result<(), CullError> {
+        let device = self.caller()?.device.clone();
+        check_viewport(&device, viewport)?;
         let [w, h] = viewport;
         let tiles = GridDims::new(w, h, self.config.tile_size).map_err(|e| CullError {
             input: CullInput::Viewport,
             message: e.to_string(),
         })?;
-        let cells =
-            tiles.tile_count() * self.config.slices as usize * self.config.lists.layers() as usize;
-        let device = self.caller()?.device.clone();
-        self.core.reserve(&device, cells)?;
+        let cells = (tiles.tile_count() as u64)
+            .saturating_mul(u64::from(self.config.slices) * u64::from(self.config.lists.layers()));
+        let max_bytes = crate::culling::frame::max_index_entries(&device) * 4;
+        if cells.saturating_mul(8) > max_bytes {
+            return refuse(
+                CullInput::Viewport,
+                format!(
+                    "{w}x{h} makes {cells} cells, more than the {} this device binds; use a larger tile size or fewer slices",
+                    max_bytes / 8
+                ),
+            );
+        }
+        self.core.reserve(&device, cells as usize)?;
         Ok(())
     }
 
@@ -889,8 +905,9 @@ impl LightCuller {
                 ..Default::default()
             })
         });
-        // Only a strategy that assigns on the CPU reads them (the others ignore them).
-        let cpu_lights: Vec<Light> = match needs_cpu_lights(&self.config) {
+        // Only a frame that assigns on the CPU reads them (the others ignore them).
+        let on_cpu = c.uses_cpu_lights(inputs, &self.config);
+        let cpu_lights: Vec<Light> = match on_cpu {
             true => inputs
                 .cpu_lights
                 .unwrap_or_default()
@@ -916,6 +933,7 @@ impl LightCuller {
                 setup,
                 light_count: n as usize,
                 lights: &cpu_lights,
+                lights_on_cpu: on_cpu,
                 transparency: inputs.transparent,
                 scene: None,
             };
@@ -1011,10 +1029,7 @@ impl Caller {
     /// Refuse inputs the kernels cannot honour, each error naming its input.
     fn check(&self, i: &CullInputs, config: &CullConfig) -> Result<Camera, CullError> {
         use CullInput as I;
-        let [w, h] = i.viewport;
-        if w == 0 || h == 0 {
-            return refuse(I::Viewport, format!("{w}x{h} has no pixels"));
-        }
+        check_viewport(&self.device, i.viewport)?;
         match i.depth {
             Some(depth) => Self::check_depth(depth.texture(), i, config)?,
             None if i.transparent => {
@@ -1103,15 +1118,25 @@ impl Caller {
         if !i.lights.usage().contains(wgpu::BufferUsages::STORAGE) {
             return refuse(I::Lights, "the light buffer lacks STORAGE usage");
         }
-        Self::check_cpu_lights(i, config)
+        self.check_cpu_lights(i, config)
     }
 
-    /// The lights on the CPU, for a strategy that assigns there: one per light, each finite
+    /// Does this frame assign on the CPU from [`CullInputs::cpu_lights`]: a strategy that
+    /// always does, or `auto` on a CPU adapter given them (as lightgrid's renderer resolves
+    /// it: `cpu` is the fastest there, README "Light assignment scaling")?
+    fn uses_cpu_lights(&self, i: &CullInputs, config: &CullConfig) -> bool {
+        needs_cpu_lights(config)
+            || (config.strategy == crate::frame::Assign::Auto
+                && self.software_adapter
+                && i.cpu_lights.is_some())
+    }
+
+    /// The lights on the CPU, for a frame that assigns there: one per light, each finite
     /// with a positive range (the GPU counts such lights and leaves them out; the CPU
-    /// strategies refuse them). Other strategies ignore them.
-    fn check_cpu_lights(i: &CullInputs, config: &CullConfig) -> Result<(), CullError> {
+    /// strategies refuse them). Other frames ignore them.
+    fn check_cpu_lights(&self, i: &CullInputs, config: &CullConfig) -> Result<(), CullError> {
         use CullInput as I;
-        if !needs_cpu_lights(config) {
+        if !self.uses_cpu_lights(i, config) {
             return Ok(());
         }
         let Some(lights) = i.cpu_lights else {
@@ -1148,6 +1173,29 @@ impl Caller {
         }
         Ok(())
     }
+}
+
+/// A viewport of at least one pixel and at most the largest 2D texture the device makes.
+fn check_viewport(device: &wgpu::Device, [w, h]: [u32; 2]) -> Result<(), CullError> {
+    if w == 0 || h == 0 {
+        return refuse(CullInput::Viewport, format!("{w}x{h} has no pixels"));
+    }
+    let max = device.limits().max_texture_dimension_2d;
+    if w > max || h > max {
+        return refuse(
+            CullInput::Viewport,
+            format!(
+                "{w}x{h} is larger than this device's largest 2D texture ({max} pixels a side)"
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// A CPU adapter (lavapipe, SwiftShader), where `auto` assigns on the CPU as lightgrid's
+/// renderer does; never on the web, where `cpu` cannot wait for its readback.
+fn software_adapter(device: &wgpu::Device) -> bool {
+    device.adapter_info().device_type == wgpu::DeviceType::Cpu && cfg!(not(target_arch = "wasm32"))
 }
 
 /// Does `config`'s strategy assign on the CPU (`CullInputs::cpu_lights`)?
