@@ -854,7 +854,8 @@ impl LightCuller {
     /// Read the caller's lights in its own struct from now on ([`LightLayout`]; the default
     /// is [`CullLight`]'s): [`CullInputs::lights`] is then the caller's buffer as it is, of
     /// `light_count × stride` bytes or more. Refuses, naming the field, a layout whose fields
-    /// are unaligned, overlap or do not fit the stride.
+    /// are unaligned, overlap or do not fit the stride. It is written through the queue, so it
+    /// holds for every frame submitted after the call (set it between frames).
     pub fn set_light_layout(&mut self, layout: LightLayout) -> Result<(), CullError> {
         layout.check()?;
         let c = self.caller()?;
