@@ -152,7 +152,8 @@ pub struct Renderer {
     queue: wgpu::Queue,
     /// R32Float blends (`GpuContext::count_blend`): forward pipelines count lighting.
     count_blend: bool,
-    /// The adapter is a software rasterizer (`GpuContext::is_software`).
+    /// `auto` assigns on the CPU here (`gpu::auto_assigns_on_cpu`: a software rasterizer, not
+    /// on a page).
     software_adapter: bool,
     /// `GpuContext::adapter_label`, for the statistics.
     adapter_label: String,
@@ -306,8 +307,7 @@ impl Renderer {
                 device: device.clone(),
                 queue: ctx.queue.clone(),
                 count_blend: ctx.count_blend,
-                // On a page, `auto` never picks the CPU strategy: its readback would wait.
-                software_adapter: ctx.is_software() && cfg!(not(target_arch = "wasm32")),
+                software_adapter: crate::gpu::auto_assigns_on_cpu(&ctx.info),
                 adapter_label: ctx.adapter_label(),
                 targets,
                 tonemap: Tonemap::new(device, settings.grid.samples),

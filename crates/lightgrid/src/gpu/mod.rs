@@ -12,6 +12,13 @@ pub(crate) use timing::{PassTimer, TimedPass};
 
 use crate::error::{Error, Result};
 
+/// Does `auto` assign lights on the CPU on this adapter: a CPU-emulated one (lavapipe,
+/// SwiftShader, where `cpu` was measured fastest), never on a page (its readback would wait)?
+/// The renderer's and a caller's `LightCuller` alike.
+pub(crate) fn auto_assigns_on_cpu(info: &wgpu::AdapterInfo) -> bool {
+    info.device_type == wgpu::DeviceType::Cpu && cfg!(not(target_arch = "wasm32"))
+}
+
 /// Run `f` inside a validation + out-of-memory error scope and turn a captured error into
 /// [`Error::Gpu`], so bad input becomes an error message instead of wgpu's default panic.
 pub(crate) fn scoped<T>(device: &wgpu::Device, stage: &str, f: impl FnOnce() -> T) -> Result<T> {

@@ -138,11 +138,11 @@ pub struct LightLayout {
 impl LightLayout {
     /// [`CullLight`]'s layout: 48 bytes, position at 0, range 12, direction 32, cosine 44.
     pub const CULL_LIGHT: LightLayout = LightLayout {
-        stride: 48,
-        position: 0,
-        range: 12,
-        direction: Some(32),
-        cos_outer: Some(44),
+        stride: std::mem::size_of::<CullLight>() as u32,
+        position: std::mem::offset_of!(CullLight, position) as u32,
+        range: std::mem::offset_of!(CullLight, range) as u32,
+        direction: Some(std::mem::offset_of!(CullLight, direction) as u32),
+        cos_outer: Some(std::mem::offset_of!(CullLight, cos_outer) as u32),
     };
 
     /// The layout as the light-preparing kernel reads it (in 4-byte words), after `check`.
@@ -1193,10 +1193,9 @@ fn check_viewport(device: &wgpu::Device, [w, h]: [u32; 2]) -> Result<(), CullErr
     Ok(())
 }
 
-/// A CPU adapter (lavapipe, SwiftShader), where `auto` assigns on the CPU as lightgrid's
-/// renderer does; never on the web, where `cpu` cannot wait for its readback.
+/// `auto`'s CPU rule ([`crate::gpu::auto_assigns_on_cpu`]) for the caller's device.
 fn software_adapter(device: &wgpu::Device) -> bool {
-    device.adapter_info().device_type == wgpu::DeviceType::Cpu && cfg!(not(target_arch = "wasm32"))
+    crate::gpu::auto_assigns_on_cpu(&device.adapter_info())
 }
 
 /// Does `config`'s strategy assign on the CPU (`CullInputs::cpu_lights`)?
