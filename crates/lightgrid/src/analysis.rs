@@ -5,7 +5,7 @@
 //! (`LightCuller::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
-    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_counts, ideal_pixel_counts, BuiltGrid,
+    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_counts, ideal_pixel_counts,
     DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
 };
 use crate::error::Result;
@@ -260,6 +260,41 @@ impl AnalysisInput<'_> {
                 && (grid_settings.depth_mask == crate::frame::DepthMask::On
                     || grid_settings.cell_box == crate::frame::CellBox::On),
         )
+    }
+}
+
+/// A pipeline's grid as its culler built it (read back after the frame's report).
+pub(crate) struct BuiltGrid {
+    pub grid: LightGrid,
+    /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
+    pub cell_bounds: Vec<[f32; 2]>,
+    /// Each cell's 2.5D depth mask and tight box (neither unless `--depth-mask on` /
+    /// `--cell-box on`).
+    pub cell_culls: Vec<crate::culling::CellCull>,
+    /// The strategy that ran (`auto` resolved).
+    pub assign: crate::frame::Assign,
+    /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
+    pub cpu_ms: f64,
+}
+
+impl BuiltGrid {
+    /// The last frame of `culler`, whose report is `report` (waits for the GPU).
+    pub(crate) fn read(
+        culler: &crate::culling::LightCuller,
+        report: &crate::culling::CullReport,
+    ) -> crate::error::Result<Self> {
+        let error = |e: crate::culling::CullError| crate::error::Error::Gpu {
+            stage: "grid download".into(),
+            message: e.to_string(),
+        };
+        let cells = culler.read_cells().map_err(error)?;
+        Ok(BuiltGrid {
+            grid: culler.read_grid().map_err(error)?,
+            cell_bounds: cells.cell_bounds,
+            cell_culls: cells.cell_culls,
+            assign: report.assign,
+            cpu_ms: report.cpu_ms,
+        })
     }
 }
 

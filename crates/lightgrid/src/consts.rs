@@ -497,5 +497,7 @@ pub mod pass_labels {
     /// The MSAA fragment-bounds render pass (`fragment_bounds.wgsl`) that widens cell bounds to
     /// where forward fragments will look their cells up.
     pub const FRAGMENT_BOUNDS: &str = "assign: fragment bounds";
+    /// The culler's copy of the caller's lights, camera-relative, with their bounding spheres.
+    pub const CULL_LIGHTS: &str = "cull: lights";
     pub(crate) const DEPTH_RANGE: &str = "assign: depth range";
 }

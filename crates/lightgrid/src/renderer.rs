@@ -20,7 +20,7 @@
 
 use crate::analysis::{self, AnalysisReadbacks};
 use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
-use crate::culling::{GridDims, ViewSetup};
+use crate::culling::{CullLight, CullReport, GridDims, ViewSetup};
 use crate::error::{Error, Result};
 use crate::frame::{
     FinishedFrame, FrameEncoder, FrameInputs, FrameIo, RenderSettings, SubmittedFrame,
@@ -127,6 +127,8 @@ fn check_shadow_tree(bvh: &crate::shadows::bvh::TriangleBvh) -> Result<()> {
 struct Uploaded<'s> {
     state: &'s FrameState,
     setup: ViewSetup,
+    /// The camera's projection (`setup.view` is its rotation).
+    proj: glam::Mat4,
     index_count: u32,
     /// Runs of one material shader: the opaque geometry's, the transparent objects'.
     opaque: Vec<Draw>,
@@ -143,6 +145,17 @@ struct Uploaded<'s> {
     shadow_maps: Option<crate::shadows::maps::MapFrame>,
 }
 
+/// Whose culler a report came from: a technique's (its pipeline id) or the transparent
+/// pass's own grid (`None`).
+type CullerOwner = Option<&'static str>;
+
+/// The frames a renderer frame had its cullers encode.
+struct CulledFrame {
+    serial: u64,
+    technique: Option<u64>,
+    transparent: Option<u64>,
+}
+
 /// Renders frames at one size on one device.
 ///
 /// It owns clones of the context's device and queue (cheap handles) and the adapter facts it
@@ -152,15 +165,10 @@ pub struct Renderer {
     queue: wgpu::Queue,
     /// R32Float blends (`GpuContext::count_blend`): forward pipelines count lighting.
     count_blend: bool,
-    /// `auto` assigns on the CPU here (`gpu::auto_assigns_on_cpu`: a software rasterizer, not
-    /// on a page).
-    software_adapter: bool,
     /// `GpuContext::adapter_label`, for the statistics.
     adapter_label: String,
     targets: Targets,
     scene_layout: wgpu::BindGroupLayout,
-    /// Group 0 of the culling kernels (`culling::cull_layout`), a subset of the scene's.
-    cull_layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     lights: GrowBuffer,
     light_bounds: GrowBuffer,
@@ -176,8 +184,13 @@ pub struct Renderer {
     /// to what its faces need within the budget's side (`shadows::maps::atlas_side`).
     shadow_atlas: ShadowAtlas,
     scene_bind_group: wgpu::BindGroup,
-    /// The culling kernels' group 0 over the same buffers.
-    cull_bind_group: wgpu::BindGroup,
+    /// The frame's lights as uploaded (camera-relative), as the grids' cullers read them on
+    /// the CPU (`cpu`, `bvh`).
+    cull_lights: Vec<CullLight>,
+    /// The culler frames of each frame in flight, to match their reports with it.
+    culled: VecDeque<CulledFrame>,
+    /// Reports collected from the cullers and not yet matched with their frame.
+    cull_reports: Vec<(CullerOwner, CullReport)>,
     /// The scene's base-colour textures (uploaded with its static geometry).
     textures: BaseTextures,
     scene: Option<SceneUpload>,
@@ -276,7 +289,6 @@ impl Renderer {
         let created = scoped(device, "creating render targets", || {
             let targets = Targets::new(device, width, height, settings.grid.samples);
             let scene_layout = scene_layout(device);
-            let cull_layout = crate::culling::cull_layout(device);
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
                 size: std::mem::size_of::<FrameUniforms>() as u64,
@@ -295,9 +307,9 @@ impl Renderer {
             shadow_atlas.bind(device, &uniforms, &shadow_data.buffer);
             let counters = FrameCounters::new(device, MAX_PASSES);
             let textures = BaseTextures::new(device, &ctx.queue, &[]);
-            let (scene_bind_group, cull_bind_group) = Self::bind_scene(
+            let scene_bind_group = Self::bind_scene(
                 device,
-                [&scene_layout, &cull_layout],
+                &scene_layout,
                 &uniforms,
                 [&lights, &light_bounds, &materials, &shadow_data],
                 [counters.buffer(), &targets.pixel_counts],
@@ -307,14 +319,12 @@ impl Renderer {
                 device: device.clone(),
                 queue: ctx.queue.clone(),
                 count_blend: ctx.count_blend,
-                software_adapter: crate::gpu::auto_assigns_on_cpu(&ctx.info),
                 adapter_label: ctx.adapter_label(),
                 targets,
                 tonemap: Tonemap::new(device, settings.grid.samples),
                 timer: PassTimer::new(ctx, MAX_PASSES),
                 counters,
                 scene_layout,
-                cull_layout,
                 uniforms,
                 lights,
                 light_bounds,
@@ -325,7 +335,9 @@ impl Renderer {
                 shadow_static_written: false,
                 shadow_atlas,
                 scene_bind_group,
-                cull_bind_group,
+                cull_lights: Vec::new(),
+                culled: VecDeque::new(),
+                cull_reports: Vec::new(),
                 textures,
                 scene: None,
                 static_upload_bytes: 0,
@@ -352,20 +364,15 @@ impl Renderer {
         })
     }
 
-    /// Group 0 of the scene and of the culling kernels, over the same buffers.
+    /// Group 0 of the scene.
     fn bind_scene(
         device: &wgpu::Device,
-        [layout, cull_layout]: [&wgpu::BindGroupLayout; 2],
+        layout: &wgpu::BindGroupLayout,
         uniforms: &wgpu::Buffer,
         [lights, light_bounds, materials, shadow_data]: [&GrowBuffer; 4],
         [counters, pixel_counts]: [&wgpu::Buffer; 2],
         (textures, atlas): (&BaseTextures, &ShadowAtlas),
-    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
-        let cull = crate::culling::bind_cull_group(
-            device,
-            cull_layout,
-            [uniforms, &lights.buffer, counters, &light_bounds.buffer],
-        );
+    ) -> wgpu::BindGroup {
         let scene = crate::gpu::bind_resources(
             device,
             "scene (group 0)",
@@ -385,7 +392,7 @@ impl Renderer {
                 wgpu::BindingResource::Sampler(&textures.nearest),
             ],
         );
-        (scene, cull)
+        scene
     }
 
     /// The frame size, `(width, height)` in pixels.
@@ -421,22 +428,21 @@ impl Renderer {
             let device = &self.device;
             let ctx = PipelineContext {
                 device,
+                queue: &self.queue,
                 scene_layout: &self.scene_layout,
-                cull_layout: &self.cull_layout,
                 dims: self.dims,
                 settings: self.settings,
                 shading: self.shading,
                 count_blend: self.count_blend,
-                software_adapter: self.software_adapter,
             };
             let t = scoped(device, &format!("creating pipeline {}", info.id), || {
                 (info.create)(&ctx)
-            })?;
+            })??;
             self.techniques.insert(info.id, t);
             if self.transparent.is_none() {
                 let pass = scoped(device, "creating the transparent pass", || {
                     TransparentPass::new(&ctx)
-                })?;
+                })??;
                 self.transparent = Some(pass);
             }
         }
@@ -564,6 +570,7 @@ impl Renderer {
         setup.spot_cull = self.settings.grid.spot_cull;
         Ok(Uploaded {
             setup,
+            proj: state.camera.proj(width as f32 / height as f32),
             index_count: static_indices + frame_geometry.indices.len() as u32,
             opaque,
             transparent,
@@ -749,6 +756,10 @@ impl Renderer {
         let relative: Vec<_> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
         let gpu_lights: Vec<GpuLight> = relative.iter().map(|l| l.to_gpu_scaled(scale)).collect();
         let bounds: Vec<[f32; 4]> = relative.iter().map(Light::bounds_gpu).collect();
+        // The grids' cullers read the same lights on the CPU (`GpuLight` is a `CullLight`).
+        self.cull_lights.clear();
+        self.cull_lights
+            .extend_from_slice(bytemuck::cast_slice::<GpuLight, CullLight>(&gpu_lights));
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
         let bb: &[u8] = bytemuck::cast_slice(&bounds);
         let grew_lights = self.lights.reserve(device, lb.len() as u64);
@@ -800,9 +811,9 @@ impl Renderer {
 
     /// Group 0 again, after a buffer it binds was replaced.
     fn rebind_scene(&mut self) {
-        (self.scene_bind_group, self.cull_bind_group) = Self::bind_scene(
+        self.scene_bind_group = Self::bind_scene(
             &self.device,
-            [&self.scene_layout, &self.cull_layout],
+            &self.scene_layout,
             &self.uniforms,
             [
                 &self.lights,
@@ -839,8 +850,6 @@ impl Renderer {
             device,
             queue,
             scene_bind_group: &self.scene_bind_group,
-            cull_bind_group: &self.cull_bind_group,
-            counters: self.counters.buffer(),
             vertices: &self.vertices.buffer,
             indices: &self.indices.buffer,
             opaque: &up.opaque,
@@ -848,6 +857,9 @@ impl Renderer {
             targets: &self.targets,
             setup: up.setup,
             lights: &up.state.lights,
+            light_buffer: &self.lights.buffer,
+            cull_lights: &self.cull_lights,
+            proj: up.proj,
             count_blend: self.count_blend,
             reused_shadow_maps: reused
                 .as_ref()
@@ -873,6 +885,7 @@ impl Renderer {
                 .encode_all(encoder, timer, &inputs, &m.atlas);
         }
         technique.encode(&inputs, &mut enc)?;
+        let technique_frame = technique.culler().map(|c| c.last_frame());
         if let Some(m) = atlas_at(false) {
             let (encoder, timer) = enc.parts();
             self.shadow_atlas
@@ -882,10 +895,10 @@ impl Renderer {
             self.readbacks
                 .encode_opaque_counts(enc.parts().0, &self.targets);
         }
-        self.transparent
-            .as_mut()
-            .expect("created with the technique")
-            .encode(&inputs, &mut enc, technique.transparent_lights())?;
+        let transparent = self.transparent.as_mut().expect("created with the technique");
+        let before = transparent.culler_mut().last_frame();
+        transparent.encode(&inputs, &mut enc, technique.transparent_lights())?;
+        let after = transparent.culler_mut().last_frame();
         let (encoder, timer) = enc.parts();
         if !technique.resolved_to_display() {
             self.tonemap
@@ -906,6 +919,11 @@ impl Renderer {
         match enc.submit(&format!("rendering with {}", info.id)) {
             Ok((io, index)) => {
                 self.counters.after_submit();
+                self.culled.push_back(CulledFrame {
+                    serial: self.serial,
+                    technique: technique_frame,
+                    transparent: (after != before).then_some(after),
+                });
                 Ok((self.serial, io, index))
             }
             Err(e) => {
@@ -915,19 +933,32 @@ impl Renderer {
         }
     }
 
-    /// Hand a finished frame's counters to the technique that rendered it (its grid builder
-    /// sizes its lists from them) and turn them into a report.
-    fn observe(&mut self, r: &FrameReadback) -> Result<FinishedFrame> {
-        if let Some(builder) = self
-            .techniques
-            .get_mut(r.tag.pipeline)
-            .and_then(|t| t.culler())
-        {
-            builder.observe(&self.device, &r.values)?;
-        }
-        if let Some(t) = &mut self.transparent {
-            t.observe(&self.device, &r.values)?;
-        }
+    /// A finished frame's report: its counters and timestamps, and its cullers' reports
+    /// (their lists grow from them). Also returns the technique's grid's report.
+    fn observe(&mut self, r: &FrameReadback) -> Result<(FinishedFrame, Option<CullReport>)> {
+        let culled = loop {
+            match self.culled.pop_front() {
+                Some(c) if c.serial == r.tag.serial => break Some(c),
+                // An older frame whose counters never came back (abandoned).
+                Some(c) if c.serial < r.tag.serial => continue,
+                Some(c) => {
+                    self.culled.push_front(c);
+                    break None;
+                }
+                None => break None,
+            }
+        };
+        let (technique, transparent) = culled.map_or((None, None), |c| (c.technique, c.transparent));
+        let technique = match technique {
+            Some(frame) => Some(self.cull_report(Some(r.tag.pipeline), frame)?),
+            None => None,
+        };
+        let transparent = match transparent {
+            Some(frame) => Some(self.cull_report(None, frame)?),
+            None => None,
+        };
+        let culls = [technique, transparent];
+        let culls = culls.iter().flatten();
         let write_overflow = r.values.write_overflow();
         if write_overflow > 0 {
             return Err(Error::Gpu {
@@ -938,14 +969,15 @@ impl Renderer {
             });
         }
         let t = self.timer.timings(&r.tag.pass_labels, &r.ticks);
-        Ok(FinishedFrame {
+        let finished = FinishedFrame {
             serial: r.tag.serial,
             pipeline: r.tag.pipeline,
             gpu_ms: t.gpu_ms,
             assign_gpu_ms: t.assign_ms,
             passes: t.passes,
-            truncated_loops: r.values.truncated_loops(),
-            overflowed: r.values.overflowed(),
+            truncated_loops: r.values.truncated_loops()
+                + culls.clone().map(|c| c.truncated_loops).sum::<u32>(),
+            overflowed: r.values.overflowed() || culls.clone().any(|c| c.overflowed),
             msaa_shading: (r.values.geometry_samples() > 0).then(|| crate::frame::MsaaShading {
                 edge_pixels: r.values.edge_pixels().into(),
                 shaded_samples: r.values.shaded_samples().into(),
@@ -953,6 +985,45 @@ impl Renderer {
             }),
             fragments_off_bounds: r.values.fragments_off_bounds().into(),
             shadow_rays: r.values.shadow_rays().into(),
+        };
+        Ok((finished, technique))
+    }
+
+    /// Culler `owner`'s report of its frame `frame` (encoded in a renderer frame the GPU has
+    /// finished, so its counters are mapped or about to be).
+    fn cull_report(&mut self, owner: CullerOwner, frame: u64) -> Result<CullReport> {
+        for wait in [false, true] {
+            if let Some(i) = self
+                .cull_reports
+                .iter()
+                .position(|(o, r)| *o == owner && r.frame == frame)
+            {
+                let (_, report) = self.cull_reports.swap_remove(i);
+                self.cull_reports
+                    .retain(|(o, r)| *o != owner || r.frame > frame);
+                return Ok(report);
+            }
+            let culler = match owner {
+                Some(id) => self.techniques.get_mut(id).and_then(|t| t.culler()),
+                None => self.transparent.as_mut().map(|t| t.culler_mut()),
+            };
+            let Some(culler) = culler else {
+                break;
+            };
+            let reports = match wait {
+                false => culler.poll(),
+                true => culler.wait(),
+            }
+            .map_err(|e| Error::Gpu {
+                stage: "light culling".into(),
+                message: e.to_string(),
+            })?;
+            self.cull_reports
+                .extend(reports.into_iter().map(|r| (owner, r)));
+        }
+        Err(Error::Gpu {
+            stage: "light culling".into(),
+            message: format!("the report of culler frame {frame} did not come back"),
         })
     }
 
@@ -965,7 +1036,7 @@ impl Renderer {
             self.counters.poll(device)?
         };
         for r in &done {
-            let f = self.observe(r)?;
+            let (f, _) = self.observe(r)?;
             self.finished.push(f);
         }
         Ok(())
@@ -1066,7 +1137,7 @@ impl Renderer {
                     stage: "frame counters".into(),
                     message: "the frame's counters did not come back".into(),
                 })?;
-            let finished = self.observe(&readback)?;
+            let (finished, cull) = self.observe(&readback)?;
             if finished.truncated_loops > 0 {
                 return Err(Error::TruncatedLoops {
                     pipeline: info.id.to_string(),
@@ -1092,9 +1163,9 @@ impl Renderer {
                 }
                 continue;
             }
-            let grid = match self.techniques.get_mut(info.id).and_then(|t| t.culler()) {
-                Some(b) => Some(b.download(&self.device, &self.queue, &readback.values)?),
-                None => None,
+            let grid = match (self.techniques.get_mut(info.id).and_then(|t| t.culler()), cull) {
+                (Some(culler), Some(report)) => Some(analysis::BuiltGrid::read(culler, &report)?),
+                _ => None,
             };
             return analysis::analyze(analysis::AnalysisInput {
                 device: &self.device,

@@ -24,33 +24,13 @@ use crate::error::{Error, Result};
 use crate::frame::{Assign, CullConfig, FrameEncoder};
 use crate::gpu::CounterValues;
 
-/// How a grid's frames reach it, beyond its [`CullConfig`]: where its bounds come from, who
-/// shades from it, and what `auto` may resolve to.
-#[derive(Clone, Copy, Debug)]
-pub struct GridUse {
-    /// Cell bounds from the frame's depth buffer, or near..far (a pipeline without a depth
-    /// pre-pass).
-    pub source: CellSource,
-    /// A forward pass shades the opaque geometry from this grid (with MSAA its fragments'
-    /// distances go into the bounds: `fragment_bounds.rs`); deferred kernels shade samples.
-    pub forward_opaque: bool,
-    /// A CPU-emulated adapter: `auto` picks `cpu` for frames that bring their lights on the
-    /// CPU (`CullFrame::lights_on_cpu`).
-    pub software_adapter: bool,
-}
-
-/// A built grid and what went into it (analysis).
-pub(crate) struct BuiltGrid {
-    pub grid: LightGrid,
+/// The cells of the last recorded frame (analysis).
+pub(crate) struct BuiltCells {
     /// The cell bounds the assignment read (view distance, `[min, max]`, min > max = empty).
     pub cell_bounds: Vec<[f32; 2]>,
     /// Each cell's 2.5D depth mask and tight box (`cell_box.rs`; neither unless
     /// `--depth-mask on` / `--cell-box on`).
     pub cell_culls: Vec<crate::culling::bounds::cell_box::CellCull>,
-    /// The strategy that ran (`auto` resolved).
-    pub assign: Assign,
-    /// CPU time of the assignment itself: `assign_cpu`, or the BVH build.
-    pub cpu_ms: f64,
 }
 
 /// What the last recorded frame's assignment was.
@@ -70,7 +50,6 @@ struct LastFrame {
 pub struct GridBuilder {
     tiles: GridDims,
     slices: u32,
-    source: CellSource,
     assign: Assign,
     lists: GridLists,
     software_adapter: bool,
@@ -86,33 +65,30 @@ pub struct GridBuilder {
 }
 
 impl GridBuilder {
-    /// The grid `config` describes over `tiles` (the frame's tile grid, one slice; a caller's
+    /// The grid `config` describes over `tiles` (the frame's tile grid, one slice; the
     /// culler sets it per frame): `config.slices` 1 builds a tiled grid, more a clustered one
     /// (slices spread each frame over the samples' depth range, or between the camera's near
-    /// and far planes without depth). `scene_layout`: the renderer's group 0, with which an
-    /// MSAA forward grid's fragment bounds draw its geometry.
+    /// and far planes without depth). `software_adapter`: `auto` picks `cpu` for frames that
+    /// bring their lights on the CPU (`CullFrame::lights_on_cpu`).
     pub fn new(
         device: &wgpu::Device,
         cull_layout: &wgpu::BindGroupLayout,
-        scene_layout: Option<&wgpu::BindGroupLayout>,
         config: &CullConfig,
         tiles: GridDims,
-        usage: GridUse,
+        software_adapter: bool,
     ) -> Self {
         let index_capacity = u64::from(config.index_capacity);
         GridBuilder {
             tiles,
             slices: config.slices,
-            source: usage.source,
             assign: config.strategy,
             lists: config.lists,
-            software_adapter: usage.software_adapter,
+            software_adapter,
             index_capacity,
             cull_layout: cull_layout.clone(),
             bounds: CellBoundsPass::new(
                 device,
                 cull_layout,
-                scene_layout,
                 crate::culling::bounds::cell_bounds::CellBoundsKey {
                     samples: config.samples,
                     depth_bounds: config.depth_bounds,
@@ -120,10 +96,9 @@ impl GridBuilder {
                     depth_mask: config.depth_mask,
                     cell_box: config.cell_box,
                 },
-                usage.forward_opaque,
                 tiles.tile_size,
             ),
-            range: (config.slices > 1 && usage.source == CellSource::Depth)
+            range: (config.slices > 1)
                 .then(|| DepthRangePass::new(device, cull_layout, config.samples)),
             buffers: GridBuffers::new(device, index_capacity),
             strategies: Vec::new(),
@@ -136,6 +111,17 @@ impl GridBuilder {
     pub(crate) fn last_cpu_entries(&self) -> Option<u32> {
         let grid = self.last.as_ref()?.cpu_grid.as_ref()?;
         Some(grid.indices.len() as u32)
+    }
+
+    /// The last recorded frame's strategy (`auto` resolved) and the CPU time of its
+    /// assignment.
+    pub(crate) fn last_assign(&self) -> Option<(Assign, f64)> {
+        self.last.as_ref().map(|l| (l.assign, l.cpu_ms))
+    }
+
+    /// The layout of the MSAA fragment-bounds group (`None` without MSAA).
+    pub(crate) fn fragments_layout(&self) -> Option<&wgpu::BindGroupLayout> {
+        self.bounds.fragments_layout()
     }
 
     /// The screen size changed (`LightCuller`: a caller's viewport).
@@ -216,7 +202,7 @@ impl GridBuilder {
     /// pre-pass) is bounded by near..far.
     pub fn build(&mut self, f: &CullFrame, enc: &mut FrameEncoder) -> Result<()> {
         let source = match f.depth {
-            Some(_) => self.source,
+            Some(_) => CellSource::Depth,
             None => CellSource::NearFar,
         };
         let dims = if self.slices > 1 {
@@ -300,37 +286,44 @@ impl GridBuilder {
         Ok(())
     }
 
-    /// The last recorded frame's grid and cell bounds (analysis; waits for the GPU). `values`
-    /// are that frame's counters.
+    /// The last recorded frame, or why there is none.
+    fn last(&self) -> Result<&LastFrame> {
+        self.last.as_ref().ok_or_else(|| Error::Gpu {
+            stage: "grid download".into(),
+            message: "no frame was recorded".into(),
+        })
+    }
+
+    /// The last recorded frame's grid (waits for the GPU). `values` are that frame's
+    /// counters.
     pub fn download(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         values: &CounterValues,
-    ) -> Result<BuiltGrid> {
-        let last = self.last.as_ref().ok_or_else(|| Error::Gpu {
-            stage: "grid download".into(),
-            message: "no frame was recorded".into(),
-        })?;
-        let grid = match &last.cpu_grid {
-            Some(g) => g.clone(),
-            None => {
-                let dims = match &self.range {
-                    // The GPU spread the slices: `last.dims` holds near..far.
-                    Some(range) if last.source == CellSource::Depth => {
-                        range.read(device, queue, &last.dims)?
-                    }
-                    _ => last.dims,
-                };
-                let strategy = self
-                    .strategies
-                    .iter()
-                    .find(|(a, _)| *a == last.assign)
-                    .map(|(_, s)| s)
-                    .expect("the last frame's strategy exists");
-                strategy.read_grid(device, queue, &self.buffers, &dims, values)?
-            }
+    ) -> Result<LightGrid> {
+        let last = self.last()?;
+        if let Some(g) = &last.cpu_grid {
+            return Ok(g.clone());
+        }
+        let dims = match &self.range {
+            // The GPU spread the slices: `last.dims` holds near..far.
+            Some(range) if last.source == CellSource::Depth => range.read(device, queue, &last.dims)?,
+            _ => last.dims,
         };
+        let strategy = self
+            .strategies
+            .iter()
+            .find(|(a, _)| *a == last.assign)
+            .map(|(_, s)| s)
+            .expect("the last frame's strategy exists");
+        strategy.read_grid(device, queue, &self.buffers, &dims, values)
+    }
+
+    /// The last recorded frame's cell bounds and culling records (analysis; waits for the
+    /// GPU).
+    pub fn download_cells(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<BuiltCells> {
+        let last = self.last()?;
         let cell_bounds = match (&last.cell_bounds, last.source) {
             (Some(b), _) => b.clone(),
             (None, CellSource::NearFar) => {
@@ -345,12 +338,9 @@ impl GridBuilder {
             }
             (None, CellSource::Depth) => self.bounds.read_culls(device, queue)?,
         };
-        Ok(BuiltGrid {
-            grid,
+        Ok(BuiltCells {
             cell_bounds,
             cell_culls,
-            assign: last.assign,
-            cpu_ms: last.cpu_ms,
         })
     }
 }

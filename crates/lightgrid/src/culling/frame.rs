@@ -4,13 +4,13 @@
 //! strategies and the culler all read it.
 
 use crate::error::{Error, Result};
-use crate::frame::FrameInputs;
 use crate::scene::{Light, ViewSetup};
 
 /// What every culling stage reads in one frame: group 0 of its kernels ([`cull_layout`]: the
 /// camera uniforms, the lights and their bounding spheres in camera-relative space, the frame
-/// counters), the depth buffer, and the camera on the CPU. The renderer fills it from its
-/// frame ([`CullFrame::of`]); [`crate::culling::embed::culler::LightCuller`] from a caller's inputs.
+/// counters), the depth buffer, and the camera on the CPU.
+/// [`crate::culling::embed::culler::LightCuller`] fills it from a caller's inputs (lightgrid's
+/// renderer is such a caller).
 pub struct CullFrame<'a> {
     pub device: &'a wgpu::Device,
     pub queue: &'a wgpu::Queue,
@@ -30,32 +30,24 @@ pub struct CullFrame<'a> {
     pub lights_on_cpu: bool,
     /// The frame draws transparent geometry (the grid's transparent lists are built).
     pub transparency: bool,
-    /// The renderer's frame: with MSAA its forward fragments' distances widen the cell bounds
-    /// (`fragment_bounds.rs` draws its geometry). `None` for a caller's depth buffer.
-    pub scene: Option<&'a FrameInputs<'a>>,
+    /// The caller's depth view as given (the render-pass attachment of `fragments`).
+    pub depth_attachment: Option<&'a wgpu::TextureView>,
+    /// MSAA forward shading: the caller's draws of the fragments it shades from the grid
+    /// ([`crate::culling::CullExtras::fragments`]).
+    #[allow(clippy::type_complexity)]
+    pub fragments: Option<&'a dyn Fn(&mut wgpu::RenderPass<'_>, &wgpu::BindGroup)>,
 }
 
 impl<'a> CullFrame<'a> {
-    /// The renderer's frame as the culling stages see it.
-    pub fn of(f: &'a FrameInputs<'a>) -> Self {
-        CullFrame {
-            device: f.device,
-            queue: f.queue,
-            bind_group: f.cull_bind_group,
-            counters: f.counters,
-            depth: Some(&f.targets.depth),
-            setup: f.setup,
-            light_count: f.lights.len(),
-            lights: f.lights,
-            lights_on_cpu: true,
-            transparency: f.has_transparency(),
-            scene: Some(f),
-        }
-    }
-
     /// The depth view (a `CellSource::Depth` grid always has one).
     pub fn depth(&self) -> &wgpu::TextureView {
         self.depth
+            .expect("a grid over the depth buffer is given the depth")
+    }
+
+    /// The caller's depth view (given with the depth).
+    pub fn depth_attachment(&self) -> &wgpu::TextureView {
+        self.depth_attachment
             .expect("a grid over the depth buffer is given the depth")
     }
 }

@@ -16,13 +16,9 @@ pub use crate::frame::{Assign, CullConfig, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
 pub(crate) use bounds::cell_bounds::cell_bounds_cpu_samples;
 pub(crate) use bounds::cell_box::CellCull;
-pub(crate) use builder::BuiltGrid;
-pub(crate) use builder::GridUse;
 pub use embed::culler::{
-    CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller, LightLayout,
+    CullError, CullExtras, CullInput, CullInputs, CullLight, CullReport, LightCuller, LightLayout,
 };
-pub(crate) use frame::CellSource;
-pub(crate) use frame::{bind_cull_group, cull_layout, CullFrame};
 pub(crate) use grid::GridBuffers;
 pub use grid::{GridDims, GridLists, LightGrid, ZBins};
 pub use oracle::ideal_lighting_computations;
@@ -53,6 +49,12 @@ pub(crate) mod testing {
 
 pub use crate::consts::pass_labels as labels;
 
+/// The key of [`LightCuller::fragment_bounds_wgsl`] (lightgrid's renderer composes its
+/// fragment-bounds shader from its parts).
+pub(crate) fn fragment_bounds_key(group: u32) -> embed::culler::CallerFragmentsKey {
+    embed::culler::CallerFragmentsKey { group }
+}
+
 pub(crate) use bounds::TILE_DEPTH_WGSL;
 pub(crate) use strategies::TILE_FRUSTUM_WGSL;
 
@@ -62,7 +64,6 @@ pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {
     let mut out = bounds::cell_bounds::CellBoundsKey::all_shaders();
     out.extend(bounds::depth_range::DepthRangeKey::all_shaders());
     out.extend([
-        bounds::fragment_bounds::shader(),
         strategies::scan::shader(),
         strategies::radix_sort::shader(),
         strategies::gpu_assign::gather_shader(),

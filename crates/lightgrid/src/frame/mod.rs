@@ -31,11 +31,6 @@ pub(crate) struct FrameInputs<'a> {
     pub device: &'a wgpu::Device,
     pub queue: &'a wgpu::Queue,
     pub scene_bind_group: &'a wgpu::BindGroup,
-    /// Group 0 of the culling kernels over the same buffers (`culling::cull_layout`).
-    pub cull_bind_group: &'a wgpu::BindGroup,
-    /// The frame counters bound in group 0 (`consts::COUNTER_*`); indirect dispatch arguments
-    /// that kernels write there are copied out of it.
-    pub counters: &'a wgpu::Buffer,
     pub vertices: &'a wgpu::Buffer,
     pub indices: &'a wgpu::Buffer,
     /// Runs of the opaque geometry's indices, one material shader each.
@@ -45,8 +40,14 @@ pub(crate) struct FrameInputs<'a> {
     pub targets: &'a Targets,
     /// Camera and frame size, for CPU light assignment.
     pub setup: ViewSetup,
-    /// The frame's lights (world space), as uploaded to group 0.
+    /// The frame's lights (world space).
     pub lights: &'a [Light],
+    /// The same lights as uploaded to group 0 (camera-relative), in the buffer and on the
+    /// CPU as a `LightCuller` reads them (`GpuLight` has `CullLight`'s layout).
+    pub light_buffer: &'a wgpu::Buffer,
+    pub cull_lights: &'a [crate::culling::CullLight],
+    /// The camera's projection (the view is `setup.view`, a rotation).
+    pub proj: glam::Mat4,
     /// The count target is blended into (see `PipelineContext::count_blend`).
     pub count_blend: bool,
     /// `--shadows maps` in a pipeline that re-uses one light's maps (its
@@ -80,6 +81,15 @@ pub struct FrameIo {
     pub readback_bytes: u64,
     /// Wall time the CPU waited for the GPU inside the frame.
     pub cpu_wait_ms: f64,
+}
+
+impl FrameIo {
+    /// Add `other`'s costs (a part of the frame recorded elsewhere).
+    pub fn add(&mut self, other: FrameIo) {
+        self.submits += other.submits;
+        self.readback_bytes += other.readback_bytes;
+        self.cpu_wait_ms += other.cpu_wait_ms;
+    }
 }
 
 /// The frame's command encoder. A pipeline records into it; only the `cpu` strategy submits
@@ -132,6 +142,21 @@ impl<'a> FrameEncoder<'a> {
             timer,
             io: FrameIo::default(),
         }
+    }
+
+    /// What the frame has cost the CPU side so far.
+    pub fn io(&self) -> FrameIo {
+        self.io
+    }
+
+    /// The encoder, the pass timer and the frame's CPU-side costs (a `LightCuller` records
+    /// into the frame and adds its own: `CullExtras`).
+    pub fn split(&mut self) -> (&mut wgpu::CommandEncoder, &mut PassTimer, &mut FrameIo) {
+        let encoder = match &mut self.encoder {
+            Recording::Owned(e) => e,
+            Recording::Borrowed(e) => &mut **e,
+        };
+        (encoder, self.timer, &mut self.io)
     }
 
     /// The encoder and the pass timer, to begin a pass.

@@ -40,9 +40,12 @@ pub(crate) struct FrameTimings {
     pub assign_ms: Option<f64>,
 }
 
-/// Hands out begin/end timestamp slots to passes; [`PassTimer::resolve_into`] copies the
-/// frame's timestamps into a buffer the frame counters read back (`gpu/counters.rs`).
-pub(crate) struct PassTimer {
+/// A frame's pass timer: hands out begin/end timestamp slots to the passes recorded into one
+/// frame (lightgrid's renderer copies them into the buffer its frame counters read back,
+/// `gpu/counters.rs`). Without `TIMESTAMP_QUERY` it times nothing. A
+/// [`crate::LightCuller`] given one ([`crate::culling::CullExtras::timer`]) times its passes
+/// in it; [`PassTimer::read_passes`] reads what a frame's passes took.
+pub struct PassTimer {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     labels: Vec<TimedPass>,
     /// The frame's submissions so far (the passes recorded now go into this one).
@@ -54,14 +57,25 @@ pub(crate) struct PassTimer {
 impl PassTimer {
     /// A timer for at most `max_passes` passes per frame.
     pub fn new(ctx: &GpuContext, max_passes: u32) -> Self {
+        Self::for_device(&ctx.device, &ctx.queue, ctx.timestamps, max_passes)
+    }
+
+    /// A timer on any device and queue (`timestamps`: the device was created with
+    /// `TIMESTAMP_QUERY`), for at most `max_passes` passes per frame.
+    pub fn for_device(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        timestamps: bool,
+        max_passes: u32,
+    ) -> Self {
         let count = max_passes * 2;
-        let queries = ctx.timestamps.then(|| {
-            let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+        let queries = timestamps.then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass timestamps"),
                 ty: wgpu::QueryType::Timestamp,
                 count,
             });
-            let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamp resolve"),
                 size: Self::bytes_for(max_passes),
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
@@ -74,7 +88,7 @@ impl PassTimer {
             labels: Vec::new(),
             submission: 0,
             capacity: max_passes,
-            period_ns: f64::from(ctx.queue.get_timestamp_period()),
+            period_ns: f64::from(queue.get_timestamp_period()),
         }
     }
 
@@ -90,8 +104,36 @@ impl PassTimer {
     }
 
     /// Bytes of the timestamps of `passes` passes.
-    pub fn bytes_for(passes: u32) -> u64 {
+    pub(crate) fn bytes_for(passes: u32) -> u64 {
         u64::from(passes) * 16
+    }
+
+    /// The GPU time of each pass timed since [`Self::reset`], once their submissions are
+    /// done (tools: submits a resolve and waits). Empty without timestamps.
+    pub fn read_passes(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> crate::error::Result<Vec<PassTiming>> {
+        let n = self.labels.len() as u32;
+        if self.queries.is_none() || n == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamp readback"),
+            size: Self::bytes_for(n),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.resolve_into(&mut encoder, &staging, 0);
+        queue.submit([encoder.finish()]);
+        let bytes = super::read_buffer(device, &staging)?;
+        let ticks: Vec<u64> = bytes
+            .chunks_exact(8)
+            .map(|c| c.iter().rev().fold(0u64, |t, &b| t << 8 | u64::from(b)))
+            .collect();
+        Ok(self.timings(&self.labels, &ticks).passes)
     }
 
     /// Forget last frame's passes.
@@ -101,12 +143,12 @@ impl PassTimer {
     }
 
     /// The passes recorded this frame, in order.
-    pub fn labels(&self) -> &[TimedPass] {
+    pub(crate) fn labels(&self) -> &[TimedPass] {
         &self.labels
     }
 
     /// Begin a compute pass labelled `label`, timed at its boundaries.
-    pub fn begin_compute<'e>(
+    pub(crate) fn begin_compute<'e>(
         &mut self,
         encoder: &'e mut wgpu::CommandEncoder,
         label: &str,
@@ -118,7 +160,7 @@ impl PassTimer {
     }
 
     /// The frame was submitted part-way: later passes go into its next submission.
-    pub fn next_submission(&mut self) {
+    pub(crate) fn next_submission(&mut self) {
         self.submission += 1;
     }
 
@@ -138,7 +180,7 @@ impl PassTimer {
     }
 
     /// Timestamp writes for a render pass labelled `label`.
-    pub fn render_pass(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    pub(crate) fn render_pass(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
         self.slot(label)
             .map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
                 query_set,
@@ -148,7 +190,7 @@ impl PassTimer {
     }
 
     /// Timestamp writes for a compute pass labelled `label`.
-    pub fn compute_pass(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+    pub(crate) fn compute_pass(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.slot(label)
             .map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
                 query_set,
@@ -159,7 +201,7 @@ impl PassTimer {
 
     /// Record the resolve of this frame's queries and their copy into `dst` at `offset`
     /// (room for [`PassTimer::bytes_for`] the recorded passes); call once, after the last pass.
-    pub fn resolve_into(
+    pub(crate) fn resolve_into(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         dst: &wgpu::Buffer,
@@ -176,7 +218,7 @@ impl PassTimer {
     }
 
     /// What the raw timestamps of `labels`' passes (two ticks per pass) say.
-    pub fn timings(&self, labels: &[TimedPass], ticks: &[u64]) -> FrameTimings {
+    pub(crate) fn timings(&self, labels: &[TimedPass], ticks: &[u64]) -> FrameTimings {
         if self.queries.is_none() {
             return FrameTimings::default();
         }

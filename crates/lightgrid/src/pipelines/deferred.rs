@@ -202,7 +202,7 @@ impl Volumes<'_> {
     }
 }
 
-fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn Technique> {
+fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Result<Box<dyn Technique>> {
     let device = ctx.device;
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.grid.samples;
@@ -244,25 +244,25 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Box<dyn T
             Shading::PerPixel,
         )
     });
-    Box::new(Deferred {
+    Ok(Box::new(Deferred {
         copy: volumes.copy_pipeline(device, &module, ctx.scene_layout, &targets),
         mark_edges,
         stencil_mark,
         shaders,
         gbuffer,
         volumes,
-    })
+    }))
 }
 
-pub(super) fn create_plain(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_plain(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Cull::Volumes, GBufferLayout::Full)
 }
 
-pub(super) fn create_stencil(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_stencil(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Cull::Stencil, GBufferLayout::Full)
 }
 
-pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_mono(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Cull::Volumes, GBufferLayout::MonoSpecular)
 }
 

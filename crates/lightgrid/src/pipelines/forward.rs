@@ -22,21 +22,21 @@ struct Forward {
     pipelines: MaterialPipelines,
 }
 
-pub(super) fn create(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create_with(ctx, "fs_main")
 }
 
 /// `forward_mono`: the same, with the light pre-pass's monochrome specular model.
-pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_mono(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create_with(ctx, "fs_mono")
 }
 
 /// `forward_mono_albedo`: the same, with `deferred_mono`'s one-value specular albedo.
-pub(super) fn create_mono_albedo(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_mono_albedo(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create_with(ctx, "fs_mono_albedo")
 }
 
-fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique> {
+fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Result<Box<dyn Technique>> {
     let module = create_module(ctx.device, &shaders()[0].specialized(ctx.shading));
     let pipelines = MaterialPipelines::new(
         ctx.device,
@@ -52,7 +52,7 @@ fn create_with(ctx: &PipelineContext, fragment_entry: &str) -> Box<dyn Technique
         },
         ctx.settings.material_draws,
     );
-    Box::new(Forward { pipelines })
+    Ok(Box::new(Forward { pipelines }))
 }
 
 impl Technique for Forward {

@@ -45,7 +45,7 @@ use super::{
     PipelineContext, Technique, TransparentLights,
 };
 use crate::consts::SCREEN_WORKGROUP;
-use crate::culling::{CellSource, LightCuller};
+use crate::culling::LightCuller;
 use crate::error::Result;
 use crate::frame::targets::counts_in_target;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
@@ -201,7 +201,7 @@ enum Irradiance {
     },
     /// The tile grid, then one compute pass over the pixels.
     Tiled {
-        builder: Box<LightCuller>,
+        builder: Box<super::PipelineGrid>,
         kernel: wgpu::ComputePipeline,
         outputs_layout: wgpu::BindGroupLayout,
         /// MSAA: the kernel's per-sample output and the pass expanding it.
@@ -435,8 +435,8 @@ fn tiled_irradiance(
     ctx: &PipelineContext,
     module: &wgpu::ShaderModule,
     attr_layout: &wgpu::BindGroupLayout,
-) -> Irradiance {
-    let builder = ctx.culler(&ctx.settings.grid.tiled(), CellSource::Depth, false);
+) -> Result<Irradiance> {
+    let builder = ctx.grid(&ctx.settings.grid.tiled(), true, false)?;
     let samples = ctx.settings.grid.samples;
     let (outputs_layout, msaa) = if samples > 1 {
         let (layout, msaa) = TiledMsaa::new(ctx, module, attr_layout);
@@ -461,12 +461,12 @@ fn tiled_irradiance(
             Some(&outputs_layout),
         ],
     );
-    Irradiance::Tiled {
+    Ok(Irradiance::Tiled {
         builder: Box::new(builder),
         kernel,
         outputs_layout,
         msaa,
-    }
+    })
 }
 
 impl Irradiance {
@@ -518,7 +518,7 @@ fn shade_pipelines(
         .collect()
 }
 
-fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
+fn create(ctx: &PipelineContext, mode: Mode) -> Result<Box<dyn Technique>> {
     let mono = mode != Mode::Full;
     let device = ctx.device;
     let size = (ctx.dims.width, ctx.dims.height);
@@ -558,7 +558,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
         samples,
     );
     let irradiance = match mode {
-        Mode::Tiled => tiled_irradiance(ctx, &module, &attr_layout),
+        Mode::Tiled => tiled_irradiance(ctx, &module, &attr_layout)?,
         _ => volume_irradiance(ctx, &module, &attr_layout, mono),
     };
     // The 1x tiled kernel stores the irradiance; with MSAA (a multisampled texture cannot be
@@ -570,7 +570,7 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
     };
     let shade = shade_pipelines(ctx, &module, &irr_layout, &irradiance, mono);
     let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    Box::new(LightPrepass {
+    Ok(Box::new(LightPrepass {
         mono,
         samples,
         attributes,
@@ -597,18 +597,18 @@ fn create(ctx: &PipelineContext, mode: Mode) -> Box<dyn Technique> {
             .then(|| target(device, "specular irradiance", size, samples, attachment)),
         attr_layout,
         irr_layout,
-    })
+    }))
 }
 
-pub(super) fn create_full(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_full(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Mode::Full)
 }
 
-pub(super) fn create_mono(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_mono(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Mode::Mono)
 }
 
-pub(super) fn create_tiled(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_tiled(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Mode::Tiled)
 }
 
@@ -650,7 +650,7 @@ impl LightPrepass {
         else {
             unreachable!("the tiled variant's irradiance")
         };
-        builder.build(&crate::culling::CullFrame::of(f), enc)?;
+        builder.encode(f, enc)?;
         let outputs = match msaa {
             Some(_) => None,
             None => Some(crate::passes::compute_outputs_to(
@@ -864,7 +864,7 @@ impl Technique for LightPrepass {
 
     fn culler(&mut self) -> Option<&mut LightCuller> {
         match &mut self.irradiance {
-            Irradiance::Tiled { builder, .. } => Some(builder),
+            Irradiance::Tiled { builder, .. } => Some(builder.culler_mut()),
             Irradiance::Volumes { .. } => None,
         }
     }
@@ -873,7 +873,7 @@ impl Technique for LightPrepass {
     /// none, so the pass builds one.
     fn transparent_lights(&self) -> TransparentLights<'_> {
         match &self.irradiance {
-            Irradiance::Tiled { builder, .. } => TransparentLights::Grid(builder),
+            Irradiance::Tiled { builder, .. } => TransparentLights::Grid(builder.culler()),
             Irradiance::Volumes { .. } => TransparentLights::Own,
         }
     }

@@ -5,12 +5,14 @@
 mod axes;
 mod deferred;
 mod forward;
+mod fragment_bounds;
+mod grid;
 mod light_prepass;
 mod tiled_deferred;
 mod tiled_forward;
 mod transparent;
 
-use crate::culling::{CellSource, CullConfig, GridDims, GridUse, LightCuller};
+use crate::culling::{CullConfig, GridDims, LightCuller};
 use crate::error::Error;
 use crate::error::Result;
 use crate::memory::MemoryModel;
@@ -21,16 +23,17 @@ use crate::frame::GBufferFormat;
 pub(crate) use crate::frame::{FrameEncoder, FrameInputs};
 pub use crate::frame::{RenderSettings, SpotCull};
 pub use axes::{check_axes_apply, find_axis, value_of, Axis, AxisValue, SettingValue, AXES};
+pub(crate) use grid::PipelineGrid;
 pub(crate) use transparent::{TransparentLights, TransparentPass};
 
 /// What a pipeline needs to create its GPU objects.
 pub struct PipelineContext<'a> {
     /// The device the pipeline's GPU objects are created on.
     pub device: &'a wgpu::Device,
+    /// Its queue (a grid's culler keeps a clone).
+    pub queue: &'a wgpu::Queue,
     /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
     pub scene_layout: &'a wgpu::BindGroupLayout,
-    /// Group 0 of the culling kernels (`culling::cull_layout`).
-    pub cull_layout: &'a wgpu::BindGroupLayout,
     /// The frame's size and tiles in pixels (`--tile`), as a one-slice grid; a clustered grid
     /// adds its view-depth slices each frame.
     pub dims: GridDims,
@@ -41,31 +44,20 @@ pub struct PipelineContext<'a> {
     pub shading: crate::scene::Shading,
     /// The adapter can blend into the R32Float count target.
     pub count_blend: bool,
-    /// A CPU-emulated adapter (lavapipe): `--assign auto` keeps assignment on the CPU.
-    pub software_adapter: bool,
 }
 
 impl PipelineContext<'_> {
-    /// A grid pipeline's [`LightCuller`] for the grid `config` describes (the settings' own,
-    /// [`RenderSettings::grid`], or a variant of it), over the frame's tiles.
-    pub fn culler(
+    /// A grid pipeline's grid: a [`LightCuller`] made with `config` (the settings' own,
+    /// [`RenderSettings::grid`], or a variant of it) as any caller's is. `depth`: bounded by
+    /// the frame's depth (else near..far); `forward_opaque`: a forward pass shades the opaque
+    /// geometry from it (with MSAA its fragments go into the bounds).
+    pub(crate) fn grid(
         &self,
         config: &CullConfig,
-        source: CellSource,
+        depth: bool,
         forward_opaque: bool,
-    ) -> LightCuller {
-        LightCuller::for_renderer(
-            self.device,
-            self.cull_layout,
-            self.scene_layout,
-            config,
-            self.dims,
-            GridUse {
-                source,
-                forward_opaque,
-                software_adapter: self.software_adapter,
-            },
-        )
+    ) -> Result<PipelineGrid> {
+        PipelineGrid::new(self, config, depth, forward_opaque)
     }
 }
 
@@ -179,7 +171,7 @@ pub struct PipelineInfo {
     pub kernel_resolve: bool,
     /// Every composed shader the pipeline creates (validated by the tests without a GPU).
     pub shaders: fn() -> Vec<ComposedShader>,
-    pub(crate) create: fn(&PipelineContext) -> Box<dyn Technique>,
+    pub(crate) create: fn(&PipelineContext) -> Result<Box<dyn Technique>>,
     /// Render targets and the traffic model (`memory.rs`).
     pub memory: fn(&RenderSettings) -> MemoryModel,
 }
@@ -460,6 +452,7 @@ pub(crate) fn light_loop_wgsl(l: crate::frame::LightLoop) -> &'static str {
 pub fn all_shaders() -> Vec<ComposedShader> {
     let mut out = crate::passes::shaders();
     out.extend(crate::culling::shaders());
+    out.push(fragment_bounds::shader());
     out.extend(crate::frame::LightLoop::ALL.map(transparent::shader));
     for p in PIPELINES {
         for s in (p.shaders)() {

@@ -19,7 +19,7 @@ use super::RenderSettings;
 use super::{FrameEncoder, FrameInputs, PipelineContext, Technique, TransparentLights};
 use crate::consts::{SCREEN_WORKGROUP, TILE_THREADS};
 use crate::culling::TILE_DEPTH_WGSL;
-use crate::culling::{CellSource, GridDims, LightCuller};
+use crate::culling::{GridDims, LightCuller};
 use crate::error::Result;
 use crate::frame::CullConfig;
 use crate::frame::MsaaResolve;
@@ -173,7 +173,7 @@ impl SampleStage for ExpandStage {
 enum Variant {
     /// Multi-pass: grid + shading kernel.
     Multi {
-        builder: Box<LightCuller>,
+        builder: Box<super::PipelineGrid>,
         label: &'static str,
     },
     /// Single kernel; group 1 holds the tile size.
@@ -349,15 +349,15 @@ struct TiledDeferred {
     dims: GridDims,
 }
 
-pub(super) fn create_multi(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_multi(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create_grid(ctx, 1, "tiled deferred shading")
 }
 
-pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_clustered(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create_grid(ctx, ctx.settings.grid.slices, "clustered deferred shading")
 }
 
-fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<dyn Technique> {
+fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Result<Box<dyn Technique>> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.grid.samples;
     let gbuffer = GBuffer::new(
@@ -369,14 +369,14 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
         samples,
         ctx.shading,
     );
-    let builder = ctx.culler(
+    let builder = ctx.grid(
         &CullConfig {
             slices,
             ..ctx.settings.grid
         },
-        CellSource::Depth,
+        true,
         false,
-    );
+    )?;
     let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let layouts = [
         Some(ctx.scene_layout),
@@ -408,7 +408,7 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
             &[(overrides::RESOLVE_IN_KERNEL, 1.0)],
         ));
     }
-    Box::new(TiledDeferred {
+    Ok(Box::new(TiledDeferred {
         gbuffer,
         outputs,
         shading,
@@ -417,10 +417,10 @@ fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Box<d
             label,
         },
         dims: ctx.dims,
-    })
+    }))
 }
 
-pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_single(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.grid.samples;
     let gbuffer = GBuffer::new(
@@ -492,7 +492,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
             &[(overrides::RESOLVE_IN_KERNEL, 1.0)],
         ));
     }
-    Box::new(TiledDeferred {
+    Ok(Box::new(TiledDeferred {
         gbuffer,
         outputs,
         shading,
@@ -501,7 +501,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Box<dyn Technique> {
             params_group,
         },
         dims: ctx.dims,
-    })
+    }))
 }
 
 impl Technique for TiledDeferred {
@@ -527,7 +527,7 @@ impl Technique for TiledDeferred {
         let shading = resolving.unwrap_or(&self.shading);
         let (group1, label, groups) = match &mut self.variant {
             Variant::Multi { builder, label } => {
-                builder.build(&crate::culling::CullFrame::of(f), enc)?;
+                builder.encode(f, enc)?;
                 let groups = (
                     dims.width.div_ceil(SCREEN_WORKGROUP),
                     dims.height.div_ceil(SCREEN_WORKGROUP),
@@ -575,7 +575,7 @@ impl Technique for TiledDeferred {
 
     fn culler(&mut self) -> Option<&mut LightCuller> {
         match &mut self.variant {
-            Variant::Multi { builder, .. } => Some(builder),
+            Variant::Multi { builder, .. } => Some(builder.culler_mut()),
             Variant::Single { .. } => None,
         }
     }
@@ -584,7 +584,7 @@ impl Technique for TiledDeferred {
     /// none, so the pass builds one.
     fn transparent_lights(&self) -> TransparentLights<'_> {
         match &self.variant {
-            Variant::Multi { builder, .. } => TransparentLights::Grid(builder),
+            Variant::Multi { builder, .. } => TransparentLights::Grid(builder.culler()),
             Variant::Single { .. } => TransparentLights::Own,
         }
     }

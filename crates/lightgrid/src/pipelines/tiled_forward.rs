@@ -15,7 +15,7 @@ use super::{
     FrameInputs, MaterialPipelines,
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, TransparentLights};
-use crate::culling::{CellSource, LightCuller};
+use crate::culling::LightCuller;
 use crate::error::Result;
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, parts, ComposedShader, SCENE_PARTS};
@@ -36,7 +36,7 @@ fn shader(l: crate::frame::LightLoop) -> ComposedShader {
 }
 
 struct TiledForward {
-    builder: LightCuller,
+    builder: super::PipelineGrid,
     /// The depth pre-pass (pre-Z and clustered).
     depth_only: Option<DepthPipelines>,
     shading: MaterialPipelines,
@@ -50,7 +50,7 @@ enum Kind {
     Clustered,
 }
 
-fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
+fn create(ctx: &PipelineContext, kind: Kind) -> Result<Box<dyn Technique>> {
     let module = create_module(
         ctx.device,
         &shader(ctx.settings.light_loop).specialized(ctx.shading),
@@ -61,12 +61,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
     } else {
         ctx.settings.grid.tiled()
     };
-    let source = if prepass {
-        CellSource::Depth
-    } else {
-        CellSource::NearFar
-    };
-    let builder = ctx.culler(&grid, source, true);
+    let builder = ctx.grid(&grid, prepass, true)?;
     let shading = MaterialPipelines::new(
         ctx.device,
         &GeometryPipelineDesc {
@@ -96,7 +91,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             },
         )
     });
-    Box::new(TiledForward {
+    Ok(Box::new(TiledForward {
         builder,
         depth_only,
         shading,
@@ -105,18 +100,18 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Box<dyn Technique> {
             Kind::PreZ => "tiled forward shading (pre-z)",
             Kind::Clustered => "clustered forward shading",
         },
-    })
+    }))
 }
 
-pub(super) fn create_plain(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_plain(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Kind::Plain)
 }
 
-pub(super) fn create_prez(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_prez(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Kind::PreZ)
 }
 
-pub(super) fn create_clustered(ctx: &PipelineContext) -> Box<dyn Technique> {
+pub(super) fn create_clustered(ctx: &PipelineContext) -> Result<Box<dyn Technique>> {
     create(ctx, Kind::Clustered)
 }
 
@@ -134,7 +129,7 @@ impl Technique for TiledForward {
             });
             depth_only.draw(&mut pass, f);
         }
-        self.builder.build(&crate::culling::CullFrame::of(f), enc)?;
+        self.builder.encode(f, enc)?;
         let (encoder, timer) = enc.parts();
         let mut pass =
             begin_lighting_pass(encoder, timer, f, self.label, self.depth_only.is_none());
@@ -144,11 +139,11 @@ impl Technique for TiledForward {
     }
 
     fn culler(&mut self) -> Option<&mut LightCuller> {
-        Some(&mut self.builder)
+        Some(self.builder.culler_mut())
     }
 
     fn transparent_lights(&self) -> TransparentLights<'_> {
-        TransparentLights::Grid(&self.builder)
+        TransparentLights::Grid(self.builder.culler())
     }
 }
 

@@ -11,12 +11,11 @@
 //! depth (a GPU strategy: the frame stays one submission without readback).
 
 use super::{FrameEncoder, FrameInputs, GeometryPipelineDesc, PipelineContext};
-use crate::culling::{CellSource, GridBuffers, GridLists, LightCuller};
+use crate::culling::{GridBuffers, GridLists, LightCuller};
 use crate::error::Result;
 use crate::frame::targets::counts_in_target;
 use crate::frame::Assign;
 use crate::frame::CullConfig;
-use crate::gpu::CounterValues;
 use crate::passes::geometry::{draw_transparent, MaterialPipelines};
 use crate::shader::{compose, create_module, parts, ComposedShader, SCENE_PARTS};
 
@@ -45,7 +44,7 @@ pub(crate) enum TransparentLights<'a> {
 pub(crate) struct TransparentPass {
     all_lights: MaterialPipelines,
     grid: MaterialPipelines,
-    own_grid: LightCuller,
+    own_grid: super::PipelineGrid,
 }
 
 /// Colour blending over the opaque image (alpha kept), counts added.
@@ -72,7 +71,7 @@ fn blended_targets(count_blend: bool) -> [Option<wgpu::ColorTargetState>; 2] {
 }
 
 impl TransparentPass {
-    pub fn new(ctx: &PipelineContext) -> Self {
+    pub fn new(ctx: &PipelineContext) -> Result<Self> {
         let module = create_module(
             ctx.device,
             &shader(ctx.settings.light_loop).specialized(ctx.shading),
@@ -81,7 +80,7 @@ impl TransparentPass {
         // over the opaque depth; one list per tile covering near..max.
         // Not the technique's grid: `--depth-bounds`, `--depth-mask` and `--cell-box` are
         // about that one.
-        let own_grid = ctx.culler(
+        let own_grid = ctx.grid(
             &CullConfig {
                 strategy: Assign::Gather,
                 lists: GridLists::Shared,
@@ -91,9 +90,9 @@ impl TransparentPass {
                 cell_box: crate::frame::CellBox::Off,
                 ..ctx.settings.grid.tiled()
             },
-            CellSource::Depth,
+            true,
             false,
-        );
+        )?;
         let grid_layout = GridBuffers::layout(ctx.device);
         let targets = blended_targets(counts_in_target(ctx.count_blend, ctx.settings.grid.samples));
         let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
@@ -112,7 +111,7 @@ impl TransparentPass {
                 ctx.settings.material_draws,
             )
         };
-        TransparentPass {
+        Ok(TransparentPass {
             all_lights: pipeline(
                 "transparent (all lights)",
                 "fs_all_lights",
@@ -124,7 +123,7 @@ impl TransparentPass {
                 &[Some(ctx.scene_layout), Some(&grid_layout)],
             ),
             own_grid,
-        }
+        })
     }
 
     /// Record the pass after a technique's opaque passes (nothing when the frame has no
@@ -142,8 +141,7 @@ impl TransparentPass {
             TransparentLights::All => None,
             TransparentLights::Grid(b) => Some(b.bind_group()),
             TransparentLights::Own => {
-                self.own_grid
-                    .build(&crate::culling::CullFrame::of(f), enc)?;
+                self.own_grid.encode(f, enc)?;
                 Some(self.own_grid.bind_group())
             }
         };
@@ -168,8 +166,8 @@ impl TransparentPass {
         Ok(())
     }
 
-    /// A finished frame's counters (the own grid's strategy sizes its lists from them).
-    pub fn observe(&mut self, device: &wgpu::Device, values: &CounterValues) -> Result<()> {
-        self.own_grid.observe(device, values)
+    /// The grid it builds for techniques without one (its reports come from its culler).
+    pub fn culler_mut(&mut self) -> &mut LightCuller {
+        self.own_grid.culler_mut()
     }
 }

@@ -240,7 +240,8 @@ fn bounds_union(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
 
 /// The GPU kernel and the bounds buffer it fills.
 pub(crate) struct CellBoundsPass {
-    /// With MSAA: the fragments' view distances folded into the bounds first.
+    /// With MSAA: the forward fragments' view distances, folded into the bounds first when
+    /// the frame draws them ([`CullFrame::fragments`]).
     fragments: Option<crate::culling::bounds::fragment_bounds::FragmentBounds>,
     /// Binding 5 without MSAA (unread).
     no_fragments: wgpu::Buffer,
@@ -277,16 +278,11 @@ fn main_pipeline(
 
 impl CellBoundsPass {
     /// The kernel `key` names (over a depth target of `key.samples` samples per pixel).
-    /// `forward_opaque`: a forward pass shades the opaque fragments from these bounds' grid.
-    /// `scene_layout`: the renderer's group 0, with which an MSAA grid's fragment bounds draw
-    /// its geometry (none for a caller's depth buffer: [`crate::culling::embed::culler::LightCuller`]). `tile_size`:
-    /// the grid's tiles (another size later builds the kernel again).
+    /// `tile_size`: the grid's tiles (another size later builds the kernel again).
     pub(crate) fn new(
         device: &wgpu::Device,
         cull_layout: &wgpu::BindGroupLayout,
-        scene_layout: Option<&wgpu::BindGroupLayout>,
         key: CellBoundsKey,
-        forward_opaque: bool,
         tile_size: u32,
     ) -> Self {
         let samples = key.samples;
@@ -313,14 +309,8 @@ impl CellBoundsPass {
             mapped_at_creation: false,
         });
         CellBoundsPass {
-            fragments: scene_layout.filter(|_| samples > 1).map(|scene_layout| {
-                crate::culling::bounds::fragment_bounds::FragmentBounds::new(
-                    device,
-                    scene_layout,
-                    samples,
-                    forward_opaque,
-                )
-            }),
+            fragments: (samples > 1)
+                .then(|| crate::culling::bounds::fragment_bounds::FragmentBounds::new(device)),
             no_fragments: storage_buffer(device, "no fragment bounds", 16),
             pipeline,
             args,
@@ -405,9 +395,9 @@ impl CellBoundsPass {
             self.pipeline = (dims.tile_size, main);
         }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dims.params()));
-        let fragment_bounds = match (&mut self.fragments, f.scene) {
-            (Some(fragments), Some(scene)) => {
-                fragments.encode(scene, enc, dims, &self.params);
+        let fragment_bounds = match (&mut self.fragments, f.fragments) {
+            (Some(fragments), Some(draw)) => {
+                fragments.encode(f, enc, dims, &self.params, draw);
                 fragments.buffer()
             }
             _ => &self.no_fragments,
@@ -435,6 +425,11 @@ impl CellBoundsPass {
         pass.dispatch_workgroups(dims.tiles_x, dims.tiles_y, 1);
         pass.set_pipeline(&self.args);
         pass.dispatch_workgroups(1, 1, 1);
+    }
+
+    /// The layout of the fragment-bounds group (MSAA only).
+    pub(crate) fn fragments_layout(&self) -> Option<&wgpu::BindGroupLayout> {
+        self.fragments.as_ref().map(|f| f.layout())
     }
 
     /// Without depth: every cell spans its slice of `[near, far]` (`slice_bounds`) and counts

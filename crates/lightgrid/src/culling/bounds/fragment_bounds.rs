@@ -1,86 +1,66 @@
-//! MSAA only: the cells' bounds widened to the view distance every forward fragment will look
-//! its cell up at (`fragment_bounds.wgsl`). A fragment covering part of a pixel is shaded at
-//! the pixel centre, which may lie off its triangle, so its depth can lie outside the bounds
-//! of every sample of its cell; a pass with the shading passes' depth tests records where the
-//! fragments that will be shaded lie, and the cell-bounds kernel unions that with the samples'
-//! bounds. A fragment still outside is counted and its frame refused (`light_grid_shade_fragment`).
+//! MSAA forward shading only: the cells' bounds widened to the view distance every forward
+//! fragment will look its cell up at. A fragment covering part of a pixel is shaded at the
+//! pixel centre, which may lie off its triangle, so its depth can lie outside the bounds of
+//! every sample of its cell. The renderer that shades from the grid draws those fragments in
+//! a render pass the culler begins ([`crate::culling::CullExtras::fragments`]), each writing
+//! its view distance into this buffer (`embed/fragments.wgsl`), and the cell-bounds kernel
+//! unions that with the samples' bounds. A fragment still outside is counted and its frame
+//! refused (lightgrid's `light_grid_shade_fragment`).
 
+use crate::culling::frame::CullFrame;
 use crate::culling::grid::GridDims;
-use crate::frame::{FrameEncoder, FrameInputs};
+use crate::frame::FrameEncoder;
 use crate::gpu::{bind_resources, grow_storage, storage_buffer};
-use crate::passes::geometry::{draw_scene, geometry_pipeline, GeometryPipelineDesc};
-use crate::scene::Shading;
-use crate::shader::{compose, create_module, src, ComposedShader, SCENE_PARTS};
 
-pub(crate) fn shader() -> ComposedShader {
-    let mut parts = SCENE_PARTS.to_vec();
-    parts.push(src::GRID_CELL);
-    parts.push(include_str!("fragment_bounds.wgsl"));
-    compose("fragment_bounds", &parts)
-}
-
+/// The fragments' bounds and the group their pass writes them through.
 pub(crate) struct FragmentBounds {
-    /// Whether a forward pass shades the opaque fragments (else only the transparent ones
-    /// look cells up).
-    forward_opaque: bool,
     layout: wgpu::BindGroupLayout,
-    opaque: wgpu::RenderPipeline,
-    transparent: wgpu::RenderPipeline,
     buffer: wgpu::Buffer,
 }
 
+/// The group of `LightCuller::fragment_bounds_wgsl`: the grid's parameters and the bounds,
+/// visible to fragment shaders.
+fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ..crate::gpu::buffer_entry(binding, ty)
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("light grid fragment bounds"),
+        entries: &[
+            entry(0, crate::gpu::UNIFORM),
+            entry(1, crate::gpu::STORAGE_RW),
+        ],
+    })
+}
+
+/// The caller's depth as its pre-pass left it (and its stencil, if the format has one).
+fn loaded(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    let stencil = view.texture().format().has_stencil_aspect();
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: stencil.then_some(wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        }),
+    }
+}
+
 impl FragmentBounds {
-    pub(crate) fn new(
-        device: &wgpu::Device,
-        scene_layout: &wgpu::BindGroupLayout,
-        samples: u32,
-        forward_opaque: bool,
-    ) -> Self {
-        // Fragment bounds evaluate no light: any shading compiles them alike.
-        let module = create_module(device, &shader().specialized(Shading::default()));
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ..crate::gpu::buffer_entry(binding, ty)
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fragment bounds (group 1)"),
-            entries: &[
-                entry(0, crate::gpu::UNIFORM),
-                entry(1, crate::gpu::STORAGE_RW),
-            ],
-        });
-        let pipeline = |label, entry, depth_compare| {
-            geometry_pipeline(
-                device,
-                &GeometryPipelineDesc {
-                    label,
-                    module: &module,
-                    fragment_entry: Some(entry),
-                    layouts: &[Some(scene_layout), Some(&layout)],
-                    color_targets: &[],
-                    depth_write: false,
-                    depth_compare,
-                    samples,
-                },
-            )
-        };
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
         FragmentBounds {
-            forward_opaque,
-            // The tests of the passes whose fragments these bound: the opaque shading passes'
-            // against the pre-pass depth, the transparent pass's against the opaque depth.
-            opaque: pipeline(
-                "assign: fragment bounds (opaque)",
-                "fs_opaque",
-                crate::depth::SURFACE,
-            ),
-            transparent: pipeline(
-                "assign: fragment bounds (transparent)",
-                "fs_transparent",
-                crate::depth::NEARER,
-            ),
-            layout,
+            layout: layout(device),
             buffer: storage_buffer(device, "fragment bounds", 1 << 14),
         }
+    }
+
+    /// The layout of the group handed to the caller's draws.
+    pub(crate) fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
     }
 
     /// The buffer the cell-bounds kernel reads (binding 5).
@@ -88,13 +68,15 @@ impl FragmentBounds {
         &self.buffer
     }
 
-    /// Record the pass over the frame's depth target; `params` holds `dims`' GridParams.
+    /// Clear the bounds and record the pass over the frame's depth (loaded, read only) in
+    /// which `draw` draws the fragments; `params` holds `dims`' GridParams.
     pub(crate) fn encode(
         &mut self,
-        f: &FrameInputs,
+        f: &CullFrame,
         enc: &mut FrameEncoder,
         dims: &GridDims,
         params: &wgpu::Buffer,
+        draw: &dyn Fn(&mut wgpu::RenderPass<'_>, &wgpu::BindGroup),
     ) {
         let device = f.device;
         grow_storage(
@@ -111,24 +93,15 @@ impl FragmentBounds {
         );
         let (encoder, timer) = enc.parts();
         encoder.clear_buffer(&self.buffer, 0, None);
-        if !self.forward_opaque && !f.has_transparency() {
-            return;
-        }
         let label = crate::consts::pass_labels::FRAGMENT_BOUNDS;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],
-            depth_stencil_attachment: Some(crate::passes::loaded_depth(&f.targets.depth)),
+            depth_stencil_attachment: Some(loaded(f.depth_attachment())),
             timestamp_writes: timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.opaque);
-        let opaque = if self.forward_opaque { f.opaque } else { &[] };
-        draw_scene(&mut pass, &FrameInputs { opaque, ..*f }, &[&group]);
-        pass.set_pipeline(&self.transparent);
-        for d in f.transparent {
-            pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
-        }
+        draw(&mut pass, &group);
     }
 }

@@ -17,8 +17,8 @@
 //! from [`LightCuller::poll`], and the lists grow from them.
 
 use crate::consts::POINT_LIGHT_COS;
-use crate::culling::builder::{GridBuilder, GridUse};
-use crate::culling::frame::{bind_cull_group, cull_layout, CellSource, CullFrame};
+use crate::culling::builder::GridBuilder;
+use crate::culling::frame::{bind_cull_group, cull_layout, CullFrame};
 use crate::culling::grid::GridDims;
 use crate::culling::strategies::registry::find_strategy;
 use crate::frame::{CullConfig, FrameEncoder, SpotCull};
@@ -316,7 +316,7 @@ impl From<crate::error::Error> for CullError {
 }
 
 /// What the GPU said about one encoded frame (from [`LightCuller::poll`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CullReport {
     /// The number [`LightCuller::encode`] returned for the frame.
     pub frame: u64,
@@ -328,6 +328,33 @@ pub struct CullReport {
     pub truncated_loops: u32,
     /// Lights refused (not finite, range not positive): in no cell.
     pub invalid_lights: u32,
+    /// The strategy that built the frame's grid (`auto` resolved).
+    pub assign: crate::frame::Assign,
+    /// CPU time of the assignment itself in milliseconds: the `cpu` strategy's, or `bvh`'s
+    /// hierarchy build; 0 for the GPU strategies.
+    pub cpu_ms: f64,
+}
+
+/// What a renderer may add to a frame's culling besides its [`CullInputs`]
+/// ([`LightCuller::encode_with`]); lightgrid's own renderer passes all three.
+#[derive(Default)]
+pub struct CullExtras<'a> {
+    /// Time every culling pass with this timer's timestamp queries (two slots per pass; the
+    /// labels start with `cull:` or `assign:`), in the caller's frame: the frame's
+    /// submissions and spans are the caller's.
+    pub timer: Option<&'a mut crate::gpu::PassTimer>,
+    /// Add what the culling cost the CPU side to the caller's frame: the `cpu` strategy's
+    /// part-way submission, the bytes it waited to read back, and the wait.
+    pub io: Option<&'a mut crate::frame::FrameIo>,
+    /// Forward shading with MSAA ([`CullConfig::samples`] above 1, a depth given): a fragment
+    /// covering part of a pixel is shaded at the pixel centre, whose depth may lie outside
+    /// every sample of its cell. The culler begins a render pass over the depth (loaded, not
+    /// written) and calls this with it and the group of [`LightCuller::fragment_bounds_wgsl`]
+    /// (layout [`LightCuller::fragment_bounds_layout`]); the caller draws the fragments it
+    /// will shade from the grid, with its shading passes' depth tests, each calling
+    /// `light_grid_bound_fragment`. The cells' bounds then hold every such fragment.
+    #[allow(clippy::type_complexity)]
+    pub fragments: Option<&'a dyn Fn(&mut wgpu::RenderPass<'_>, &wgpu::BindGroup)>,
 }
 
 impl CullReport {
@@ -383,6 +410,41 @@ impl ShaderKey for CallerGridKey {
     }
 }
 
+/// The part of [`LightCuller::fragment_bounds_wgsl`] after the grid's parameters.
+const FRAGMENTS_WGSL: &str = include_str!("fragments.wgsl");
+
+/// The MSAA fragment-bounds WGSL at bind group `group` ([`LightCuller::fragment_bounds_wgsl`]):
+/// like [`CallerGridKey`], only `light_grid` names.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CallerFragmentsKey {
+    pub group: u32,
+}
+
+impl ShaderKey for CallerFragmentsKey {
+    const STAGE: &'static str = "light grid fragment bounds (caller)";
+    const PRELUDE: bool = false;
+
+    fn all() -> Vec<Self> {
+        (0..wgpu::Limits::default().max_bind_groups)
+            .map(|group| CallerFragmentsKey { group })
+            .collect()
+    }
+
+    fn defs(self) -> Vec<Def> {
+        let mut defs = CallerGridKey { group: self.group }.defs();
+        defs.push(Def::Wgsl(
+            "LIGHT_GRID_DEPTH_SLACK",
+            "f32".into(),
+            format!("{:?}", crate::consts::ASSIGN_DEPTH_SLACK),
+        ));
+        defs
+    }
+
+    fn parts(self) -> Vec<&'static str> {
+        vec![src::GRID_PARAMS, FRAGMENTS_WGSL, src::GRID_CELL]
+    }
+}
+
 /// Culls a caller's lights into lightgrid's light grid, in the caller's encoder.
 ///
 /// ```no_run
@@ -423,12 +485,11 @@ pub struct LightCuller {
     core: GridBuilder,
     /// What the grid is.
     config: CullConfig,
-    /// A caller's culler: what turns its inputs into the culling kernels' group 0. `None` in
-    /// lightgrid's renderer, whose frames bring their own ([`CullFrame::of`]).
-    caller: Option<Box<Caller>>,
+    /// What turns the caller's inputs into the culling kernels' group 0, and its frames.
+    caller: Caller,
 }
 
-/// What a caller's [`LightCuller`] keeps besides the grid's stages.
+/// What a [`LightCuller`] keeps besides the grid's stages.
 struct Caller {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -446,13 +507,20 @@ struct Caller {
     /// The caller's light layout, and its words for the light-preparing kernel.
     light_layout: LightLayout,
     light_layout_buffer: wgpu::Buffer,
-    timer: PassTimer,
     frames: u64,
     /// The newest finished frame's number and counters ([`LightCuller::read_grid`]).
     last_report: Option<(u64, crate::gpu::CounterValues)>,
-    /// Frames whose grid the CPU built, and its index entries (their reports carry them: the
-    /// GPU counted none).
-    cpu_entries: Vec<(u64, u32)>,
+    /// Frames encoded and not reported yet: what their reports carry besides the counters.
+    encoded: Vec<EncodedFrame>,
+}
+
+/// What a frame's report carries that its counters do not.
+struct EncodedFrame {
+    frame: u64,
+    assign: crate::frame::Assign,
+    cpu_ms: f64,
+    /// Index entries of a grid the CPU built (the GPU counted none).
+    cpu_entries: u32,
 }
 
 /// Refuse a configuration the culler cannot build on `device`, naming why.
@@ -552,10 +620,9 @@ impl Caller {
             light_layout,
             light_layout_buffer,
             software_adapter: software_adapter(device),
-            timer: PassTimer::disabled(),
             frames: 0,
             last_report: None,
-            cpu_entries: Vec::new(),
+            encoded: Vec::new(),
         }
     }
 
@@ -564,7 +631,7 @@ impl Caller {
     /// their bounding spheres.
     fn prepare_lights(
         &mut self,
-        encoder: &mut wgpu::CommandEncoder,
+        enc: &mut FrameEncoder,
         inputs: &CullInputs,
         uniforms: &FrameUniforms,
     ) {
@@ -607,11 +674,9 @@ impl Caller {
                 entry(5, &self.light_layout_buffer),
             ],
         });
+        let (encoder, timer) = enc.parts();
         self.counters.clear(encoder);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("cull: lights"),
-            timestamp_writes: None,
-        });
+        let mut pass = timer.begin_compute(encoder, crate::consts::pass_labels::CULL_LIGHTS);
         pass.set_pipeline(&self.prep);
         pass.set_bind_group(0, &prep_group, &[]);
         let (x, y) = groups_1d(n.div_ceil(crate::consts::ASSIGN_THREADS));
@@ -629,7 +694,9 @@ pub(crate) fn prep_shader() -> ComposedShader {
 /// The caller-facing module at every group a default wgpu device has, for the validation
 /// test.
 pub(crate) fn embed_shaders() -> Vec<ComposedShader> {
-    CallerGridKey::all_shaders()
+    let mut all = CallerGridKey::all_shaders();
+    all.extend(CallerFragmentsKey::all_shaders());
+    all
 }
 
 impl LightCuller {
@@ -650,88 +717,19 @@ impl LightCuller {
                 }
             })?;
         let mut core = crate::gpu::scoped(device, "creating the light culler", || {
-            GridBuilder::new(
-                device,
-                &layout,
-                None,
-                &config,
-                tiles,
-                GridUse {
-                    source: CellSource::Depth,
-                    forward_opaque: false,
-                    // `Auto` picks `cpu` on a CPU adapter for frames that bring their lights
-                    // on the CPU (`CullFrame::lights_on_cpu`).
-                    software_adapter: software_adapter(device),
-                },
-            )
+            // `Auto` picks `cpu` on a CPU adapter for frames that bring their lights on the
+            // CPU (`CullFrame::lights_on_cpu`).
+            GridBuilder::new(device, &layout, &config, tiles, software_adapter(device))
         })?;
         core.prepare(device)?;
+        let caller = crate::gpu::scoped(device, "creating the light culler", || {
+            Caller::new(device, queue, layout)
+        })?;
         Ok(LightCuller {
             core,
             config,
-            caller: Some(Box::new(Caller::new(device, queue, layout))),
+            caller,
         })
-    }
-
-    /// lightgrid's renderer's culler for the grid `config` describes: its frames bring the
-    /// culling kernels' group 0 (over `cull_layout`) and the depth ([`CullFrame::of`]),
-    /// `usage` says the rest (`--assign` may be `cpu`). The one way in besides
-    /// [`Self::new`], until the renderer's frames go through [`Self::encode`].
-    pub(crate) fn for_renderer(
-        device: &wgpu::Device,
-        cull_layout: &wgpu::BindGroupLayout,
-        scene_layout: &wgpu::BindGroupLayout,
-        config: &CullConfig,
-        tiles: GridDims,
-        usage: GridUse,
-    ) -> Self {
-        LightCuller {
-            core: GridBuilder::new(
-                device,
-                cull_layout,
-                Some(scene_layout),
-                config,
-                tiles,
-                usage,
-            ),
-            config: *config,
-            caller: None,
-        }
-    }
-
-    /// Record a renderer frame's grid (`GridBuilder::build`).
-    pub(crate) fn build(
-        &mut self,
-        f: &CullFrame,
-        enc: &mut FrameEncoder,
-    ) -> crate::error::Result<()> {
-        self.core.build(f, enc)
-    }
-
-    /// A renderer frame's counters: the lists grow from them.
-    pub(crate) fn observe(
-        &mut self,
-        device: &wgpu::Device,
-        values: &crate::gpu::CounterValues,
-    ) -> crate::error::Result<()> {
-        self.core.observe(device, values)
-    }
-
-    /// The last renderer frame's grid (analysis; waits).
-    pub(crate) fn download(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        values: &crate::gpu::CounterValues,
-    ) -> crate::error::Result<crate::culling::builder::BuiltGrid> {
-        self.core.download(device, queue, values)
-    }
-
-    fn caller(&mut self) -> Result<&mut Caller, CullError> {
-        match self.caller.as_deref_mut() {
-            Some(c) => Ok(c),
-            None => not_a_callers(),
-        }
     }
 
     /// The limits a device needs for the culler: the defaults, with the 16 storage buffers per
@@ -791,6 +789,24 @@ impl LightCuller {
         )
     }
 
+    /// MSAA forward shading ([`CullExtras::fragments`]): the WGSL of the group the culler
+    /// hands the caller's fragment draws, at bind group `group`, declaring
+    /// `light_grid_bound_fragment(pixel: vec2<f32>, view_distance: f32, transparent: bool)`:
+    /// the fragment at framebuffer position `pixel` and view distance `view_distance` (within
+    /// near..far) will look its cell up there (`transparent`: with
+    /// `light_grid_cell_transparent`). Every name it declares starts with `light_grid` or
+    /// `LightGrid`; it is not meant to share a module with [`Self::wgsl`] (both declare
+    /// `light_grid`).
+    pub fn fragment_bounds_wgsl(group: u32) -> String {
+        CallerFragmentsKey { group }.shader().source()
+    }
+
+    /// The layout of the group [`CullExtras::fragments`] is handed (`None` unless
+    /// [`CullConfig::samples`] is above 1), for the caller's fragment-bounds pipelines.
+    pub fn fragment_bounds_layout(&self) -> Option<&wgpu::BindGroupLayout> {
+        self.core.fragments_layout()
+    }
+
     /// The layout of [`Self::bind_group`], for the caller's pipeline layout (visible to
     /// fragment and compute stages).
     pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
@@ -823,7 +839,7 @@ impl LightCuller {
     /// every tile's mask words, `lights + tiles × ⌈lights / 32⌉`), so that such frames never
     /// replace [`Self::bind_group`]. It may replace it once, now: take the group after this.
     pub fn reserve(&mut self, viewport: [u32; 2]) -> Result<(), CullError> {
-        let device = self.caller()?.device.clone();
+        let device = self.caller.device.clone();
         check_viewport(&device, viewport)?;
         let [w, h] = viewport;
         let tiles = GridDims::new(w, h, self.config.tile_size).map_err(|e| CullError {
@@ -858,7 +874,7 @@ impl LightCuller {
     /// holds for every frame submitted after the call (set it between frames).
     pub fn set_light_layout(&mut self, layout: LightLayout) -> Result<(), CullError> {
         layout.check()?;
-        let c = self.caller()?;
+        let c = &mut self.caller;
         c.light_layout = layout;
         c.queue.write_buffer(
             &c.light_layout_buffer,
@@ -870,9 +886,7 @@ impl LightCuller {
 
     /// The layout the culler reads the caller's lights with.
     pub fn light_layout(&self) -> LightLayout {
-        self.caller
-            .as_deref()
-            .map_or(LightLayout::CULL_LIGHT, |c| c.light_layout)
+        self.caller.light_layout
     }
 
     /// Record one frame's culling into `encoder` after the caller's depth pre-pass. The
@@ -883,10 +897,19 @@ impl LightCuller {
         encoder: &mut wgpu::CommandEncoder,
         inputs: &CullInputs,
     ) -> Result<u64, CullError> {
+        self.encode_with(encoder, inputs, CullExtras::default())
+    }
+
+    /// [`Self::encode`] with what a renderer may add ([`CullExtras`]): its pass timer, its
+    /// frame's CPU-side costs, and with MSAA forward shading the draws of its fragments.
+    pub fn encode_with(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &CullInputs,
+        extras: CullExtras,
+    ) -> Result<u64, CullError> {
         let core = &mut self.core;
-        let Some(c) = self.caller.as_deref_mut() else {
-            return not_a_callers();
-        };
+        let c = &mut self.caller;
         let camera = c.check(inputs, &self.config)?;
         let (width, height) = (inputs.viewport[0], inputs.viewport[1]);
         let tile_size = self.config.tile_size;
@@ -917,14 +940,19 @@ impl LightCuller {
                 .collect(),
             false => Vec::new(),
         };
-        c.timer.reset();
         c.frames += 1;
         let frame = c.frames;
         let setup = camera.setup(inputs, self.config.spot_cull);
         let uniforms = camera.uniforms(inputs, self.config.spot_cull);
-        let device = c.device.clone();
+        let (device, queue) = (c.device.clone(), c.queue.clone());
+        let mut own_timer = PassTimer::disabled();
+        let timer = match extras.timer {
+            Some(t) => t,
+            None => &mut own_timer,
+        };
+        let mut enc = FrameEncoder::borrowed(&device, &queue, encoder, timer);
         let result = crate::gpu::scoped(&device, "recording the light culler", || {
-            c.prepare_lights(encoder, inputs, &uniforms);
+            c.prepare_lights(&mut enc, inputs, &uniforms);
             let f = CullFrame {
                 device: &c.device,
                 queue: &c.queue,
@@ -936,23 +964,53 @@ impl LightCuller {
                 lights: &cpu_lights,
                 lights_on_cpu: on_cpu,
                 transparency: inputs.transparent,
-                scene: None,
+                depth_attachment: inputs.depth,
+                fragments: extras.fragments,
             };
-            let mut enc = FrameEncoder::borrowed(&c.device, &c.queue, encoder, &mut c.timer);
             core.build(&f, &mut enc)
         });
-        result??;
-        if let Some(entries) = core.last_cpu_entries() {
-            c.cpu_entries.push((frame, entries));
+        let io = enc.io();
+        if let Some(total) = extras.io {
+            total.add(io);
         }
+        drop(enc);
+        result??;
+        let (assign, cpu_ms) = core.last_assign().expect("a frame was built");
+        c.encoded.push(EncodedFrame {
+            frame,
+            assign,
+            cpu_ms,
+            cpu_entries: core.last_cpu_entries().unwrap_or(0),
+        });
         let tag = FrameTag {
             serial: frame,
             pipeline: "LightCuller",
             pass_labels: Vec::new(),
         };
-        c.counters.encode_copy(&c.device, encoder, &c.timer, tag);
+        c.counters
+            .encode_copy(&c.device, encoder, &PassTimer::disabled(), tag);
         c.counters.map_on_submit(encoder);
         Ok(frame)
+    }
+
+    /// The number of the last frame [`Self::encode`] recorded (0 before the first).
+    pub fn last_frame(&self) -> u64 {
+        self.caller.frames
+    }
+
+    /// The last encoded frame's report, collected ([`Self::wait`], or `poll` until it came).
+    fn last_values(&self) -> Result<crate::gpu::CounterValues, CullError> {
+        let c = &self.caller;
+        match c.last_report {
+            Some((frame, values)) if frame == c.frames => Ok(values),
+            _ => refuse(
+                CullInput::Config,
+                format!(
+                    "frame {} has not been reported yet: call wait (or poll until it is) before reading it back",
+                    c.frames
+                ),
+            ),
+        }
     }
 
     /// The grid the last encoded frame built, read back (tests and tools; waits for the
@@ -961,35 +1019,38 @@ impl LightCuller {
     /// must have been collected first ([`Self::wait`]). The offsets and the order of a cell's
     /// lights follow the order the GPU's workgroups finished in; the lists themselves do not.
     pub fn read_grid(&self) -> Result<crate::culling::LightGrid, CullError> {
-        let Some(c) = self.caller.as_deref() else {
-            return not_a_callers();
-        };
-        match c.last_report {
-            Some((frame, values)) if frame == c.frames => {
-                Ok(self.core.download(&c.device, &c.queue, &values)?.grid)
-            }
-            _ => refuse(
-                CullInput::Config,
-                format!(
-                    "frame {} has not been reported yet: call wait (or poll until it is) before read_grid",
-                    c.frames
-                ),
-            ),
-        }
+        let values = self.last_values()?;
+        let c = &self.caller;
+        Ok(self.core.download(&c.device, &c.queue, &values)?)
+    }
+
+    /// The view-distance bounds `[min, max]` of every cell of the last encoded frame's grid
+    /// (min > max: no samples; without depth each cell's slice of near..far), as
+    /// [`Self::read_grid`] reads the lists (tests and tools; waits for the GPU).
+    pub fn read_cell_bounds(&self) -> Result<Vec<[f32; 2]>, CullError> {
+        Ok(self.read_cells()?.cell_bounds)
+    }
+
+    /// The cell bounds and culling records of the last encoded frame (the renderer's
+    /// analysis).
+    pub(crate) fn read_cells(&self) -> Result<crate::culling::builder::BuiltCells, CullError> {
+        self.last_values()?;
+        let c = &self.caller;
+        Ok(self.core.download_cells(&c.device, &c.queue)?)
     }
 
     /// The reports of the frames the GPU has finished since the last call, oldest first,
     /// without waiting (the caller's event loop polls the device, or this does). The lists
     /// grow from them.
     pub fn poll(&mut self) -> Result<Vec<CullReport>, CullError> {
-        let c = self.caller()?;
+        let c = &mut self.caller;
         let readbacks = c.counters.poll(&c.device)?;
         self.reports(readbacks)
     }
 
     /// [`Self::poll`] after waiting for every submitted frame (tests, tools).
     pub fn wait(&mut self) -> Result<Vec<CullReport>, CullError> {
-        let c = self.caller()?;
+        let c = &mut self.caller;
         let readbacks = c.counters.wait(&c.device)?;
         self.reports(readbacks)
     }
@@ -998,18 +1059,31 @@ impl LightCuller {
         &mut self,
         readbacks: Vec<crate::gpu::FrameReadback>,
     ) -> Result<Vec<CullReport>, CullError> {
-        let device = self.caller()?.device.clone();
         let mut out = Vec::with_capacity(readbacks.len());
         for r in readbacks {
-            self.core.observe(&device, &r.values)?;
-            let c = self.caller()?;
+            self.core.observe(&self.caller.device, &r.values)?;
+            let c = &mut self.caller;
+            let write_overflow = r.values.write_overflow();
+            if write_overflow > 0 {
+                return refuse(
+                    CullInput::Device,
+                    format!(
+                        "frame {}: {write_overflow} light indices did not fit the counted lists (count and write passes disagree)",
+                        r.tag.serial
+                    ),
+                );
+            }
             c.last_report = Some((r.tag.serial, r.values));
-            let cpu_entries = c
-                .cpu_entries
+            let encoded = c
+                .encoded
                 .iter()
-                .position(|&(frame, _)| frame == r.tag.serial)
-                .map_or(0, |i| c.cpu_entries.swap_remove(i).1);
-            c.cpu_entries.retain(|&(frame, _)| frame > r.tag.serial);
+                .position(|e| e.frame == r.tag.serial)
+                .map(|i| c.encoded.swap_remove(i));
+            c.encoded.retain(|e| e.frame > r.tag.serial);
+            let (assign, cpu_ms, cpu_entries) =
+                encoded.map_or((self.config.strategy, 0.0, 0), |e| {
+                    (e.assign, e.cpu_ms, e.cpu_entries)
+                });
             out.push(CullReport {
                 frame: r.tag.serial,
                 index_entries: r
@@ -1020,6 +1094,8 @@ impl LightCuller {
                 overflowed: r.values.overflowed(),
                 truncated_loops: r.values.truncated_loops(),
                 invalid_lights: r.values.invalid_lights(),
+                assign,
+                cpu_ms,
             });
         }
         Ok(out)
@@ -1201,15 +1277,6 @@ fn software_adapter(device: &wgpu::Device) -> bool {
 /// Does `config`'s strategy assign on the CPU (`CullInputs::cpu_lights`)?
 fn needs_cpu_lights(config: &CullConfig) -> bool {
     find_strategy(config.strategy).is_some_and(|s| s.cpu_lights)
-}
-
-/// The refusal of a caller's method on lightgrid's renderer's culler, whose frames come
-/// from the renderer.
-fn not_a_callers<T>() -> Result<T, CullError> {
-    refuse(
-        CullInput::Config,
-        "lightgrid's renderer's culler takes its frames from the renderer",
-    )
 }
 
 fn entry(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
