@@ -5,8 +5,8 @@
 //! (`LightCuller::download`) and everything lands in [`FrameStats`].
 
 use crate::culling::{
-    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_counts, ideal_pixel_counts,
-    DepthRange, GridDims, GridLists, LightGrid, ViewSetup,
+    assign_cpu, cell_bounds_cpu_samples, ideal_fragment_counts, ideal_pixel_counts, DepthRange,
+    GridDims, GridLists, LightGrid, ViewSetup,
 };
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
@@ -287,11 +287,10 @@ impl BuiltGrid {
             stage: "grid download".into(),
             message: e.to_string(),
         };
-        let cells = culler.read_cells().map_err(error)?;
         Ok(BuiltGrid {
             grid: culler.read_grid().map_err(error)?,
-            cell_bounds: cells.cell_bounds,
-            cell_culls: cells.cell_culls,
+            cell_bounds: culler.read_cell_bounds().map_err(error)?,
+            cell_culls: culler.read_cell_culls().map_err(error)?,
             assign: report.assign,
             cpu_ms: report.cpu_ms,
         })

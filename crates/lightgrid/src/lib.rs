@@ -35,8 +35,8 @@ pub mod stats;
 pub use analysis::FrameOutput;
 /// The light grid for any wgpu renderer (`culling/embed/culler.rs`; README, "Embedding").
 pub use culling::{
-    Assign, CullConfig, CullError, CullInput, CullInputs, CullLight, CullReport, LightCuller,
-    LightLayout,
+    Assign, CullConfig, CullError, CullExtras, CullInput, CullInputs, CullLight, CullReport,
+    LightCuller, LightLayout,
 };
 pub use error::{Error, Result};
 pub use frame::{CellBox, DepthBounds, DepthMask, SpotCull};

@@ -895,7 +895,10 @@ impl Renderer {
             self.readbacks
                 .encode_opaque_counts(enc.parts().0, &self.targets);
         }
-        let transparent = self.transparent.as_mut().expect("created with the technique");
+        let transparent = self
+            .transparent
+            .as_mut()
+            .expect("created with the technique");
         let before = transparent.culler_mut().last_frame();
         transparent.encode(&inputs, &mut enc, technique.transparent_lights())?;
         let after = transparent.culler_mut().last_frame();
@@ -948,7 +951,8 @@ impl Renderer {
                 None => break None,
             }
         };
-        let (technique, transparent) = culled.map_or((None, None), |c| (c.technique, c.transparent));
+        let (technique, transparent) =
+            culled.map_or((None, None), |c| (c.technique, c.transparent));
         let technique = match technique {
             Some(frame) => Some(self.cull_report(Some(r.tag.pipeline), frame)?),
             None => None,
@@ -1163,7 +1167,10 @@ impl Renderer {
                 }
                 continue;
             }
-            let grid = match (self.techniques.get_mut(info.id).and_then(|t| t.culler()), cull) {
+            let grid = match (
+                self.techniques.get_mut(info.id).and_then(|t| t.culler()),
+                cull,
+            ) {
                 (Some(culler), Some(report)) => Some(analysis::BuiltGrid::read(culler, &report)?),
                 _ => None,
             };

@@ -9,9 +9,11 @@
 
 use glam::{Mat4, Vec3};
 use lightgrid::culling::GridLists;
+use lightgrid::frame::FrameIo;
+use lightgrid::gpu::PassTimer;
 use lightgrid::{
-    Assign, CellBox, CullConfig, CullError, CullInput, CullInputs, CullLight, DepthBounds,
-    DepthMask, LightCuller, LightLayout,
+    Assign, CellBox, CullConfig, CullError, CullExtras, CullInput, CullInputs, CullLight,
+    DepthBounds, DepthMask, LightCuller, LightLayout,
 };
 use wgpu::util::DeviceExt;
 
@@ -22,6 +24,13 @@ const FAR: f32 = 100.0;
 
 /// The caller's device: the first Vulkan adapter (lavapipe on CI), never a silent pass.
 fn device() -> (wgpu::Device, wgpu::Queue) {
+    let (device, queue, _) = device_with(false);
+    (device, queue)
+}
+
+/// [`device`], with `TIMESTAMP_QUERY` when `timestamps` and the adapter has it (the last
+/// value says whether it was granted).
+fn device_with(timestamps: bool) -> (wgpu::Device, wgpu::Queue, bool) {
     let instance =
         wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))
@@ -29,12 +38,18 @@ fn device() -> (wgpu::Device, wgpu::Queue) {
     if std::env::var("CI").is_ok_and(|v| v == "true") {
         assert_eq!(adapter.get_info().backend, wgpu::Backend::Vulkan);
     }
-    pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+    let features = match timestamps {
+        true => adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+        false => wgpu::Features::empty(),
+    };
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         // Exactly what the culler asks for: every strategy must be created within it.
         required_limits: LightCuller::required_limits(&adapter),
+        required_features: features,
         ..Default::default()
     }))
-    .expect("a device with the culler's limits")
+    .expect("a device with the culler's limits");
+    (device, queue, !features.is_empty())
 }
 
 /// A small deterministic generator (the test's own).
@@ -496,6 +511,37 @@ impl Caller {
         }
     }
 
+    /// The caller's depth pre-pass (every sample its own depth) into `encoder`.
+    fn depth_prepass(&self, encoder: &mut wgpu::CommandEncoder) {
+        let device = &self.device;
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &self.depth_pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: self.check.as_entire_binding(),
+            }],
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("caller depth pre-pass"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(if self.cam.standard { 1.0 } else { 0.0 }),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.depth_pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
     fn inputs(&self) -> CullInputs<'_> {
         CullInputs {
             depth: Some(&self.depth_view),
@@ -562,34 +608,7 @@ impl Caller {
             bytemuck::cast_slice(&[proj[2][0], proj[2][1]]),
         );
         let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &self.depth_pipeline.get_bind_group_layout(0),
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.check.as_entire_binding(),
-                }],
-            });
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("caller depth pre-pass"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(if self.cam.standard { 1.0 } else { 0.0 }),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.depth_pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.draw(0..3, 0..1);
-        }
+        self.depth_prepass(&mut encoder);
         let inputs = CullInputs {
             depth: mode.depth.then_some(&self.depth_view),
             transparent: mode.transparent_lists,
@@ -1566,6 +1585,181 @@ fn transparent_lists_cover_surfaces_in_front_of_the_depth() {
         },
     );
     assert_eq!(e.input, CullInput::Depth, "{e}");
+}
+
+/// What a renderer adds through `encode_with` ([`CullExtras`]), as lightgrid's own renderer
+/// does: its pass timer holds the culling passes; its frame's CPU-side costs gain `cpu`'s
+/// part-way readback; the report names the strategy that ran and its CPU time; and with MSAA
+/// the fragments it draws in the culler's pass widen their cells' bounds.
+#[test]
+fn extras_time_the_passes_count_the_readback_and_bound_msaa_fragments() {
+    let (device, queue, timestamps) = device_with(true);
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        assert!(timestamps, "lavapipe offers TIMESTAMP_QUERY");
+    }
+    let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+    let lights = lights(&cam, 300, 53);
+    let caller = Caller::new(&device, &queue, 1, cam, &lights);
+    for strategy in [Assign::Cpu, Assign::Gather, Assign::Auto] {
+        let config = CullConfig {
+            strategy,
+            index_capacity: 1 << 17,
+            ..CullConfig::default()
+        };
+        let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+        let mut timer = PassTimer::for_device(&device, &queue, timestamps, 64);
+        let mut io = FrameIo::default();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        caller.depth_prepass(&mut encoder);
+        let inputs = CullInputs {
+            cpu_lights: Some(&caller.cpu_lights),
+            ..caller.inputs()
+        };
+        let extras = CullExtras {
+            timer: Some(&mut timer),
+            io: Some(&mut io),
+            fragments: None,
+        };
+        let frame = culler
+            .encode_with(&mut encoder, &inputs, extras)
+            .expect("culling");
+        queue.submit([encoder.finish()]);
+        let reports = culler.wait().expect("reports");
+        let report = reports.iter().find(|r| r.frame == frame).expect("report");
+        assert!(report.is_complete(), "{strategy:?}: {report:?}");
+        let ran = report.assign;
+        assert_ne!(ran, Assign::Auto, "auto is reported resolved");
+        if strategy != Assign::Auto {
+            assert_eq!(ran, strategy);
+        }
+        if ran == Assign::Cpu {
+            // The cell bounds read back part-way: one submission, its bytes, its wait.
+            assert_eq!(io.submits, 1, "{strategy:?}: {io:?}");
+            assert!(io.readback_bytes > 0, "{strategy:?}: {io:?}");
+            assert!(report.cpu_ms > 0.0, "{strategy:?}: {report:?}");
+        } else {
+            assert_eq!(
+                io,
+                FrameIo::default(),
+                "{strategy:?}: a GPU strategy adds nothing"
+            );
+            assert_eq!(report.cpu_ms, 0.0);
+        }
+        let passes = timer.read_passes(&device, &queue).expect("timings");
+        let labels: Vec<&str> = passes.iter().map(|p| p.label.as_str()).collect();
+        match timestamps {
+            true => {
+                for wanted in [
+                    lightgrid::culling::labels::CULL_LIGHTS,
+                    "assign: cell bounds",
+                ] {
+                    assert!(labels.contains(&wanted), "{strategy:?}: {labels:?}");
+                }
+                assert!(passes.iter().all(|p| p.ms >= 0.0 && p.ms.is_finite()));
+            }
+            false => assert!(passes.is_empty()),
+        }
+    }
+    // MSAA: every pixel's fragment at a view distance nearer than any sample, drawn in the
+    // culler's pass; every tile's bounds then reach it, and without the draws some do not.
+    const W_FRAG: f32 = 2.0 * NEAR;
+    let msaa = Caller::new(
+        &device,
+        &queue,
+        4,
+        camera(Vec3::new(3.0, 2.0, 10.0), false),
+        &lights,
+    );
+    let config = CullConfig {
+        strategy: Assign::Gather,
+        samples: 4,
+        slices: 1,
+        index_capacity: 1 << 17,
+        ..CullConfig::default()
+    };
+    let mut culler = LightCuller::new(&device, &queue, config).expect("culler");
+    assert!(LightCuller::new(&device, &queue, CullConfig::default())
+        .expect("culler")
+        .fragment_bounds_layout()
+        .is_none());
+    let layout = culler.fragment_bounds_layout().expect("MSAA").clone();
+    let source = format!(
+        "{}\n@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {{
+             let p = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+             return vec4<f32>(p * 2.0 - 1.0, 0.5, 1.0);
+         }}
+         @fragment fn fs(@builtin(position) pos: vec4<f32>) {{
+             light_grid_bound_fragment(pos.xy, {W_FRAG:?}, false);
+         }}",
+        LightCuller::fragment_bounds_wgsl(0)
+    );
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("caller fragments"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("caller fragments"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("caller fragments"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: 4,
+            ..Default::default()
+        },
+        multiview_mask: None,
+        cache: None,
+    });
+    let draw = |pass: &mut wgpu::RenderPass<'_>, group: &wgpu::BindGroup| {
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..3, 0..1);
+    };
+    for with_fragments in [false, true] {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        msaa.depth_prepass(&mut encoder);
+        let extras = CullExtras {
+            fragments: with_fragments.then_some(&draw as _),
+            ..CullExtras::default()
+        };
+        culler
+            .encode_with(&mut encoder, &msaa.inputs(), extras)
+            .expect("culling");
+        queue.submit([encoder.finish()]);
+        let reports = culler.wait().expect("reports");
+        assert!(reports.iter().all(|r| r.is_complete()), "{reports:?}");
+        let bounds = culler.read_cell_bounds().expect("bounds");
+        let reach = bounds
+            .iter()
+            .filter(|b| b[0] <= W_FRAG * 1.001 && b[0] <= b[1])
+            .count();
+        match with_fragments {
+            true => assert_eq!(reach, bounds.len(), "every tile holds its fragments"),
+            false => assert!(reach < bounds.len(), "the samples alone lie farther"),
+        }
+    }
 }
 
 fn refused(culler: &mut LightCuller, device: &wgpu::Device, inputs: &CullInputs) -> CullError {

@@ -308,7 +308,9 @@ impl GridBuilder {
         }
         let dims = match &self.range {
             // The GPU spread the slices: `last.dims` holds near..far.
-            Some(range) if last.source == CellSource::Depth => range.read(device, queue, &last.dims)?,
+            Some(range) if last.source == CellSource::Depth => {
+                range.read(device, queue, &last.dims)?
+            }
             _ => last.dims,
         };
         let strategy = self

@@ -15,7 +15,7 @@ mod strategies;
 pub use crate::frame::{Assign, CullConfig, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};
 pub(crate) use bounds::cell_bounds::cell_bounds_cpu_samples;
-pub(crate) use bounds::cell_box::CellCull;
+pub use bounds::cell_box::CellCull;
 pub use embed::culler::{
     CullError, CullExtras, CullInput, CullInputs, CullLight, CullReport, LightCuller, LightLayout,
 };

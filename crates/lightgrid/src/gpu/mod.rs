@@ -7,8 +7,8 @@ mod timing;
 pub use context::{list_adapters, AdapterSummary, DeviceLimits, GpuContext};
 pub use counters::COUNTER_BYTES;
 pub(crate) use counters::{CounterValues, FrameCounters, FrameReadback, FrameTag};
-pub use timing::{PassTimer, PassTiming};
 pub(crate) use timing::TimedPass;
+pub use timing::{PassTimer, PassTiming};
 
 use crate::error::{Error, Result};
 

@@ -20,9 +20,22 @@ const GROUP: u32 = 1;
 pub(crate) fn shader() -> ComposedShader {
     let culler = crate::culling::fragment_bounds_key(GROUP);
     let mut parts = SCENE_PARTS.to_vec();
-    parts.extend(culler.parts().into_iter().filter(|p| !SCENE_PARTS.contains(p)));
+    parts.extend(
+        culler
+            .parts()
+            .into_iter()
+            .filter(|p| !SCENE_PARTS.contains(p)),
+    );
     parts.push(include_str!("fragment_bounds.wgsl"));
-    compose_defs("fragment_bounds", &culler.defs(), &parts)
+    // Less what the constants prelude already declares.
+    let defs: Vec<_> = (culler.defs().into_iter())
+        .filter(|d| {
+            !crate::consts::WGSL_CONSTS
+                .iter()
+                .any(|(n, _)| *n == d.name())
+        })
+        .collect();
+    compose_defs("fragment_bounds", &defs, &parts)
 }
 
 /// The pipelines drawing a grid's fragments.
@@ -83,7 +96,12 @@ impl FragmentDraws {
     }
 
     /// Draw frame `f`'s fragments into the culler's pass, its group at 1.
-    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass, group: &wgpu::BindGroup, f: &FrameInputs) {
+    pub(crate) fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        group: &wgpu::BindGroup,
+        f: &FrameInputs,
+    ) {
         pass.set_pipeline(&self.opaque);
         let opaque = if self.forward_opaque { f.opaque } else { &[] };
         draw_scene(pass, &FrameInputs { opaque, ..*f }, &[group]);

@@ -75,7 +75,8 @@ impl PipelineGrid {
         let extras = CullExtras {
             timer: Some(timer),
             io: Some(io),
-            fragments: fragments.map(|_| &draw as &dyn Fn(&mut wgpu::RenderPass<'_>, &wgpu::BindGroup)),
+            fragments: fragments
+                .map(|_| &draw as &dyn Fn(&mut wgpu::RenderPass<'_>, &wgpu::BindGroup)),
         };
         self.culler
             .encode_with(encoder, &inputs, extras)

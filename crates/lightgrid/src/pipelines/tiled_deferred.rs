@@ -357,7 +357,11 @@ pub(super) fn create_clustered(ctx: &PipelineContext) -> Result<Box<dyn Techniqu
     create_grid(ctx, ctx.settings.grid.slices, "clustered deferred shading")
 }
 
-fn create_grid(ctx: &PipelineContext, slices: u32, label: &'static str) -> Result<Box<dyn Technique>> {
+fn create_grid(
+    ctx: &PipelineContext,
+    slices: u32,
+    label: &'static str,
+) -> Result<Box<dyn Technique>> {
     let (w, h) = (ctx.dims.width, ctx.dims.height);
     let samples = ctx.settings.grid.samples;
     let gbuffer = GBuffer::new(

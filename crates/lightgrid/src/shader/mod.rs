@@ -126,7 +126,8 @@ pub enum Def {
 }
 
 impl Def {
-    fn name(&self) -> &'static str {
+    /// The name it declares.
+    pub(crate) fn name(&self) -> &'static str {
         match self {
             Def::Bool(name, _) | Def::U32(name, _) | Def::Wgsl(name, _, _) => name,
         }

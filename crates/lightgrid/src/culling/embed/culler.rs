@@ -1031,9 +1031,14 @@ impl LightCuller {
         Ok(self.read_cells()?.cell_bounds)
     }
 
-    /// The cell bounds and culling records of the last encoded frame (the renderer's
-    /// analysis).
-    pub(crate) fn read_cells(&self) -> Result<crate::culling::builder::BuiltCells, CullError> {
+    /// Each cell's culling record beyond its bounds, as [`Self::read_cell_bounds`] reads
+    /// them: its 2.5D depth mask and tight box ([`CullConfig::depth_mask`],
+    /// [`CullConfig::cell_box`]; neither when both are off).
+    pub fn read_cell_culls(&self) -> Result<Vec<crate::culling::CellCull>, CullError> {
+        Ok(self.read_cells()?.cell_culls)
+    }
+
+    fn read_cells(&self) -> Result<crate::culling::builder::BuiltCells, CullError> {
         self.last_values()?;
         let c = &self.caller;
         Ok(self.core.download_cells(&c.device, &c.queue)?)
@@ -1080,8 +1085,8 @@ impl LightCuller {
                 .position(|e| e.frame == r.tag.serial)
                 .map(|i| c.encoded.swap_remove(i));
             c.encoded.retain(|e| e.frame > r.tag.serial);
-            let (assign, cpu_ms, cpu_entries) =
-                encoded.map_or((self.config.strategy, 0.0, 0), |e| {
+            let (assign, cpu_ms, cpu_entries) = encoded
+                .map_or((self.config.strategy, 0.0, 0), |e| {
                     (e.assign, e.cpu_ms, e.cpu_entries)
                 });
             out.push(CullReport {
@@ -1452,8 +1457,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_embedded_module_declares_only_prefixed_names() {
-        let module = naga::front::wgsl::parse_str(&LightCuller::wgsl(2)).expect("parses");
+    fn the_embedded_modules_declare_only_prefixed_names() {
+        for source in [LightCuller::wgsl(2), LightCuller::fragment_bounds_wgsl(2)] {
+            declares_only_prefixed_names(&source);
+        }
+    }
+
+    fn declares_only_prefixed_names(source: &str) {
+        let module = naga::front::wgsl::parse_str(source).expect("parses");
         for (_, g) in module.global_variables.iter() {
             let name = g.name.as_deref().unwrap_or("");
             assert!(name.starts_with("light_grid"), "{name}");
