@@ -145,6 +145,18 @@ struct Uploaded<'s> {
     shadow_maps: Option<crate::shadows::maps::MapFrame>,
 }
 
+/// Every frame starts with its counters cleared, and with MSAA its per-pixel counts.
+fn clear_frame_counters(
+    counters: &FrameCounters,
+    targets: &Targets,
+    encoder: &mut wgpu::CommandEncoder,
+) {
+    counters.clear(encoder);
+    if targets.samples > 1 {
+        encoder.clear_buffer(&targets.pixel_counts, 0, None);
+    }
+}
+
 /// Whose culler a report came from: a technique's (its pipeline id) or the transparent
 /// pass's own grid (`None`).
 type CullerOwner = Option<&'static str>;
@@ -836,8 +848,7 @@ impl Renderer {
         up: &Uploaded,
         analysis: bool,
     ) -> Result<(u64, FrameIo, wgpu::SubmissionIndex)> {
-        let device = &self.device;
-        let queue = &self.queue;
+        let (device, queue) = (&self.device, &self.queue);
         let technique = self.techniques.get_mut(info.id).expect("prepared");
         self.timer.reset();
         let reused = up.shadow_maps.as_ref().filter(|m| m.reused).map(|frame| {
@@ -866,12 +877,7 @@ impl Renderer {
                 .map(|r| r as &dyn crate::frame::ReusedShadowMaps),
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
-        self.counters.clear(enc.parts().0);
-        if self.targets.samples > 1 {
-            enc.parts()
-                .0
-                .clear_buffer(&self.targets.pixel_counts, 0, None);
-        }
+        clear_frame_counters(&self.counters, &self.targets, enc.parts().0);
         // Shadow maps all in flight before shading; a re-using pipeline renders each light's
         // itself, and the atlas after it for the transparent pass's forward shading.
         let atlas_at = |before: bool| {
@@ -895,13 +901,11 @@ impl Renderer {
             self.readbacks
                 .encode_opaque_counts(enc.parts().0, &self.targets);
         }
-        let transparent = self
+        let transparent = (self
             .transparent
             .as_mut()
-            .expect("created with the technique");
-        let before = transparent.culler_mut().last_frame();
-        transparent.encode(&inputs, &mut enc, technique.transparent_lights())?;
-        let after = transparent.culler_mut().last_frame();
+            .expect("created with the technique"))
+        .encode(&inputs, &mut enc, technique.transparent_lights())?;
         let (encoder, timer) = enc.parts();
         if !technique.resolved_to_display() {
             self.tonemap
@@ -925,7 +929,7 @@ impl Renderer {
                 self.culled.push_back(CulledFrame {
                     serial: self.serial,
                     technique: technique_frame,
-                    transparent: (after != before).then_some(after),
+                    transparent,
                 });
                 Ok((self.serial, io, index))
             }

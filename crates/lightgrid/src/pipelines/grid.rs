@@ -6,9 +6,21 @@
 
 use super::fragment_bounds::FragmentDraws;
 use super::PipelineContext;
-use crate::culling::{CullConfig, CullExtras, CullInputs, LightCuller};
+use crate::culling::{CullConfig, CullError, CullExtras, CullInput, CullInputs, LightCuller};
 use crate::error::{Error, Result};
 use crate::frame::{FrameEncoder, FrameInputs};
+
+/// The renderer's error for a culler's refusal: what the device could not do is a GPU
+/// error, the rest (the grid's description, a frame too large for it) a setting's.
+fn cull_error(e: CullError) -> Error {
+    match e.input {
+        CullInput::Device => Error::Gpu {
+            stage: "light culling".into(),
+            message: e.message,
+        },
+        _ => Error::invalid("light grid", e.message),
+    }
+}
 
 /// One grid of a pipeline and how its frames reach it.
 pub(crate) struct PipelineGrid {
@@ -28,8 +40,7 @@ impl PipelineGrid {
         depth: bool,
         forward_opaque: bool,
     ) -> Result<Self> {
-        let culler = LightCuller::new(ctx.device, ctx.queue, *config)
-            .map_err(|e| Error::invalid("grid", e.to_string()))?;
+        let culler = LightCuller::new(ctx.device, ctx.queue, *config).map_err(cull_error)?;
         let fragments = culler
             .fragment_bounds_layout()
             .filter(|_| depth)
@@ -80,10 +91,7 @@ impl PipelineGrid {
         };
         self.culler
             .encode_with(encoder, &inputs, extras)
-            .map_err(|e| Error::Gpu {
-                stage: "light culling".into(),
-                message: e.to_string(),
-            })?;
+            .map_err(cull_error)?;
         Ok(())
     }
 

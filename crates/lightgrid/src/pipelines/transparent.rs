@@ -127,21 +127,24 @@ impl TransparentPass {
     }
 
     /// Record the pass after a technique's opaque passes (nothing when the frame has no
-    /// transparent geometry).
+    /// transparent geometry). Returns the frame number of its own grid's culler when it
+    /// built that grid.
     pub fn encode(
         &mut self,
         f: &FrameInputs,
         enc: &mut FrameEncoder,
         lights: TransparentLights,
-    ) -> Result<()> {
+    ) -> Result<Option<u64>> {
         if !f.has_transparency() {
-            return Ok(());
+            return Ok(None);
         }
+        let mut own_frame = None;
         let grid = match lights {
             TransparentLights::All => None,
             TransparentLights::Grid(b) => Some(b.bind_group()),
             TransparentLights::Own => {
                 self.own_grid.encode(f, enc)?;
+                own_frame = Some(self.own_grid.culler().last_frame());
                 Some(self.own_grid.bind_group())
             }
         };
@@ -163,7 +166,7 @@ impl TransparentPass {
             None => draw_transparent(&mut pass, f, &[], &self.all_lights),
             Some(g) => draw_transparent(&mut pass, f, &[g], &self.grid),
         }
-        Ok(())
+        Ok(own_frame)
     }
 
     /// The grid it builds for techniques without one (its reports come from its culler).

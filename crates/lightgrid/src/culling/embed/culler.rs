@@ -307,9 +307,15 @@ fn refuse<T>(input: CullInput, message: impl Into<String>) -> Result<T, CullErro
 }
 
 impl From<crate::error::Error> for CullError {
+    /// A grid the description cannot build (too many cells for the device) is the
+    /// configuration's fault; the rest is the device's.
     fn from(e: crate::error::Error) -> Self {
+        let input = match e {
+            crate::error::Error::Invalid { .. } => CullInput::Config,
+            _ => CullInput::Device,
+        };
         CullError {
-            input: CullInput::Device,
+            input,
             message: e.to_string(),
         }
     }
