@@ -20,7 +20,7 @@
 
 use crate::analysis::{self, AnalysisReadbacks};
 use crate::consts::{MAX_FRAME_EDGE, MAX_LIGHTS};
-use crate::culling::{CullLight, CullReport, GridDims, ViewSetup};
+use crate::culling::{CullReport, GridDims, ViewSetup};
 use crate::error::{Error, Result};
 use crate::frame::{
     FinishedFrame, FrameEncoder, FrameInputs, FrameIo, RenderSettings, SubmittedFrame,
@@ -196,9 +196,9 @@ pub struct Renderer {
     /// to what its faces need within the budget's side (`shadows::maps::atlas_side`).
     shadow_atlas: ShadowAtlas,
     scene_bind_group: wgpu::BindGroup,
-    /// The frame's lights as uploaded (camera-relative), as the grids' cullers read them on
-    /// the CPU (`cpu`, `bvh`).
-    cull_lights: Vec<CullLight>,
+    /// The frame's lights as uploaded (camera-relative), which the grids' cullers also read
+    /// on the CPU (`cpu`, `bvh`).
+    gpu_lights: Vec<GpuLight>,
     /// The culler frames of each frame in flight, to match their reports with it.
     culled: VecDeque<CulledFrame>,
     /// Reports collected from the cullers and not yet matched with their frame.
@@ -347,7 +347,7 @@ impl Renderer {
                 shadow_static_written: false,
                 shadow_atlas,
                 scene_bind_group,
-                cull_lights: Vec::new(),
+                gpu_lights: Vec::new(),
                 culled: VecDeque::new(),
                 cull_reports: Vec::new(),
                 textures,
@@ -766,12 +766,10 @@ impl Renderer {
         // The BRDF the modules were made for (`upload_static` keeps it the scene's).
         let scale = lighting.light_scale(self.shading.brdf);
         let relative: Vec<_> = state.lights.iter().map(|l| l.relative_to(eye)).collect();
-        let gpu_lights: Vec<GpuLight> = relative.iter().map(|l| l.to_gpu_scaled(scale)).collect();
+        let mut gpu_lights = std::mem::take(&mut self.gpu_lights);
+        gpu_lights.clear();
+        gpu_lights.extend(relative.iter().map(|l| l.to_gpu_scaled(scale)));
         let bounds: Vec<[f32; 4]> = relative.iter().map(Light::bounds_gpu).collect();
-        // The grids' cullers read the same lights on the CPU (`GpuLight` is a `CullLight`).
-        self.cull_lights.clear();
-        self.cull_lights
-            .extend_from_slice(bytemuck::cast_slice::<GpuLight, CullLight>(&gpu_lights));
         let lb: &[u8] = bytemuck::cast_slice(&gpu_lights);
         let bb: &[u8] = bytemuck::cast_slice(&bounds);
         let grew_lights = self.lights.reserve(device, lb.len() as u64);
@@ -780,6 +778,9 @@ impl Renderer {
         }
         self.lights.write(queue, 0, lb);
         self.light_bounds.write(queue, 0, bb);
+        let bytes = (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64;
+        // Kept for the grids' cullers.
+        self.gpu_lights = gpu_lights;
         let (width, height) = self.size();
         let view = state.camera.rotation();
         let proj = state.camera.proj(width as f32 / height as f32);
@@ -800,7 +801,7 @@ impl Renderer {
             _pad2: 0,
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-        (lb.len() + bb.len() + std::mem::size_of::<FrameUniforms>()) as u64
+        bytes
     }
 
     /// The shadow maps' texture as the last frame left it (`--shadows maps`; analysis: waits
@@ -869,7 +870,7 @@ impl Renderer {
             setup: up.setup,
             lights: &up.state.lights,
             light_buffer: &self.lights.buffer,
-            cull_lights: &self.cull_lights,
+            gpu_lights: &self.gpu_lights,
             proj: up.proj,
             count_blend: self.count_blend,
             reused_shadow_maps: reused

@@ -33,7 +33,7 @@ pub struct CullFrame<'a> {
     /// The caller's depth view as given (the render-pass attachment of `fragments`).
     pub depth_attachment: Option<&'a wgpu::TextureView>,
     /// MSAA forward shading: the caller's draws of the fragments it shades from the grid
-    /// ([`crate::culling::CullExtras::fragments`]).
+    /// (`CullExtras::fragments`).
     #[allow(clippy::type_complexity)]
     pub fragments: Option<&'a dyn Fn(&mut wgpu::RenderPass<'_>, &wgpu::BindGroup)>,
 }

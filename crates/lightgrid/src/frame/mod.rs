@@ -43,9 +43,9 @@ pub(crate) struct FrameInputs<'a> {
     /// The frame's lights (world space).
     pub lights: &'a [Light],
     /// The same lights as uploaded to group 0 (camera-relative), in the buffer and on the
-    /// CPU as a `LightCuller` reads them (`GpuLight` has `CullLight`'s layout).
+    /// CPU (a `LightCuller` reads both: `GpuLight` has `CullLight`'s layout).
     pub light_buffer: &'a wgpu::Buffer,
-    pub cull_lights: &'a [crate::culling::CullLight],
+    pub gpu_lights: &'a [crate::gpu_types::GpuLight],
     /// The camera's projection (the view is `setup.view`, a rotation).
     pub proj: glam::Mat4,
     /// The count target is blended into (see `PipelineContext::count_blend`).

@@ -68,8 +68,8 @@ impl PipelineGrid {
             // Cells spanning near..far already cover every transparent fragment.
             transparent: self.depth && f.has_transparency(),
             lights: f.light_buffer,
-            cpu_lights: Some(f.cull_lights),
-            light_count: f.cull_lights.len() as u32,
+            cpu_lights: Some(bytemuck::cast_slice(f.gpu_lights)),
+            light_count: f.gpu_lights.len() as u32,
             view: setup.view.to_cols_array_2d(),
             proj: f.proj.to_cols_array_2d(),
             near: setup.near,

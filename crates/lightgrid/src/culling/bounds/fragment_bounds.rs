@@ -2,7 +2,7 @@
 //! fragment will look its cell up at. A fragment covering part of a pixel is shaded at the
 //! pixel centre, which may lie off its triangle, so its depth can lie outside the bounds of
 //! every sample of its cell. The renderer that shades from the grid draws those fragments in
-//! a render pass the culler begins ([`crate::culling::CullExtras::fragments`]), each writing
+//! a render pass the culler begins (`CullExtras::fragments`), each writing
 //! its view distance into this buffer (`embed/fragments.wgsl`), and the cell-bounds kernel
 //! unions that with the samples' bounds. A fragment still outside is counted and its frame
 //! refused (lightgrid's `light_grid_shade_fragment`).

@@ -1024,7 +1024,7 @@ impl LightCuller {
     /// buffer's numbering (a z-binned grid as the per-cell lists it stands for). Its report
     /// must have been collected first ([`Self::wait`]). The offsets and the order of a cell's
     /// lights follow the order the GPU's workgroups finished in; the lists themselves do not.
-    pub fn read_grid(&self) -> Result<crate::culling::LightGrid, CullError> {
+    pub fn read_grid(&self) -> Result<crate::culling::grid::LightGrid, CullError> {
         let values = self.last_values()?;
         let c = &self.caller;
         Ok(self.core.download(&c.device, &c.queue, &values)?)
@@ -1040,7 +1040,9 @@ impl LightCuller {
     /// Each cell's culling record beyond its bounds, as [`Self::read_cell_bounds`] reads
     /// them: its 2.5D depth mask and tight box ([`CullConfig::depth_mask`],
     /// [`CullConfig::cell_box`]; neither when both are off).
-    pub fn read_cell_culls(&self) -> Result<Vec<crate::culling::CellCull>, CullError> {
+    pub fn read_cell_culls(
+        &self,
+    ) -> Result<Vec<crate::culling::bounds::cell_box::CellCull>, CullError> {
         Ok(self.read_cells()?.cell_culls)
     }
 
