@@ -498,6 +498,6 @@ pub mod pass_labels {
     /// where forward fragments will look their cells up.
     pub const FRAGMENT_BOUNDS: &str = "assign: fragment bounds";
     /// The culler's copy of the caller's lights, camera-relative, with their bounding spheres.
-    pub const CULL_LIGHTS: &str = "cull: lights";
+    pub const CULL_LIGHTS: &str = "assign: lights";
     pub(crate) const DEPTH_RANGE: &str = "assign: depth range";
 }

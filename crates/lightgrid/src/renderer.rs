@@ -447,9 +447,18 @@ impl Renderer {
                 shading: self.shading,
                 count_blend: self.count_blend,
             };
-            let t = scoped(device, &format!("creating pipeline {}", info.id), || {
-                (info.create)(&ctx)
-            })??;
+            let stage = format!("creating pipeline {}", info.id);
+            let t = scoped(device, &stage, || (info.create)(&ctx))?.map_err(|e| match e {
+                // A refusal from inside (its light grid's culler) names the pipeline too.
+                Error::Gpu {
+                    stage: inner,
+                    message,
+                } => Error::Gpu {
+                    stage: format!("{stage} ({inner})"),
+                    message,
+                },
+                e => e,
+            })?;
             self.techniques.insert(info.id, t);
             if self.transparent.is_none() {
                 let pass = scoped(device, "creating the transparent pass", || {

@@ -52,6 +52,47 @@ fn device_with(timestamps: bool) -> (wgpu::Device, wgpu::Queue, bool) {
     (device, queue, !features.is_empty())
 }
 
+/// A full-screen triangle (`vs`) whose fragments (`fs`) run over a Depth32Float target of
+/// `samples` samples, every depth test passing; `depth_write`: they write their depth.
+fn fullscreen_depth_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layout: Option<&wgpu::PipelineLayout>,
+    samples: u32,
+    depth_write: bool,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("caller full-screen pass"),
+        layout,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(depth_write),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: samples,
+            ..Default::default()
+        },
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// A small deterministic generator (the test's own).
 struct Rng(u64);
 impl Rng {
@@ -415,36 +456,7 @@ impl Caller {
             label: Some("caller depth"),
             source: wgpu::ShaderSource::Wgsl(DEPTH_WGSL.into()),
         });
-        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("caller depth"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: samples,
-                ..Default::default()
-            },
-            multiview_mask: None,
-            cache: None,
-        });
+        let depth_pipeline = fullscreen_depth_pipeline(device, &module, None, samples, true);
         let rot = Mat4::from_mat3(glam::Mat3::from_mat4(cam.view));
         let p = cam.proj.to_cols_array_2d();
         let check = Check {
@@ -1702,36 +1714,7 @@ fn extras_time_the_passes_count_the_readback_and_bound_msaa_fragments() {
         bind_group_layouts: &[Some(&layout)],
         immediate_size: 0,
     });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("caller fragments"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs"),
-            compilation_options: Default::default(),
-            targets: &[],
-        }),
-        primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: wgpu::TextureFormat::Depth32Float,
-            depth_write_enabled: Some(false),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState {
-            count: 4,
-            ..Default::default()
-        },
-        multiview_mask: None,
-        cache: None,
-    });
+    let pipeline = fullscreen_depth_pipeline(&device, &module, Some(&pipeline_layout), 4, false);
     let draw = |pass: &mut wgpu::RenderPass<'_>, group: &wgpu::BindGroup| {
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, group, &[]);

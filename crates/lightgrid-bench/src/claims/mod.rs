@@ -463,6 +463,7 @@ mod tests {
             ("depth pre-pass", Some(0)),
             ("light pre-pass attributes", Some(0)),
             ("assign: cell bounds", Some(1)),
+            ("assign: lights", Some(1)),
             ("assign: gather spill", Some(1)),
             ("tiled irradiance (mono specular)", Some(1)),
             ("tiled forward shading (pre-z)", Some(2)),

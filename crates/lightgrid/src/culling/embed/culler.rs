@@ -308,15 +308,17 @@ fn refuse<T>(input: CullInput, message: impl Into<String>) -> Result<T, CullErro
 
 impl From<crate::error::Error> for CullError {
     /// A grid the description cannot build (too many cells for the device) is the
-    /// configuration's fault; the rest is the device's.
+    /// configuration's fault, named by its setting; the rest is the device's.
     fn from(e: crate::error::Error) -> Self {
-        let input = match e {
-            crate::error::Error::Invalid { .. } => CullInput::Config,
-            _ => CullInput::Device,
-        };
-        CullError {
-            input,
-            message: e.to_string(),
+        match e {
+            crate::error::Error::Invalid { what, reason } => CullError {
+                input: CullInput::Config,
+                message: format!("{what}: {reason}"),
+            },
+            e => CullError {
+                input: CullInput::Device,
+                message: e.to_string(),
+            },
         }
     }
 }
@@ -346,7 +348,7 @@ pub struct CullReport {
 #[derive(Default)]
 pub struct CullExtras<'a> {
     /// Time every culling pass with this timer's timestamp queries (two slots per pass; the
-    /// labels start with `cull:` or `assign:`), in the caller's frame: the frame's
+    /// labels start with `assign:`), in the caller's frame: the frame's
     /// submissions and spans are the caller's.
     pub timer: Option<&'a mut crate::gpu::PassTimer>,
     /// Add what the culling cost the CPU side to the caller's frame: the `cpu` strategy's
