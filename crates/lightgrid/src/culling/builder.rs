@@ -150,19 +150,13 @@ impl GridBuilder {
         Ok(())
     }
 
-    /// Create `assign`'s strategy now (`auto`: both it may resolve to), so a device that
+    /// Create `assign`'s strategy now (`auto`: the one for few lights), so a device that
     /// cannot run it fails here rather than at the first frame.
     pub(crate) fn prepare(&mut self, device: &wgpu::Device) -> Result<()> {
-        let wanted = match self.assign {
-            Assign::Auto => vec![
-                Assign::Auto.resolve(0, self.software_adapter),
-                Assign::Auto.resolve(usize::MAX, self.software_adapter),
-            ],
-            a => vec![a],
-        };
-        for a in wanted {
-            self.strategy(device, a)?;
-        }
+        // `auto`: the strategy of small light counts; the other one at the first frame that
+        // needs it (a browser binding 10 storage buffers runs `gather`, not `bvh-gpu`).
+        let a = self.assign.resolve(0, self.software_adapter);
+        self.strategy(device, a)?;
         Ok(())
     }
 
