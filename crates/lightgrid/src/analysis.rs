@@ -51,7 +51,7 @@ pub struct FrameOutput {
 }
 
 /// Where a frame's per-pixel lighting counts are read from: the count target, or with MSAA
-/// the `pixel_counts` buffer (`frame/targets.rs`).
+/// the per-pixel counts after the frame counters (`gpu/counters.rs`).
 enum CountsReadback {
     Target(Readback),
     Pixels(BufferReadback),
@@ -70,12 +70,19 @@ impl CountsReadback {
         }
     }
 
-    fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        counters: &wgpu::Buffer,
+    ) {
         match self {
             CountsReadback::Target(r) => {
                 r.encode(encoder, &targets.counts_texture, wgpu::TextureAspect::All)
             }
-            CountsReadback::Pixels(r) => r.encode(encoder, &targets.pixel_counts),
+            CountsReadback::Pixels(r) => {
+                r.encode_from(encoder, counters, crate::gpu::COUNTER_BYTES)
+            }
         }
     }
 
@@ -121,8 +128,13 @@ impl AnalysisReadbacks {
 
     /// Record the copy of the counts the opaque passes made (before the transparent pass),
     /// so the transparent pass's share of the lighting computations is known.
-    pub fn encode_opaque_counts(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
-        self.opaque_counts.encode(encoder, targets);
+    pub fn encode_opaque_counts(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        counters: &wgpu::Buffer,
+    ) {
+        self.opaque_counts.encode(encoder, targets, counters);
     }
 
     /// Record the copies (after the tonemap).
@@ -131,10 +143,11 @@ impl AnalysisReadbacks {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         targets: &Targets,
+        counters: &wgpu::Buffer,
     ) {
         let all = wgpu::TextureAspect::All;
         self.image.encode(encoder, &targets.ldr_texture, all);
-        self.counts.encode(encoder, targets);
+        self.counts.encode(encoder, targets, counters);
         match &self.depth {
             DepthReadback::Target(r) => r.encode(
                 encoder,

@@ -29,7 +29,7 @@ use crate::gpu::{scoped, FrameCounters, FrameReadback, FrameTag, GpuContext, Pas
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::base_textures::BaseTextures;
 use crate::passes::shadow_atlas::ShadowAtlas;
-use crate::passes::{scene_layout, Targets, Tonemap};
+use crate::passes::{scene_layout_with, SceneBounds, Targets, Tonemap};
 use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
 use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, Shading, SpotCull};
 use std::collections::{HashMap, VecDeque};
@@ -145,18 +145,6 @@ struct Uploaded<'s> {
     shadow_maps: Option<crate::shadows::maps::MapFrame>,
 }
 
-/// Every frame starts with its counters cleared, and with MSAA its per-pixel counts.
-fn clear_frame_counters(
-    counters: &FrameCounters,
-    targets: &Targets,
-    encoder: &mut wgpu::CommandEncoder,
-) {
-    counters.clear(encoder);
-    if targets.samples > 1 {
-        encoder.clear_buffer(&targets.pixel_counts, 0, None);
-    }
-}
-
 /// Whose culler a report came from: a technique's (its pipeline id) or the transparent
 /// pass's own grid (`None`).
 type CullerOwner = Option<&'static str>;
@@ -180,14 +168,16 @@ pub struct Renderer {
     /// `GpuContext::adapter_label`, for the statistics.
     adapter_label: String,
     targets: Targets,
-    scene_layout: wgpu::BindGroupLayout,
+    /// Group 0's layouts: the light bounds seen by the vertex stage only, and also by compute
+    /// (`SceneBounds`).
+    scene_layout: [wgpu::BindGroupLayout; 2],
     uniforms: wgpu::Buffer,
     lights: GrowBuffer,
     light_bounds: GrowBuffer,
     materials: GrowBuffer,
     vertices: GrowBuffer,
     indices: GrowBuffer,
-    /// The shadow rays' buffer (`shading/shadows.wgsl`, group 0 binding 8): a header, the
+    /// The shadow rays' buffer (`shading/shadows.wgsl`, group 0 binding 7): a header, the
     /// static triangles' hierarchy (written once per scene: `shadow_static_written`), the
     /// moving ones' and the casters (every frame). Two vec4s, never read, without shadows.
     shadow_data: GrowBuffer,
@@ -195,7 +185,8 @@ pub struct Renderer {
     /// The shadow maps' texture (`--shadows maps`; 1x1 and unread otherwise), sized per frame
     /// to what its faces need within the budget's side (`shadows::maps::atlas_side`).
     shadow_atlas: ShadowAtlas,
-    scene_bind_group: wgpu::BindGroup,
+    /// Group 0 for each of `scene_layout`.
+    scene_bind_group: [wgpu::BindGroup; 2],
     /// The frame's lights as uploaded (camera-relative), which the grids' cullers also read
     /// on the CPU (`cpu`, `bvh`).
     gpu_lights: Vec<GpuLight>,
@@ -300,7 +291,8 @@ impl Renderer {
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {
             let targets = Targets::new(device, width, height, settings.grid.samples);
-            let scene_layout = scene_layout(device);
+            let scene_layout =
+                [SceneBounds::Vertex, SceneBounds::Compute].map(|b| scene_layout_with(device, b));
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
                 size: std::mem::size_of::<FrameUniforms>() as u64,
@@ -317,14 +309,20 @@ impl Renderer {
             let maps = settings.shadows == crate::scene::Shadows::Maps;
             let mut shadow_atlas = ShadowAtlas::new(device, maps);
             shadow_atlas.bind(device, &uniforms, &shadow_data.buffer);
-            let counters = FrameCounters::new(device, MAX_PASSES);
+            // With MSAA the per-pixel lighting counts follow the counters.
+            let pixels = if settings.grid.samples > 1 {
+                u64::from(width) * u64::from(height)
+            } else {
+                0
+            };
+            let counters = FrameCounters::new(device, MAX_PASSES, pixels);
             let textures = BaseTextures::new(device, &ctx.queue, &[]);
             let scene_bind_group = Self::bind_scene(
                 device,
                 &scene_layout,
                 &uniforms,
                 [&lights, &light_bounds, &materials, &shadow_data],
-                [counters.buffer(), &targets.pixel_counts],
+                counters.buffer(),
                 (&textures, &shadow_atlas),
             );
             Renderer {
@@ -376,35 +374,35 @@ impl Renderer {
         })
     }
 
-    /// Group 0 of the scene.
+    /// Group 0 of the scene, for each of its layouts.
     fn bind_scene(
         device: &wgpu::Device,
-        layout: &wgpu::BindGroupLayout,
+        layouts: &[wgpu::BindGroupLayout; 2],
         uniforms: &wgpu::Buffer,
         [lights, light_bounds, materials, shadow_data]: [&GrowBuffer; 4],
-        [counters, pixel_counts]: [&wgpu::Buffer; 2],
+        counters: &wgpu::Buffer,
         (textures, atlas): (&BaseTextures, &ShadowAtlas),
-    ) -> wgpu::BindGroup {
-        let scene = crate::gpu::bind_resources(
-            device,
-            "scene (group 0)",
-            layout,
-            &[
-                uniforms.as_entire_binding(),
-                lights.buffer.as_entire_binding(),
-                materials.buffer.as_entire_binding(),
-                counters.as_entire_binding(),
-                light_bounds.buffer.as_entire_binding(),
-                pixel_counts.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&textures.view),
-                wgpu::BindingResource::Sampler(&textures.sampler),
-                shadow_data.buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&atlas.view),
-                wgpu::BindingResource::Sampler(&atlas.sampler),
-                wgpu::BindingResource::Sampler(&textures.nearest),
-            ],
-        );
-        scene
+    ) -> [wgpu::BindGroup; 2] {
+        layouts.each_ref().map(|layout| {
+            crate::gpu::bind_resources(
+                device,
+                "scene (group 0)",
+                layout,
+                &[
+                    uniforms.as_entire_binding(),
+                    lights.buffer.as_entire_binding(),
+                    materials.buffer.as_entire_binding(),
+                    counters.as_entire_binding(),
+                    light_bounds.buffer.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&textures.view),
+                    wgpu::BindingResource::Sampler(&textures.sampler),
+                    shadow_data.buffer.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&atlas.view),
+                    wgpu::BindingResource::Sampler(&atlas.sampler),
+                    wgpu::BindingResource::Sampler(&textures.nearest),
+                ],
+            )
+        })
     }
 
     /// The frame size, `(width, height)` in pixels.
@@ -441,7 +439,8 @@ impl Renderer {
             let ctx = PipelineContext {
                 device,
                 queue: &self.queue,
-                scene_layout: &self.scene_layout,
+                scene_layout: &self.scene_layout[0],
+                scene_culling_layout: &self.scene_layout[1],
                 dims: self.dims,
                 settings: self.settings,
                 shading: self.shading,
@@ -843,7 +842,7 @@ impl Renderer {
                 &self.materials,
                 &self.shadow_data,
             ],
-            [self.counters.buffer(), &self.targets.pixel_counts],
+            self.counters.buffer(),
             (&self.textures, &self.shadow_atlas),
         );
         self.shadow_atlas
@@ -870,7 +869,8 @@ impl Renderer {
         let inputs = FrameInputs {
             device,
             queue,
-            scene_bind_group: &self.scene_bind_group,
+            scene_bind_group: &self.scene_bind_group[0],
+            scene_culling_bind_group: &self.scene_bind_group[1],
             vertices: &self.vertices.buffer,
             indices: &self.indices.buffer,
             opaque: &up.opaque,
@@ -887,7 +887,7 @@ impl Renderer {
                 .map(|r| r as &dyn crate::frame::ReusedShadowMaps),
         };
         let mut enc = FrameEncoder::new(device, queue, &mut self.timer);
-        clear_frame_counters(&self.counters, &self.targets, enc.parts().0);
+        self.counters.clear(enc.parts().0);
         // Shadow maps all in flight before shading; a re-using pipeline renders each light's
         // itself, and the atlas after it for the transparent pass's forward shading.
         let atlas_at = |before: bool| {
@@ -908,8 +908,11 @@ impl Renderer {
                 .encode_all(encoder, timer, &inputs, &m.atlas);
         }
         if analysis && inputs.has_transparency() {
-            self.readbacks
-                .encode_opaque_counts(enc.parts().0, &self.targets);
+            self.readbacks.encode_opaque_counts(
+                enc.parts().0,
+                &self.targets,
+                self.counters.buffer(),
+            );
         }
         let transparent = (self
             .transparent
@@ -922,7 +925,8 @@ impl Renderer {
                 .encode(device, encoder, timer, &self.targets.hdr, &self.targets.ldr);
         }
         if analysis {
-            self.readbacks.encode(device, encoder, &self.targets);
+            self.readbacks
+                .encode(device, encoder, &self.targets, self.counters.buffer());
         }
         self.serial += 1;
         let tag = FrameTag {

@@ -294,9 +294,8 @@ fn a_loop_cut_short_is_counted() {
     );
     let counters = buffer(COUNTER_BYTES as usize, wgpu::BufferUsages::STORAGE);
     let bounds = buffer(16, wgpu::BufferUsages::STORAGE);
-    let pixel_counts = buffer(16, wgpu::BufferUsages::STORAGE);
     let textures = lightgrid::passes::base_textures::BaseTextures::new(device, &ctx.queue, &[]);
-    // The shadow bindings (8-10), unread here.
+    // The shadow bindings (7-9), unread here.
     let shadow_data = buffer(32, wgpu::BufferUsages::STORAGE);
     let atlas = device
         .create_texture(&wgpu::TextureDescriptor {
@@ -328,7 +327,6 @@ fn a_loop_cut_short_is_counted() {
             materials.as_entire_binding(),
             counters.as_entire_binding(),
             bounds.as_entire_binding(),
-            pixel_counts.as_entire_binding(),
             wgpu::BindingResource::TextureView(&textures.view),
             wgpu::BindingResource::Sampler(&textures.sampler),
             shadow_data.as_entire_binding(),

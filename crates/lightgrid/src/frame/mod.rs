@@ -31,6 +31,8 @@ pub(crate) struct FrameInputs<'a> {
     pub device: &'a wgpu::Device,
     pub queue: &'a wgpu::Queue,
     pub scene_bind_group: &'a wgpu::BindGroup,
+    /// Group 0 for `PipelineContext::scene_culling_layout`.
+    pub scene_culling_bind_group: &'a wgpu::BindGroup,
     pub vertices: &'a wgpu::Buffer,
     pub indices: &'a wgpu::Buffer,
     /// Runs of the opaque geometry's indices, one material shader each.

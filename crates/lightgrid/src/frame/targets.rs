@@ -155,9 +155,6 @@ pub(crate) struct Targets {
     pub counts: wgpu::TextureView,
     pub ldr_texture: wgpu::Texture,
     pub ldr: wgpu::TextureView,
-    /// Per pixel, the lighting computations of every pass (`array<atomic<u32>>`, group 0
-    /// binding 5), cleared every frame; used instead of `counts` when `samples` > 1.
-    pub pixel_counts: wgpu::Buffer,
 }
 
 impl Targets {
@@ -205,23 +202,10 @@ impl Targets {
             LDR_FORMAT,
             U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST | U::TEXTURE_BINDING,
         );
-        let pixel_counts = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("pixel lighting counts"),
-            size: if samples > 1 {
-                u64::from(width) * u64::from(height) * 4
-            } else {
-                16
-            },
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         Targets {
             width,
             height,
             samples,
-            pixel_counts,
             hdr: hdr.create_view(&Default::default()),
             depth: depth_texture.create_view(&Default::default()),
             depth_texture,

@@ -113,12 +113,15 @@ pub(crate) struct FrameCounters {
 }
 
 impl FrameCounters {
-    /// Counters plus room for `max_passes` passes' timestamps per frame.
-    pub fn new(device: &wgpu::Device, max_passes: u32) -> Self {
+    /// Counters plus room for `max_passes` passes' timestamps per frame, and after the
+    /// counters `pixels` per-pixel lighting counts (MSAA frames: `count_pixel` in
+    /// `scene_bindings.wgsl`; one buffer keeps group 0 within WebGPU's 8 storage buffers per
+    /// stage).
+    pub fn new(device: &wgpu::Device, max_passes: u32, pixels: u64) -> Self {
         FrameCounters {
             buffer: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame counters"),
-                size: COUNTER_BYTES,
+                size: COUNTER_BYTES + pixels * 4,
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::COPY_SRC
                     | wgpu::BufferUsages::COPY_DST,
@@ -135,7 +138,7 @@ impl FrameCounters {
         &self.buffer
     }
 
-    /// Record the clear that starts a frame.
+    /// Record the clear that starts a frame (the counters and the pixel counts).
     pub fn clear(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.clear_buffer(&self.buffer, 0, None);
     }

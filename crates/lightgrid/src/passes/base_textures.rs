@@ -16,7 +16,7 @@ pub(crate) const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 
 /// The scene's base-colour texture array and its samplers (see the module docs).
 pub struct BaseTextures {
-    /// `D2Array` view: one layer per texture, full mip chain (group 0, binding 6).
+    /// `D2Array` view: one layer per texture, full mip chain (group 0, binding 5).
     pub view: wgpu::TextureView,
     /// Repeating trilinear sampler (group 0, binding 7).
     pub sampler: wgpu::Sampler,
@@ -141,21 +141,21 @@ fn sampler_descriptor() -> wgpu::SamplerDescriptor<'static> {
     }
 }
 
-/// The layout entry of binding 11, the nearest sampler, fragment stage.
+/// The layout entry of binding 10, the nearest sampler, fragment stage.
 pub(crate) fn nearest_layout_entry() -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
-        binding: 11,
+        binding: 10,
         visibility: wgpu::ShaderStages::FRAGMENT,
         ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
         count: None,
     }
 }
 
-/// The layout entries of bindings 6 (the array) and 7 (the sampler), fragment stage.
+/// The layout entries of bindings 5 (the array) and 6 (the sampler), fragment stage.
 pub(crate) fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
     [
         wgpu::BindGroupLayoutEntry {
-            binding: 6,
+            binding: 5,
             visibility: wgpu::ShaderStages::FRAGMENT,
             ty: wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Float { filterable: true },
@@ -165,7 +165,7 @@ pub(crate) fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
             count: None,
         },
         wgpu::BindGroupLayoutEntry {
-            binding: 7,
+            binding: 6,
             visibility: wgpu::ShaderStages::FRAGMENT,
             ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             count: None,

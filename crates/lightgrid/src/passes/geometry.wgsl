@@ -48,10 +48,10 @@ fn vs_main(v: VertexIn) -> VertexOut {
 
 // The scene's base-colour textures (group 0; `passes/base_textures.rs`): one array, a layer
 // per texture, sRGB-decoded when sampled, mipmapped, repeating.
-@group(0) @binding(6) var base_textures: texture_2d_array<f32>;
-@group(0) @binding(7) var base_sampler: sampler;
+@group(0) @binding(5) var base_textures: texture_2d_array<f32>;
+@group(0) @binding(6) var base_sampler: sampler;
 // Nearest-texel magnification, for textures whose glTF sampler asks for it.
-@group(0) @binding(11) var nearest_sampler: sampler;
+@group(0) @binding(10) var nearest_sampler: sampler;
 
 // Where a material's textures are read at a sample: both coordinate sets and their screen
 // derivatives (taken here, in uniform control flow, so textures can be read in branches

@@ -230,9 +230,29 @@ pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
     }
 }
 
+/// Which stages see group 0's light bounds (`scene_layout_with`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SceneBounds {
+    /// The light volumes' vertex stage only: every shading pass, whose grid (3 storage
+    /// buffers) then fits WebGPU's default 8 per stage beside group 0's 4 (5 with MSAA's
+    /// sample outputs in compute).
+    Vertex,
+    /// Also compute: the single-kernel tiled deferred pass, which culls in the kernel.
+    Compute,
+}
+
 /// Layout of group 0 (`shading/scene_bindings.wgsl`): frame uniforms, lights, materials,
-/// and (`passes/geometry.wgsl`) the base-colour textures.
+/// and (`passes/geometry.wgsl`) the base-colour textures; the light bounds visible to the
+/// vertex stage only (every pipeline's passes but the single-kernel tiled deferred one's).
 pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    scene_layout_with(device, SceneBounds::Vertex)
+}
+
+/// [`scene_layout`] with the light bounds visible to `bounds`' stages.
+pub(crate) fn scene_layout_with(
+    device: &wgpu::Device,
+    bounds: SceneBounds,
+) -> wgpu::BindGroupLayout {
     let storage = |binding, size: usize| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
@@ -259,15 +279,21 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             storage(1, std::mem::size_of::<GpuLight>()),
             storage(2, std::mem::size_of::<GpuMaterial>()),
             // Per light its bounding sphere [centre, radius]: placing the light volumes
-            // (vertex) and culling in the single-kernel tiled deferred pass (compute). Not
-            // visible to fragment stages, which keeps forward shading with a grid within
-            // WebGPU's 8 storage buffers per stage (the grid adds 3).
+            // (vertex) and, with `SceneBounds::Compute`, culling in the single-kernel tiled
+            // deferred pass. Not visible to fragment stages, nor to the other compute passes
+            // (each a storage buffer fewer per stage: see `SceneBounds`).
             wgpu::BindGroupLayoutEntry {
-                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
+                visibility: match bounds {
+                    SceneBounds::Vertex => wgpu::ShaderStages::VERTEX,
+                    SceneBounds::Compute => {
+                        wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE
+                    }
+                },
                 ..storage(4, 16)
             },
-            // The frame counters (`gpu/counters.rs`): written by fragment and compute stages
-            // (a vertex stage may not write storage).
+            // The frame counters (`gpu/counters.rs`), with MSAA the per-pixel lighting counts
+            // after them: written by fragment and compute stages (a vertex stage may not
+            // write storage).
             wgpu::BindGroupLayoutEntry {
                 binding: 3,
                 visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
@@ -278,26 +304,15 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 },
                 count: None,
             },
-            // Per-pixel lighting counts with MSAA (`Targets::pixel_counts`).
-            wgpu::BindGroupLayoutEntry {
-                binding: 5,
-                visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: NonZeroU64::new(4),
-                },
-                count: None,
-            },
             // The base-colour texture array and its sampler (`base_textures.rs`).
             base_textures::layout_entries()[0],
             base_textures::layout_entries()[1],
             // The shadow rays' hierarchies and casters (`shading/shadows.wgsl`): a header of
             // two vec4s at least.
-            storage(8, 32),
+            storage(7, 32),
             // The shadow atlas and its comparison sampler (`shadow_atlas.rs`).
             wgpu::BindGroupLayoutEntry {
-                binding: 9,
+                binding: 8,
                 visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Depth,
@@ -307,7 +322,7 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 count: None,
             },
             wgpu::BindGroupLayoutEntry {
-                binding: 10,
+                binding: 9,
                 visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                 count: None,

@@ -120,7 +120,17 @@ impl BufferReadback {
 
     /// Record the copy of `source`'s first bytes.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, source: &wgpu::Buffer) {
-        encoder.copy_buffer_to_buffer(source, 0, &self.staging, 0, self.bytes);
+        self.encode_from(encoder, source, 0);
+    }
+
+    /// Record the copy of `source`'s bytes from `offset` on.
+    pub fn encode_from(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::Buffer,
+        offset: u64,
+    ) {
+        encoder.copy_buffer_to_buffer(source, offset, &self.staging, 0, self.bytes);
     }
 
     /// The copied words (waits for the GPU).

@@ -34,6 +34,9 @@ pub struct PipelineContext<'a> {
     pub queue: &'a wgpu::Queue,
     /// Group 0 layout (`shading/scene_bindings.wgsl`), shared by all pipelines.
     pub scene_layout: &'a wgpu::BindGroupLayout,
+    /// The same with the light bounds visible to compute (the single-kernel tiled deferred
+    /// pass, which culls in its kernel; `passes::SceneBounds`).
+    pub(crate) scene_culling_layout: &'a wgpu::BindGroupLayout,
     /// The frame's size and tiles in pixels (`--tile`), as a one-slice grid; a clustered grid
     /// adds its view-depth slices each frame.
     pub dims: GridDims,

@@ -467,7 +467,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Result<Box<dyn Technique>>
         }],
     });
     let layouts = [
-        Some(ctx.scene_layout),
+        Some(ctx.scene_culling_layout),
         Some(&params_layout),
         Some(&gbuffer.read_layout),
         Some(&outputs_layout),
@@ -529,6 +529,11 @@ impl Technique for TiledDeferred {
             Outputs::Targets(_) => None,
         };
         let shading = resolving.unwrap_or(&self.shading);
+        // The single kernel culls in the kernel: its group 0 shows it the light bounds.
+        let scene = match self.variant {
+            Variant::Multi { .. } => f.scene_bind_group,
+            Variant::Single { .. } => f.scene_culling_bind_group,
+        };
         let (group1, label, groups) = match &mut self.variant {
             Variant::Multi { builder, label } => {
                 builder.encode(f, enc)?;
@@ -557,7 +562,7 @@ impl Technique for TiledDeferred {
         let (encoder, timer) = enc.parts();
         let mut pass = timer.begin_compute(encoder, label);
         pass.set_pipeline(shading);
-        pass.set_bind_group(0, f.scene_bind_group, &[]);
+        pass.set_bind_group(0, scene, &[]);
         pass.set_bind_group(1, group1, &[]);
         pass.set_bind_group(2, &read_group, &[]);
         pass.set_bind_group(3, &outputs, &[]);

@@ -8,21 +8,21 @@
 @group(0) @binding(4) var<storage, read> light_bounds: array<vec4<f32>>;
 // The frame counters (slots COUNTER_* from consts.rs), cleared at the start of every frame and
 // read back after it: truncated loops, index-list and pair sizes, indirect dispatch arguments.
-@group(0) @binding(3) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;
-// With MSAA, per pixel the lighting computations of every pass (row-major), cleared every
-// frame: a fragment shader runs once per pixel and primitive, so a per-sample count target
-// cannot count it (`frame/targets.rs`).
-@group(0) @binding(5) var<storage, read_write> pixel_counts: array<atomic<u32>>;
+// With MSAA, per pixel the lighting computations of every pass follow them (row-major from
+// slot COUNTER_SLOTS): a fragment shader runs once per pixel and primitive, so a per-sample
+// count target cannot count it. One buffer for both keeps group 0 within WebGPU's default
+// 8 storage buffers per stage (`gpu/counters.rs`).
+@group(0) @binding(3) var<storage, read_write> frame_counters: array<atomic<u32>>;
 
 // Set for pipelines drawing into multisampled targets (MSAA): the count goes to the pixel's
-// entry of `pixel_counts` instead of the count target (which such a pipeline does not have),
+// count after the frame counters instead of the count target (which such a pipeline does not have),
 // and a grid fragment checks that its cell holds it (`light_grid_shade_fragment`).
 override MULTISAMPLED: bool = false;
 
 // Add `count` lighting computations to pixel `p`'s count (MSAA frames).
 fn count_pixel(p: vec2<u32>, count: u32) {
     if (count > 0u) {
-        atomicAdd(&pixel_counts[p.y * u32(frame.viewport.x) + p.x], count);
+        atomicAdd(&frame_counters[COUNTER_SLOTS + p.y * u32(frame.viewport.x) + p.x], count);
     }
 }
 

@@ -11,7 +11,7 @@
 //         0: two children, the left one following the node)]
 //   triangle: [v0], [v1 - v0], [v2 - v0]
 //   casters: one bit per light, 128 lights per vec4
-@group(0) @binding(8) var<storage, read> shadow_data: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> shadow_data: array<vec4<f32>>;
 
 // Does light `index` cast shadows this frame (`--shadow-lights`)?
 fn shadow_casts(index: u32) -> bool {
@@ -122,8 +122,8 @@ fn shadow_blocked(index: u32, p: vec3<f32>, n: vec3<f32>, light_pos: vec3<f32>) 
 //   matrices: per face its view-projection's columns (camera-relative -> clip, depth near / w)
 // Face f of a light lies in tile f of the atlas (all in flight), or in tile (f - first face)
 // of the one re-used cube, 3 tiles a row (SHADOWS_MAPS_REUSED: the light-volume pipelines).
-@group(0) @binding(9) var shadow_atlas: texture_depth_2d;
-@group(0) @binding(10) var shadow_sampler: sampler_comparison;
+@group(0) @binding(8) var shadow_atlas: texture_depth_2d;
+@group(0) @binding(9) var shadow_sampler: sampler_comparison;
 
 // A face's view-projection.
 fn shadow_tile_matrix(face: u32) -> mat4x4<f32> {

@@ -255,8 +255,13 @@ pub(crate) struct CellBoundsPass {
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     bounds: wgpu::Buffer,
-    occupied: wgpu::Buffer,
-    occupancy: wgpu::Buffer,
+    /// The cell lists (`cell_bounds.wgsl`): a 4-word header (the occupied cells' number and
+    /// their dispatch arguments), the occupied cells, and as the second half of the rest the
+    /// assignment kernels' spill list (`assign_bindings.wgsl`).
+    lists: wgpu::Buffer,
+    /// The header's dispatch arguments, copied out after the kernel (the lists are bound
+    /// read-write where they feed an indirect dispatch).
+    dispatch_args: wgpu::Buffer,
     /// Each cell's 2.5D depth mask and tight box (`cell_box.rs`: `CellCull`, 48 bytes; neither
     /// without `--depth-mask on` / `--cell-box on`).
     culls: wgpu::Buffer,
@@ -293,9 +298,8 @@ impl CellBoundsPass {
                 crate::gpu::buffer_entry(1, crate::gpu::UNIFORM),
                 crate::gpu::buffer_entry(2, crate::gpu::STORAGE_RW),
                 crate::gpu::buffer_entry(3, crate::gpu::STORAGE_RW),
-                crate::gpu::buffer_entry(4, crate::gpu::STORAGE_RW),
-                crate::gpu::buffer_entry(5, crate::gpu::STORAGE_READ),
-                crate::gpu::buffer_entry(6, crate::gpu::STORAGE_RW),
+                crate::gpu::buffer_entry(4, crate::gpu::STORAGE_READ),
+                crate::gpu::buffer_entry(5, crate::gpu::STORAGE_RW),
             ],
         });
         let s = key.shader();
@@ -319,16 +323,11 @@ impl CellBoundsPass {
             layout,
             params,
             bounds: storage_buffer(device, "cell bounds", 1 << 14),
-            occupied: storage_buffer(device, "occupied cells", 1 << 13),
-            occupancy: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("occupancy"),
-                size: 16,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::INDIRECT
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
+            lists: storage_buffer(device, "cell lists", 1 << 13),
+            dispatch_args: crate::culling::strategies::gpu_assign::indirect_args_buffer(
+                device,
+                "occupied cells dispatch arguments",
+            ),
             culls: no_culls(device),
             culled: key.culled(),
             cells: 0,
@@ -376,11 +375,12 @@ impl CellBoundsPass {
                 (self.cells * CULL_BYTES) as u64,
             );
         }
+        // The header, then room for every cell twice (occupied, spilled).
         grow_storage(
             device,
-            &mut self.occupied,
-            "occupied cells",
-            (self.cells * 4) as u64,
+            &mut self.lists,
+            "cell lists",
+            (16 + self.cells * 8) as u64,
         );
     }
 
@@ -411,13 +411,12 @@ impl CellBoundsPass {
                 wgpu::BindingResource::TextureView(depth),
                 self.params.as_entire_binding(),
                 self.bounds.as_entire_binding(),
-                self.occupied.as_entire_binding(),
-                self.occupancy.as_entire_binding(),
+                self.lists.as_entire_binding(),
                 fragment_bounds.as_entire_binding(),
                 self.culls.as_entire_binding(),
             ],
         );
-        encoder.clear_buffer(&self.occupancy, 0, None);
+        encoder.clear_buffer(&self.lists, 0, Some(16));
         let mut pass = timer.begin_compute(encoder, crate::consts::pass_labels::CELL_BOUNDS);
         pass.set_pipeline(&self.pipeline.1);
         pass.set_bind_group(0, cull, &[]);
@@ -425,6 +424,8 @@ impl CellBoundsPass {
         pass.dispatch_workgroups(dims.tiles_x, dims.tiles_y, 1);
         pass.set_pipeline(&self.args);
         pass.dispatch_workgroups(1, 1, 1);
+        drop(pass);
+        encoder.copy_buffer_to_buffer(&self.lists, 4, &self.dispatch_args, 0, 12);
     }
 
     /// The layout of the fragment-bounds group (MSAA only).
@@ -448,11 +449,11 @@ impl CellBoundsPass {
             let culls = vec![NO_CULL; self.cells];
             queue.write_buffer(&self.culls, 0, bytemuck::cast_slice(&culls));
         }
-        let list: Vec<u32> = (0..self.cells as u32).collect();
-        queue.write_buffer(&self.occupied, 0, bytemuck::cast_slice(&list));
         let n = self.cells as u32;
         let (x, y) = crate::gpu::groups_1d(n);
-        queue.write_buffer(&self.occupancy, 0, bytemuck::cast_slice(&[n, x, y, 1]));
+        let list: Vec<u32> = [n, x, y, 1].into_iter().chain(0..n).collect();
+        queue.write_buffer(&self.lists, 0, bytemuck::cast_slice(&list));
+        queue.write_buffer(&self.dispatch_args, 0, bytemuck::cast_slice(&[x, y, 1]));
     }
 
     /// The grid's parameters the kernel reads (a uniform buffer).
@@ -475,15 +476,15 @@ impl CellBoundsPass {
         &self.culls
     }
 
-    /// The occupied cells (`array<u32>`, in no particular order).
-    pub fn occupied_buffer(&self) -> &wgpu::Buffer {
-        &self.occupied
+    /// The cell lists (`array<u32>`): the occupied-cell count, 3 words, the occupied cells
+    /// (in no particular order), and the spill list's room.
+    pub fn lists_buffer(&self) -> &wgpu::Buffer {
+        &self.lists
     }
 
-    /// `[count, x, y, z]`: the occupied-cell count and, from byte 4, indirect dispatch
-    /// arguments of one workgroup per occupied cell.
-    pub fn occupancy_buffer(&self) -> &wgpu::Buffer {
-        &self.occupancy
+    /// Indirect dispatch arguments of one workgroup per occupied cell.
+    pub fn dispatch_args(&self) -> &wgpu::Buffer {
+        &self.dispatch_args
     }
 
     /// The bounds of the last recorded frame (submits nothing itself: call after the frame's

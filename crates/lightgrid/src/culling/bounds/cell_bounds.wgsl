@@ -5,28 +5,30 @@
 // ASSIGN_DEPTH_SLACK of a slice boundary counts for both slices, as the shading pass may place
 // it in either. Positive floats order like their bit patterns, so u32 atomics do the
 // reduction. CPU twin: `cell_bounds_cpu` (cell_bounds.rs).
-// Cells with samples are also appended to `occupied_cells` (in no particular order), and
-// args_main turns their number into indirect dispatch arguments, so the per-cell assignment
-// kernels run one workgroup per occupied cell instead of one per cell.
+// Cells with samples are also appended to the occupied-cell list of `cell_lists` (in no
+// particular order), and args_main turns their number into indirect dispatch arguments, so
+// the per-cell assignment kernels run one workgroup per occupied cell instead of one per cell.
 
 // With MSAA every sample of every pixel (tiled-forward-shading §4.6: the bounds cover every
 // sample a fragment may shade).
 @group(1) @binding(0) var depth_tex: DepthTexture;
 @group(1) @binding(1) var<uniform> light_grid: LightGridParams;
 @group(1) @binding(2) var<storage, read_write> bounds_out: array<vec2<f32>>;
-@group(1) @binding(3) var<storage, read_write> occupied_cells: array<u32>;
-// [0]: occupied cells; [1..4]: workgroup counts for dispatch_workgroups_indirect.
-@group(1) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>, 4>;
+// The cell lists (`CellBoundsPass::lists_buffer`): [0] the occupied cells' number, [1..4] the
+// workgroup counts for dispatch_workgroups_indirect, from [4] the occupied cells; the second
+// half of what follows is the assignment kernels' spill list (assign_bindings.wgsl). One
+// buffer keeps the assignment kernels within WebGPU's 8 storage buffers per stage.
+@group(1) @binding(3) var<storage, read_write> cell_lists: array<atomic<u32>>;
 // With MSAA, the bounds of the fragments each cell's shading will look up
 // (`fragment_bounds.wgsl`: (0xffffffff - min bits, max bits), zero = none); unused without.
-@group(1) @binding(5) var<storage, read> fragment_bounds: array<u32>;
+@group(1) @binding(4) var<storage, read> fragment_bounds: array<u32>;
 // Each cell's culling record (cell_box.wgsl): with DEPTH_MASK (`--depth-mask on`) its 2.5D
 // depth mask (depth_mask.wgsl), the bins of its bounds that hold samples, found by a second
 // sweep over the tile once the bounds are known; with CELL_BOX (`--cell-box on`) the
 // view-space box of its samples' pixel footprints, reduced in the first sweep; for the
 // transparent layer of separate lists neither. Without either (CELL_CULLS false) the buffer
 // holds one record of neither, which every cell reads, and the kernel writes nothing.
-@group(1) @binding(6) var<storage, read_write> cell_culls: array<CellCull>;
+@group(1) @binding(5) var<storage, read_write> cell_culls: array<CellCull>;
 
 #if CELL_BOX
 // Per slice of the tile: the view-space x and y extent of its samples' pixel footprints, as
@@ -380,7 +382,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
 fn write_bounds(cell: u32, b: vec2<f32>) {
     bounds_out[cell] = b;
     if (b.x <= b.y) {
-        occupied_cells[atomicAdd(&occupancy[0], 1u)] = cell;
+        atomicStore(&cell_lists[4u + atomicAdd(&cell_lists[0], 1u)], cell);
     }
 }
 
@@ -446,9 +448,9 @@ fn bounds_union(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
 // One invocation: the occupied-cell count as (x, y, 1) workgroups, x at most 65535.
 @compute @workgroup_size(1)
 fn args_main() {
-    let n = atomicLoad(&occupancy[0]);
+    let n = atomicLoad(&cell_lists[0]);
     let x = min(max(n, 1u), 65535u);
-    atomicStore(&occupancy[1], x);
-    atomicStore(&occupancy[2], (n + x - 1u) / x);
-    atomicStore(&occupancy[3], 1u);
+    atomicStore(&cell_lists[1], x);
+    atomicStore(&cell_lists[2], (n + x - 1u) / x);
+    atomicStore(&cell_lists[3], 1u);
 }

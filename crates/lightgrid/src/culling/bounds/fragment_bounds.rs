@@ -63,7 +63,7 @@ impl FragmentBounds {
         &self.layout
     }
 
-    /// The buffer the cell-bounds kernel reads (binding 5).
+    /// The buffer the cell-bounds kernel reads (binding 4).
     pub(crate) fn buffer(&self) -> &wgpu::Buffer {
         &self.buffer
     }

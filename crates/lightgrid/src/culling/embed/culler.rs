@@ -572,7 +572,7 @@ impl Caller {
         });
         let lights = storage_buffer(device, "culler lights", 48 * 64);
         let bounds = storage_buffer(device, "culler light bounds", 16 * 64);
-        let counters = FrameCounters::new(device, 0);
+        let counters = FrameCounters::new(device, 0, 0);
         let group = bind_cull_group(
             device,
             &layout,

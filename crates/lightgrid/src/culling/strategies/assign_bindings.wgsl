@@ -14,14 +14,20 @@
 @group(1) @binding(1) var<storage, read> cell_bounds: array<vec2<f32>>;
 @group(1) @binding(2) var<storage, read_write> cells: array<vec2<u32>>;   // (offset, count)
 @group(1) @binding(3) var<storage, read_write> indices: array<u32>;
-@group(1) @binding(4) var<storage, read_write> spill_cells: array<u32>;
-// The cells holding samples and their number (cell_bounds.wgsl); per-cell kernels are
-// dispatched indirectly, one workgroup per entry.
-@group(1) @binding(5) var<storage, read> occupied_cells: array<u32>;
-@group(1) @binding(6) var<storage, read> occupancy: array<u32, 4>;
+// The cell lists (cell_bounds.wgsl): [0] the number of cells holding samples, from [4]
+// those cells (per-cell kernels are dispatched indirectly, one workgroup per entry), and
+// from `spill_base()` the cells whose lists overflowed the workgroup list (the spill pass's).
+// One buffer keeps gather within WebGPU's 8 storage buffers per stage.
+@group(1) @binding(4) var<storage, read_write> cell_lists: array<u32>;
 // Each cell's 2.5D depth mask and tight box (cell_box.wgsl; neither unless `--depth-mask on`
 // / `--cell-box on`).
-@group(1) @binding(7) var<storage, read> cell_culls: array<CellCull>;
+@group(1) @binding(5) var<storage, read> cell_culls: array<CellCull>;
+
+// Where the spill list starts: the second half of `cell_lists` after its 4-word header (the
+// buffer holds at least 4 + 2 x the cell count words: `CellBoundsPass::ensure`).
+fn spill_base() -> u32 {
+    return 4u + (arrayLength(&cell_lists) - 4u) / 2u;
+}
 
 // Cell c's culling record: a grid without masks or boxes binds one record of neither, which
 // every cell reads.
@@ -38,12 +44,12 @@ fn cell_of_group(wg: vec3<u32>, nwg: vec3<u32>, spill: bool) -> u32 {
         if (i >= atomicLoad(&frame_counters[COUNTER_SPILLS])) {
             return NO_CELL;
         }
-        return spill_cells[i];
+        return cell_lists[spill_base() + i];
     }
-    if (i >= occupancy[0]) {
+    if (i >= cell_lists[0]) {
         return NO_CELL;
     }
-    return occupied_cells[i];
+    return cell_lists[4u + i];
 }
 
 // The cell's frustum: its tile's side planes and its samples' view-distance bounds (an empty
@@ -106,7 +112,7 @@ fn end_cell(c: u32, li: u32, spill: bool) {
             cell_base = base;
             cells[c] = vec2<u32>(base, n);
             if (n > CELL_LIST_CAPACITY) {
-                spill_cells[atomicAdd(&frame_counters[COUNTER_SPILLS], 1u)] = c;
+                cell_lists[spill_base() + atomicAdd(&frame_counters[COUNTER_SPILLS], 1u)] = c;
             }
         }
     }

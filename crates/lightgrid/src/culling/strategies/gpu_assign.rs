@@ -16,14 +16,13 @@
 
 use crate::consts::COUNTER_SPILL_ARGS;
 use crate::culling::bounds::cell_bounds::CellBoundsPass;
-use crate::culling::grid::{GridBuffers, GridDims};
+use crate::culling::grid::GridBuffers;
 use crate::culling::strategies::scan::ScanPass;
 use crate::culling::strategies::{AssignFrame, ListCapacity, StrategyContext};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
-    bind_resources, buffer_layout, grow_storage, storage_buffer, CounterValues, PassTimer,
-    STORAGE_READ, STORAGE_RW, UNIFORM,
+    bind_resources, buffer_layout, CounterValues, PassTimer, STORAGE_READ, STORAGE_RW, UNIFORM,
 };
 use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
@@ -51,14 +50,14 @@ pub(crate) fn bvh_shader() -> ComposedShader {
     cell_shader("bvh traversal", include_str!("bvh.wgsl"))
 }
 
-/// Group 1 layout (`assign_bindings.wgsl`), the spill list and the spill pass's arguments.
+/// Group 1 layout (`assign_bindings.wgsl`) and the spill pass's arguments (the spill list
+/// is the second half of the cell lists: `CellBoundsPass::lists_buffer`).
 pub struct AssignCommon {
     pub layout: wgpu::BindGroupLayout,
     pub scan: ScanPass,
     /// The spill pass's arguments, copied out of the frame counters (a buffer bound for
     /// storage cannot also feed an indirect dispatch).
     spill_args: wgpu::Buffer,
-    spill_cells: wgpu::Buffer,
 }
 
 impl AssignCommon {
@@ -73,28 +72,22 @@ impl AssignCommon {
                 STORAGE_RW,
                 STORAGE_RW,
                 STORAGE_READ,
-                STORAGE_READ,
-                STORAGE_READ,
             ],
         );
         AssignCommon {
             layout,
             scan: ScanPass::new(device),
             spill_args: indirect_args_buffer(device, "spill pass arguments"),
-            spill_cells: storage_buffer(device, "spill cells", 1 << 12),
         }
     }
 
-    /// Group 1 for a frame: grow the spill list, bind the grid and the cell bounds and masks.
+    /// Group 1 for a frame: bind the grid, the cell bounds and lists, and the masks.
     pub fn bind(
-        &mut self,
+        &self,
         device: &wgpu::Device,
         grid: &GridBuffers,
         bounds: &CellBoundsPass,
-        dims: &GridDims,
     ) -> wgpu::BindGroup {
-        let bytes = (dims.cell_count() * 4) as u64;
-        grow_storage(device, &mut self.spill_cells, "spill cells", bytes);
         bind_resources(
             device,
             "light assignment",
@@ -104,9 +97,7 @@ impl AssignCommon {
                 bounds.buffer().as_entire_binding(),
                 grid.cells_buffer().as_entire_binding(),
                 grid.indices_buffer().as_entire_binding(),
-                self.spill_cells.as_entire_binding(),
-                bounds.occupied_buffer().as_entire_binding(),
-                bounds.occupancy_buffer().as_entire_binding(),
+                bounds.lists_buffer().as_entire_binding(),
                 bounds.cull_buffer().as_entire_binding(),
             ],
         )
@@ -195,7 +186,7 @@ impl CellKernels {
             dims.cell_count(),
             self.capacity.entries as usize,
         );
-        let group = self.common.bind(device, grid, bounds, dims);
+        let group = self.common.bind(device, grid, bounds);
         let (encoder, timer) = enc.parts();
         // Cells without samples are never visited: their entries stay (0, 0).
         encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
@@ -213,7 +204,7 @@ impl CellKernels {
         };
         pass(encoder, timer, &format!("assign: {name}"), &|p| {
             p.set_pipeline(&self.main);
-            p.dispatch_workgroups_indirect(bounds.occupancy_buffer(), 4);
+            p.dispatch_workgroups_indirect(bounds.dispatch_args(), 0);
             p.set_pipeline(&self.spill_args);
             p.dispatch_workgroups(1, 1, 1);
         });

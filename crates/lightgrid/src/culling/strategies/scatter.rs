@@ -161,7 +161,7 @@ impl AssignStrategy for ScatterStrategy {
         // The whole pair buffer is sorted: its bound length is what the kernels see.
         let slots = self.sort.keys.size() / 4;
         grid.ensure(device, f.queue, dims, dims.cell_count(), slots as usize);
-        let common = self.common.bind(device, grid, bounds, dims);
+        let common = self.common.bind(device, grid, bounds);
         let own = self.bind(device);
         let groups = [f.bind_group, &common, &own];
         let (encoder, timer) = enc.parts();
