@@ -101,7 +101,8 @@ pub(crate) const COUNTER_PAIRS_OUT_OF_ROOM: u32 = 6;
 pub(crate) const COUNTER_INVALID_LIGHTS: u32 = 7;
 /// Three slots: the spill pass's indirect dispatch arguments (x, y, z).
 pub(crate) const COUNTER_SPILL_ARGS: u32 = 8;
-/// Three slots: the scatter emit pass's indirect dispatch arguments (x, y, z).
+/// Three slots: the scatter emit pass's indirect dispatch arguments (x, y, z); the fourth
+/// holds the number of items they cover (`scatter.wgsl`'s `items_args_main`).
 pub(crate) const COUNTER_ITEM_ARGS: u32 = 12;
 /// Pixels the edge-aware MSAA shading kernels shaded per sample (samples differing in depth,
 /// normal or material: `EDGE_*`).

@@ -53,8 +53,9 @@ impl<'a> CullFrame<'a> {
 }
 
 /// Group 0 of every culling kernel: `shading/scene_bindings.wgsl`'s bindings 0 (the frame
-/// uniforms), 1 (lights), 3 (frame counters) and 4 (bounding spheres); the materials, MSAA
-/// pixel counts and textures of the renderer's group 0 are not part of it.
+/// uniforms) and 3 (frame counters), and the light records at 5
+/// (`culling/embed/light_records.wgsl`): two storage buffers. The lights, materials, bounds
+/// and textures of the renderer's group 0 are not part of it.
 pub fn cull_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     use crate::gpu::{STORAGE_READ, STORAGE_RW, UNIFORM};
     let entry = |binding, ty| crate::gpu::buffer_entry(binding, ty);
@@ -62,18 +63,17 @@ pub fn cull_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         label: Some("culling (group 0)"),
         entries: &[
             entry(0, UNIFORM),
-            entry(1, STORAGE_READ),
             entry(3, STORAGE_RW),
-            entry(4, STORAGE_READ),
+            entry(5, STORAGE_READ),
         ],
     })
 }
 
-/// A group 0 for [`cull_layout`] over `[uniforms, lights, counters, bounds]`.
+/// A group 0 for [`cull_layout`] over `[uniforms, counters, light records]`.
 pub fn bind_cull_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
-    [uniforms, lights, counters, bounds]: [&wgpu::Buffer; 4],
+    [uniforms, counters, records]: [&wgpu::Buffer; 3],
 ) -> wgpu::BindGroup {
     fn entry(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
         wgpu::BindGroupEntry {
@@ -84,12 +84,7 @@ pub fn bind_cull_group(
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("culling (group 0)"),
         layout,
-        entries: &[
-            entry(0, uniforms),
-            entry(1, lights),
-            entry(3, counters),
-            entry(4, bounds),
-        ],
+        entries: &[entry(0, uniforms), entry(3, counters), entry(5, records)],
     })
 }
 

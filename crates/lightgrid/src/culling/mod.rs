@@ -56,7 +56,7 @@ pub(crate) fn fragment_bounds_key(group: u32) -> embed::culler::CallerFragmentsK
 }
 
 pub(crate) use bounds::TILE_DEPTH_WGSL;
-pub(crate) use strategies::TILE_FRUSTUM_WGSL;
+pub(crate) use strategies::{LIGHT_CULL_SCENE_WGSL, TILE_FRUSTUM_WGSL};
 
 /// Every assignment shader, for the validation test: every value of the keyed stages.
 pub(crate) fn shaders() -> Vec<crate::shader::ComposedShader> {

@@ -94,9 +94,11 @@ impl ShaderKey for KernelKey {
                 src::LIGHT_GRID,
                 super::light_loop_wgsl(self.light_loop)
             ]),
-            Kernel::Single => {
-                parts.extend(parts![TILE_DEPTH_WGSL, crate::culling::TILE_FRUSTUM_WGSL])
-            }
+            Kernel::Single => parts.extend(parts![
+                TILE_DEPTH_WGSL,
+                crate::culling::LIGHT_CULL_SCENE_WGSL,
+                crate::culling::TILE_FRUSTUM_WGSL
+            ]),
         }
         if self.samples == 1 {
             parts.push(COMPUTE_OUTPUTS_WGSL);

@@ -12,6 +12,19 @@ struct Light {
     cos_outer: f32,
 }
 
+// What culling reads of a light: the sphere around everything it reaches (centre, radius)
+// and its reach (a spot's cone). LightCuller's kernels read one record per light
+// (`culling/embed/light_records.wgsl`, written by `cull_lights.wgsl`); the renderer's
+// single-kernel tiled deferred pass builds it from its lights and bounds
+// (`light_cull_scene.wgsl`).
+struct CullRecord {
+    sphere: vec4<f32>,
+    position: vec3<f32>,
+    range: f32,
+    direction: vec3<f32>,
+    cos_outer: f32,
+}
+
 struct Material {
     diffuse: vec3<f32>,
     alpha: f32,

@@ -1,7 +1,7 @@
 // LightCuller's first pass: a caller's lights (world space, in the caller's own struct as
-// `LightLayout` describes it; `CullLight`'s by default) into the camera-relative copy every
-// culling kernel reads (`Light`), and each light's
-// bounding sphere (`Light::bounding_sphere`'s formula, in f32 as the CPU computes it). A
+// `LightLayout` describes it; `CullLight`'s by default) into the camera-relative record every
+// culling kernel reads (`CullRecord`: the light's reach and its bounding sphere,
+// `Light::bounding_sphere`'s formula in f32 as the CPU computes it). A
 // light whose position, range or spot cone is not finite, or whose range is not positive, is
 // counted (COUNTER_INVALID_LIGHTS) and given a sphere no cell holds: the report says the
 // frame lacks it, never a silently wrong grid.
@@ -21,10 +21,9 @@ struct CallerLightLayout {
 }
 
 @group(0) @binding(1) var<storage, read> caller_lights: array<u32>;
-@group(0) @binding(2) var<storage, read_write> lights_out: array<Light>;
-@group(0) @binding(3) var<storage, read_write> bounds_out: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;
-@group(0) @binding(5) var<uniform> caller_layout: CallerLightLayout;
+@group(0) @binding(2) var<storage, read_write> records_out: array<CullRecord>;
+@group(0) @binding(3) var<storage, read_write> frame_counters: array<atomic<u32>, COUNTER_SLOTS>;
+@group(0) @binding(4) var<uniform> caller_layout: CallerLightLayout;
 
 fn caller_f32(word: u32) -> f32 {
     return bitcast<f32>(caller_lights[word]);
@@ -99,10 +98,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         l.position = (frame.inv_view * vec4<f32>(0.0, 0.0, 1e30, 0.0)).xyz;
         l.range = 0.0;
         l.cos_outer = POINT_LIGHT_COS;
-        lights_out[i] = l;
-        bounds_out[i] = vec4<f32>(l.position, 0.0);
+        records_out[i] = CullRecord(vec4<f32>(l.position, 0.0), l.position, l.range, l.direction, l.cos_outer);
         return;
     }
-    lights_out[i] = l;
-    bounds_out[i] = light_bounding_sphere(l);
+    records_out[i] = CullRecord(light_bounding_sphere(l), l.position, l.range, l.direction, l.cos_outer);
 }

@@ -497,15 +497,18 @@ pub struct LightCuller {
     caller: Caller,
 }
 
+/// Bytes of a `CullRecord` (`shading/types.wgsl`): sphere, position and range, direction
+/// and outer cone.
+const RECORD_BYTES: u64 = 48;
+
 /// What a [`LightCuller`] keeps besides the grid's stages.
 struct Caller {
     device: wgpu::Device,
     queue: wgpu::Queue,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
-    /// The camera-relative copy of the caller's lights and their bounding spheres.
-    lights: wgpu::Buffer,
-    bounds: wgpu::Buffer,
+    /// Per light of the caller's, its camera-relative `CullRecord` (`light_records.wgsl`).
+    records: wgpu::Buffer,
     counters: FrameCounters,
     group: wgpu::BindGroup,
     prep: wgpu::ComputePipeline,
@@ -570,14 +573,9 @@ impl Caller {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let lights = storage_buffer(device, "culler lights", 48 * 64);
-        let bounds = storage_buffer(device, "culler light bounds", 16 * 64);
+        let records = storage_buffer(device, "culler light records", RECORD_BYTES * 64);
         let counters = FrameCounters::new(device, 0, 0);
-        let group = bind_cull_group(
-            device,
-            &layout,
-            [&uniforms, &lights, counters.buffer(), &bounds],
-        );
+        let group = bind_cull_group(device, &layout, [&uniforms, counters.buffer(), &records]);
         let prep_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cull lights"),
             entries: &[
@@ -585,8 +583,7 @@ impl Caller {
                 buffer_entry(1, STORAGE_READ),
                 buffer_entry(2, STORAGE_RW),
                 buffer_entry(3, STORAGE_RW),
-                buffer_entry(4, STORAGE_RW),
-                buffer_entry(5, UNIFORM),
+                buffer_entry(4, UNIFORM),
             ],
         });
         let light_layout = LightLayout::CULL_LIGHT;
@@ -613,8 +610,7 @@ impl Caller {
             queue: queue.clone(),
             layout,
             uniforms,
-            lights,
-            bounds,
+            records,
             counters,
             group,
             prep,
@@ -638,28 +634,16 @@ impl Caller {
         uniforms: &FrameUniforms,
     ) {
         let n = inputs.light_count;
-        let grown_lights = grow_storage(
+        if grow_storage(
             &self.device,
-            &mut self.lights,
-            "culler lights",
-            u64::from(n.max(1)) * 48,
-        );
-        let grown_bounds = grow_storage(
-            &self.device,
-            &mut self.bounds,
-            "culler light bounds",
-            u64::from(n.max(1)) * 16,
-        );
-        if grown_lights || grown_bounds {
+            &mut self.records,
+            "culler light records",
+            u64::from(n.max(1)) * RECORD_BYTES,
+        ) {
             self.group = bind_cull_group(
                 &self.device,
                 &self.layout,
-                [
-                    &self.uniforms,
-                    &self.lights,
-                    self.counters.buffer(),
-                    &self.bounds,
-                ],
+                [&self.uniforms, self.counters.buffer(), &self.records],
             );
         }
         self.queue
@@ -670,10 +654,9 @@ impl Caller {
             entries: &[
                 entry(0, &self.uniforms),
                 entry(1, inputs.lights),
-                entry(2, &self.lights),
-                entry(3, &self.bounds),
-                entry(4, self.counters.buffer()),
-                entry(5, &self.light_layout_buffer),
+                entry(2, &self.records),
+                entry(3, self.counters.buffer()),
+                entry(4, &self.light_layout_buffer),
             ],
         });
         let (encoder, timer) = enc.parts();

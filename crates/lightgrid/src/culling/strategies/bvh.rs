@@ -234,20 +234,42 @@ pub fn traverse_bvh_cpu(
     LightGrid::from_lists(*dims, &lists)
 }
 
-/// The hierarchy's GPU buffers (group 2 of the traversal kernels).
+/// The hierarchy's GPU buffer (group 2 of the traversal kernels, `bvh.wgsl`): the order
+/// (the leaf slots' lights) padded to a multiple of 4 entries, then the nodes. One binding
+/// keeps the walk within WebGPU's default 8 storage buffers per stage.
 pub struct BvhBuffers {
     pub layout: wgpu::BindGroupLayout,
-    nodes: wgpu::Buffer,
-    order: wgpu::Buffer,
+    data: wgpu::Buffer,
+}
+
+/// Bytes the order of `lights` lights takes at the start of [`BvhBuffers`]' buffer.
+fn order_bytes(lights: usize) -> u64 {
+    lights.div_ceil(4) as u64 * 16
 }
 
 impl BvhBuffers {
     pub fn new(device: &wgpu::Device) -> Self {
         BvhBuffers {
-            layout: buffer_layout(device, "light bvh (group 2)", &[STORAGE_READ, STORAGE_READ]),
-            nodes: storage_buffer(device, "bvh nodes", 1 << 12),
-            order: storage_buffer(device, "bvh order", 1 << 12),
+            layout: buffer_layout(device, "light bvh (group 2)", &[STORAGE_READ]),
+            data: storage_buffer(device, "bvh", 1 << 12),
         }
+    }
+
+    /// Make room for `lights` lights' order and `nodes` nodes; returns where the nodes start.
+    fn fit(&mut self, device: &wgpu::Device, lights: usize, nodes: usize) -> u64 {
+        let at = order_bytes(lights);
+        let bytes = at + (nodes * std::mem::size_of::<BvhNode>()) as u64;
+        grow_storage(device, &mut self.data, "bvh", bytes);
+        at
+    }
+
+    fn bind(&self, device: &wgpu::Device) -> wgpu::BindGroup {
+        bind_resources(
+            device,
+            "light bvh",
+            &self.layout,
+            &[self.data.as_entire_binding()],
+        )
     }
 
     /// Upload a hierarchy and bind it.
@@ -257,23 +279,31 @@ impl BvhBuffers {
         queue: &wgpu::Queue,
         bvh: &LightBvh,
     ) -> wgpu::BindGroup {
-        let nodes: &[u8] = bytemuck::cast_slice(&bvh.nodes);
-        let order: &[u8] = bytemuck::cast_slice(&bvh.order);
-        grow_storage(device, &mut self.nodes, "bvh nodes", nodes.len() as u64);
-        grow_storage(device, &mut self.order, "bvh order", order.len() as u64);
-        if !nodes.is_empty() {
-            queue.write_buffer(&self.nodes, 0, nodes);
-            queue.write_buffer(&self.order, 0, order);
+        let at = self.fit(device, bvh.order.len(), bvh.nodes.len());
+        if !bvh.nodes.is_empty() {
+            queue.write_buffer(&self.data, 0, bytemuck::cast_slice(&bvh.order));
+            queue.write_buffer(&self.data, at, bytemuck::cast_slice(&bvh.nodes));
         }
-        bind_resources(
-            device,
-            "light bvh",
-            &self.layout,
-            &[
-                self.nodes.as_entire_binding(),
-                self.order.as_entire_binding(),
-            ],
-        )
+        self.bind(device)
+    }
+
+    /// Record the copies of a hierarchy built on the GPU (`nodes` nodes in `node_buffer`,
+    /// the order of `lights` lights in `order`) and bind it.
+    pub fn copy(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        lights: usize,
+        (node_buffer, nodes): (&wgpu::Buffer, usize),
+        order: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let at = self.fit(device, lights, nodes);
+        if nodes > 0 {
+            encoder.copy_buffer_to_buffer(order, 0, &self.data, 0, lights as u64 * 4);
+            let node_bytes = (nodes * std::mem::size_of::<BvhNode>()) as u64;
+            encoder.copy_buffer_to_buffer(node_buffer, 0, &self.data, at, node_bytes);
+        }
+        self.bind(device)
     }
 }
 

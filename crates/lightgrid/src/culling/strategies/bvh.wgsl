@@ -7,8 +7,22 @@
 
 const WORKGROUP_SIZE: u32 = BVH_WIDTH;
 
-@group(2) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
-@group(2) @binding(1) var<storage, read> bvh_order: array<u32>;
+// The hierarchy (bvh.rs `BvhBuffers`): the leaf slots' lights, four per entry and
+// ceil(light_count / 4) entries, then the nodes, two entries each. One buffer keeps the walk
+// within WebGPU's default 8 storage buffers per stage.
+@group(2) @binding(0) var<storage, read> bvh: array<vec4<u32>>;
+
+fn bvh_node(i: u32) -> BvhNode {
+    let at = (frame.light_count + 3u) / 4u + 2u * i;
+    let a = bvh[at];
+    let b = bvh[at + 1u];
+    return BvhNode(bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), b.w);
+}
+
+// The light of leaf slot `slot`.
+fn bvh_light(slot: u32) -> u32 {
+    return bvh[slot / 4u][slot % 4u];
+}
 
 var<workgroup> bvh_stack: array<u32, BVH_STACK>;
 var<workgroup> bvh_top: u32;
@@ -20,27 +34,28 @@ fn traverse_cell(wg: vec3<u32>, nwg: vec3<u32>, li: u32, spill: bool) {
     begin_cell(li);
     if (li == 0u) {
         bvh_stack[0] = 0u;
-        bvh_top = select(0u, 1u, frame.light_count > 0u && box_in_cell(f, bvh_nodes[0].lo, bvh_nodes[0].hi));
+        let root = bvh_node(0u);
+        bvh_top = select(0u, 1u, frame.light_count > 0u && box_in_cell(f, root.lo, root.hi));
     }
     loop {
         let top = workgroupUniformLoad(&bvh_top);
         if (top == 0u) {
             break;
         }
-        let node = bvh_nodes[bvh_stack[top - 1u]];
+        let node = bvh_node(bvh_stack[top - 1u]);
         if (li == 0u) {
             atomicStore(&bvh_pushed, 0u);
         }
         workgroupBarrier();
         if (li < (node.count & ~BVH_LEAF)) {
             if ((node.count & BVH_LEAF) != 0u) {
-                let l = bvh_order[node.first + li];
+                let l = bvh_light(node.first + li);
                 if (light_in_tile(f, l)) {
                     record_hit(c, l, spill);
                 }
             } else {
                 let child = node.first + li;
-                let b = bvh_nodes[child];
+                let b = bvh_node(child);
                 if (box_in_cell(f, b.lo, b.hi)) {
                     let s = atomicAdd(&bvh_pushed, 1u);
                     bvh_stack[top - 1u + s] = child;

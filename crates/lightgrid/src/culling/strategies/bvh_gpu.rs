@@ -27,6 +27,7 @@ pub(crate) fn shader() -> ComposedShader {
             src::TYPES,
             src::GRID_PARAMS,
             src::SCENE_BINDINGS,
+            crate::culling::strategies::LIGHT_RECORDS_WGSL,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             include_str!("bvh_build.wgsl"),
         ],
@@ -173,9 +174,15 @@ impl GpuBvhBuild {
         }
     }
 
-    /// (nodes, order) for the traversal's group 2.
-    pub fn buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
-        (&self.nodes, &self.sort.vals)
+    /// The nodes (and their number for `lights` lights) and the order for the traversal's
+    /// group 2.
+    pub fn buffers(&self, lights: usize) -> ((&wgpu::Buffer, usize), &wgpu::Buffer) {
+        let nodes = if lights == 0 {
+            0
+        } else {
+            bvh_levels(lights).iter().map(|l| l.1 as usize).sum()
+        };
+        ((&self.nodes, nodes), &self.sort.vals)
     }
 }
 
@@ -183,29 +190,27 @@ impl GpuBvhBuild {
 /// `bvh`'s, all in the frame's one submission.
 struct GpuBvhStrategy {
     kernels: CellKernels,
-    layout: wgpu::BindGroupLayout,
+    buffers: BvhBuffers,
     build: GpuBvhBuild,
 }
 
 pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> {
-    let layout = BvhBuffers::new(ctx.device).layout;
+    let buffers = BvhBuffers::new(ctx.device);
     Box::new(GpuBvhStrategy {
-        kernels: CellKernels::new(ctx, "bvh", &bvh_shader(), &[&layout]),
+        kernels: CellKernels::new(ctx, "bvh", &bvh_shader(), &[&buffers.layout]),
         build: GpuBvhBuild::new(ctx.device, ctx.cull_layout),
-        layout,
+        buffers,
     })
 }
 
 impl AssignStrategy for GpuBvhStrategy {
     fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
         self.build.encode(a.f, enc, self.kernels.scan());
-        let (nodes, order) = self.build.buffers();
-        let group = bind_resources(
-            a.f.device,
-            "light bvh (gpu build)",
-            &self.layout,
-            &[nodes.as_entire_binding(), order.as_entire_binding()],
-        );
+        let lights = a.f.light_count;
+        let (nodes, order) = self.build.buffers(lights);
+        let group = self
+            .buffers
+            .copy(a.f.device, enc.parts().0, lights, nodes, order);
         self.kernels.encode(a, enc, &[&group]);
         Ok(StrategyRun::default())
     }

@@ -35,6 +35,7 @@ fn cell_shader(name: &str, body: &'static str) -> ComposedShader {
             src::TYPES,
             src::GRID_PARAMS,
             src::SCENE_BINDINGS,
+            crate::culling::strategies::LIGHT_RECORDS_WGSL,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             ASSIGN_BINDINGS_WGSL,
             body,
@@ -50,6 +51,17 @@ pub(crate) fn bvh_shader() -> ComposedShader {
     cell_shader("bvh traversal", include_str!("bvh.wgsl"))
 }
 
+/// Group 1's bindings (`assign_bindings.wgsl`): the grid's parameters, the cell bounds, the
+/// cells, the index list, the cell lists, the cells' culling records.
+pub(crate) const ASSIGN_GROUP1: [wgpu::BufferBindingType; 6] = [
+    UNIFORM,
+    STORAGE_READ,
+    STORAGE_RW,
+    STORAGE_RW,
+    STORAGE_RW,
+    STORAGE_READ,
+];
+
 /// Group 1 layout (`assign_bindings.wgsl`) and the spill pass's arguments (the spill list
 /// is the second half of the cell lists: `CellBoundsPass::lists_buffer`).
 pub struct AssignCommon {
@@ -62,18 +74,7 @@ pub struct AssignCommon {
 
 impl AssignCommon {
     pub fn new(device: &wgpu::Device) -> Self {
-        let layout = buffer_layout(
-            device,
-            "light assignment (group 1)",
-            &[
-                UNIFORM,
-                STORAGE_READ,
-                STORAGE_RW,
-                STORAGE_RW,
-                STORAGE_RW,
-                STORAGE_READ,
-            ],
-        );
+        let layout = buffer_layout(device, "light assignment (group 1)", &ASSIGN_GROUP1);
         AssignCommon {
             layout,
             scan: ScanPass::new(device),

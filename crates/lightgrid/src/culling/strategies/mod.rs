@@ -18,7 +18,14 @@ pub(crate) mod scan;
 pub(crate) mod scatter;
 pub(crate) mod zbin;
 
-/// `tile_frustum` / `light_in_tile` (needs the scene bindings), with the 2.5D depth mask and
+/// `light_cull(l)` in LightCuller's kernels: group 0's light records (after the scene
+/// bindings).
+pub(crate) const LIGHT_RECORDS_WGSL: &str = include_str!("../embed/light_records.wgsl");
+/// `light_cull(l)` from the renderer's group 0, its lights and their bounds (the
+/// single-kernel tiled deferred pass).
+pub(crate) const LIGHT_CULL_SCENE_WGSL: &str = include_str!("../embed/light_cull_scene.wgsl");
+
+/// `tile_frustum` / `light_in_tile` (needs the scene bindings and a `light_cull`), with the 2.5D depth mask and
 /// tight-cell box tests.
 pub(crate) const TILE_FRUSTUM_WGSL: &[&str] = &[
     crate::culling::bounds::DEPTH_MASK_WGSL,

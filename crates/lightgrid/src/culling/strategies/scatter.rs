@@ -10,17 +10,17 @@
 
 use crate::consts::{ASSIGN_THREADS, COUNTER_ITEM_ARGS};
 use crate::culling::strategies::gpu_assign::{
-    copy_dispatch_args, indirect_args_buffer, AssignCommon,
+    copy_dispatch_args, indirect_args_buffer, ASSIGN_GROUP1,
 };
 use crate::culling::strategies::radix_sort::RadixSort;
+use crate::culling::strategies::scan::ScanPass;
 use crate::culling::strategies::{
     AssignFrame, AssignStrategy, ListCapacity, StrategyContext, StrategyRun,
 };
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
-    bind_resources, buffer_layout, groups_1d, grow_storage, storage_buffer, CounterValues,
-    PassTimer, STORAGE_RW,
+    buffer_entry, groups_1d, grow_storage, storage_buffer, CounterValues, PassTimer, STORAGE_RW,
 };
 use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
@@ -31,6 +31,7 @@ pub(crate) fn shader() -> ComposedShader {
             src::TYPES,
             src::GRID_PARAMS,
             src::SCENE_BINDINGS,
+            crate::culling::strategies::LIGHT_RECORDS_WGSL,
             src::GRID_CELL,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             include_str!("assign_bindings.wgsl"),
@@ -40,16 +41,158 @@ pub(crate) fn shader() -> ComposedShader {
     )
 }
 
+/// The bindings of groups 1 (`assign_bindings.wgsl`) and 2 (`scatter.wgsl`) one kernel
+/// uses: its pipeline layout holds only those, so no kernel binds more than WebGPU's default
+/// 8 storage buffers per stage (group 0's 2 and all of these would be 12).
+struct KernelUse {
+    entry: &'static str,
+    group1: &'static [u32],
+    group2: &'static [u32],
+}
+
+/// Group 2's bindings: light items, item offsets, pair keys, pair values, item total, light
+/// rectangles.
+const GROUP2: [wgpu::BufferBindingType; 6] = [STORAGE_RW; 6];
+
+/// Steps 1, 3, 4, 5 and 7 of `scatter.wgsl`, in order.
+const KERNELS: [KernelUse; 6] = [
+    KernelUse {
+        entry: "rect_main",
+        group1: &[0],
+        group2: &[0, 5],
+    },
+    KernelUse {
+        entry: "items_args_main",
+        group1: &[],
+        group2: &[4],
+    },
+    KernelUse {
+        entry: "emit_main",
+        group1: &[0, 1, 5],
+        group2: &[1, 2, 3, 5],
+    },
+    KernelUse {
+        entry: "pad_main",
+        group1: &[],
+        group2: &[2],
+    },
+    KernelUse {
+        entry: "bounds_main",
+        group1: &[2],
+        group2: &[2],
+    },
+    KernelUse {
+        entry: "counts_main",
+        group1: &[0, 2],
+        group2: &[],
+    },
+];
+const RECT: usize = 0;
+const ITEMS_ARGS: usize = 1;
+const EMIT: usize = 2;
+const PAD: usize = 3;
+const BOUNDS: usize = 4;
+const COUNTS: usize = 5;
+
+/// The layout of the bindings `used` of a group whose bindings have `types` (none when
+/// nothing is used).
+fn subset_layout(
+    device: &wgpu::Device,
+    label: &str,
+    types: &[wgpu::BufferBindingType],
+    used: &[u32],
+) -> Option<wgpu::BindGroupLayout> {
+    let entries: Vec<_> = used
+        .iter()
+        .map(|&b| buffer_entry(b, types[b as usize]))
+        .collect();
+    (!used.is_empty()).then(|| {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &entries,
+        })
+    })
+}
+
+/// A scatter kernel: its pipeline and its own layouts of groups 1 and 2.
+struct Kernel {
+    pipeline: wgpu::ComputePipeline,
+    layouts: [Option<wgpu::BindGroupLayout>; 2],
+    uses: &'static KernelUse,
+}
+
+impl Kernel {
+    fn new(ctx: &StrategyContext, shader: &ComposedShader, uses: &'static KernelUse) -> Self {
+        let device = ctx.device;
+        let label = format!("scatter {}", uses.entry);
+        let layouts = [
+            subset_layout(device, &label, &ASSIGN_GROUP1, uses.group1),
+            subset_layout(device, &label, &GROUP2, uses.group2),
+        ];
+        let pipeline = compute_pipeline(
+            device,
+            &label,
+            shader,
+            uses.entry,
+            &[
+                Some(ctx.cull_layout),
+                layouts[0].as_ref(),
+                layouts[1].as_ref(),
+            ],
+        );
+        Kernel {
+            pipeline,
+            layouts,
+            uses,
+        }
+    }
+
+    /// Its groups 1 and 2 over the frame's buffers (`group1` in `ASSIGN_GROUP1`'s order,
+    /// `group2` in `GROUP2`'s).
+    fn bind(
+        &self,
+        device: &wgpu::Device,
+        group1: &[&wgpu::Buffer; 6],
+        group2: &[&wgpu::Buffer; 6],
+    ) -> [Option<wgpu::BindGroup>; 2] {
+        let bind =
+            |layout: &Option<wgpu::BindGroupLayout>, used: &[u32], all: &[&wgpu::Buffer; 6]| {
+                layout.as_ref().map(|layout| {
+                    let entries: Vec<_> = used
+                        .iter()
+                        .map(|&b| wgpu::BindGroupEntry {
+                            binding: b,
+                            resource: all[b as usize].as_entire_binding(),
+                        })
+                        .collect();
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(self.uses.entry),
+                        layout,
+                        entries: &entries,
+                    })
+                })
+            };
+        [
+            bind(&self.layouts[0], self.uses.group1, group1),
+            bind(&self.layouts[1], self.uses.group2, group2),
+        ]
+    }
+}
+
+/// How a kernel is dispatched.
+enum Dispatch<'a> {
+    /// One invocation per item of this many.
+    Items(u64),
+    /// One invocation.
+    Once,
+    /// Arguments from this buffer.
+    Indirect(&'a wgpu::Buffer),
+}
+
 /// `--assign scatter`.
 struct ScatterStrategy {
-    common: AssignCommon,
-    layout: wgpu::BindGroupLayout,
-    rect: wgpu::ComputePipeline,
-    items_args: wgpu::ComputePipeline,
-    emit: wgpu::ComputePipeline,
-    pad: wgpu::ComputePipeline,
-    bounds: wgpu::ComputePipeline,
-    counts: wgpu::ComputePipeline,
+    scan: ScanPass,
+    kernels: Vec<Kernel>,
     light_items: wgpu::Buffer,
     item_offsets: wgpu::Buffer,
     item_total: wgpu::Buffer,
@@ -63,21 +206,10 @@ struct ScatterStrategy {
 
 pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> {
     let device = ctx.device;
-    let common = AssignCommon::new(device);
-    let layout = buffer_layout(device, "scatter (group 2)", &[STORAGE_RW; 6]);
     let s = shader();
-    let layouts = [Some(ctx.cull_layout), Some(&common.layout), Some(&layout)];
-    let pipeline =
-        |entry: &str| compute_pipeline(device, &format!("scatter {entry}"), &s, entry, &layouts);
     Box::new(ScatterStrategy {
-        rect: pipeline("rect_main"),
-        items_args: pipeline("items_args_main"),
-        emit: pipeline("emit_main"),
-        pad: pipeline("pad_main"),
-        bounds: pipeline("bounds_main"),
-        counts: pipeline("counts_main"),
-        layout,
-        common,
+        scan: ScanPass::new(device),
+        kernels: KERNELS.iter().map(|k| Kernel::new(ctx, &s, k)).collect(),
         light_items: storage_buffer(device, "scatter light items", 1 << 12),
         item_offsets: storage_buffer(device, "scatter item offsets", 1 << 12),
         item_total: storage_buffer(device, "scatter item total", 16),
@@ -88,44 +220,32 @@ pub(super) fn create_strategy(ctx: &StrategyContext) -> Box<dyn AssignStrategy> 
     })
 }
 
-impl ScatterStrategy {
-    fn bind(&self, device: &wgpu::Device) -> wgpu::BindGroup {
-        bind_resources(
-            device,
-            "scatter",
-            &self.layout,
-            &[
-                self.light_items.as_entire_binding(),
-                self.item_offsets.as_entire_binding(),
-                self.sort.keys.as_entire_binding(),
-                self.sort.vals.as_entire_binding(),
-                self.item_total.as_entire_binding(),
-                self.light_rects.as_entire_binding(),
-            ],
-        )
-    }
-}
-
-/// A compute pass of one pipeline with groups 0..=2.
-fn pass<'e>(
-    encoder: &'e mut wgpu::CommandEncoder,
+/// A compute pass running `steps` (kernel, its groups 1 and 2, dispatch) in order.
+fn pass(
+    encoder: &mut wgpu::CommandEncoder,
     timer: &mut PassTimer,
     label: &str,
-    pipeline: &wgpu::ComputePipeline,
-    groups: [&wgpu::BindGroup; 3],
-) -> wgpu::ComputePass<'e> {
+    group0: &wgpu::BindGroup,
+    steps: &[(&Kernel, &[Option<wgpu::BindGroup>; 2], Dispatch)],
+) {
     let mut pass = timer.begin_compute(encoder, label);
-    pass.set_pipeline(pipeline);
-    for (i, g) in groups.iter().enumerate() {
-        pass.set_bind_group(i as u32, *g, &[]);
+    pass.set_bind_group(0, group0, &[]);
+    for (kernel, groups, dispatch) in steps {
+        pass.set_pipeline(&kernel.pipeline);
+        for (i, g) in groups.iter().enumerate() {
+            if let Some(g) = g {
+                pass.set_bind_group(1 + i as u32, g, &[]);
+            }
+        }
+        match dispatch {
+            Dispatch::Items(n) => {
+                let (x, y) = groups_1d((n.div_ceil(u64::from(ASSIGN_THREADS)) as u32).max(1));
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            Dispatch::Once => pass.dispatch_workgroups(1, 1, 1),
+            Dispatch::Indirect(args) => pass.dispatch_workgroups_indirect(args, 0),
+        }
     }
-    pass
-}
-
-/// Dispatch one invocation per item of `items`.
-fn dispatch_items(pass: &mut wgpu::ComputePass, items: u64) {
-    let (x, y) = groups_1d((items.div_ceil(u64::from(ASSIGN_THREADS)) as u32).max(1));
-    pass.dispatch_workgroups(x, y, 1);
 }
 
 impl AssignStrategy for ScatterStrategy {
@@ -161,16 +281,39 @@ impl AssignStrategy for ScatterStrategy {
         // The whole pair buffer is sorted: its bound length is what the kernels see.
         let slots = self.sort.keys.size() / 4;
         grid.ensure(device, f.queue, dims, dims.cell_count(), slots as usize);
-        let common = self.common.bind(device, grid, bounds);
-        let own = self.bind(device);
-        let groups = [f.bind_group, &common, &own];
+        let group1 = [
+            grid.params_buffer(),
+            bounds.buffer(),
+            grid.cells_buffer(),
+            grid.indices_buffer(),
+            bounds.lists_buffer(),
+            bounds.cull_buffer(),
+        ];
+        let group2 = [
+            &self.light_items,
+            &self.item_offsets,
+            &self.sort.keys,
+            &self.sort.vals,
+            &self.item_total,
+            &self.light_rects,
+        ];
+        let groups: Vec<_> = self
+            .kernels
+            .iter()
+            .map(|k| k.bind(device, &group1, &group2))
+            .collect();
+        let k = |i: usize| (&self.kernels[i], &groups[i]);
+        let step = |i: usize, d| (k(i).0, k(i).1, d);
         let (encoder, timer) = enc.parts();
         // 1. Tile rectangles and items per light; 2. their offsets; 3. dispatch arguments.
-        {
-            let mut p = pass(encoder, timer, "assign: scatter rects", &self.rect, groups);
-            dispatch_items(&mut p, lights);
-        }
-        self.common.scan.encode(
+        pass(
+            encoder,
+            timer,
+            "assign: scatter rects",
+            f.bind_group,
+            &[step(RECT, Dispatch::Items(lights))],
+        );
+        self.scan.encode(
             device,
             encoder,
             timer,
@@ -180,24 +323,25 @@ impl AssignStrategy for ScatterStrategy {
             lights,
             (&self.item_total, 0),
         );
-        {
-            let mut p = pass(
-                encoder,
-                timer,
-                "assign: scatter args",
-                &self.items_args,
-                groups,
-            );
-            p.dispatch_workgroups(1, 1, 1);
-        }
+        pass(
+            encoder,
+            timer,
+            "assign: scatter args",
+            f.bind_group,
+            &[step(ITEMS_ARGS, Dispatch::Once)],
+        );
         copy_dispatch_args(encoder, f.counters, COUNTER_ITEM_ARGS, &self.item_args);
         // 4. Pairs, one invocation per (light, tile); 5. padding past the pairs.
-        {
-            let mut p = pass(encoder, timer, "assign: scatter emit", &self.emit, groups);
-            p.dispatch_workgroups_indirect(&self.item_args, 0);
-            p.set_pipeline(&self.pad);
-            dispatch_items(&mut p, slots);
-        }
+        pass(
+            encoder,
+            timer,
+            "assign: scatter emit",
+            f.bind_group,
+            &[
+                step(EMIT, Dispatch::Indirect(&self.item_args)),
+                step(PAD, Dispatch::Items(slots)),
+            ],
+        );
         // 6. Sort by cell (keys 0xffffffff past the pairs sort last: enough bits for the
         // cell count itself), 7. cell offsets and counts from the sorted keys.
         let cell_bits = u32::BITS - (dims.cell_count() as u32).leading_zeros();
@@ -206,23 +350,21 @@ impl AssignStrategy for ScatterStrategy {
             f.queue,
             encoder,
             timer,
-            &self.common.scan,
+            &self.scan,
             slots as u32,
             cell_bits,
         );
         encoder.clear_buffer(grid.cells_buffer(), 0, Some((dims.cell_count() * 8) as u64));
-        {
-            let mut p = pass(
-                encoder,
-                timer,
-                "assign: scatter cell ranges",
-                &self.bounds,
-                groups,
-            );
-            dispatch_items(&mut p, slots);
-            p.set_pipeline(&self.counts);
-            dispatch_items(&mut p, dims.cell_count() as u64);
-        }
+        pass(
+            encoder,
+            timer,
+            "assign: scatter cell ranges",
+            f.bind_group,
+            &[
+                step(BOUNDS, Dispatch::Items(slots)),
+                step(COUNTS, Dispatch::Items(dims.cell_count() as u64)),
+            ],
+        );
         encoder.copy_buffer_to_buffer(&self.sort.vals, 0, grid.indices_buffer(), 0, slots * 4);
         Ok(StrategyRun::default())
     }

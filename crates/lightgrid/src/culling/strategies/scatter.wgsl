@@ -15,6 +15,8 @@
 // 5. pad_main: keys past the emitted pairs become 0xffffffff, so they sort last;
 // 6. (radix sort of the whole pair buffer by cell);
 // 7. bounds_main / counts_main: each cell's (offset, count) from the sorted keys.
+// Each kernel's pipeline layout holds only the bindings it uses (`scatter.rs` `KERNELS`):
+// all of them together are 12 storage buffers, each kernel's at most WebGPU's default 8.
 
 @group(2) @binding(0) var<storage, read_write> light_items: array<u32>;
 @group(2) @binding(1) var<storage, read_write> item_offsets: array<u32>;
@@ -37,7 +39,7 @@ fn rect_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (l >= frame.light_count) {
         return;
     }
-    let b = light_bounds[l];
+    let b = light_cull(l).sphere;
     let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
     let rect = light_tiles(c, b.w);
     light_rects[l] = rect;
@@ -56,6 +58,7 @@ fn items_args_main() {
     atomicStore(&frame_counters[COUNTER_ITEM_ARGS], x);
     atomicStore(&frame_counters[COUNTER_ITEM_ARGS + 1u], (blocks + x - 1u) / x);
     atomicStore(&frame_counters[COUNTER_ITEM_ARGS + 2u], 1u);
+    atomicStore(&frame_counters[COUNTER_ITEM_ARGS + 3u], item_total[0]);
 }
 
 // Bisection steps that find any light among MAX_LIGHTS (2^20): ceil(log2(2^20 + 1)).
@@ -66,7 +69,7 @@ const SEARCH_STEPS: u32 = 21u;
 @compute @workgroup_size(ASSIGN_THREADS)
 fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat_index(gid, nwg);
-    if (i >= item_total[0]) {
+    if (i >= atomicLoad(&frame_counters[COUNTER_ITEM_ARGS + 3u])) {
         return;
     }
     var lo = 0u;
@@ -89,8 +92,8 @@ fn emit_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let width = u32(rect.z - rect.x + 1);
     let tile = u32(rect.y + i32(k / width)) * light_grid.tiles_x + u32(rect.x + i32(k % width));
 
-    let light = lights[l];
-    let b = light_bounds[l];
+    let light = light_cull(l);
+    let b = light.sphere;
     let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
     let radius = b.w;
     let w_min = -c.z - b.w;

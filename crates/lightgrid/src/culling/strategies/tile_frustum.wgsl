@@ -94,7 +94,7 @@ fn sphere_in_tile(f: TileFrustum, c: vec3<f32>, r: f32) -> bool {
 // 1 for point lights and when spots are culled by their sphere only (`spot_cull` 0). The
 // argument for why this never rejects a sphere the cone reaches is at its CPU twin,
 // `ViewLight::cone_margin`.
-fn cone_margin(light: Light, cell: vec4<f32>) -> f32 {
+fn cone_margin(light: CullRecord, cell: vec4<f32>) -> f32 {
     if (frame.spot_cull == 0u || light.cos_outer <= POINT_LIGHT_COS) {
         return 1.0;
     }
@@ -147,7 +147,7 @@ fn box_in_cell(f: TileFrustum, lo: vec3<f32>, hi: vec3<f32>) -> bool {
 fn reach_box(l: u32, c: vec3<f32>, radius: f32) -> array<vec3<f32>, 2> {
     var lo = c - vec3<f32>(radius);
     var hi = c + vec3<f32>(radius);
-    let light = lights[l];
+    let light = light_cull(l);
     if (frame.spot_cull == 0u || light.cos_outer <= 0.0) {
         return array<vec3<f32>, 2>(lo, hi);
     }
@@ -171,12 +171,13 @@ fn reach_box(l: u32, c: vec3<f32>, radius: f32) -> array<vec3<f32>, 2> {
 // its cone, the cone may reach the frustum's bounding sphere and the sector's box reaches
 // into the frustum.
 fn light_in_tile(f: TileFrustum, l: u32) -> bool {
-    let b = light_bounds[l];
+    let light = light_cull(l);
+    let b = light.sphere;
     let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
-    if (!sphere_in_tile(f, c, b.w) || cone_margin(lights[l], f.sphere) < 0.0) {
+    if (!sphere_in_tile(f, c, b.w) || cone_margin(light, f.sphere) < 0.0) {
         return false;
     }
-    if (frame.spot_cull == 0u || lights[l].cos_outer <= 0.0) {
+    if (frame.spot_cull == 0u || light.cos_outer <= 0.0) {
         return true;
     }
     let sector = reach_box(l, c, b.w);

@@ -37,6 +37,7 @@ pub(crate) fn shader() -> ComposedShader {
             src::TYPES,
             src::GRID_PARAMS,
             src::SCENE_BINDINGS,
+            crate::culling::strategies::LIGHT_RECORDS_WGSL,
             crate::culling::strategies::TILE_FRUSTUM_WGSL,
             src::GRID_CELL,
             include_str!("light_tiles.wgsl"),
