@@ -936,8 +936,8 @@ fn a_gltf_file_opened_in_the_page_renders_as_natively_and_a_bad_one_is_refused()
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Every pipeline of the registry on the page, and with 4x MSAA every one that takes it:
-/// each renders what it renders natively. Small frames: the point is each pipeline's wiring
+/// Every pipeline of the registry on the page, and with 4x MSAA every one that takes it, on a
+/// device with WebGPU's default limits: each renders what it renders natively. Small frames: the point is each pipeline's wiring
 /// on WebGPU, not the scene.
 #[test]
 fn every_pipeline_renders_on_the_page_as_natively() {
@@ -953,7 +953,7 @@ fn every_pipeline_renders_on_the_page_as_natively() {
     for (id, msaa) in cases {
         let what = format!("{id} msaa {msaa}");
         session.open(&format!(
-            "scene=robots-few&pipeline={id}&msaa={msaa}&frame=40&size=160x120&paused"
+            "scene=robots-few&pipeline={id}&msaa={msaa}&frame=40&size=160x120&paused&limits=webgpu"
         ));
         let b = &mut session.b;
         b.wait_for(&what, |s| {
@@ -996,45 +996,35 @@ fn every_pipeline_renders_on_the_page_as_natively() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// In a browser that offers only WebGPU's default limits (`?limits=webgpu` asks for them),
-/// the grid pipelines need more storage buffers per stage than the 8 guaranteed: the page
-/// refuses with the browser's reason, which names the limit and the count, never a wrong
-/// or blank frame passed off as right.
+/// The page asks for WebGPU's default limits (8 storage buffers per stage, what every
+/// browser guarantees) unless `?limits=adapter`: the device it gets has exactly 8, and a grid
+/// pipeline renders on it (`every_pipeline_renders_on_the_page_as_natively` renders them
+/// all); with `?limits=adapter` it gets the adapter's (SwiftShader offers 10) and renders too.
 #[test]
-fn with_webgpu_default_limits_the_page_names_the_limit_that_refuses_a_pipeline() {
+fn the_page_asks_for_webgpu_default_limits_unless_told_otherwise() {
     let mut session = session("web-limits");
-    session.open("scene=robots-few&pipeline=clustered_forward&size=160x120&paused&limits=webgpu");
-    let (b, dir) = (&mut session.b, session.dir.clone());
-    let deadline = Instant::now() + Duration::from_secs(120);
-    let fatal = loop {
-        let f = b.eval("window.lightgrid ? window.lightgrid.fatal() ?? null : null");
-        if let Some(f) = f.as_str() {
-            break f.to_string();
+    for (query, storage) in [
+        ("", Some(8)),
+        ("&limits=webgpu", Some(8)),
+        ("&limits=adapter", None),
+    ] {
+        session.open(&format!(
+            "scene=robots-few&pipeline=clustered_forward&size=160x120&paused{query}"
+        ));
+        let b = &mut session.b;
+        let s = b.wait_for(query, |s| {
+            s["pipeline"] == "clustered_forward"
+                && s["pending"] == false
+                && s["settled"].as_u64().unwrap_or(0) >= 2
+        });
+        b.assert_no_errors(query);
+        let got = s["storage_buffers"]
+            .as_u64()
+            .expect("the page reports its device's limit");
+        match storage {
+            Some(n) => assert_eq!(got, n, "{query}: the device's storage buffers per stage"),
+            None => assert!(got >= 8, "{query}: the adapter's limit {got}"),
         }
-        assert!(
-            Instant::now() < deadline,
-            "the page never refused the pipeline"
-        );
-        std::thread::sleep(Duration::from_millis(200));
-    };
-    eprintln!("refused: {fatal}");
-    assert!(
-        fatal.contains("clustered_forward") && fatal.to_lowercase().contains("storage buffers"),
-        "the refusal does not name the pipeline and the limit: {fatal}"
-    );
-    // The page shows it within its next check (every 0.5 s).
-    let mut shown = serde_json::Value::Null;
-    for _ in 0..50 {
-        shown = b.eval("document.getElementById('error').textContent");
-        if shown.as_str().is_some_and(|s| !s.is_empty()) {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(100));
     }
-    assert_eq!(
-        shown.as_str(),
-        Some(fatal.as_str()),
-        "the page does not show the refusal"
-    );
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&session.dir);
 }

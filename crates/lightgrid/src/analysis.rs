@@ -348,7 +348,7 @@ struct Counts {
 impl Counts {
     fn read(a: &AnalysisInput, samples: u64) -> Result<Counts> {
         let sum = |counts: &[u32]| counts.iter().map(|&c| u64::from(c)).sum::<u64>();
-        // Counted by the count target where it can blend, always with MSAA (`pixel_counts`).
+        // Counted by the count target where it can blend, always with MSAA (the per-pixel counts after the frame counters).
         let countable = a.count_blend || samples > 1;
         let counts = if countable {
             Some(a.readbacks.counts.read(a.device)?)

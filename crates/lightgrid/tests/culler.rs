@@ -31,6 +31,11 @@ fn device() -> (wgpu::Device, wgpu::Queue) {
 /// [`device`], with `TIMESTAMP_QUERY` when `timestamps` and the adapter has it (the last
 /// value says whether it was granted).
 fn device_with(timestamps: bool) -> (wgpu::Device, wgpu::Queue, bool) {
+    device_limited(timestamps, None)
+}
+
+/// [`device_with`], with `storage` storage buffers per stage instead of the culler's limits'.
+fn device_limited(timestamps: bool, storage: Option<u32>) -> (wgpu::Device, wgpu::Queue, bool) {
     let instance =
         wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))
@@ -44,7 +49,12 @@ fn device_with(timestamps: bool) -> (wgpu::Device, wgpu::Queue, bool) {
     };
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         // Exactly what the culler asks for: every strategy must be created within it.
-        required_limits: LightCuller::required_limits(&adapter),
+        required_limits: wgpu::Limits {
+            max_storage_buffers_per_shader_stage: storage.unwrap_or(
+                LightCuller::required_limits(&adapter).max_storage_buffers_per_shader_stage,
+            ),
+            ..LightCuller::required_limits(&adapter)
+        },
         required_features: features,
         ..Default::default()
     }))
@@ -2258,5 +2268,64 @@ fn bad_use_is_a_typed_error_naming_the_input() {
             report.index_entries, 0,
             "{strategy:?} without lights: {report:?}"
         );
+    }
+}
+
+/// The culler asks for WebGPU's default limits and every strategy runs within them (every
+/// test here culls on such a device); the budget is tight: with one storage buffer fewer
+/// per stage the strategies binding 8 (the BVH walks, scatter's emit kernel) are refused with
+/// an error naming the limit, and those binding fewer still run. A binding added past 8
+/// fails the first half.
+#[test]
+fn every_strategy_fits_webgpu_default_limits_and_the_ones_at_eight_name_the_limit() {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))
+        .expect("an adapter (CI installs mesa-vulkan-drivers)");
+    assert_eq!(
+        LightCuller::required_limits(&adapter),
+        wgpu::Limits::default(),
+        "the culler asks for no more than WebGPU's defaults"
+    );
+    for storage in [None, Some(7)] {
+        let cam = camera(Vec3::new(3.0, 2.0, 10.0), false);
+        let lights = lights(&cam, 200, 61);
+        let (device, queue, _) = device_limited(false, storage);
+        let caller = Caller::new(&device, &queue, 1, cam, &lights);
+        for strategy in strategies().into_iter().filter(|&a| a != Assign::Auto) {
+            let what = format!("{strategy:?} with {storage:?} storage buffers per stage");
+            let config = CullConfig {
+                strategy,
+                index_capacity: 1 << 17,
+                ..CullConfig::default()
+            };
+            let culled = LightCuller::new(&device, &queue, config).and_then(|mut culler| {
+                let mut encoder = device.create_command_encoder(&Default::default());
+                caller.depth_prepass(&mut encoder);
+                let inputs = CullInputs {
+                    cpu_lights: Some(&caller.cpu_lights),
+                    ..caller.inputs()
+                };
+                culler.encode(&mut encoder, &inputs)?;
+                queue.submit([encoder.finish()]);
+                culler.wait()
+            });
+            let at_eight = matches!(strategy, Assign::Bvh | Assign::BvhGpu | Assign::Scatter);
+            match (storage, culled) {
+                (Some(_), Err(e)) if at_eight => assert!(
+                    e.to_string()
+                        .contains("max_storage_buffers_per_shader_stage"),
+                    "{what}: the refusal names the limit: {e}"
+                ),
+                (Some(_), Ok(_)) if at_eight => panic!("{what}: binds 8, yet ran on 7"),
+                (_, Ok(reports)) => {
+                    assert!(
+                        reports.iter().all(|r| r.is_complete()),
+                        "{what}: {reports:?}"
+                    )
+                }
+                (_, Err(e)) => panic!("{what}: {e}"),
+            }
+        }
     }
 }

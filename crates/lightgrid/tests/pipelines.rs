@@ -210,7 +210,12 @@ fn check_images(
     (w, h): (u32, u32),
     settings: RenderSettings,
 ) -> std::collections::HashMap<&'static str, u64> {
-    let ctx = common::gpu();
+    // The 32-bit G-buffer asks for more colour bytes per sample than WebGPU's defaults
+    // (`the_32_bit_gbuffer_asks_for_more_than_webgpus_defaults`).
+    let ctx = match settings.gbuffer {
+        GBufferFormat::F16 => common::gpu(),
+        GBufferFormat::F32 => common::gpu_with(lightgrid::gpu::DeviceLimits::Adapter),
+    };
     let scene = &s.name;
     let mut r = Renderer::new(&ctx, w, h, settings).unwrap();
     let mut references = std::collections::HashMap::new();
@@ -610,6 +615,35 @@ fn cone_culling_is_tighter_than_sphere_culling() {
     );
     let d = lightgrid::image_io::diff(&img_s, &img_c).unwrap().0;
     assert!(d.max <= 1.0, "{d:?}");
+}
+
+/// WebGPU's default limits allow 32 bytes of colour attachments per sample: the 32-bit
+/// G-buffer's four 16-byte targets are refused by every pipeline that draws one, with the
+/// setting and the limit named, and the pipelines without one still render.
+#[test]
+fn the_32_bit_gbuffer_asks_for_more_than_webgpus_defaults() {
+    let ctx = common::gpu();
+    let s = catalog::build("robots-few", &SceneParams::default()).unwrap();
+    let settings = RenderSettings {
+        gbuffer: GBufferFormat::F32,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&ctx, 64, 48, settings).unwrap();
+    for p in PIPELINES.iter() {
+        let gbuffer = p.id.contains("deferred");
+        match r.render(&s, 0, p.id) {
+            Ok(_) => assert!(!gbuffer, "{}: rendered a 32-bit G-buffer", p.id),
+            Err(e) => {
+                let e = e.to_string();
+                assert!(gbuffer, "{}: {e}", p.id);
+                assert!(
+                    e.contains("gbuffer") && e.contains("max_color_attachment_bytes_per_sample"),
+                    "{}: {e}",
+                    p.id
+                );
+            }
+        }
+    }
 }
 
 #[test]

@@ -27,11 +27,12 @@ pub struct PageOptions {
 
 impl PageOptions {
     /// Keys: `scene` (a catalog scene), `pipeline`, `frame`, `size` (`WxH`, the canvas's
-    /// size in physical pixels), `tile`, `msaa`, `paused`, `limits` (`adapter`, the
-    /// default, or `webgpu`: WebGPU's default limits), `script` (the viewer's
+    /// size in physical pixels), `tile`, `msaa`, `paused`, `limits` (`webgpu`, the
+    /// default: WebGPU's default limits, what every browser offers; or `adapter`: the
+    /// adapter's own), `script` (the viewer's
     /// `at N ACTION; ...`). An unknown key or a bad value is an error, never ignored.
     pub fn from_query(query: &str) -> Result<PageOptions> {
-        let mut limits = DeviceLimits::Adapter;
+        let mut limits = DeviceLimits::WebGpu;
         let mut view = ViewOptions {
             adapter: None,
             request: SceneRequest::new("robots-many"),
@@ -220,6 +221,7 @@ impl App {
                 "width": w,
                 "height": h,
                 "adapter": self.report.adapter,
+                "storage_buffers": self.ctx.device.limits().max_storage_buffers_per_shader_stage,
                 "frames": self.report.frames,
                 "message": self.message.clone().unwrap_or_default(),
                 "screenshots_waiting": self.screenshots.len(),

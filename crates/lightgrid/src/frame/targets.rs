@@ -43,7 +43,7 @@ pub fn check_msaa(
 
 /// Does a frame count its lighting computations in the count target (`COUNT_FORMAT`)? Where
 /// the adapter blends R32Float and without MSAA; with MSAA every pass adds into
-/// `Targets::pixel_counts` instead.
+/// the per-pixel counts after the frame counters (`gpu/counters.rs`) instead.
 pub(crate) fn counts_in_target(count_blend: bool, samples: u32) -> bool {
     count_blend && samples == 1
 }
@@ -141,7 +141,7 @@ pub(crate) fn loaded_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthSte
 
 /// The frame's render targets. With MSAA (`samples` > 1) HDR colour and depth hold every
 /// sample; the tonemap pass resolves them into the single-sample display target, and the
-/// lighting counts are added per pixel into `pixel_counts` (a count target per sample would
+/// lighting counts are added per pixel after the frame counters (a count target per sample would
 /// count a fragment once per covered sample, or, blended, lose the samples failing the depth
 /// test: a fragment shader runs once per pixel and primitive).
 pub(crate) struct Targets {

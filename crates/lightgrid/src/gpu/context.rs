@@ -105,11 +105,10 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
 /// The limits a device is asked for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DeviceLimits {
-    /// The adapter's own: large light lists need big storage bindings, and the grid kernels
-    /// bind up to 16 storage buffers per stage.
+    /// The adapter's own: the largest storage bindings (very long light lists) and textures.
     Adapter,
-    /// WebGPU's defaults, what every page may rely on: a pipeline that needs more is refused
-    /// with the limit and the count (README, "In a browser").
+    /// WebGPU's defaults, what every page may rely on: every pipeline and strategy runs
+    /// within them (8 storage buffers per stage, 4 bind groups; README, "Platforms").
     WebGpu,
 }
 
@@ -147,9 +146,23 @@ impl GpuContext {
         Self::with_display(None, wanted)
     }
 
+    /// [`GpuContext::new`] asking for `limits` whatever the environment says (the tests run
+    /// every pipeline on WebGPU's defaults).
+    pub fn with_limits(wanted: Option<&str>, limits: DeviceLimits) -> Result<Self> {
+        Self::open_adapter(None, wanted, limits)
+    }
+
     /// [`GpuContext::new`] on an instance that knows a window system's `display`, so that
     /// surfaces of its windows can be created ([`GpuContext::instance`]).
     pub fn with_display(display: Option<Display>, wanted: Option<&str>) -> Result<Self> {
+        Self::open_adapter(display, wanted, DeviceLimits::from_env())
+    }
+
+    fn open_adapter(
+        display: Option<Display>,
+        wanted: Option<&str>,
+        limits: DeviceLimits,
+    ) -> Result<Self> {
         let instance = instance(display);
         let adapters = sorted_adapters(&instance);
         if adapters.is_empty() {
@@ -191,7 +204,7 @@ impl GpuContext {
             }
         }
         .expect("checked above");
-        Self::from_adapter(instance, adapter)
+        pollster::block_on(Self::open(instance, adapter, limits))
     }
 
     /// The page's context (wasm32): the browser's WebGPU adapter and a device on it. Nothing
@@ -216,10 +229,6 @@ impl GpuContext {
                 ))
             })?;
         Self::open(instance, adapter, limits).await
-    }
-
-    fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
-        pollster::block_on(Self::open(instance, adapter, DeviceLimits::from_env()))
     }
 
     async fn open(

@@ -102,8 +102,23 @@ impl GBuffer {
         size: (u32, u32),
         samples: u32,
         shading: Shading,
-    ) -> Self {
+    ) -> crate::error::Result<Self> {
         let tf = format.texture_format();
+        // WebGPU's default limits allow 32 bytes of colour attachments per sample: the 16-bit
+        // G-buffer's four targets; the 32-bit one asks for more (a refusal naming the limit,
+        // never a validation error mid-frame).
+        let targets = (0..TARGET_NAMES.len()).filter(|&l| layout.has(l)).count() as u32;
+        let bytes = targets * format.bytes_per_target();
+        let allowed = device.limits().max_color_attachment_bytes_per_sample;
+        if bytes > allowed {
+            return Err(crate::error::Error::invalid(
+                "gbuffer",
+                format!(
+                    "the {}-bit G-buffer's {targets} targets need {bytes} bytes of colour attachments per sample; this device allows {allowed} (max_color_attachment_bytes_per_sample, 32 in WebGPU's default limits): use --gbuffer 16, or a device with the adapter's limits",
+                    format.bits()
+                ),
+            ));
+        }
         let views: Vec<Option<wgpu::TextureView>> = TARGET_NAMES
             .iter()
             .enumerate()
@@ -142,11 +157,11 @@ impl GBuffer {
                 samples,
             },
         );
-        GBuffer {
+        Ok(GBuffer {
             read_layout: Self::read_layout(device, &views, samples),
             views,
             pipeline,
-        }
+        })
     }
 
     /// Bindings 0-3 are the targets by location (those the layout has), 4 the depth.

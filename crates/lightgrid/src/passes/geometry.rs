@@ -18,7 +18,7 @@ pub(crate) struct GeometryPipelineDesc<'a> {
     pub depth_write: bool,
     pub depth_compare: wgpu::CompareFunction,
     /// Samples per pixel of the targets (`RenderSettings::msaa`). Above one, a lighting
-    /// shader counts into `pixel_counts` (`lit_out.wgsl`'s `MULTISAMPLED`).
+    /// shader counts into the per-pixel counts (`count_pixel`, `lit_out.wgsl`'s `MULTISAMPLED`).
     pub samples: u32,
 }
 
@@ -351,7 +351,7 @@ pub(crate) fn begin_lighting_pass<'e>(
 }
 
 /// HDR (cleared to black) and, when countable, the count target (cleared to zero); with
-/// MSAA the counts go to `pixel_counts` instead.
+/// MSAA the counts go to the per-pixel counts after the frame counters instead.
 pub(crate) fn lighting_attachments<'a>(
     f: &'a FrameInputs,
 ) -> [Option<wgpu::RenderPassColorAttachment<'a>>; 2] {

@@ -737,7 +737,7 @@ impl LightVolumes {
         }
     }
 
-    /// With MSAA, lighting fragments count into `pixel_counts` (`lit_out.wgsl`).
+    /// With MSAA, lighting fragments count into the per-pixel counts after the frame counters (`lit_out.wgsl`).
     fn constants(&self) -> Vec<(&'static str, f64)> {
         if self.samples > 1 {
             vec![(crate::shader::overrides::MULTISAMPLED, 1.0)]

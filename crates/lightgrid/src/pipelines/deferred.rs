@@ -115,7 +115,7 @@ struct Deferred {
     shaders: Vec<Shaders>,
 }
 
-/// HDR and count targets, both additive (no count target with MSAA: `pixel_counts`).
+/// HDR and count targets, both additive (no count target with MSAA: the per-pixel counts after the frame counters).
 fn volume_targets(count_blend: bool, samples: u32) -> [Option<wgpu::ColorTargetState>; 2] {
     [
         Some(additive(HDR_FORMAT)),
@@ -214,7 +214,7 @@ fn create(ctx: &PipelineContext, cull: Cull, layout: GBufferLayout) -> Result<Bo
         (w, h),
         samples,
         ctx.shading,
-    );
+    )?;
     let volumes = LightVolumes::new(device, w, h, samples);
     let module = create_module(
         device,

@@ -7,7 +7,7 @@
 // once, at its centre (`fs_light`, `fs_base`: the colour covers all its samples), and the
 // samples of an edge pixel one by one where they lie (`fs_light_sample`, `fs_base_sample`,
 // which read `sample_index` and so run per sample). Lighting computations count into
-// `pixel_counts` (`lit`); the base passes count the edge pixels, the samples shaded and the
+// the per-pixel counts (`count_pixel`, `lit`); the base passes count the edge pixels, the samples shaded and the
 // samples with geometry into the frame counters, as the edge-aware kernel counts them.
 //
 // Counting per pixel: with MSAA a pixel that two primitives of one draw share (a volume

@@ -8,7 +8,7 @@
 // an edge pixel sample by sample where each lies (`fs_irradiance*_sample`, which read
 // `sample_index` and so run per sample). The shading pass tests the same edge bit: per pixel
 // elsewhere (every sample holds the pixel's irradiance: sample 0's is read), per sample on
-// edge pixels (each sample reads its own). Lighting computations count into `pixel_counts`,
+// edge pixels (each sample reads its own). Lighting computations count into the per-pixel counts (`count_pixel`),
 // each pixel once (by the fragment covering sample 0, as in `deferred.wgsl`); the full-screen
 // `fs_count*` draws count edge pixels, irradiance samples computed and samples with geometry.
 // Entries with side effects force the early depth and stencil tests, so the per-sample

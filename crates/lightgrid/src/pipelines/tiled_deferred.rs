@@ -374,7 +374,7 @@ fn create_grid(
         (w, h),
         samples,
         ctx.shading,
-    );
+    )?;
     let builder = ctx.grid(
         &CullConfig {
             slices,
@@ -437,7 +437,7 @@ pub(super) fn create_single(ctx: &PipelineContext) -> Result<Box<dyn Technique>>
         (w, h),
         samples,
         ctx.shading,
-    );
+    )?;
     let (outputs_layout, mut outputs) = kernel_outputs(ctx.device, (w, h), samples);
     let params_layout = ctx
         .device

@@ -15,7 +15,7 @@
 // (`sample_expand.wgsl`), where the transparent pass blends and the tonemap resolves. Or,
 // with RESOLVE_IN_KERNEL, the samples are resolved here (Trick 1; both in
 // msaa_sample_outputs.wgsl, shared with the single kernel's MSAA variant).
-// Counts go to `pixel_counts` (lighting computations) and the frame counters (edge pixels,
+// Counts go to the per-pixel counts (`count_pixel`: lighting computations) and the frame counters (edge pixels,
 // samples shaded, samples with geometry).
 
 // The queue of edge samples and the counts: msaa_edge_queue.wgsl.

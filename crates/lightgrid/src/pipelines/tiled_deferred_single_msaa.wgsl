@@ -22,7 +22,7 @@
 // in-kernel resolve's sums (2 KiB): 13 KiB at 8x, within WebGPU's default 16 KiB; 16x needs
 // 21 KiB, which native adapters offer (the device takes the adapter's limits).
 // Counts: every shading point of the tile loops the tile's whole list, added to its pixel in
-// `pixel_counts`; the frame counters get edge pixels, samples shaded and samples with geometry,
+// the per-pixel counts (`count_pixel`); the frame counters get edge pixels, samples shaded and samples with geometry,
 // as the grid kernel's.
 
 @group(1) @binding(0) var<uniform> tile: LightGridParams;

@@ -11,7 +11,7 @@
 // of the workgroup after a barrier. Each sample's mono irradiance (diffuse rgb, specular
 // luminance) goes to `sample_irradiance` as two pack2x16float words; a fragment pass writes
 // it into the multisampled irradiance target (`fs_expand_irradiance`) for the shading pass.
-// Counts go to `pixel_counts` and the frame counters (edge pixels, samples computed, samples
+// Counts go to the per-pixel counts (`count_pixel`) and the frame counters (edge pixels, samples computed, samples
 // with geometry).
 
 // Per sample (pixel * SAMPLES + sample): the irradiance as two pack2x16float words.

@@ -44,10 +44,19 @@ pub fn list_strategies() -> Vec<Assign> {
 }
 
 /// A GPU context, or a failing test. A missing adapter is never a pass: install
-/// `mesa-vulkan-drivers` for Mesa's software Vulkan adapter (what CI does).
+/// `mesa-vulkan-drivers` for Mesa's software Vulkan adapter (what CI does). The device has
+/// WebGPU's default limits (8 storage buffers per stage, 4 bind groups), what every browser
+/// offers: every pipeline and strategy the tests render runs within them, and a binding
+/// beyond them fails the tests.
 pub fn gpu() -> GpuContext {
+    gpu_with(lightgrid::gpu::DeviceLimits::WebGpu)
+}
+
+/// [`gpu`] with `limits`: the adapter's for what asks for more than WebGPU's defaults (the
+/// 32-bit G-buffer's 64 bytes of colour attachments per sample).
+pub fn gpu_with(limits: lightgrid::gpu::DeviceLimits) -> GpuContext {
     let wanted = std::env::var("LIGHTGRID_ADAPTER").ok();
-    match GpuContext::new(wanted.as_deref()) {
+    match GpuContext::with_limits(wanted.as_deref(), limits) {
         Ok(ctx) => {
             // CI installs lavapipe; a GL fallback there would mean the install step broke.
             if std::env::var("CI").is_ok_and(|v| v == "true") && wanted.is_none() {

@@ -373,10 +373,6 @@ impl CullReport {
     }
 }
 
-/// Storage buffers the culling kernels' pipeline layouts bind in one stage at most (scatter's
-/// three groups; `tests/culler.rs` creates every strategy on a device with exactly this).
-pub(crate) const STORAGE_BUFFERS_PER_STAGE: u32 = 16;
-
 /// The caller-facing WGSL's own part: the grid's bindings (at group `LIGHT_GRID_GROUP`) and
 /// the accessors. The cell addressing and z-bin walk are lightgrid's own parts, whose names
 /// already carry the `light_grid` prefix, so nothing collides with the caller's names.
@@ -556,10 +552,10 @@ fn check_config(device: &wgpu::Device, config: &CullConfig) -> Result<(), CullEr
             ),
         );
     }
-    // A device binding fewer storage buffers per stage than `STORAGE_BUFFERS_PER_STAGE` runs
-    // the strategies that fit it (a browser's 10 run `gather`); one that does not fit is
-    // refused when it is created, with the device's (or the browser's) message naming the
-    // limit and the count.
+    // A device binding fewer storage buffers per stage than WebGPU's default 8 (what gather,
+    // the BVH walks and scatter's emit kernel bind) runs the strategies that fit it; one that does not fit is refused
+    // when it is created, with the device's (or the browser's) message naming the limit and
+    // the count.
     Ok(())
 }
 
@@ -717,18 +713,14 @@ impl LightCuller {
         })
     }
 
-    /// The limits a device needs for the culler: the defaults, with the 16 storage buffers per
-    /// stage the kernels bind and the adapter's largest storage bindings (long light lists),
-    /// for `wgpu::DeviceDescriptor::required_limits`.
-    pub fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
-        let a = adapter.limits();
-        wgpu::Limits {
-            max_storage_buffers_per_shader_stage: STORAGE_BUFFERS_PER_STAGE
-                .max(wgpu::Limits::default().max_storage_buffers_per_shader_stage),
-            max_storage_buffer_binding_size: a.max_storage_buffer_binding_size,
-            max_buffer_size: a.max_buffer_size,
-            ..wgpu::Limits::default()
-        }
+    /// The limits a device needs for the culler, for `wgpu::DeviceDescriptor::required_limits`:
+    /// WebGPU's defaults, what every browser offers. Every strategy's kernels bind at most
+    /// 8 storage buffers per stage in at most 3 groups, and a
+    /// caller's shading pass adds the grid's group (3). The adapter is not consulted; a
+    /// caller wanting index lists longer than the default 128 MiB binding raises
+    /// `max_storage_buffer_binding_size` itself (the culler reads the device's limits).
+    pub fn required_limits(_adapter: &wgpu::Adapter) -> wgpu::Limits {
+        wgpu::Limits::default()
     }
 
     /// The caller's shading pass's WGSL for the grid at bind group `group`: the bindings, and

@@ -5,3 +5,7 @@ fn light_cull(l: u32) -> CullRecord {
     let light = lights[l];
     return CullRecord(light_bounds[l], light.position, light.range, light.direction, light.cos_outer);
 }
+
+fn light_sphere(l: u32) -> vec4<f32> {
+    return light_bounds[l];
+}

@@ -29,7 +29,7 @@ fn item(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 }
 
 fn view_centre(l: u32) -> vec3<f32> {
-    return (frame.view * vec4<f32>(light_cull(l).sphere.xyz, 1.0)).xyz;
+    return (frame.view * vec4<f32>(light_sphere(l).xyz, 1.0)).xyz;
 }
 
 @compute @workgroup_size(ASSIGN_THREADS)
@@ -85,7 +85,7 @@ fn leaves_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     for (; k < count; k = k + 1u) {
         let l = vals[first + k];
         let c = view_centre(l);
-        let r = light_cull(l).sphere.w;
+        let r = light_sphere(l).w;
         // The padding of `pad` in bvh.rs: GPU and CPU view positions differ by a few ulps.
         let e = r * 2e-4 + max(max(abs(c.x), abs(c.y)), abs(c.z)) * 1e-5 + 1e-5;
         let b = reach_box(l, c, r);

@@ -9,6 +9,9 @@
 //! the cursor's order (the tests compare them as sets).
 
 use crate::consts::{ASSIGN_THREADS, COUNTER_ITEM_ARGS};
+use crate::culling::bounds::cell_bounds::CellBoundsPass;
+use crate::culling::frame::CullFrame;
+use crate::culling::grid::{GridBuffers, GridDims};
 use crate::culling::strategies::gpu_assign::{
     copy_dispatch_args, indirect_args_buffer, ASSIGN_GROUP1,
 };
@@ -248,37 +251,26 @@ fn pass(
     }
 }
 
-impl AssignStrategy for ScatterStrategy {
-    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
-        let AssignFrame {
-            f,
-            grid,
-            bounds,
-            dims,
-            ..
-        } = a;
+impl ScatterStrategy {
+    /// Room for the frame's lights and pairs, and each kernel's groups 1 and 2; returns the
+    /// pair slots (the whole pair buffer is sorted: its bound length is what the kernels see).
+    fn prepare(
+        &mut self,
+        f: &CullFrame,
+        grid: &mut GridBuffers,
+        bounds: &CellBoundsPass,
+        dims: &GridDims,
+    ) -> (u64, Vec<[Option<wgpu::BindGroup>; 2]>) {
         let device = f.device;
-        let lights = f.light_count as u64;
-        grow_storage(
-            device,
-            &mut self.light_items,
-            "scatter light items",
-            lights.max(1) * 4,
-        );
-        grow_storage(
-            device,
-            &mut self.item_offsets,
-            "scatter item offsets",
-            lights.max(1) * 4,
-        );
-        grow_storage(
-            device,
-            &mut self.light_rects,
-            "scatter light rects",
-            lights.max(1) * 16,
-        );
+        let lights = (f.light_count as u64).max(1);
+        for (buffer, label, bytes) in [
+            (&mut self.light_items, "scatter light items", 4),
+            (&mut self.item_offsets, "scatter item offsets", 4),
+            (&mut self.light_rects, "scatter light rects", 16),
+        ] {
+            grow_storage(device, buffer, label, lights * bytes);
+        }
         self.sort.ensure(device, self.pairs.entries);
-        // The whole pair buffer is sorted: its bound length is what the kernels see.
         let slots = self.sort.keys.size() / 4;
         grid.ensure(device, f.queue, dims, dims.cell_count(), slots as usize);
         let group1 = [
@@ -297,11 +289,27 @@ impl AssignStrategy for ScatterStrategy {
             &self.item_total,
             &self.light_rects,
         ];
-        let groups: Vec<_> = self
+        let groups = self
             .kernels
             .iter()
             .map(|k| k.bind(device, &group1, &group2))
             .collect();
+        (slots, groups)
+    }
+}
+
+impl AssignStrategy for ScatterStrategy {
+    fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
+        let AssignFrame {
+            f,
+            grid,
+            bounds,
+            dims,
+            ..
+        } = a;
+        let device = f.device;
+        let lights = f.light_count as u64;
+        let (slots, groups) = self.prepare(f, grid, bounds, dims);
         let k = |i: usize| (&self.kernels[i], &groups[i]);
         let step = |i: usize, d| (k(i).0, k(i).1, d);
         let (encoder, timer) = enc.parts();

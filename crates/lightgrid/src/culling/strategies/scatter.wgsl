@@ -39,7 +39,7 @@ fn rect_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (l >= frame.light_count) {
         return;
     }
-    let b = light_cull(l).sphere;
+    let b = light_sphere(l);
     let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
     let rect = light_tiles(c, b.w);
     light_rects[l] = rect;

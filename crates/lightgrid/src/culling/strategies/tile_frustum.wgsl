@@ -171,10 +171,13 @@ fn reach_box(l: u32, c: vec3<f32>, radius: f32) -> array<vec3<f32>, 2> {
 // its cone, the cone may reach the frustum's bounding sphere and the sector's box reaches
 // into the frustum.
 fn light_in_tile(f: TileFrustum, l: u32) -> bool {
-    let light = light_cull(l);
-    let b = light.sphere;
+    let b = light_sphere(l);
     let c = (frame.view * vec4<f32>(b.xyz, 1.0)).xyz;
-    if (!sphere_in_tile(f, c, b.w) || cone_margin(light, f.sphere) < 0.0) {
+    if (!sphere_in_tile(f, c, b.w)) {
+        return false;
+    }
+    let light = light_cull(l);
+    if (cone_margin(light, f.sphere) < 0.0) {
         return false;
     }
     if (frame.spot_cull == 0u || light.cos_outer <= 0.0) {

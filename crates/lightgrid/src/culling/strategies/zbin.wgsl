@@ -27,7 +27,7 @@ fn item(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 }
 
 fn view_sphere(l: u32) -> vec4<f32> {
-    let b = light_cull(l).sphere;
+    let b = light_sphere(l);
     return vec4<f32>((frame.view * vec4<f32>(b.xyz, 1.0)).xyz, b.w);
 }
 
