@@ -154,7 +154,8 @@ impl GridBuilder {
     /// cannot run it fails here rather than at the first frame.
     pub(crate) fn prepare(&mut self, device: &wgpu::Device) -> Result<()> {
         // `auto`: the strategy of small light counts; the other one at the first frame that
-        // needs it (a browser binding 10 storage buffers runs `gather`, not `bvh-gpu`).
+        // needs it (a device below WebGPU's default 8 storage buffers per stage may run
+        // `gather`, 7, and not `bvh-gpu`, 8).
         let a = self.assign.resolve(0, self.software_adapter);
         self.strategy(device, a)?;
         Ok(())

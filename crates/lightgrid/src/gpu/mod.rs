@@ -192,6 +192,18 @@ pub fn bind_resources(
     })
 }
 
+/// A 16-byte INDIRECT buffer that dispatch arguments written by a kernel (into the frame
+/// counters, or the cell lists' header) are copied to: a buffer bound for storage cannot
+/// also feed an indirect dispatch in the same pass.
+pub(crate) fn indirect_args_buffer(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: 16,
+        usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 /// A storage buffer (also copy source and destination) of at least `size` bytes.
 pub(crate) fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

@@ -324,7 +324,7 @@ impl CellBoundsPass {
             params,
             bounds: storage_buffer(device, "cell bounds", 1 << 14),
             lists: storage_buffer(device, "cell lists", 1 << 13),
-            dispatch_args: crate::culling::strategies::gpu_assign::indirect_args_buffer(
+            dispatch_args: crate::gpu::indirect_args_buffer(
                 device,
                 "occupied cells dispatch arguments",
             ),

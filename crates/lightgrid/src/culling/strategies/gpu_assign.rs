@@ -22,7 +22,8 @@ use crate::culling::strategies::{AssignFrame, ListCapacity, StrategyContext};
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
-    bind_resources, buffer_layout, CounterValues, PassTimer, STORAGE_READ, STORAGE_RW, UNIFORM,
+    bind_resources, buffer_layout, indirect_args_buffer, CounterValues, PassTimer, STORAGE_READ,
+    STORAGE_RW, UNIFORM,
 };
 use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
@@ -103,17 +104,6 @@ impl AssignCommon {
             ],
         )
     }
-}
-
-/// A 16-byte INDIRECT buffer that dispatch arguments written into the frame counters are
-/// copied to.
-pub fn indirect_args_buffer(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: 16,
-        usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 /// Record the copy of three dispatch arguments from frame-counter slot `slot` on.

@@ -12,9 +12,7 @@ use crate::consts::{ASSIGN_THREADS, COUNTER_ITEM_ARGS};
 use crate::culling::bounds::cell_bounds::CellBoundsPass;
 use crate::culling::frame::CullFrame;
 use crate::culling::grid::{GridBuffers, GridDims};
-use crate::culling::strategies::gpu_assign::{
-    copy_dispatch_args, indirect_args_buffer, ASSIGN_GROUP1,
-};
+use crate::culling::strategies::gpu_assign::{copy_dispatch_args, ASSIGN_GROUP1};
 use crate::culling::strategies::radix_sort::RadixSort;
 use crate::culling::strategies::scan::ScanPass;
 use crate::culling::strategies::{
@@ -23,7 +21,8 @@ use crate::culling::strategies::{
 use crate::error::Result;
 use crate::frame::FrameEncoder;
 use crate::gpu::{
-    buffer_entry, groups_1d, grow_storage, storage_buffer, CounterValues, PassTimer, STORAGE_RW,
+    buffer_entry, groups_1d, grow_storage, indirect_args_buffer, storage_buffer, CounterValues,
+    PassTimer, STORAGE_RW,
 };
 use crate::shader::{compose, compute_pipeline, parts, src, ComposedShader};
 
