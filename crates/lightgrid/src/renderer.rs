@@ -145,6 +145,17 @@ struct Uploaded<'s> {
     shadow_maps: Option<crate::shadows::maps::MapFrame>,
 }
 
+/// The frame's shadow maps when its pipeline re-uses one light's maps (`ReusedShadowMaps`).
+fn reused_maps<'a>(
+    atlas: &'a ShadowAtlas,
+    up: &'a Uploaded,
+) -> Option<crate::passes::shadow_atlas::ReusedMaps<'a>> {
+    up.shadow_maps
+        .as_ref()
+        .filter(|m| m.reused)
+        .map(|frame| crate::passes::shadow_atlas::ReusedMaps { atlas, frame })
+}
+
 /// Whose culler a report came from: a technique's (its pipeline id) or the transparent
 /// pass's own grid (`None`).
 type CullerOwner = Option<&'static str>;
@@ -860,12 +871,7 @@ impl Renderer {
         let (device, queue) = (&self.device, &self.queue);
         let technique = self.techniques.get_mut(info.id).expect("prepared");
         self.timer.reset();
-        let reused = up.shadow_maps.as_ref().filter(|m| m.reused).map(|frame| {
-            crate::passes::shadow_atlas::ReusedMaps {
-                atlas: &self.shadow_atlas,
-                frame,
-            }
-        });
+        let reused = reused_maps(&self.shadow_atlas, up);
         let inputs = FrameInputs {
             device,
             queue,
