@@ -552,10 +552,10 @@ fn check_config(device: &wgpu::Device, config: &CullConfig) -> Result<(), CullEr
             ),
         );
     }
-    // A device binding fewer storage buffers per stage than WebGPU's default 8 (what gather,
-    // the BVH walks and scatter's emit kernel bind) runs the strategies that fit it; one that does not fit is refused
-    // when it is created, with the device's (or the browser's) message naming the limit and
-    // the count.
+    // A device binding fewer storage buffers per stage than WebGPU's default 8 (what the BVH
+    // walks and scatter's emit kernel bind) runs the strategies that fit it; one that does not
+    // fit is refused when it is created, with the device's (or the browser's) message naming
+    // the limit and the count.
     Ok(())
 }
 

@@ -45,6 +45,8 @@ pub struct GpuBvhBuild {
     inner: wgpu::ComputePipeline,
     params: UniformSlots,
     nodes: wgpu::Buffer,
+    /// The nodes the last `encode` built (0 without lights).
+    node_count: usize,
     centre_box: wgpu::Buffer,
     sort: RadixSort,
 }
@@ -69,6 +71,7 @@ impl GpuBvhBuild {
             layout,
             params: UniformSlots::new::<LevelParams>(device, "bvh build levels", MAX_LEVELS),
             nodes: storage_buffer(device, "bvh nodes (gpu build)", 1 << 12),
+            node_count: 0,
             centre_box: storage_buffer(device, "bvh centre box", 32),
             sort: RadixSort::new(device),
         }
@@ -79,11 +82,13 @@ impl GpuBvhBuild {
     pub fn encode(&mut self, f: &CullFrame, enc: &mut FrameEncoder, scan: &ScanPass) {
         let device = f.device;
         let n = f.light_count as u32;
+        self.node_count = 0;
         if n == 0 {
             return;
         }
         let levels = bvh_levels(n as usize);
         let node_count: u32 = levels.iter().map(|l| l.1).sum();
+        self.node_count = node_count as usize;
         grow_storage(
             device,
             &mut self.nodes,
@@ -174,15 +179,10 @@ impl GpuBvhBuild {
         }
     }
 
-    /// The nodes (and their number for `lights` lights) and the order for the traversal's
-    /// group 2.
-    pub fn buffers(&self, lights: usize) -> ((&wgpu::Buffer, usize), &wgpu::Buffer) {
-        let nodes = if lights == 0 {
-            0
-        } else {
-            bvh_levels(lights).iter().map(|l| l.1 as usize).sum()
-        };
-        ((&self.nodes, nodes), &self.sort.vals)
+    /// The nodes the last `encode` built (and their number) and the order, for the
+    /// traversal's group 2.
+    pub fn buffers(&self) -> ((&wgpu::Buffer, usize), &wgpu::Buffer) {
+        ((&self.nodes, self.node_count), &self.sort.vals)
     }
 }
 
@@ -207,7 +207,7 @@ impl AssignStrategy for GpuBvhStrategy {
     fn encode(&mut self, a: AssignFrame, enc: &mut FrameEncoder) -> Result<StrategyRun> {
         self.build.encode(a.f, enc, self.kernels.scan());
         let lights = a.f.light_count;
-        let (nodes, order) = self.build.buffers(lights);
+        let (nodes, order) = self.build.buffers();
         let group = self
             .buffers
             .copy(a.f.device, enc.parts().0, lights, nodes, order);
