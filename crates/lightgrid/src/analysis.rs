@@ -11,7 +11,7 @@ use crate::culling::{
 use crate::error::Result;
 use crate::frame::{FinishedFrame, FrameIo, RenderSettings};
 use crate::memory::{ForwardPlusTable1, FrameMemory, MemoryModel};
-use crate::passes::{BufferReadback, DepthSamples, Readback, Targets};
+use crate::passes::{BufferReadback, DepthBits, DepthSamples, Readback, Targets};
 use crate::pipelines::PipelineInfo;
 use crate::scene::{rasterize, FrameState, Light};
 use crate::stats::{FrameStats, TimingSource};
@@ -100,6 +100,8 @@ impl CountsReadback {
 enum DepthReadback {
     Target(Readback),
     Samples(DepthSamples),
+    /// Drawn into a copyable target first (GL: `DepthBits`).
+    Drawn(DepthBits),
 }
 
 /// The staging buffers an analysis frame copies its image, counts and depth into.
@@ -112,7 +114,14 @@ pub(crate) struct AnalysisReadbacks {
 }
 
 impl AnalysisReadbacks {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
+    /// `depth_copies`: the device copies depth textures to buffers
+    /// (`DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES`; not GL).
+    pub fn new(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+        samples: u32,
+        depth_copies: bool,
+    ) -> Self {
         let size = (width, height);
         AnalysisReadbacks {
             image: Readback::new(device, "image readback", width, height),
@@ -120,6 +129,8 @@ impl AnalysisReadbacks {
             opaque_counts: CountsReadback::new(device, "opaque counts readback", size, samples),
             depth: if samples > 1 {
                 DepthReadback::Samples(DepthSamples::new(device, size, samples))
+            } else if !depth_copies {
+                DepthReadback::Drawn(DepthBits::new(device, size))
             } else {
                 DepthReadback::Target(Readback::new(device, "depth readback", width, height))
             },
@@ -155,6 +166,7 @@ impl AnalysisReadbacks {
                 wgpu::TextureAspect::DepthOnly,
             ),
             DepthReadback::Samples(d) => d.encode(device, encoder, &targets.depth),
+            DepthReadback::Drawn(d) => d.encode(device, encoder, &targets.depth),
         }
     }
 
@@ -163,6 +175,7 @@ impl AnalysisReadbacks {
         match &self.depth {
             DepthReadback::Target(r) => Ok(vec![r.read_f32(device)?]),
             DepthReadback::Samples(d) => d.read(device),
+            DepthReadback::Drawn(d) => Ok(vec![d.read(device)?]),
         }
     }
 }

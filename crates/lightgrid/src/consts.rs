@@ -30,6 +30,10 @@ pub const MIN_TILE_SIZE: u32 = 4;
 /// Largest tile edge `--tile` accepts, in pixels.
 pub const MAX_TILE_SIZE: u32 = 64;
 
+/// Texels of a light in the texture grid's light texture (`Rgba32Float`, 16 bytes each:
+/// `GpuLight`'s size / 16; `culling/texture_grid.rs`).
+pub const LIGHT_TEXELS: u32 = (std::mem::size_of::<crate::gpu_types::GpuLight>() / 16) as u32;
+
 /// Threads along one edge of a per-tile workgroup (depth bounds, single-kernel tiled deferred):
 /// 16×16 = 256 invocations stride over the tile's pixels, so any tile size works.
 pub(crate) const TILE_THREADS: u32 = 16;
@@ -368,6 +372,7 @@ pub const WGSL_CONSTS: &[(&str, WgslConst)] = &[
     ),
     ("SHADOW_NO_TREE", WgslConst::U32(SHADOW_NO_TREE)),
     ("MAX_TILE_SIZE", WgslConst::U32(MAX_TILE_SIZE)),
+    ("LIGHT_TEXELS", WgslConst::U32(LIGHT_TEXELS)),
     ("TILE_THREADS", WgslConst::U32(TILE_THREADS)),
     ("TILE_LIGHT_BATCH", WgslConst::U32(TILE_LIGHT_BATCH)),
     ("ASSIGN_DEPTH_SLACK", WgslConst::F32(ASSIGN_DEPTH_SLACK)),

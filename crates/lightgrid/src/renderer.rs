@@ -30,7 +30,7 @@ use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::passes::base_textures::BaseTextures;
 use crate::passes::shadow_atlas::ShadowAtlas;
 use crate::passes::{scene_layout_with, SceneBounds, Targets, Tonemap};
-use crate::pipelines::{self, PipelineContext, Technique, TransparentPass};
+use crate::pipelines::{self, PipelineContext, Technique, TransparentLights, TransparentPass};
 use crate::scene::{Draw, FrameState, Geometry, Light, Lighting, Scene, Shading, SpotCull};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, OnceLock};
@@ -176,6 +176,9 @@ pub struct Renderer {
     queue: wgpu::Queue,
     /// R32Float blends (`GpuContext::count_blend`): forward pipelines count lighting.
     count_blend: bool,
+    /// The adapter runs the compute grid and the compute passes reading depth
+    /// ([`Renderer::runs_compute`]); not wgpu's GL backend.
+    compute_grid: bool,
     /// `GpuContext::adapter_label`, for the statistics.
     adapter_label: String,
     targets: Targets,
@@ -301,7 +304,13 @@ impl Renderer {
         let dims = GridDims::new(width, height, settings.grid.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {
-            let targets = Targets::new(device, width, height, settings.grid.samples);
+            let targets = Targets::new(
+                device,
+                width,
+                height,
+                settings.grid.samples,
+                ctx.count_blend,
+            );
             let scene_layout =
                 [SceneBounds::Vertex, SceneBounds::Compute].map(|b| scene_layout_with(device, b));
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
@@ -340,6 +349,7 @@ impl Renderer {
                 device: device.clone(),
                 queue: ctx.queue.clone(),
                 count_blend: ctx.count_blend,
+                compute_grid: Renderer::runs_compute(ctx),
                 adapter_label: ctx.adapter_label(),
                 targets,
                 tonemap: Tonemap::new(device, settings.grid.samples),
@@ -367,7 +377,13 @@ impl Renderer {
                 transparent: None,
                 settings,
                 dims,
-                readbacks: AnalysisReadbacks::new(device, width, height, settings.grid.samples),
+                readbacks: AnalysisReadbacks::new(
+                    device,
+                    (width, height),
+                    settings.grid.samples,
+                    ctx.downlevel()
+                        .contains(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES),
+                ),
                 serial: 0,
                 in_flight: VecDeque::new(),
                 finished: Vec::new(),
@@ -411,6 +427,7 @@ impl Renderer {
                     wgpu::BindingResource::TextureView(&atlas.view),
                     wgpu::BindingResource::Sampler(&atlas.sampler),
                     wgpu::BindingResource::Sampler(&textures.nearest),
+                    wgpu::BindingResource::TextureView(&textures.view),
                 ],
             )
         })
@@ -433,7 +450,57 @@ impl Renderer {
         &self.targets.ldr
     }
 
+    /// Does `ctx`'s adapter run compute shaders reading depth and storage buffers written by
+    /// fragment shaders (every pipeline)? Not wgpu's GL backend: it cannot `textureLoad` a
+    /// depth texture as depth (naga's GLSL has no such load), llvmpipe GL's multisampled
+    /// reads in compute return 0, and WebGL2 has neither compute nor storage buffers. There
+    /// `forward` and the texture grid's tiled forward run (`--grid-storage auto` picks it).
+    pub fn runs_compute(ctx: &GpuContext) -> bool {
+        use wgpu::DownlevelFlags as D;
+        ctx.downlevel()
+            .contains(D::COMPUTE_SHADERS | D::FRAGMENT_WRITABLE_STORAGE)
+            && ctx.info.backend != wgpu::Backend::Gl
+    }
+
+    /// Refuse what an adapter without the compute grid cannot render right (`runs_compute`).
+    fn check_downlevel(&self, info: &pipelines::PipelineInfo) -> Result<()> {
+        if self.compute_grid {
+            return Ok(());
+        }
+        let textures =
+            self.settings.grid_storage.resolve(false) == crate::frame::GridStorage::Textures;
+        let reason = if self.settings.grid.samples > 1 {
+            Some(
+                "MSAA (its analysis and edge passes read multisampled depth in compute)"
+                    .to_string(),
+            )
+        } else if info.id == pipelines::ids::FORWARD || (info.texture_grid && textures) {
+            None
+        } else if info.texture_grid {
+            Some(format!(
+                "{} with --grid-storage buffers (its grid is built by compute passes)",
+                info.id
+            ))
+        } else {
+            Some(format!(
+                "{} (it reads depth or builds its grid in compute passes)",
+                info.id
+            ))
+        };
+        match reason {
+            None => Ok(()),
+            Some(what) => Err(Error::invalid(
+                "adapter",
+                format!(
+                    "{} cannot run {what}: wgpu's GL backend cannot load depth textures in shaders and llvmpipe GL's multisampled compute reads return 0, so it runs `forward` and tiled_forward / tiled_forward_prez with --grid-storage textures at 1 sample; use a Vulkan, Metal or DX12 adapter for the rest",
+                    self.adapter_label
+                ),
+            )),
+        }
+    }
+
     fn prepare_technique(&mut self, info: &'static pipelines::PipelineInfo) -> Result<()> {
+        self.check_downlevel(info)?;
         if let (true, pipelines::Msaa::Refused(reason)) =
             (self.settings.grid.samples > 1, info.msaa)
         {
@@ -456,6 +523,7 @@ impl Renderer {
                 settings: self.settings,
                 shading: self.shading,
                 count_blend: self.count_blend,
+                compute_grid: self.compute_grid,
             };
             let stage = format!("creating pipeline {}", info.id);
             let t = scoped(device, &stage, || (info.create)(&ctx))?.map_err(|e| match e {
@@ -469,12 +537,19 @@ impl Renderer {
                 },
                 e => e,
             })?;
+            let own_grid = matches!(t.transparent_lights(), TransparentLights::Own);
             self.techniques.insert(info.id, t);
             if self.transparent.is_none() {
                 let pass = scoped(device, "creating the transparent pass", || {
                     TransparentPass::new(&ctx)
                 })??;
                 self.transparent = Some(pass);
+            }
+            if own_grid {
+                let pass = self.transparent.as_mut().expect("created above");
+                scoped(device, "creating the transparent pass's grid", || {
+                    pass.ensure_own_grid(&ctx)
+                })??;
             }
         }
         Ok(())
@@ -1033,7 +1108,7 @@ impl Renderer {
             }
             let culler = match owner {
                 Some(id) => self.techniques.get_mut(id).and_then(|t| t.culler()),
-                None => self.transparent.as_mut().map(|t| t.culler_mut()),
+                None => self.transparent.as_mut().and_then(|t| t.culler_mut()),
             };
             let Some(culler) = culler else {
                 break;

@@ -11,6 +11,7 @@ mod grid;
 mod oracle;
 mod spot_ray;
 mod strategies;
+pub(crate) mod texture_grid;
 
 pub use crate::frame::{Assign, CullConfig, AUTO_GATHER_MAX_LIGHTS};
 pub use crate::scene::{ViewLight, ViewSetup};

@@ -12,7 +12,7 @@ pub mod targets;
 
 pub use settings::{
     validate_msaa, validate_tile_size, Assign, Brdf, CellBox, CullConfig, DepthBounds, DepthMask,
-    DepthReduction, GBufferFormat, GridLists, LightLoop, MaterialDraws, MsaaResolve,
+    DepthReduction, GBufferFormat, GridLists, GridStorage, LightLoop, MaterialDraws, MsaaResolve,
     RenderSettings, Shadows, SpotCull, AUTO_GATHER_MAX_LIGHTS,
 };
 pub(crate) use settings::{

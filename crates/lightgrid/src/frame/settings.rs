@@ -19,6 +19,10 @@ pub struct RenderSettings {
     /// The light loop of grid pipelines (`--light-loop`).
     #[serde(default)]
     pub light_loop: LightLoop,
+    /// Where tiled forward keeps its grid (`--grid-storage`): storage buffers built by a
+    /// `LightCuller`, or textures built on the CPU (no compute; `culling/texture_grid.rs`).
+    #[serde(default)]
+    pub grid_storage: GridStorage,
     /// The light function's BRDF (`--brdf`); `None` (`auto`): the scene's own
     /// (`scene::Lighting::brdf`: Blinn-Phong for the catalog, GGX for glTF files).
     #[serde(default)]
@@ -169,6 +173,50 @@ impl LightLoop {
         match self {
             LightLoop::Lane => "lane",
             LightLoop::Subgroup => "subgroup",
+        }
+    }
+}
+
+/// Where `tiled_forward` and `tiled_forward_prez` keep their light grid (`--grid-storage`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GridStorage {
+    /// Textures where the adapter cannot run the compute grid (no compute shaders or no
+    /// storage buffers in fragment shaders, or wgpu's GL backend, whose compute cannot read
+    /// depth), else buffers.
+    #[default]
+    Auto,
+    /// Storage buffers, built by the `--assign` strategy (a `LightCuller`).
+    Buffers,
+    /// Textures read with `textureLoad`, built on the CPU, with no compute pass
+    /// (tiled-forward-shading §4.2; `culling/texture_grid.rs`).
+    Textures,
+}
+
+impl GridStorage {
+    /// Every value `--grid-storage` accepts, the default first.
+    pub const ALL: [GridStorage; 3] = [
+        GridStorage::Auto,
+        GridStorage::Buffers,
+        GridStorage::Textures,
+    ];
+
+    /// The value's name, as `--grid-storage` takes it and results show it.
+    pub fn name(self) -> &'static str {
+        match self {
+            GridStorage::Auto => "auto",
+            GridStorage::Buffers => "buffers",
+            GridStorage::Textures => "textures",
+        }
+    }
+
+    /// `Buffers` or `Textures`: `Auto` resolved for an adapter that runs the compute grid
+    /// (`compute_grid`) or not.
+    pub fn resolve(self, compute_grid: bool) -> GridStorage {
+        match (self, compute_grid) {
+            (GridStorage::Auto, true) => GridStorage::Buffers,
+            (GridStorage::Auto, false) => GridStorage::Textures,
+            (s, _) => s,
         }
     }
 }
@@ -359,6 +407,7 @@ impl Default for RenderSettings {
             material_draws: MaterialDraws::PerMaterial,
             msaa_resolve: MsaaResolve::Separate,
             light_loop: LightLoop::Lane,
+            grid_storage: GridStorage::Auto,
             brdf: None,
             shadows: Shadows::Off,
             shadow_lights: None,

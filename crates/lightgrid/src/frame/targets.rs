@@ -167,7 +167,15 @@ impl Targets {
             + bytes(LDR_FORMAT)
     }
 
-    pub fn new(device: &wgpu::Device, width: u32, height: u32, samples: u32) -> Self {
+    /// `count_blend`: forward pipelines count into the count target (`counts_in_target`); else
+    /// it is not a render attachment (GL cannot render into R32Float at all).
+    pub fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        samples: u32,
+        count_blend: bool,
+    ) -> Self {
         let make =
             |label, format, usage| render_texture(device, label, format, (width, height), usage);
         let make_ms = |label, format, usage| {
@@ -190,10 +198,15 @@ impl Targets {
             DEPTH_FORMAT,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | depth_usage,
         );
+        let rendered = if count_blend {
+            U::RENDER_ATTACHMENT
+        } else {
+            U::empty()
+        };
         let counts_texture = make(
             "lighting counts",
             COUNT_FORMAT,
-            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::COPY_SRC,
+            rendered | U::STORAGE_BINDING | U::COPY_SRC,
         );
         // COPY_DST: the MSAA kernels' in-kernel resolve copies its colours in;
         // TEXTURE_BINDING: the viewer draws it onto its window.

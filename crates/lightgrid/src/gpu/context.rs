@@ -65,6 +65,15 @@ fn instance(display: Option<Display>) -> wgpu::Instance {
     })
 }
 
+/// The backends searched for `wanted`: GL only when asked for by name (`--adapter gl`), as
+/// it runs fewer pipelines (`GpuContext::gl_refusal`).
+fn backends_for(wanted: Option<&str>) -> wgpu::Backends {
+    match wanted.map(|w| w.trim().to_lowercase()).as_deref() {
+        Some("gl") | Some("opengl") => wgpu::Backends::GL,
+        _ => BACKENDS,
+    }
+}
+
 fn rank(info: &wgpu::AdapterInfo) -> u32 {
     match info.device_type {
         wgpu::DeviceType::DiscreteGpu => 0,
@@ -75,8 +84,8 @@ fn rank(info: &wgpu::AdapterInfo) -> u32 {
     }
 }
 
-fn sorted_adapters(instance: &wgpu::Instance) -> Vec<wgpu::Adapter> {
-    let mut adapters = pollster::block_on(instance.enumerate_adapters(BACKENDS));
+fn sorted_adapters(instance: &wgpu::Instance, backends: wgpu::Backends) -> Vec<wgpu::Adapter> {
+    let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
     adapters.sort_by_key(|a| rank(&a.get_info()));
     adapters
 }
@@ -95,7 +104,7 @@ fn summarize(index: usize, info: &wgpu::AdapterInfo) -> AdapterSummary {
 
 /// Every adapter wgpu sees, in preference order (index 0 is the default choice).
 pub fn list_adapters() -> Vec<AdapterSummary> {
-    sorted_adapters(&instance(None))
+    sorted_adapters(&instance(None), BACKENDS)
         .iter()
         .enumerate()
         .map(|(i, a)| summarize(i, &a.get_info()))
@@ -137,7 +146,10 @@ fn matches(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
         return i == index;
     }
     let backend = format!("{:?}", info.backend).to_lowercase();
-    backend == w || info.name.to_lowercase().contains(&w) || info.driver.to_lowercase().contains(&w)
+    backend == w
+        || (w == "opengl" && backend == "gl")
+        || info.name.to_lowercase().contains(&w)
+        || info.driver.to_lowercase().contains(&w)
 }
 
 impl GpuContext {
@@ -164,7 +176,7 @@ impl GpuContext {
         limits: DeviceLimits,
     ) -> Result<Self> {
         let instance = instance(display);
-        let adapters = sorted_adapters(&instance);
+        let adapters = sorted_adapters(&instance, backends_for(wanted));
         if adapters.is_empty() {
             return Err(Error::NoAdapter(NO_ADAPTER_HELP.to_string()));
         }
@@ -173,11 +185,6 @@ impl GpuContext {
             Some(w) if w.trim().is_empty() => {
                 return Err(Error::NoAdapter(
                     "--adapter is empty; give an index from `lightgrid list`, a backend (vulkan) or part of an adapter's name".into(),
-                ))
-            }
-            Some(w) if w.trim().eq_ignore_ascii_case("gl") || w.trim().eq_ignore_ascii_case("opengl") => {
-                return Err(Error::NoAdapter(
-                    "GL adapters are not supported: lightgrid's lighting-count target needs R32Float blending and forward shaders write storage buffers, which the GL backend lacks; use Vulkan (on a machine without a GPU: `sudo apt-get install -y mesa-vulkan-drivers libvulkan1`)".into(),
                 ))
             }
             Some(w) => {
@@ -346,6 +353,12 @@ impl GpuContext {
                     })
             })
             .collect()
+    }
+
+    /// What the adapter can do beyond or short of WebGPU (`wgpu::DownlevelFlags`): GL lacks
+    /// depth-to-buffer copies; WebGL2 compute shaders and storage buffers.
+    pub fn downlevel(&self) -> wgpu::DownlevelFlags {
+        self.adapter.get_downlevel_capabilities().flags
     }
 
     /// Largest 2D texture edge the device accepts.

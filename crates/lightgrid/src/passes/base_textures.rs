@@ -141,14 +141,14 @@ fn sampler_descriptor() -> wgpu::SamplerDescriptor<'static> {
     }
 }
 
-/// The layout entry of binding 10, the nearest sampler, fragment stage.
-pub(crate) fn nearest_layout_entry() -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding: 10,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-        count: None,
-    }
+/// The layout entries of binding 10, the nearest sampler, and 11, the same array again for
+/// it (fragment stage): GLSL combines a texture with one sampler, so the GL backend cannot
+/// sample one binding through two samplers.
+pub(crate) fn nearest_layout_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+    let [mut texture, mut sampler] = layout_entries();
+    texture.binding = 11;
+    sampler.binding = 10;
+    [sampler, texture]
 }
 
 /// The layout entries of bindings 5 (the array) and 6 (the sampler), fragment stage.

@@ -51,7 +51,9 @@ fn vs_main(v: VertexIn) -> VertexOut {
 @group(0) @binding(5) var base_textures: texture_2d_array<f32>;
 @group(0) @binding(6) var base_sampler: sampler;
 // Nearest-texel magnification, for textures whose glTF sampler asks for it.
+// The same array bound again for it: GLSL (the GL backend) pairs a texture with one sampler.
 @group(0) @binding(10) var nearest_sampler: sampler;
+@group(0) @binding(11) var base_textures_nearest: texture_2d_array<f32>;
 
 // Where a material's textures are read at a sample: both coordinate sets and their screen
 // derivatives (taken here, in uniform control flow, so textures can be read in branches
@@ -116,7 +118,7 @@ fn material_texel(m: Material, t: TexCoords, slot: u32, texture: u32, none: vec4
     );
     let layer = texture - 1u;
     if (((m.nearest >> slot) & 1u) != 0u) {
-        return textureSampleGrad(base_textures, nearest_sampler, uv, layer, ddx, ddy);
+        return textureSampleGrad(base_textures_nearest, nearest_sampler, uv, layer, ddx, ddy);
     }
     return textureSampleGrad(base_textures, base_sampler, uv, layer, ddx, ddy);
 }

@@ -2,6 +2,7 @@
 //! the scene bind group (group 0) and the tonemap pass.
 
 pub mod base_textures;
+pub(crate) mod depth_texels;
 mod gbuffer;
 pub(crate) mod geometry;
 mod light_volumes;
@@ -20,7 +21,7 @@ pub(crate) use light_volumes::{
     Fullscreen, FullscreenVolumeDesc, LightVolumes, VolumeDraw, VolumePipelineDesc, VOLUME_WGSL,
 };
 pub use readback::Readback;
-pub(crate) use readback::{BufferReadback, DepthSamples};
+pub(crate) use readback::{BufferReadback, DepthBits, DepthSamples};
 pub(crate) use tonemap::Tonemap;
 
 use crate::gpu_types::{FrameUniforms, GpuLight, GpuMaterial, GpuVertex};
@@ -34,6 +35,7 @@ pub fn shaders() -> Vec<ComposedShader> {
     out.extend(readback::DepthSamplesKey::all_shaders());
     out.push(gbuffer::shader());
     out.push(shadow_atlas::shader());
+    out.push(depth_texels::shader());
     out
 }
 
@@ -327,8 +329,9 @@ pub(crate) fn scene_layout_with(
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                 count: None,
             },
-            // The textures' nearest sampler (glTF's magFilter NEAREST).
-            base_textures::nearest_layout_entry(),
+            // The textures' nearest sampler (glTF's magFilter NEAREST) and the array again.
+            base_textures::nearest_layout_entries()[0],
+            base_textures::nearest_layout_entries()[1],
         ],
     })
 }

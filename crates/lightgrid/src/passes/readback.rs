@@ -230,3 +230,50 @@ impl DepthSamples {
             .collect())
     }
 }
+
+/// A single-sample depth target read back where it cannot be copied to a buffer (wgpu's GL
+/// backend lacks `DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES`): drawn bit for bit into
+/// an R32Uint target (`depth_texels.rs`), which is copied.
+pub(crate) struct DepthBits {
+    pass: super::depth_texels::DepthTexelPass,
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    readback: Readback,
+}
+
+impl DepthBits {
+    pub fn new(device: &wgpu::Device, (width, height): (u32, u32)) -> Self {
+        use super::depth_texels::{DepthTexelEntry, DepthTexelPass};
+        let entry = DepthTexelEntry::Bits;
+        let texture = crate::frame::targets::render_texture(
+            device,
+            "depth bits",
+            entry.format(),
+            (width, height),
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        DepthBits {
+            pass: DepthTexelPass::new(device, entry, 1),
+            view: texture.create_view(&Default::default()),
+            texture,
+            readback: Readback::new(device, "depth bits readback", width, height),
+        }
+    }
+
+    /// Record the drawing of `depth` (the frame's depth target) and its copy.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+    ) {
+        self.pass.draw(device, encoder, depth, &self.view, None);
+        self.readback
+            .encode(encoder, &self.texture, wgpu::TextureAspect::All);
+    }
+
+    /// The depth-buffer values (waits for the GPU).
+    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<f32>> {
+        self.readback.read_f32(device)
+    }
+}

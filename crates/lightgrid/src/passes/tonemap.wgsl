@@ -15,7 +15,7 @@ fn fs_tonemap(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(pos.xy);
     var sum = vec3<f32>(0.0);
     for (var s = 0u; s < SAMPLES; s = s + 1u) {
-        sum += tone(textureLoad(hdr, p, s).rgb);
+        sum += tone(textureLoad(hdr, p, i32(s)).rgb);
     }
     return vec4<f32>(sum / f32(SAMPLES), 1.0);
 }

@@ -11,7 +11,7 @@ use super::PipelineInfo;
 use crate::frame::CullConfig;
 use crate::frame::{
     Assign, Brdf, CellBox, DepthBounds, DepthMask, DepthReduction, GBufferFormat, GridLists,
-    LightLoop, MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull,
+    GridStorage, LightLoop, MaterialDraws, MsaaResolve, RenderSettings, Shadows, SpotCull,
 };
 
 /// A setting's values by name (the option's values, the results' columns).
@@ -154,6 +154,21 @@ impl SettingValue for LightLoop {
         match self {
             LightLoop::Lane => "each lane walks its own cell's lights",
             LightLoop::Subgroup => "the subgroup takes its lanes' lights one at a time for all of them (needs subgroups)",
+        }
+    }
+}
+
+impl SettingValue for GridStorage {
+    const FLAG: &'static str = "grid-storage";
+    const VALUES: &'static [Self] = &GridStorage::ALL;
+    fn name(self) -> &'static str {
+        GridStorage::name(self)
+    }
+    fn help(self) -> &'static str {
+        match self {
+            GridStorage::Auto => "textures where the adapter cannot run the compute grid (no compute or fragment storage buffers, or GL), else buffers",
+            GridStorage::Buffers => "storage buffers built by the --assign strategy",
+            GridStorage::Textures => "textures read with textureLoad, assigned on the CPU, no compute pass (tiled-forward-shading 4.2)",
         }
     }
 }
@@ -489,6 +504,19 @@ pub const AXES: &[Axis] = &[
             Ok(())
         },
         label: |v| format!("{v} loop"),
+    },
+    Axis {
+        flag: "grid-storage",
+        column: "grid_storage",
+        help: "where tiled forward keeps its light grid: storage buffers from a LightCuller, or textures built on the CPU that need no compute shaders or storage buffers (WebGL2, GL)",
+        values: values::<GridStorage>,
+        applies: |p, _| p.texture_grid,
+        get: |s| s.grid_storage.name().to_string(),
+        set: |s, v| {
+            s.grid_storage = GridStorage::parse(v)?;
+            Ok(())
+        },
+        label: |v| format!("{v} grid"),
     },
     Axis {
         flag: "brdf",

@@ -9,19 +9,91 @@
 //! clustered_forward (tiled-forward-shading §4.8): as tiled_forward_prez, with a grid of
 //! (tile, view-depth slice) clusters, each bounded by its own samples; each fragment reads its
 //! cluster's list.
+//!
+//! With `--grid-storage textures` (chosen by `auto` where the adapter cannot run the compute
+//! grid: GL, WebGL2) tiled_forward and tiled_forward_prez keep the grid in textures built on
+//! the CPU, with no compute pass (`culling/texture_grid.rs`); the pre-Z tile bounds are then
+//! drawn by a fragment shader and read back. Clusters are bounded by the compute cell-bounds
+//! kernel, so clustered_forward has no texture grid.
 
 use super::{
     begin_lighting_pass, draw_scene_materials, lighting_targets, DepthPipelines, FrameEncoder,
     FrameInputs, MaterialPipelines,
 };
 use super::{GeometryPipelineDesc, PipelineContext, RenderSettings, Technique, TransparentLights};
+use crate::culling::texture_grid::TextureGrid;
 use crate::culling::LightCuller;
 use crate::error::Result;
+use crate::frame::{Assign, CellBox, DepthBounds, DepthMask, GridStorage, LightLoop};
 use crate::memory::{MemoryModel, Traffic, DEPTH_BYTES, HDR_BYTES, INDEX_BYTES, LIGHT_BYTES};
 use crate::shader::{compose, create_module, parts, ComposedShader, SCENE_PARTS};
 
 pub(super) fn shaders() -> Vec<ComposedShader> {
-    crate::frame::LightLoop::ALL.map(shader).to_vec()
+    let mut out = crate::frame::LightLoop::ALL.map(shader).to_vec();
+    out.push(texel_shader());
+    out
+}
+
+/// The forward shading pass reading the texture grid (`--grid-storage textures`).
+fn texel_shader() -> ComposedShader {
+    let parts = parts![
+        crate::shader::TEXEL_SCENE_PARTS,
+        include_str!("tiled_forward.wgsl"),
+    ];
+    compose("tiled_forward (texture grid)", &parts)
+}
+
+/// Where the pipeline's grid lives (`--grid-storage`).
+enum Grid {
+    Buffers(super::PipelineGrid),
+    Textures(TextureGrid),
+}
+
+impl Grid {
+    fn layout(&self) -> &wgpu::BindGroupLayout {
+        match self {
+            Grid::Buffers(g) => g.bind_group_layout(),
+            Grid::Textures(g) => g.bind_group_layout(),
+        }
+    }
+
+    fn bind_group(&self) -> &wgpu::BindGroup {
+        match self {
+            Grid::Buffers(g) => g.bind_group(),
+            Grid::Textures(g) => g.bind_group(),
+        }
+    }
+}
+
+/// The texture grid, for the settings it can be built with: one sample, CPU assignment,
+/// each tile bounded by its samples' whole depth range, the lane loop.
+fn texture_grid(ctx: &PipelineContext, prepass: bool) -> Result<TextureGrid> {
+    let s = &ctx.settings;
+    let g = &s.grid;
+    let refused = [
+        (
+            g.samples > 1,
+            "--msaa above 1 (it is built from single-sample depth)",
+        ),
+        (
+            !matches!(g.strategy, Assign::Auto | Assign::Cpu),
+            "--assign other than cpu (it is assigned on the CPU)",
+        ),
+        (
+            g.depth_bounds != DepthBounds::Both,
+            "--depth-bounds other than both",
+        ),
+        (g.depth_mask != DepthMask::Off, "--depth-mask on"),
+        (g.cell_box != CellBox::Off, "--cell-box on"),
+        (s.light_loop != LightLoop::Lane, "--light-loop subgroup"),
+    ];
+    if let Some((_, what)) = refused.iter().find(|(r, _)| *r) {
+        return Err(crate::error::Error::invalid(
+            "grid-storage",
+            format!("the texture grid does not take {what}; use --grid-storage buffers"),
+        ));
+    }
+    Ok(TextureGrid::new(ctx.device, ctx.dims, prepass))
 }
 
 /// The forward shading pass with the light loop `l`.
@@ -36,7 +108,7 @@ fn shader(l: crate::frame::LightLoop) -> ComposedShader {
 }
 
 struct TiledForward {
-    builder: super::PipelineGrid,
+    grid: Grid,
     /// The depth pre-pass (pre-Z and clustered).
     depth_only: Option<DepthPipelines>,
     shading: MaterialPipelines,
@@ -51,24 +123,30 @@ enum Kind {
 }
 
 fn create(ctx: &PipelineContext, kind: Kind) -> Result<Box<dyn Technique>> {
-    let module = create_module(
-        ctx.device,
-        &shader(ctx.settings.light_loop).specialized(ctx.shading),
-    );
     let prepass = kind != Kind::Plain;
-    let grid = if kind == Kind::Clustered {
+    let textures = kind != Kind::Clustered
+        && ctx.settings.grid_storage.resolve(ctx.compute_grid) == GridStorage::Textures;
+    let source = match textures {
+        true => texel_shader(),
+        false => shader(ctx.settings.light_loop),
+    };
+    let module = create_module(ctx.device, &source.specialized(ctx.shading));
+    let config = if kind == Kind::Clustered {
         ctx.settings.grid
     } else {
         ctx.settings.grid.tiled()
     };
-    let builder = ctx.grid(&grid, prepass, true)?;
+    let grid = match textures {
+        true => Grid::Textures(texture_grid(ctx, prepass)?),
+        false => Grid::Buffers(ctx.grid(&config, prepass, true)?),
+    };
     let shading = MaterialPipelines::new(
         ctx.device,
         &GeometryPipelineDesc {
             label: "tiled forward shading",
             module: &module,
             fragment_entry: Some("fs_main"),
-            layouts: &[Some(ctx.scene_layout), Some(builder.bind_group_layout())],
+            layouts: &[Some(ctx.scene_layout), Some(grid.layout())],
             color_targets: &lighting_targets(ctx.count_blend, ctx.settings.grid.samples),
             depth_write: !prepass,
             depth_compare: crate::depth::SURFACE,
@@ -92,7 +170,7 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Result<Box<dyn Technique>> {
         )
     });
     Ok(Box::new(TiledForward {
-        builder,
+        grid,
         depth_only,
         shading,
         label: match kind {
@@ -129,21 +207,32 @@ impl Technique for TiledForward {
             });
             depth_only.draw(&mut pass, f);
         }
-        self.builder.encode(f, enc)?;
+        match &mut self.grid {
+            Grid::Buffers(g) => g.encode(f, enc)?,
+            Grid::Textures(g) => g.encode(f, enc)?,
+        }
         let (encoder, timer) = enc.parts();
         let mut pass =
             begin_lighting_pass(encoder, timer, f, self.label, self.depth_only.is_none());
-        draw_scene_materials(&mut pass, f, &[self.builder.bind_group()], &self.shading);
+        draw_scene_materials(&mut pass, f, &[self.grid.bind_group()], &self.shading);
         drop(pass);
         Ok(())
     }
 
     fn culler(&mut self) -> Option<&mut LightCuller> {
-        Some(self.builder.culler_mut())
+        match &mut self.grid {
+            Grid::Buffers(g) => Some(g.culler_mut()),
+            Grid::Textures(_) => None,
+        }
     }
 
+    /// The texture grid holds opaque lists only: the transparent pass loops every light, as
+    /// `forward`'s does (no compute, like the grid).
     fn transparent_lights(&self) -> TransparentLights<'_> {
-        TransparentLights::Grid(self.builder.culler())
+        match &self.grid {
+            Grid::Buffers(g) => TransparentLights::Grid(g.culler()),
+            Grid::Textures(_) => TransparentLights::All,
+        }
     }
 }
 

@@ -12,7 +12,7 @@
 
 use super::{FrameEncoder, FrameInputs, GeometryPipelineDesc, PipelineContext};
 use crate::culling::{GridBuffers, GridLists, LightCuller};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::frame::targets::counts_in_target;
 use crate::frame::Assign;
 use crate::frame::CullConfig;
@@ -44,7 +44,7 @@ pub(crate) enum TransparentLights<'a> {
 pub(crate) struct TransparentPass {
     all_lights: MaterialPipelines,
     grid: MaterialPipelines,
-    own_grid: super::PipelineGrid,
+    own_grid: Option<super::PipelineGrid>,
 }
 
 /// Colour blending over the opaque image (alpha kept), counts added.
@@ -76,23 +76,6 @@ impl TransparentPass {
             ctx.device,
             &shader(ctx.settings.light_loop).specialized(ctx.shading),
         );
-        // A GPU strategy (gather), so the frame still makes one submission and no readback,
-        // over the opaque depth; one list per tile covering near..max.
-        // Not the technique's grid: `--depth-bounds`, `--depth-mask` and `--cell-box` are
-        // about that one.
-        let own_grid = ctx.grid(
-            &CullConfig {
-                strategy: Assign::Gather,
-                lists: GridLists::Shared,
-                depth_bounds: crate::frame::DepthBounds::Both,
-                depth_reduction: crate::frame::DepthReduction::Atomics,
-                depth_mask: crate::frame::DepthMask::Off,
-                cell_box: crate::frame::CellBox::Off,
-                ..ctx.settings.grid.tiled()
-            },
-            true,
-            false,
-        )?;
         let grid_layout = GridBuffers::layout(ctx.device);
         let targets = blended_targets(counts_in_target(ctx.count_blend, ctx.settings.grid.samples));
         let pipeline = |label, entry, layouts: &[Option<&wgpu::BindGroupLayout>]| {
@@ -122,8 +105,35 @@ impl TransparentPass {
                 "fs_grid",
                 &[Some(ctx.scene_layout), Some(&grid_layout)],
             ),
-            own_grid,
+            own_grid: None,
         })
+    }
+
+    /// Create the grid the pass builds for techniques without one (`TransparentLights::Own`),
+    /// once, when the first such technique is created: a renderer that never needs it (a GL
+    /// device running `forward`, which has no compute) never makes its compute pipelines.
+    pub fn ensure_own_grid(&mut self, ctx: &PipelineContext) -> Result<()> {
+        if self.own_grid.is_some() {
+            return Ok(());
+        }
+        // A GPU strategy (gather), so the frame still makes one submission and no readback,
+        // over the opaque depth; one list per tile covering near..max.
+        // Not the technique's grid: `--depth-bounds`, `--depth-mask` and `--cell-box` are
+        // about that one.
+        self.own_grid = Some(ctx.grid(
+            &CullConfig {
+                strategy: Assign::Gather,
+                lists: GridLists::Shared,
+                depth_bounds: crate::frame::DepthBounds::Both,
+                depth_reduction: crate::frame::DepthReduction::Atomics,
+                depth_mask: crate::frame::DepthMask::Off,
+                cell_box: crate::frame::CellBox::Off,
+                ..ctx.settings.grid.tiled()
+            },
+            true,
+            false,
+        )?);
+        Ok(())
     }
 
     /// Record the pass after a technique's opaque passes (nothing when the frame has no
@@ -143,9 +153,13 @@ impl TransparentPass {
             TransparentLights::All => None,
             TransparentLights::Grid(b) => Some(b.bind_group()),
             TransparentLights::Own => {
-                self.own_grid.encode(f, enc)?;
-                own_frame = Some(self.own_grid.culler().last_frame());
-                Some(self.own_grid.bind_group())
+                let own = self.own_grid.as_mut().ok_or_else(|| Error::Gpu {
+                    stage: "transparent pass".into(),
+                    message: "its own grid was not created with the technique".into(),
+                })?;
+                own.encode(f, enc)?;
+                own_frame = Some(own.culler().last_frame());
+                Some(own.bind_group())
             }
         };
         let (encoder, timer) = enc.parts();
@@ -170,7 +184,7 @@ impl TransparentPass {
     }
 
     /// The grid it builds for techniques without one (its reports come from its culler).
-    pub fn culler_mut(&mut self) -> &mut LightCuller {
-        self.own_grid.culler_mut()
+    pub fn culler_mut(&mut self) -> Option<&mut LightCuller> {
+        self.own_grid.as_mut().map(|g| g.culler_mut())
     }
 }

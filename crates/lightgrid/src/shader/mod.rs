@@ -36,8 +36,10 @@ pub mod src {
     pub(crate) const LIGHT_FUNCTION: &str = include_str!("../shading/lighting.wgsl");
     /// The shadow rays and maps the light function casts and reads.
     pub(crate) const SHADOWS: &str = include_str!("../shading/shadows.wgsl");
-    /// The light function and the shadows it casts.
-    pub(crate) const LIGHTING: &[&str] = &[LIGHT_FUNCTION, SHADOWS];
+    /// `scene_light(i)`: the light function's lights, from group 0's storage buffer.
+    pub(crate) const SCENE_LIGHT: &str = include_str!("../shading/scene_light.wgsl");
+    /// The light function, its lights and the shadows it casts.
+    pub(crate) const LIGHTING: &[&str] = &[SCENE_LIGHT, LIGHT_FUNCTION, SHADOWS];
     pub(crate) const GEOMETRY: &str = include_str!("../passes/geometry.wgsl");
     /// Cell addressing (`light_grid_slice`, `light_grid_cell`); needs a `light_grid` binding.
     pub(crate) const GRID_CELL: &str = include_str!("../culling/grid/grid_cell.wgsl");
@@ -48,6 +50,9 @@ pub mod src {
     /// The grid's bindings, cell addressing and z-bin walk; one of the light loops below
     /// follows it.
     pub(crate) const LIGHT_GRID: &[&str] = &[GRID_CELL, ZBIN_WALK, GRID_BINDINGS];
+    /// The texture grid's bindings and accessors, and `scene_light` from its light texture
+    /// (`--grid-storage textures`); follows `GRID_CELL`.
+    pub(crate) const GRID_TEXELS: &str = include_str!("../culling/grid/light_grid_texels.wgsl");
     /// `light_grid_shade` and `light_grid_irradiance_mono`, one lane at a time
     /// (`--light-loop lane`).
     pub(crate) const LIGHT_LOOP_LANE: &str = include_str!("../culling/grid/light_loop_lane.wgsl");
@@ -67,6 +72,21 @@ pub(crate) const SCENE_PARTS: &[&str] = &[
     src::TYPES,
     src::GRID_PARAMS,
     src::SCENE_BINDINGS,
+    src::SCENE_LIGHT,
+    src::LIGHT_FUNCTION,
+    src::SHADOWS,
+    src::GEOMETRY,
+    src::LIT_OUT,
+];
+
+/// As [`SCENE_PARTS`], with the texture grid in place of the light buffer: its bindings,
+/// cell addressing and accessors, `scene_light` reading its light texture.
+pub(crate) const TEXEL_SCENE_PARTS: &[&str] = &[
+    src::TYPES,
+    src::GRID_PARAMS,
+    src::SCENE_BINDINGS,
+    src::GRID_CELL,
+    src::GRID_TEXELS,
     src::LIGHT_FUNCTION,
     src::SHADOWS,
     src::GEOMETRY,

@@ -105,7 +105,7 @@ fn ggx_terms(s: Surface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32, e: vec
 // spot light with a finite range, times its visibility where it casts shadows
 // (`SHADING_SHADOWS`, shadows.wgsl). `view_dir` points from the surface to the eye.
 fn light_terms(s: Surface, view_dir: vec3<f32>, index: u32) -> LightTerms {
-    let light = lights[index];
+    let light = scene_light(index);
     var out: LightTerms;
     out.diffuse = vec3<f32>(0.0);
     out.specular = vec3<f32>(0.0);
