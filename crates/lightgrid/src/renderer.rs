@@ -1271,7 +1271,15 @@ impl Renderer {
                 cull,
             ) {
                 (Some(culler), Some(report)) => Some(analysis::BuiltGrid::read(culler, &report)?),
-                _ => None,
+                _ => self.techniques[info.id]
+                    .texture_grid()
+                    .map(|t| analysis::BuiltGrid {
+                        grid: t.grid.clone(),
+                        cell_bounds: t.bounds.clone(),
+                        cell_culls: Vec::new(),
+                        assign: crate::frame::Assign::Cpu,
+                        cpu_ms: t.cpu_ms,
+                    }),
             };
             return analysis::analyze(analysis::AnalysisInput {
                 device: &self.device,

@@ -21,7 +21,7 @@
 //! holds; a frame needing more is refused with both numbers, never truncated.
 
 use crate::consts::LIGHT_TEXELS;
-use crate::culling::grid::GridDims;
+use crate::culling::grid::{GridDims, LightGrid};
 use crate::culling::strategies::assign_cpu::{assign_cpu, DepthRange};
 use crate::error::{Error, Result};
 use crate::frame::{FrameEncoder, FrameInputs};
@@ -205,7 +205,7 @@ impl TileDepth {
         dims: &GridDims,
     ) -> Result<Vec<[f32; 2]>> {
         let (encoder, timer) = enc.parts();
-        let label = "tile depth (fragment)";
+        let label = "assign: tile depth (fragment)";
         self.pass.draw(
             f.device,
             encoder,
@@ -252,8 +252,19 @@ impl TileDepth {
     }
 }
 
+/// The last frame's grid as the CPU built it (what analysis reports and the tests check
+/// against the oracle; the textures hold exactly these arrays).
+pub(crate) struct BuiltTextureGrid {
+    pub grid: LightGrid,
+    /// Per tile, the view-distance bounds it was built for (`[near, far]` without a pre-pass).
+    pub bounds: Vec<[f32; 2]>,
+    /// CPU time of `assign_cpu`.
+    pub cpu_ms: f64,
+}
+
 /// A tiled grid in textures, built on the CPU (see the module docs).
 pub(crate) struct TextureGrid {
+    last: Option<BuiltTextureGrid>,
     dims: GridDims,
     edge: u32,
     params: wgpu::Buffer,
@@ -326,6 +337,7 @@ impl TextureGrid {
         );
         let bind_group = Self::bind(device, &layout, &params, &cells, &indices, &lights);
         TextureGrid {
+            last: None,
             dims,
             edge,
             params,
@@ -372,7 +384,9 @@ impl TextureGrid {
             .map_or(DepthRange::NearFar, DepthRange::Cells);
         // The world-space lights with the frame's camera (`ViewSetup::to_view` moves them
         // to the eye); the texture gets the camera-relative ones, in the same order.
+        let start = web_time::Instant::now();
         let grid = assign_cpu(&f.setup, &self.dims, f.lights, range);
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
         check_capacity(self.edge, f.lights.len() as u64, grid.indices.len() as u64)?;
         let (device, queue) = (f.device, f.queue);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.dims.params()));
@@ -414,7 +428,23 @@ impl TextureGrid {
                 &self.lights,
             );
         }
+        let bounds = bounds.unwrap_or_else(|| {
+            crate::culling::bounds::cell_bounds::slice_bounds(
+                &self.dims,
+                [f.setup.near, f.setup.far],
+            )
+        });
+        self.last = Some(BuiltTextureGrid {
+            grid,
+            bounds,
+            cpu_ms,
+        });
         Ok(())
+    }
+
+    /// The last frame's grid.
+    pub fn last(&self) -> Option<&BuiltTextureGrid> {
+        self.last.as_ref()
     }
 
     /// Group 1 of the shading pass.

@@ -119,6 +119,10 @@ pub enum DeviceLimits {
     /// WebGPU's defaults, what every page may rely on: every pipeline and strategy runs
     /// within them (8 storage buffers per stage, 4 bind groups; README, "Platforms").
     WebGpu,
+    /// WebGPU's defaults with 2D textures at most this many texels on a side (WebGL2
+    /// guarantees 2048): the texture grid's capacity follows the edge
+    /// (`--grid-storage textures`), and its tests reach it with a small one.
+    WebGpuTextureEdge(u32),
 }
 
 impl DeviceLimits {
@@ -135,6 +139,10 @@ impl DeviceLimits {
         match self {
             DeviceLimits::Adapter => adapter.limits(),
             DeviceLimits::WebGpu => wgpu::Limits::default(),
+            DeviceLimits::WebGpuTextureEdge(edge) => wgpu::Limits {
+                max_texture_dimension_2d: edge,
+                ..wgpu::Limits::default()
+            },
         }
     }
 }

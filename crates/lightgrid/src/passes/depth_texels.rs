@@ -58,7 +58,7 @@ impl DepthTexelPass {
         });
         let label = match entry {
             DepthTexelEntry::Bits => "depth texels",
-            DepthTexelEntry::TileDepth => "tile depth (fragment)",
+            DepthTexelEntry::TileDepth => "assign: tile depth (fragment)",
         };
         let constants = [("TILE", f64::from(tile))];
         let pipeline = super::fullscreen_pipeline(

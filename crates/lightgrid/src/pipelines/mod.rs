@@ -78,6 +78,11 @@ pub(crate) trait Technique {
     fn culler(&mut self) -> Option<&mut LightCuller> {
         None
     }
+    /// The grid a pipeline built on the CPU into textures (`--grid-storage textures`), as
+    /// its last frame left it: analysis reports it as it does a culler's.
+    fn texture_grid(&self) -> Option<&crate::culling::texture_grid::BuiltTextureGrid> {
+        None
+    }
     /// Where the frame's transparent fragments find their lights (after `encode`): a grid
     /// pipeline's own grid, or by default a grid the transparent pass builds.
     fn transparent_lights(&self) -> TransparentLights<'_> {

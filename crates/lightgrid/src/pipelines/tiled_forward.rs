@@ -226,6 +226,13 @@ impl Technique for TiledForward {
         }
     }
 
+    fn texture_grid(&self) -> Option<&crate::culling::texture_grid::BuiltTextureGrid> {
+        match &self.grid {
+            Grid::Buffers(_) => None,
+            Grid::Textures(g) => g.last(),
+        }
+    }
+
     /// The texture grid holds opaque lists only: the transparent pass loops every light, as
     /// `forward`'s does (no compute, like the grid).
     fn transparent_lights(&self) -> TransparentLights<'_> {
