@@ -60,7 +60,7 @@ impl DepthTexelPass {
             DepthTexelEntry::Bits => "depth texels",
             DepthTexelEntry::TileDepth => "assign: tile depth (fragment)",
         };
-        let constants = [("TILE", f64::from(tile))];
+        let constants = [(crate::shader::overrides::TILE, f64::from(tile))];
         let pipeline = super::fullscreen_pipeline(
             device,
             &super::FullscreenDesc {

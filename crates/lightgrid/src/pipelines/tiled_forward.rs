@@ -45,8 +45,8 @@ fn texel_shader() -> ComposedShader {
 
 /// Where the pipeline's grid lives (`--grid-storage`).
 enum Grid {
-    Buffers(super::PipelineGrid),
-    Textures(TextureGrid),
+    Buffers(Box<super::PipelineGrid>),
+    Textures(Box<TextureGrid>),
 }
 
 impl Grid {
@@ -137,8 +137,8 @@ fn create(ctx: &PipelineContext, kind: Kind) -> Result<Box<dyn Technique>> {
         ctx.settings.grid.tiled()
     };
     let grid = match textures {
-        true => Grid::Textures(texture_grid(ctx, prepass)?),
-        false => Grid::Buffers(ctx.grid(&config, prepass, true)?),
+        true => Grid::Textures(Box::new(texture_grid(ctx, prepass)?)),
+        false => Grid::Buffers(Box::new(ctx.grid(&config, prepass, true)?)),
     };
     let shading = MaterialPipelines::new(
         ctx.device,

@@ -383,14 +383,17 @@ pub mod overrides {
     pub(crate) const WIDTH: &str = "WIDTH";
     /// `cell_bounds.wgsl`: invocations per workgroup, one per row of the grid's tiles.
     pub(crate) const CELL_THREADS: &str = "CELL_THREADS";
+    /// `depth_texels.wgsl`: the tile edge of the texture grid's tile depth bounds.
+    pub(crate) const TILE: &str = "TILE";
     /// Every override of the library's shaders.
     #[cfg_attr(not(feature = "testing"), allow(dead_code))]
-    pub const ALL: [&str; 5] = [
+    pub const ALL: [&str; 6] = [
         MULTISAMPLED,
         MATERIAL_SHADER,
         RESOLVE_IN_KERNEL,
         WIDTH,
         CELL_THREADS,
+        TILE,
     ];
 }
 
