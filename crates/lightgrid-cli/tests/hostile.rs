@@ -562,8 +562,16 @@ fn counts_and_thresholds_are_bounded_where_parsed() {
         ),
         (&["--adapter", "", "render"], "--adapter is empty"),
         (
-            &["--adapter", "gl", "render"],
-            "GL adapters are not supported",
+            &[
+                "--adapter",
+                "gl",
+                "render",
+                "--pipeline",
+                "tiled_deferred",
+                "--size",
+                "8x8",
+            ],
+            "cannot run tiled_deferred",
         ),
         (
             &["--adapter", "nope", "render"],

@@ -3,10 +3,10 @@
 //! Order of preference: discrete GPU, integrated, virtual, then software adapters (Mesa
 //! lavapipe). `--adapter` overrides the choice by index, name or backend.
 //!
-//! GL adapters are not offered: the lighting-count target needs R32Float blending, which GL
-//! (llvmpipe GL, and WebGL-class drivers) only has as a downlevel exception wgpu does not
-//! enable, and forward shaders write storage buffers from fragment shaders; every GL render
-//! failed at target creation. Vulkan, Metal and DX12 are used ([`BACKENDS`]).
+//! Vulkan, Metal and DX12 are searched ([`BACKENDS`]); wgpu's GL backend only when asked for
+//! by name (`--adapter gl`): it runs `forward` and the texture grid's tiled forward, and the
+//! renderer refuses the rest (`Renderer::runs_compute`: no depth loads in GLSL, llvmpipe GL's
+//! multisampled compute reads return 0, R32Float neither blendable nor renderable).
 
 use crate::error::{Error, Result};
 
@@ -45,13 +45,13 @@ pub struct AdapterSummary {
     pub driver: String,
 }
 
-/// The backends lightgrid renders with (not GL: see the module docs).
+/// The backends searched unless GL is asked for by name (see the module docs).
 pub const BACKENDS: wgpu::Backends = wgpu::Backends::VULKAN
     .union(wgpu::Backends::METAL)
     .union(wgpu::Backends::DX12);
 
 const NO_ADAPTER_HELP: &str = "no GPU adapter found. lightgrid needs a Vulkan, Metal or DX12 \
-adapter (GL cannot run its render targets); on a machine without a GPU install Mesa's software Vulkan driver: \
+adapter (`--adapter gl` runs only `forward` and the texture grid); on a machine without a GPU install Mesa's software Vulkan driver: \
 `sudo apt-get install -y mesa-vulkan-drivers libvulkan1` (Debian/Ubuntu)";
 
 /// A display handle for the instance: a window system's display (the viewer's), or none for
