@@ -8,7 +8,7 @@ use crate::files::Files;
 use anyhow::Result;
 use clap::Args;
 use lightgrid::frame::{
-    Assign, Brdf, CellBox, DepthBounds, DepthMask, GridLists, MsaaResolve, Shadows,
+    Assign, Brdf, CellBox, DepthBounds, DepthMask, GridLists, GridStorage, MsaaResolve, Shadows,
 };
 use lightgrid::gpu::GpuContext;
 use lightgrid::passes::GBufferFormat;
@@ -86,6 +86,13 @@ pub(crate) enum Preset {
     /// `clustered_forward`); frames 0..259 every 130 at the papers' size (640x360 on a
     /// software adapter): frame time, shadow-map memory, shadow rays.
     Shadows,
+    /// The texture grid against the storage grid (tiled-forward-shading §4.2; `--grid-storage
+    /// buffers,textures`), and with storage buffers CPU against GPU assignment (`--assign
+    /// cpu,gather`; the texture grid is always assigned on the CPU): tiled forward with and
+    /// without pre-Z on robots-many and scattered (without glass), frames 0..259 every 20, at
+    /// the papers' size (640x360 on a software adapter), 16-pixel tiles: frame time, grid
+    /// memory, and the grid's indices and cells (what the CPU grids upload per frame).
+    GridStorage,
 }
 
 #[derive(Args)]
@@ -436,6 +443,20 @@ fn study_preset(preset: Preset, hardware: bool) -> BenchDefaults {
                 measure(&[Assign::Auto, Assign::ZBin]),
                 measure(&DepthMask::ALL),
                 measure(&CellBox::ALL),
+            ],
+            size: Some(papers_size(hardware)),
+            tile: Some(16),
+            transparency: false,
+            ..study(hardware, |_| false)
+        },
+        Preset::GridStorage => BenchDefaults {
+            scenes: vec!["robots-many", "scattered"],
+            pipelines: [ids::TILED_FORWARD, ids::TILED_FORWARD_PREZ]
+                .map(String::from)
+                .to_vec(),
+            settings: vec![
+                measure(&[GridStorage::Buffers, GridStorage::Textures]),
+                measure(&[Assign::Cpu, Assign::Gather]),
             ],
             size: Some(papers_size(hardware)),
             tile: Some(16),

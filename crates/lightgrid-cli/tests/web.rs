@@ -1028,3 +1028,65 @@ fn the_page_asks_for_webgpu_default_limits_unless_told_otherwise() {
     }
     let _ = std::fs::remove_dir_all(&session.dir);
 }
+
+/// `?gltf=PATH` opens a glTF file on the page's own origin as the picker does (no picker:
+/// the address alone shows a file), rendering what `lightgrid render --scene FILE` renders;
+/// a file the server does not have is reported in the page's error line.
+#[test]
+fn the_address_opens_a_gltf_file_on_the_pages_own_origin() {
+    let mut session = session("web-address-gltf");
+    let dir = session.dir.clone();
+    let stem = format!("address-test-{}", std::process::id());
+    let name = format!("{stem}.glb");
+    let glb = build_page().join(&name);
+    let o = lightgrid(&[
+        "export",
+        "--scene",
+        "robots-few",
+        "--frame",
+        "40",
+        "--out",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "export:\n{}", stderr(&o));
+    session.open(&format!(
+        "gltf={name}&pipeline=tiled_forward_prez&size=160x90&paused&frame=20"
+    ));
+    let b = &mut session.b;
+    let s = b.wait_for("the address's file", |s| {
+        s["scene"] == stem.as_str()
+            && s["pending"] == false
+            && s["message"] == ""
+            && s["settled"].as_u64().unwrap_or(0) >= 2
+    });
+    let frame = s["frame"].as_u64().unwrap() as u32;
+    let web = b.screenshot("address-file");
+    b.assert_no_errors("the address's file");
+    let native = render_scene(
+        &dir,
+        glb.to_str().unwrap(),
+        "tiled_forward_prez",
+        frame,
+        "160x90",
+    );
+    std::fs::remove_file(&glb).unwrap();
+    assert_equal(&web, &native, "?gltf=robots.glb, tiled_forward_prez");
+
+    // A path the server does not have: the error line names it and the status.
+    session.open("gltf=no-such-file.glb");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        let e = session
+            .b
+            .eval("document.getElementById('error')?.textContent ?? ''");
+        let e = e.as_str().unwrap_or("");
+        if e.contains("no-such-file.glb") && e.contains("404") {
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "no error for a missing file: {e:?}"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}

@@ -333,6 +333,8 @@ fn a_loop_cut_short_is_counted() {
             wgpu::BindingResource::TextureView(&atlas),
             wgpu::BindingResource::Sampler(&compare),
             wgpu::BindingResource::Sampler(&textures.nearest),
+            // The array again for the nearest sampler (GLSL pairs a texture with one sampler).
+            wgpu::BindingResource::TextureView(&textures.view),
         ],
     );
     let mut encoder = device.create_command_encoder(&Default::default());

@@ -83,8 +83,12 @@ impl PageOptions {
                 "script" => {
                     view.script = crate::script::parse(&value).map_err(|e| bad(&e))?;
                 }
+                // A glTF file on the page's origin: the page's script fetches it and opens it
+                // as a picked one (`open_file`).
+                "gltf" if !value.is_empty() => {}
+                "gltf" => return Err(bad("a path to a glTF file on this page's origin")),
                 _ => bail!(
-                    "the page's address: unknown key '{key}'; valid: scene, pipeline, frame, size, tile, msaa, paused, limits, script"
+                    "the page's address: unknown key '{key}'; valid: scene, pipeline, frame, size, tile, msaa, paused, limits, script, gltf"
                 ),
             }
         }

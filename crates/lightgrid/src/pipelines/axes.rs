@@ -296,6 +296,13 @@ impl Axis {
     }
 }
 
+/// Is `p`'s grid in storage buffers, built by a `LightCuller` (what the grid's options are
+/// about)? Not where `--grid-storage textures` puts a texture-grid pipeline's in textures,
+/// assigned on the CPU (`culling/texture_grid.rs`).
+fn buffer_grid(p: &PipelineInfo, s: &RenderSettings) -> bool {
+    !(p.texture_grid && s.grid_storage == GridStorage::Textures)
+}
+
 fn values<T: SettingValue>() -> Vec<AxisValue> {
     T::VALUES
         .iter()
@@ -350,11 +357,24 @@ pub const AXES: &[Axis] = &[
         label: |v| format!("g{v}"),
     },
     Axis {
+        flag: "grid-storage",
+        column: "grid_storage",
+        help: "where tiled forward keeps its light grid: storage buffers from a LightCuller, or textures built on the CPU that need no compute shaders or storage buffers (WebGL2, GL)",
+        values: values::<GridStorage>,
+        applies: |p, _| p.texture_grid,
+        get: |s| s.grid_storage.name().to_string(),
+        set: |s, v| {
+            s.grid_storage = GridStorage::parse(v)?;
+            Ok(())
+        },
+        label: |v| format!("{v} grid"),
+    },
+    Axis {
         flag: "assign",
         column: "assign",
         help: "who builds the light grid of grid pipelines (not tiled_deferred_single, which culls inside its kernel)",
         values: values::<Assign>,
-        applies: |p, _| p.assign,
+        applies: |p, s| p.assign && buffer_grid(p, s),
         get: |s| s.grid.strategy.name().to_string(),
         set: |s, v| {
             s.grid.strategy = Assign::parse(v)?;
@@ -367,7 +387,7 @@ pub const AXES: &[Axis] = &[
         column: "index_capacity",
         help: "index entries the light lists of --assign grids start with (1 to 33554432; they grow from the frames' counters, a frame whose lists did not fit is counted)",
         values: Vec::new,
-        applies: |p, _| p.assign,
+        applies: |p, s| p.assign && buffer_grid(p, s),
         get: |s| s.grid.index_capacity.to_string(),
         set: |s, v| {
             s.grid.index_capacity = number(v)?;
@@ -393,7 +413,7 @@ pub const AXES: &[Axis] = &[
         column: "lists",
         help: "the light lists of grid pipelines with an --assign grid, for frames with transparent objects",
         values: values::<GridLists>,
-        applies: |p, _| p.assign,
+        applies: |p, s| p.assign && buffer_grid(p, s),
         get: |s| SettingValue::name(s.grid.lists).to_string(),
         set: |s, v| {
             s.grid.lists = GridLists::parse(v)?;
@@ -458,7 +478,7 @@ pub const AXES: &[Axis] = &[
         column: "depth_reduction",
         help: "how the cell-bounds kernel of tiled grids built from depth reduces a tile's samples (clustered grids always use atomics)",
         values: values::<DepthReduction>,
-        applies: |p, _| reduces_tile_depth(p),
+        applies: |p, s| reduces_tile_depth(p) && buffer_grid(p, s),
         get: |s| s.grid.depth_reduction.name().to_string(),
         set: |s, v| {
             s.grid.depth_reduction = DepthReduction::parse(v)?;
@@ -471,7 +491,7 @@ pub const AXES: &[Axis] = &[
         column: "depth_mask",
         help: "2.5D culling of the grids --assign builds from the depth buffer (needs --depth-bounds both)",
         values: values::<DepthMask>,
-        applies: |p, s| p.depth_bounds && p.assign && s.grid.strategy != Assign::ZBin,
+        applies: |p, s| p.depth_bounds && p.assign && s.grid.strategy != Assign::ZBin && buffer_grid(p, s),
         get: |s| s.grid.depth_mask.name().to_string(),
         set: |s, v| {
             s.grid.depth_mask = DepthMask::parse(v)?;
@@ -484,7 +504,7 @@ pub const AXES: &[Axis] = &[
         column: "cell_box",
         help: "tight cells of the grids --assign builds from the depth buffer: each cell's samples' view-space box (needs --depth-bounds both)",
         values: values::<CellBox>,
-        applies: |p, s| p.depth_bounds && p.assign && s.grid.strategy != Assign::ZBin,
+        applies: |p, s| p.depth_bounds && p.assign && s.grid.strategy != Assign::ZBin && buffer_grid(p, s),
         get: |s| s.grid.cell_box.name().to_string(),
         set: |s, v| {
             s.grid.cell_box = CellBox::parse(v)?;
@@ -497,26 +517,13 @@ pub const AXES: &[Axis] = &[
         column: "light_loop",
         help: "the light loop of the pipelines that shade from a LightCuller grid: per lane, or scalarized over the subgroup (one light at a time for all lanes; adapters with subgroups)",
         values: values::<LightLoop>,
-        applies: |p, _| p.assign,
+        applies: |p, s| p.assign && buffer_grid(p, s),
         get: |s| s.light_loop.name().to_string(),
         set: |s, v| {
             s.light_loop = LightLoop::parse(v)?;
             Ok(())
         },
         label: |v| format!("{v} loop"),
-    },
-    Axis {
-        flag: "grid-storage",
-        column: "grid_storage",
-        help: "where tiled forward keeps its light grid: storage buffers from a LightCuller, or textures built on the CPU that need no compute shaders or storage buffers (WebGL2, GL)",
-        values: values::<GridStorage>,
-        applies: |p, _| p.texture_grid,
-        get: |s| s.grid_storage.name().to_string(),
-        set: |s, v| {
-            s.grid_storage = GridStorage::parse(v)?;
-            Ok(())
-        },
-        label: |v| format!("{v} grid"),
     },
     Axis {
         flag: "brdf",
