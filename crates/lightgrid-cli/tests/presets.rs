@@ -619,3 +619,60 @@ fn clustered_preset_checks_fig_4_6_on_both_views() {
         "Clustered shading depends much less on the view",
     );
 }
+
+/// The grid-storage preset measures tiled forward with and without pre-Z with the grid in
+/// buffers (CPU and GPU assignment) and in textures (CPU only: `--assign` does not apply to
+/// it, so no series is doubled): the texture grid lists exactly what `--assign cpu` lists
+/// (the same CPU assignment), and every run is timed.
+#[test]
+fn grid_storage_preset_measures_buffers_and_textures_side_by_side() {
+    let out = bench(&[
+        "--preset",
+        "grid-storage",
+        "--size",
+        "96x54",
+        "--frames",
+        "0..259:130",
+    ]);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    let (scene, pipe, frame, storage, assign, lit, gpu) = (
+        col("scene"),
+        col("pipeline"),
+        col("frame"),
+        col("grid_storage"),
+        col("assign"),
+        col("lighting_computations"),
+        col("gpu_ms"),
+    );
+    let mut counts = std::collections::BTreeMap::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let series = format!("{}/{}", f[storage], f[assign]);
+        let n: u64 = f[lit].parse().unwrap();
+        assert!(f[gpu].parse::<f64>().unwrap() > 0.0, "{line}: untimed");
+        let key = (
+            f[scene].to_string(),
+            f[pipe].to_string(),
+            f[frame].to_string(),
+        );
+        counts
+            .entry(key)
+            .or_insert_with(std::collections::BTreeMap::new)
+            .insert(series, n);
+    }
+    assert!(!counts.is_empty());
+    for (key, series) in &counts {
+        let names: Vec<&str> = series.keys().map(String::as_str).collect();
+        assert_eq!(
+            names,
+            ["buffers/cpu", "buffers/gather", "textures/"],
+            "{key:?}: the series"
+        );
+        assert_eq!(
+            series["textures/"], series["buffers/cpu"],
+            "{key:?}: the texture grid is the CPU grid"
+        );
+    }
+}
