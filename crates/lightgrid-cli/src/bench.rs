@@ -302,6 +302,24 @@ fn preset_defaults(preset: Preset, hardware: bool, supported: &[u32]) -> BenchDe
     }
 }
 
+/// `--preset grid-storage` (see [`Preset::GridStorage`]).
+fn grid_storage_preset(hardware: bool) -> BenchDefaults {
+    BenchDefaults {
+        scenes: vec!["robots-many", "scattered"],
+        pipelines: [ids::TILED_FORWARD, ids::TILED_FORWARD_PREZ]
+            .map(String::from)
+            .to_vec(),
+        settings: vec![
+            measure(&[GridStorage::Buffers, GridStorage::Textures]),
+            measure(&[Assign::Cpu, Assign::Gather]),
+        ],
+        size: Some(papers_size(hardware)),
+        tile: Some(16),
+        transparency: false,
+        ..study(hardware, |_| false)
+    }
+}
+
 /// The presets that reproduce a paper's figure at its conditions (its tile count, size and
 /// scenes).
 fn paper_preset(preset: Preset, hardware: bool, supported: &[u32]) -> BenchDefaults {
@@ -449,20 +467,7 @@ fn study_preset(preset: Preset, hardware: bool) -> BenchDefaults {
             transparency: false,
             ..study(hardware, |_| false)
         },
-        Preset::GridStorage => BenchDefaults {
-            scenes: vec!["robots-many", "scattered"],
-            pipelines: [ids::TILED_FORWARD, ids::TILED_FORWARD_PREZ]
-                .map(String::from)
-                .to_vec(),
-            settings: vec![
-                measure(&[GridStorage::Buffers, GridStorage::Textures]),
-                measure(&[Assign::Cpu, Assign::Gather]),
-            ],
-            size: Some(papers_size(hardware)),
-            tile: Some(16),
-            transparency: false,
-            ..study(hardware, |_| false)
-        },
+        Preset::GridStorage => grid_storage_preset(hardware),
         Preset::Brdf => BenchDefaults {
             pipelines: [
                 ids::FORWARD,

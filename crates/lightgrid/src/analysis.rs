@@ -114,14 +114,13 @@ pub(crate) struct AnalysisReadbacks {
 }
 
 impl AnalysisReadbacks {
-    /// `depth_copies`: the device copies depth textures to buffers
-    /// (`DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES`; not GL).
-    pub fn new(
-        device: &wgpu::Device,
-        (width, height): (u32, u32),
-        samples: u32,
-        depth_copies: bool,
-    ) -> Self {
+    /// Depth is drawn into a copyable target first where the device cannot copy depth
+    /// textures to buffers (`DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES`; not GL).
+    pub fn new(ctx: &crate::gpu::GpuContext, (width, height): (u32, u32), samples: u32) -> Self {
+        let device = &ctx.device;
+        let depth_copies = ctx
+            .downlevel()
+            .contains(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES);
         let size = (width, height);
         AnalysisReadbacks {
             image: Readback::new(device, "image readback", width, height),

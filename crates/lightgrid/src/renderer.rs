@@ -304,13 +304,7 @@ impl Renderer {
         let dims = GridDims::new(width, height, settings.grid.tile_size)?;
         let device = &ctx.device;
         let created = scoped(device, "creating render targets", || {
-            let targets = Targets::new(
-                device,
-                width,
-                height,
-                settings.grid.samples,
-                ctx.count_blend,
-            );
+            let targets = Targets::new(ctx, width, height, settings.grid.samples);
             let scene_layout =
                 [SceneBounds::Vertex, SceneBounds::Compute].map(|b| scene_layout_with(device, b));
             let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
@@ -377,13 +371,7 @@ impl Renderer {
                 transparent: None,
                 settings,
                 dims,
-                readbacks: AnalysisReadbacks::new(
-                    device,
-                    (width, height),
-                    settings.grid.samples,
-                    ctx.downlevel()
-                        .contains(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES),
-                ),
+                readbacks: AnalysisReadbacks::new(ctx, (width, height), settings.grid.samples),
                 serial: 0,
                 in_flight: VecDeque::new(),
                 finished: Vec::new(),

@@ -167,15 +167,11 @@ impl Targets {
             + bytes(LDR_FORMAT)
     }
 
-    /// `count_blend`: forward pipelines count into the count target (`counts_in_target`); else
-    /// it is not a render attachment (GL cannot render into R32Float at all).
-    pub fn new(
-        device: &wgpu::Device,
-        width: u32,
-        height: u32,
-        samples: u32,
-        count_blend: bool,
-    ) -> Self {
+    /// Where R32Float does not blend (`GpuContext::count_blend`), forward pipelines do not
+    /// count into the count target (`counts_in_target`) and it is not a render attachment
+    /// (GL cannot render into R32Float at all).
+    pub fn new(ctx: &crate::gpu::GpuContext, width: u32, height: u32, samples: u32) -> Self {
+        let (device, count_blend) = (&ctx.device, ctx.count_blend);
         let make =
             |label, format, usage| render_texture(device, label, format, (width, height), usage);
         let make_ms = |label, format, usage| {
