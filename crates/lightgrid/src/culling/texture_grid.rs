@@ -131,26 +131,21 @@ impl TexelRows {
     }
 }
 
+/// A 2D texture the CPU writes and shaders `textureLoad`.
 fn texel_texture(
     device: &wgpu::Device,
     label: &str,
     format: wgpu::TextureFormat,
-    (width, height): (u32, u32),
+    size: (u32, u32),
 ) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+    use wgpu::TextureUsages as U;
+    crate::frame::targets::render_texture(
+        device,
+        label,
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    })
+        size,
+        U::TEXTURE_BINDING | U::COPY_DST,
+    )
 }
 
 /// Step 1: the tile depth bounds drawn by a fragment shader and the buffer they are read from.
@@ -165,20 +160,14 @@ struct TileDepth {
 impl TileDepth {
     fn new(device: &wgpu::Device, dims: &GridDims) -> Self {
         let entry = DepthTexelEntry::TileDepth;
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("tile depth"),
-            size: wgpu::Extent3d {
-                width: dims.tiles_x,
-                height: dims.tiles_y,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: entry.format(),
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        use wgpu::TextureUsages as U;
+        let texture = crate::frame::targets::render_texture(
+            device,
+            "tile depth",
+            entry.format(),
+            (dims.tiles_x, dims.tiles_y),
+            U::RENDER_ATTACHMENT | U::COPY_SRC,
+        );
         let padded_row = (dims.tiles_x * 16).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
