@@ -31,8 +31,8 @@ pub const MIN_TILE_SIZE: u32 = 4;
 pub const MAX_TILE_SIZE: u32 = 64;
 
 /// Texels of a light in the texture grid's light texture (`Rgba32Float`, 16 bytes each:
-/// `GpuLight`'s size / 16; `culling/texture_grid.rs`).
-pub const LIGHT_TEXELS: u32 = (std::mem::size_of::<crate::gpu_types::GpuLight>() / 16) as u32;
+/// `GpuLight`'s 48 bytes, asserted in `gpu_types.rs`; `culling/texture_grid.rs`).
+pub const LIGHT_TEXELS: u32 = 3;
 
 /// Threads along one edge of a per-tile workgroup (depth bounds, single-kernel tiled deferred):
 /// 16×16 = 256 invocations stride over the tile's pixels, so any tile size works.

@@ -164,6 +164,8 @@ pub struct GridParams {
 
 const _: () = assert!(std::mem::size_of::<GridParams>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 48);
+// The texture grid stores a light as `LIGHT_TEXELS` Rgba32Float texels.
+const _: () = assert!(std::mem::size_of::<GpuLight>() == crate::consts::LIGHT_TEXELS as usize * 16);
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 272);
 const _: () = assert!(std::mem::size_of::<GpuVertex>() == 56);
 const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 304);
