@@ -296,8 +296,9 @@ impl TextureGrid {
         })
     }
 
-    /// `dims`: the tiles (one slice); `depth`: bounded by the pre-pass's depth.
-    pub fn new(device: &wgpu::Device, dims: GridDims, depth: bool) -> Self {
+    /// `dims`: the tiles (one slice), written into the grid's uniform once; `depth`: bounded
+    /// by the pre-pass's depth.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, dims: GridDims, depth: bool) -> Self {
         let edge = device.limits().max_texture_dimension_2d;
         let layout = Self::layout(device);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -306,6 +307,7 @@ impl TextureGrid {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        queue.write_buffer(&params, 0, bytemuck::bytes_of(&dims.params()));
         let cells = texel_texture(
             device,
             "texture grid cells",
@@ -378,7 +380,6 @@ impl TextureGrid {
         let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
         check_capacity(self.edge, f.lights.len() as u64, grid.indices.len() as u64)?;
         let (device, queue) = (f.device, f.queue);
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.dims.params()));
         queue.write_texture(
             self.cells.as_image_copy(),
             bytemuck::cast_slice(&grid.cells),

@@ -93,7 +93,7 @@ fn texture_grid(ctx: &PipelineContext, prepass: bool) -> Result<TextureGrid> {
             format!("the texture grid does not take {what}; use --grid-storage buffers"),
         ));
     }
-    Ok(TextureGrid::new(ctx.device, ctx.dims, prepass))
+    Ok(TextureGrid::new(ctx.device, ctx.queue, ctx.dims, prepass))
 }
 
 /// The forward shading pass with the light loop `l`.

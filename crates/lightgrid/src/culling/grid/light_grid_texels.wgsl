@@ -33,24 +33,26 @@ fn light_grid_cell_count(cell: u32) -> u32 {
     return light_grid_cell_texel(cell).y;
 }
 
-// The index (into the lights) of the light at position `i` of the cell's list.
-fn light_grid_light(cell: u32, i: u32) -> u32 {
-    let k = light_grid_cell_texel(cell).x + i;
+// Entry `k` of the index lists (row-major).
+fn light_grid_index_entry(k: u32) -> u32 {
     let width = textureDimensions(light_grid_index_texels).x;
     return textureLoad(light_grid_index_texels, vec2<i32>(vec2<u32>(k % width, k / width)), 0).x;
+}
+
+// The index (into the lights) of the light at position `i` of the cell's list.
+fn light_grid_light(cell: u32, i: u32) -> u32 {
+    return light_grid_index_entry(light_grid_cell_texel(cell).x + i);
 }
 
 // A forward fragment: its surface lit by the lights of `cell` (Listing 1's computeLight).
 // The texture grid is single-sample, so no fragment leaves its cell's bounds (`w` unused).
 fn light_grid_shade_fragment(s: Surface, view_dir: vec3<f32>, cell: u32, w: f32) -> vec3<f32> {
+    // The cell's texel read once, not per light (`light_grid_light` reads it each time).
     let c = light_grid_cell_texel(cell);
-    let width = textureDimensions(light_grid_index_texels).x;
     var acc = vec3<f32>(0.0);
     var i = 0u;
     for (; i < c.y; i = i + 1u) {
-        let k = c.x + i;
-        let light = textureLoad(light_grid_index_texels, vec2<i32>(vec2<u32>(k % width, k / width)), 0).x;
-        acc += shade_light(s, view_dir, light);
+        acc += shade_light(s, view_dir, light_grid_index_entry(c.x + i));
     }
     check_loop(i, c.y);
     return acc;
